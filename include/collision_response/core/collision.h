@@ -1,0 +1,42 @@
+// One collision on request: validation, the choice of line of impact and restitution, and the
+// impact itself. What ComputeCollision.srv serves, without ROS.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "collision_response/core/body.h"
+#include "collision_response/core/expected.h"
+#include "collision_response/core/impact.h"
+#include "collision_response/core/materials.h"
+
+namespace collision_response::core {
+
+struct CollisionRequest {
+  Body a;
+  Body b;
+  /// Line of impact from a to b, any length; zero: from a's centre to b's.
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  /// Used when neither body names a material; must be 0 when both do.
+  double restitution = 0.0;
+  /// Effects to apply; empty: the seed's frictionless, spinless model.
+  std::vector<std::string> effects;
+};
+
+struct CollisionOutcome {
+  ImpactResponse<double> impact;       ///< velocities after, impulse, energy lost
+  Eigen::Vector3d line_of_impact;      ///< unit, a -> b
+  double restitution = 0.0;            ///< the coefficient used
+  bool oblique = false;                ///< a velocity had a component across the line
+  Eigen::Vector3d angular_velocity_a;  ///< rad/s after (unchanged without spin)
+  Eigen::Vector3d angular_velocity_b;  ///< rad/s after (unchanged without spin)
+};
+
+/// Validates every field of `request` (see validation.h), picks the coefficient of restitution
+/// (the pair's from `materials` when both bodies name a material, the request's when neither
+/// does; one without the other is an error), and resolves the impact.
+Expected<CollisionOutcome> computeCollision(const CollisionRequest& request,
+                                            const MaterialTable& materials);
+
+}  // namespace collision_response::core

@@ -1,0 +1,39 @@
+// Checks of every input the core accepts, each failure an Error naming the field and the reason.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+
+#include "collision_response/core/body.h"
+#include "collision_response/core/expected.h"
+
+namespace collision_response::core {
+
+/// The shortest text that reads back as the same double ("0.1", "-1", "nan", "inf").
+std::string formatNumber(double value);
+/// "[x, y, z]" with formatNumber.
+std::string formatVector(const Eigen::Vector3d& value);
+
+Status checkFinite(double value, const std::string& field);
+Status checkFinite(const Eigen::Vector3d& value, const std::string& field);
+/// 0 <= e <= 1 (e = 0 plastic, e = 1 elastic).
+Status checkRestitution(double restitution, const std::string& field);
+/// > 0 and 1/mass finite, or +inf (immovable).
+Status checkMass(double mass, const std::string& field);
+/// Finite and >= 0.
+Status checkRadius(double radius, const std::string& field);
+/// A material or body id: not empty, no whitespace or control characters.
+Status checkName(const std::string& name, const std::string& field);
+
+/// Mass, radius, position, velocity and angular velocity of one body; `prefix` names it ("a").
+Status checkBody(const Body& body, const std::string& prefix);
+
+/// The unit line of impact, pointing from a to b: `normal` scaled to unit length when it is
+/// nonzero; when it is zero, the direction from a's centre to b's. Errors: a non-finite normal,
+/// or a zero normal with coincident centres (no line of impact).
+Expected<Eigen::Vector3d> lineOfImpact(const Eigen::Vector3d& normal,
+                                       const Eigen::Vector3d& position_a,
+                                       const Eigen::Vector3d& position_b,
+                                       const std::string& field = "normal");
+
+}  // namespace collision_response::core

@@ -1,0 +1,63 @@
+# Shared by scripts/demo.sh and scripts/test.sh: install what the package needs from Debian's
+# archive, and build it as a standalone catkin package in the ignored folder .ws/ (build space
+# .ws/build, devel space .ws/devel). No symbolic link back into the repository, so rosrun's
+# search of the package folder meets no loop.
+# Safe to run again: installs only what is missing, rebuilds incrementally.
+
+repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+ws="$repo/.ws"
+mkdir -p "$ws"
+
+# Debian 12 packages: ROS 1 (catkin, roscpp, messages, tf2, rostest), Eigen, gtest, and what the
+# benchmarks and fuzzers use.
+PACKAGES=(
+  build-essential cmake catkin
+  libroscpp-dev rosout ros-message-generation ros-message-runtime
+  libstd-msgs-dev ros-std-msgs libgeometry-msgs-dev ros-geometry-msgs
+  libtf2-dev libtf2-ros-dev libtf2-eigen-dev libeigen3-dev
+  librostest-dev python3-rostest python3-roslaunch python3-rosmaster python3-rosservice
+  googletest libgtest-dev
+)
+
+as_root() {
+  if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi
+}
+
+install_packages() {
+  local missing=()
+  for package in "${PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" ||
+      missing+=("$package")
+  done
+  if [ ${#missing[@]} -eq 0 ]; then
+    echo "== all ${#PACKAGES[@]} Debian packages are installed"
+    return 0
+  fi
+  echo "== installing ${#missing[@]} Debian packages: ${missing[*]}"
+  as_root apt-get update -qq
+  as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${PACKAGES[@]}" >/dev/null
+}
+
+build_workspace() {
+  echo "== building in $ws"
+  # /usr/bin/python3: a python3 earlier on PATH (pyenv) may lack catkin_pkg.
+  cmake -S "$repo" -B "$ws/build" -DCATKIN_DEVEL_PREFIX="$ws/devel" \
+    -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCOLLISION_RESPONSE_WERROR=ON "$@" &&
+    cmake --build "$ws/build" -- -j2
+}
+
+source_workspace() {
+  # setup.bash reads unset variables; relax -u while it runs.
+  set +u
+  # shellcheck disable=SC1091
+  source "$ws/devel/setup.bash"
+  set -u
+  # A name every process can resolve, also on machines whose hostname does not resolve.
+  export ROS_HOSTNAME="${ROS_HOSTNAME:-localhost}"
+}
+
+# A free TCP port for a private ROS master, so that the scripts never touch a running one.
+free_port() {
+  /usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("localhost", 0)); print(s.getsockname()[1])'
+}

@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Every test: install, build with warnings as errors, run the gtest and rostest suites, and end
+# with one line "N passed, N failed".
+set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+install_packages
+if ! build_workspace >"$ws/build.log" 2>&1; then
+  tail -60 "$ws/build.log"
+  echo "build failed (log: $ws/build.log)"
+  echo "0 passed, 1 failed"
+  exit 1
+fi
+source_workspace
+rm -rf "$ws/build/test_results"
+status=0
+cmake --build "$ws/build" --target run_tests -- -j2 >"$ws/test.log" 2>&1 || status=$?
+grep -E '^\[ *(RUN|OK|FAILED|PASSED) *\]|FAILURE|ERROR|^\[(ROS)?TEST\]' "$ws/test.log" | grep -v -E '^\[ *(RUN|OK) ' || true
+if [ "$status" -ne 0 ]; then
+  tail -40 "$ws/test.log"
+  echo "run_tests exited with status $status (log: $ws/test.log)"
+fi
+/usr/bin/python3 "$repo/scripts/count_results.py" "$ws/build/test_results" "$status"

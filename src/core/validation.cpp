@@ -1,0 +1,104 @@
+#include "collision_response/core/validation.h"
+
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <limits>
+
+namespace collision_response::core {
+
+std::string formatNumber(double value) {
+  if (std::isnan(value)) return "nan";
+  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+  std::array<char, 32> buffer{};
+  const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
+  return std::string(buffer.data(), result.ptr);
+}
+
+std::string formatVector(const Eigen::Vector3d& value) {
+  return "[" + formatNumber(value.x()) + ", " + formatNumber(value.y()) + ", " +
+         formatNumber(value.z()) + "]";
+}
+
+Status checkFinite(double value, const std::string& field) {
+  if (!std::isfinite(value))
+    return Error{field, "must be a finite number, got " + formatNumber(value)};
+  return Ok{};
+}
+
+Status checkFinite(const Eigen::Vector3d& value, const std::string& field) {
+  static const std::array<const char*, 3> kAxes = {"x", "y", "z"};
+  for (int axis = 0; axis < 3; ++axis) {
+    if (!std::isfinite(value[axis])) {
+      return Error{field + "." + kAxes[axis],
+                   "must be a finite number, got " + formatNumber(value[axis])};
+    }
+  }
+  return Ok{};
+}
+
+Status checkRestitution(double restitution, const std::string& field) {
+  if (!(restitution >= 0.0 && restitution <= 1.0)) {
+    return Error{field,
+                 "coefficient of restitution must be in [0, 1] (0 plastic, 1 elastic), got " +
+                     formatNumber(restitution)};
+  }
+  return Ok{};
+}
+
+Status checkMass(double mass, const std::string& field) {
+  if (std::isnan(mass) || !(mass > 0.0)) {
+    return Error{field, "must be > 0 kg, or .inf for an immovable body, got " + formatNumber(mass)};
+  }
+  if (!std::isfinite(inverseMass(mass))) {
+    return Error{field, "is too small: 1/mass overflows (got " + formatNumber(mass) + " kg)"};
+  }
+  return Ok{};
+}
+
+Status checkRadius(double radius, const std::string& field) {
+  if (!std::isfinite(radius) || radius < 0.0) {
+    return Error{field, "must be a finite number >= 0 m, got " + formatNumber(radius)};
+  }
+  return Ok{};
+}
+
+Status checkName(const std::string& name, const std::string& field) {
+  if (name.empty()) return Error{field, "must not be empty"};
+  for (const char c : name) {
+    if (static_cast<unsigned char>(c) <= ' ' || c == 0x7f) {
+      return Error{field, "'" + name + "' contains whitespace or a control character"};
+    }
+  }
+  return Ok{};
+}
+
+Status checkBody(const Body& body, const std::string& prefix) {
+  if (auto status = checkMass(body.mass, prefix + ".mass"); !status) return status;
+  if (auto status = checkRadius(body.radius, prefix + ".radius"); !status) return status;
+  if (auto status = checkFinite(body.position, prefix + ".position"); !status) return status;
+  if (auto status = checkFinite(body.velocity, prefix + ".velocity"); !status) return status;
+  return checkFinite(body.angular_velocity, prefix + ".angular_velocity");
+}
+
+Expected<Eigen::Vector3d> lineOfImpact(const Eigen::Vector3d& normal,
+                                       const Eigen::Vector3d& position_a,
+                                       const Eigen::Vector3d& position_b,
+                                       const std::string& field) {
+  if (auto status = checkFinite(normal, field); !status) return status.error();
+  // stableNormalized() rescales before squaring, so 1e-300 and 1e300 normals both work.
+  if (normal != Eigen::Vector3d::Zero()) return Eigen::Vector3d(normal.stableNormalized());
+  const Eigen::Vector3d centre_to_centre = position_b - position_a;
+  if (!centre_to_centre.allFinite()) {
+    return Error{field,
+                 "is zero and the centres are too far apart to derive it (b.position - "
+                 "a.position overflows); give the normal"};
+  }
+  if (centre_to_centre == Eigen::Vector3d::Zero()) {
+    return Error{field, "is zero and a.position equals b.position " + formatVector(position_a) +
+                            ": no line of impact; give a nonzero normal"};
+  }
+  return Eigen::Vector3d(centre_to_centre.stableNormalized());
+}
+
+}  // namespace collision_response::core

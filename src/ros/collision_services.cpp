@@ -1,0 +1,70 @@
+#include "collision_response/ros/collision_services.h"
+
+#include "collision_response/core/collision.h"
+#include "collision_response/core/restitution.h"
+#include "collision_response/core/validation.h"
+#include "collision_response/ros/conversions.h"
+
+namespace collision_response {
+
+void answerComputeCollision(const ComputeCollision::Request& request,
+                            const core::MaterialTable& materials,
+                            ComputeCollision::Response& response) {
+  core::CollisionRequest core_request;
+  core_request.a = toCore(request.a);
+  core_request.b = toCore(request.b);
+  core_request.normal = toEigen(request.normal);
+  core_request.restitution = request.restitution;
+  core_request.effects = request.effects;
+
+  response = ComputeCollision::Response();
+  const auto outcome = core::computeCollision(core_request, materials);
+  if (!outcome) {
+    response.success = false;
+    response.message = outcome.error().message();
+    return;
+  }
+  const core::ImpactResponse<double>& impact = outcome->impact;
+  response.success = true;
+  response.velocity_a = toVector3Msg(impact.velocity_a);
+  response.velocity_b = toVector3Msg(impact.velocity_b);
+  response.angular_velocity_a = toVector3Msg(outcome->angular_velocity_a);
+  response.angular_velocity_b = toVector3Msg(outcome->angular_velocity_b);
+  response.normal = toVector3Msg(outcome->line_of_impact);
+  response.restitution = outcome->restitution;
+  response.impulse = impact.normal_impulse;
+  response.oblique = outcome->oblique;
+  response.approaching = impact.approaching;
+  response.energy_lost = impact.energy_lost;
+  response.message =
+      impact.approaching
+          ? std::string(outcome->oblique ? "oblique" : "direct") +
+                " impact, e = " + core::formatNumber(outcome->restitution) + ", impulse " +
+                core::formatNumber(impact.normal_impulse) + " N s"
+          : "not approaching ((v_b - v_a).normal = " + core::formatNumber(-impact.approach_speed) +
+                " m/s >= 0): velocities unchanged";
+}
+
+void answerEstimateRestitution(const EstimateRestitution::Request& request,
+                               const core::MaterialTable& materials,
+                               EstimateRestitution::Response& response) {
+  response = EstimateRestitution::Response();
+  const auto restitution = core::restitutionFromHeights(request.drop_height, request.bounce_height);
+  if (!restitution) {
+    response.success = false;
+    response.message = restitution.error().message();
+    return;
+  }
+  const core::NearestMaterial nearest = core::nearestMaterial(materials, *restitution);
+  response.success = true;
+  response.restitution = *restitution;
+  response.nearest_material = nearest.name;
+  response.nearest_material_restitution = nearest.restitution;
+  response.message = "e = sqrt(" + core::formatNumber(request.bounce_height) + " / " +
+                     core::formatNumber(request.drop_height) +
+                     ") = " + core::formatNumber(*restitution) +
+                     "; nearest material: " + nearest.name + " (" +
+                     core::formatNumber(nearest.restitution) + " on concrete)";
+}
+
+}  // namespace collision_response

@@ -1,0 +1,99 @@
+#include "collision_response/ros/parameters.h"
+
+namespace collision_response {
+namespace {
+
+const char* typeName(XmlRpc::XmlRpcValue::Type type) {
+  switch (type) {
+    case XmlRpc::XmlRpcValue::TypeBoolean:
+      return "a boolean";
+    case XmlRpc::XmlRpcValue::TypeInt:
+      return "an integer";
+    case XmlRpc::XmlRpcValue::TypeDouble:
+      return "a number";
+    case XmlRpc::XmlRpcValue::TypeString:
+      return "a string";
+    case XmlRpc::XmlRpcValue::TypeArray:
+      return "a list";
+    case XmlRpc::XmlRpcValue::TypeStruct:
+      return "a mapping";
+    default:
+      return "another type";
+  }
+}
+
+core::Error wrongType(const XmlRpc::XmlRpcValue& value, const std::string& field,
+                      const std::string& expected) {
+  return core::Error{field, "must be " + expected + ", got " + typeName(value.getType())};
+}
+
+}  // namespace
+
+std::string joinKey(const std::string& parent, const std::string& child) {
+  return parent.empty() ? child : parent + "/" + child;
+}
+
+std::string indexKey(const std::string& parent, std::size_t index) {
+  return parent + "[" + std::to_string(index) + "]";
+}
+
+core::Status checkStruct(const XmlRpc::XmlRpcValue& value, const std::string& field) {
+  if (value.getType() != XmlRpc::XmlRpcValue::TypeStruct)
+    return wrongType(value, field, "a mapping");
+  return core::Ok{};
+}
+
+core::Status checkArray(const XmlRpc::XmlRpcValue& value, const std::string& field) {
+  if (value.getType() != XmlRpc::XmlRpcValue::TypeArray) return wrongType(value, field, "a list");
+  return core::Ok{};
+}
+
+core::Status checkKeys(const XmlRpc::XmlRpcValue& value, const std::set<std::string>& known,
+                       const std::string& field) {
+  if (auto status = checkStruct(value, field); !status) return status;
+  for (auto it = value.begin(); it != value.end(); ++it) {
+    if (known.count(it->first) == 0) {
+      std::string list;
+      for (const std::string& key : known) list += (list.empty() ? "" : ", ") + key;
+      return core::Error{joinKey(field, it->first), "unknown key; known here: " + list};
+    }
+  }
+  return core::Ok{};
+}
+
+core::Expected<double> readDouble(const XmlRpc::XmlRpcValue& value, const std::string& field) {
+  // XmlRpcValue's conversion operators are not const; copy to read.
+  XmlRpc::XmlRpcValue copy = value;
+  if (copy.getType() == XmlRpc::XmlRpcValue::TypeDouble) return static_cast<double>(copy);
+  if (copy.getType() == XmlRpc::XmlRpcValue::TypeInt)
+    return static_cast<double>(static_cast<int>(copy));
+  return wrongType(value, field, "a number");
+}
+
+core::Expected<std::string> readString(const XmlRpc::XmlRpcValue& value, const std::string& field) {
+  XmlRpc::XmlRpcValue copy = value;
+  if (copy.getType() == XmlRpc::XmlRpcValue::TypeString) return static_cast<std::string>(copy);
+  return wrongType(value, field, "a string");
+}
+
+core::Expected<bool> readBool(const XmlRpc::XmlRpcValue& value, const std::string& field) {
+  XmlRpc::XmlRpcValue copy = value;
+  if (copy.getType() == XmlRpc::XmlRpcValue::TypeBoolean) return static_cast<bool>(copy);
+  return wrongType(value, field, "true or false");
+}
+
+core::Expected<Eigen::Vector3d> readVector3(const XmlRpc::XmlRpcValue& value,
+                                            const std::string& field) {
+  if (value.getType() != XmlRpc::XmlRpcValue::TypeArray || value.size() != 3) {
+    return core::Error{field, "must be a list of three numbers [x, y, z]"};
+  }
+  Eigen::Vector3d result;
+  for (int i = 0; i < 3; ++i) {
+    const auto component = readDouble(value[i], indexKey(field, static_cast<std::size_t>(i)));
+    if (!component) return component.error();
+    result[i] = *component;
+  }
+  return result;
+}
+
+}  // namespace collision_response

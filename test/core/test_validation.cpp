@@ -1,0 +1,171 @@
+// Every validation error of a single collision: refused, with the field named and the reason.
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <string>
+
+#include "collision_response/core/collision.h"
+#include "collision_response/core/restitution.h"
+#include "collision_response/core/validation.h"
+
+namespace collision_response::core {
+namespace {
+
+constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+CollisionRequest goodRequest() {
+  CollisionRequest request;
+  request.a.id = "a";
+  request.a.mass = 2.0;
+  request.a.velocity = Eigen::Vector3d(3, 0, 0);
+  request.b.id = "b";
+  request.b.mass = 1.0;
+  request.b.position = Eigen::Vector3d(1, 0, 0);
+  request.b.velocity = Eigen::Vector3d(-1, 0, 0);
+  request.restitution = 0.5;
+  return request;
+}
+
+// Refused, naming `field`, with `words` in the reason.
+void expectRefused(const CollisionRequest& request, const std::string& field,
+                   const std::string& words) {
+  const auto outcome = computeCollision(request, MaterialTable::seed());
+  ASSERT_FALSE(outcome.ok()) << "expected a refusal naming " << field;
+  EXPECT_EQ(outcome.error().field, field) << outcome.error().message();
+  EXPECT_NE(outcome.error().reason.find(words), std::string::npos) << outcome.error().message();
+}
+
+TEST(Validation, GoodRequestIsAccepted) {
+  const auto outcome = computeCollision(goodRequest(), MaterialTable::seed());
+  ASSERT_TRUE(outcome.ok());
+  EXPECT_EQ(outcome->impact.velocity_a, Eigen::Vector3d(1, 0, 0));  // the seed's 2 kg / 1 kg case
+  EXPECT_EQ(outcome->impact.velocity_b, Eigen::Vector3d(3, 0, 0));
+}
+
+TEST(Validation, Mass) {
+  for (const double bad : {0.0, -1.0, kNan, -kInf, 1e-310}) {
+    CollisionRequest request = goodRequest();
+    request.a.mass = bad;
+    expectRefused(request, "a.mass", "");
+  }
+  CollisionRequest request = goodRequest();
+  request.b.mass = -1.0;
+  expectRefused(request, "b.mass", "> 0");
+}
+
+TEST(Validation, BothImmovable) {
+  CollisionRequest request = goodRequest();
+  request.a.mass = kInf;
+  request.b.mass = kInf;
+  expectRefused(request, "b.mass", "both immovable");
+}
+
+TEST(Validation, Radius) {
+  for (const double bad : {-0.1, kNan, kInf}) {
+    CollisionRequest request = goodRequest();
+    request.b.radius = bad;
+    expectRefused(request, "b.radius", ">= 0");
+  }
+}
+
+TEST(Validation, NonFiniteVectorsNameTheComponent) {
+  CollisionRequest request = goodRequest();
+  request.a.velocity.y() = kNan;
+  expectRefused(request, "a.velocity.y", "finite");
+  request = goodRequest();
+  request.b.position.z() = kInf;
+  expectRefused(request, "b.position.z", "finite");
+  request = goodRequest();
+  request.a.angular_velocity.x() = -kInf;
+  expectRefused(request, "a.angular_velocity.x", "finite");
+  request = goodRequest();
+  request.normal.x() = kNan;
+  expectRefused(request, "normal.x", "finite");
+}
+
+TEST(Validation, Restitution) {
+  for (const double bad : {-0.01, 1.5, kNan, kInf}) {
+    CollisionRequest request = goodRequest();
+    request.restitution = bad;
+    expectRefused(request, "restitution", "[0, 1]");
+  }
+}
+
+TEST(Validation, NoLineOfImpact) {
+  CollisionRequest request = goodRequest();
+  request.b.position = request.a.position;
+  expectRefused(request, "normal", "no line of impact");
+  // A nonzero normal makes coincident centres fine.
+  request.normal = Eigen::Vector3d(0, 0, 2);
+  EXPECT_TRUE(computeCollision(request, MaterialTable::seed()).ok());
+}
+
+TEST(Validation, NormalIsScaledToUnitLength) {
+  for (const double scale : {1e-300, 1e-5, 7.0, 1e300}) {
+    const auto n = lineOfImpact(Eigen::Vector3d(0, 0, scale), Eigen::Vector3d::Zero(),
+                                Eigen::Vector3d::Zero());
+    ASSERT_TRUE(n.ok()) << scale;
+    EXPECT_EQ(*n, Eigen::Vector3d(0, 0, 1)) << scale;
+  }
+  const auto derived =
+      lineOfImpact(Eigen::Vector3d::Zero(), Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(1, 1, -4));
+  ASSERT_TRUE(derived.ok());
+  EXPECT_EQ(*derived, Eigen::Vector3d(0, 0, -1));
+}
+
+TEST(Validation, BodyAgainstItself) {
+  CollisionRequest request = goodRequest();
+  request.b.id = "a";
+  expectRefused(request, "b.id", "itself");
+}
+
+TEST(Validation, Materials) {
+  CollisionRequest request = goodRequest();
+  request.a.material = "tennis_ball";
+  request.b.material = "kryptonite";
+  request.restitution = 0.0;
+  expectRefused(request, "b.material", "unknown material 'kryptonite'");
+
+  request.b.material = "";
+  expectRefused(request, "b.material", "name both");
+
+  request.b.material = "concrete";
+  request.restitution = 0.5;
+  expectRefused(request, "restitution", "must be 0 when both bodies name a material");
+
+  request.restitution = 0.0;
+  const auto outcome = computeCollision(request, MaterialTable::seed());
+  ASSERT_TRUE(outcome.ok());
+  EXPECT_EQ(outcome->restitution, 0.712);
+}
+
+TEST(Validation, Effects) {
+  CollisionRequest request = goodRequest();
+  request.effects = {"magnetism"};
+  expectRefused(request, "effects[0]", "unknown effect 'magnetism'");
+}
+
+TEST(Validation, DropTestHeights) {
+  EXPECT_EQ(restitutionFromHeights(0.0, 0.0).error().field, "drop_height");
+  EXPECT_EQ(restitutionFromHeights(-1.0, 0.0).error().field, "drop_height");
+  EXPECT_EQ(restitutionFromHeights(kNan, 0.5).error().field, "drop_height");
+  EXPECT_EQ(restitutionFromHeights(kInf, 0.5).error().field, "drop_height");
+  EXPECT_EQ(restitutionFromHeights(1.0, -0.5).error().field, "bounce_height");
+  EXPECT_EQ(restitutionFromHeights(1.0, kNan).error().field, "bounce_height");
+  const auto higher = restitutionFromHeights(1.0, 1.5);
+  ASSERT_FALSE(higher.ok());
+  EXPECT_EQ(higher.error().field, "bounce_height");
+  EXPECT_NE(higher.error().reason.find("e > 1"), std::string::npos);
+}
+
+TEST(Validation, NumbersInMessagesReadBack) {
+  EXPECT_EQ(formatNumber(0.1), "0.1");
+  EXPECT_EQ(formatNumber(-1.0), "-1");
+  EXPECT_EQ(formatNumber(kNan), "nan");
+  EXPECT_EQ(formatNumber(-kInf), "-inf");
+  EXPECT_EQ(formatVector(Eigen::Vector3d(1, 2.5, -3)), "[1, 2.5, -3]");
+}
+
+}  // namespace
+}  // namespace collision_response::core

@@ -1,0 +1,224 @@
+// Calls the running collision_response node's services over ROS (rostest: real master, real
+// node) with good and bad requests. Expected numbers are closed forms worked out in comments.
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "collision_response/ComputeCollision.h"
+#include "collision_response/EstimateRestitution.h"
+
+namespace {
+
+using collision_response::ComputeCollision;
+using collision_response::EstimateRestitution;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+
+class Services : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(ros::service::waitForService("/collision_response/compute_collision", 20000));
+    ASSERT_TRUE(ros::service::waitForService("/collision_response/estimate_restitution", 20000));
+    compute_ = node_.serviceClient<ComputeCollision>("/collision_response/compute_collision", true);
+    estimate_ =
+        node_.serviceClient<EstimateRestitution>("/collision_response/estimate_restitution", true);
+  }
+
+  ComputeCollision::Response call(const ComputeCollision::Request& request) {
+    ComputeCollision srv;
+    srv.request = request;
+    EXPECT_TRUE(compute_.call(srv)) << "the service must answer every request";
+    return srv.response;
+  }
+
+  // The seed's 2 kg at 3 m/s against 1 kg at -1 m/s along x, e = 0.5:
+  // v_a' = (6 - 1 + 0.5 * 1 * (-4)) / 3 = 1, v_b' = (5 + 0.5 * 2 * 4) / 3 = 3.
+  static ComputeCollision::Request seedRequest() {
+    ComputeCollision::Request request;
+    request.a.id = "a";
+    request.a.mass = 2.0;
+    request.a.velocity.x = 3.0;
+    request.b.id = "b";
+    request.b.mass = 1.0;
+    request.b.position.x = 1.0;
+    request.b.velocity.x = -1.0;
+    request.restitution = 0.5;
+    return request;
+  }
+
+  void expectSeedAnswer() {
+    const auto response = call(seedRequest());
+    ASSERT_TRUE(response.success) << response.message;
+    EXPECT_DOUBLE_EQ(response.velocity_a.x, 1.0);
+    EXPECT_DOUBLE_EQ(response.velocity_b.x, 3.0);
+  }
+
+  void expectRefused(const ComputeCollision::Request& request, const std::string& field) {
+    const auto response = call(request);
+    EXPECT_FALSE(response.success);
+    EXPECT_EQ(response.message.rfind(field + ":", 0), 0u)
+        << "message must start with the field '" << field << "': " << response.message;
+    EXPECT_EQ(response.velocity_a.x, 0.0) << "a refused request carries no numbers";
+    // The node keeps serving, correctly.
+    expectSeedAnswer();
+  }
+
+  ros::NodeHandle node_;
+  ros::ServiceClient compute_;
+  ros::ServiceClient estimate_;
+};
+
+TEST_F(Services, SeedCombinedFormulas) {
+  const auto response = call(seedRequest());
+  ASSERT_TRUE(response.success) << response.message;
+  EXPECT_EQ(response.velocity_a.x, 1.0);
+  EXPECT_EQ(response.velocity_b.x, 3.0);
+  EXPECT_EQ(response.normal.x, 1.0);  // derived from the positions
+  EXPECT_TRUE(response.approaching);
+  EXPECT_FALSE(response.oblique);
+  // J = m_a (v_a - v_a') = 2 * 2 = 4; lost (1/2) mu (1 - e^2) d^2 = 0.5 * 2/3 * 0.75 * 16 = 4.
+  EXPECT_DOUBLE_EQ(response.impulse, 4.0);
+  EXPECT_DOUBLE_EQ(response.energy_lost, 4.0);
+}
+
+TEST_F(Services, ObliqueImpactChangesOnlyTheNormalComponent) {
+  // Equal masses, e = 1, a at (3, 4, 0) hits b at rest; the line of impact (from the centres)
+  // is x, so the x components are exchanged and y is kept: a' = (0, 4, 0), b' = (3, 0, 0).
+  ComputeCollision::Request request;
+  request.a.mass = 0.17;
+  request.a.velocity.x = 3.0;
+  request.a.velocity.y = 4.0;
+  request.b.mass = 0.17;
+  request.b.position.x = 0.06;
+  request.restitution = 1.0;
+  const auto response = call(request);
+  ASSERT_TRUE(response.success) << response.message;
+  EXPECT_TRUE(response.oblique);
+  EXPECT_EQ(response.velocity_a.x, 0.0);
+  EXPECT_EQ(response.velocity_a.y, 4.0);
+  EXPECT_EQ(response.velocity_b.x, 3.0);
+  EXPECT_EQ(response.velocity_b.y, 0.0);
+  EXPECT_EQ(response.energy_lost, 0.0);
+}
+
+TEST_F(Services, ImmovableWallGivesExactlyMinusEV) {
+  ComputeCollision::Request request;
+  request.a.mass = 0.057;
+  request.a.material = "tennis_ball";
+  request.a.velocity.z = -4.43;
+  request.b.mass = kInf;
+  request.b.material = "concrete";
+  request.normal.z = -1.0;
+  const auto response = call(request);
+  ASSERT_TRUE(response.success) << response.message;
+  EXPECT_EQ(response.restitution, 0.712);
+  EXPECT_EQ(response.velocity_a.z, 0.712 * 4.43);  // -e v, to the last bit
+  EXPECT_EQ(response.velocity_b.z, 0.0);
+}
+
+TEST_F(Services, SceneMaterialsAndPairsAreUsed) {
+  ComputeCollision::Request request = seedRequest();
+  request.restitution = 0.0;
+  request.a.material = "rubber";
+  request.b.material = "steel_ball_bearing";
+  auto response = call(request);
+  ASSERT_TRUE(response.success) << response.message;
+  EXPECT_EQ(response.restitution, 0.7);  // the scene's pair
+  request.b.material = "concrete";
+  response = call(request);
+  ASSERT_TRUE(response.success) << response.message;
+  EXPECT_EQ(response.restitution, 0.85);  // rubber's own coefficient
+  request.b.material = "tennis_ball";
+  response = call(request);
+  ASSERT_TRUE(response.success) << response.message;
+  EXPECT_EQ(response.restitution, 0.712);  // min(0.85, 0.712)
+}
+
+TEST_F(Services, SeparatingBodiesAreNotApproaching) {
+  ComputeCollision::Request request = seedRequest();
+  request.a.velocity.x = -3.0;
+  const auto response = call(request);
+  ASSERT_TRUE(response.success) << response.message;
+  EXPECT_FALSE(response.approaching);
+  EXPECT_EQ(response.velocity_a.x, -3.0);
+  EXPECT_EQ(response.impulse, 0.0);
+}
+
+TEST_F(Services, BadRequestsNameTheFieldAndTheNodeKeepsServing) {
+  auto request = seedRequest();
+  request.a.mass = -1.0;
+  expectRefused(request, "a.mass");
+
+  request = seedRequest();
+  request.restitution = 1.5;
+  expectRefused(request, "restitution");
+
+  request = seedRequest();
+  request.b.velocity.y = kNan;
+  expectRefused(request, "b.velocity.y");
+
+  request = seedRequest();
+  request.a.mass = kInf;
+  request.b.mass = kInf;
+  expectRefused(request, "b.mass");
+
+  request = seedRequest();
+  request.b.position = request.a.position;  // and normal zero: no line of impact
+  expectRefused(request, "normal");
+
+  request = seedRequest();
+  request.a.material = "tennis_ball";
+  request.b.material = "unobtainium";
+  request.restitution = 0.0;
+  expectRefused(request, "b.material");
+
+  request = seedRequest();
+  request.effects = {"warp"};
+  expectRefused(request, "effects[0]");
+}
+
+TEST_F(Services, EstimateRestitutionFromHeights) {
+  EstimateRestitution srv;
+  srv.request.drop_height = 2.0;
+  srv.request.bounce_height = 0.5;  // e = sqrt(0.25) = 0.5 exactly
+  ASSERT_TRUE(estimate_.call(srv));
+  ASSERT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_EQ(srv.response.restitution, 0.5);
+
+  srv.request.drop_height = 1.0;
+  srv.request.bounce_height = 0.712 * 0.712;
+  ASSERT_TRUE(estimate_.call(srv));
+  ASSERT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_NEAR(srv.response.restitution, 0.712, 1e-15);
+  EXPECT_EQ(srv.response.nearest_material, "tennis_ball");
+  EXPECT_EQ(srv.response.nearest_material_restitution, 0.712);
+
+  // e = sqrt(0.9) = 0.9487: range_golf_ball (0.858) is nearer than the scene's rubber (0.85).
+  srv.request.bounce_height = 0.9;
+  ASSERT_TRUE(estimate_.call(srv));
+  EXPECT_EQ(srv.response.nearest_material, "range_golf_ball");
+
+  srv.request.drop_height = 1.0;
+  srv.request.bounce_height = 2.0;
+  ASSERT_TRUE(estimate_.call(srv));
+  EXPECT_FALSE(srv.response.success);
+  EXPECT_EQ(srv.response.message.rfind("bounce_height:", 0), 0u) << srv.response.message;
+
+  srv.request.drop_height = kNan;
+  ASSERT_TRUE(estimate_.call(srv));
+  EXPECT_FALSE(srv.response.success);
+  EXPECT_EQ(srv.response.message.rfind("drop_height:", 0), 0u) << srv.response.message;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "services_test");
+  ros::NodeHandle node;  // keeps the node alive for the test's lifetime
+  return RUN_ALL_TESTS();
+}
