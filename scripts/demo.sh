@@ -1,21 +1,32 @@
 #!/usr/bin/env bash
-# The demo: install, build, start a private ROS master and the collision_response node, call its
-# services on the seed's examples, print the answers, and stop everything it started.
+# The demo: install, build, start a private ROS master, the collision_response node and the
+# scene player on a scene (default: the billiards break; any scene of config/scenes/ by name),
+# print each impact as one line, and stop everything it started.
+#   bash scripts/demo.sh [scene] [duration_s]     e.g. bash scripts/demo.sh cradle 2
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+scene="${1:-billiards_break}"
+duration="${2:-3}"
+[ -f "$repo/config/scenes/$scene.yaml" ] || {
+  echo "no scene '$scene'; scenes: $(cd "$repo/config/scenes" && ls *.yaml | sed 's/\.yaml//' | tr '\n' ' ')"
+  exit 2
+}
 install_packages
 build_workspace >"$ws/build.log" 2>&1 || { tail -40 "$ws/build.log"; echo "build failed (log: $ws/build.log)"; exit 1; }
 source_workspace
 export ROS_MASTER_URI="http://localhost:$(free_port)"
 
-echo "== roslaunch collision_response collision_response.launch (private master at $ROS_MASTER_URI)"
-# roslaunch starts the master and the node; stopping roslaunch stops both.
-roslaunch collision_response collision_response.launch >"$ws/demo-node.log" 2>&1 &
+echo "== roslaunch collision_response demo.launch scene:=$scene duration:=$duration"
+echo "   (a private master at $ROS_MASTER_URI; the scene's file: config/scenes/$scene.yaml)"
+# roslaunch starts the master, the node, the player and the printer, and stops them all when
+# the player has played the scene. Only the printer's lines are shown; the rest is in the log.
+roslaunch collision_response demo.launch scene:="$scene" duration:="$duration" \
+  >"$ws/demo.log" 2>&1 &
 launch_pid=$!
-trap 'kill -INT $launch_pid 2>/dev/null; wait $launch_pid 2>/dev/null || true' EXIT
-
-for _ in $(seq 100); do
-  rosservice list 2>/dev/null | grep -q /collision_response/estimate_restitution && break
-  sleep 0.2
-done
-rosrun collision_response seed_examples </dev/null
+trap 'kill -INT $launch_pid 2>/dev/null || true' EXIT
+tail -n +1 --pid=$launch_pid -f "$ws/demo.log" | grep --line-buffered -E '^(impact|done)' || true
+wait $launch_pid 2>/dev/null || true
+if grep -q -E 'FATAL|ERROR' "$ws/demo.log"; then
+  echo "== errors from the nodes (full log: $ws/demo.log):"
+  grep -E 'FATAL|ERROR' "$ws/demo.log" | head -5
+fi

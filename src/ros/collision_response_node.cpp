@@ -13,27 +13,49 @@ CollisionResponseNode::CollisionResponseNode(const ros::NodeHandle& node,
 
 bool CollisionResponseNode::initialize() {
   const std::string scene_key = private_node_.resolveName("scene");
-  XmlRpc::XmlRpcValue scene;
-  if (private_node_.getParam("scene", scene)) {
-    auto materials = loadMaterials(scene, scene_key);
-    if (!materials) {
-      ROS_FATAL_STREAM("collision_response: bad scene: " << materials.error().message());
+  XmlRpc::XmlRpcValue scene_value;
+  if (private_node_.getParam("scene", scene_value)) {
+    auto scene = loadScene(scene_value, scene_key);
+    if (!scene) {
+      ROS_FATAL_STREAM("collision_response: bad scene: " << scene.error().message());
       return false;
     }
-    materials_ = std::move(materials.value());
+    auto params = MonitorParams::load(private_node_);
+    if (!params) {
+      ROS_FATAL_STREAM("collision_response: bad parameter: " << params.error().message());
+      return false;
+    }
+    materials_ = scene->materials;
+    logScene(*scene, *params);
+    monitor_ = std::make_unique<ImpactMonitorRos>(node_, *scene, *params);
   } else {
     ROS_WARN_STREAM("collision_response: no " << scene_key
-                                              << " parameter; using the seed's materials only");
+                                              << " parameter: serving the services with the "
+                                                 "seed's materials, no impact monitor");
   }
-  ROS_INFO_STREAM("collision_response: " << materials_.names().size()
-                                         << " materials, restitution_combine: "
-                                         << core::toString(materials_.combineRule()));
 
   compute_collision_server_ = private_node_.advertiseService(
       "compute_collision", &CollisionResponseNode::onComputeCollision, this);
   estimate_restitution_server_ = private_node_.advertiseService(
       "estimate_restitution", &CollisionResponseNode::onEstimateRestitution, this);
   return true;
+}
+
+void CollisionResponseNode::logScene(const core::Scene& scene, const MonitorParams& params) const {
+  ROS_INFO_STREAM("collision_response: scene: fixed_frame "
+                  << scene.fixed_frame << ", detection " << core::toString(scene.detection)
+                  << ", effects " << core::toString(scene.effects));
+  ROS_INFO_STREAM("collision_response: restitution_threshold "
+                  << scene.restitution_threshold << " m/s, restitution_combine "
+                  << core::toString(scene.materials.combineRule()) << ", "
+                  << scene.materials.names().size() << " materials");
+  ROS_INFO_STREAM("collision_response: " << scene.bodies.size() << " bodies, "
+                                         << scene.obstacles.size() << " obstacles");
+  ROS_INFO_STREAM("collision_response: transform_timeout "
+                  << params.transform_timeout << " s, frame_velocity_interval "
+                  << params.frame_velocity_interval << " s, body_timeout " << params.body_timeout
+                  << " s, contact_tolerance " << params.contact_tolerance << ", clock_jump_back "
+                  << params.clock_jump_back << " s, queue_size " << params.queue_size);
 }
 
 // Both callbacks answer every request: a refused one with success = false and the reason. No

@@ -76,7 +76,182 @@ core::Status loadPairEntries(const XmlRpc::XmlRpcValue& pairs, const std::string
   return core::Ok{};
 }
 
+core::Status readBodies(const XmlRpc::XmlRpcValue& list, const std::string& field,
+                        core::Scene& scene) {
+  if (auto status = checkArray(list, field); !status) return status;
+  for (int i = 0; i < list.size(); ++i) {
+    const std::string entry_field = indexKey(field, static_cast<std::size_t>(i));
+    const XmlRpc::XmlRpcValue& entry = list[i];
+    if (auto status =
+            checkKeys(entry, {"id", "mass", "radius", "material", "topic", "position", "velocity"},
+                      entry_field);
+        !status) {
+      return status;
+    }
+    core::BodySpec body;
+    for (const char* required : {"id", "mass", "radius", "material"}) {
+      if (!entry.hasMember(required)) {
+        return core::Error{joinKey(entry_field, required), "is required"};
+      }
+    }
+    auto id = readString(entry["id"], joinKey(entry_field, "id"));
+    if (!id) return id.error();
+    body.id = *id;
+    auto mass = readDouble(entry["mass"], joinKey(entry_field, "mass"));
+    if (!mass) return mass.error();
+    body.mass = *mass;
+    auto radius = readDouble(entry["radius"], joinKey(entry_field, "radius"));
+    if (!radius) return radius.error();
+    body.radius = *radius;
+    auto material = readString(entry["material"], joinKey(entry_field, "material"));
+    if (!material) return material.error();
+    body.material = *material;
+    if (entry.hasMember("topic")) {
+      auto topic = readString(entry["topic"], joinKey(entry_field, "topic"));
+      if (!topic) return topic.error();
+      body.topic = *topic;
+    }
+    if (entry.hasMember("position")) {
+      auto position = readVector3(entry["position"], joinKey(entry_field, "position"));
+      if (!position) return position.error();
+      body.position = *position;
+    }
+    if (entry.hasMember("velocity")) {
+      auto velocity = readVector3(entry["velocity"], joinKey(entry_field, "velocity"));
+      if (!velocity) return velocity.error();
+      body.velocity = *velocity;
+    }
+    scene.bodies.push_back(body);
+  }
+  return core::Ok{};
+}
+
+core::Status readObstacles(const XmlRpc::XmlRpcValue& list, const std::string& field,
+                           core::Scene& scene) {
+  if (auto status = checkArray(list, field); !status) return status;
+  for (int i = 0; i < list.size(); ++i) {
+    const std::string entry_field = indexKey(field, static_cast<std::size_t>(i));
+    const XmlRpc::XmlRpcValue& entry = list[i];
+    if (auto status = checkStruct(entry, entry_field); !status) return status;
+    for (const char* required : {"id", "type", "material"}) {
+      if (!entry.hasMember(required)) {
+        return core::Error{joinKey(entry_field, required), "is required"};
+      }
+    }
+    core::ObstacleSpec obstacle;
+    auto type = readString(entry["type"], joinKey(entry_field, "type"));
+    if (!type) return type.error();
+    if (*type == "plane") {
+      obstacle.shape = core::ObstacleShape::kPlane;
+      if (auto status = checkKeys(entry, {"id", "type", "material", "frame", "normal", "offset"},
+                                  entry_field);
+          !status) {
+        return status;
+      }
+      if (!entry.hasMember("normal")) {
+        return core::Error{joinKey(entry_field, "normal"), "is required for a plane"};
+      }
+      auto normal = readVector3(entry["normal"], joinKey(entry_field, "normal"));
+      if (!normal) return normal.error();
+      obstacle.normal = *normal;
+      if (entry.hasMember("offset")) {
+        auto offset = readDouble(entry["offset"], joinKey(entry_field, "offset"));
+        if (!offset) return offset.error();
+        obstacle.offset = *offset;
+      }
+    } else if (*type == "sphere") {
+      obstacle.shape = core::ObstacleShape::kSphere;
+      if (auto status = checkKeys(entry, {"id", "type", "material", "frame", "position", "radius"},
+                                  entry_field);
+          !status) {
+        return status;
+      }
+      if (!entry.hasMember("radius")) {
+        return core::Error{joinKey(entry_field, "radius"), "is required for a sphere"};
+      }
+      auto radius = readDouble(entry["radius"], joinKey(entry_field, "radius"));
+      if (!radius) return radius.error();
+      obstacle.radius = *radius;
+      if (entry.hasMember("position")) {
+        auto position = readVector3(entry["position"], joinKey(entry_field, "position"));
+        if (!position) return position.error();
+        obstacle.position = *position;
+      }
+    } else {
+      return core::Error{joinKey(entry_field, "type"),
+                         "unknown obstacle type '" + *type + "'; known: plane, sphere"};
+    }
+    auto id = readString(entry["id"], joinKey(entry_field, "id"));
+    if (!id) return id.error();
+    obstacle.id = *id;
+    auto material = readString(entry["material"], joinKey(entry_field, "material"));
+    if (!material) return material.error();
+    obstacle.material = *material;
+    if (entry.hasMember("frame")) {
+      auto frame = readString(entry["frame"], joinKey(entry_field, "frame"));
+      if (!frame) return frame.error();
+      obstacle.frame = *frame;
+    }
+    scene.obstacles.push_back(obstacle);
+  }
+  return core::Ok{};
+}
+
 }  // namespace
+
+core::Expected<core::Scene> loadScene(const XmlRpc::XmlRpcValue& value, const std::string& field) {
+  auto materials = loadMaterials(value, field);
+  if (!materials) return materials.error();
+  core::Scene scene;
+  scene.materials = std::move(materials.value());
+  if (value.hasMember("fixed_frame")) {
+    auto frame = readString(value["fixed_frame"], joinKey(field, "fixed_frame"));
+    if (!frame) return frame.error();
+    scene.fixed_frame = *frame;
+  }
+  if (value.hasMember("detection")) {
+    const std::string key = joinKey(field, "detection");
+    auto name = readString(value["detection"], key);
+    if (!name) return name.error();
+    auto detection = core::parseDetection(*name, key);
+    if (!detection) return detection.error();
+    scene.detection = *detection;
+  }
+  if (value.hasMember("effects")) {
+    const std::string key = joinKey(field, "effects");
+    if (auto status = checkArray(value["effects"], key); !status) return status.error();
+    for (int i = 0; i < value["effects"].size(); ++i) {
+      const std::string item = indexKey(key, static_cast<std::size_t>(i));
+      auto name = readString(value["effects"][i], item);
+      if (!name) return name.error();
+      if (auto status = core::addEffect(*name, item, scene.effects); !status) return status.error();
+    }
+  }
+  if (value.hasMember("gravity")) {
+    auto gravity = readVector3(value["gravity"], joinKey(field, "gravity"));
+    if (!gravity) return gravity.error();
+    scene.gravity = *gravity;
+  }
+  if (value.hasMember("restitution_threshold")) {
+    auto threshold =
+        readDouble(value["restitution_threshold"], joinKey(field, "restitution_threshold"));
+    if (!threshold) return threshold.error();
+    scene.restitution_threshold = *threshold;
+  }
+  if (value.hasMember("bodies")) {
+    if (auto status = readBodies(value["bodies"], joinKey(field, "bodies"), scene); !status) {
+      return status.error();
+    }
+  }
+  if (value.hasMember("obstacles")) {
+    if (auto status = readObstacles(value["obstacles"], joinKey(field, "obstacles"), scene);
+        !status) {
+      return status.error();
+    }
+  }
+  if (auto status = core::validateScene(scene, field); !status) return status.error();
+  return scene;
+}
 
 core::Expected<core::MaterialTable> loadMaterials(const XmlRpc::XmlRpcValue& scene,
                                                   const std::string& field) {

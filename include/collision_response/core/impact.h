@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -83,14 +84,16 @@ ImpactResponse<Scalar> resolveImpact(Scalar inverse_mass_a, const Vector3<Scalar
   return response;
 }
 
-/// True when a velocity has a component across the line of impact (the seed's oblique impact),
-/// beyond rounding: |v_perp| > 64 eps |v| in the max norm (no squares, so no overflow).
+/// True when a velocity has a component across the line of impact (the seed's oblique impact):
+/// |v_perp| > 1e-9 |v| in the max norm (an angle of more than about 1e-9 rad; 64 ulps in float).
+/// The margin keeps rounding and measured data (a velocity through tf, a derived normal) from
+/// calling a direct impact oblique. Max norms: no squares, so no overflow.
 template <typename Scalar>
 bool hasObliqueComponent(const Vector3<Scalar>& velocity, const Vector3<Scalar>& line_of_impact) {
   const Vector3<Scalar> perpendicular = velocity - velocity.dot(line_of_impact) * line_of_impact;
-  constexpr Scalar kTolerance = 64 * std::numeric_limits<Scalar>::epsilon();
+  const Scalar tolerance = std::max(Scalar(1e-9), 64 * std::numeric_limits<Scalar>::epsilon());
   return perpendicular.template lpNorm<Eigen::Infinity>() >
-         kTolerance * velocity.template lpNorm<Eigen::Infinity>();
+         tolerance * velocity.template lpNorm<Eigen::Infinity>();
 }
 
 }  // namespace collision_response::core

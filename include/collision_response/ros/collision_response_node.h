@@ -1,11 +1,15 @@
-// The collision_response node: loads the scene and serves the collision services.
+// The collision_response node: loads the scene, serves the collision services and runs the
+// impact monitor on the scene's bodies.
 #pragma once
 
 #include <ros/ros.h>
 
+#include <memory>
+
 #include "collision_response/ComputeCollision.h"
 #include "collision_response/EstimateRestitution.h"
 #include "collision_response/core/materials.h"
+#include "collision_response/ros/impact_monitor_ros.h"
 
 namespace collision_response {
 
@@ -14,18 +18,21 @@ class CollisionResponseNode {
   /// `node` resolves topics (relative names), `private_node` the `~` parameters and services.
   CollisionResponseNode(const ros::NodeHandle& node, const ros::NodeHandle& private_node);
 
-  /// Reads and validates `~scene`, advertises the services. On a bad scene it logs the error
-  /// (naming the parameter and the reason) and returns false.
+  /// Reads and validates `~scene` and the monitor's parameters, advertises the services and
+  /// starts the monitor. On a bad parameter it logs the error (naming the parameter and the
+  /// reason) and returns false.
   bool initialize();
 
  private:
   bool onComputeCollision(ComputeCollision::Request& request, ComputeCollision::Response& response);
   bool onEstimateRestitution(EstimateRestitution::Request& request,
                              EstimateRestitution::Response& response);
+  void logScene(const core::Scene& scene, const MonitorParams& params) const;
 
   ros::NodeHandle node_;
   ros::NodeHandle private_node_;
   core::MaterialTable materials_ = core::MaterialTable::seed();
+  std::unique_ptr<ImpactMonitorRos> monitor_;
   ros::ServiceServer compute_collision_server_;
   ros::ServiceServer estimate_restitution_server_;
 };

@@ -1,4 +1,4 @@
-// The scene file (`~scene`, loaded from config/scenes/*.yaml by the launch file) -> core types.
+// The scene file (`~scene`, loaded from config/scenes/*.yaml by the launch file) -> core::Scene.
 #pragma once
 
 #include <XmlRpcValue.h>
@@ -7,6 +7,7 @@
 
 #include "collision_response/core/expected.h"
 #include "collision_response/core/materials.h"
+#include "collision_response/core/scene.h"
 
 namespace collision_response {
 
@@ -15,5 +16,9 @@ namespace collision_response {
 /// Unknown keys, unknown materials, duplicate names and out-of-range coefficients are errors.
 core::Expected<core::MaterialTable> loadMaterials(const XmlRpc::XmlRpcValue& scene,
                                                   const std::string& field);
+
+/// The whole scene (keys in README.md, "Scene file"), validated (core::validateScene). Every
+/// error names the parameter (`field`/bodies[2]/mass) and the reason.
+core::Expected<core::Scene> loadScene(const XmlRpc::XmlRpcValue& scene, const std::string& field);
 
 }  // namespace collision_response

@@ -1,0 +1,75 @@
+// A scene: what the monitor watches (bodies, immovable obstacles) and how (detection, effects,
+// threshold, materials). Read from the scene file by the ROS layer; validated here.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "collision_response/core/expected.h"
+#include "collision_response/core/materials.h"
+
+namespace collision_response::core {
+
+/// `discrete`: overlap tested at each received instant. `continuous`: the exact instant of first
+/// contact along the motion predicted from each body's last state.
+enum class Detection { kContinuous, kDiscrete };
+Expected<Detection> parseDetection(const std::string& name, const std::string& field);
+const char* toString(Detection detection);
+
+/// The effects a scene may turn on; none is the seed's model.
+struct Effects {
+  bool gravity = false;
+  bool friction = false;
+  bool spin = false;
+};
+/// Adds the effect `name` ("gravity" | "friction" | "spin") to `effects`; unknown or repeated
+/// names are errors naming `field`.
+Status addEffect(const std::string& name, const std::string& field, Effects& effects);
+std::string toString(const Effects& effects);
+
+/// A body the monitor tracks. `position` and `velocity` are its initial state for the scene
+/// player; the monitor takes states from topics.
+struct BodySpec {
+  std::string id;
+  double mass = 1.0;     ///< kg, or +inf: an immovable body whose motion comes from its states
+  double radius = 0.0;   ///< m
+  std::string material;  ///< required
+  std::string topic;     ///< its own BodyState topic; empty: only `body_states`
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< m, initial, in the fixed frame
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< m/s, initial, in the fixed frame
+};
+
+enum class ObstacleShape { kPlane, kSphere };
+
+/// An immovable obstacle: a plane {x : normal.x = offset} whose free side is the one `normal`
+/// points to, or a sphere. Given in `frame` (empty: the fixed frame); a frame that moves makes a
+/// moving obstacle.
+struct ObstacleSpec {
+  std::string id;
+  ObstacleShape shape = ObstacleShape::kPlane;
+  std::string material;  ///< required
+  std::string frame;     ///< tf frame the geometry is given in; empty: the fixed frame
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();   ///< plane: unit (normalised on load)
+  double offset = 0.0;                                 ///< plane: m, normal.x = offset
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< sphere: centre, m
+  double radius = 0.0;                                 ///< sphere: m
+};
+
+struct Scene {
+  std::string fixed_frame = "world";
+  Detection detection = Detection::kContinuous;
+  Effects effects;
+  Eigen::Vector3d gravity = Eigen::Vector3d(0.0, 0.0, -9.81);  ///< m/s^2, with the effect only
+  double restitution_threshold = 0.0;  ///< m/s: slower approaches do not bounce (e = 0)
+  MaterialTable materials = MaterialTable::seed();
+  std::vector<BodySpec> bodies;
+  std::vector<ObstacleSpec> obstacles;
+};
+
+/// Every value and cross-reference of a scene: ids unique among bodies and obstacles, masses,
+/// radii, known materials, finite vectors, nonzero plane normals. Fields are named as scene file
+/// keys under `prefix` ("~scene/bodies[2]/mass").
+Status validateScene(const Scene& scene, const std::string& prefix);
+
+}  // namespace collision_response::core

@@ -1,0 +1,48 @@
+// Impacts that strike at one instant and share bodies (a cluster): one joint solve, so that the
+// answer depends on the contacts, not on the order anybody lists them.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <vector>
+
+namespace collision_response::core {
+
+/// A body of the cluster: inverse mass (0: immovable, an obstacle) and velocity (updated).
+struct ClusterBody {
+  double inverse_mass = 0.0;
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+};
+
+/// A contact of the cluster between bodies `a` and `b` (indices into the cluster's bodies).
+struct ClusterContact {
+  std::size_t a = 0;
+  std::size_t b = 0;
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();  ///< unit, a -> b
+  double restitution = 0.0;                           ///< the coefficient this contact uses
+};
+
+/// What one contact of the cluster received.
+struct ContactOutcome {
+  double impulse = 0.0;         ///< N s, >= 0, on b along the normal, on a against it
+  double approach_speed = 0.0;  ///< m/s, -(v_b - v_a).n before
+  double energy_lost = 0.0;     ///< J, this contact's share: J (1 - e)(-d) / 2
+};
+
+/// Resolves contacts that all strike at one instant, updating the bodies' velocities.
+///
+/// Model (Newton's restitution on every contact at once): find impulses J >= 0 such that every
+/// contact that receives one leaves with d_k' = -e_k d_k, where d_k = (v_b - v_a).n_k. With
+/// v_i' = v_i + w_i sum_k s_ik J_k n_k (s_ik = +1 for b, -1 for a), this is the linear system
+/// A J = -(1 + e) d, A_kl = sum_i w_i s_ik s_il n_k.n_l. A contact whose solution would pull
+/// (J_k < 0) is dropped and the rest solved again (an active set), so no contact adhesion. The
+/// kinetic energy changes by sum_k J_k (d_k + d_k') / 2 = -sum_k J_k (1 - e_k)(-d_k) / 2 <= 0.
+/// One contact alone is resolved by resolveImpact, exact to the last bit.
+///
+/// Two balls striking a third from both sides at once receive equal impulses; a chain struck at
+/// one end (a cradle) is not solved here at once: the caller resolves, in rounds, only the
+/// contacts that approach, so the impact travels down the chain ball by ball.
+std::vector<ContactOutcome> resolveSimultaneous(std::vector<ClusterBody>& bodies,
+                                                const std::vector<ClusterContact>& contacts);
+
+}  // namespace collision_response::core

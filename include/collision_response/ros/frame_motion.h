@@ -1,0 +1,37 @@
+// Where a tf frame is and how it moves, relative to the fixed frame: from tf2 over time.
+#pragma once
+
+#include <ros/time.h>
+#include <tf2_ros/buffer.h>
+
+#include <Eigen/Geometry>
+#include <string>
+
+#include "collision_response/core/expected.h"
+
+namespace collision_response {
+
+/// A frame's pose in the fixed frame at one instant, and its velocity there.
+struct FrameMotion {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();      ///< fixed <- frame
+  Eigen::Vector3d linear_velocity = Eigen::Vector3d::Zero();   ///< m/s of the frame's origin
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  ///< rad/s, in the fixed frame
+
+  /// A point given in the frame, in the fixed frame.
+  Eigen::Vector3d point(const Eigen::Vector3d& in_frame) const { return pose * in_frame; }
+  /// The velocity in the fixed frame of a body at `in_frame` moving at `velocity_in_frame`
+  /// relative to the frame (expressed in it): R v + v_origin + w x (R p).
+  Eigen::Vector3d velocity(const Eigen::Vector3d& in_frame,
+                           const Eigen::Vector3d& velocity_in_frame) const;
+};
+
+/// Looks up `frame` in `fixed_frame` at `stamp` and at `stamp - interval` (the velocity is the
+/// finite difference: exact for a frame moving at constant velocity, as tf interpolates linearly
+/// between its samples). A frame equal to the fixed frame, or empty, is the identity at rest.
+/// The error says which frames and why (not yet available, not connected, ...).
+core::Expected<FrameMotion> lookupFrameMotion(const tf2_ros::Buffer& buffer,
+                                              const std::string& fixed_frame,
+                                              const std::string& frame, const ros::Time& stamp,
+                                              const ros::Duration& interval);
+
+}  // namespace collision_response

@@ -1,0 +1,12 @@
+// scene_player: plays a scene file's bodies on `body_states` and applies the impacts it hears.
+#include <ros/ros.h>
+
+#include "collision_response/ros/scene_player.h"
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "scene_player");
+  collision_response::ScenePlayer player(ros::NodeHandle(), ros::NodeHandle("~"));
+  if (!player.initialize()) return 1;
+  ros::spin();
+  return 0;
+}

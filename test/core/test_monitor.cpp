@@ -1,0 +1,164 @@
+// The impact monitor without ROS: states in, impacts out, against closed forms.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "collision_response/core/monitor.h"
+
+namespace collision_response::core {
+namespace {
+
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+using V = Eigen::Vector3d;
+
+Scene sceneWithRestitution(double restitution) {
+  Scene scene;
+  EXPECT_TRUE(
+      scene.materials.addMaterial("test", Material{restitution, {}}, "materials/test").ok());
+  return scene;
+}
+
+BodySpec ball(const std::string& id, double mass, double radius) {
+  BodySpec body;
+  body.id = id;
+  body.mass = mass;
+  body.radius = radius;
+  body.material = "test";
+  return body;
+}
+
+BodyStateSample state(const ImpactMonitor& monitor, const std::string& id, double time,
+                      const V& position, const V& velocity) {
+  BodyStateSample sample;
+  sample.body = *monitor.bodyIndex(id);
+  sample.time = time;
+  sample.position = position;
+  sample.velocity = velocity;
+  return sample;
+}
+
+// States of bodies moving in straight lines, as a source that ignores collisions publishes them.
+std::vector<BodyStateSample> straight(const ImpactMonitor& monitor,
+                                      const std::vector<std::string>& ids,
+                                      const std::vector<V>& start, const std::vector<V>& velocity,
+                                      double time) {
+  std::vector<BodyStateSample> states;
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    states.push_back(state(monitor, ids[i], time, start[i] + velocity[i] * time, velocity[i]));
+  }
+  return states;
+}
+
+TEST(Monitor, HitBetweenTwoStatesIsFoundAtItsExactInstant) {
+  // A at x = 0 moving +1 m/s, B at x = 1 moving -1 m/s, radii 0.1: the gap 0.8 m closes at
+  // 2 m/s, contact at t = 0.4 s, at x = 0.5. Equal masses, e = 0.5: v_a' = -0.5, v_b' = 0.5.
+  Scene scene = sceneWithRestitution(0.5);
+  scene.bodies = {ball("a", 1.0, 0.1), ball("b", 1.0, 0.1)};
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  const std::vector<std::string> ids = {"a", "b"};
+  const std::vector<V> start = {V(0, 0, 0), V(1, 0, 0)};
+  const std::vector<V> velocity = {V(1, 0, 0), V(-1, 0, 0)};
+  EXPECT_TRUE(monitor.step(0.0, straight(monitor, ids, start, velocity, 0.0)).impacts.empty());
+  const StepReport report = monitor.step(1.0, straight(monitor, ids, start, velocity, 1.0));
+  ASSERT_EQ(report.impacts.size(), 1u);
+  const ImpactRecord& impact = report.impacts[0];
+  EXPECT_NEAR(impact.time, 0.4, 4 * kEps);
+  EXPECT_EQ(monitor.body(impact.body_a).id, "a");
+  EXPECT_EQ(monitor.body(impact.other).id, "b");
+  EXPECT_NEAR(impact.contact_point.x(), 0.5, 4 * kEps);
+  EXPECT_EQ(impact.normal, V(1, 0, 0));
+  EXPECT_EQ(impact.velocity_a_after, V(-0.5, 0, 0));
+  EXPECT_EQ(impact.velocity_b_after, V(0.5, 0, 0));
+  EXPECT_EQ(impact.restitution, 0.5);
+  // J = (1 + e) mu |d| = 1.5 * 0.5 * 2 = 1.5; lost (1/2) mu (1 - e^2) d^2 = 0.25 * 0.75 * 4 = 0.75.
+  EXPECT_NEAR(impact.impulse, 1.5, 4 * kEps);
+  EXPECT_NEAR(impact.energy_lost, 0.75, 4 * kEps);
+}
+
+TEST(Monitor, SourceThatIgnoresCollisionsGetsTheImpactOnce) {
+  Scene scene = sceneWithRestitution(0.5);
+  scene.bodies = {ball("a", 1.0, 0.1), ball("b", 1.0, 0.1)};
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  const std::vector<std::string> ids = {"a", "b"};
+  const std::vector<V> start = {V(0, 0, 0), V(1, 0, 0)};
+  const std::vector<V> velocity = {V(1, 0, 0), V(-1, 0, 0)};
+  std::size_t impacts = 0;
+  for (int k = 0; k <= 20; ++k) {  // 0.1 s apart, the balls pass through each other
+    impacts +=
+        monitor.step(0.1 * k, straight(monitor, ids, start, velocity, 0.1 * k)).impacts.size();
+  }
+  EXPECT_EQ(impacts, 1u);
+}
+
+TEST(Monitor, ImpactAlreadyAppliedBySourceIsFound) {
+  // The source bounced the ball itself: the state after the wall already moves away.
+  Scene scene = sceneWithRestitution(0.8);
+  scene.bodies = {ball("ball", 0.1, 0.05)};
+  ObstacleSpec floor;
+  floor.id = "floor";
+  floor.material = "test";
+  scene.obstacles = {floor};
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  // At t = 0: 0.25 m up (surface 0.2 m above the floor), falling at 1 m/s: contact at t = 0.2.
+  monitor.step(0.0, {state(monitor, "ball", 0.0, V(0, 0, 0.25), V(0, 0, -1))});
+  const StepReport report =
+      monitor.step(0.3, {state(monitor, "ball", 0.3, V(0, 0, 0.13), V(0, 0, 0.8))});
+  ASSERT_EQ(report.impacts.size(), 1u);
+  EXPECT_NEAR(report.impacts[0].time, 0.2, 4 * kEps);
+  EXPECT_TRUE(report.impacts[0].other_is_obstacle);
+  EXPECT_EQ(report.impacts[0].normal, V(0, 0, -1));
+  EXPECT_EQ(report.impacts[0].velocity_a_after, V(0, 0, 0.8));  // -e v, exactly
+  EXPECT_NEAR(report.impacts[0].contact_point.z(), 0.0, 4 * kEps);
+}
+
+TEST(Monitor, DiscreteFindsTheImpactAtTheSampleAfter) {
+  Scene scene = sceneWithRestitution(0.5);
+  scene.detection = Detection::kDiscrete;
+  scene.bodies = {ball("a", 1.0, 0.1), ball("b", 1.0, 0.1)};
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  const std::vector<std::string> ids = {"a", "b"};
+  const std::vector<V> start = {V(0, 0, 0), V(1, 0, 0)};
+  const std::vector<V> velocity = {V(1, 0, 0), V(-1, 0, 0)};
+  std::vector<ImpactRecord> impacts;
+  for (int k = 0; k <= 12; ++k) {  // samples 0.15 s apart: 0.3, then 0.45, after contact at 0.4
+    for (const auto& impact :
+         monitor.step(0.15 * k, straight(monitor, ids, start, velocity, 0.15 * k)).impacts) {
+      impacts.push_back(impact);
+    }
+  }
+  ASSERT_EQ(impacts.size(), 1u);         // once, though the balls overlap for several samples
+  EXPECT_EQ(impacts[0].time, 0.15 * 3);  // the first sample after 0.4 s
+  // Overlapping by 0.1 m at 0.45 s: the line of impact is still the line of centres.
+  EXPECT_EQ(impacts[0].normal, V(1, 0, 0));
+}
+
+TEST(Monitor, DifferentStampsArePredictedToOneInstant) {
+  // b's state is older (t = 0) than a's (t = 0.2): b is predicted forward; contact at t = 0.4.
+  Scene scene = sceneWithRestitution(1.0);
+  scene.bodies = {ball("a", 1.0, 0.1), ball("b", 1.0, 0.1)};
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  monitor.step(0.0, {state(monitor, "a", 0.0, V(0, 0, 0), V(1, 0, 0)),
+                     state(monitor, "b", 0.0, V(1, 0, 0), V(-1, 0, 0))});
+  EXPECT_TRUE(
+      monitor.step(0.2, {state(monitor, "a", 0.2, V(0.2, 0, 0), V(1, 0, 0))}).impacts.empty());
+  const StepReport report = monitor.step(0.6, {state(monitor, "a", 0.6, V(0.6, 0, 0), V(1, 0, 0))});
+  ASSERT_EQ(report.impacts.size(), 1u);
+  EXPECT_NEAR(report.impacts[0].time, 0.4, 4 * kEps);
+}
+
+TEST(Monitor, StaleStatesAreDropped) {
+  Scene scene = sceneWithRestitution(1.0);
+  scene.bodies = {ball("a", 1.0, 0.1)};
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  monitor.step(1.0, {state(monitor, "a", 1.0, V(0, 0, 0), V(1, 0, 0))});
+  const StepReport report = monitor.step(0.5, {state(monitor, "a", 0.5, V(9, 9, 9), V(0, 0, 0))});
+  EXPECT_EQ(report.stale_states, 1u);
+  EXPECT_EQ(monitor.predictedState(0, 1.0)->first, V(0, 0, 0));
+}
+
+}  // namespace
+}  // namespace collision_response::core
