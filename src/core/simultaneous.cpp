@@ -59,14 +59,20 @@ std::vector<ContactOutcome> resolveSimultaneous(std::vector<ClusterBody>& bodies
       if (active[k]) rows.push_back(k);
     }
     const auto size = static_cast<Eigen::Index>(rows.size());
-    Eigen::MatrixXd system(size, size);
-    Eigen::VectorXd target(size);
+    // Solved in long double (11 more bits) and rounded once: the impulses are the doubles
+    // nearest the exact solution, so contacts that are mirror images of each other receive the
+    // same impulse to the bit, whatever order the solver visits them in.
+    using MatrixL = Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic>;
+    using VectorL = Eigen::Matrix<long double, Eigen::Dynamic, 1>;
+    MatrixL system(size, size);
+    VectorL target(size);
     for (Eigen::Index i = 0; i < size; ++i) {
-      target[i] = (1.0 + contacts[rows[i]].restitution) * approach[rows[i]];
+      target[i] = (1.0L + contacts[rows[i]].restitution) * approach[rows[i]];
       for (Eigen::Index j = 0; j < size; ++j) system(i, j) = coupling(rows[i], rows[j]);
     }
     // Minimum-norm least squares: also right when two contacts are redundant (A singular).
-    const Eigen::VectorXd solution = system.completeOrthogonalDecomposition().solve(target);
+    const Eigen::VectorXd solution =
+        system.completeOrthogonalDecomposition().solve(target).cast<double>();
     impulses.setZero();
     Eigen::Index most_negative = -1;
     for (Eigen::Index i = 0; i < size; ++i) {

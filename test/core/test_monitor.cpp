@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -158,6 +159,110 @@ TEST(Monitor, StaleStatesAreDropped) {
   const StepReport report = monitor.step(0.5, {state(monitor, "a", 0.5, V(9, 9, 9), V(0, 0, 0))});
   EXPECT_EQ(report.stale_states, 1u);
   EXPECT_EQ(monitor.predictedState(0, 1.0)->first, V(0, 0, 0));
+}
+
+// Final velocities of every body after the steps, by id.
+std::map<std::string, V> finalVelocities(const ImpactMonitor& monitor, double time) {
+  std::map<std::string, V> result;
+  for (std::size_t i = 0; i < monitor.bodyCount(); ++i) {
+    result[monitor.body(i).id] = monitor.predictedState(i, time)->second;
+  }
+  return result;
+}
+
+// Newton's cradle, e = 1, equal masses: ball 1 strikes four touching balls; the impact travels
+// ball by ball (each pair exchanges velocities exactly) and ball 5 leaves with ball 1's speed.
+TEST(Monitor, CradleOfFiveElasticBalls) {
+  Scene scene = sceneWithRestitution(1.0);
+  std::vector<BodyStateSample> states;
+  for (int i = 1; i <= 5; ++i)
+    scene.bodies.push_back(ball("ball_" + std::to_string(i), 0.26, 0.02));
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  std::vector<BodyStateSample> start;
+  start.push_back(state(monitor, "ball_1", 0.0, V(-0.06, 0, 0), V(0.5, 0, 0)));
+  for (int i = 2; i <= 5; ++i) {
+    start.push_back(
+        state(monitor, "ball_" + std::to_string(i), 0.0, V(0.04 * (i - 2), 0, 0), V::Zero()));
+  }
+  monitor.step(0.0, start);
+  const StepReport report = monitor.step(0.1, {});
+  ASSERT_EQ(report.impacts.size(), 4u);
+  for (const ImpactRecord& impact : report.impacts) {
+    EXPECT_NEAR(impact.time, 0.04, 4 * kEps);  // the 0.02 m gap closes at 0.5 m/s
+    EXPECT_EQ(impact.energy_lost, 0.0);
+  }
+  const auto velocities = finalVelocities(monitor, 0.1);
+  EXPECT_EQ(velocities.at("ball_1"), V::Zero());
+  EXPECT_EQ(velocities.at("ball_2"), V::Zero());
+  EXPECT_EQ(velocities.at("ball_3"), V::Zero());
+  EXPECT_EQ(velocities.at("ball_4"), V::Zero());
+  EXPECT_EQ(velocities.at("ball_5"), V(0.5, 0, 0));
+}
+
+// Two balls strike a resting middle one from both sides at the same instant. The joint solve
+// (A J = -(1 + e) d with A = [[2, -1], [-1, 2]] for unit masses, d = (-1, -1)) gives
+// J = (1 + e)(1, 1): the middle ball stays at rest and the outer ones leave at -e and +e, as
+// off a wall. The answer is symmetric.
+TEST(Monitor, SymmetricStrikeFromBothSides) {
+  Scene scene = sceneWithRestitution(0.5);
+  scene.bodies = {ball("left", 1.0, 0.1), ball("middle", 1.0, 0.1), ball("right", 1.0, 0.1)};
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  monitor.step(0.0, {state(monitor, "left", 0.0, V(-1, 0, 0), V(1, 0, 0)),
+                     state(monitor, "middle", 0.0, V(0, 0, 0), V::Zero()),
+                     state(monitor, "right", 0.0, V(1, 0, 0), V(-1, 0, 0))});
+  const StepReport report = monitor.step(1.0, {});
+  ASSERT_EQ(report.impacts.size(), 2u);
+  EXPECT_EQ(report.impacts[0].time, report.impacts[1].time);
+  EXPECT_EQ(report.impacts[0].impulse, report.impacts[1].impulse);
+  EXPECT_NEAR(report.impacts[0].impulse, 1.5, 4 * kEps);
+  const auto velocities = finalVelocities(monitor, 1.0);
+  EXPECT_EQ(velocities.at("left").x(), -velocities.at("right").x());
+  EXPECT_NEAR(velocities.at("left").x(), -0.5, 4 * kEps);
+  EXPECT_NEAR(velocities.at("middle").x(), 0.0, 4 * kEps);
+}
+
+// The same scene listed in every order, its states arriving in every order: the same impacts
+// and velocities, bit for bit (bodies are indexed by sorted id).
+TEST(Monitor, OrderOfListingAndOfStatesDoesNotMatter) {
+  // A small rack struck off-centre: simultaneous, asymmetric contacts.
+  struct Start {
+    std::string id;
+    V position, velocity;
+  };
+  const double r = 0.028575;
+  const std::vector<Start> starts = {{"cue", V(0, 0.01, 0), V(3, 0, 0)},
+                                     {"one", V(1, 0, 0), V::Zero()},
+                                     {"two", V(1 + r * std::sqrt(3.0), -r, 0), V::Zero()},
+                                     {"three", V(1 + r * std::sqrt(3.0), r, 0), V::Zero()},
+                                     {"four", V(1 + 2 * r * std::sqrt(3.0), 0, 0), V::Zero()}};
+  std::vector<std::size_t> order = {0, 1, 2, 3, 4};
+  std::map<std::string, V> reference;
+  std::vector<double> reference_impulses;
+  int permutations = 0;
+  do {
+    Scene scene = sceneWithRestitution(0.8);
+    for (const std::size_t i : order) scene.bodies.push_back(ball(starts[i].id, 0.17, r));
+    ImpactMonitor monitor(scene, MonitorSettings{});
+    std::vector<BodyStateSample> samples;
+    for (const std::size_t i : order) {
+      samples.push_back(state(monitor, starts[i].id, 0.0, starts[i].position, starts[i].velocity));
+    }
+    monitor.step(0.0, samples);
+    const StepReport report = monitor.step(1.0, {});
+    std::vector<double> impulses;
+    for (const ImpactRecord& impact : report.impacts) impulses.push_back(impact.impulse);
+    const auto velocities = finalVelocities(monitor, 1.0);
+    if (permutations == 0) {
+      reference = velocities;
+      reference_impulses = impulses;
+      EXPECT_GE(impulses.size(), 3u);
+    } else {
+      ASSERT_EQ(velocities, reference) << "permutation " << permutations;
+      ASSERT_EQ(impulses, reference_impulses) << "permutation " << permutations;
+    }
+    ++permutations;
+  } while (std::next_permutation(order.begin(), order.end()));
+  EXPECT_EQ(permutations, 120);
 }
 
 }  // namespace
