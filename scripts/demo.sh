@@ -24,7 +24,7 @@ roslaunch collision_response demo.launch scene:="$scene" duration:="$duration" \
   >"$ws/demo.log" 2>&1 &
 launch_pid=$!
 trap 'kill -INT $launch_pid 2>/dev/null || true' EXIT
-tail -n +1 --pid=$launch_pid -f "$ws/demo.log" | grep --line-buffered -E '^(impact|done)' || true
+tail -n +1 --pid=$launch_pid -f "$ws/demo.log" | grep --line-buffered -E '^(impact|restitution|done)' || true
 wait $launch_pid 2>/dev/null || true
 if grep -q -E 'FATAL|ERROR' "$ws/demo.log"; then
   echo "== errors from the nodes (full log: $ws/demo.log):"

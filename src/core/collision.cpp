@@ -1,5 +1,9 @@
 #include "collision_response/core/collision.h"
 
+#include <cmath>
+
+#include "collision_response/core/friction.h"
+#include "collision_response/core/scene.h"
 #include "collision_response/core/validation.h"
 
 namespace collision_response::core {
@@ -34,18 +38,33 @@ Expected<double> chooseRestitution(const CollisionRequest& request,
   return request.restitution;
 }
 
-Status checkEffects(const std::vector<std::string>& effects) {
-  for (std::size_t i = 0; i < effects.size(); ++i) {
-    const std::string field = "effects[" + std::to_string(i) + "]";
-    const std::string& name = effects[i];
-    if (name == "gravity" || name == "friction" || name == "spin") {
-      return Error{field, "effect '" + name +
-                              "' is not available in this version; leave effects empty for the "
-                              "seed's frictionless model"};
+Expected<Effects> parseEffects(const std::vector<std::string>& names) {
+  Effects effects;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (auto status = addEffect(names[i], "effects[" + std::to_string(i) + "]", effects); !status) {
+      return status.error();
     }
-    return Error{field, "unknown effect '" + name + "'; known: gravity, friction, spin"};
   }
-  return Ok{};
+  return effects;
+}
+
+Expected<double> chooseFriction(const CollisionRequest& request, const MaterialTable& materials) {
+  if (!request.a.material.empty() && !request.b.material.empty()) {
+    const auto pair =
+        materials.friction(request.a.material, request.b.material, "a.material", "b.material");
+    if (pair && request.friction != 0.0) {
+      return Error{"friction",
+                   "must be 0 when both bodies name a material: the pair's "
+                   "coefficient " +
+                       formatNumber(*pair) + " is used, got " + formatNumber(request.friction)};
+    }
+    return pair;
+  }
+  if (!std::isfinite(request.friction) || request.friction < 0.0) {
+    return Error{"friction", "Coulomb coefficient must be a finite number >= 0, got " +
+                                 formatNumber(request.friction)};
+  }
+  return request.friction;
 }
 
 }  // namespace
@@ -63,11 +82,20 @@ Expected<CollisionOutcome> computeCollision(const CollisionRequest& request,
     return Error{"b.id",
                  "is the same as a.id ('" + request.a.id + "'): a body cannot collide with itself"};
   }
-  if (auto status = checkEffects(request.effects); !status) return status.error();
+  const auto effects = parseEffects(request.effects);
+  if (!effects) return effects.error();
   const auto line_of_impact = lineOfImpact(request.normal, request.a.position, request.b.position);
   if (!line_of_impact) return line_of_impact.error();
   const auto restitution = chooseRestitution(request, materials);
   if (!restitution) return restitution.error();
+  if (!effects->friction && request.friction != 0.0) {
+    return Error{"friction", "is " + formatNumber(request.friction) +
+                                 " but the friction effect is not requested (add \"friction\" "
+                                 "to effects)"};
+  }
+  const auto friction =
+      effects->friction ? chooseFriction(request, materials) : Expected<double>(0.0);
+  if (!friction) return friction.error();
 
   CollisionOutcome outcome;
   outcome.line_of_impact = *line_of_impact;
@@ -78,6 +106,31 @@ Expected<CollisionOutcome> computeCollision(const CollisionRequest& request,
                     hasObliqueComponent(request.b.velocity, outcome.line_of_impact);
   outcome.angular_velocity_a = request.a.angular_velocity;
   outcome.angular_velocity_b = request.b.angular_velocity;
+  if (effects->friction) {
+    ClusterBody a{inverseMass(request.a), outcome.impact.velocity_a, request.a.angular_velocity,
+                  0.0};
+    ClusterBody b{inverseMass(request.b), outcome.impact.velocity_b, request.b.angular_velocity,
+                  0.0};
+    FrictionOutcome friction_outcome;
+    if (effects->spin) {
+      a.inverse_inertia = inverseInertia(a.inverse_mass, request.a.radius, request.a.inertia);
+      b.inverse_inertia = inverseInertia(b.inverse_mass, request.b.radius, request.b.inertia);
+      friction_outcome =
+          applyFriction<true>(a, b, outcome.line_of_impact, request.a.radius, request.b.radius,
+                              *friction, outcome.impact.normal_impulse);
+    } else {
+      friction_outcome =
+          applyFriction<false>(a, b, outcome.line_of_impact, request.a.radius, request.b.radius,
+                               *friction, outcome.impact.normal_impulse);
+    }
+    outcome.impact.velocity_a = a.velocity;
+    outcome.impact.velocity_b = b.velocity;
+    outcome.angular_velocity_a = a.angular_velocity;
+    outcome.angular_velocity_b = b.angular_velocity;
+    outcome.friction_impulse = friction_outcome.impulse;
+    outcome.sticking = friction_outcome.sticking;
+    outcome.impact.energy_lost += friction_outcome.energy_lost;
+  }
   return outcome;
 }
 

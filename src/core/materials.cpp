@@ -137,6 +137,24 @@ Expected<double> MaterialTable::restitution(const std::string& first, const std:
                    "': neither is measured; list the pair under pairs:"};
 }
 
+Expected<double> MaterialTable::friction(const std::string& first, const std::string& second,
+                                         const std::string& field_first,
+                                         const std::string& field_second) const {
+  if (auto status = checkKnown(first, field_first); !status) return status.error();
+  if (auto status = checkKnown(second, field_second); !status) return status.error();
+  if (const auto pair = pairs_.find(key(first, second));
+      pair != pairs_.end() && pair->second.friction) {
+    return *pair->second.friction;
+  }
+  const auto own = [this](const std::string& name) {
+    return materials_.at(name).friction.value_or(kDefaultFriction);
+  };
+  if (first == kReferenceSurface && second == kReferenceSurface) return kDefaultFriction;
+  if (second == kReferenceSurface) return own(first);
+  if (first == kReferenceSurface) return own(second);
+  return combine(combine_rule_, own(first), own(second));
+}
+
 std::vector<std::pair<std::string, double>> MaterialTable::againstReferenceSurface() const {
   std::vector<std::pair<std::string, double>> result;
   for (const auto& entry : materials_) {

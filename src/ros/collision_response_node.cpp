@@ -25,13 +25,6 @@ bool CollisionResponseNode::initialize() {
       ROS_FATAL_STREAM("collision_response: bad parameter: " << params.error().message());
       return false;
     }
-    if (scene->effects.gravity || scene->effects.friction || scene->effects.spin) {
-      ROS_FATAL_STREAM("collision_response: " << scene_key
-                                              << "/effects: " << core::toString(scene->effects)
-                                              << " are not available in this version; leave "
-                                                 "effects empty for the seed's model");
-      return false;
-    }
     materials_ = scene->materials;
     logScene(*scene, *params);
     monitor_ = std::make_unique<ImpactMonitorRos>(node_, *scene, *params);

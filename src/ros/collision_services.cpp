@@ -1,5 +1,7 @@
 #include "collision_response/ros/collision_services.h"
 
+#include <tuple>
+
 #include "collision_response/core/collision.h"
 #include "collision_response/core/restitution.h"
 #include "collision_response/core/validation.h"
@@ -10,14 +12,25 @@ namespace collision_response {
 void answerComputeCollision(const ComputeCollision::Request& request,
                             const core::MaterialTable& materials,
                             ComputeCollision::Response& response) {
+  response = ComputeCollision::Response();
   core::CollisionRequest core_request;
   core_request.a = toCore(request.a);
   core_request.b = toCore(request.b);
   core_request.normal = toEigen(request.normal);
   core_request.restitution = request.restitution;
+  core_request.friction = request.friction;
   core_request.effects = request.effects;
-
-  response = ComputeCollision::Response();
+  for (const auto& [body, message, field] :
+       {std::make_tuple(&core_request.a, &request.a, "a.inertia"),
+        std::make_tuple(&core_request.b, &request.b, "b.inertia")}) {
+    const auto inertia = core::parseInertia(message->inertia, field);
+    if (!inertia) {
+      response.success = false;
+      response.message = inertia.error().message();
+      return;
+    }
+    body->inertia = *inertia;
+  }
   const auto outcome = core::computeCollision(core_request, materials);
   if (!outcome) {
     response.success = false;
@@ -35,6 +48,8 @@ void answerComputeCollision(const ComputeCollision::Request& request,
   response.impulse = impact.normal_impulse;
   response.oblique = outcome->oblique;
   response.approaching = impact.approaching;
+  response.friction_impulse = outcome->friction_impulse;
+  response.sticking = outcome->sticking;
   response.energy_lost = impact.energy_lost;
   response.message =
       impact.approaching

@@ -311,6 +311,7 @@ void ImpactMonitorRos::publish(const ros::Time& stamp, const core::StepReport& r
     impact.normal = toVector3Msg(record.normal);
     impact.restitution = record.restitution;
     impact.impulse = record.impulse;
+    impact.friction_impulse = record.friction_impulse;
     impact.oblique = record.oblique;
     impact.velocity_a_before = toTwist(record.velocity_a_before, record.angular_velocity_a_before);
     impact.velocity_a_after = toTwist(record.velocity_a_after, record.angular_velocity_a_after);

@@ -121,6 +121,14 @@ core::Status readBodies(const XmlRpc::XmlRpcValue& list, const std::string& fiel
       if (!velocity) return velocity.error();
       body.velocity = *velocity;
     }
+    if (entry.hasMember("inertia")) {
+      const std::string key = joinKey(entry_field, "inertia");
+      auto name = readString(entry["inertia"], key);
+      if (!name) return name.error();
+      auto inertia = core::parseInertia(*name, key);
+      if (!inertia) return inertia.error();
+      body.inertia = *inertia;
+    }
     scene.bodies.push_back(body);
   }
   return core::Ok{};

@@ -2,6 +2,9 @@
 
 #include <geometry_msgs/TransformStamped.h>
 
+#include <cmath>
+#include <cstdio>
+
 #include "collision_response/BodyStateArray.h"
 #include "collision_response/ros/conversions.h"
 #include "collision_response/ros/parameters.h"
@@ -80,6 +83,12 @@ bool ScenePlayer::initialize() {
   private_node_.param("rate", rate_, rate_);
   private_node_.param("duration", duration_, duration_);
   private_node_.param("start_delay", start_delay_, start_delay_);
+  private_node_.param("contact_tolerance", contact_tolerance_, contact_tolerance_);
+  private_node_.param("report_restitution", report_restitution_, report_restitution_);
+  if (!(std::isfinite(contact_tolerance_) && contact_tolerance_ >= 0)) {
+    ROS_FATAL_STREAM("scene_player: ~contact_tolerance must be a finite number >= 0");
+    return false;
+  }
   if (!(std::isfinite(rate_) && rate_ > 0)) {
     ROS_FATAL_STREAM("scene_player: " << private_node_.resolveName("rate")
                                       << ": must be > 0 Hz, got " << rate_);
@@ -90,20 +99,53 @@ bool ScenePlayer::initialize() {
     ROS_FATAL_STREAM("scene_player: ~duration and ~start_delay must be finite numbers >= 0 s");
     return false;
   }
-  for (const core::BodySpec& body : scene_.bodies) radius_[body.id] = body.radius;
+  for (const core::BodySpec& body : scene_.bodies) {
+    radius_[body.id] = body.radius;
+    body_spec_[body.id] = &body;
+  }
+  if (scene_.effects.gravity) gravity_ = scene_.gravity;
+  for (const core::ObstacleSpec& obstacle : scene_.obstacles) {
+    if (obstacle.shape != core::ObstacleShape::kPlane || !obstacle.frame.empty()) continue;
+    fixed_planes_.push_back(core::Plane{obstacle.normal.normalized(), obstacle.offset});
+    fixed_plane_material_.push_back(obstacle.material);
+  }
   ROS_INFO_STREAM("scene_player: " << scene_.bodies.size() << " bodies at " << rate_
                                    << " Hz, duration " << duration_ << " s (0: until stopped), "
                                    << frames_.size() << " moving frames");
 
   state_publisher_ = node_.advertise<BodyStateArray>("body_states", 100);
+  apex_publisher_ = node_.advertise<BodyState>("apexes", 100);
   impact_subscriber_ = node_.subscribe("impacts", 100, &ScenePlayer::onImpacts, this);
   created_ = ros::Time::now();
   timer_ = node_.createTimer(ros::Duration(1.0 / rate_), &ScenePlayer::onTimer, this);
   return true;
 }
 
+ScenePlayer::Segment ScenePlayer::makeSegment(const core::BodySpec& body, const ros::Time& start,
+                                              const Eigen::Vector3d& position,
+                                              const Eigen::Vector3d& velocity) const {
+  Segment segment{start, position, velocity, Eigen::Vector3d::Zero(), false};
+  if (std::isinf(body.mass) || gravity_ == Eigen::Vector3d::Zero()) return segment;
+  segment.acceleration = gravity_;
+  const auto plane = core::restingPlane(position, velocity, body.radius, fixed_planes_, gravity_,
+                                        contact_tolerance_);
+  if (plane) {
+    const Eigen::Vector3d& normal = fixed_planes_[*plane].normal;
+    segment.velocity -= segment.velocity.dot(normal) * normal;
+    segment.acceleration = core::restingAcceleration(gravity_, normal);
+    segment.apex_published = true;  // a slide has no apex
+  }
+  return segment;
+}
+
 Eigen::Vector3d ScenePlayer::positionAt(const Segment& segment, const ros::Time& time) const {
-  return segment.position + segment.velocity * (time - segment.start).toSec();
+  return core::positionAfter(segment.position, segment.velocity, segment.acceleration,
+                             (time - segment.start).toSec());
+}
+
+Eigen::Vector3d ScenePlayer::velocityAt(const Segment& segment, const ros::Time& time) const {
+  return core::velocityAfter(segment.velocity, segment.acceleration,
+                             (time - segment.start).toSec());
 }
 
 void ScenePlayer::onTimer(const ros::TimerEvent& event) {
@@ -116,7 +158,7 @@ void ScenePlayer::onTimer(const ros::TimerEvent& event) {
     started_ = true;
     start_ = now;
     for (const core::BodySpec& body : scene_.bodies) {
-      segments_[body.id] = Segment{start_, body.position, body.velocity};
+      segments_[body.id] = makeSegment(body, start_, body.position, body.velocity);
     }
   }
   if (duration_ > 0 && (now - start_).toSec() > duration_) {
@@ -125,6 +167,7 @@ void ScenePlayer::onTimer(const ros::TimerEvent& event) {
     return;
   }
   publishStates(now);
+  publishApexes(now);
 }
 
 void ScenePlayer::publishStates(const ros::Time& time) {
@@ -148,7 +191,7 @@ void ScenePlayer::publishStates(const ros::Time& time) {
     state.id = body.id;
     state.pose.position = toPointMsg(positionAt(segment, time));
     state.pose.orientation.w = 1.0;
-    state.twist.linear = toVector3Msg(segment.velocity);
+    state.twist.linear = toVector3Msg(velocityAt(segment, time));
     array.states.push_back(state);
   }
   state_publisher_.publish(array);
@@ -190,7 +233,45 @@ void ScenePlayer::applyImpact(const std::string& id, const ros::Time& stamp,
         1.0, "scene_player: ignored an impact on '" << id << "' older than its last applied one");
     return;
   }
-  segment = Segment{stamp, centre, velocity_after};
+  segment = makeSegment(*body_spec_.at(id), stamp, centre, velocity_after);
+  ++bounces_[id];
+}
+
+void ScenePlayer::publishApexes(const ros::Time& time) {
+  const double g = gravity_.norm();
+  if (!(g > 0)) return;
+  const Eigen::Vector3d up = -gravity_ / g;
+  for (auto& [id, segment] : segments_) {
+    const double rising = segment.velocity.dot(up);
+    if (segment.apex_published || !(rising > 0)) continue;
+    const ros::Time apex_time = segment.start + ros::Duration(rising / g);
+    if (apex_time > time) continue;
+    segment.apex_published = true;
+    // The closed form, not the sample: v.up / g after the segment's start.
+    const Eigen::Vector3d apex = positionAt(segment, apex_time);
+    BodyState state;
+    state.header.stamp = apex_time;
+    state.header.frame_id = scene_.fixed_frame;
+    state.id = id;
+    state.pose.position = toPointMsg(apex);
+    state.pose.orientation.w = 1.0;
+    state.twist.linear = toVector3Msg(velocityAt(segment, apex_time));
+    apex_publisher_.publish(state);
+    if (!report_restitution_ || bounces_[id] != 1 || fixed_planes_.empty()) continue;
+    // The seed's method: dropped from rest, e = sqrt(h'/h), heights of the lowest point above
+    // the first fixed plane (the floor), the drop's from the scene's initial position.
+    const core::BodySpec& body = *body_spec_.at(id);
+    const core::Plane& floor = fixed_planes_.front();
+    const double drop = floor.normal.dot(body.position) - floor.offset - body.radius;
+    const double bounce = floor.normal.dot(apex) - floor.offset - body.radius;
+    const auto measured =
+        scene_.materials.restitution(body.material, fixed_plane_material_.front());
+    const double recovered = std::sqrt(bounce / drop);
+    std::printf("restitution %-26s table %.3f  recovered %.15f  relative error %.1e\n",
+                body.material.c_str(), measured ? *measured : NAN, recovered,
+                measured ? std::abs(recovered - *measured) / *measured : NAN);
+    std::fflush(stdout);
+  }
 }
 
 }  // namespace collision_response

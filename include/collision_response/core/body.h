@@ -5,6 +5,8 @@
 #include <limits>
 #include <string>
 
+#include "collision_response/core/friction.h"
+
 namespace collision_response::core {
 
 /// A sphere taking part in impacts. Every vector is in one common frame (the caller's).
@@ -16,6 +18,7 @@ struct Body {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();          ///< m, centre of mass
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();          ///< m/s, of the centre of mass
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  ///< rad/s
+  Inertia inertia = Inertia::kSolid;  ///< with the spin effect: solid or hollow sphere
 };
 
 /// The immovable limit m -> infinity of the seed's slides.

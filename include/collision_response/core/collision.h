@@ -20,7 +20,11 @@ struct CollisionRequest {
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
   /// Used when neither body names a material; must be 0 when both do.
   double restitution = 0.0;
-  /// Effects to apply; empty: the seed's frictionless, spinless model.
+  /// Coulomb mu, with the friction effect: used when neither body names a material; must be 0
+  /// when both do (the pair's is used).
+  double friction = 0.0;
+  /// Effects to apply: "gravity" (accepted; an instantaneous impact does not feel it),
+  /// "friction", "spin". Empty: the seed's frictionless, spinless model.
   std::vector<std::string> effects;
 };
 
@@ -29,13 +33,17 @@ struct CollisionOutcome {
   Eigen::Vector3d line_of_impact;      ///< unit, a -> b
   double restitution = 0.0;            ///< the coefficient used
   bool oblique = false;                ///< a velocity had a component across the line
+  double friction_impulse = 0.0;       ///< N s, tangential (friction effect)
+  bool sticking = false;               ///< friction stopped the slip
   Eigen::Vector3d angular_velocity_a;  ///< rad/s after (unchanged without spin)
   Eigen::Vector3d angular_velocity_b;  ///< rad/s after (unchanged without spin)
 };
 
 /// Validates every field of `request` (see validation.h), picks the coefficient of restitution
-/// (the pair's from `materials` when both bodies name a material, the request's when neither
-/// does; one without the other is an error), and resolves the impact.
+/// and friction (the pair's from `materials` when both bodies name a material, the request's
+/// when neither does; one without the other is an error), and resolves the impact: the normal
+/// impulse (resolveImpact), then with the friction effect Coulomb friction (applyFriction), with
+/// the spin effect turning the bodies. The energy lost adds the friction's work.
 Expected<CollisionOutcome> computeCollision(const CollisionRequest& request,
                                             const MaterialTable& materials);
 

@@ -20,6 +20,10 @@ const char* toString(CombineRule rule);
 /// min(x, y), max(x, y), (x + y) / 2, x y, or sqrt(x y).
 double combine(CombineRule rule, double x, double y);
 
+/// Coulomb friction coefficient of a material that names none (the seed measures restitution
+/// only): 0.5, a middling value for a ball on a hard floor. Set `friction` to override it.
+inline constexpr double kDefaultFriction = 0.5;
+
 /// The name of the seed's reference surface: every measured coefficient is a ball against it.
 inline constexpr const char* kReferenceSurface = "concrete";
 
@@ -74,6 +78,13 @@ class MaterialTable {
   Expected<double> restitution(const std::string& first, const std::string& second,
                                const std::string& field_first = "first",
                                const std::string& field_second = "second") const;
+
+  /// Coulomb friction coefficient of two materials, by the same rules as restitution: a pair's
+  /// measured `friction`; a material against the reference surface: its own; otherwise the
+  /// combine rule on the two own coefficients (kDefaultFriction where a material names none).
+  Expected<double> friction(const std::string& first, const std::string& second,
+                            const std::string& field_first = "first",
+                            const std::string& field_second = "second") const;
 
   /// Each material with a coefficient against the reference surface, and that coefficient.
   std::vector<std::pair<std::string, double>> againstReferenceSurface() const;

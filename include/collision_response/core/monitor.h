@@ -11,7 +11,9 @@
 #include <utility>
 #include <vector>
 
+#include "collision_response/core/motion.h"
 #include "collision_response/core/scene.h"
+#include "collision_response/core/simultaneous.h"
 
 namespace collision_response::core {
 
@@ -57,8 +59,9 @@ struct ImpactRecord {
   Eigen::Vector3d contact_point = Eigen::Vector3d::Zero();
   Eigen::Vector3d normal = Eigen::Vector3d::UnitX();  ///< unit, a -> other
   double restitution = 0.0;
-  double impulse = 0.0;
-  double energy_lost = 0.0;
+  double impulse = 0.0;           ///< N s, normal
+  double friction_impulse = 0.0;  ///< N s, tangential (friction effect), against b's slip
+  double energy_lost = 0.0;       ///< J, normal closed form plus the friction's work
   bool oblique = false;
   Eigen::Vector3d velocity_a_before, velocity_a_after, velocity_b_before, velocity_b_after;
   Eigen::Vector3d angular_velocity_a_before, angular_velocity_a_after;
@@ -88,6 +91,11 @@ struct StepReport {
 ///   none approaches: a cradle's impact travels ball by ball; balls striking one ball from both
 ///   sides at once share the impulse symmetrically. Bodies are indexed by sorted id, so nothing
 ///   depends on the order of the scene's list or of the states.
+/// - effects (chosen once, from the scene): gravity makes the motion parabolic (the instants of
+///   contact from the ballistic roots) and lets a body rest on a fixed plane; friction and spin
+///   act at impacts (applyFriction). An effect that is off is not on any path: the motion model
+///   is a template parameter chosen once per step, the friction step a function chosen at
+///   construction.
 /// - a state older than its body's track, or a state right after an impact that the monitor
 ///   applied to that body, does not replace the track (the monitor's post-impact motion is the
 ///   newer knowledge); the next state does.
@@ -114,6 +122,8 @@ class ImpactMonitor {
   bool started() const { return started_; }
   double now() const { return now_; }
   std::size_t trackedBodies() const;
+  /// The plane obstacle a body rests on (gravity), if any.
+  std::optional<std::size_t> restingOn(std::size_t body) const;
   /// A body's predicted position and velocity at `time`; empty when it is not tracked.
   std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> predictedState(std::size_t body,
                                                                             double time) const;
@@ -127,8 +137,17 @@ class ImpactMonitor {
     Eigen::Vector3d position = Eigen::Vector3d::Zero();
     Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
     Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
+    Eigen::Vector3d acceleration = Eigen::Vector3d::Zero();  ///< gravity, or its part along a plane
+    int resting_on = -1;                                     ///< obstacle index, -1: none
     double last_state_time = kNever;
     double last_impact_time = kNever;
+  };
+  /// Motion models, chosen once per step: no per-pair branch on gravity.
+  struct StraightLine {
+    static constexpr bool kAccelerates = false;
+  };
+  struct UnderGravity {
+    static constexpr bool kAccelerates = true;
   };
   struct ObstacleTrack {
     bool known = false;
@@ -144,23 +163,35 @@ class ImpactMonitor {
   };
 
   bool isObstacle(std::size_t participant) const { return participant >= bodies_.size(); }
+  bool isPlane(std::size_t participant) const;
   bool known(std::size_t participant) const;
   double inverseMassOf(std::size_t participant) const;
+  template <class Motion>
   Eigen::Vector3d positionAt(std::size_t participant, double time) const;
-  Eigen::Vector3d velocityOf(std::size_t participant) const;
+  template <class Motion>
+  Eigen::Vector3d velocityAt(std::size_t participant, double time) const;
   Eigen::Vector3d angularVelocityOf(std::size_t participant) const;
+  template <class Motion>
   Geometry geometry(const Pair& pair, double time) const;
+  template <class Motion>
   std::optional<double> timeOfImpact(const Pair& pair, double from, double horizon) const;
-  bool approaching(const Pair& pair, const Eigen::Vector3d& normal) const;
+  template <class Motion>
+  bool approaching(const Pair& pair, const Eigen::Vector3d& normal, double time) const;
   double restitutionOf(const Pair& pair) const;
+  bool resting(const Pair& pair) const;
+  /// After a body's velocity changed: does it now rest on a fixed plane (gravity)?
+  void updateResting(std::size_t body);
 
   /// Pairs worth testing in (from, to]: both tracked, not both immovable.
   std::vector<Pair> candidatePairs() const;
   /// Resolves, in rounds, the pairs of `touching` that approach at `time`.
+  template <class Motion>
   bool resolveInstant(double time, const std::vector<Pair>& touching, StepReport& report);
   void applyStates(const std::vector<BodyStateSample>& states, StepReport& report);
   void forgetStaleBodies(double time);
+  template <class Motion>
   StepReport stepContinuous(double time, const std::vector<BodyStateSample>& states);
+  template <class Motion>
   StepReport stepDiscrete(double time, const std::vector<BodyStateSample>& states);
 
   MonitorSettings settings_;
@@ -169,10 +200,17 @@ class ImpactMonitor {
   std::vector<BodySpec> bodies_;         // sorted by id
   std::vector<ObstacleSpec> obstacles_;  // sorted by id
   std::map<std::string, std::size_t> body_index_;
-  std::vector<double> radius_;                    // per participant
-  std::vector<double> inverse_mass_;              // per body
+  std::vector<double> radius_;           // per participant
+  std::vector<double> inverse_mass_;     // per body
+  std::vector<double> inverse_inertia_;  // per body, 0 without spin
+  Effects effects_;
+  Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();  // zero without the gravity effect
+  ClusterFrictionStep friction_step_ = nullptr;        // null without the friction effect
+  std::vector<Plane> fixed_planes_;                    // for resting, with their obstacles:
+  std::vector<std::size_t> fixed_plane_obstacle_;
   std::vector<std::size_t> material_;             // per participant, into restitution_
   std::vector<std::vector<double>> restitution_;  // material x material
+  std::vector<std::vector<double>> friction_;     // material x material
   std::vector<Track> tracks_;
   std::vector<ObstacleTrack> obstacle_tracks_;
   std::set<Pair> overlapping_;  // discrete: pairs overlapping at the previous step

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "collision_response/core/expected.h"
+#include "collision_response/core/friction.h"
 #include "collision_response/core/materials.h"
 
 namespace collision_response::core {
@@ -36,6 +37,7 @@ struct BodySpec {
   double radius = 0.0;   ///< m
   std::string material;  ///< required
   std::string topic;     ///< its own BodyState topic; empty: only `body_states`
+  Inertia inertia = Inertia::kSolid;  ///< with the spin effect: I = 2/5 m r^2 or 2/3 m r^2
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< m, initial, in the fixed frame
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< m/s, initial, in the fixed frame
 };

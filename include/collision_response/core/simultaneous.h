@@ -8,10 +8,13 @@
 
 namespace collision_response::core {
 
-/// A body of the cluster: inverse mass (0: immovable, an obstacle) and velocity (updated).
+/// A body of the cluster: inverse mass (0: immovable, an obstacle), velocity (updated) and, for
+/// friction and spin, angular velocity and inverse moment of inertia (a sphere's is a scalar).
 struct ClusterBody {
   double inverse_mass = 0.0;
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
+  double inverse_inertia = 0.0;  ///< 1/(kg m^2); 0: does not turn (immovable, point, no spin)
 };
 
 /// A contact of the cluster between bodies `a` and `b` (indices into the cluster's bodies).

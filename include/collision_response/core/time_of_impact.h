@@ -74,4 +74,47 @@ std::optional<Scalar> timeOfImpactPlane(Scalar gap, Scalar rate, Scalar horizon)
   return time;
 }
 
+/// The earliest t in (0, horizon] at which a sphere under constant acceleration reaches a plane:
+/// gap(t) = gap + rate t + (acceleration / 2) t^2 = 0 with gap decreasing there (entering), where
+/// gap = n.p - offset - r, rate = n.(v_sphere - v_plane), acceleration = n.a_sphere. The gap may
+/// start inside the touching band (a ball just bounced): the root there, where the ball leaves,
+/// is not an entry; the one where it comes back is.
+///
+/// Roots of A t^2 + B t + C (A = acceleration/2, B = rate, C = gap) in the cancellation-free form:
+/// q = -(B + sign(B) sqrt(B^2 - 4 A C)) / 2, roots q / A and C / q; -B and sign(B) sqrt(D) have the
+/// same sign, so they add without cancellation (a falling ball's entry 2 gap / (sqrt(D) - rate)
+/// keeps its digits for a 1e-12 m gap).
+template <typename Scalar>
+std::optional<Scalar> timeOfImpactPlaneBallistic(Scalar gap, Scalar rate, Scalar acceleration,
+                                                 Scalar horizon) {
+  if (acceleration == 0) {
+    if (!(rate < 0) || gap < 0) return std::nullopt;
+    const Scalar time = gap / -rate;
+    if (!(time <= horizon)) return std::nullopt;
+    return time;
+  }
+  const Scalar half_acceleration = acceleration / 2;
+  const Scalar discriminant = rate * rate - 2 * acceleration * gap;
+  if (discriminant < 0) return std::nullopt;
+  const Scalar q = -(rate + std::copysign(std::sqrt(discriminant), rate)) / 2;
+  std::optional<Scalar> best;
+  const auto consider = [&](Scalar time) {
+    const bool entering = rate + acceleration * time < 0;
+    if (time >= 0 && time <= horizon && entering && (!best || time < *best)) best = time;
+  };
+  consider(q / half_acceleration);
+  if (q != 0) consider(gap / q);
+  return best;
+}
+
+/// The earliest t in (0, horizon] at which two spheres with a relative acceleration a (one falls,
+/// the other is held) come into contact: |s + v t + (a/2) t^2| = R, entering. The squared
+/// distance minus R^2 is a quartic in t; its real roots are found on [0, horizon] (companion
+/// matrix), each polished by Newton's method on the quartic, and the first entering one kept.
+/// a = 0 is timeOfImpactSpheres.
+std::optional<double> timeOfImpactSpheresAccelerated(const Eigen::Vector3d& separation,
+                                                     const Eigen::Vector3d& relative_velocity,
+                                                     const Eigen::Vector3d& relative_acceleration,
+                                                     double contact_distance, double horizon);
+
 }  // namespace collision_response::core
