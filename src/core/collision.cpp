@@ -106,6 +106,7 @@ Expected<CollisionOutcome> computeCollision(const CollisionRequest& request,
                     hasObliqueComponent(request.b.velocity, outcome.line_of_impact);
   outcome.angular_velocity_a = request.a.angular_velocity;
   outcome.angular_velocity_b = request.b.angular_velocity;
+#ifndef COLLISION_RESPONSE_NO_EFFECTS
   if (effects->friction) {
     ClusterBody a{inverseMass(request.a), outcome.impact.velocity_a, request.a.angular_velocity,
                   0.0};
@@ -131,6 +132,7 @@ Expected<CollisionOutcome> computeCollision(const CollisionRequest& request,
     outcome.sticking = friction_outcome.sticking;
     outcome.impact.energy_lost += friction_outcome.energy_lost;
   }
+#endif
   return outcome;
 }
 

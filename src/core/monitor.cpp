@@ -2,23 +2,36 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 
 #include "collision_response/core/body.h"
 #include "collision_response/core/friction.h"
-#include "collision_response/core/impact.h"
-#include "collision_response/core/time_of_impact.h"
 
 namespace collision_response::core {
-namespace {
 
-constexpr double kEps = std::numeric_limits<double>::epsilon();
-/// A pair approaches when its normal relative velocity is below -64 ulps of the speeds: what a
-/// resolved impact leaves behind by rounding (e = 0 gives d' = 0 only up to a few ulps) must not
-/// count as a new approach.
-constexpr double kApproachTolerance = 64 * kEps;
-
-}  // namespace
+// The motion-dependent members live in monitor_straight.cpp and monitor_gravity.cpp (see
+// monitor_motion.h); here they are only called.
+extern template Eigen::Vector3d ImpactMonitor::positionAt<ImpactMonitor::StraightLine>(
+    std::size_t, double) const;
+extern template Eigen::Vector3d ImpactMonitor::velocityAt<ImpactMonitor::StraightLine>(
+    std::size_t, double) const;
+extern template ImpactMonitor::Geometry ImpactMonitor::geometry<ImpactMonitor::StraightLine>(
+    const Pair&, double) const;
+extern template StepReport ImpactMonitor::stepContinuous<ImpactMonitor::StraightLine>(
+    double, const std::vector<BodyStateSample>&);
+extern template StepReport ImpactMonitor::stepDiscrete<ImpactMonitor::StraightLine>(
+    double, const std::vector<BodyStateSample>&);
+#ifndef COLLISION_RESPONSE_NO_EFFECTS
+extern template Eigen::Vector3d ImpactMonitor::positionAt<ImpactMonitor::UnderGravity>(
+    std::size_t, double) const;
+extern template Eigen::Vector3d ImpactMonitor::velocityAt<ImpactMonitor::UnderGravity>(
+    std::size_t, double) const;
+extern template ImpactMonitor::Geometry ImpactMonitor::geometry<ImpactMonitor::UnderGravity>(
+    const Pair&, double) const;
+extern template StepReport ImpactMonitor::stepContinuous<ImpactMonitor::UnderGravity>(
+    double, const std::vector<BodyStateSample>&);
+extern template StepReport ImpactMonitor::stepDiscrete<ImpactMonitor::UnderGravity>(
+    double, const std::vector<BodyStateSample>&);
+#endif
 
 ImpactMonitor::ImpactMonitor(const Scene& scene, const MonitorSettings& settings)
     : settings_(settings),
@@ -30,9 +43,15 @@ ImpactMonitor::ImpactMonitor(const Scene& scene, const MonitorSettings& settings
   const auto by_id = [](const auto& x, const auto& y) { return x.id < y.id; };
   std::sort(bodies_.begin(), bodies_.end(), by_id);
   std::sort(obstacles_.begin(), obstacles_.end(), by_id);
+#ifdef COLLISION_RESPONSE_NO_EFFECTS
+  // The benchmark's reference build: the effects compiled out, to show what "off" costs.
+  effects_ = Effects{};
+#endif
   if (effects_.gravity) gravity_ = scene.gravity;
   if (effects_.friction) {
+#ifndef COLLISION_RESPONSE_NO_EFFECTS
     friction_step_ = effects_.spin ? &applyFrictionToCluster<true> : &applyFrictionToCluster<false>;
+#endif
   }
 
   std::vector<std::string> material_names;
@@ -123,10 +142,12 @@ std::optional<std::size_t> ImpactMonitor::restingOn(std::size_t body) const {
 std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> ImpactMonitor::predictedState(
     std::size_t body, double time) const {
   if (!tracks_[body].known) return std::nullopt;
+#ifndef COLLISION_RESPONSE_NO_EFFECTS
   if (effects_.gravity) {
     return std::make_pair(positionAt<UnderGravity>(body, time),
                           velocityAt<UnderGravity>(body, time));
   }
+#endif
   return std::make_pair(positionAt<StraightLine>(body, time), velocityAt<StraightLine>(body, time));
 }
 
@@ -144,107 +165,10 @@ double ImpactMonitor::inverseMassOf(std::size_t participant) const {
   return isObstacle(participant) ? 0.0 : inverse_mass_[participant];
 }
 
-template <class Motion>
-Eigen::Vector3d ImpactMonitor::positionAt(std::size_t participant, double time) const {
-  if (isObstacle(participant)) {
-    const ObstaclePose& pose = obstacle_tracks_[participant - bodies_.size()].pose;
-    return pose.position + pose.velocity * (time - pose.time);
-  }
-  const Track& track = tracks_[participant];
-  if constexpr (Motion::kAccelerates) {
-    return positionAfter(track.position, track.velocity, track.acceleration, time - track.time);
-  } else {
-    return track.position + track.velocity * (time - track.time);
-  }
-}
-
-template <class Motion>
-Eigen::Vector3d ImpactMonitor::velocityAt(std::size_t participant, double time) const {
-  if (isObstacle(participant)) return obstacle_tracks_[participant - bodies_.size()].pose.velocity;
-  const Track& track = tracks_[participant];
-  if constexpr (Motion::kAccelerates) {
-    return velocityAfter(track.velocity, track.acceleration, time - track.time);
-  } else {
-    static_cast<void>(time);
-    return track.velocity;
-  }
-}
-
 Eigen::Vector3d ImpactMonitor::angularVelocityOf(std::size_t participant) const {
   return isObstacle(participant)
              ? obstacle_tracks_[participant - bodies_.size()].pose.angular_velocity
              : tracks_[participant].angular_velocity;
-}
-
-template <class Motion>
-ImpactMonitor::Geometry ImpactMonitor::geometry(const Pair& pair, double time) const {
-  const auto [a, other] = pair;
-  const Eigen::Vector3d position_a = positionAt<Motion>(a, time);
-  Geometry result;
-  if (isPlane(other)) {
-    const ObstaclePose& plane = obstacle_tracks_[other - bodies_.size()].pose;
-    const double offset = plane.offset + plane.normal.dot(plane.velocity) * (time - plane.time);
-    result.normal = -plane.normal;  // from the body into the plane
-    result.gap = plane.normal.dot(position_a) - offset - radius_[a];
-    result.tolerance = touchingBand(radius_[a], settings_.contact_tolerance, position_a, offset);
-    result.valid = true;
-    return result;
-  }
-  const Eigen::Vector3d position_other = positionAt<Motion>(other, time);
-  const Eigen::Vector3d separation = position_other - position_a;
-  const double distance = separation.norm();
-  if (!(distance > 0)) return result;  // coincident centres: no line of impact
-  const double contact_distance = radius_[a] + radius_[other];
-  result.normal = separation / distance;
-  result.gap = distance - contact_distance;
-  result.tolerance = settings_.contact_tolerance * contact_distance +
-                     16 * kEps *
-                         (position_a.lpNorm<Eigen::Infinity>() +
-                          position_other.lpNorm<Eigen::Infinity>() + contact_distance);
-  result.valid = true;
-  return result;
-}
-
-template <class Motion>
-std::optional<double> ImpactMonitor::timeOfImpact(const Pair& pair, double from,
-                                                  double horizon) const {
-  const auto [a, other] = pair;
-  const Eigen::Vector3d relative_velocity =
-      velocityAt<Motion>(other, from) - velocityAt<Motion>(a, from);
-  if (isPlane(other)) {
-    const ObstaclePose& plane = obstacle_tracks_[other - bodies_.size()].pose;
-    const Geometry g = geometry<Motion>(pair, from);
-    const double rate = -plane.normal.dot(relative_velocity);
-    if constexpr (Motion::kAccelerates) {
-      return timeOfImpactPlaneBallistic(g.gap, rate, plane.normal.dot(tracks_[a].acceleration),
-                                        horizon);
-    } else {
-      return timeOfImpactPlane(g.gap, rate, horizon);
-    }
-  }
-  const Eigen::Vector3d separation = positionAt<Motion>(other, from) - positionAt<Motion>(a, from);
-  const double contact_distance = radius_[a] + radius_[other];
-  if constexpr (Motion::kAccelerates) {
-    // Two bodies under the same gravity keep the straight-line relative problem.
-    const Eigen::Vector3d acceleration_other =
-        isObstacle(other) ? Eigen::Vector3d::Zero() : tracks_[other].acceleration;
-    return timeOfImpactSpheresAccelerated(separation, relative_velocity,
-                                          acceleration_other - tracks_[a].acceleration,
-                                          contact_distance, horizon);
-  } else {
-    return timeOfImpactSpheres<double>(separation, relative_velocity, contact_distance, horizon);
-  }
-}
-
-template <class Motion>
-bool ImpactMonitor::approaching(const Pair& pair, const Eigen::Vector3d& normal,
-                                double time) const {
-  const Eigen::Vector3d velocity_a = velocityAt<Motion>(pair.first, time);
-  const Eigen::Vector3d velocity_other = velocityAt<Motion>(pair.second, time);
-  const double relative_normal = (velocity_other - velocity_a).dot(normal);
-  const double scale =
-      velocity_a.lpNorm<Eigen::Infinity>() + velocity_other.lpNorm<Eigen::Infinity>();
-  return relative_normal < -kApproachTolerance * scale;
 }
 
 double ImpactMonitor::restitutionOf(const Pair& pair) const {
@@ -286,143 +210,6 @@ std::vector<ImpactMonitor::Pair> ImpactMonitor::candidatePairs() const {
   return pairs;
 }
 
-template <class Motion>
-bool ImpactMonitor::resolveInstant(double time, const std::vector<Pair>& touching,
-                                   StepReport& report) {
-  // Positions do not change during an instant: the geometry is computed once.
-  std::vector<std::pair<Pair, Geometry>> contacts_at_instant;
-  for (const Pair& pair : touching) {
-    const Geometry g = geometry<Motion>(pair, time);
-    if (g.valid) contacts_at_instant.emplace_back(pair, g);
-  }
-  for (int round = 0; round < settings_.max_rounds_per_instant; ++round) {
-    std::vector<std::size_t> striking;  // indices into contacts_at_instant
-    for (std::size_t k = 0; k < contacts_at_instant.size(); ++k) {
-      const auto& [pair, g] = contacts_at_instant[k];
-      if (approaching<Motion>(pair, g.normal, time)) striking.push_back(k);
-    }
-    if (striking.empty()) return true;
-
-    // Clusters: contacts that share a movable body are solved together.
-    const std::size_t participants = bodies_.size() + obstacles_.size();
-    std::vector<std::size_t> parent(participants);
-    std::iota(parent.begin(), parent.end(), 0);
-    const auto find = [&parent](std::size_t x) {
-      while (parent[x] != x) x = parent[x] = parent[parent[x]];
-      return x;
-    };
-    for (const std::size_t k : striking) {
-      const auto [a, other] = contacts_at_instant[k].first;
-      if (inverseMassOf(a) > 0 && inverseMassOf(other) > 0) parent[find(a)] = find(other);
-    }
-    const auto cluster_of = [&](std::size_t k) {
-      const auto [a, other] = contacts_at_instant[k].first;
-      return inverseMassOf(a) > 0 ? find(a) : find(other);
-    };
-    std::vector<std::vector<std::size_t>> clusters;
-    std::map<std::size_t, std::size_t> cluster_slot;
-    for (const std::size_t k : striking) {
-      const auto [slot, inserted] = cluster_slot.emplace(cluster_of(k), clusters.size());
-      if (inserted) clusters.emplace_back();
-      clusters[slot->second].push_back(k);
-    }
-
-    for (const std::vector<std::size_t>& cluster : clusters) {
-      std::vector<std::size_t> members;  // participants, local index = position here
-      const auto local = [&members](std::size_t participant) {
-        const auto found = std::find(members.begin(), members.end(), participant);
-        if (found != members.end()) return static_cast<std::size_t>(found - members.begin());
-        members.push_back(participant);
-        return members.size() - 1;
-      };
-      std::vector<ClusterContact> cluster_contacts;
-      std::vector<FrictionContact> frictions;
-      for (const std::size_t k : cluster) {
-        const auto& [pair, g] = contacts_at_instant[k];
-        ClusterContact contact;
-        contact.a = local(pair.first);
-        contact.b = local(pair.second);
-        contact.normal = g.normal;
-        const double approach_speed =
-            (velocityAt<Motion>(pair.first, time) - velocityAt<Motion>(pair.second, time))
-                .dot(g.normal);
-        // Restitution threshold: an approach at or above it bounces; slower ones rest (e = 0).
-        contact.restitution = approach_speed >= restitution_threshold_ ? restitutionOf(pair) : 0.0;
-        if constexpr (Motion::kAccelerates) {
-          // A bounce off a plane too slow to leave the touching band is a rest (restSpeed).
-          const double pressing = g.normal.dot(gravity_);  // normal points into the plane
-          if (isPlane(pair.second) && pressing > 0 &&
-              contact.restitution * approach_speed <= restSpeed(pressing, g.tolerance)) {
-            contact.restitution = 0.0;
-          }
-        }
-        cluster_contacts.push_back(contact);
-        frictions.push_back(
-            FrictionContact{radius_[pair.first], radius_[pair.second],
-                            friction_[material_[pair.first]][material_[pair.second]], 0.0});
-      }
-      std::vector<ClusterBody> cluster_bodies;
-      for (const std::size_t participant : members) {
-        ClusterBody body;
-        body.inverse_mass = inverseMassOf(participant);
-        body.velocity = velocityAt<Motion>(participant, time);
-        body.angular_velocity = angularVelocityOf(participant);
-        body.inverse_inertia = isObstacle(participant) ? 0.0 : inverse_inertia_[participant];
-        cluster_bodies.push_back(body);
-      }
-      const std::vector<ClusterBody> before = cluster_bodies;
-      const std::vector<ContactOutcome> outcomes =
-          resolveSimultaneous(cluster_bodies, cluster_contacts);
-      std::vector<FrictionOutcome> friction_outcomes(cluster_contacts.size());
-      if (friction_step_ != nullptr) {
-        for (std::size_t c = 0; c < frictions.size(); ++c) {
-          frictions[c].normal_impulse = outcomes[c].impulse;
-        }
-        friction_step_(cluster_bodies, cluster_contacts, frictions, friction_outcomes);
-      }
-
-      for (std::size_t m = 0; m < members.size(); ++m) {
-        if (isObstacle(members[m]) || inverseMassOf(members[m]) == 0.0) continue;
-        Track& track = tracks_[members[m]];
-        track.position = positionAt<Motion>(members[m], time);  // before the velocity changes
-        track.time = time;
-        track.velocity = cluster_bodies[m].velocity;
-        track.angular_velocity = cluster_bodies[m].angular_velocity;
-        track.last_impact_time = time;
-        if constexpr (Motion::kAccelerates) updateResting(members[m]);
-      }
-      for (std::size_t c = 0; c < cluster.size(); ++c) {
-        const auto& [pair, g] = contacts_at_instant[cluster[c]];
-        const ClusterContact& contact = cluster_contacts[c];
-        ImpactRecord record;
-        record.time = time;
-        record.body_a = pair.first;
-        record.other_is_obstacle = isObstacle(pair.second);
-        record.other = record.other_is_obstacle ? pair.second - bodies_.size() : pair.second;
-        record.normal = g.normal;
-        record.contact_point =
-            positionAt<Motion>(pair.first, time) + (radius_[pair.first] + 0.5 * g.gap) * g.normal;
-        record.restitution = contact.restitution;
-        record.impulse = outcomes[c].impulse;
-        record.friction_impulse = friction_outcomes[c].impulse;
-        record.energy_lost = outcomes[c].energy_lost + friction_outcomes[c].energy_lost;
-        record.velocity_a_before = before[contact.a].velocity;
-        record.velocity_b_before = before[contact.b].velocity;
-        record.velocity_a_after = cluster_bodies[contact.a].velocity;
-        record.velocity_b_after = cluster_bodies[contact.b].velocity;
-        record.angular_velocity_a_before = before[contact.a].angular_velocity;
-        record.angular_velocity_b_before = before[contact.b].angular_velocity;
-        record.angular_velocity_a_after = cluster_bodies[contact.a].angular_velocity;
-        record.angular_velocity_b_after = cluster_bodies[contact.b].angular_velocity;
-        record.oblique = hasObliqueComponent(record.velocity_a_before, g.normal) ||
-                         hasObliqueComponent(record.velocity_b_before, g.normal);
-        report.impacts.push_back(record);
-      }
-    }
-  }
-  return false;
-}
-
 void ImpactMonitor::applyStates(const std::vector<BodyStateSample>& states, StepReport& report) {
   std::vector<BodyStateSample> ordered = states;
   std::stable_sort(ordered.begin(), ordered.end(), [](const auto& x, const auto& y) {
@@ -444,7 +231,7 @@ void ImpactMonitor::applyStates(const std::vector<BodyStateSample>& states, Step
     track.position = state.position;
     track.velocity = state.velocity;
     track.angular_velocity = state.angular_velocity;
-    updateResting(state.body);
+    if (effects_.gravity) updateResting(state.body);
   }
 }
 
@@ -463,8 +250,12 @@ StepReport ImpactMonitor::step(double time, const std::vector<BodyStateSample>& 
       now_ = time;
       if (detection_ == Detection::kDiscrete) {
         for (const Pair& pair : candidatePairs()) {
+#ifndef COLLISION_RESPONSE_NO_EFFECTS
           const Geometry g = effects_.gravity ? geometry<UnderGravity>(pair, time)
                                               : geometry<StraightLine>(pair, time);
+#else
+          const Geometry g = geometry<StraightLine>(pair, time);
+#endif
           if (g.valid && g.gap < -g.tolerance) overlapping_.insert(pair);
         }
       }
@@ -473,86 +264,17 @@ StepReport ImpactMonitor::step(double time, const std::vector<BodyStateSample>& 
   }
   forgetStaleBodies(time);
   // The motion model is chosen here, once per step, not in the per-pair loops.
+#ifdef COLLISION_RESPONSE_NO_EFFECTS
+  return detection_ == Detection::kContinuous ? stepContinuous<StraightLine>(time, states)
+                                              : stepDiscrete<StraightLine>(time, states);
+#else
   if (detection_ == Detection::kContinuous) {
     return effects_.gravity ? stepContinuous<UnderGravity>(time, states)
                             : stepContinuous<StraightLine>(time, states);
   }
   return effects_.gravity ? stepDiscrete<UnderGravity>(time, states)
                           : stepDiscrete<StraightLine>(time, states);
-}
-
-template <class Motion>
-StepReport ImpactMonitor::stepContinuous(double time, const std::vector<BodyStateSample>& states) {
-  StepReport report;
-  const std::vector<Pair> pairs = candidatePairs();
-  double instant = now_;
-  std::vector<Pair> struck;  // the pairs whose first contact is `instant`
-  for (int count = 0;; ++count) {
-    if (count >= settings_.max_instants_per_step) {
-      report.truncated = true;
-      break;
-    }
-    std::vector<Pair> touching = struck;
-    for (const Pair& pair : pairs) {
-      const Geometry g = geometry<Motion>(pair, instant);
-      if (g.valid && std::abs(g.gap) <= g.tolerance &&
-          std::find(struck.begin(), struck.end(), pair) == struck.end()) {
-        touching.push_back(pair);
-      }
-    }
-    if (!resolveInstant<Motion>(instant, touching, report)) {
-      report.truncated = true;
-      break;
-    }
-    // The next first contact. A touching pair that does not approach (it was just resolved, or
-    // slides) never comes back in a straight line; under gravity it may (a ball that bounced
-    // falls back), so its next entry is looked for, except on the plane it rests on.
-    double next = INFINITY;
-    struck.clear();
-    for (const Pair& pair : pairs) {
-      if (resting(pair)) continue;
-      const Geometry g = geometry<Motion>(pair, instant);
-      if (!g.valid) continue;
-      const bool touching_now = std::abs(g.gap) <= g.tolerance;
-      if (!Motion::kAccelerates && touching_now) continue;
-      const auto delay = timeOfImpact<Motion>(pair, instant, time - instant);
-      if (!delay) continue;
-      const double when = std::min(instant + *delay, time);
-      // No progress on a pair already handled at this instant would loop for ever.
-      if (touching_now && !(when > instant)) continue;
-      if (when < next) {
-        next = when;
-        struck.assign(1, pair);
-      } else if (when == next) {
-        struck.push_back(pair);
-      }
-    }
-    if (struck.empty()) break;
-    instant = next;
-  }
-  applyStates(states, report);
-  now_ = time;
-  return report;
-}
-
-template <class Motion>
-StepReport ImpactMonitor::stepDiscrete(double time, const std::vector<BodyStateSample>& states) {
-  StepReport report;
-  applyStates(states, report);
-  now_ = time;
-  const std::vector<Pair> pairs = candidatePairs();
-  std::vector<Pair> touching;
-  for (const Pair& pair : pairs) {
-    const Geometry g = geometry<Motion>(pair, time);
-    if (g.valid && g.gap <= g.tolerance && overlapping_.count(pair) == 0) touching.push_back(pair);
-  }
-  if (!resolveInstant<Motion>(time, touching, report)) report.truncated = true;
-  overlapping_.clear();
-  for (const Pair& pair : pairs) {
-    const Geometry g = geometry<Motion>(pair, time);
-    if (g.valid && g.gap < -g.tolerance) overlapping_.insert(pair);
-  }
-  return report;
+#endif
 }
 
 }  // namespace collision_response::core

@@ -17,6 +17,10 @@ std::optional<double> timeOfImpactSpheresAccelerated(const Eigen::Vector3d& sepa
   const Eigen::Vector3d& v = relative_velocity;
   const Eigen::Vector3d& a = relative_acceleration;
   const double distance = s.norm();
+  // Too far to close the gap within the horizon even head-on and accelerating all the way.
+  if (distance - contact_distance > (v.norm() + 0.5 * a.norm() * horizon) * horizon) {
+    return std::nullopt;
+  }
   // |p(t)|^2 - R^2 with p = s + v t + (a/2) t^2, in the time unit `horizon` (t = tau horizon).
   const double h = horizon;
   Eigen::Matrix<double, 5, 1> coefficients;

@@ -181,6 +181,31 @@ TEST_F(Services, BadRequestsNameTheFieldAndTheNodeKeepsServing) {
   expectRefused(request, "effects[0]");
 }
 
+// A solid ball (m, r) striking the floor at (3, 0, -4) m/s, e = 0.5, friction 0.2 and spin on:
+// J_n = 1.5 m 4 bounds friction at 0.2 J_n = 1.2 m, stopping the slip takes m 3 / 3.5 (less),
+// so it sticks and rolls away at (5/7) 3 m/s, spinning (5/7) 3 / r rad/s.
+TEST_F(Services, FrictionAndSpinMakeTheBallRoll) {
+  ComputeCollision::Request request;
+  request.a.mass = 0.057;
+  request.a.radius = 0.033;
+  request.a.velocity.x = 3.0;
+  request.a.velocity.z = -4.0;
+  request.b.mass = kInf;
+  request.normal.z = -1.0;
+  request.restitution = 0.5;
+  request.friction = 0.2;
+  request.effects = {"friction", "spin"};
+  const auto response = call(request);
+  ASSERT_TRUE(response.success) << response.message;
+  EXPECT_TRUE(response.sticking);
+  EXPECT_NEAR(response.velocity_a.x, 15.0 / 7.0, 1e-14);
+  EXPECT_NEAR(response.angular_velocity_a.y, 15.0 / 7.0 / 0.033, 1e-12);
+  EXPECT_EQ(response.velocity_a.z, 2.0);
+
+  request.a.inertia = "cube";
+  expectRefused(request, "a.inertia");
+}
+
 TEST_F(Services, EstimateRestitutionFromHeights) {
   EstimateRestitution srv;
   srv.request.drop_height = 2.0;

@@ -184,9 +184,11 @@ class ImpactMonitor {
 
   /// Pairs worth testing in (from, to]: both tracked, not both immovable.
   std::vector<Pair> candidatePairs() const;
-  /// Resolves, in rounds, the pairs of `touching` that approach at `time`.
+  /// Resolves, in rounds, the pairs of `touching` that approach at `time`; the bodies whose
+  /// motion changed are added to `changed`.
   template <class Motion>
-  bool resolveInstant(double time, const std::vector<Pair>& touching, StepReport& report);
+  bool resolveInstant(double time, const std::vector<Pair>& touching, StepReport& report,
+                      std::vector<std::size_t>& changed);
   void applyStates(const std::vector<BodyStateSample>& states, StepReport& report);
   void forgetStaleBodies(double time);
   template <class Motion>

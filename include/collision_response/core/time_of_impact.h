@@ -51,7 +51,11 @@ std::optional<Scalar> timeOfImpactSpheres(const Vector3<Scalar>& separation,
   const Scalar distance = s.norm();
   const Scalar gap = distance - radius;
   if (gap < 0) return std::nullopt;
-  const Scalar speed_times_radius = v.norm() * radius;
+  const Scalar speed = v.norm();
+  // Too far to close the gap within the horizon even head-on (one unit of scaled time is
+  // length_unit / speed_unit seconds).
+  if (gap > speed * (horizon * (speed_unit / length_unit))) return std::nullopt;
+  const Scalar speed_times_radius = speed * radius;
   const Scalar miss = v.cross(s).norm();  // |v x s|: how far off-centre the approach is
   const Scalar discriminant = (speed_times_radius - miss) * (speed_times_radius + miss);
   if (discriminant < 0) return std::nullopt;  // the spheres pass each other
