@@ -28,8 +28,12 @@ def main():
         summary = path.name.startswith("rostest-")
         for case in root.iter("testcase"):
             name = f"{path.stem}: {case.get('classname', '')}.{case.get('name', '')}"
-            if case.find("failure") is not None or case.find("error") is not None:
+            problem = case.find("failure") if case.find("failure") is not None else case.find("error")
+            if problem is not None:
                 print(f"FAILED: {name}")
+                detail = (problem.get("message") or "") + "\n" + (problem.text or "")
+                for line in detail.strip().splitlines()[:12]:
+                    print(f"    {line}")
                 failed += 1
             elif case.find("skipped") is not None or summary:
                 continue
