@@ -55,7 +55,8 @@ void CollisionResponseNode::logScene(const core::Scene& scene, const MonitorPara
                   << params.transform_timeout << " s, frame_velocity_interval "
                   << params.frame_velocity_interval << " s, body_timeout " << params.body_timeout
                   << " s, contact_tolerance " << params.contact_tolerance << ", clock_jump_back "
-                  << params.clock_jump_back << " s, queue_size " << params.queue_size);
+                  << params.clock_jump_back << " s, queue_size " << params.queue_size
+                  << ", max_states " << params.max_states);
 }
 
 // Both callbacks answer every request: a refused one with success = false and the reason. No

@@ -81,6 +81,11 @@ core::Expected<MonitorParams> MonitorParams::load(const ros::NodeHandle& private
   if (auto s = readPositive(private_node, "clock_jump_back", params.clock_jump_back, false); !s) {
     return s.error();
   }
+  private_node.param("max_states", params.max_states, params.max_states);
+  if (params.max_states < 1) {
+    return core::Error{private_node.resolveName("max_states"),
+                       "must be >= 1, got " + std::to_string(params.max_states)};
+  }
   private_node.param("queue_size", params.queue_size, params.queue_size);
   if (params.queue_size < 1) {
     return core::Error{private_node.resolveName("queue_size"),
@@ -110,7 +115,16 @@ ImpactMonitorRos::ImpactMonitorRos(ros::NodeHandle node, const core::Scene& scen
 }
 
 void ImpactMonitorRos::onStateArray(const BodyStateArray::ConstPtr& message) {
-  enqueue(Pending{ros::WallTime::now(), array_subscriber_.getTopic(), message->states});
+  const std::string topic = array_subscriber_.getTopic();
+  if (message->states.size() > static_cast<std::size_t>(params_.max_states)) {
+    count("dropped: too many states in one message");
+    warnings_.warn(topic + " size",
+                   topic +
+                       ": dropped a message: states: " + std::to_string(message->states.size()) +
+                       " states exceed ~max_states (" + std::to_string(params_.max_states) + ")");
+    return;
+  }
+  enqueue(Pending{ros::WallTime::now(), topic, message->states});
 }
 
 void ImpactMonitorRos::onState(const BodyState::ConstPtr& message, const std::string& topic,
@@ -119,8 +133,8 @@ void ImpactMonitorRos::onState(const BodyState::ConstPtr& message, const std::st
   if (state.id.empty()) state.id = id;  // the topic names the body
   if (state.id != id) {
     count("dropped: id does not match the topic");
-    ROS_WARN_STREAM_THROTTLE(1.0, topic << ": dropped a state with id '" << state.id
-                                        << "': this topic carries body '" << id << "'");
+    warnings_.warn(topic + " id", topic + ": dropped a state: id: '" + state.id +
+                                      "' does not match this topic's body '" + id + "'");
     return;
   }
   enqueue(Pending{ros::WallTime::now(), topic, {state}});
@@ -157,21 +171,24 @@ bool ImpactMonitorRos::processHead() {
     const auto index = monitor_.bodyIndex(state.id);
     if (!index) {
       count("dropped: unknown id");
-      ROS_WARN_STREAM_THROTTLE(1.0, head.source << ": dropped a state: id: unknown body '"
-                                                << state.id << "' (not in the scene's bodies)");
+      warnings_.warn(
+          head.source + " id " + state.id,
+          head.source + ": dropped a state: id: " +
+              (state.id.empty() ? std::string("is empty")
+                                : "unknown body '" + state.id + "' (not in the scene's bodies)"));
       continue;
     }
     if (state.header.stamp.isZero()) {
       count("dropped: zero stamp");
-      ROS_WARN_STREAM_THROTTLE(1.0, head.source << ": dropped the state of '" << state.id
-                                                << "': header.stamp: is zero; a state needs the "
-                                                   "instant it holds");
+      warnings_.warn(head.source + " stamp", head.source + ": dropped the state of '" + state.id +
+                                                 "': header.stamp: is zero; a state needs the "
+                                                 "instant it holds");
       continue;
     }
     if (const std::string bad = firstNonFinite(state); !bad.empty()) {
       count("dropped: non-finite value");
-      ROS_WARN_STREAM_THROTTLE(
-          1.0, head.source << ": dropped the state of '" << state.id << "': " << bad);
+      warnings_.warn(head.source + " " + bad.substr(0, bad.find(':')),
+                     head.source + ": dropped the state of '" + state.id + "': " + bad);
       continue;
     }
     const std::string frame = frameOf(state, scene_.fixed_frame);
@@ -180,9 +197,10 @@ bool ImpactMonitorRos::processHead() {
     if (!motion) {
       if (may_wait) return false;
       count("dropped: transform missing");
-      ROS_WARN_STREAM_THROTTLE(1.0, head.source << ": dropped the state of '" << state.id
-                                                << "' after waiting " << params_.transform_timeout
-                                                << " s: " << motion.error().message());
+      warnings_.warn(head.source + " frame " + frame,
+                     head.source + ": dropped the state of '" + state.id + "' after waiting " +
+                         core::formatNumber(params_.transform_timeout) +
+                         " s: header.frame_id: " + motion.error().message());
       continue;
     }
     const Eigen::Vector3d position = toEigen(state.pose.position);

@@ -126,6 +126,7 @@ TEST_F(MonitorFrames, StatePublishedInAMovingCameraFrame) {
 
 TEST_F(MonitorFrames, BodyOnItsOwnTopic) {
   ros::Publisher own = harness_.node().advertise<BodyState>("/own_b/state", 100);
+  ros::WallDuration(0.5).sleep();  // let the connection settle before the first state
   ASSERT_TRUE(MonitorHarness::waitFor([&own] { return own.getNumSubscribers() > 0; }, 10.0));
   const ros::Time start = window();
   for (int k = 0; k <= 10; ++k) {

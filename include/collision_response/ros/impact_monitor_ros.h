@@ -17,6 +17,7 @@
 #include "collision_response/ImpactArray.h"
 #include "collision_response/core/monitor.h"
 #include "collision_response/core/scene.h"
+#include "collision_response/ros/throttled_warning.h"
 
 namespace collision_response {
 
@@ -28,6 +29,7 @@ struct MonitorParams {
   double contact_tolerance = 1e-9;        ///< fraction of the contact distance that is touching
   double clock_jump_back = 1.0;           ///< s: a stamp this much older than now is a clock jump
   int queue_size = 1000;                  ///< input messages waiting for transforms, at most
+  int max_states = 100000;                ///< states in one BodyStateArray, at most
 
   /// Reads `~transform_timeout` and the others; a bad value is an error naming it.
   static core::Expected<MonitorParams> load(const ros::NodeHandle& private_node);
@@ -78,6 +80,7 @@ class ImpactMonitorRos {
   ros::Time epoch_;
   std::set<std::size_t> placed_obstacles_;  ///< tf-attached obstacles placed at least once
   std::map<std::string, std::uint64_t> counters_;
+  ThrottledWarning warnings_;
 };
 
 }  // namespace collision_response
