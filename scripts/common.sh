@@ -17,7 +17,7 @@ PACKAGES=(
   libtf2-dev libtf2-ros-dev libtf2-eigen-dev libeigen3-dev
   librostest-dev python3-rostest python3-roslaunch python3-rosmaster python3-rosservice
   rosbash python3-rostopic python3-rosnode python3-rosparam tf2-tools
-  googletest libgtest-dev
+  googletest libgtest-dev clang libclang-rt-14-dev
 )
 
 as_root() {

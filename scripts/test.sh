@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Every test: install, build with warnings as errors, run the gtest and rostest suites, and end
-# with one line "N passed, N failed".
+# Every test: install, build with warnings as errors, run the gtest and rostest suites, the unit
+# tests under ASan and UBSan, and the fuzzers briefly; end with one line "N passed, N failed".
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 install_packages
@@ -19,4 +19,8 @@ if [ "$status" -ne 0 ]; then
   tail -40 "$ws/test.log"
   echo "run_tests exited with status $status (log: $ws/test.log)"
 fi
+# The unit tests again under AddressSanitizer and UndefinedBehaviorSanitizer, and a short run
+# of each fuzzer (bash scripts/fuzz.sh 600 for a long one). Their results join the count.
+bash "$repo/scripts/sanitize.sh" || true
+bash "$repo/scripts/fuzz.sh" "${FUZZ_SECONDS:-30}" || true
 /usr/bin/python3 "$repo/scripts/count_results.py" "$ws/build/test_results" "$status"

@@ -109,20 +109,18 @@ Expected<CollisionOutcome> computeCollision(const CollisionRequest& request,
 #ifndef COLLISION_RESPONSE_NO_EFFECTS
   if (effects->friction) {
     ClusterBody a{inverseMass(request.a), outcome.impact.velocity_a, request.a.angular_velocity,
-                  0.0};
+                  0.0, request.a.radius};
     ClusterBody b{inverseMass(request.b), outcome.impact.velocity_b, request.b.angular_velocity,
-                  0.0};
+                  0.0, request.b.radius};
     FrictionOutcome friction_outcome;
     if (effects->spin) {
-      a.inverse_inertia = inverseInertia(a.inverse_mass, request.a.radius, request.a.inertia);
-      b.inverse_inertia = inverseInertia(b.inverse_mass, request.b.radius, request.b.inertia);
-      friction_outcome =
-          applyFriction<true>(a, b, outcome.line_of_impact, request.a.radius, request.b.radius,
-                              *friction, outcome.impact.normal_impulse);
+      a.spin_factor = spinFactor(a.inverse_mass, request.a.radius, request.a.inertia);
+      b.spin_factor = spinFactor(b.inverse_mass, request.b.radius, request.b.inertia);
+      friction_outcome = applyFriction<true>(a, b, outcome.line_of_impact, *friction,
+                                             outcome.impact.normal_impulse);
     } else {
-      friction_outcome =
-          applyFriction<false>(a, b, outcome.line_of_impact, request.a.radius, request.b.radius,
-                               *friction, outcome.impact.normal_impulse);
+      friction_outcome = applyFriction<false>(a, b, outcome.line_of_impact, *friction,
+                                              outcome.impact.normal_impulse);
     }
     outcome.impact.velocity_a = a.velocity;
     outcome.impact.velocity_b = b.velocity;
@@ -133,6 +131,23 @@ Expected<CollisionOutcome> computeCollision(const CollisionRequest& request,
     outcome.impact.energy_lost += friction_outcome.energy_lost;
   }
 #endif
+  // Finite inputs whose answer is beyond the doubles (masses and speeds of 1e200: an energy of
+  // 1e600 J) are refused by name rather than answered with an infinity.
+  const std::pair<const char*, bool> results[] = {
+      {"velocity_a", outcome.impact.velocity_a.allFinite()},
+      {"velocity_b", outcome.impact.velocity_b.allFinite()},
+      {"angular_velocity_a", outcome.angular_velocity_a.allFinite()},
+      {"angular_velocity_b", outcome.angular_velocity_b.allFinite()},
+      {"impulse", std::isfinite(outcome.impact.normal_impulse)},
+      {"friction_impulse", std::isfinite(outcome.friction_impulse)},
+      {"energy_lost", std::isfinite(outcome.impact.energy_lost)}};
+  for (const auto& [field, finite] : results) {
+    if (!finite) {
+      return Error{field,
+                   "is beyond the range of double (the masses and speeds are too large "
+                   "for the answer to be represented)"};
+    }
+  }
   return outcome;
 }
 

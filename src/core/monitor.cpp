@@ -66,8 +66,8 @@ ImpactMonitor::ImpactMonitor(const Scene& scene, const MonitorSettings& settings
     body_index_[bodies_[i].id] = i;
     radius_.push_back(bodies_[i].radius);
     inverse_mass_.push_back(inverseMass(bodies_[i].mass));
-    inverse_inertia_.push_back(
-        effects_.spin ? inverseInertia(inverse_mass_.back(), bodies_[i].radius, bodies_[i].inertia)
+    spin_factor_.push_back(
+        effects_.spin ? spinFactor(inverse_mass_.back(), bodies_[i].radius, bodies_[i].inertia)
                       : 0.0);
     material_.push_back(material_index(bodies_[i].material));
   }

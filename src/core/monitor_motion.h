@@ -197,8 +197,7 @@ bool ImpactMonitor::resolveInstant(double time, const std::vector<Pair>& touchin
         cluster_contacts.push_back(contact);
         if (friction_step_ != nullptr) {
           frictions.push_back(
-              FrictionContact{radius_[pair.first], radius_[pair.second],
-                              friction_[material_[pair.first]][material_[pair.second]], 0.0});
+              FrictionContact{friction_[material_[pair.first]][material_[pair.second]], 0.0});
         }
       }
       std::vector<ClusterBody> cluster_bodies;
@@ -207,7 +206,8 @@ bool ImpactMonitor::resolveInstant(double time, const std::vector<Pair>& touchin
         body.inverse_mass = inverseMassOf(participant);
         body.velocity = velocityAt<Motion>(participant, time);
         body.angular_velocity = angularVelocityOf(participant);
-        body.inverse_inertia = isObstacle(participant) ? 0.0 : inverse_inertia_[participant];
+        body.spin_factor = isObstacle(participant) ? 0.0 : spin_factor_[participant];
+        body.radius = radius_[participant];
         cluster_bodies.push_back(body);
       }
       const std::vector<ClusterBody> before = cluster_bodies;

@@ -13,42 +13,67 @@ std::optional<double> timeOfImpactSpheresAccelerated(const Eigen::Vector3d& sepa
     return timeOfImpactSpheres<double>(separation, relative_velocity, contact_distance, horizon);
   }
   if (!(horizon > 0)) return std::nullopt;
-  const Eigen::Vector3d& s = separation;
-  const Eigen::Vector3d& v = relative_velocity;
-  const Eigen::Vector3d& a = relative_acceleration;
+  // Units in which every term is at most about 1: lengths by a power of two L near the sizes;
+  // time by T, the least of the horizon, the time to cross L at the speed and the time to cross
+  // it under the acceleration. Then p(tau) = s + v tau + (a/2) tau^2 with |s| ~ 1, |v| <= 1,
+  // |a| <= 1 and the horizon is tau <= horizon / T.
+  const double length =
+      powerOfTwoBelow(std::max(separation.lpNorm<Eigen::Infinity>(), contact_distance));
+  const double speed = relative_velocity.lpNorm<Eigen::Infinity>();
+  const double acceleration = relative_acceleration.lpNorm<Eigen::Infinity>();
+  double unit = horizon;
+  if (speed > 0) unit = std::min(unit, length / speed);
+  unit = std::min(unit, std::sqrt(length / acceleration));
+  if (!(unit > 0) || !std::isfinite(unit)) return std::nullopt;
+  const Eigen::Vector3d s = separation / length;
+  const Eigen::Vector3d v = relative_velocity * (unit / length);
+  const Eigen::Vector3d a = relative_acceleration * (unit * unit / length);
+  const double radius = contact_distance / length;
+  const double reach = horizon / unit;  // the horizon in units of T
   const double distance = s.norm();
   // Too far to close the gap within the horizon even head-on and accelerating all the way.
-  if (distance - contact_distance > (v.norm() + 0.5 * a.norm() * horizon) * horizon) {
-    return std::nullopt;
-  }
-  // |p(t)|^2 - R^2 with p = s + v t + (a/2) t^2, in the time unit `horizon` (t = tau horizon).
-  const double h = horizon;
-  Eigen::Matrix<double, 5, 1> coefficients;
-  coefficients << (distance - contact_distance) * (distance + contact_distance), 2 * s.dot(v) * h,
-      (v.dot(v) + s.dot(a)) * h * h, v.dot(a) * h * h * h, 0.25 * a.dot(a) * h * h * h * h;
-  Eigen::PolynomialSolver<double, 4> solver(coefficients);
-  std::vector<double> roots;
-  solver.realRoots(roots, 1e-6);
+  if (distance - radius > (v.norm() + 0.5 * a.norm() * reach) * reach) return std::nullopt;
 
-  const auto position = [&](double t) -> Eigen::Vector3d { return s + t * (v + 0.5 * t * a); };
-  const auto velocity = [&](double t) -> Eigen::Vector3d { return v + t * a; };
+  // |p(tau)|^2 - R^2, a quartic; leading terms that vanish against the others are dropped so
+  // that the companion matrix never divides by (nearly) zero.
+  std::vector<double> coefficients = {(distance - radius) * (distance + radius), 2 * s.dot(v),
+                                      v.dot(v) + s.dot(a), v.dot(a), 0.25 * a.dot(a)};
+  double largest = 0;
+  for (const double c : coefficients) largest = std::max(largest, std::abs(c));
+  while (coefficients.size() > 1 && std::abs(coefficients.back()) <= 1e-250 * largest) {
+    coefficients.pop_back();
+  }
+  std::vector<double> roots;
+  if (coefficients.size() == 2) {
+    roots.push_back(-coefficients[0] / coefficients[1]);
+  } else if (coefficients.size() > 2) {
+    const Eigen::VectorXd polynomial = Eigen::Map<const Eigen::VectorXd>(
+        coefficients.data(), static_cast<Eigen::Index>(coefficients.size()));
+    Eigen::PolynomialSolver<double, Eigen::Dynamic> solver(polynomial);
+    solver.realRoots(roots, 1e-6 * std::max(1.0, reach));
+  }
+
+  const auto position = [&](double tau) -> Eigen::Vector3d {
+    return s + tau * (v + 0.5 * tau * a);
+  };
+  const auto velocity = [&](double tau) -> Eigen::Vector3d { return v + tau * a; };
   std::optional<double> best;
-  for (const double root : roots) {
-    if (root < -1e-6 || root > 1 + 1e-6) continue;
-    double t = root * h;
+  for (double tau : roots) {
+    if (!std::isfinite(tau) || tau < -1e-6 || tau > reach * (1 + 1e-6) + 1e-6) continue;
     for (int iteration = 0; iteration < 4; ++iteration) {  // Newton on |p|^2 - R^2
-      const Eigen::Vector3d p = position(t);
-      const double value = (p.norm() - contact_distance) * (p.norm() + contact_distance);
-      const double slope = 2 * p.dot(velocity(t));
-      if (slope == 0) break;
-      t -= value / slope;
+      const Eigen::Vector3d p = position(tau);
+      const double value = (p.norm() - radius) * (p.norm() + radius);
+      const double slope = 2 * p.dot(velocity(tau));
+      if (!(slope != 0)) break;
+      tau -= value / slope;
     }
-    if (!(t >= 0 && t <= horizon)) continue;
-    if (!(position(t).dot(velocity(t)) < 0)) continue;  // leaving or grazing, not entering
-    if (std::abs(position(t).norm() - contact_distance) > 1e-6 * (contact_distance + distance)) {
+    if (!(tau >= 0 && tau <= reach)) continue;
+    if (!(position(tau).dot(velocity(tau)) < 0)) continue;  // leaving or grazing, not entering
+    if (std::abs(position(tau).norm() - radius) > 1e-6 * (radius + distance)) {
       continue;  // a spurious root of the companion matrix
     }
-    if (!best || t < *best) best = t;
+    const double time = std::min(tau * unit, horizon);
+    if (!best || time < *best) best = time;
   }
   return best;
 }

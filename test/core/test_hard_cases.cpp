@@ -83,9 +83,8 @@ void checkCase(const HardCase& c) {
   SCOPED_TRACE(c.name);
   V n = V::Zero();
   n[c.axis] = 1.0;
-  const ImpactResponse<double> r = resolveImpact(inverseMass(c.mass_a), c.velocity_a,
-                                                 inverseMass(c.mass_b), c.velocity_b, n,
-                                                 c.restitution);
+  const ImpactResponse<double> r = resolveImpact(
+      inverseMass(c.mass_a), c.velocity_a, inverseMass(c.mass_b), c.velocity_b, n, c.restitution);
   ASSERT_TRUE(r.velocity_a.allFinite() && r.velocity_b.allFinite());
   ASSERT_FALSE(std::isnan(r.normal_impulse) || std::isnan(r.energy_lost));
   const double normal_scale =
@@ -111,12 +110,13 @@ void checkCase(const HardCase& c) {
   EXPECT_GE(r.energy_lost, 0.0);
   if (std::isfinite(c.mass_a) && std::isfinite(c.mass_b)) {
     const long double ma = c.mass_a, mb = c.mass_b;
-    const LongVector before = ma * c.velocity_a.cast<long double>() + mb * c.velocity_b.cast<long double>();
-    const LongVector after = ma * r.velocity_a.cast<long double>() + mb * r.velocity_b.cast<long double>();
-    const long double scale = ma * (c.velocity_a.cast<long double>().norm() +
-                                    r.velocity_a.cast<long double>().norm()) +
-                              mb * (c.velocity_b.cast<long double>().norm() +
-                                    r.velocity_b.cast<long double>().norm());
+    const LongVector before =
+        ma * c.velocity_a.cast<long double>() + mb * c.velocity_b.cast<long double>();
+    const LongVector after =
+        ma * r.velocity_a.cast<long double>() + mb * r.velocity_b.cast<long double>();
+    const long double scale =
+        ma * (c.velocity_a.cast<long double>().norm() + r.velocity_a.cast<long double>().norm()) +
+        mb * (c.velocity_b.cast<long double>().norm() + r.velocity_b.cast<long double>().norm());
     EXPECT_LE((after - before).cwiseAbs().maxCoeff(), 4 * kEps * scale) << "momentum";
   }
 }
@@ -285,8 +285,8 @@ TEST(HardCases, TimeOfImpactDiscriminantExactlyZero) {
   const auto t = timeOfImpactSpheres<double>(V(3, 1, 0), V(-1, 0, 0), 1.0, 10.0);
   ASSERT_TRUE(t);
   EXPECT_NEAR(*t, 3.0, 4 * kEps * 3);
-  const auto f = timeOfImpactSpheres<float>(Eigen::Vector3f(3, 1, 0), Eigen::Vector3f(-1, 0, 0),
-                                            1.0f, 10.0f);
+  const auto f =
+      timeOfImpactSpheres<float>(Eigen::Vector3f(3, 1, 0), Eigen::Vector3f(-1, 0, 0), 1.0f, 10.0f);
   ASSERT_TRUE(f);
   EXPECT_NEAR(*f, 3.0f, 4 * std::numeric_limits<float>::epsilon() * 3);
 }
@@ -304,12 +304,14 @@ Scene rowScene(int balls, double restitution, bool rotate_listing = false) {
     body.material = "steel";
     scene.bodies.push_back(body);
   }
-  if (rotate_listing) std::rotate(scene.bodies.begin(), scene.bodies.begin() + 1, scene.bodies.end());
+  if (rotate_listing)
+    std::rotate(scene.bodies.begin(), scene.bodies.begin() + 1, scene.bodies.end());
   return scene;
 }
 
 /// A row of touching balls, the first 0.02 m away moving at 1 m/s; the velocities after.
-std::vector<double> strikeRow(const Scene& scene, int balls, const std::vector<std::size_t>& order) {
+std::vector<double> strikeRow(const Scene& scene, int balls,
+                              const std::vector<std::size_t>& order) {
   ImpactMonitor monitor(scene, MonitorSettings{});
   std::vector<BodyStateSample> states;
   for (const std::size_t i : order) {
@@ -348,7 +350,8 @@ TEST(HardCases, NewtonsCradlesOf3And5WithEOneAndBelow) {
     in >> balls >> restitution;
     std::vector<double> expected(static_cast<std::size_t>(balls));
     for (double& v : expected) in >> v;
-    const std::vector<double> velocities = strikeRow(rowScene(balls, restitution), balls, identity(balls));
+    const std::vector<double> velocities =
+        strikeRow(rowScene(balls, restitution), balls, identity(balls));
     long double momentum = 0;
     for (int i = 0; i < balls; ++i) {
       EXPECT_NEAR(velocities[i], expected[i], 8 * kEps) << balls << " balls, e " << restitution;
@@ -490,6 +493,67 @@ TEST(HardCases, ThresholdApproachJustAboveItBounces) {
 
 // 8. A ball bouncing to rest under gravity: Gravity.BallBouncesToRestInFinitelyManyImpacts and
 // Gravity.ZeroThresholdStillComesToRest in test_effects.cpp.
+
+}  // namespace
+}  // namespace collision_response::core
+
+namespace collision_response::core {
+namespace {
+
+// --- Found by the fuzzers (fuzz/), each a regression test -------------------------------------
+
+// (The 1e370 mass ratio is the data case ratio_1e370_heavy_share, in
+// MassRatiosFrom1eMinus15To1e15InBothOrders.)
+
+// A plane approached at 1e200 m/s under gravity: rate^2 overflowed the discriminant.
+TEST(FuzzFindings, BallisticRootWithAHugeRate) {
+  const auto t = timeOfImpactPlaneBallistic(1.0, -1e200, -9.81, 1.0);
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(*t, 1e-200, 4 * kEps * 1e-200);  // gap / |rate|; gravity adds 1e-600 relative
+  // Deep inside with a subnormal acceleration: gap / scale overflowed to a bogus root at -0.
+  EXPECT_FALSE(timeOfImpactPlaneBallistic(-5.4861293007693085e+303, -1.9999847412109375e-235,
+                                          3.9525251667299724e-323, 8.0));
+}
+
+// A subnormal rate (3.2e-319 m/s, leaving) falling back under 1.2e-45 m/s^2: t = 2 rate / |a|,
+// which halving the rate before summing lost to rounding.
+TEST(FuzzFindings, BallisticReturnWithASubnormalRate) {
+  const double rate = 3.2378592100206092e-319, acceleration = -1.1999969482421875e-45;
+  const auto t = timeOfImpactPlaneBallistic(0.0, rate, acceleration, 1.0);
+  ASSERT_TRUE(t);
+  const long double expected = 2.0L * rate / -static_cast<long double>(acceleration);
+  EXPECT_NEAR(*t, static_cast<double>(expected), 4 * kEps * static_cast<double>(expected));
+}
+
+// Falling at 1 m/s under 1e-300 m/s^2: the quartic's leading coefficient underflowed to zero
+// and the companion matrix divided by it. Now it is the straight answer, t = 1.
+TEST(FuzzFindings, AcceleratedSpheresWithANegligibleAcceleration) {
+  const auto t =
+      timeOfImpactSpheresAccelerated(V(0, 0, 2), V(0, 0, -1), V(0, 0, -1e-300), 1.0, 10.0);
+  ASSERT_TRUE(t);
+  EXPECT_NEAR(*t, 1.0, 1e-12);
+}
+
+// A huge ball (1e145 kg, radius 1e145 m) sliding on an immovable floor with friction and spin:
+// its 1/I = w / (k r^2) underflowed to 0, the friction impulse came out 3.5 times too large,
+// reversed the slip and added energy. Scale does not change the closed form: sticking, it rolls
+// away at (5/7) v_x.
+TEST(FuzzFindings, FrictionOnAHugeSpinningBall) {
+  CollisionRequest request;
+  request.a.mass = kImmovableMass;
+  request.b.mass = 1e145;
+  request.b.radius = 1e145;
+  request.b.position = V(0, 0, 1e145);
+  request.b.velocity = V(3, 0, -4);
+  request.restitution = 0.5;
+  request.friction = 1.0;
+  request.effects = {"friction", "spin"};
+  const auto outcome = computeCollision(request, MaterialTable::seed());
+  ASSERT_TRUE(outcome.ok()) << outcome.error().message();
+  EXPECT_TRUE(outcome->sticking);
+  EXPECT_NEAR(outcome->impact.velocity_b.x(), 15.0 / 7.0, 8 * kEps * 3);
+  EXPECT_NEAR(outcome->angular_velocity_b.y() * 1e145, 15.0 / 7.0, 1e-12);  // rolls: w r = v
+}
 
 }  // namespace
 }  // namespace collision_response::core

@@ -159,6 +159,16 @@ TEST(Validation, DropTestHeights) {
   EXPECT_NE(higher.error().reason.find("e > 1"), std::string::npos);
 }
 
+TEST(Validation, AnAnswerBeyondTheDoublesIsRefusedByName) {
+  // 1e200 kg at 1e200 m/s: the impulse (~1e400 N s) and the energy (~1e600 J) are not doubles.
+  CollisionRequest request = goodRequest();
+  request.a.mass = 1e200;
+  request.b.mass = 1e200;
+  request.a.velocity = Eigen::Vector3d(1e200, 0, 0);
+  request.b.velocity = Eigen::Vector3d(-1e200, 0, 0);
+  expectRefused(request, "impulse", "beyond the range of double");
+}
+
 TEST(Validation, NumbersInMessagesReadBack) {
   EXPECT_EQ(formatNumber(0.1), "0.1");
   EXPECT_EQ(formatNumber(-1.0), "-1");

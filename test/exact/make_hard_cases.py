@@ -76,6 +76,10 @@ def write_hard_cases():
         for e in (0.0, 0.5, 1.0):
             case(f"ratio_1e{exponent}_e{e}", 1.0, (1.0, 0.25, 0), ratio, (-2.0, 0.5, 0), 0, e)
             case(f"ratio_1e{exponent}_e{e}_swapped", ratio, (1.0, 0.25, 0), 1.0, (-2.0, 0.5, 0), 0, e)
+    # Found by the fuzzer: a ratio of 1e370, where the heavy body's share w_b / W underflows
+    # although its velocity change (~1.5e-245) is a double.
+    case("ratio_1e370_heavy_share", 1.5176391601562498e-245, (1.8078308105468747e+125, 0, 0),
+         1.8078308105468747e+125, (0.0, 0, 0), 0, 0.0)
     for e in (0.0, 0.6, 1.0):
         case(f"immovable_b_e{e}", 0.3, (0, 0, -3.5), INF, (0, 0, 0), 2, e)
         case(f"immovable_a_e{e}", INF, (0, 1.5, 0), 0.3, (0, -0.5, 0.25), 1, e)

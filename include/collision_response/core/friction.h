@@ -18,11 +18,11 @@ enum class Inertia { kSolid, kHollow };
 Expected<Inertia> parseInertia(const std::string& name, const std::string& field);
 const char* toString(Inertia inertia);
 
-/// 1/I of a sphere: 1 / (k m r^2) = w / (k r^2); 0 for an immovable body or a point (r = 0).
-inline double inverseInertia(double inverse_mass, double radius, Inertia inertia) {
+/// 1/k of a sphere's I = k m r^2 (5/2 solid, 3/2 hollow), as ClusterBody::spin_factor; 0 for an
+/// immovable body or a point (r = 0), which do not turn.
+inline double spinFactor(double inverse_mass, double radius, Inertia inertia) {
   if (inverse_mass == 0.0 || radius == 0.0) return 0.0;
-  const double k = inertia == Inertia::kSolid ? 2.0 / 5.0 : 2.0 / 3.0;
-  return inverse_mass / (k * radius * radius);
+  return inertia == Inertia::kSolid ? 5.0 / 2.0 : 3.0 / 2.0;
 }
 
 struct FrictionOutcome {
@@ -34,9 +34,9 @@ struct FrictionOutcome {
 /// Coulomb friction at an impact whose normal impulse `normal_impulse` has been applied.
 ///
 /// The slip is the tangential velocity of b's surface relative to a's at the contact point
-/// (p_a + arm_a n = p_b - arm_b n): u = (v_b + w_b x (-arm_b n)) - (v_a + w_a x (arm_a n)),
+/// (p_a + r_a n = p_b - r_b n): u = (v_b + w_b x (-r_b n)) - (v_a + w_a x (r_a n)),
 /// u_t = u - (u.n) n. Stopping it takes J_stick = |u_t| / W_t, with the tangential inverse mass
-/// W_t = w_a + w_b + arm_a^2 / I_a + arm_b^2 / I_b (for a sphere r^2 / I = 1 / (k m)). The impulse
+/// W_t = w_a + w_b + r_a^2 / I_a + r_b^2 / I_b, where r^2 / I = w / k for a sphere. The impulse
 /// is J_t = min(J_stick, mu J_n): the contact sticks when the bound allows, slides otherwise. It
 /// never exceeds mu J_n and never reverses the slip (J_t <= J_stick), so the work it does,
 /// J_t (2 |u_t| - J_t W_t) / 2, is >= 0: friction never adds energy.
@@ -46,14 +46,14 @@ struct FrictionOutcome {
 /// terms, angular velocities untouched).
 template <bool kSpin>
 FrictionOutcome applyFriction(ClusterBody& a, ClusterBody& b, const Eigen::Vector3d& normal,
-                              double arm_a, double arm_b, double friction, double normal_impulse) {
+                              double friction, double normal_impulse) {
   FrictionOutcome outcome;
   Eigen::Vector3d slip = b.velocity - a.velocity;
   double tangential_inverse_mass = a.inverse_mass + b.inverse_mass;
   if constexpr (kSpin) {
-    slip += b.angular_velocity.cross(-arm_b * normal) - a.angular_velocity.cross(arm_a * normal);
-    tangential_inverse_mass +=
-        arm_a * arm_a * a.inverse_inertia + arm_b * arm_b * b.inverse_inertia;
+    slip +=
+        b.angular_velocity.cross(-b.radius * normal) - a.angular_velocity.cross(a.radius * normal);
+    tangential_inverse_mass += a.inverse_mass * a.spin_factor + b.inverse_mass * b.spin_factor;
   }
   const Eigen::Vector3d tangential = slip - slip.dot(normal) * normal;
   const double slip_speed = tangential.norm();
@@ -69,8 +69,15 @@ FrictionOutcome applyFriction(ClusterBody& a, ClusterBody& b, const Eigen::Vecto
   a.velocity += a.inverse_mass * impulse_on_a;
   b.velocity -= b.inverse_mass * impulse_on_a;
   if constexpr (kSpin) {
-    a.angular_velocity += a.inverse_inertia * (arm_a * normal).cross(impulse_on_a);
-    b.angular_velocity += b.inverse_inertia * (-arm_b * normal).cross(-impulse_on_a);
+    // dw = (1/I) (r n x J) = ((w/k) J / r) (n x t): the velocity change w J first, then / r.
+    if (a.spin_factor != 0.0) {
+      a.angular_velocity +=
+          (a.inverse_mass * outcome.impulse) * a.spin_factor / a.radius * normal.cross(direction);
+    }
+    if (b.spin_factor != 0.0) {
+      b.angular_velocity +=
+          (b.inverse_mass * outcome.impulse) * b.spin_factor / b.radius * normal.cross(direction);
+    }
   }
   outcome.energy_lost =
       0.5 * outcome.impulse * (2 * slip_speed - outcome.impulse * tangential_inverse_mass);
@@ -79,8 +86,6 @@ FrictionOutcome applyFriction(ClusterBody& a, ClusterBody& b, const Eigen::Vecto
 
 /// What applyFriction needs of one contact of a cluster besides the bodies.
 struct FrictionContact {
-  double arm_a = 0.0;           ///< m, from a's centre to the contact along the normal
-  double arm_b = 0.0;           ///< m, from b's centre to the contact against the normal
   double friction = 0.0;        ///< mu of the pair
   double normal_impulse = 0.0;  ///< N s, already applied
 };
@@ -94,9 +99,9 @@ void applyFrictionToCluster(std::vector<ClusterBody>& bodies,
                             std::vector<FrictionOutcome>& outcomes) {
   outcomes.assign(contacts.size(), FrictionOutcome{});
   for (std::size_t k = 0; k < contacts.size(); ++k) {
-    outcomes[k] = applyFriction<kSpin>(bodies[contacts[k].a], bodies[contacts[k].b],
-                                       contacts[k].normal, frictions[k].arm_a, frictions[k].arm_b,
-                                       frictions[k].friction, frictions[k].normal_impulse);
+    outcomes[k] =
+        applyFriction<kSpin>(bodies[contacts[k].a], bodies[contacts[k].b], contacts[k].normal,
+                             frictions[k].friction, frictions[k].normal_impulse);
   }
 }
 using ClusterFrictionStep = void (*)(std::vector<ClusterBody>&, const std::vector<ClusterContact>&,

@@ -27,6 +27,17 @@ struct ImpactResponse {
   bool approaching = false;
 };
 
+/// share x, with share = w / W: as (w / W) x while the share is a normal double, as (w x) / W
+/// when it would underflow (a mass ratio beyond ~1e308: the heavy body's share of the change is
+/// still a double after the product, not before). Each term depends only on its own w, so
+/// swapping the bodies swaps the terms exactly.
+template <typename Scalar>
+Scalar shareOf(Scalar inverse_mass, Scalar total_inverse_mass, Scalar value) {
+  const Scalar share = inverse_mass / total_inverse_mass;
+  if (share >= std::numeric_limits<Scalar>::min() || inverse_mass == 0) return share * value;
+  return inverse_mass * value / total_inverse_mass;
+}
+
 /// Resolves a frictionless impact (the seed's model) along the unit `line_of_impact` n, which
 /// points from a to b.
 ///
@@ -66,11 +77,14 @@ ImpactResponse<Scalar> resolveImpact(Scalar inverse_mass_a, const Vector3<Scalar
   if (!response.approaching) return response;
 
   const Scalar total_inverse_mass = inverse_mass_a + inverse_mass_b;  // W
-  const Scalar share_a = inverse_mass_a / total_inverse_mass;
-  const Scalar share_b = inverse_mass_b / total_inverse_mass;
-  const Scalar centre_of_mass_normal = share_b * normal_a + share_a * normal_b;
-  const Scalar normal_a_after = centre_of_mass_normal + restitution * share_a * relative_normal;
-  const Scalar normal_b_after = centre_of_mass_normal - restitution * share_b * relative_normal;
+  const Scalar centre_of_mass_normal = shareOf(inverse_mass_b, total_inverse_mass, normal_a) +
+                                       shareOf(inverse_mass_a, total_inverse_mass, normal_b);
+  const Scalar normal_a_after =
+      centre_of_mass_normal +
+      restitution * shareOf(inverse_mass_a, total_inverse_mass, relative_normal);
+  const Scalar normal_b_after =
+      centre_of_mass_normal -
+      restitution * shareOf(inverse_mass_b, total_inverse_mass, relative_normal);
 
   // Perpendicular parts carried over unchanged, normal parts replaced.
   response.velocity_a = (velocity_a - normal_a * n) + normal_a_after * n;

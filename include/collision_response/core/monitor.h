@@ -202,9 +202,9 @@ class ImpactMonitor {
   std::vector<BodySpec> bodies_;         // sorted by id
   std::vector<ObstacleSpec> obstacles_;  // sorted by id
   std::map<std::string, std::size_t> body_index_;
-  std::vector<double> radius_;           // per participant
-  std::vector<double> inverse_mass_;     // per body
-  std::vector<double> inverse_inertia_;  // per body, 0 without spin
+  std::vector<double> radius_;        // per participant
+  std::vector<double> inverse_mass_;  // per body
+  std::vector<double> spin_factor_;   // per body, 1/k, 0 without spin
   Effects effects_;
   Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();  // zero without the gravity effect
   ClusterFrictionStep friction_step_ = nullptr;        // null without the friction effect

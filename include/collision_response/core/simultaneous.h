@@ -9,12 +9,16 @@
 namespace collision_response::core {
 
 /// A body of the cluster: inverse mass (0: immovable, an obstacle), velocity (updated) and, for
-/// friction and spin, angular velocity and inverse moment of inertia (a sphere's is a scalar).
+/// friction and spin, angular velocity, radius and 1/k of its moment of inertia I = k m r^2.
 struct ClusterBody {
   double inverse_mass = 0.0;
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
-  double inverse_inertia = 0.0;  ///< 1/(kg m^2); 0: does not turn (immovable, point, no spin)
+  /// 1/k (5/2 solid, 3/2 hollow); 0: does not turn (immovable, a point, no spin effect). Kept as
+  /// a factor, not as 1/I = w / (k r^2): that underflows for large bodies (r = 1e145 m) while
+  /// every quantity friction needs, w/k and (w/k)/r, does not.
+  double spin_factor = 0.0;
+  double radius = 0.0;  ///< m
 };
 
 /// A contact of the cluster between bodies `a` and `b` (indices into the cluster's bodies).

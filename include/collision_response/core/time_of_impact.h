@@ -97,10 +97,25 @@ std::optional<Scalar> timeOfImpactPlaneBallistic(Scalar gap, Scalar rate, Scalar
     if (!(time <= horizon)) return std::nullopt;
     return time;
   }
+  // Scaled by the larger of |rate| and sqrt(|2 a gap|), so that rate^2 - 2 a gap neither
+  // overflows (rates of 1e155 and beyond) nor underflows: with u = sqrt|a| sqrt|gap| (no
+  // overflow), 2 a gap / scale^2 = 2 sign(a gap) (u / scale)^2, at most 1 in size.
+  const Scalar geometric = std::sqrt(std::abs(acceleration)) * std::sqrt(std::abs(gap));
+  const Scalar scale = std::max(std::abs(rate), std::sqrt(Scalar(2)) * geometric);
+  if (!(scale > 0) || !std::isfinite(scale)) return std::nullopt;
+  const Scalar scaled_rate = rate / scale;
+  const Scalar scaled_geometric = geometric / scale;
+  const Scalar sign = (acceleration < 0) != (gap < 0) ? Scalar(-1) : Scalar(1);
+  const Scalar scaled_discriminant =
+      scaled_rate * scaled_rate - 2 * sign * scaled_geometric * scaled_geometric;
+  if (scaled_discriminant < 0) return std::nullopt;
+  const Scalar root = std::sqrt(scaled_discriminant) * scale;
+  // Summed before halving where that cannot overflow: halving a subnormal rate first would
+  // round away its last bits.
+  const Scalar q = std::max(std::abs(rate), root) < std::numeric_limits<Scalar>::max() / 4
+                       ? -(rate + std::copysign(root, rate)) / 2
+                       : -(rate / 2 + std::copysign(root / 2, rate));
   const Scalar half_acceleration = acceleration / 2;
-  const Scalar discriminant = rate * rate - 2 * acceleration * gap;
-  if (discriminant < 0) return std::nullopt;
-  const Scalar q = -(rate + std::copysign(std::sqrt(discriminant), rate)) / 2;
   std::optional<Scalar> best;
   const auto consider = [&](Scalar time) {
     const bool entering = rate + acceleration * time < 0;
