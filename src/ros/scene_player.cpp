@@ -2,8 +2,10 @@
 
 #include <geometry_msgs/TransformStamped.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <tuple>
 
 #include "collision_response/BodyStateArray.h"
 #include "collision_response/ros/conversions.h"
@@ -99,16 +101,7 @@ bool ScenePlayer::initialize() {
     ROS_FATAL_STREAM("scene_player: ~duration and ~start_delay must be finite numbers >= 0 s");
     return false;
   }
-  for (const core::BodySpec& body : scene_.bodies) {
-    radius_[body.id] = body.radius;
-    body_spec_[body.id] = &body;
-  }
-  if (scene_.effects.gravity) gravity_ = scene_.gravity;
-  for (const core::ObstacleSpec& obstacle : scene_.obstacles) {
-    if (obstacle.shape != core::ObstacleShape::kPlane || !obstacle.frame.empty()) continue;
-    fixed_planes_.push_back(core::Plane{obstacle.normal.normalized(), obstacle.offset});
-    fixed_plane_material_.push_back(obstacle.material);
-  }
+
   ROS_INFO_STREAM("scene_player: " << scene_.bodies.size() << " bodies at " << rate_
                                    << " Hz, duration " << duration_ << " s (0: until stopped), "
                                    << frames_.size() << " moving frames");
@@ -121,45 +114,15 @@ bool ScenePlayer::initialize() {
   return true;
 }
 
-ScenePlayer::Segment ScenePlayer::makeSegment(const core::BodySpec& body, const ros::Time& start,
-                                              const Eigen::Vector3d& position,
-                                              const Eigen::Vector3d& velocity) const {
-  Segment segment{start, position, velocity, Eigen::Vector3d::Zero(), false};
-  if (std::isinf(body.mass) || gravity_ == Eigen::Vector3d::Zero()) return segment;
-  segment.acceleration = gravity_;
-  const auto plane = core::restingPlane(position, velocity, body.radius, fixed_planes_, gravity_,
-                                        contact_tolerance_);
-  if (plane) {
-    const Eigen::Vector3d& normal = fixed_planes_[*plane].normal;
-    segment.velocity -= segment.velocity.dot(normal) * normal;
-    segment.acceleration = core::restingAcceleration(gravity_, normal);
-    segment.apex_published = true;  // a slide has no apex
-  }
-  return segment;
-}
-
-Eigen::Vector3d ScenePlayer::positionAt(const Segment& segment, const ros::Time& time) const {
-  return core::positionAfter(segment.position, segment.velocity, segment.acceleration,
-                             (time - segment.start).toSec());
-}
-
-Eigen::Vector3d ScenePlayer::velocityAt(const Segment& segment, const ros::Time& time) const {
-  return core::velocityAfter(segment.velocity, segment.acceleration,
-                             (time - segment.start).toSec());
-}
-
 void ScenePlayer::onTimer(const ros::TimerEvent& event) {
   const ros::Time now = event.current_real;
-  if (!started_) {
+  if (!playback_) {
     // Start once the monitor listens and the start delay is over (so a printer can connect).
     if ((now - created_).toSec() < start_delay_ || state_publisher_.getNumSubscribers() == 0) {
       return;
     }
-    started_ = true;
     start_ = now;
-    for (const core::BodySpec& body : scene_.bodies) {
-      segments_[body.id] = makeSegment(body, start_, body.position, body.velocity);
-    }
+    playback_ = std::make_unique<core::Playback>(scene_, contact_tolerance_, 0.0);
   }
   if (duration_ > 0 && (now - start_).toSec() > duration_) {
     ROS_INFO_STREAM("scene_player: " << duration_ << " s played; stopping");
@@ -184,88 +147,69 @@ void ScenePlayer::publishStates(const ros::Time& time) {
   BodyStateArray array;
   array.header.stamp = time;
   array.header.frame_id = scene_.fixed_frame;
-  for (const core::BodySpec& body : scene_.bodies) {
-    const Segment& segment = segments_.at(body.id);
+  const double t = sinceStart(time);
+  for (std::size_t i = 0; i < scene_.bodies.size(); ++i) {
     BodyState state;
     state.header = array.header;
-    state.id = body.id;
-    state.pose.position = toPointMsg(positionAt(segment, time));
+    state.id = scene_.bodies[i].id;
+    state.pose.position = toPointMsg(playback_->position(i, t));
     state.pose.orientation.w = 1.0;
-    state.twist.linear = toVector3Msg(velocityAt(segment, time));
+    state.twist.linear = toVector3Msg(playback_->velocity(i, t));
     array.states.push_back(state);
   }
   state_publisher_.publish(array);
 }
 
 void ScenePlayer::onImpacts(const ImpactArray::ConstPtr& message) {
+  if (!playback_) return;
+  // The body's centre at the instant of impact: in continuous detection the contact point is
+  // exact (the surfaces touch there), so the centre is one radius back along the normal; the
+  // stamp is rounded to the nanosecond and the motion is not replayed from it. In discrete
+  // detection the bodies overlap at the sample: the centre is where the player had it.
+  const bool exact_contact = scene_.detection == core::Detection::kContinuous;
   for (const Impact& impact : message->impacts) {
     const Eigen::Vector3d contact = toEigen(impact.contact_point);
     const Eigen::Vector3d normal = toEigen(impact.normal);
-    // The body's centre at the instant of impact: in continuous detection the contact point is
-    // exact (the surfaces touch there), so the centre is one radius back along the normal; the
-    // stamp is rounded to the nanosecond and the motion is not replayed from it. In discrete
-    // detection the bodies overlap at the sample: the centre is where the player had it.
-    const bool exact_contact = scene_.detection == core::Detection::kContinuous;
-    if (radius_.count(impact.body_a) != 0) {
+    const double t = sinceStart(impact.header.stamp);
+    for (const auto& [id, side, after] :
+         {std::make_tuple(impact.body_a, -1.0, toEigen(impact.velocity_a_after.linear)),
+          std::make_tuple(impact.body_b, +1.0, toEigen(impact.velocity_b_after.linear))}) {
+      const auto body = playback_->bodyIndex(id);
+      if (!body) continue;  // an obstacle
       const Eigen::Vector3d centre =
-          exact_contact ? Eigen::Vector3d(contact - radius_[impact.body_a] * normal)
-                        : positionAt(segments_.at(impact.body_a), impact.header.stamp);
-      applyImpact(impact.body_a, impact.header.stamp, centre,
-                  toEigen(impact.velocity_a_after.linear));
-    }
-    if (radius_.count(impact.body_b) != 0) {
-      const Eigen::Vector3d centre =
-          exact_contact ? Eigen::Vector3d(contact + radius_[impact.body_b] * normal)
-                        : positionAt(segments_.at(impact.body_b), impact.header.stamp);
-      applyImpact(impact.body_b, impact.header.stamp, centre,
-                  toEigen(impact.velocity_b_after.linear));
+          exact_contact ? Eigen::Vector3d(contact + side * scene_.bodies[*body].radius * normal)
+                        : playback_->position(*body, t);
+      if (!playback_->applyImpact(*body, t, centre, after)) {
+        ROS_WARN_STREAM_THROTTLE(1.0, "scene_player: ignored an impact on '"
+                                          << id << "' older than its last applied one");
+      }
     }
   }
-}
-
-void ScenePlayer::applyImpact(const std::string& id, const ros::Time& stamp,
-                              const Eigen::Vector3d& centre,
-                              const Eigen::Vector3d& velocity_after) {
-  if (!started_) return;
-  Segment& segment = segments_.at(id);
-  if (stamp < segment.start) {
-    ROS_WARN_STREAM_THROTTLE(
-        1.0, "scene_player: ignored an impact on '" << id << "' older than its last applied one");
-    return;
-  }
-  segment = makeSegment(*body_spec_.at(id), stamp, centre, velocity_after);
-  ++bounces_[id];
 }
 
 void ScenePlayer::publishApexes(const ros::Time& time) {
-  const double g = gravity_.norm();
-  if (!(g > 0)) return;
-  const Eigen::Vector3d up = -gravity_ / g;
-  for (auto& [id, segment] : segments_) {
-    const double rising = segment.velocity.dot(up);
-    if (segment.apex_published || !(rising > 0)) continue;
-    const ros::Time apex_time = segment.start + ros::Duration(rising / g);
-    if (apex_time > time) continue;
-    segment.apex_published = true;
-    // The closed form, not the sample: v.up / g after the segment's start.
-    const Eigen::Vector3d apex = positionAt(segment, apex_time);
+  for (const core::Apex& apex : playback_->apexesUntil(sinceStart(time))) {
+    const core::BodySpec& body = scene_.bodies[apex.body];
     BodyState state;
-    state.header.stamp = apex_time;
+    state.header.stamp = start_ + ros::Duration(apex.time);
     state.header.frame_id = scene_.fixed_frame;
-    state.id = id;
-    state.pose.position = toPointMsg(apex);
+    state.id = body.id;
+    state.pose.position = toPointMsg(apex.position);
     state.pose.orientation.w = 1.0;
-    state.twist.linear = toVector3Msg(velocityAt(segment, apex_time));
+    state.twist.linear = toVector3Msg(apex.velocity);
     apex_publisher_.publish(state);
-    if (!report_restitution_ || bounces_[id] != 1 || fixed_planes_.empty()) continue;
+    if (!report_restitution_ || apex.impacts_before != 1) continue;
     // The seed's method: dropped from rest, e = sqrt(h'/h), heights of the lowest point above
-    // the first fixed plane (the floor), the drop's from the scene's initial position.
-    const core::BodySpec& body = *body_spec_.at(id);
-    const core::Plane& floor = fixed_planes_.front();
-    const double drop = floor.normal.dot(body.position) - floor.offset - body.radius;
-    const double bounce = floor.normal.dot(apex) - floor.offset - body.radius;
-    const auto measured =
-        scene_.materials.restitution(body.material, fixed_plane_material_.front());
+    // the first plane obstacle (the floor), the drop's from the scene's initial position.
+    const auto floor = std::find_if(scene_.obstacles.begin(), scene_.obstacles.end(),
+                                    [](const core::ObstacleSpec& o) {
+                                      return o.shape == core::ObstacleShape::kPlane && o.frame.empty();
+                                    });
+    if (floor == scene_.obstacles.end()) continue;
+    const Eigen::Vector3d normal = floor->normal.normalized();
+    const double drop = normal.dot(body.position) - floor->offset - body.radius;
+    const double bounce = normal.dot(apex.position) - floor->offset - body.radius;
+    const auto measured = scene_.materials.restitution(body.material, floor->material);
     const double recovered = std::sqrt(bounce / drop);
     std::printf("restitution %-26s table %.3f  recovered %.15f  relative error %.1e\n",
                 body.material.c_str(), measured ? *measured : NAN, recovered,

@@ -6,12 +6,12 @@
 #include <tf2_ros/transform_broadcaster.h>
 
 #include <Eigen/Core>
-#include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "collision_response/ImpactArray.h"
-#include "collision_response/core/motion.h"
+#include "collision_response/core/playback.h"
 #include "collision_response/core/scene.h"
 
 namespace collision_response {
@@ -33,29 +33,13 @@ class ScenePlayer {
   bool initialize();
 
  private:
-  /// Motion since `start` in closed form: a straight line, a parabola under gravity, or a slide
-  /// along the plane the body rests on (core/motion.h, the monitor's own model).
-  struct Segment {
-    ros::Time start;
-    Eigen::Vector3d position = Eigen::Vector3d::Zero();
-    Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
-    Eigen::Vector3d acceleration = Eigen::Vector3d::Zero();
-    bool apex_published = false;  ///< its highest point (against gravity) has been published
-  };
-  /// A new segment from `start`, under gravity, or resting on a fixed plane when it touches one
-  /// slowly (core::restingPlane).
-  Segment makeSegment(const core::BodySpec& body, const ros::Time& start,
-                      const Eigen::Vector3d& position, const Eigen::Vector3d& velocity) const;
-  Eigen::Vector3d positionAt(const Segment& segment, const ros::Time& time) const;
-  Eigen::Vector3d velocityAt(const Segment& segment, const ros::Time& time) const;
   void onTimer(const ros::TimerEvent& event);
   void onImpacts(const ImpactArray::ConstPtr& message);
-  void applyImpact(const std::string& id, const ros::Time& stamp, const Eigen::Vector3d& centre,
-                   const Eigen::Vector3d& velocity_after);
   void publishStates(const ros::Time& time);
-  /// Publishes on `apexes` each segment's highest point once it is past; with
-  /// ~report_restitution, prints e = sqrt(h'/h) of each body's first bounce off a plane.
+  /// Publishes on `apexes` each flight's highest point once it is past; with
+  /// ~report_restitution, prints e = sqrt(h'/h) of each body's first bounce off the floor.
   void publishApexes(const ros::Time& time);
+  double sinceStart(const ros::Time& time) const { return (time - start_).toSec(); }
 
   ros::NodeHandle node_;
   ros::NodeHandle private_node_;
@@ -66,16 +50,9 @@ class ScenePlayer {
   double start_delay_ = 1.0;
   double contact_tolerance_ = 1e-9;
   bool report_restitution_ = false;
-  Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();  ///< zero without the gravity effect
-  std::vector<core::Plane> fixed_planes_;
-  std::vector<std::string> fixed_plane_material_;
-  std::map<std::string, const core::BodySpec*> body_spec_;
-  std::map<std::string, int> bounces_;  ///< impacts seen per body, for the restitution report
   ros::Time created_;
   ros::Time start_;
-  bool started_ = false;
-  std::map<std::string, Segment> segments_;
-  std::map<std::string, double> radius_;
+  std::unique_ptr<core::Playback> playback_;  ///< from the start on (the bodies' motion)
   ros::Publisher state_publisher_;
   ros::Publisher apex_publisher_;
   ros::Subscriber impact_subscriber_;
