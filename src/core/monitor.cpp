@@ -194,8 +194,8 @@ void ImpactMonitor::updateResting(std::size_t body) {
   track.acceleration = restingAcceleration(gravity_, normal);
 }
 
-std::vector<ImpactMonitor::Pair> ImpactMonitor::candidatePairs() const {
-  std::vector<Pair> pairs;
+void ImpactMonitor::candidatePairs(std::vector<Pair>& pairs) const {
+  pairs.clear();
   for (std::size_t a = 0; a < bodies_.size(); ++a) {
     if (!tracks_[a].known) continue;
     for (std::size_t b = a + 1; b < bodies_.size(); ++b) {
@@ -207,7 +207,6 @@ std::vector<ImpactMonitor::Pair> ImpactMonitor::candidatePairs() const {
       if (obstacle_tracks_[o].known) pairs.emplace_back(a, bodies_.size() + o);
     }
   }
-  return pairs;
 }
 
 void ImpactMonitor::applyStates(const std::vector<BodyStateSample>& states, StepReport& report) {
@@ -249,7 +248,8 @@ StepReport ImpactMonitor::step(double time, const std::vector<BodyStateSample>& 
       started_ = true;
       now_ = time;
       if (detection_ == Detection::kDiscrete) {
-        for (const Pair& pair : candidatePairs()) {
+        candidatePairs(scratch_.pairs);
+        for (const Pair& pair : scratch_.pairs) {
 #ifndef COLLISION_RESPONSE_NO_EFFECTS
           const Geometry g = effects_.gravity ? geometry<UnderGravity>(pair, time)
                                               : geometry<StraightLine>(pair, time);

@@ -70,9 +70,16 @@ ImpactMonitor::Geometry ImpactMonitor::geometry(const Pair& pair, double time) c
   const Eigen::Vector3d position_other = positionAt<Motion>(other, time);
   const Eigen::Vector3d separation = position_other - position_a;
   const double distance = separation.norm();
-  if (!(distance > 0)) return result;  // coincident centres: no line of impact
   const double contact_distance = radius_[a] + radius_[other];
-  result.normal = separation / distance;
+  if (!(distance > 0)) {
+    // Coincident centres (a sample caught one body right through the other): no line of
+    // centres; the line of impact is the direction of approach, if there is one.
+    const Eigen::Vector3d approach = velocityAt<Motion>(a, time) - velocityAt<Motion>(other, time);
+    if (!(approach.norm() > 0)) return result;
+    result.normal = approach.normalized();
+  } else {
+    result.normal = separation / distance;
+  }
   result.gap = distance - contact_distance;
   result.tolerance = settings_.contact_tolerance * contact_distance +
                      16 * kEps *
@@ -267,29 +274,53 @@ bool ImpactMonitor::resolveInstant(double time, const std::vector<Pair>& touchin
 template <class Motion>
 StepReport ImpactMonitor::stepContinuous(double time, const std::vector<BodyStateSample>& states) {
   StepReport report;
-  const std::vector<Pair> pairs = candidatePairs();
-  // Each body's pairs, so that after an impact only the pairs of the bodies it changed are
-  // looked at again: the others' next contact has not moved.
-  std::vector<std::vector<std::size_t>> pairs_of(bodies_.size());
-  for (std::size_t k = 0; k < pairs.size(); ++k) {
-    pairs_of[pairs[k].first].push_back(k);
-    if (!isObstacle(pairs[k].second)) pairs_of[pairs[k].second].push_back(k);
+  // Buffers reused from step to step: a step allocates nothing once they have grown.
+  std::vector<Pair>& pairs = scratch_.pairs;
+  candidatePairs(pairs);
+  const std::size_t count = pairs.size();
+  // Each body's pairs (compressed rows), so that after an impact only the pairs of the bodies
+  // it changed are looked at again: the others' next contact has not moved.
+  std::vector<std::size_t>& offsets = scratch_.pair_offsets;
+  std::vector<std::size_t>& pair_of = scratch_.pair_indices;
+  offsets.assign(bodies_.size() + 1, 0);
+  for (const Pair& pair : pairs) {
+    ++offsets[pair.first + 1];
+    if (!isObstacle(pair.second)) ++offsets[pair.second + 1];
   }
-  std::vector<double> next_contact(pairs.size(), INFINITY);
-  std::vector<char> handled_now(pairs.size(), 0);  // touching at the current instant
-  // The next first contact of a pair from `from`. A touching pair that does not approach (it
-  // was just resolved, or slides) never comes back in a straight line; under gravity it may (a
-  // ball that bounced falls back), so its next entry is looked for, except on the plane it
-  // rests on.
-  const auto schedule = [&](std::size_t k, double from) {
+  for (std::size_t i = 0; i < bodies_.size(); ++i) offsets[i + 1] += offsets[i];
+  pair_of.resize(offsets.back());
+  std::vector<std::size_t>& fill = scratch_.fill;
+  fill.assign(offsets.begin(), offsets.end() - 1);
+  for (std::size_t k = 0; k < count; ++k) {
+    pair_of[fill[pairs[k].first]++] = k;
+    if (!isObstacle(pairs[k].second)) pair_of[fill[pairs[k].second]++] = k;
+  }
+  std::vector<double>& next_contact = scratch_.next_contact;
+  next_contact.assign(count, INFINITY);
+
+  // The next first contact of a pair from `from`, given its geometry then. A touching pair
+  // that does not approach (it was just resolved, or slides) never comes back in a straight
+  // line; under gravity it may (a ball that bounced falls back), so its next entry is looked
+  // for, except on the plane it rests on.
+  const auto schedule = [&](std::size_t k, double from, const Geometry& g) {
     next_contact[k] = INFINITY;
     const Pair& pair = pairs[k];
-    if (resting(pair)) return;
-    const Geometry g = geometry<Motion>(pair, from);
-    if (!g.valid) return;
+    if (!g.valid || resting(pair)) return;
     const bool touching_now = std::abs(g.gap) <= g.tolerance;
     if (!Motion::kAccelerates && touching_now) return;
-    const auto delay = timeOfImpact<Motion>(pair, from, time - from);
+    // Out of reach within the step even head-on (and accelerating all the way): no root needed.
+    const double horizon = time - from;
+    const double speed =
+        (velocityAt<Motion>(pair.second, from) - velocityAt<Motion>(pair.first, from)).norm();
+    double reach = speed * horizon;
+    if constexpr (Motion::kAccelerates) {
+      const Eigen::Vector3d acceleration_other =
+          isObstacle(pair.second) ? Eigen::Vector3d::Zero() : tracks_[pair.second].acceleration;
+      reach +=
+          0.5 * (acceleration_other - tracks_[pair.first].acceleration).norm() * horizon * horizon;
+    }
+    if (g.gap > reach) return;
+    const auto delay = timeOfImpact<Motion>(pair, from, horizon);
     if (!delay) return;
     const double when = std::min(from + *delay, time);
     // No progress on a pair already handled at this instant would loop for ever.
@@ -300,45 +331,53 @@ StepReport ImpactMonitor::stepContinuous(double time, const std::vector<BodyStat
   // At the start every pair may touch (the states were just taken); later only the pairs
   // reached from the struck ones through touching contacts (a chain, a rack).
   double instant = now_;
+  std::vector<Geometry>& start_geometry = scratch_.geometry;
+  start_geometry.resize(count);
   std::vector<std::size_t> touching;
-  for (std::size_t k = 0; k < pairs.size(); ++k) {
-    const Geometry g = geometry<Motion>(pairs[k], instant);
+  for (std::size_t k = 0; k < count; ++k) {
+    start_geometry[k] = geometry<Motion>(pairs[k], instant);
+    const Geometry& g = start_geometry[k];
     if (g.valid && std::abs(g.gap) <= g.tolerance) touching.push_back(k);
   }
   bool first = true;
-  for (int count = 0;; ++count) {
-    if (count >= settings_.max_instants_per_step) {
+  std::vector<Pair> touching_pairs;
+  std::vector<std::size_t> changed;
+  std::vector<char>& queued = scratch_.queued;
+  std::vector<std::size_t> frontier;
+  for (int instants = 0;; ++instants) {
+    if (instants >= settings_.max_instants_per_step) {
       report.truncated = true;
       break;
     }
-    std::vector<Pair> touching_pairs;
-    for (const std::size_t k : touching) {
-      touching_pairs.push_back(pairs[k]);
-      handled_now[k] = 1;
-    }
-    std::vector<std::size_t> changed;
-    if (!resolveInstant<Motion>(instant, touching_pairs, report, changed)) {
+    touching_pairs.clear();
+    for (const std::size_t k : touching) touching_pairs.push_back(pairs[k]);
+    changed.clear();
+    if (!touching_pairs.empty() &&
+        !resolveInstant<Motion>(instant, touching_pairs, report, changed)) {
       report.truncated = true;
       break;
     }
     if (first) {
-      for (std::size_t k = 0; k < pairs.size(); ++k) schedule(k, instant);
+      // Geometry is unchanged by an impact: positions do not jump.
+      for (std::size_t k = 0; k < count; ++k) schedule(k, instant, start_geometry[k]);
       first = false;
     } else {
       for (const std::size_t body : changed) {
-        for (const std::size_t k : pairs_of[body]) schedule(k, instant);
+        for (std::size_t j = offsets[body]; j < offsets[body + 1]; ++j) {
+          const std::size_t k = pair_of[j];
+          schedule(k, instant, geometry<Motion>(pairs[k], instant));
+        }
       }
     }
-    for (const std::size_t k : touching) handled_now[k] = 0;
 
     const auto earliest = std::min_element(next_contact.begin(), next_contact.end());
     if (earliest == next_contact.end() || !std::isfinite(*earliest)) break;
     instant = *earliest;
     // The struck pairs, and every contact touching their bodies, transitively.
     touching.clear();
-    std::vector<char> queued(bodies_.size(), 0);
-    std::vector<std::size_t> frontier;
-    for (std::size_t k = 0; k < pairs.size(); ++k) {
+    queued.assign(bodies_.size(), 0);
+    frontier.clear();
+    for (std::size_t k = 0; k < count; ++k) {
       if (next_contact[k] != instant) continue;
       touching.push_back(k);
       for (const std::size_t participant : {pairs[k].first, pairs[k].second}) {
@@ -351,7 +390,8 @@ StepReport ImpactMonitor::stepContinuous(double time, const std::vector<BodyStat
     while (!frontier.empty()) {
       const std::size_t body = frontier.back();
       frontier.pop_back();
-      for (const std::size_t k : pairs_of[body]) {
+      for (std::size_t j = offsets[body]; j < offsets[body + 1]; ++j) {
+        const std::size_t k = pair_of[j];
         if (std::find(touching.begin(), touching.end(), k) != touching.end()) continue;
         const Geometry g = geometry<Motion>(pairs[k], instant);
         if (!g.valid || std::abs(g.gap) > g.tolerance) continue;
@@ -375,7 +415,8 @@ StepReport ImpactMonitor::stepDiscrete(double time, const std::vector<BodyStateS
   StepReport report;
   applyStates(states, report);
   now_ = time;
-  const std::vector<Pair> pairs = candidatePairs();
+  std::vector<Pair>& pairs = scratch_.pairs;
+  candidatePairs(pairs);
   std::vector<Pair> touching;
   for (const Pair& pair : pairs) {
     const Geometry g = geometry<Motion>(pair, time);

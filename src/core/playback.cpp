@@ -21,8 +21,7 @@ Playback::Playback(const Scene& scene, double contact_tolerance, double start)
 
 Playback::Segment Playback::makeSegment(std::size_t body, double start,
                                         const Eigen::Vector3d& position,
-                                        const Eigen::Vector3d& velocity,
-                                        int impacts_before) const {
+                                        const Eigen::Vector3d& velocity, int impacts_before) const {
   Segment segment{start, position, velocity, Eigen::Vector3d::Zero(), false, impacts_before};
   const BodySpec& spec = scene_.bodies[body];
   if (std::isinf(spec.mass) || gravity_ == Eigen::Vector3d::Zero()) return segment;
@@ -62,9 +61,9 @@ void Playback::applyImpact(const ImpactMonitor& monitor, const ImpactRecord& imp
     const auto body = bodyIndex(monitor.body(monitor_body).id);
     if (!body) return;
     const double radius = scene_.bodies[*body].radius;
-    const Eigen::Vector3d centre = exact_contact
-                                       ? Eigen::Vector3d(impact.contact_point + side * radius * impact.normal)
-                                       : position(*body, impact.time);
+    const Eigen::Vector3d centre =
+        exact_contact ? Eigen::Vector3d(impact.contact_point + side * radius * impact.normal)
+                      : position(*body, impact.time);
     applyImpact(*body, impact.time, centre, after);
   };
   apply(impact.body_a, -1.0, impact.velocity_a_after);
@@ -83,8 +82,8 @@ std::vector<Apex> Playback::apexesUntil(double time) {
     const double apex_time = segment.start + rising / g;
     if (apex_time > time) continue;
     segment.apex_reported = true;
-    apexes.push_back(Apex{i, apex_time, position(i, apex_time), velocity(i, apex_time),
-                          segment.impacts_before});
+    apexes.push_back(
+        Apex{i, apex_time, position(i, apex_time), velocity(i, apex_time), segment.impacts_before});
   }
   return apexes;
 }

@@ -137,6 +137,24 @@ TEST(Monitor, DiscreteFindsTheImpactAtTheSampleAfter) {
   EXPECT_EQ(impacts[0].normal, V(1, 0, 0));
 }
 
+// A sample that catches a fast ball with its centre exactly on the other's: no line of centres,
+// so the line of impact is the direction of approach (not a missed impact).
+TEST(Monitor, DiscreteCoincidentCentresUseTheDirectionOfApproach) {
+  Scene scene = sceneWithRestitution(1.0);
+  scene.detection = Detection::kDiscrete;
+  scene.bodies = {ball("fast", 1.0, 0.02), ball("still", 1.0, 0.01)};
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  monitor.step(0.0, {state(monitor, "fast", 0.0, V(0.95, 0, 0), V(50, 0, 0)),
+                     state(monitor, "still", 0.0, V(1, 0, 0), V::Zero())});
+  const StepReport report =
+      monitor.step(0.001, {state(monitor, "fast", 0.001, V(1, 0, 0), V(50, 0, 0))});
+  ASSERT_EQ(report.impacts.size(), 1u);
+  EXPECT_EQ(report.impacts[0].normal, V(1, 0, 0));
+  // Equal masses, e = 1: the velocities are exchanged.
+  EXPECT_EQ(report.impacts[0].velocity_a_after, V::Zero());
+  EXPECT_EQ(report.impacts[0].velocity_b_after, V(50, 0, 0));
+}
+
 TEST(Monitor, DifferentStampsArePredictedToOneInstant) {
   // b's state is older (t = 0) than a's (t = 0.2): b is predicted forward; contact at t = 0.4.
   Scene scene = sceneWithRestitution(1.0);

@@ -159,7 +159,7 @@ class ImpactMonitor {
     Eigen::Vector3d normal;  ///< unit, a -> other
     double gap = 0.0;        ///< m, surface to surface along the normal; < 0 overlapping
     double tolerance = 0.0;  ///< m, |gap| within it is touching
-    bool valid = false;      ///< false: coincident centres, no line of impact
+    bool valid = false;      ///< false: coincident centres and no approach: no line of impact
   };
 
   bool isObstacle(std::size_t participant) const { return participant >= bodies_.size(); }
@@ -183,7 +183,7 @@ class ImpactMonitor {
   void updateResting(std::size_t body);
 
   /// Pairs worth testing in (from, to]: both tracked, not both immovable.
-  std::vector<Pair> candidatePairs() const;
+  void candidatePairs(std::vector<Pair>& pairs) const;
   /// Resolves, in rounds, the pairs of `touching` that approach at `time`; the bodies whose
   /// motion changed are added to `changed`.
   template <class Motion>
@@ -216,6 +216,15 @@ class ImpactMonitor {
   std::vector<Track> tracks_;
   std::vector<ObstacleTrack> obstacle_tracks_;
   std::set<Pair> overlapping_;  // discrete: pairs overlapping at the previous step
+  /// Working memory of a step, kept so that steps do not allocate.
+  struct Scratch {
+    std::vector<Pair> pairs;
+    std::vector<std::size_t> pair_offsets, pair_indices, fill;
+    std::vector<double> next_contact;
+    std::vector<Geometry> geometry;
+    std::vector<char> queued;
+  };
+  Scratch scratch_;
   bool started_ = false;
   double now_ = 0.0;
 };

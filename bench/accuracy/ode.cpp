@@ -1,0 +1,100 @@
+// ODE on the benchmark's scenes (only in the benchmark; the product never links ODE).
+#include <ode/ode.h>
+
+#include <map>
+
+#include "harness.h"
+
+namespace collision_response::bench {
+namespace {
+
+struct OdeWorld {
+  dWorldID world;
+  dSpaceID space;
+  dJointGroupID contacts;
+  const core::Scene* scene;
+  std::map<dGeomID, std::string> material;
+  std::size_t contact_count = 0;
+};
+
+void nearCallback(void* data, dGeomID first, dGeomID second) {
+  auto* w = static_cast<OdeWorld*>(data);
+  dContact contact[4];
+  const int found = dCollide(first, second, 4, &contact[0].geom, sizeof(dContact));
+  if (found == 0) return;
+  const double e = *w->scene->materials.restitution(w->material.at(first), w->material.at(second));
+  for (int i = 0; i < found; ++i) {
+    contact[i].surface.mode = dContactBounce;
+    contact[i].surface.mu = 0;
+    contact[i].surface.bounce = e;
+    contact[i].surface.bounce_vel = 0;
+    const dJointID joint = dJointCreateContact(w->world, w->contacts, &contact[i]);
+    dJointAttach(joint, dGeomGetBody(first), dGeomGetBody(second));
+  }
+  ++w->contact_count;
+}
+
+}  // namespace
+
+Engine odeEngine() {
+  return [](const core::Scene& scene, double rate, double duration) {
+    static const bool initialised = (dInitODE2(0), true);
+    (void)initialised;
+    OdeWorld w{dWorldCreate(), dHashSpaceCreate(nullptr), dJointGroupCreate(0), &scene, {}, 0};
+    const V g = scene.effects.gravity ? scene.gravity : V::Zero();
+    dWorldSetGravity(w.world, g.x(), g.y(), g.z());
+    std::vector<dBodyID> bodies;
+    for (const core::BodySpec& spec : scene.bodies) {
+      const dBodyID body = dBodyCreate(w.world);
+      dMass mass;
+      dMassSetSphereTotal(&mass, spec.mass, spec.radius);
+      dBodySetMass(body, &mass);
+      dBodySetPosition(body, spec.position.x(), spec.position.y(), spec.position.z());
+      dBodySetLinearVel(body, spec.velocity.x(), spec.velocity.y(), spec.velocity.z());
+      dBodySetAutoDisableFlag(body, 0);
+      const dGeomID geom = dCreateSphere(w.space, spec.radius);
+      dGeomSetBody(geom, body);
+      w.material[geom] = spec.material;
+      bodies.push_back(body);
+    }
+    for (const core::ObstacleSpec& spec : scene.obstacles) {
+      dGeomID geom;
+      if (spec.shape == core::ObstacleShape::kPlane) {
+        const V n = spec.normal.normalized();
+        geom = dCreatePlane(w.space, n.x(), n.y(), n.z(), spec.offset);
+      } else {
+        geom = dCreateSphere(w.space, spec.radius);
+        dGeomSetPosition(geom, spec.position.x(), spec.position.y(), spec.position.z());
+      }
+      w.material[geom] = spec.material;
+    }
+
+    Run run;
+    const auto updates = static_cast<long>(std::llround(duration * rate));
+    const double dt = 1.0 / rate;
+    for (long k = 0; k <= updates; ++k) {
+      if (k > 0) {
+        dSpaceCollide(w.space, &w, &nearCallback);
+        dWorldStep(w.world, dt);
+        dJointGroupEmpty(w.contacts);
+      }
+      run.times.push_back(static_cast<double>(k) * dt);
+      std::vector<V> positions, velocities;
+      for (const dBodyID body : bodies) {
+        const dReal* p = dBodyGetPosition(body);
+        const dReal* v = dBodyGetLinearVel(body);
+        positions.emplace_back(p[0], p[1], p[2]);
+        velocities.emplace_back(v[0], v[1], v[2]);
+      }
+      run.positions.push_back(positions);
+      run.velocities.push_back(velocities);
+    }
+    run.impacts = w.contact_count;
+    dJointGroupDestroy(w.contacts);
+    dSpaceDestroy(w.space);
+    dWorldDestroy(w.world);
+    return run;
+  };
+}
+
+}  // namespace collision_response::bench

@@ -1,0 +1,122 @@
+#include <cmath>
+#include <random>
+
+#include "harness.h"
+
+namespace collision_response::bench {
+namespace {
+
+core::BodySpec ball(const std::string& id, double mass, double radius, const std::string& material,
+                    const V& position, const V& velocity = V::Zero()) {
+  core::BodySpec body;
+  body.id = id;
+  body.mass = mass;
+  body.radius = radius;
+  body.material = material;
+  body.position = position;
+  body.velocity = velocity;
+  return body;
+}
+
+core::ObstacleSpec plane(const std::string& id, const V& normal, double offset,
+                         const std::string& material) {
+  core::ObstacleSpec obstacle;
+  obstacle.id = id;
+  obstacle.normal = normal;
+  obstacle.offset = offset;
+  obstacle.material = material;
+  return obstacle;
+}
+
+}  // namespace
+
+// The seed's drop test: one ball of each material 1 m above concrete, gravity on.
+BenchScene dropTestScene() {
+  BenchScene bench{"drop_test", {}, 2.5};
+  core::Scene& scene = bench.scene;
+  scene.effects.gravity = true;
+  int i = 0;
+  for (const core::SeedMeasurement& row : core::seedTable()) {
+    scene.bodies.push_back(ball(row.material, 0.1, 0.03, row.material, V(0.3 * i++, 0, 1.03)));
+  }
+  scene.obstacles.push_back(plane("floor", V(0, 0, 1), 0.0, "concrete"));
+  return bench;
+}
+
+// An idealised Newton's cradle: five touching balls (e = 1), the first 0.02 m away at 1 m/s.
+BenchScene cradleScene() {
+  BenchScene bench{"cradle", {}, 0.1};
+  core::Scene& scene = bench.scene;
+  (void)scene.materials.addMaterial("polished_steel", core::Material{1.0, {}}, "m");
+  scene.bodies.push_back(ball("ball_1", 0.26, 0.02, "polished_steel", V(-0.06, 0, 0), V(1, 0, 0)));
+  for (int i = 2; i <= 5; ++i) {
+    scene.bodies.push_back(
+        ball("ball_" + std::to_string(i), 0.26, 0.02, "polished_steel", V(0.04 * (i - 2), 0, 0)));
+  }
+  return bench;
+}
+
+// The billiards break of config/scenes/billiards_break.yaml: the cue ball at 6 m/s into a rack
+// of fifteen touching balls on a 2.54 m x 1.27 m table.
+BenchScene breakScene() {
+  BenchScene bench{"billiards_break", {}, 1.0};
+  core::Scene& scene = bench.scene;
+  (void)scene.materials.addMaterial("cushion", core::Material{0.75, {}}, "m");
+  const double r = 0.028575;
+  scene.bodies.push_back(ball("cue", 0.17, r, "billiard_ball", V(0.635, 0.635, 0), V(6, 0, 0)));
+  int n = 1;
+  for (int row = 0; row < 5; ++row) {
+    for (int j = 0; j <= row; ++j) {
+      char id[16];
+      std::snprintf(id, sizeof id, "ball_%02d", n++);
+      scene.bodies.push_back(
+          ball(id, 0.17, r, "billiard_ball",
+               V(1.905 + row * r * std::sqrt(3.0), 0.635 + (j - row / 2.0) * 2 * r, 0)));
+    }
+  }
+  scene.obstacles.push_back(plane("cushion_head", V(1, 0, 0), 0.0, "cushion"));
+  scene.obstacles.push_back(plane("cushion_foot", V(-1, 0, 0), -2.54, "cushion"));
+  scene.obstacles.push_back(plane("cushion_right", V(0, 1, 0), 0.0, "cushion"));
+  scene.obstacles.push_back(plane("cushion_left", V(0, -1, 0), -1.27, "cushion"));
+  return bench;
+}
+
+// A fast ball (radius 0.02 m, 50 m/s) against a thin post (a fixed sphere of radius 0.01 m)
+// 1 m ahead: 2.5 cm of travel per step at 2 kHz, half a metre at 100 Hz.
+BenchScene tunnellingScene() {
+  BenchScene bench{"tunnelling", {}, 0.1};
+  core::Scene& scene = bench.scene;
+  (void)scene.materials.addMaterial("hard", core::Material{0.8, {}}, "m");
+  scene.bodies.push_back(ball("bullet", 0.01, 0.02, "hard", V(0, 0, 0), V(50, 0, 0)));
+  core::ObstacleSpec post;
+  post.id = "post";
+  post.shape = core::ObstacleShape::kSphere;
+  post.radius = 0.01;
+  post.position = V(1, 0, 0);
+  post.material = "hard";
+  scene.obstacles.push_back(post);
+  return bench;
+}
+
+// 64 elastic balls in a closed 2 m box, random velocities up to 2 m/s: energy must stay.
+BenchScene gasScene() {
+  BenchScene bench{"sphere_gas", {}, 2.0};
+  core::Scene& scene = bench.scene;
+  (void)scene.materials.addMaterial("elastic", core::Material{1.0, {}}, "m");
+  std::mt19937_64 engine(7);
+  std::uniform_real_distribution<double> speed(-2, 2);
+  for (int i = 0; i < 64; ++i) {
+    scene.bodies.push_back(
+        ball("gas_" + std::to_string(100 + i), 0.1, 0.05, "elastic",
+             V(0.25 + 0.5 * (i % 4), 0.25 + 0.5 * ((i / 4) % 4), 0.25 + 0.5 * (i / 16)),
+             V(speed(engine), speed(engine), speed(engine))));
+  }
+  const V normals[] = {V(1, 0, 0), V(-1, 0, 0), V(0, 1, 0), V(0, -1, 0), V(0, 0, 1), V(0, 0, -1)};
+  for (int i = 0; i < 6; ++i) {
+    scene.obstacles.push_back(
+        plane("wall_" + std::to_string(i), normals[i], i % 2 ? -2.0 : 0.0, "elastic"));
+  }
+  return bench;
+}
+
+}  // namespace collision_response::bench
