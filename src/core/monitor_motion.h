@@ -148,9 +148,20 @@ bool ImpactMonitor::resolveInstant(double time, const std::vector<Pair>& touchin
     }
     if (striking.empty()) return true;
 
-    // Clusters: contacts that share a movable body are solved together.
-    const std::size_t participants = bodies_.size() + obstacles_.size();
-    std::vector<std::size_t> parent(participants);
+    // Clusters: contacts that share a movable body are solved together (a union-find over the
+    // participants of the striking contacts only, numbered in sorted order).
+    std::vector<std::size_t> involved;
+    for (const std::size_t k : striking) {
+      involved.push_back(contacts_at_instant[k].first.first);
+      involved.push_back(contacts_at_instant[k].first.second);
+    }
+    std::sort(involved.begin(), involved.end());
+    involved.erase(std::unique(involved.begin(), involved.end()), involved.end());
+    const auto slot_of = [&involved](std::size_t participant) {
+      return static_cast<std::size_t>(
+          std::lower_bound(involved.begin(), involved.end(), participant) - involved.begin());
+    };
+    std::vector<std::size_t> parent(involved.size());
     std::iota(parent.begin(), parent.end(), 0);
     const auto find = [&parent](std::size_t x) {
       while (parent[x] != x) x = parent[x] = parent[parent[x]];
@@ -158,11 +169,13 @@ bool ImpactMonitor::resolveInstant(double time, const std::vector<Pair>& touchin
     };
     for (const std::size_t k : striking) {
       const auto [a, other] = contacts_at_instant[k].first;
-      if (inverseMassOf(a) > 0 && inverseMassOf(other) > 0) parent[find(a)] = find(other);
+      if (inverseMassOf(a) > 0 && inverseMassOf(other) > 0) {
+        parent[find(slot_of(a))] = find(slot_of(other));
+      }
     }
     const auto cluster_of = [&](std::size_t k) {
       const auto [a, other] = contacts_at_instant[k].first;
-      return inverseMassOf(a) > 0 ? find(a) : find(other);
+      return inverseMassOf(a) > 0 ? find(slot_of(a)) : find(slot_of(other));
     };
     std::vector<std::vector<std::size_t>> clusters;
     std::map<std::size_t, std::size_t> cluster_slot;
@@ -272,31 +285,151 @@ bool ImpactMonitor::resolveInstant(double time, const std::vector<Pair>& touchin
 }
 
 template <class Motion>
+Box ImpactMonitor::sweptBox(std::size_t body, double from, double to) const {
+  const Eigen::Vector3d start = positionAt<Motion>(body, from);
+  const Eigen::Vector3d end = positionAt<Motion>(body, to);
+  Box box{start.cwiseMin(end), start.cwiseMax(end)};
+  if constexpr (Motion::kAccelerates) {
+    // A parabola's extreme along an axis, where that axis's velocity turns.
+    const Eigen::Vector3d velocity = velocityAt<Motion>(body, from);
+    const Eigen::Vector3d& acceleration = tracks_[body].acceleration;
+    for (int axis = 0; axis < 3; ++axis) {
+      if (acceleration[axis] == 0) continue;
+      const double turn = -velocity[axis] / acceleration[axis];
+      if (turn > 0 && turn < to - from) {
+        const double extreme = positionAt<Motion>(body, from + turn)[axis];
+        box.low[axis] = std::min(box.low[axis], extreme);
+        box.high[axis] = std::max(box.high[axis], extreme);
+      }
+    }
+  }
+  // The body's size, with room for the touching band and the rounding of the positions.
+  const double pad = radius_[body] * (1 + 2 * settings_.contact_tolerance) +
+                     64 * kEps * (box.low.cwiseAbs().maxCoeff() + box.high.cwiseAbs().maxCoeff());
+  box.low.array() -= pad;
+  box.high.array() += pad;
+  return box;
+}
+
+template <class Motion>
+bool ImpactMonitor::mayReachObstacle(const Box& box, std::size_t obstacle) const {
+  const ObstacleSpec& spec = obstacles_[obstacle];
+  if (!spec.frame.empty()) return true;  // a moving obstacle: always a candidate
+  const ObstaclePose& pose = obstacle_tracks_[obstacle].pose;
+  if (spec.shape == ObstacleShape::kPlane) {
+    // The box's lowest point along the normal: does it reach the plane?
+    const Eigen::Vector3d centre = 0.5 * (box.low + box.high);
+    const Eigen::Vector3d half = 0.5 * (box.high - box.low);
+    return pose.normal.dot(centre) - pose.normal.cwiseAbs().dot(half) <= pose.offset;
+  }
+  const Box post{pose.position.array() - spec.radius, pose.position.array() + spec.radius};
+  return post.overlaps(box);
+}
+
+template <class Motion>
+void ImpactMonitor::broadphasePairs(double from, double to, std::vector<Pair>& pairs) {
+  std::vector<Box>& boxes = scratch_.boxes;
+  std::vector<char>& active = scratch_.active;
+  boxes.resize(bodies_.size());
+  active.assign(bodies_.size(), 0);
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    if (!tracks_[i].known) continue;
+    active[i] = 1;
+    boxes[i] = sweptBox<Motion>(i, from, to);
+  }
+  scratch_.hash.build(boxes, active);
+  scratch_.hash.overlappingPairs(scratch_.body_pairs);
+  // Merged in the canonical order: a body's pairs with bodies (sorted), then with obstacles
+  // (whose indices follow every body's).
+  pairs.clear();
+  std::size_t next = 0;
+  const std::vector<std::pair<std::size_t, std::size_t>>& body_pairs = scratch_.body_pairs;
+  for (std::size_t a = 0; a < bodies_.size(); ++a) {
+    for (; next < body_pairs.size() && body_pairs[next].first == a; ++next) {
+      if (inverse_mass_[a] + inverse_mass_[body_pairs[next].second] > 0) {
+        pairs.push_back(body_pairs[next]);
+      }
+    }
+    if (!active[a] || inverse_mass_[a] == 0.0) continue;
+    for (std::size_t o = 0; o < obstacles_.size(); ++o) {
+      if (obstacle_tracks_[o].known && mayReachObstacle<Motion>(boxes[a], o)) {
+        pairs.emplace_back(a, bodies_.size() + o);
+      }
+    }
+  }
+  scratch_.changed_boxes.clear();
+}
+
+template <class Motion>
+std::vector<std::size_t> ImpactMonitor::addReachablePairs(
+    std::size_t body, double from, double to, std::vector<Pair>& pairs,
+    const std::vector<std::vector<std::size_t>>& pairs_of) {
+  const Box box = sweptBox<Motion>(body, from, to);
+  std::vector<std::size_t>& found = scratch_.found;
+  scratch_.hash.query(box, found);
+  // Bodies changed earlier in the step are in the grid with their old boxes: test their new.
+  for (const auto& [other, other_box] : scratch_.changed_boxes) {
+    if (other_box.overlaps(box)) found.push_back(other);
+  }
+  scratch_.changed_boxes.emplace_back(body, box);
+  const auto known_pair = [&](const Pair& pair) {
+    for (const std::size_t k : pairs_of[body]) {
+      if (pairs[k] == pair) return true;
+    }
+    return false;
+  };
+  std::vector<std::size_t> added;
+  const auto add = [&](const Pair& pair) {
+    if (known_pair(pair)) return;
+    pairs.push_back(pair);
+    added.push_back(pairs.size() - 1);
+  };
+  for (const std::size_t other : found) {
+    if (other == body || !tracks_[other].known ||
+        inverse_mass_[body] + inverse_mass_[other] == 0.0) {
+      continue;
+    }
+    add(Pair(std::min(body, other), std::max(body, other)));
+  }
+  if (inverse_mass_[body] > 0) {
+    for (std::size_t o = 0; o < obstacles_.size(); ++o) {
+      if (obstacle_tracks_[o].known && mayReachObstacle<Motion>(box, o)) {
+        add(Pair(body, bodies_.size() + o));
+      }
+    }
+  }
+  return added;
+}
+
+template <class Motion>
 StepReport ImpactMonitor::stepContinuous(double time, const std::vector<BodyStateSample>& states) {
   StepReport report;
   // Buffers reused from step to step: a step allocates nothing once they have grown.
   std::vector<Pair>& pairs = scratch_.pairs;
-  candidatePairs(pairs);
+  if (settings_.broadphase) {
+    broadphasePairs<Motion>(now_, time, pairs);
+  } else {
+    candidatePairs(pairs);
+  }
+  // Each body's pairs, so that after an impact only the pairs of the bodies it changed are
+  // looked at again: the others' next contact has not moved.
+  std::vector<std::vector<std::size_t>>& pairs_of = scratch_.pairs_of;
+  pairs_of.resize(bodies_.size());
+  for (std::vector<std::size_t>& list : pairs_of) list.clear();
+  const auto index_pair = [&](std::size_t k) {
+    pairs_of[pairs[k].first].push_back(k);
+    if (!isObstacle(pairs[k].second)) pairs_of[pairs[k].second].push_back(k);
+  };
+  for (std::size_t k = 0; k < pairs.size(); ++k) index_pair(k);
   const std::size_t count = pairs.size();
-  // Each body's pairs (compressed rows), so that after an impact only the pairs of the bodies
-  // it changed are looked at again: the others' next contact has not moved.
-  std::vector<std::size_t>& offsets = scratch_.pair_offsets;
-  std::vector<std::size_t>& pair_of = scratch_.pair_indices;
-  offsets.assign(bodies_.size() + 1, 0);
-  for (const Pair& pair : pairs) {
-    ++offsets[pair.first + 1];
-    if (!isObstacle(pair.second)) ++offsets[pair.second + 1];
-  }
-  for (std::size_t i = 0; i < bodies_.size(); ++i) offsets[i + 1] += offsets[i];
-  pair_of.resize(offsets.back());
-  std::vector<std::size_t>& fill = scratch_.fill;
-  fill.assign(offsets.begin(), offsets.end() - 1);
-  for (std::size_t k = 0; k < count; ++k) {
-    pair_of[fill[pairs[k].first]++] = k;
-    if (!isObstacle(pairs[k].second)) pair_of[fill[pairs[k].second]++] = k;
-  }
   std::vector<double>& next_contact = scratch_.next_contact;
   next_contact.assign(count, INFINITY);
+  // The pending first contacts, earliest on top; an entry whose time no longer matches its
+  // pair's (rescheduled since) is stale and skipped.
+  using Event = std::pair<double, std::size_t>;
+  std::vector<Event>& events = scratch_.events;
+  events.clear();
+  const auto later = [](const Event& x, const Event& y) { return x.first > y.first; };
 
   // The next first contact of a pair from `from`, given its geometry then. A touching pair
   // that does not approach (it was just resolved, or slides) never comes back in a straight
@@ -326,6 +459,8 @@ StepReport ImpactMonitor::stepContinuous(double time, const std::vector<BodyStat
     // No progress on a pair already handled at this instant would loop for ever.
     if (touching_now && !(when > from)) return;
     next_contact[k] = when;
+    events.emplace_back(when, k);
+    std::push_heap(events.begin(), events.end(), later);
   };
 
   // At the start every pair may touch (the states were just taken); later only the pairs
@@ -343,7 +478,8 @@ StepReport ImpactMonitor::stepContinuous(double time, const std::vector<BodyStat
   std::vector<Pair> touching_pairs;
   std::vector<std::size_t> changed;
   std::vector<char>& queued = scratch_.queued;
-  std::vector<std::size_t> frontier;
+  queued.assign(bodies_.size(), 0);
+  std::vector<std::size_t> frontier, frontier_seen;
   for (int instants = 0;; ++instants) {
     if (instants >= settings_.max_instants_per_step) {
       report.truncated = true;
@@ -363,26 +499,43 @@ StepReport ImpactMonitor::stepContinuous(double time, const std::vector<BodyStat
       first = false;
     } else {
       for (const std::size_t body : changed) {
-        for (std::size_t j = offsets[body]; j < offsets[body + 1]; ++j) {
-          const std::size_t k = pair_of[j];
+        // Its new motion may reach bodies its swept box did not: new candidate pairs.
+        if (settings_.broadphase) {
+          for (const std::size_t k :
+               addReachablePairs<Motion>(body, instant, time, pairs, pairs_of)) {
+            next_contact.push_back(INFINITY);
+            index_pair(k);
+          }
+        }
+        for (const std::size_t k : pairs_of[body]) {
           schedule(k, instant, geometry<Motion>(pairs[k], instant));
         }
       }
     }
 
-    const auto earliest = std::min_element(next_contact.begin(), next_contact.end());
-    if (earliest == next_contact.end() || !std::isfinite(*earliest)) break;
-    instant = *earliest;
+    while (!events.empty() && events.front().first != next_contact[events.front().second]) {
+      std::pop_heap(events.begin(), events.end(), later);  // stale
+      events.pop_back();
+    }
+    if (events.empty()) break;
+    instant = events.front().first;
     // The struck pairs, and every contact touching their bodies, transitively.
+    for (const std::size_t body : frontier_seen) queued[body] = 0;
+    frontier_seen.clear();
     touching.clear();
-    queued.assign(bodies_.size(), 0);
     frontier.clear();
-    for (std::size_t k = 0; k < count; ++k) {
-      if (next_contact[k] != instant) continue;
+    while (!events.empty() && events.front().first == instant) {
+      const std::size_t k = events.front().second;
+      const bool current = next_contact[k] == instant;
+      std::pop_heap(events.begin(), events.end(), later);
+      events.pop_back();
+      if (!current || std::find(touching.begin(), touching.end(), k) != touching.end()) continue;
+      next_contact[k] = INFINITY;
       touching.push_back(k);
       for (const std::size_t participant : {pairs[k].first, pairs[k].second}) {
         if (!isObstacle(participant) && !queued[participant]) {
           queued[participant] = 1;
+          frontier_seen.push_back(participant);
           frontier.push_back(participant);
         }
       }
@@ -390,8 +543,7 @@ StepReport ImpactMonitor::stepContinuous(double time, const std::vector<BodyStat
     while (!frontier.empty()) {
       const std::size_t body = frontier.back();
       frontier.pop_back();
-      for (std::size_t j = offsets[body]; j < offsets[body + 1]; ++j) {
-        const std::size_t k = pair_of[j];
+      for (const std::size_t k : pairs_of[body]) {
         if (std::find(touching.begin(), touching.end(), k) != touching.end()) continue;
         const Geometry g = geometry<Motion>(pairs[k], instant);
         if (!g.valid || std::abs(g.gap) > g.tolerance) continue;
@@ -399,11 +551,15 @@ StepReport ImpactMonitor::stepContinuous(double time, const std::vector<BodyStat
         const std::size_t other = pairs[k].first == body ? pairs[k].second : pairs[k].first;
         if (!isObstacle(other) && !queued[other]) {
           queued[other] = 1;
+          frontier_seen.push_back(other);
           frontier.push_back(other);
         }
       }
     }
-    std::sort(touching.begin(), touching.end());  // the canonical order of the pairs
+    // The canonical order of the pairs (by their bodies' sorted ids, not by when the
+    // broadphase found them).
+    std::sort(touching.begin(), touching.end(),
+              [&pairs](std::size_t x, std::size_t y) { return pairs[x] < pairs[y]; });
   }
   applyStates(states, report);
   now_ = time;
@@ -416,7 +572,11 @@ StepReport ImpactMonitor::stepDiscrete(double time, const std::vector<BodyStateS
   applyStates(states, report);
   now_ = time;
   std::vector<Pair>& pairs = scratch_.pairs;
-  candidatePairs(pairs);
+  if (settings_.broadphase) {
+    broadphasePairs<Motion>(time, time, pairs);
+  } else {
+    candidatePairs(pairs);
+  }
   std::vector<Pair> touching;
   for (const Pair& pair : pairs) {
     const Geometry g = geometry<Motion>(pair, time);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -281,6 +282,60 @@ TEST(Monitor, OrderOfListingAndOfStatesDoesNotMatter) {
     ++permutations;
   } while (std::next_permutation(order.begin(), order.end()));
   EXPECT_EQ(permutations, 120);
+}
+
+// The broadphase only leaves out pairs that cannot meet: a random gas (with gravity and without,
+// continuous and discrete) gives the very same impacts, to the bit, with it and with every pair.
+TEST(Monitor, BroadphaseGivesTheSameImpactsAsEveryPair) {
+  for (const bool gravity : {false, true}) {
+    for (const Detection detection : {Detection::kContinuous, Detection::kDiscrete}) {
+      Scene scene = sceneWithRestitution(0.9);
+      scene.effects.gravity = gravity;
+      scene.detection = detection;
+      std::mt19937_64 engine(17);
+      std::uniform_real_distribution<double> unit(0, 1);
+      for (int i = 0; i < 300; ++i) {
+        BodySpec body =
+            ball("gas_" + std::to_string(1000 + i), 0.1 + unit(engine), 0.02 + 0.08 * unit(engine));
+        body.position = V(4 * unit(engine), 4 * unit(engine), 4 * unit(engine));
+        body.velocity = V(6 * unit(engine) - 3, 6 * unit(engine) - 3, 6 * unit(engine) - 3);
+        scene.bodies.push_back(body);
+      }
+      const V normals[] = {V(1, 0, 0),  V(-1, 0, 0), V(0, 1, 0),
+                           V(0, -1, 0), V(0, 0, 1),  V(0, 0, -1)};
+      for (int i = 0; i < 6; ++i) {
+        ObstacleSpec wall;
+        wall.id = "wall_" + std::to_string(i);
+        wall.material = "test";
+        wall.normal = normals[i];
+        wall.offset = i % 2 ? -4.0 : 0.0;
+        scene.obstacles.push_back(wall);
+      }
+      MonitorSettings with, without;
+      without.broadphase = false;
+      ImpactMonitor fast(scene, with), slow(scene, without);
+      std::vector<BodyStateSample> start;
+      for (const BodySpec& body : scene.bodies) {
+        start.push_back(state(fast, body.id, 0.0, body.position, body.velocity));
+      }
+      fast.step(0.0, start);
+      slow.step(0.0, start);
+      std::size_t impacts = 0;
+      for (int k = 1; k <= 50; ++k) {
+        const StepReport a = fast.step(0.02 * k, {}), b = slow.step(0.02 * k, {});
+        ASSERT_EQ(a.impacts.size(), b.impacts.size()) << "step " << k;
+        for (std::size_t i = 0; i < a.impacts.size(); ++i) {
+          ASSERT_EQ(a.impacts[i].time, b.impacts[i].time);
+          ASSERT_EQ(a.impacts[i].body_a, b.impacts[i].body_a);
+          ASSERT_EQ(a.impacts[i].other, b.impacts[i].other);
+          ASSERT_EQ(a.impacts[i].velocity_a_after, b.impacts[i].velocity_a_after);
+          ASSERT_EQ(a.impacts[i].velocity_b_after, b.impacts[i].velocity_b_after);
+        }
+        impacts += a.impacts.size();
+      }
+      EXPECT_GT(impacts, 100u) << "the gas must collide for the comparison to mean something";
+    }
+  }
 }
 
 }  // namespace

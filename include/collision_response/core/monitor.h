@@ -8,9 +8,11 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
+#include "collision_response/core/broadphase.h"
 #include "collision_response/core/motion.h"
 #include "collision_response/core/scene.h"
 #include "collision_response/core/simultaneous.h"
@@ -29,6 +31,9 @@ struct MonitorSettings {
   /// reported truncated.
   int max_rounds_per_instant = 10000;
   int max_instants_per_step = 10000;
+  /// Candidate pairs from a spatial hash of the bodies' swept boxes (about linear in the
+  /// bodies); false: every pair (for tests that compare the two).
+  bool broadphase = true;
 };
 
 /// A body's state at one instant, in the fixed frame.
@@ -184,6 +189,22 @@ class ImpactMonitor {
 
   /// Pairs worth testing in (from, to]: both tracked, not both immovable.
   void candidatePairs(std::vector<Pair>& pairs) const;
+  /// The same, those whose boxes swept over [from, to] overlap (the broadphase), sorted.
+  template <class Motion>
+  void broadphasePairs(double from, double to, std::vector<Pair>& pairs);
+  /// After `body` changed at `from`: pairs its new motion over [from, to] may form that are
+  /// not candidates yet, appended to `pairs`; their indices.
+  template <class Motion>
+  std::vector<std::size_t> addReachablePairs(std::size_t body, double from, double to,
+                                             std::vector<Pair>& pairs,
+                                             const std::vector<std::vector<std::size_t>>& pairs_of);
+  /// Whether a body's swept box may reach a (fixed) obstacle; moving obstacles always may.
+  template <class Motion>
+  bool mayReachObstacle(const Box& box, std::size_t obstacle) const;
+  /// The box a body sweeps over [from, to], padded by its radius.
+  template <class Motion>
+  Box sweptBox(std::size_t body, double from, double to) const;
+
   /// Resolves, in rounds, the pairs of `touching` that approach at `time`; the bodies whose
   /// motion changed are added to `changed`.
   template <class Motion>
@@ -219,10 +240,17 @@ class ImpactMonitor {
   /// Working memory of a step, kept so that steps do not allocate.
   struct Scratch {
     std::vector<Pair> pairs;
-    std::vector<std::size_t> pair_offsets, pair_indices, fill;
+    std::vector<std::vector<std::size_t>> pairs_of;
     std::vector<double> next_contact;
     std::vector<Geometry> geometry;
     std::vector<char> queued;
+    std::vector<Box> boxes;
+    std::vector<char> active;
+    SpatialHash hash;
+    std::vector<std::pair<std::size_t, std::size_t>> body_pairs;
+    std::vector<std::pair<double, std::size_t>> events;
+    std::vector<std::pair<std::size_t, Box>> changed_boxes;
+    std::vector<std::size_t> found;
   };
   Scratch scratch_;
   bool started_ = false;

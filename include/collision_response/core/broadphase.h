@@ -1,0 +1,61 @@
+// The broadphase: which pairs of bodies could meet during a step, in about linear time.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+namespace collision_response::core {
+
+/// An axis-aligned box.
+struct Box {
+  Eigen::Vector3d low = Eigen::Vector3d::Zero();
+  Eigen::Vector3d high = Eigen::Vector3d::Zero();
+  bool overlaps(const Box& other) const {
+    return (low.array() <= other.high.array()).all() && (other.low.array() <= high.array()).all();
+  }
+};
+
+/// A uniform grid, hashed by cell: each box is entered in every cell it covers; boxes that
+/// share a cell and overlap are candidate pairs.
+///
+/// Why a grid: the bodies of a scene (balls, parts, robots' links) are of similar sizes and
+/// their boxes here are swept over one step, so with cells about the size of a typical box
+/// each box covers a few cells and each cell holds a few boxes: building and querying cost
+/// about O(n), whatever the scene's extent and however the bodies line up. A sweep-and-prune
+/// sorts every step and degrades to O(n^2) when the bodies line up along its axis (a row of
+/// balls, a rack seen along its axis); a dynamic tree pays to rebalance when every box moves
+/// every step, which is the normal case here. The cell size is the median box extent; a box
+/// covering more than kMaxCells cells (one huge body) is kept aside and tested against all.
+class SpatialHash {
+ public:
+  static constexpr std::size_t kMaxCells = 64;
+
+  /// Enters `boxes` (indexed by body; `active[i]` false: left out).
+  void build(const std::vector<Box>& boxes, const std::vector<char>& active);
+
+  /// Every pair (i < j) of active boxes that overlap, sorted, each once.
+  void overlappingPairs(std::vector<std::pair<std::size_t, std::size_t>>& pairs);
+
+  /// The active boxes that overlap `box`, sorted, each once.
+  void query(const Box& box, std::vector<std::size_t>& found) const;
+
+ private:
+  struct Cell {
+    std::int64_t x, y, z;
+  };
+  Cell cellOf(const Eigen::Vector3d& point) const;
+  static std::uint64_t key(std::int64_t x, std::int64_t y, std::int64_t z);
+  /// Calls visit(key) for every cell `box` covers; false when it covers more than kMaxCells.
+  template <typename Visit>
+  bool forEachCell(const Box& box, Visit visit) const;
+
+  const std::vector<Box>* boxes_ = nullptr;
+  const std::vector<char>* active_ = nullptr;
+  double cell_size_ = 1.0;
+  std::vector<std::pair<std::uint64_t, std::size_t>> entries_;  // (cell key, box), sorted
+  std::vector<std::size_t> large_;                              // boxes kept aside
+};
+
+}  // namespace collision_response::core
