@@ -17,6 +17,7 @@ PACKAGES=(
   libtf2-dev libtf2-ros-dev libtf2-eigen-dev libeigen3-dev
   librostest-dev python3-rostest python3-roslaunch python3-rosmaster python3-rosservice
   rosbash python3-rostopic python3-rosnode python3-rosparam tf2-tools
+  libnodelet-dev libnodeletlib-dev libnodeletlib-tools pluginlib-dev
   googletest libgtest-dev clang libclang-rt-14-dev
 )
 
@@ -42,7 +43,7 @@ install_packages() {
 build_workspace() {
   echo "== building in $ws"
   # /usr/bin/python3: a python3 earlier on PATH (pyenv) may lack catkin_pkg.
-  cmake -S "$repo" -B "$ws/build" -DCATKIN_DEVEL_PREFIX="$ws/devel" \
+  cmake -S "$repo" -B "$ws/build" -DCATKIN_DEVEL_PREFIX="$ws/devel" -DPython3_EXECUTABLE=/usr/bin/python3 \
     -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DCOLLISION_RESPONSE_WERROR=ON "$@" &&
     cmake --build "$ws/build" -- -j2

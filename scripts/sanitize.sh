@@ -12,7 +12,7 @@ mkdir -p "$build" "$results"
 echo "== building the unit tests with -fsanitize=address,undefined in $build"
 flags="-O1 -g -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
 cmake -S "$repo" -B "$build/build" -DCATKIN_DEVEL_PREFIX="$build/devel" \
-  -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=None -DCATKIN_ENABLE_TESTING=ON \
+  -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=None -DCATKIN_ENABLE_TESTING=ON \
   -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
   -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=address,undefined" >"$build/build.log" 2>&1
 cmake --build "$build/build" --target core_tests ros_unit_tests -- -j2 >>"$build/build.log" 2>&1 ||

@@ -124,7 +124,7 @@ void ImpactMonitorRos::onStateArray(const BodyStateArray::ConstPtr& message) {
                        " states exceed ~max_states (" + std::to_string(params_.max_states) + ")");
     return;
   }
-  enqueue(Pending{ros::WallTime::now(), topic, message->states});
+  enqueue(Pending{ros::WallTime::now(), topic, message, {}});
 }
 
 void ImpactMonitorRos::onState(const BodyState::ConstPtr& message, const std::string& topic,
@@ -137,7 +137,7 @@ void ImpactMonitorRos::onState(const BodyState::ConstPtr& message, const std::st
                                       "' does not match this topic's body '" + id + "'");
     return;
   }
-  enqueue(Pending{ros::WallTime::now(), topic, {state}});
+  enqueue(Pending{ros::WallTime::now(), topic, nullptr, {state}});
 }
 
 void ImpactMonitorRos::enqueue(Pending pending) {
@@ -167,7 +167,7 @@ bool ImpactMonitorRos::processHead() {
   const Pending& head = queue_.front();
   const bool may_wait = (ros::WallTime::now() - head.received).toSec() < params_.transform_timeout;
   std::vector<Converted> converted;
-  for (const BodyState& state : head.states) {
+  for (const BodyState& state : head.states()) {
     const auto index = monitor_.bodyIndex(state.id);
     if (!index) {
       count("dropped: unknown id");

@@ -201,10 +201,10 @@ void ScenePlayer::publishApexes(const ros::Time& time) {
     if (!report_restitution_ || apex.impacts_before != 1) continue;
     // The seed's method: dropped from rest, e = sqrt(h'/h), heights of the lowest point above
     // the first plane obstacle (the floor), the drop's from the scene's initial position.
-    const auto floor = std::find_if(scene_.obstacles.begin(), scene_.obstacles.end(),
-                                    [](const core::ObstacleSpec& o) {
-                                      return o.shape == core::ObstacleShape::kPlane && o.frame.empty();
-                                    });
+    const auto floor = std::find_if(
+        scene_.obstacles.begin(), scene_.obstacles.end(), [](const core::ObstacleSpec& o) {
+          return o.shape == core::ObstacleShape::kPlane && o.frame.empty();
+        });
     if (floor == scene_.obstacles.end()) continue;
     const Eigen::Vector3d normal = floor->normal.normalized();
     const double drop = normal.dot(body.position) - floor->offset - body.radius;

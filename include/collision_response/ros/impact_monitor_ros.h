@@ -44,10 +44,14 @@ class ImpactMonitorRos {
   const std::map<std::string, std::uint64_t>& counters() const { return counters_; }
 
  private:
+  /// An input waiting for its transforms: an array, kept as received (no copy of its
+  /// states; a nodelet's publisher's message itself), or one state.
   struct Pending {
     ros::WallTime received;
     std::string source;  ///< the topic, for warnings
-    std::vector<BodyState> states;
+    BodyStateArray::ConstPtr array;
+    std::vector<BodyState> single;
+    const std::vector<BodyState>& states() const { return array ? array->states : single; }
   };
   struct Converted {
     ros::Time stamp;
