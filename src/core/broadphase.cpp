@@ -38,8 +38,11 @@ bool SpatialHash::forEachCell(const Box& box, Visit visit) const {
 void SpatialHash::build(const std::vector<Box>& boxes, const std::vector<char>& active) {
   boxes_ = &boxes;
   active_ = &active;
+  keyed_.clear();
   entries_.clear();
   large_.clear();
+  bucket_bits_ = 0;
+  bucket_start_.assign(2, 0);
   std::vector<double> extents;
   extents.reserve(boxes.size());
   for (std::size_t i = 0; i < boxes.size(); ++i) {
@@ -51,40 +54,70 @@ void SpatialHash::build(const std::vector<Box>& boxes, const std::vector<char>& 
   cell_size_ = median > 0 && std::isfinite(median) ? median : 1.0;
   for (std::size_t i = 0; i < boxes.size(); ++i) {
     if (!active[i]) continue;
-    const std::size_t before = entries_.size();
-    if (!forEachCell(boxes[i], [&](std::uint64_t k) { entries_.emplace_back(k, i); })) {
-      entries_.resize(before);
+    const std::size_t before = keyed_.size();
+    if (!forEachCell(boxes[i], [&](std::uint64_t k) { keyed_.emplace_back(k, i); })) {
+      keyed_.resize(before);
       large_.push_back(i);
     }
   }
-  std::sort(entries_.begin(), entries_.end());
+  // About two buckets an entry; a counting sort groups the entries by bucket.
+  while ((std::size_t{1} << bucket_bits_) < 2 * keyed_.size() && bucket_bits_ < 40) ++bucket_bits_;
+  const std::size_t buckets = std::size_t{1} << bucket_bits_;
+  bucket_start_.assign(buckets + 1, 0);
+  for (const auto& entry : keyed_) ++bucket_start_[bucketOf(entry.first) + 1];
+  for (std::size_t b = 0; b < buckets; ++b) bucket_start_[b + 1] += bucket_start_[b];
+  entries_.resize(keyed_.size());
+  for (const auto& entry : keyed_) {
+    // bucket_start_[b] is bucket b's cursor while the entries are placed.
+    entries_[bucket_start_[bucketOf(entry.first)]++] = entry;
+  }
+  // The cursors ended at each bucket's end, which is the next bucket's start: shift them back.
+  for (std::size_t b = buckets; b > 0; --b) bucket_start_[b] = bucket_start_[b - 1];
+  bucket_start_[0] = 0;
 }
 
 void SpatialHash::overlappingPairs(std::vector<std::pair<std::size_t, std::size_t>>& pairs) {
   pairs.clear();
+  unordered_.clear();
   if (boxes_ == nullptr) return;
   const std::vector<Box>& boxes = *boxes_;
-  for (std::size_t begin = 0; begin < entries_.size();) {
-    std::size_t end = begin;
-    while (end < entries_.size() && entries_[end].first == entries_[begin].first) ++end;
+  const std::size_t buckets = bucket_start_.size() - 1;
+  for (std::size_t b = 0; b < buckets; ++b) {
+    const std::size_t begin = bucket_start_[b], end = bucket_start_[b + 1];
     for (std::size_t i = begin; i < end; ++i) {
       for (std::size_t j = i + 1; j < end; ++j) {
-        const std::size_t a = entries_[i].second, b = entries_[j].second;
-        if (a != b && boxes[a].overlaps(boxes[b]))
-          pairs.emplace_back(std::min(a, b), std::max(a, b));
+        if (entries_[i].first != entries_[j].first) continue;  // another cell, same bucket
+        const std::size_t a = entries_[i].second, c = entries_[j].second;
+        if (a == c || !boxes[a].overlaps(boxes[c])) continue;
+        // Two boxes share every cell their intersection covers: the pair is reported in one
+        // of them only, the cell of the intersection's low corner, so no pair comes twice.
+        const Cell corner = cellOf(boxes[a].low.cwiseMax(boxes[c].low));
+        if (key(corner.x, corner.y, corner.z) != entries_[i].first) continue;
+        unordered_.emplace_back(std::min(a, c), std::max(a, c));
       }
     }
-    begin = end;
   }
   for (const std::size_t big : large_) {
     for (std::size_t other = 0; other < boxes.size(); ++other) {
-      if (other != big && (*active_)[other] && boxes[big].overlaps(boxes[other])) {
-        pairs.emplace_back(std::min(big, other), std::max(big, other));
-      }
+      if (other == big || !(*active_)[other] || !boxes[big].overlaps(boxes[other])) continue;
+      const bool other_large = std::find(large_.begin(), large_.end(), other) != large_.end();
+      if (other_large && other < big) continue;  // two large boxes: reported once
+      unordered_.emplace_back(std::min(big, other), std::max(big, other));
     }
   }
-  std::sort(pairs.begin(), pairs.end());
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  // Sorted by a counting sort on the first body, then each (short) run on the second.
+  first_count_.assign(boxes.size() + 1, 0);
+  for (const auto& pair : unordered_) ++first_count_[pair.first + 1];
+  for (std::size_t i = 0; i < boxes.size(); ++i) first_count_[i + 1] += first_count_[i];
+  pairs.resize(unordered_.size());
+  for (const auto& pair : unordered_) pairs[first_count_[pair.first]++] = pair;
+  for (std::size_t begin = 0; begin < pairs.size();) {
+    std::size_t end = begin + 1;
+    while (end < pairs.size() && pairs[end].first == pairs[begin].first) ++end;
+    std::sort(pairs.begin() + static_cast<std::ptrdiff_t>(begin),
+              pairs.begin() + static_cast<std::ptrdiff_t>(end));
+    begin = end;
+  }
 }
 
 void SpatialHash::query(const Box& box, std::vector<std::size_t>& found) const {
@@ -92,9 +125,11 @@ void SpatialHash::query(const Box& box, std::vector<std::size_t>& found) const {
   if (boxes_ == nullptr) return;
   const std::vector<Box>& boxes = *boxes_;
   const bool small = forEachCell(box, [&](std::uint64_t k) {
-    auto it = std::lower_bound(entries_.begin(), entries_.end(), std::make_pair(k, std::size_t{0}));
-    for (; it != entries_.end() && it->first == k; ++it) {
-      if (boxes[it->second].overlaps(box)) found.push_back(it->second);
+    const std::size_t b = bucketOf(k);
+    for (std::size_t i = bucket_start_[b]; i < bucket_start_[b + 1]; ++i) {
+      if (entries_[i].first == k && boxes[entries_[i].second].overlaps(box)) {
+        found.push_back(entries_[i].second);
+      }
     }
   });
   if (!small) {  // a huge query box: test every entered box

@@ -210,11 +210,19 @@ void ImpactMonitor::candidatePairs(std::vector<Pair>& pairs) const {
 }
 
 void ImpactMonitor::applyStates(const std::vector<BodyStateSample>& states, StepReport& report) {
-  std::vector<BodyStateSample> ordered = states;
-  std::stable_sort(ordered.begin(), ordered.end(), [](const auto& x, const auto& y) {
+  const auto earlier = [](const BodyStateSample& x, const BodyStateSample& y) {
     return x.time < y.time || (x.time == y.time && x.body < y.body);
-  });
-  for (const BodyStateSample& state : ordered) {
+  };
+  // Sources usually send their bodies in one order, and the states of one array share a stamp:
+  // the copy and sort are paid only when the states are not in order already.
+  const std::vector<BodyStateSample>* ordered = &states;
+  std::vector<BodyStateSample> sorted;
+  if (!std::is_sorted(states.begin(), states.end(), earlier)) {
+    sorted = states;
+    std::stable_sort(sorted.begin(), sorted.end(), earlier);
+    ordered = &sorted;
+  }
+  for (const BodyStateSample& state : *ordered) {
     Track& track = tracks_[state.body];
     if (state.time <= track.last_state_time) {
       ++report.stale_states;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <utility>
 
 #include "collision_response/core/validation.h"
@@ -167,8 +168,24 @@ bool ImpactMonitorRos::processHead() {
   const Pending& head = queue_.front();
   const bool may_wait = (ros::WallTime::now() - head.received).toSec() < params_.transform_timeout;
   std::vector<Converted> converted;
-  for (const BodyState& state : head.states()) {
-    const auto index = monitor_.bodyIndex(state.id);
+  converted.reserve(head.states().size());
+  std::optional<core::Expected<FrameMotion>> motion;
+  std::string motion_frame;
+  ros::Time motion_stamp;
+  const std::vector<BodyState>& states = head.states();
+  if (index_hints_.size() < states.size()) index_hints_.resize(states.size(), 0);
+  for (std::size_t place = 0; place < states.size(); ++place) {
+    const BodyState& state = states[place];
+    // A source sends its bodies in the same order every time: the body found at this place
+    // in the last array is tried before the lookup by id.
+    std::optional<std::size_t> index;
+    const std::size_t hint = index_hints_[place];
+    if (hint < monitor_.bodyCount() && monitor_.body(hint).id == state.id) {
+      index = hint;
+    } else {
+      index = monitor_.bodyIndex(state.id);
+      if (index) index_hints_[place] = *index;
+    }
     if (!index) {
       count("dropped: unknown id");
       warnings_.warn(
@@ -192,25 +209,31 @@ bool ImpactMonitorRos::processHead() {
       continue;
     }
     const std::string frame = frameOf(state, scene_.fixed_frame);
-    const auto motion = lookupFrameMotion(tf_buffer_, scene_.fixed_frame, frame, state.header.stamp,
-                                          ros::Duration(params_.frame_velocity_interval));
-    if (!motion) {
+    // The states of an array usually share a frame and a stamp: one lookup serves them all.
+    if (!motion || frame != motion_frame || state.header.stamp != motion_stamp) {
+      motion = lookupFrameMotion(tf_buffer_, scene_.fixed_frame, frame, state.header.stamp,
+                                 ros::Duration(params_.frame_velocity_interval));
+      motion_frame = frame;
+      motion_stamp = state.header.stamp;
+    }
+    if (!*motion) {
       if (may_wait) return false;
       count("dropped: transform missing");
       warnings_.warn(head.source + " frame " + frame,
                      head.source + ": dropped the state of '" + state.id + "' after waiting " +
                          core::formatNumber(params_.transform_timeout) +
-                         " s: header.frame_id: " + motion.error().message());
+                         " s: header.frame_id: " + motion->error().message());
       continue;
     }
     const Eigen::Vector3d position = toEigen(state.pose.position);
     Converted item;
     item.stamp = state.header.stamp;
     item.sample.body = *index;
-    item.sample.position = motion->point(position);
-    item.sample.velocity = motion->velocity(position, toEigen(state.twist.linear));
+    const FrameMotion& frame_motion = **motion;
+    item.sample.position = frame_motion.point(position);
+    item.sample.velocity = frame_motion.velocity(position, toEigen(state.twist.linear));
     item.sample.angular_velocity =
-        motion->pose.linear() * toEigen(state.twist.angular) + motion->angular_velocity;
+        frame_motion.pose.linear() * toEigen(state.twist.angular) + frame_motion.angular_velocity;
     converted.push_back(item);
   }
   if (converted.empty()) return true;
@@ -231,11 +254,14 @@ bool ImpactMonitorRos::processHead() {
   }
 
   // One step per distinct stamp, oldest first.
-  std::stable_sort(converted.begin(), converted.end(),
-                   [](const auto& x, const auto& y) { return x.stamp < y.stamp; });
+  const auto older = [](const Converted& x, const Converted& y) { return x.stamp < y.stamp; };
+  if (!std::is_sorted(converted.begin(), converted.end(), older)) {
+    std::stable_sort(converted.begin(), converted.end(), older);
+  }
   for (std::size_t begin = 0; begin < converted.size();) {
     std::size_t end = begin;
     std::vector<core::BodyStateSample> samples;
+    samples.reserve(converted.size() - begin);
     while (end < converted.size() && converted[end].stamp == converted[begin].stamp) {
       samples.push_back(converted[end].sample);
       ++end;

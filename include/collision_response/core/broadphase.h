@@ -51,11 +51,26 @@ class SpatialHash {
   template <typename Visit>
   bool forEachCell(const Box& box, Visit visit) const;
 
+  /// The bucket of a cell key (Fibonacci hashing into 2^bucket_bits_ buckets).
+  std::size_t bucketOf(std::uint64_t key) const {
+    return bucket_bits_ == 0
+               ? 0
+               : static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> (64 - bucket_bits_));
+  }
+
   const std::vector<Box>* boxes_ = nullptr;
   const std::vector<char>* active_ = nullptr;
   double cell_size_ = 1.0;
-  std::vector<std::pair<std::uint64_t, std::size_t>> entries_;  // (cell key, box), sorted
+  // The (cell key, box) entries grouped by bucket with a counting sort: building is O(entries),
+  // where sorting them was the step's largest cost at 10,000 bodies. Keys that share a bucket
+  // are told apart by comparing the keys.
+  std::vector<std::pair<std::uint64_t, std::size_t>> keyed_;    // as entered
+  std::vector<std::pair<std::uint64_t, std::size_t>> entries_;  // grouped by bucket
+  std::vector<std::size_t> bucket_start_;                       // entries_ of bucket b: [b], [b+1])
+  unsigned bucket_bits_ = 0;
   std::vector<std::size_t> large_;                              // boxes kept aside
+  std::vector<std::size_t> first_count_;                        // overlappingPairs' counting sort
+  std::vector<std::pair<std::size_t, std::size_t>> unordered_;  // its input
 };
 
 }  // namespace collision_response::core

@@ -8,6 +8,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <unordered_map>
 #include <unordered_set>
 #include <utility>
 #include <vector>
@@ -222,7 +223,7 @@ class ImpactMonitor {
   double restitution_threshold_;
   std::vector<BodySpec> bodies_;         // sorted by id
   std::vector<ObstacleSpec> obstacles_;  // sorted by id
-  std::map<std::string, std::size_t> body_index_;
+  std::unordered_map<std::string, std::size_t> body_index_;
   std::vector<double> radius_;        // per participant
   std::vector<double> inverse_mass_;  // per body
   std::vector<double> spin_factor_;   // per body, 1/k, 0 without spin

@@ -84,6 +84,7 @@ class ImpactMonitorRos {
   ros::Time epoch_;
   std::set<std::size_t> placed_obstacles_;  ///< tf-attached obstacles placed at least once
   std::map<std::string, std::uint64_t> counters_;
+  std::vector<std::size_t> index_hints_;  ///< body index of each place of the last array
   ThrottledWarning warnings_;
 };
 

@@ -1,0 +1,210 @@
+// node_benchmark: drives a running collision_response node over ROS and measures it.
+//   ~mode: "load"    publishes every body of ~scene (a gas) in one BodyStateArray at ~rate Hz
+//                    for ~seconds, applying the impacts the node publishes (the scene player's
+//                    loop), and reports the node's CPU share (from /proc/~pid/stat), the latency
+//                    from publishing a state array to receiving the impacts it revealed
+//                    (p50, p99), and the node's resident memory every ~memory_every s;
+//          "service" calls ~compute_collision and the empty service alternately ~calls times
+//                    each over persistent connections and reports both round trips.
+// Results as JSON on stdout (scripts/performance.sh).
+#include <ros/ros.h>
+#include <std_srvs/Empty.h>
+
+#include <unistd.h>
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "collision_response/BodyStateArray.h"
+#include "collision_response/ComputeCollision.h"
+#include "collision_response/ImpactArray.h"
+#include "collision_response/core/playback.h"
+#include "collision_response/ros/conversions.h"
+#include "collision_response/ros/scene_loader.h"
+
+namespace {
+
+using namespace collision_response;
+
+double percentile(std::vector<double> values, double fraction) {
+  if (values.empty()) return NAN;
+  std::sort(values.begin(), values.end());
+  return values[static_cast<std::size_t>(fraction * static_cast<double>(values.size() - 1))];
+}
+
+/// CPU seconds (user + system) used so far by process `pid`.
+double cpuSeconds(int pid) {
+  std::ifstream file("/proc/" + std::to_string(pid) + "/stat");
+  std::string line;
+  std::getline(file, line);
+  std::istringstream in(line.substr(line.rfind(')') + 2));
+  std::string field;
+  std::vector<std::string> fields;
+  while (in >> field) fields.push_back(field);
+  // After the command: state is field 3 of the whole line; utime and stime are 14 and 15.
+  const double ticks = std::stod(fields.at(11)) + std::stod(fields.at(12));
+  return ticks / static_cast<double>(sysconf(_SC_CLK_TCK));
+}
+
+double residentMegabytes(int pid) {
+  std::ifstream file("/proc/" + std::to_string(pid) + "/statm");
+  double size = 0, resident = 0;
+  file >> size >> resident;
+  return resident * static_cast<double>(sysconf(_SC_PAGESIZE)) / 1e6;
+}
+
+int load(ros::NodeHandle& node, ros::NodeHandle& private_node) {
+  XmlRpc::XmlRpcValue value;
+  if (!private_node.getParam("scene", value)) return 2;
+  auto scene = loadScene(value, private_node.resolveName("scene"));
+  if (!scene) {
+    std::fprintf(stderr, "%s\n", scene.error().message().c_str());
+    return 2;
+  }
+  const double rate = private_node.param("rate", 100.0);
+  const double seconds = private_node.param("seconds", 10.0);
+  const double memory_every = private_node.param("memory_every", 10.0);
+  const int pid = private_node.param("pid", 0);
+  core::Playback playback(*scene, 1e-9, 0.0);
+  ros::Publisher states = node.advertise<BodyStateArray>("body_states", 10);
+  std::map<ros::Time, ros::WallTime> published;
+  std::vector<double> latencies;
+  std::size_t impacts = 0;
+  ros::Time start;
+  const bool exact_contact = scene->detection == core::Detection::kContinuous;
+  ros::Subscriber subscriber =
+      node.subscribe<ImpactArray>("impacts", 100, [&](const ImpactArray::ConstPtr& message) {
+        const auto sent = published.find(message->header.stamp);
+        if (sent != published.end())
+          latencies.push_back((ros::WallTime::now() - sent->second).toSec());
+        for (const Impact& impact : message->impacts) {
+          const double t = (impact.header.stamp - start).toSec();
+          for (const auto& [id, side, after] :
+               {std::make_tuple(impact.body_a, -1.0, toEigen(impact.velocity_a_after.linear)),
+                std::make_tuple(impact.body_b, +1.0, toEigen(impact.velocity_b_after.linear))}) {
+            const auto body = playback.bodyIndex(id);
+            if (!body) continue;
+            const Eigen::Vector3d centre =
+                exact_contact
+                    ? Eigen::Vector3d(toEigen(impact.contact_point) +
+                                      side * scene->bodies[*body].radius * toEigen(impact.normal))
+                    : playback.position(*body, t);
+            playback.applyImpact(*body, t, centre, after);
+          }
+          ++impacts;
+        }
+      });
+  while (ros::ok() && states.getNumSubscribers() == 0) ros::WallDuration(0.05).sleep();
+  ros::WallDuration(1.0).sleep();
+  BodyStateArray array;
+  array.states.resize(scene->bodies.size());
+  for (std::size_t i = 0; i < scene->bodies.size(); ++i) {
+    array.states[i].id = scene->bodies[i].id;
+    array.states[i].pose.orientation.w = 1.0;
+  }
+  start = ros::Time::now();
+  const double cpu_start = pid ? cpuSeconds(pid) : 0.0;
+  const ros::WallTime wall_start = ros::WallTime::now();
+  std::vector<std::pair<double, double>> memory;
+  double next_memory = 0;
+  const auto ticks = static_cast<long>(seconds * rate);
+  for (long k = 0; k < ticks && ros::ok(); ++k) {
+    const ros::WallTime due = wall_start + ros::WallDuration(static_cast<double>(k) / rate);
+    while (ros::WallTime::now() < due) {
+      ros::spinOnce();
+      ros::WallDuration(0.0002).sleep();
+    }
+    const ros::Time stamp = start + ros::Duration(static_cast<double>(k) / rate);
+    const double t = (stamp - start).toSec();
+    array.header.stamp = stamp;
+    for (std::size_t i = 0; i < array.states.size(); ++i) {
+      BodyState& state = array.states[i];
+      state.header.stamp = stamp;
+      state.pose.position = toPointMsg(playback.position(i, t));
+      state.twist.linear = toVector3Msg(playback.velocity(i, t));
+    }
+    published[stamp] = ros::WallTime::now();
+    states.publish(array);
+    if (pid && (ros::WallTime::now() - wall_start).toSec() >= next_memory) {
+      memory.emplace_back((ros::WallTime::now() - wall_start).toSec(), residentMegabytes(pid));
+      next_memory += memory_every;
+    }
+  }
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(0.5);
+  while (ros::WallTime::now() < end) {
+    ros::spinOnce();
+    ros::WallDuration(0.001).sleep();
+  }
+  const double wall = (ros::WallTime::now() - wall_start).toSec();
+  const double cpu = pid ? cpuSeconds(pid) - cpu_start : NAN;
+  std::printf(
+      "{\"bodies\": %zu, \"rate\": %g, \"seconds\": %g, \"updates\": %ld, \"impacts\": %zu, "
+      "\"cpu_share\": %g, \"latency_p50\": %g, \"latency_p99\": %g, \"latency_samples\": %zu, "
+      "\"memory\": [",
+      scene->bodies.size(), rate, seconds, ticks, impacts, cpu / wall, percentile(latencies, 0.5),
+      percentile(latencies, 0.99), latencies.size());
+  for (std::size_t i = 0; i < memory.size(); ++i) {
+    std::printf("%s[%g, %g]", i ? ", " : "", memory[i].first, memory[i].second);
+  }
+  std::printf("]}\n");
+  return 0;
+}
+
+int service(ros::NodeHandle& node, ros::NodeHandle& private_node) {
+  const int calls = private_node.param("calls", 2000);
+  ros::ServiceClient compute =
+      node.serviceClient<ComputeCollision>("/collision_response/compute_collision", true);
+  ros::ServiceClient empty = node.serviceClient<std_srvs::Empty>("/empty_service/empty", true);
+  if (!compute.waitForExistence(ros::Duration(20)) || !empty.waitForExistence(ros::Duration(20)))
+    return 2;
+  ComputeCollision collision;
+  collision.request.a.mass = 2.0;
+  collision.request.a.velocity.x = 3.0;
+  collision.request.b.mass = 1.0;
+  collision.request.b.position.x = 1.0;
+  collision.request.b.velocity.x = -1.0;
+  collision.request.restitution = 0.5;
+  std_srvs::Empty nothing;
+  std::vector<double> compute_times, empty_times;
+  using Clock = std::chrono::steady_clock;
+  // The first 100 calls of each warm up; the order alternates so that neither service always
+  // follows the other.
+  for (int i = 0; i < 2 * (calls + 100); ++i) {
+    const bool call_compute = (i % 4 == 0) || (i % 4 == 3);
+    const auto t0 = Clock::now();
+    if (call_compute ? !compute.call(collision) || !collision.response.success
+                     : !empty.call(nothing)) {
+      return 3;
+    }
+    const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    if (i < 200) continue;
+    (call_compute ? compute_times : empty_times).push_back(seconds);
+  }
+  const auto mean = [](const std::vector<double>& v) {
+    double sum = 0;
+    for (const double x : v) sum += x;
+    return sum / static_cast<double>(v.size());
+  };
+  std::printf(
+      "{\"calls\": %d, \"compute_mean\": %g, \"compute_p50\": %g, \"compute_p99\": %g, "
+      "\"empty_mean\": %g, \"empty_p50\": %g, \"empty_p99\": %g}\n",
+      calls, mean(compute_times), percentile(compute_times, 0.5), percentile(compute_times, 0.99),
+      mean(empty_times), percentile(empty_times, 0.5), percentile(empty_times, 0.99));
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "node_benchmark");
+  ros::NodeHandle node;
+  ros::NodeHandle private_node("~");
+  const std::string mode = private_node.param<std::string>("mode", "load");
+  return mode == "service" ? service(node, private_node) : load(node, private_node);
+}

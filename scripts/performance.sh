@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# Scale: the core per update for 1k, 10k and 100k bodies beside Bullet (Google Benchmark); the
+# node over ROS with 10,000 bodies at 100 Hz (CPU share, latency, memory over a long run); the
+# collision service's round trip beside an empty service. Writes doc/performance.md.
+#   bash scripts/performance.sh                    # the memory run lasts 10 minutes
+#   MEMORY_SECONDS=60 bash scripts/performance.sh  # a shorter one
+set -euo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
+PACKAGES+=(libbenchmark-dev libbullet-dev libstd-srvs-dev ros-std-srvs linux-perf)
+install_packages
+build_workspace >"$ws/build.log" 2>&1 || { tail -40 "$ws/build.log"; exit 1; }
+cmake --build "$ws/build" --target bench_scale node_benchmark empty_service -- -j2 \
+  >>"$ws/build.log" 2>&1 || { tail -40 "$ws/build.log"; exit 1; }
+source_workspace
+bin="$ws/devel/lib/collision_response"
+out="$ws/performance"
+mkdir -p "$out"
+rm -f "$out"/*.json
+
+echo "== core: 1k, 10k, 100k bodies, and Bullet on the same gas"
+"$bin/bench_scale" --benchmark_format=json --benchmark_out="$out/scale.json" >"$out/scale.log" 2>&1
+
+echo "== the node over ROS"
+bodies="${BODIES:-10000}"
+/usr/bin/python3 - "$bodies" "$out/gas.yaml" <<'PY'
+import math, random, sys
+count, path = int(sys.argv[1]), sys.argv[2]
+side = math.ceil(count ** (1 / 3))
+random.seed(5)
+lines = ["scene:", "  fixed_frame: world", "  detection: continuous",
+         "  materials: {elastic: {restitution: 1.0}}", "  bodies:"]
+for i in range(count):
+    x, y, z = 0.25 + 0.5 * (i % side), 0.25 + 0.5 * ((i // side) % side), 0.25 + 0.5 * (i // (side * side))
+    v = [random.uniform(-2, 2) for _ in range(3)]
+    lines.append(f"    - {{id: gas_{1000000 + i}, mass: 0.1, radius: 0.05, material: elastic, "
+                 f"position: [{x}, {y}, {z}], velocity: [{v[0]:.6f}, {v[1]:.6f}, {v[2]:.6f}]}}")
+lines.append("  obstacles:")
+size = 0.5 * side
+for i, (n, offset) in enumerate([("[1, 0, 0]", 0), ("[-1, 0, 0]", -size), ("[0, 1, 0]", 0),
+                                 ("[0, -1, 0]", -size), ("[0, 0, 1]", 0), ("[0, 0, -1]", -size)]):
+    lines.append(f"    - {{id: wall_{i}, type: plane, normal: {n}, offset: {offset}, material: elastic}}")
+open(path, "w").write("\n".join(lines) + "\n")
+PY
+port=$(free_port)
+export ROS_MASTER_URI="http://localhost:$port"
+pids=()
+cleanup() { for pid in "${pids[@]}"; do kill -INT "$pid" 2>/dev/null || true; done; wait 2>/dev/null || true; }
+trap cleanup EXIT
+roscore -p "$port" >"$out/roscore.log" 2>&1 &
+pids+=($!)
+until rosparam list >/dev/null 2>&1; do sleep 0.2; done
+rosparam load "$out/gas.yaml" /collision_response
+rosparam load "$out/gas.yaml" /node_benchmark
+"$bin/collision_response_node" >"$out/node.log" 2>&1 &
+node_pid=$!
+pids+=($node_pid)
+"$bin/empty_service" >"$out/empty.log" 2>&1 &
+pids+=($!)
+until rosservice list 2>/dev/null | grep -q /empty_service/empty &&
+  rosservice list 2>/dev/null | grep -q /collision_response/compute_collision; do sleep 0.2; done
+
+echo "== service round trips (persistent clients, alternating)"
+"$bin/node_benchmark" _mode:=service _calls:=5000 >"$out/service.json"
+echo "== ${bodies} bodies at 100 Hz for 20 s"
+# Where the node's time goes: a profile of 8 s in the middle of the run (when perf may sample).
+( sleep 8 && perf record -g -o "$out/perf.data" -p "$node_pid" -- sleep 8 >"$out/perf.log" 2>&1 &&
+  perf report -i "$out/perf.data" --no-children --sort dso,sym -g none 2>/dev/null |
+  grep -v '^#' | grep -v '^$' | head -15 >"$out/profile.txt" ) &
+profiler=$!
+"$bin/node_benchmark" _mode:=load _rate:=100 _seconds:=20 _pid:="$node_pid" >"$out/load.json"
+wait "$profiler" || echo "(no profile: perf could not sample here, see $out/perf.log)"
+memory_seconds="${MEMORY_SECONDS:-600}"
+if [ "$memory_seconds" -gt 0 ]; then
+  echo "== memory: ${bodies} bodies at 100 Hz for ${memory_seconds} s"
+  "$bin/node_benchmark" _mode:=load _rate:=100 _seconds:="$memory_seconds" _memory_every:=30 \
+    _pid:="$node_pid" >"$out/memory.json"
+fi
+/usr/bin/python3 "$repo/scripts/performance_report.py" "$out" "$repo/doc/performance.md"
+cat "$repo/doc/performance.md"
