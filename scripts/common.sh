@@ -18,6 +18,10 @@ PACKAGES=(
   librostest-dev python3-rostest python3-roslaunch python3-rosmaster python3-rosservice
   rosbash python3-rostopic python3-rosnode python3-rosparam tf2-tools
   libnodelet-dev libnodeletlib-dev libnodeletlib-tools pluginlib-dev
+  libvisualization-msgs-dev ros-visualization-msgs
+  libdiagnostic-updater-dev libdiagnostic-msgs-dev ros-diagnostic-msgs
+  libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
+  python3-rospy python3-genpy catkin-lint
   googletest libgtest-dev clang libclang-rt-14-dev
 )
 

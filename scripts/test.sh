@@ -22,5 +22,15 @@ fi
 # The unit tests again under AddressSanitizer and UndefinedBehaviorSanitizer, and a short run
 # of each fuzzer (bash scripts/fuzz.sh 600 for a long one). Their results join the count.
 bash "$repo/scripts/sanitize.sh" || true
+# catkin_lint on the package (warnings count as failures): one counted case.
+mkdir -p "$ws/build/test_results/collision_response"
+if lint=$(catkin_lint --strict "$repo" 2>&1); then
+  printf '<testsuite><testcase classname="catkin_lint" name="package"/></testsuite>\n' \
+    >"$ws/build/test_results/collision_response/catkin_lint.xml"
+else
+  echo "$lint"
+  printf '<testsuite><testcase classname="catkin_lint" name="package"><failure message="catkin_lint --strict reported problems (printed above)"/></testcase></testsuite>\n' \
+    >"$ws/build/test_results/collision_response/catkin_lint.xml"
+fi
 bash "$repo/scripts/fuzz.sh" "${FUZZ_SECONDS:-30}" || true
 /usr/bin/python3 "$repo/scripts/count_results.py" "$ws/build/test_results" "$status"

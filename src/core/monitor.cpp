@@ -54,7 +54,7 @@ ImpactMonitor::ImpactMonitor(const Scene& scene, const MonitorSettings& settings
 #endif
   }
 
-  std::vector<std::string> material_names;
+  std::vector<std::string>& material_names = material_names_;
   const auto material_index = [&material_names](const std::string& name) {
     const auto found = std::find(material_names.begin(), material_names.end(), name);
     if (found != material_names.end())
@@ -78,19 +78,7 @@ ImpactMonitor::ImpactMonitor(const Scene& scene, const MonitorSettings& settings
   // The pair coefficients, once: impacts look them up by index. Pairs that cannot meet (two
   // obstacles) or have no coefficient (validateScene refuses scenes where such a pair can meet)
   // hold NaN.
-  const std::size_t count = material_names.size();
-  restitution_.assign(count, std::vector<double>(count, NAN));
-  friction_.assign(count, std::vector<double>(count, NAN));
-  for (std::size_t i = 0; i < count; ++i) {
-    for (std::size_t j = 0; j < count; ++j) {
-      if (const auto value = scene.materials.restitution(material_names[i], material_names[j])) {
-        restitution_[i][j] = *value;
-      }
-      if (const auto value = scene.materials.friction(material_names[i], material_names[j])) {
-        friction_[i][j] = *value;
-      }
-    }
-  }
+  computePairCoefficients(scene.materials);
 
   tracks_.resize(bodies_.size());
   obstacle_tracks_.resize(obstacles_.size());
@@ -107,6 +95,35 @@ ImpactMonitor::ImpactMonitor(const Scene& scene, const MonitorSettings& settings
       fixed_plane_obstacle_.push_back(i);
     }
   }
+}
+
+void ImpactMonitor::computePairCoefficients(const MaterialTable& materials) {
+  const std::size_t count = material_names_.size();
+  restitution_.assign(count, std::vector<double>(count, NAN));
+  friction_.assign(count, std::vector<double>(count, NAN));
+  for (std::size_t i = 0; i < count; ++i) {
+    for (std::size_t j = 0; j < count; ++j) {
+      if (const auto value = materials.restitution(material_names_[i], material_names_[j])) {
+        restitution_[i][j] = *value;
+      }
+      if (const auto value = materials.friction(material_names_[i], material_names_[j])) {
+        friction_[i][j] = *value;
+      }
+    }
+  }
+}
+
+void ImpactMonitor::tune(Detection detection, double restitution_threshold,
+                         const MaterialTable& materials) {
+  if (detection != detection_) overlapping_.clear();
+  detection_ = detection;
+  restitution_threshold_ = restitution_threshold;
+  computePairCoefficients(materials);
+}
+
+std::optional<ObstaclePose> ImpactMonitor::obstaclePose(std::size_t obstacle) const {
+  if (!obstacle_tracks_[obstacle].known) return std::nullopt;
+  return obstacle_tracks_[obstacle].pose;
 }
 
 std::optional<std::size_t> ImpactMonitor::bodyIndex(const std::string& id) const {

@@ -1,7 +1,9 @@
 #include "collision_response/ros/collision_response_node.h"
 
+#include <cmath>
 #include <exception>
 
+#include "collision_response/core/validation.h"
 #include "collision_response/ros/collision_services.h"
 #include "collision_response/ros/scene_loader.h"
 
@@ -28,6 +30,24 @@ bool CollisionResponseNode::initialize() {
     materials_ = scene->materials;
     logScene(*scene, *params);
     monitor_ = std::make_unique<ImpactMonitorRos>(node_, *scene, *params);
+
+    // Diagnostics, named after this node (or nodelet): ~diagnostic_period s apart (default 1).
+    diagnostics_ = std::make_unique<diagnostic_updater::Updater>(node_, private_node_,
+                                                                 private_node_.getNamespace());
+    diagnostics_->setHardwareID("none");
+    diagnostics_->add("impact monitor", monitor_.get(), &ImpactMonitorRos::diagnose);
+    diagnostics_timer_ = node_.createWallTimer(
+        ros::WallDuration(0.1), [this](const ros::WallTimerEvent&) { diagnostics_->update(); });
+
+    // Live tuning, starting from the scene's values.
+    config_.detection = core::toString(scene->detection);
+    config_.restitution_threshold = scene->restitution_threshold;
+    config_.restitution_combine = core::toString(scene->materials.combineRule());
+    reconfigure_ = std::make_unique<dynamic_reconfigure::Server<MonitorConfig>>(reconfigure_mutex_,
+                                                                                private_node_);
+    reconfigure_->updateConfig(config_);
+    reconfigure_->setCallback(
+        [this](MonitorConfig& config, std::uint32_t level) { onReconfigure(config, level); });
   } else {
     ROS_WARN_STREAM("collision_response: no " << scene_key
                                               << " parameter: serving the services with the "
@@ -57,6 +77,42 @@ void CollisionResponseNode::logScene(const core::Scene& scene, const MonitorPara
                   << " s, contact_tolerance " << params.contact_tolerance << ", clock_jump_back "
                   << params.clock_jump_back << " s, queue_size " << params.queue_size
                   << ", max_states " << params.max_states);
+}
+
+void CollisionResponseNode::onReconfigure(MonitorConfig& config, std::uint32_t /*level*/) {
+  const std::string prefix = private_node_.getNamespace() + "/";
+  auto detection = core::parseDetection(config.detection, prefix + "detection");
+  if (!detection) {
+    ROS_ERROR_STREAM("collision_response: reconfigure refused: " << detection.error().message()
+                                                                 << "; kept " << config_.detection);
+    config.detection = config_.detection;
+    detection = core::parseDetection(config.detection, prefix + "detection");
+  }
+  auto rule = core::parseCombineRule(config.restitution_combine, prefix + "restitution_combine");
+  if (!rule) {
+    ROS_ERROR_STREAM("collision_response: reconfigure refused: "
+                     << rule.error().message() << "; kept " << config_.restitution_combine);
+    config.restitution_combine = config_.restitution_combine;
+    rule = core::parseCombineRule(config.restitution_combine, prefix + "restitution_combine");
+  }
+  if (!std::isfinite(config.restitution_threshold) || config.restitution_threshold < 0.0) {
+    ROS_ERROR_STREAM("collision_response: reconfigure refused: "
+                     << prefix << "restitution_threshold: must be a finite number >= 0 m/s, got "
+                     << core::formatNumber(config.restitution_threshold) << "; kept "
+                     << config_.restitution_threshold);
+    config.restitution_threshold = config_.restitution_threshold;
+  }
+  if (config.detection != config_.detection ||
+      config.restitution_threshold != config_.restitution_threshold ||
+      config.restitution_combine != config_.restitution_combine) {
+    ROS_INFO_STREAM("collision_response: reconfigured: detection "
+                    << config.detection << ", restitution_threshold "
+                    << config.restitution_threshold << " m/s, restitution_combine "
+                    << config.restitution_combine);
+  }
+  monitor_->tune(*detection, config.restitution_threshold, *rule);
+  materials_.setCombineRule(*rule);
+  config_ = config;
 }
 
 // Both callbacks answer every request: a refused one with success = false and the reason. No

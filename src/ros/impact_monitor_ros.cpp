@@ -82,6 +82,14 @@ core::Expected<MonitorParams> MonitorParams::load(const ros::NodeHandle& private
   if (auto s = readPositive(private_node, "clock_jump_back", params.clock_jump_back, false); !s) {
     return s.error();
   }
+  for (const auto& [key, value] :
+       {std::make_pair("marker_rate", &params.markers.rate),
+        std::make_pair("impact_marker_lifetime", &params.markers.impact_lifetime),
+        std::make_pair("impulse_marker_scale", &params.markers.impulse_scale),
+        std::make_pair("plane_marker_size", &params.markers.plane_size),
+        std::make_pair("contact_marker_diameter", &params.markers.contact_diameter)}) {
+    if (auto s = readPositive(private_node, key, *value, false); !s) return s.error();
+  }
   private_node.param("max_states", params.max_states, params.max_states);
   if (params.max_states < 1) {
     return core::Error{private_node.resolveName("max_states"),
@@ -111,12 +119,15 @@ ImpactMonitorRos::ImpactMonitorRos(ros::NodeHandle node, const core::Scene& scen
         }));
   }
   impact_publisher_ = node_.advertise<ImpactArray>("impacts", 100);
+  marker_publisher_ = node_.advertise<visualization_msgs::MarkerArray>("markers", 10);
   queue_timer_ = node_.createWallTimer(ros::WallDuration(0.005),
                                        [this](const ros::WallTimerEvent&) { processQueue(); });
 }
 
 void ImpactMonitorRos::onStateArray(const BodyStateArray::ConstPtr& message) {
   const std::string topic = array_subscriber_.getTopic();
+  ++period_.messages;
+  period_.states += message->states.size();
   if (message->states.size() > static_cast<std::size_t>(params_.max_states)) {
     count("dropped: too many states in one message");
     warnings_.warn(topic + " size",
@@ -130,6 +141,8 @@ void ImpactMonitorRos::onStateArray(const BodyStateArray::ConstPtr& message) {
 
 void ImpactMonitorRos::onState(const BodyState::ConstPtr& message, const std::string& topic,
                                const std::string& id) {
+  ++period_.messages;
+  ++period_.states;
   BodyState state = *message;
   if (state.id.empty()) state.id = id;  // the topic names the body
   if (state.id != id) {
@@ -269,11 +282,16 @@ bool ImpactMonitorRos::processHead() {
     step(converted[begin].stamp, samples);
     begin = end;
   }
+  const double latency = (ros::WallTime::now() - head.received).toSec();
+  period_.latency_seconds += latency;
+  period_.latency_seconds_max = std::max(period_.latency_seconds_max, latency);
+  ++period_.latencies;
   return true;
 }
 
 void ImpactMonitorRos::step(const ros::Time& stamp,
                             const std::vector<core::BodyStateSample>& samples) {
+  const ros::WallTime began = ros::WallTime::now();
   if (!monitor_.started()) epoch_ = stamp;
   if (monitor_.started() && toLine(stamp) < monitor_.now() - params_.clock_jump_back) {
     count("clock jumped back");
@@ -300,6 +318,10 @@ void ImpactMonitorRos::step(const ros::Time& stamp,
                              "step; the step was cut short");
   }
   publish(stamp, report);
+  const double seconds = (ros::WallTime::now() - began).toSec();
+  period_.step_seconds += seconds;
+  period_.step_seconds_max = std::max(period_.step_seconds_max, seconds);
+  ++period_.steps;
 }
 
 void ImpactMonitorRos::updateObstacles(const ros::Time& stamp) {
@@ -340,7 +362,6 @@ void ImpactMonitorRos::updateObstacles(const ros::Time& stamp) {
 }
 
 void ImpactMonitorRos::publish(const ros::Time& stamp, const core::StepReport& report) {
-  if (report.impacts.empty()) return;
   ImpactArray array;
   array.header.stamp = stamp;
   array.header.frame_id = scene_.fixed_frame;
@@ -366,8 +387,102 @@ void ImpactMonitorRos::publish(const ros::Time& stamp, const core::StepReport& r
     ROS_DEBUG_STREAM("impact " << impact.body_a << " -> " << impact.body_b << " at "
                                << impact.header.stamp << ", impulse " << impact.impulse);
   }
-  counters_["impacts published"] += array.impacts.size();
-  impact_publisher_.publish(array);
+  if (!array.impacts.empty()) {
+    counters_["impacts published"] += array.impacts.size();
+    period_.impacts += array.impacts.size();
+    impact_publisher_.publish(array);
+  }
+  if (marker_publisher_.getNumSubscribers() > 0) publishMarkers(stamp, array);
+}
+
+void ImpactMonitorRos::publishMarkers(const ros::Time& stamp, const ImpactArray& impacts) {
+  visualization_msgs::MarkerArray markers;
+  for (const Impact& impact : impacts.impacts) {
+    appendImpactMarkers(impact, next_impact_marker_, params_.markers, markers);
+    next_impact_marker_ = (next_impact_marker_ + 1) % kImpactIds;
+  }
+  const ros::WallTime now = ros::WallTime::now();
+  if ((now - last_scene_markers_).toSec() >= 1.0 / params_.markers.rate) {
+    last_scene_markers_ = now;
+    const double time = toLine(stamp);
+    for (std::size_t i = 0; i < monitor_.bodyCount(); ++i) {
+      const auto state = monitor_.predictedState(i, time);
+      markers.markers.push_back(
+          bodyMarker(monitor_.body(i), static_cast<int>(i),
+                     state ? std::optional<Eigen::Vector3d>(state->first) : std::nullopt,
+                     scene_.fixed_frame, stamp));
+    }
+    for (std::size_t i = 0; i < monitor_.obstacleCount(); ++i) {
+      const auto pose = monitor_.obstaclePose(i);
+      if (!pose) continue;  // a tf-attached obstacle not placed yet
+      const core::ObstacleSpec& spec = monitor_.obstacle(i);
+      const Eigen::Vector3d position = spec.shape == core::ObstacleShape::kSphere
+                                           ? Eigen::Vector3d(pose->position)
+                                           : Eigen::Vector3d(pose->offset * pose->normal);
+      markers.markers.push_back(obstacleMarker(spec, static_cast<int>(i), position, pose->normal,
+                                               scene_.fixed_frame, stamp, params_.markers));
+    }
+  }
+  if (!markers.markers.empty()) marker_publisher_.publish(markers);
+}
+
+void ImpactMonitorRos::tune(core::Detection detection, double restitution_threshold,
+                            core::CombineRule rule) {
+  scene_.detection = detection;
+  scene_.restitution_threshold = restitution_threshold;
+  scene_.materials.setCombineRule(rule);
+  monitor_.tune(detection, restitution_threshold, scene_.materials);
+}
+
+void ImpactMonitorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  const ros::WallTime now = ros::WallTime::now();
+  const double seconds = std::max((now - period_.start).toSec(), 1e-9);
+  std::map<std::string, std::uint64_t> dropped;  // in this period, by reason
+  for (const auto& [what, count] : counters_) {
+    const std::uint64_t before = period_.counters.count(what) ? period_.counters.at(what) : 0;
+    if (count > before && what.rfind("dropped", 0) == 0) dropped[what] = count - before;
+  }
+  if (!dropped.empty()) {
+    std::string reasons;
+    for (const auto& [what, count] : dropped) {
+      reasons += (reasons.empty() ? "" : "; ") + what.substr(std::string("dropped: ").size()) +
+                 " (" + std::to_string(count) + ")";
+    }
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "states dropped: " + reasons);
+  } else if (period_.messages == 0) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::OK,
+                   "no states received in the last " + core::formatNumber(seconds) + " s");
+  } else {
+    status.summary(diagnostic_msgs::DiagnosticStatus::OK,
+                   std::to_string(monitor_.trackedBodies()) + " bodies tracked");
+  }
+  status.add("detection", core::toString(scene_.detection));
+  status.add("restitution threshold (m/s)", scene_.restitution_threshold);
+  status.add("combine rule", core::toString(scene_.materials.combineRule()));
+  status.add("bodies in the scene", monitor_.bodyCount());
+  status.add("bodies tracked", monitor_.trackedBodies());
+  status.add("input messages per second", static_cast<double>(period_.messages) / seconds);
+  status.add("states per second", static_cast<double>(period_.states) / seconds);
+  status.add("impacts per second", static_cast<double>(period_.impacts) / seconds);
+  status.add("updates", period_.steps);
+  status.add("processing time per update, mean (ms)",
+             period_.steps ? 1e3 * period_.step_seconds / static_cast<double>(period_.steps) : 0.0);
+  status.add("processing time per update, max (ms)", 1e3 * period_.step_seconds_max);
+  status.add("arrival to publication, mean (ms)",
+             period_.latencies
+                 ? 1e3 * period_.latency_seconds / static_cast<double>(period_.latencies)
+                 : 0.0);
+  status.add("arrival to publication, max (ms)", 1e3 * period_.latency_seconds_max);
+  status.add("messages waiting for transforms", queue_.size());
+  const auto total = [this](const std::string& what) {
+    const auto found = counters_.find(what);
+    return found == counters_.end() ? std::uint64_t{0} : found->second;
+  };
+  status.add("transforms missing (states dropped, total)", total("dropped: transform missing"));
+  status.add("obstacle transforms missing (total)", total("obstacle transform missing"));
+  for (const auto& [what, count] : counters_) status.add(what + " (total)", count);
+  period_ = Period{};
+  period_.counters = counters_;
 }
 
 }  // namespace collision_response

@@ -117,6 +117,14 @@ class ImpactMonitor {
 
   /// Where a tf-attached obstacle is, from `pose.time` on. Fixed obstacles are set from the scene.
   void setObstaclePose(std::size_t obstacle, const ObstaclePose& pose);
+  /// Where an obstacle was last placed; empty for a tf-attached one not placed yet.
+  std::optional<ObstaclePose> obstaclePose(std::size_t obstacle) const;
+
+  /// Live tuning (dynamic_reconfigure): the detection mode, the restitution threshold and the
+  /// materials' coefficients (a new combine rule) from the next step on. The tracks are kept;
+  /// after a change of detection mode, a pair that overlaps at that instant may be reported
+  /// once more. The caller validates the values (as validateScene does).
+  void tune(Detection detection, double restitution_threshold, const MaterialTable& materials);
 
   /// Advances the monitor to `time` with the states given (each at its own time <= `time`;
   /// states after `time` are the caller's error). See the class comment.
@@ -232,6 +240,10 @@ class ImpactMonitor {
   ClusterFrictionStep friction_step_ = nullptr;        // null without the friction effect
   std::vector<Plane> fixed_planes_;                    // for resting, with their obstacles:
   std::vector<std::size_t> fixed_plane_obstacle_;
+  /// Fills restitution_ and friction_ from the materials' table.
+  void computePairCoefficients(const MaterialTable& materials);
+
+  std::vector<std::string> material_names_;       // the scene's materials, indexed
   std::vector<std::size_t> material_;             // per participant, into restitution_
   std::vector<std::vector<double>> restitution_;  // material x material
   std::vector<std::vector<double>> friction_;     // material x material

@@ -1,6 +1,7 @@
 // The impact monitor on ROS: body states in (any tf frame), impacts out.
 #pragma once
 
+#include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
@@ -17,6 +18,7 @@
 #include "collision_response/ImpactArray.h"
 #include "collision_response/core/monitor.h"
 #include "collision_response/core/scene.h"
+#include "collision_response/ros/markers.h"
 #include "collision_response/ros/throttled_warning.h"
 
 namespace collision_response {
@@ -30,6 +32,7 @@ struct MonitorParams {
   double clock_jump_back = 1.0;           ///< s: a stamp this much older than now is a clock jump
   int queue_size = 1000;                  ///< input messages waiting for transforms, at most
   int max_states = 100000;                ///< states in one BodyStateArray, at most
+  MarkerParams markers;                   ///< ~marker_rate, ~impact_marker_lifetime, ...
 
   /// Reads `~transform_timeout` and the others; a bad value is an error naming it.
   static core::Expected<MonitorParams> load(const ros::NodeHandle& private_node);
@@ -42,6 +45,12 @@ class ImpactMonitorRos {
 
   /// Counts of what the monitor did and dropped, by reason (for logs and diagnostics).
   const std::map<std::string, std::uint64_t>& counters() const { return counters_; }
+
+  /// Live tuning (dynamic_reconfigure), validated by the caller: see core::ImpactMonitor::tune.
+  void tune(core::Detection detection, double restitution_threshold, core::CombineRule rule);
+
+  /// The monitor's status for /diagnostics: rates, bodies tracked, drops by reason, timing.
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
  private:
   /// An input waiting for its transforms: an array, kept as received (no copy of its
@@ -67,6 +76,9 @@ class ImpactMonitorRos {
   void step(const ros::Time& stamp, const std::vector<core::BodyStateSample>& samples);
   void updateObstacles(const ros::Time& stamp);
   void publish(const ros::Time& stamp, const core::StepReport& report);
+  /// Bodies and obstacles (at most ~marker_rate), and the arrows of `impacts`; only while
+  /// somebody subscribes to `markers`.
+  void publishMarkers(const ros::Time& stamp, const ImpactArray& impacts);
   double toLine(const ros::Time& stamp) const { return (stamp - epoch_).toSec(); }
   void count(const std::string& what) { ++counters_[what]; }
 
@@ -79,12 +91,25 @@ class ImpactMonitorRos {
   ros::Subscriber array_subscriber_;
   std::vector<ros::Subscriber> body_subscribers_;
   ros::Publisher impact_publisher_;
+  ros::Publisher marker_publisher_;
+  ros::WallTime last_scene_markers_;
+  int next_impact_marker_ = 0;
   ros::WallTimer queue_timer_;
   std::deque<Pending> queue_;
   ros::Time epoch_;
   std::set<std::size_t> placed_obstacles_;  ///< tf-attached obstacles placed at least once
   std::map<std::string, std::uint64_t> counters_;
   std::vector<std::size_t> index_hints_;  ///< body index of each place of the last array
+  /// Since the last diagnostics report: inputs, steps and their processing time (wall).
+  struct Period {
+    ros::WallTime start = ros::WallTime::now();
+    std::uint64_t messages = 0, states = 0, steps = 0, impacts = 0;
+    double step_seconds = 0.0, step_seconds_max = 0.0;
+    double latency_seconds = 0.0, latency_seconds_max = 0.0;  ///< arrival to publication
+    std::uint64_t latencies = 0;
+    std::map<std::string, std::uint64_t> counters;  ///< counters_ at the period's start
+  };
+  Period period_;
   ThrottledWarning warnings_;
 };
 

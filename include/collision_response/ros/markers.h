@@ -1,0 +1,54 @@
+// rviz markers of the monitor's scene: bodies, obstacles, impacts and contact points.
+#pragma once
+
+#include <visualization_msgs/MarkerArray.h>
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+
+#include "collision_response/Impact.h"
+#include "collision_response/core/scene.h"
+
+namespace collision_response {
+
+/// What the markers look like: `~markers/...` parameters.
+struct MarkerParams {
+  double rate = 30.0;              ///< Hz: bodies and obstacles at most this often
+  double impact_lifetime = 0.5;    ///< s: how long an impact's arrow and contact point stay
+  double impulse_scale = 0.2;      ///< m per N s: an impact's arrow length per unit impulse
+  double plane_size = 4.0;         ///< m: the side of the square drawn for a plane obstacle
+  double contact_diameter = 0.02;  ///< m: the sphere drawn at a contact point
+};
+
+/// Marker namespaces. Ids are stable: a body's and an obstacle's is its index among the
+/// scene's bodies (obstacles) sorted by id; impacts count up and wrap at kImpactIds.
+inline constexpr const char* kBodiesNamespace = "bodies";
+inline constexpr const char* kObstaclesNamespace = "obstacles";
+inline constexpr const char* kImpactsNamespace = "impacts";
+inline constexpr const char* kContactsNamespace = "contacts";
+inline constexpr int kImpactIds = 10000;
+
+/// The colour of a material: the seed's materials have their own; any other material a
+/// colour from its name (the same name, the same colour, in every run).
+std_msgs::ColorRGBA materialColour(const std::string& material);
+
+/// A body as a sphere (id `index`), or its deletion when it is not tracked (`position` empty).
+visualization_msgs::Marker bodyMarker(const core::BodySpec& body, int index,
+                                      const std::optional<Eigen::Vector3d>& position,
+                                      const std::string& frame, const ros::Time& stamp);
+
+/// An obstacle: a sphere, or a plane as a thin square of side `plane_size` centred on the
+/// plane's point nearest the origin (`position`) with its normal.
+visualization_msgs::Marker obstacleMarker(const core::ObstacleSpec& obstacle, int index,
+                                          const Eigen::Vector3d& position,
+                                          const Eigen::Vector3d& normal, const std::string& frame,
+                                          const ros::Time& stamp, const MarkerParams& params);
+
+/// An impact: an arrow from the contact point along the normal (towards body_b, the direction
+/// of the impulse on body_b), impulse_scale m per N s long, and a sphere at the contact point;
+/// both with id `id` in their namespaces and the lifetime `impact_lifetime`.
+void appendImpactMarkers(const Impact& impact, int id, const MarkerParams& params,
+                         visualization_msgs::MarkerArray& array);
+
+}  // namespace collision_response

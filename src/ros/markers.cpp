@@ -1,0 +1,139 @@
+#include "collision_response/ros/markers.h"
+
+#include <Eigen/Geometry>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <map>
+
+#include "collision_response/ros/conversions.h"
+
+namespace collision_response {
+namespace {
+
+std_msgs::ColorRGBA rgba(float r, float g, float b, float a = 1.0f) {
+  std_msgs::ColorRGBA colour;
+  colour.r = r;
+  colour.g = g;
+  colour.b = b;
+  colour.a = a;
+  return colour;
+}
+
+/// A bright colour from a hue in [0, 1) (HSV with full saturation and value).
+std_msgs::ColorRGBA fromHue(double hue) {
+  const double h = 6.0 * (hue - std::floor(hue));
+  const double x = 1.0 - std::abs(std::fmod(h, 2.0) - 1.0);
+  const std::array<std::array<double, 3>, 6> sectors = {
+      {{1, x, 0}, {x, 1, 0}, {0, 1, x}, {0, x, 1}, {x, 0, 1}, {1, 0, x}}};
+  const auto& rgb = sectors[static_cast<std::size_t>(h) % 6];
+  return rgba(static_cast<float>(rgb[0]), static_cast<float>(rgb[1]), static_cast<float>(rgb[2]));
+}
+
+visualization_msgs::Marker base(const std::string& ns, int id, int type, const std::string& frame,
+                                const ros::Time& stamp) {
+  visualization_msgs::Marker marker;
+  marker.header.frame_id = frame;
+  marker.header.stamp = stamp;
+  marker.ns = ns;
+  marker.id = id;
+  marker.type = type;
+  marker.action = visualization_msgs::Marker::ADD;
+  marker.pose.orientation.w = 1.0;
+  return marker;
+}
+
+}  // namespace
+
+std_msgs::ColorRGBA materialColour(const std::string& material) {
+  // The seed's balls in colours that recall them; the reference surface grey.
+  static const std::map<std::string, std_msgs::ColorRGBA> known = {
+      {"concrete", rgba(0.6f, 0.6f, 0.6f)},
+      {"range_golf_ball", rgba(1.0f, 1.0f, 1.0f)},
+      {"tennis_ball", rgba(0.8f, 1.0f, 0.0f)},
+      {"billiard_ball", rgba(0.9f, 0.1f, 0.1f)},
+      {"hand_ball", rgba(1.0f, 0.5f, 0.0f)},
+      {"wooden_ball", rgba(0.6f, 0.4f, 0.2f)},
+      {"steel_ball_bearing", rgba(0.75f, 0.8f, 0.85f)},
+      {"glass_marble", rgba(0.3f, 0.7f, 1.0f)},
+      {"rubber_band_ball", rgba(0.9f, 0.2f, 0.7f)},
+      {"hollow_hard_plastic_ball", rgba(0.2f, 0.8f, 0.3f)},
+  };
+  const auto found = known.find(material);
+  if (found != known.end()) return found->second;
+  std::uint32_t hash = 2166136261u;  // FNV-1a of the name: the same in every run
+  for (const char c : material) hash = (hash ^ static_cast<unsigned char>(c)) * 16777619u;
+  return fromHue(static_cast<double>(hash % 360u) / 360.0);
+}
+
+visualization_msgs::Marker bodyMarker(const core::BodySpec& body, int index,
+                                      const std::optional<Eigen::Vector3d>& position,
+                                      const std::string& frame, const ros::Time& stamp) {
+  visualization_msgs::Marker marker =
+      base(kBodiesNamespace, index, visualization_msgs::Marker::SPHERE, frame, stamp);
+  if (!position) {
+    marker.action = visualization_msgs::Marker::DELETE;
+    return marker;
+  }
+  marker.pose.position = toPointMsg(*position);
+  marker.scale.x = marker.scale.y = marker.scale.z = 2.0 * body.radius;
+  marker.color = materialColour(body.material);
+  marker.text = body.id;
+  return marker;
+}
+
+visualization_msgs::Marker obstacleMarker(const core::ObstacleSpec& obstacle, int index,
+                                          const Eigen::Vector3d& position,
+                                          const Eigen::Vector3d& normal, const std::string& frame,
+                                          const ros::Time& stamp, const MarkerParams& params) {
+  const bool sphere = obstacle.shape == core::ObstacleShape::kSphere;
+  visualization_msgs::Marker marker = base(
+      kObstaclesNamespace, index,
+      sphere ? visualization_msgs::Marker::SPHERE : visualization_msgs::Marker::CUBE, frame, stamp);
+  marker.pose.position = toPointMsg(position);
+  marker.color = materialColour(obstacle.material);
+  marker.text = obstacle.id;
+  if (sphere) {
+    marker.scale.x = marker.scale.y = marker.scale.z = 2.0 * obstacle.radius;
+    return marker;
+  }
+  // A thin square whose z axis is the plane's normal.
+  const Eigen::Quaterniond turn =
+      Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), normal.normalized());
+  marker.pose.orientation.x = turn.x();
+  marker.pose.orientation.y = turn.y();
+  marker.pose.orientation.z = turn.z();
+  marker.pose.orientation.w = turn.w();
+  marker.scale.x = marker.scale.y = params.plane_size;
+  marker.scale.z = 1e-3 * params.plane_size;
+  marker.color.a = 0.4f;  // see-through, so bodies behind it show
+  return marker;
+}
+
+void appendImpactMarkers(const Impact& impact, int id, const MarkerParams& params,
+                         visualization_msgs::MarkerArray& array) {
+  visualization_msgs::Marker arrow = base(kImpactsNamespace, id, visualization_msgs::Marker::ARROW,
+                                          impact.header.frame_id, impact.header.stamp);
+  const Eigen::Vector3d from = toEigen(impact.contact_point);
+  const Eigen::Vector3d to = from + params.impulse_scale * impact.impulse * toEigen(impact.normal);
+  arrow.points = {toPointMsg(from), toPointMsg(to)};
+  const double shaft = 0.5 * params.contact_diameter;
+  arrow.scale.x = shaft;        // shaft diameter
+  arrow.scale.y = 2.0 * shaft;  // head diameter
+  arrow.scale.z = 0.0;          // head length: rviz's default
+  arrow.color = rgba(1.0f, 0.2f, 0.2f);
+  arrow.lifetime = ros::Duration(params.impact_lifetime);
+  arrow.text = impact.body_a + " -> " + impact.body_b;
+  array.markers.push_back(arrow);
+
+  visualization_msgs::Marker contact =
+      base(kContactsNamespace, id, visualization_msgs::Marker::SPHERE, impact.header.frame_id,
+           impact.header.stamp);
+  contact.pose.position = impact.contact_point;
+  contact.scale.x = contact.scale.y = contact.scale.z = params.contact_diameter;
+  contact.color = rgba(1.0f, 1.0f, 0.0f);
+  contact.lifetime = ros::Duration(params.impact_lifetime);
+  array.markers.push_back(contact);
+}
+
+}  // namespace collision_response
