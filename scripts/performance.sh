@@ -63,12 +63,14 @@ echo "== service round trips (persistent clients, alternating)"
 "$bin/node_benchmark" _mode:=service _calls:=5000 >"$out/service.json"
 echo "== ${bodies} bodies at 100 Hz for 20 s"
 # Where the node's time goes: a profile of 8 s in the middle of the run (when perf may sample).
+rm -f "$out/profile.txt"
 ( sleep 8 && perf record -g -o "$out/perf.data" -p "$node_pid" -- sleep 8 >"$out/perf.log" 2>&1 &&
-  perf report -i "$out/perf.data" --no-children --sort dso,sym -g none 2>/dev/null |
-  grep -v '^#' | grep -v '^$' | head -15 >"$out/profile.txt" ) &
+  { perf report -i "$out/perf.data" --no-children --sort dso,sym -g none 2>/dev/null |
+    grep -v '^#' | grep -v '^$' | head -15 >"$out/profile.txt" || true; } ) &
 profiler=$!
 "$bin/node_benchmark" _mode:=load _rate:=100 _seconds:=20 _pid:="$node_pid" >"$out/load.json"
-wait "$profiler" || echo "(no profile: perf could not sample here, see $out/perf.log)"
+wait "$profiler" || true
+[ -s "$out/profile.txt" ] || echo "(no profile: perf could not sample here, see $out/perf.log)"
 memory_seconds="${MEMORY_SECONDS:-600}"
 if [ "$memory_seconds" -gt 0 ]; then
   echo "== memory: ${bodies} bodies at 100 Hz for ${memory_seconds} s"

@@ -120,8 +120,10 @@ ImpactMonitorRos::ImpactMonitorRos(ros::NodeHandle node, const core::Scene& scen
   }
   impact_publisher_ = node_.advertise<ImpactArray>("impacts", 100);
   marker_publisher_ = node_.advertise<visualization_msgs::MarkerArray>("markers", 10);
-  queue_timer_ = node_.createWallTimer(ros::WallDuration(0.005),
-                                       [this](const ros::WallTimerEvent&) { processQueue(); });
+  // Retries inputs that wait for transforms; it runs only while some input waits.
+  queue_timer_ = node_.createWallTimer(
+      ros::WallDuration(0.005), [this](const ros::WallTimerEvent&) { processQueue(); },
+      /*oneshot=*/false, /*autostart=*/false);
 }
 
 void ImpactMonitorRos::onStateArray(const BodyStateArray::ConstPtr& message) {
@@ -174,6 +176,11 @@ void ImpactMonitorRos::processQueue() {
     count("dropped: internal error");
     ROS_ERROR_STREAM_THROTTLE(1.0, "collision_response: dropped a message: " << error.what());
     if (!queue_.empty()) queue_.pop_front();
+  }
+  if (queue_.empty()) {
+    queue_timer_.stop();
+  } else {
+    queue_timer_.start();  // no effect when already running
   }
 }
 
