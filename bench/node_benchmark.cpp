@@ -4,9 +4,11 @@
 //                    loop), and reports the node's CPU share (from /proc/~pid/stat), the latency
 //                    from publishing a state array to receiving the impacts it revealed
 //                    (p50, p99), and the node's resident memory every ~memory_every s;
-//          "service" calls ~compute_collision and the empty service alternately ~calls times
+//          "service" calls ~service (a compute_collision service) and the empty service alternately
+//          ~calls times
 //                    each over persistent connections and reports both round trips.
 // Results as JSON on stdout (scripts/performance.sh).
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <ros/ros.h>
 #include <std_srvs/Empty.h>
 
@@ -102,6 +104,21 @@ int load(ros::NodeHandle& node, ros::NodeHandle& private_node) {
           ++impacts;
         }
       });
+  // The node's own view, from /diagnostics: mean and max from a message's arrival to the
+  // publication of its impacts, per diagnostics period.
+  std::vector<double> node_means, node_maxima;
+  ros::Subscriber diagnostics = node.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 100, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& array) {
+        for (const auto& status : array->status) {
+          if (status.name.find("impact monitor") == std::string::npos) continue;
+          for (const auto& pair : status.values) {
+            if (pair.key == "arrival to publication, mean (ms)")
+              node_means.push_back(std::stod(pair.value));
+            if (pair.key == "arrival to publication, max (ms)")
+              node_maxima.push_back(std::stod(pair.value));
+          }
+        }
+      });
   while (ros::ok() && states.getNumSubscribers() == 0) ros::WallDuration(0.05).sleep();
   ros::WallDuration(1.0).sleep();
   BodyStateArray array;
@@ -144,13 +161,25 @@ int load(ros::NodeHandle& node, ros::NodeHandle& private_node) {
     ros::WallDuration(0.001).sleep();
   }
   const double wall = (ros::WallTime::now() - wall_start).toSec();
+  // Periods before the first state array report no latency (0): skip those.
+  std::vector<double> means, maxima;
+  for (std::size_t i = 0; i < node_means.size(); ++i) {
+    if (node_maxima.at(i) > 0) {
+      means.push_back(node_means[i]);
+      maxima.push_back(node_maxima[i]);
+    }
+  }
+  const double node_latency_mean = percentile(means, 0.5) * 1e-3;
+  const double node_latency_max =
+      maxima.empty() ? NAN : *std::max_element(maxima.begin(), maxima.end()) * 1e-3;
   const double cpu = pid ? cpuSeconds(pid) - cpu_start : NAN;
   std::printf(
       "{\"bodies\": %zu, \"rate\": %g, \"seconds\": %g, \"updates\": %ld, \"impacts\": %zu, "
       "\"cpu_share\": %g, \"latency_p50\": %g, \"latency_p99\": %g, \"latency_samples\": %zu, "
+      "\"node_latency_median_of_means\": %g, \"node_latency_max\": %g, "
       "\"memory\": [",
       scene->bodies.size(), rate, seconds, ticks, impacts, cpu / wall, percentile(latencies, 0.5),
-      percentile(latencies, 0.99), latencies.size());
+      percentile(latencies, 0.99), latencies.size(), node_latency_mean, node_latency_max);
   for (std::size_t i = 0; i < memory.size(); ++i) {
     std::printf("%s[%g, %g]", i ? ", " : "", memory[i].first, memory[i].second);
   }
@@ -160,8 +189,9 @@ int load(ros::NodeHandle& node, ros::NodeHandle& private_node) {
 
 int service(ros::NodeHandle& node, ros::NodeHandle& private_node) {
   const int calls = private_node.param("calls", 2000);
-  ros::ServiceClient compute =
-      node.serviceClient<ComputeCollision>("/collision_response/compute_collision", true);
+  const std::string service_name =
+      private_node.param<std::string>("service", "/collision_response/compute_collision");
+  ros::ServiceClient compute = node.serviceClient<ComputeCollision>(service_name, true);
   ros::ServiceClient empty = node.serviceClient<std_srvs::Empty>("/empty_service/empty", true);
   if (!compute.waitForExistence(ros::Duration(20)) || !empty.waitForExistence(ros::Duration(20)))
     return 2;

@@ -4,6 +4,7 @@
 # collision service's round trip beside an empty service. Writes doc/performance.md.
 #   bash scripts/performance.sh                    # the memory run lasts 10 minutes
 #   MEMORY_SECONDS=60 bash scripts/performance.sh  # a shorter one
+#   MEMORY_SECONDS=0 bash scripts/performance.sh   # none: the report keeps the last memory run
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 PACKAGES+=(libbenchmark-dev libbullet-dev libstd-srvs-dev ros-std-srvs linux-perf)
@@ -15,7 +16,9 @@ source_workspace
 bin="$ws/devel/lib/collision_response"
 out="$ws/performance"
 mkdir -p "$out"
-rm -f "$out"/*.json
+# A run without the memory part (MEMORY_SECONDS=0) keeps the last memory run's table.
+rm -f "$out"/scale.json "$out"/service*.json "$out"/load.json
+[ "${MEMORY_SECONDS:-600}" -gt 0 ] && rm -f "$out/memory.json"
 
 echo "== core: 1k, 10k, 100k bodies, and Bullet on the same gas"
 "$bin/bench_scale" --benchmark_format=json --benchmark_out="$out/scale.json" >"$out/scale.log" 2>&1
@@ -54,21 +57,33 @@ rosparam load "$out/gas.yaml" /node_benchmark
 "$bin/collision_response_node" >"$out/node.log" 2>&1 &
 node_pid=$!
 pids+=($node_pid)
+# The service is measured on a second node that serves the services alone (the default scene),
+# beside the empty service; the node with the 10,000 bodies is measured under load below.
+rosparam load "$repo/config/scenes/default.yaml" /collision_response_services
+"$bin/collision_response_node" __name:=collision_response_services >"$out/services_node.log" 2>&1 &
+pids+=($!)
 "$bin/empty_service" >"$out/empty.log" 2>&1 &
 pids+=($!)
 until rosservice list 2>/dev/null | grep -q /empty_service/empty &&
+  rosservice list 2>/dev/null | grep -q /collision_response_services/compute_collision &&
   rosservice list 2>/dev/null | grep -q /collision_response/compute_collision; do sleep 0.2; done
 
-echo "== service round trips (persistent clients, alternating)"
-"$bin/node_benchmark" _mode:=service _calls:=5000 >"$out/service.json"
+echo "== service round trips (persistent clients, alternating; three rounds)"
+for round in 1 2 3; do
+  "$bin/node_benchmark" _mode:=service _calls:=5000 _service:=/collision_response_services/compute_collision \
+    >"$out/service_$round.json"
+done
 echo "== ${bodies} bodies at 100 Hz for 20 s"
-# Where the node's time goes: a profile of 8 s in the middle of the run (when perf may sample).
+"$bin/node_benchmark" _mode:=load _rate:=100 _seconds:=20 _pid:="$node_pid" >"$out/load.json"
+# Where the node's time goes: perf samples the node for 8 s of a second load run (not the
+# measured one: sampling costs the node time).
+echo "== where the time goes: perf on a second run of 12 s"
 rm -f "$out/profile.txt"
-( sleep 8 && perf record -g -o "$out/perf.data" -p "$node_pid" -- sleep 8 >"$out/perf.log" 2>&1 &&
+( sleep 3 && perf record -g -o "$out/perf.data" -p "$node_pid" -- sleep 8 >"$out/perf.log" 2>&1 &&
   { perf report -i "$out/perf.data" --no-children --sort dso,sym -g none 2>/dev/null |
     grep -v '^#' | grep -v '^$' | head -15 >"$out/profile.txt" || true; } ) &
 profiler=$!
-"$bin/node_benchmark" _mode:=load _rate:=100 _seconds:=20 _pid:="$node_pid" >"$out/load.json"
+"$bin/node_benchmark" _mode:=load _rate:=100 _seconds:=12 >/dev/null
 wait "$profiler" || true
 [ -s "$out/profile.txt" ] || echo "(no profile: perf could not sample here, see $out/perf.log)"
 memory_seconds="${MEMORY_SECONDS:-600}"
