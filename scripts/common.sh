@@ -21,7 +21,7 @@ PACKAGES=(
   libvisualization-msgs-dev ros-visualization-msgs
   libdiagnostic-updater-dev libdiagnostic-msgs-dev ros-diagnostic-msgs
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
-  python3-rospy python3-genpy catkin-lint
+  python3-rospy python3-genpy python3-geometry-msgs catkin-lint
   googletest libgtest-dev clang libclang-rt-14-dev
 )
 
