@@ -46,6 +46,10 @@ install_packages() {
 
 build_workspace() {
   echo "== building in $ws"
+  # catkin writes the test environment (build/catkin_generated/setup_cached.sh) when it
+  # configures, with only the devel folders that exist then: made first, so that a first build
+  # puts the generated Python messages on the tests' PYTHONPATH (rospy tests need them).
+  mkdir -p "$ws/devel/lib/python3/dist-packages" "$ws/devel/lib/pkgconfig"
   # /usr/bin/python3: a python3 earlier on PATH (pyenv) may lack catkin_pkg.
   cmake -S "$repo" -B "$ws/build" -DCATKIN_DEVEL_PREFIX="$ws/devel" -DPython3_EXECUTABLE=/usr/bin/python3 \
     -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
