@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "box_walls.h"
 #include "collision_response/core/impact.h"
 #include "collision_response/core/monitor.h"
 #ifdef COLLISION_RESPONSE_WITH_BULLET
@@ -46,15 +47,7 @@ Gas makeGas(int count) {
     body.velocity = V(speed(engine), speed(engine), speed(engine));
     gas.scene.bodies.push_back(body);
   }
-  const V normals[] = {V(1, 0, 0), V(-1, 0, 0), V(0, 1, 0), V(0, -1, 0), V(0, 0, 1), V(0, 0, -1)};
-  for (int i = 0; i < 6; ++i) {
-    core::ObstacleSpec wall;
-    wall.id = "wall_" + std::to_string(i);
-    wall.material = "elastic";
-    wall.normal = normals[i];
-    wall.offset = i % 2 ? -gas.size : 0.0;
-    gas.scene.obstacles.push_back(wall);
-  }
+  addBoxWalls(gas.scene, gas.size, "elastic");
   return gas;
 }
 

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "box_walls.h"
 #include "collision_response/core/collision.h"
 #include "collision_response/core/monitor.h"
 
@@ -35,15 +36,7 @@ inline core::Scene boxScene(bool gravity, bool friction, bool spin) {
   scene.effects.friction = friction;
   scene.effects.spin = spin;
   const double size = 2.0;
-  const V normals[] = {V(1, 0, 0), V(-1, 0, 0), V(0, 1, 0), V(0, -1, 0), V(0, 0, 1), V(0, 0, -1)};
-  for (int i = 0; i < 6; ++i) {
-    core::ObstacleSpec wall;
-    wall.id = "wall_" + std::to_string(i);
-    wall.material = "billiard_ball";
-    wall.normal = normals[i];
-    wall.offset = i % 2 == 0 ? 0.0 : -size;
-    scene.obstacles.push_back(wall);
-  }
+  addBoxWalls(scene, size, "billiard_ball");
   for (int i = 0; i < 100; ++i) {
     core::BodySpec body;
     body.id = "ball_" + std::to_string(1000 + i);

@@ -71,3 +71,16 @@ source_workspace() {
 free_port() {
   /usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("localhost", 0)); print(s.getsockname()[1])'
 }
+
+# A private ROS master on a free port (ROS_MASTER_URI exported), stopped with every process in
+# `pids` when the script exits. usage: start_private_master LOG_FILE
+pids=()
+start_private_master() {
+  local port
+  port=$(free_port)
+  export ROS_MASTER_URI="http://localhost:$port"
+  trap 'for pid in "${pids[@]}"; do kill -INT "$pid" 2>/dev/null || true; done; wait 2>/dev/null || true' EXIT
+  roscore -p "$port" >"$1" 2>&1 &
+  pids+=($!)
+  until rosparam list >/dev/null 2>&1; do sleep 0.2; done
+}

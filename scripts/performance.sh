@@ -44,14 +44,7 @@ for i, (n, offset) in enumerate([("[1, 0, 0]", 0), ("[-1, 0, 0]", -size), ("[0, 
     lines.append(f"    - {{id: wall_{i}, type: plane, normal: {n}, offset: {offset}, material: elastic}}")
 open(path, "w").write("\n".join(lines) + "\n")
 PY
-port=$(free_port)
-export ROS_MASTER_URI="http://localhost:$port"
-pids=()
-cleanup() { for pid in "${pids[@]}"; do kill -INT "$pid" 2>/dev/null || true; done; wait 2>/dev/null || true; }
-trap cleanup EXIT
-roscore -p "$port" >"$out/roscore.log" 2>&1 &
-pids+=($!)
-until rosparam list >/dev/null 2>&1; do sleep 0.2; done
+start_private_master "$out/roscore.log"
 rosparam load "$out/gas.yaml" /collision_response
 rosparam load "$out/gas.yaml" /node_benchmark
 "$bin/collision_response_node" >"$out/node.log" 2>&1 &

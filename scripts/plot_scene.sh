@@ -13,14 +13,7 @@ build_workspace >"$ws/build.log" 2>&1 || { tail -40 "$ws/build.log"; echo "build
 source_workspace
 out="$ws/plots"
 mkdir -p "$out"
-port=$(free_port)
-export ROS_MASTER_URI="http://localhost:$port"
-pids=()
-cleanup() { for pid in "${pids[@]}"; do kill -INT "$pid" 2>/dev/null || true; done; wait 2>/dev/null || true; }
-trap cleanup EXIT
-roscore -p "$port" >"$out/roscore.log" 2>&1 &
-pids+=($!)
-until rosparam list >/dev/null 2>&1; do sleep 0.2; done
+start_private_master "$out/roscore.log"
 rm -f "$out/$scene.bag"
 rosbag record -O "$out/$scene.bag" /body_states /impacts >"$out/rosbag.log" 2>&1 &
 recorder=$!
