@@ -52,7 +52,7 @@ template <class Motion>
 void ContactSchedule<Motion>::schedule(std::size_t k, double from, const Geometry& g) {
   next_contact_[k] = INFINITY;
   const Pair& pair = pairs_[k];
-  if (!g.valid || world_.resting(pair)) return;
+  if (!g.valid || world_.lasting(pair)) return;
   // A touching pair that does not approach (it was just resolved, or slides) never comes back
   // in a straight line; under gravity it may (a ball that bounced falls back), so its next entry
   // is looked for, except on the plane it rests on.
@@ -92,12 +92,17 @@ void ContactSchedule<Motion>::reschedule(std::size_t body, double instant) {
 }
 
 template <class Motion>
-bool ContactSchedule<Motion>::next(double& instant, std::vector<std::size_t>& touching) {
+double ContactSchedule<Motion>::earliest() {
   while (!events_.empty() && events_.front().first != next_contact_[events_.front().second]) {
     std::pop_heap(events_.begin(), events_.end(), later);  // stale
     events_.pop_back();
   }
-  if (events_.empty()) return false;
+  return events_.empty() ? INFINITY : events_.front().first;
+}
+
+template <class Motion>
+bool ContactSchedule<Motion>::next(double& instant, std::vector<std::size_t>& touching) {
+  if (earliest() == INFINITY) return false;
   instant = events_.front().first;
   // The struck pairs, and every contact touching their bodies, transitively.
   for (const std::size_t body : frontier_seen_) queued_[body] = 0;

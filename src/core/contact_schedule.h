@@ -29,6 +29,8 @@ class ContactSchedule {
   /// After `body`'s motion changed at `instant`: the pairs its new motion may form, and all its
   /// pairs rescheduled (the others' next contact has not moved).
   void reschedule(std::size_t body, double instant);
+  /// The instant of the next first contact; infinity when none is left before the step's end.
+  double earliest();
   /// The next instant of contact and the contacts touching then: the struck pairs and every
   /// contact touching their bodies, transitively (a chain, a rack), in the canonical order of
   /// their bodies' sorted ids. False when no contact is left before the step's end.

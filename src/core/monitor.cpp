@@ -12,6 +12,7 @@
 #include "collision_response/core/cluster_solver.h"
 #include "contact_schedule.h"
 #include "instant_resolver.h"
+#include "lasting_contact.h"
 #include "monitor_world.h"
 #include "motion_model.h"
 
@@ -83,7 +84,13 @@ void applyStates(World& world, const std::vector<BodyStateSample>& states, StepR
     track.position = state.position;
     track.velocity = state.velocity;
     track.angular_velocity = state.angular_velocity;
-    if (world.effects.gravity) world.updateResting(state.body);
+    if (world.effects.gravity) {
+      // Free until the groups of lasting contact are formed again from the new states.
+      track.acceleration =
+          world.inverse_mass[state.body] > 0 ? world.gravity : Eigen::Vector3d::Zero();
+      track.angular_acceleration.setZero();
+      world.groups_current = false;
+    }
   }
 }
 
@@ -95,41 +102,115 @@ void forgetStaleBodies(World& world, double time) {
   }
 }
 
+/// Every tracked movable body stops where it is at `time` for the rest of the step: the last
+/// fallback when a step's work runs out twice (nothing moves, so nothing goes into anything).
+template <class Motion>
+void holdEverything(World& world, double time) {
+  for (std::size_t body = 0; body < world.bodies.size(); ++body) {
+    Track& track = world.tracks[body];
+    if (!track.known || world.inverse_mass[body] == 0.0) continue;
+    track.position = monitor::positionAt<Motion>(world, body, time);
+    track.time = time;
+    track.velocity.setZero();
+    track.angular_velocity.setZero();
+    track.acceleration.setZero();
+    track.angular_acceleration.setZero();
+  }
+  monitor::clearGroups(world);
+}
+
 /// Continuous detection: from the last states, the first contact of every candidate pair,
-/// earliest first; at each instant of contact the touching contacts are resolved, and the pairs
-/// of the bodies whose motion changed are scheduled again; then the states at `time` are taken.
+/// earliest first, and (gravity) the events of the groups of lasting contact; at each instant of
+/// contact the touching contacts are resolved, the groups of the bodies whose motion changed
+/// are formed again and their pairs scheduled again; then the states at `time` are taken.
+///
+/// When the step's instants run out (a ball wedged in a gap bouncing ever faster), every pair
+/// struck in the step is resolved at once as one inelastic cluster, so none of them approaches,
+/// and the step goes on with a second budget; if that runs out too, every body is held where it
+/// is until the step's end. Both count in report.fallbacks.
 template <class Motion>
 StepReport continuousStep(World& world, double time, const std::vector<BodyStateSample>& states) {
   StepReport report;
   monitor::candidatePairs<Motion>(world, world.now, time, world.scratch.pairs);
   ContactSchedule<Motion> schedule(world, time);
+  const monitor::PairIndex index{world.scratch.pairs, world.scratch.pairs_of};
   double instant = world.now;
   std::vector<std::size_t> touching;
   schedule.touchingAtStart(instant, touching);
   std::vector<Pair> touching_pairs;
   std::vector<std::size_t> changed;
+  std::vector<std::size_t> event_bodies;  // a group event's bodies: their groups form again
+  int budget = world.settings.max_instants_per_step;
+  bool fell_back = false;
   for (int instants = 0;; ++instants) {
-    if (instants >= world.settings.max_instants_per_step) {
+    changed.clear();
+    if (instants >= budget) {
       report.truncated = true;
-      break;
+      ++report.fallbacks;
+      if (fell_back) {
+        holdEverything<Motion>(world, instant);
+        break;
+      }
+      fell_back = true;
+      budget += world.settings.max_instants_per_step;
+      std::vector<Pair> struck;
+      for (const ImpactRecord& impact : report.impacts) {
+        struck.emplace_back(impact.body_a, impact.other_is_obstacle
+                                               ? impact.other + world.bodyCount()
+                                               : impact.other);
+      }
+      std::sort(struck.begin(), struck.end());
+      struck.erase(std::unique(struck.begin(), struck.end()), struck.end());
+      monitor::resolveInelastically<Motion>(world, instant, struck, report, changed);
     }
     touching_pairs.clear();
     for (const std::size_t k : touching) touching_pairs.push_back(schedule.pair(k));
-    changed.clear();
-    if (!touching_pairs.empty() &&
-        !monitor::resolveInstant<Motion>(world, instant, touching_pairs, report, changed)) {
-      report.truncated = true;
-      break;
+    if (!touching_pairs.empty()) {
+      monitor::resolveInstant<Motion>(world, instant, touching_pairs, report, changed);
     }
+    if constexpr (Motion::kAccelerates) {
+      // Lasting contact: the groups of the bodies whose motion changed (at the start, of every
+      // body, unless the groups hold already for these tracks).
+      std::vector<std::size_t> seeds = changed;
+      seeds.insert(seeds.end(), event_bodies.begin(), event_bodies.end());
+      if (instants == 0 && !world.groups_current) {
+        monitor::clearGroups(world);
+        seeds.clear();
+        for (std::size_t body = 0; body < world.bodies.size(); ++body) {
+          if (world.tracks[body].known) seeds.push_back(body);
+        }
+      }
+      if (!seeds.empty()) monitor::formGroups(world, instant, seeds, index, changed);
+      std::sort(changed.begin(), changed.end());
+      changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
+    }
+    event_bodies.clear();
     if (instants == 0) {
       schedule.scheduleAll(instant);
     } else {
       for (const std::size_t body : changed) schedule.reschedule(body, instant);
     }
+    // The next event: the earliest first contact, or (gravity) a group's motion changing.
+    if constexpr (Motion::kAccelerates) {
+      const double next_contact = schedule.earliest();
+      const auto [next_group_event, group] = monitor::nextGroupEvent(world);
+      if (next_group_event <= time && next_group_event <= next_contact) {
+        instant = next_group_event;
+        touching.clear();
+        event_bodies = world.groups[group].bodies;
+        world.groups[group].next_event = INFINITY;
+        continue;
+      }
+    }
     if (!schedule.next(instant, touching)) break;
   }
   applyStates(world, states, report);
   world.now = time;
+  if constexpr (Motion::kAccelerates) {
+    std::vector<std::size_t> formed;
+    monitor::formAllGroups(world, time, formed);
+    monitor::reportContacts(world, time, report.contacts);
+  }
   return report;
 }
 
@@ -150,13 +231,16 @@ StepReport discreteStep(World& world, double time, const std::vector<BodyStateSa
     }
   }
   std::vector<std::size_t> changed;
-  if (!monitor::resolveInstant<Motion>(world, time, touching, report, changed)) {
-    report.truncated = true;
-  }
+  monitor::resolveInstant<Motion>(world, time, touching, report, changed);
   world.overlapping.clear();
   for (const Pair& pair : pairs) {
     const Geometry g = monitor::geometry<Motion>(world, pair, time);
     if (g.valid && g.gap < -g.tolerance) world.overlapping.insert(pair);
+  }
+  if constexpr (Motion::kAccelerates) {
+    std::vector<std::size_t> formed;
+    monitor::formAllGroups(world, time, formed);
+    monitor::reportContacts(world, time, report.contacts);
   }
   return report;
 }
@@ -177,20 +261,6 @@ void start(World& world, double time) {
 }
 
 }  // namespace
-
-void World::updateResting(std::size_t body) {
-  Track& track = tracks[body];
-  track.resting_on = -1;
-  track.acceleration = inverse_mass[body] > 0 ? gravity : Eigen::Vector3d::Zero();
-  if (!effects.gravity || inverse_mass[body] == 0.0) return;
-  const auto plane = restingPlane(track.position, track.velocity, radius[body], fixed_planes,
-                                  gravity, settings.contact_tolerance);
-  if (!plane) return;
-  const Eigen::Vector3d& normal = fixed_planes[*plane].normal;
-  track.resting_on = static_cast<int>(fixed_plane_obstacle[*plane]);
-  track.velocity -= track.velocity.dot(normal) * normal;  // along the plane
-  track.acceleration = restingAcceleration(gravity, normal);
-}
 
 ImpactMonitor::ImpactMonitor(const Scene& scene, const MonitorSettings& settings)
     : world_(std::make_unique<World>()) {
@@ -242,11 +312,8 @@ ImpactMonitor::ImpactMonitor(const Scene& scene, const MonitorSettings& settings
     pose.normal = obstacle.normal.normalized();
     pose.offset = obstacle.offset;
     world.obstacle_tracks[i] = monitor::ObstacleTrack{true, pose};
-    if (obstacle.shape == ObstacleShape::kPlane) {
-      world.fixed_planes.push_back(Plane{pose.normal, pose.offset});
-      world.fixed_plane_obstacle.push_back(i);
-    }
   }
+  world.partners.assign(world.bodies.size(), {});
 }
 
 ImpactMonitor::ImpactMonitor(const ImpactMonitor& other)
@@ -272,6 +339,7 @@ void ImpactMonitor::tune(Detection detection, double restitution_threshold,
                          const MaterialTable& materials) {
   World& world = *world_;
   if (detection != world.detection) world.overlapping.clear();
+  world.groups_current = false;  // friction coefficients may have changed
   world.detection = detection;
   world.restitution_threshold = restitution_threshold;
   computePairCoefficients(world, materials);
@@ -290,6 +358,7 @@ std::optional<std::size_t> ImpactMonitor::bodyIndex(const std::string& id) const
 
 void ImpactMonitor::setObstaclePose(std::size_t obstacle, const ObstaclePose& pose) {
   world_->obstacle_tracks[obstacle] = monitor::ObstacleTrack{true, pose};
+  world_->groups_current = false;
 }
 
 void ImpactMonitor::reset() {
@@ -299,6 +368,8 @@ void ImpactMonitor::reset() {
     if (!world.obstacles[i].frame.empty()) world.obstacle_tracks[i] = monitor::ObstacleTrack{};
   }
   world.overlapping.clear();
+  monitor::clearGroups(world);
+  world.contact_since.clear();
   world.started = false;
   world.now = 0.0;
 }
@@ -309,9 +380,12 @@ std::size_t ImpactMonitor::trackedBodies() const {
 }
 
 std::optional<std::size_t> ImpactMonitor::restingOn(std::size_t body) const {
-  const Track& track = world_->tracks[body];
-  if (!track.known || track.resting_on < 0) return std::nullopt;
-  return static_cast<std::size_t>(track.resting_on);
+  const World& world = *world_;
+  if (!world.tracks[body].known || world.partners.empty()) return std::nullopt;
+  for (const std::size_t other : world.partners[body]) {
+    if (world.isObstacle(other)) return other - world.bodyCount();
+  }
+  return std::nullopt;
 }
 
 std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> ImpactMonitor::predictedState(

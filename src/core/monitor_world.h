@@ -5,8 +5,10 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cstddef>
 #include <limits>
+#include <map>
 #include <set>
 #include <string>
 #include <unordered_map>
@@ -15,6 +17,7 @@
 
 #include "collision_response/core/broadphase.h"
 #include "collision_response/core/cluster_solver.h"
+#include "collision_response/core/contact_forces.h"
 #include "collision_response/core/friction.h"
 #include "collision_response/core/monitor.h"
 #include "collision_response/core/motion.h"
@@ -36,8 +39,10 @@ struct Track {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
-  Eigen::Vector3d acceleration = Eigen::Vector3d::Zero();  ///< gravity, or its part along a plane
-  int resting_on = -1;                                     ///< obstacle index, -1: none
+  /// Gravity, or (in lasting contact) what gravity and the contact forces leave.
+  Eigen::Vector3d acceleration = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_acceleration = Eigen::Vector3d::Zero();  ///< rolling: from friction
+  int group = -1;  ///< its group of lasting contact (World::groups), -1: none
   double last_state_time = kNever;
   double last_impact_time = kNever;
 };
@@ -56,6 +61,25 @@ struct Geometry {
   double gap = 0.0;        ///< m, surface to surface along the normal; < 0 overlapping
   double tolerance = 0.0;  ///< m, |gap| within it is touching
   bool valid = false;      ///< false: coincident centres and no approach: no line of impact
+};
+
+/// A contact that lasts: the pair presses with a steady force (ContactForce), at `time`.
+struct GroupContact {
+  Pair pair;
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();  ///< unit, a -> other
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  ContactForce force;
+  double since = 0.0;  ///< s, the instant it began to last
+};
+
+/// Bodies that rest, slide or roll on each other and on obstacles (lasting contact), and the
+/// motion their contact forces give them from `time` on, until `next_event` (a slip that stops).
+struct ContactGroup {
+  bool alive = false;
+  double time = 0.0;
+  std::vector<std::size_t> bodies;     ///< sorted
+  std::vector<GroupContact> contacts;  ///< the pressed ones, in the canonical order of pairs
+  double next_event = std::numeric_limits<double>::infinity();
 };
 
 /// Working memory of a step, kept so that steps do not allocate once it has grown.
@@ -87,15 +111,18 @@ struct World {
   Effects effects;                   // what this build runs of the scene's (runnableEffects)
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  // zero without the gravity effect
   FrictionModel friction_model;                       // empty without the friction effect
-  std::vector<Plane> fixed_planes;                    // for resting, with their obstacles:
-  std::vector<std::size_t> fixed_plane_obstacle;
-  std::vector<std::string> material_names;       // the scene's materials, indexed
-  std::vector<std::size_t> material;             // per participant, into restitution
-  std::vector<std::vector<double>> restitution;  // material x material
-  std::vector<std::vector<double>> friction;     // material x material
+  std::vector<std::string> material_names;            // the scene's materials, indexed
+  std::vector<std::size_t> material;                  // per participant, into restitution
+  std::vector<std::vector<double>> restitution;       // material x material
+  std::vector<std::vector<double>> friction;          // material x material
   std::vector<Track> tracks;
   std::vector<ObstacleTrack> obstacle_tracks;
-  std::set<Pair> overlapping;  // discrete: pairs overlapping at the previous step
+  std::set<Pair> overlapping;        // discrete: pairs overlapping at the previous step
+  std::vector<ContactGroup> groups;  // lasting contact (gravity)
+  std::vector<std::vector<std::size_t>> partners;  // per body: its lasting contacts' others
+  std::map<Pair, double> contact_since;            // every lasting pair's start, and those the
+                                                   // rest rule set to begin at an instant
+  bool groups_current = false;                     // the groups hold for the tracks at `now`
   Scratch scratch;
   bool started = false;
   double now = 0.0;
@@ -116,23 +143,18 @@ struct World {
   double inverseMassOf(std::size_t participant) const {
     return isObstacle(participant) ? 0.0 : inverse_mass[participant];
   }
-  Eigen::Vector3d angularVelocityOf(std::size_t participant) const {
-    return isObstacle(participant) ? obstaclePose(participant).angular_velocity
-                                   : tracks[participant].angular_velocity;
-  }
   double restitutionOf(const Pair& pair) const {
     return restitution[material[pair.first]][material[pair.second]];
   }
   double frictionOf(const Pair& pair) const {
     return friction[material[pair.first]][material[pair.second]];
   }
-  /// The pair is a body and the plane it rests on (gravity).
-  bool resting(const Pair& pair) const {
-    return isObstacle(pair.second) &&
-           tracks[pair.first].resting_on == static_cast<int>(pair.second - bodies.size());
+  /// The pair is a lasting contact: its motion keeps it touching (no first contact to look for).
+  bool lasting(const Pair& pair) const {
+    if (partners.empty()) return false;
+    const std::vector<std::size_t>& others = partners[pair.first];
+    return std::find(others.begin(), others.end(), pair.second) != others.end();
   }
-  /// After a body's velocity changed: does it now rest on a fixed plane (gravity)?
-  void updateResting(std::size_t body);
 };
 
 }  // namespace collision_response::core::monitor

@@ -23,6 +23,9 @@ struct StraightLine {
     return track.position + track.velocity * (time - track.time);
   }
   static Eigen::Vector3d velocity(const Track& track, double /*time*/) { return track.velocity; }
+  static Eigen::Vector3d angularVelocity(const Track& track, double /*time*/) {
+    return track.angular_velocity;
+  }
 };
 
 /// Parabolas under the track's acceleration (gravity, or its part along the plane a body rests
@@ -34,6 +37,9 @@ struct UnderGravity {
   }
   static Eigen::Vector3d velocity(const Track& track, double time) {
     return velocityAfter(track.velocity, track.acceleration, time - track.time);
+  }
+  static Eigen::Vector3d angularVelocity(const Track& track, double time) {
+    return velocityAfter(track.angular_velocity, track.angular_acceleration, time - track.time);
   }
 };
 
@@ -51,6 +57,12 @@ template <class Motion>
 Eigen::Vector3d velocityAt(const World& world, std::size_t participant, double time) {
   if (world.isObstacle(participant)) return world.obstaclePose(participant).velocity;
   return Motion::velocity(world.tracks[participant], time);
+}
+
+template <class Motion>
+Eigen::Vector3d angularVelocityAt(const World& world, std::size_t participant, double time) {
+  if (world.isObstacle(participant)) return world.obstaclePose(participant).angular_velocity;
+  return Motion::angularVelocity(world.tracks[participant], time);
 }
 
 /// The acceleration the model gives a participant (obstacles move in straight lines).

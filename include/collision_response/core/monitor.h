@@ -70,10 +70,39 @@ struct ImpactRecord {
   Eigen::Vector3d angular_velocity_b_before, angular_velocity_b_after;
 };
 
+/// How a lasting contact carries its force.
+enum class ContactState {
+  kResting,  ///< no slip and no relative motion
+  kSliding,  ///< the surfaces slip (frictionless contacts slide as soon as they move)
+  kRolling,  ///< no slip at the contact point while the bodies move (static friction)
+};
+const char* toString(ContactState state);
+
+/// A contact that lasts (gravity): a body rests, slides or rolls on another or on an obstacle.
+struct ContactRecord {
+  double time = 0.0;       ///< s, the instant the forces below hold
+  std::size_t body_a = 0;  ///< a body index
+  std::size_t other = 0;   ///< a body index, or an obstacle index when other_is_obstacle
+  bool other_is_obstacle = false;
+  Eigen::Vector3d contact_point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();         ///< unit, a -> other
+  double normal_force = 0.0;                                 ///< N, >= 0, on other along the normal
+  Eigen::Vector3d friction_force = Eigen::Vector3d::Zero();  ///< N, on other (a: opposite)
+  ContactState state = ContactState::kResting;
+  double since = 0.0;  ///< s, the instant the contact began to last
+};
+
 struct StepReport {
   std::vector<ImpactRecord> impacts;
+  /// The lasting contacts at the step's time (with the gravity effect), in the order of their
+  /// pairs.
+  std::vector<ContactRecord> contacts;
   std::size_t stale_states = 0;  ///< states not newer than their body's last one: dropped
-  bool truncated = false;        ///< a guard of MonitorSettings stopped the step
+  /// A guard of MonitorSettings ran out (rounds at an instant, instants in the step).
+  bool truncated = false;
+  /// What the fallbacks did when a guard ran out, so that no body goes into another: a cluster
+  /// resolved as one inelastic cluster, or the step's bodies held where they were.
+  std::size_t fallbacks = 0;
 };
 
 /// Watches the scene's bodies and obstacles and finds their impacts.
