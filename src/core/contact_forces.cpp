@@ -209,6 +209,79 @@ Trial solveModes(const Group& group, const std::vector<Mode>& modes,
   return trial;
 }
 
+/// The tolerances' scales: the accelerations and speeds the group has.
+struct Scales {
+  Real acceleration = 0, speed = 0, slip_tolerance = 0;
+};
+Scales scalesOf(const std::vector<ForceBody>& bodies, const ContactForceSettings& settings) {
+  Scales scales;
+  for (const ForceBody& body : bodies) {
+    scales.acceleration = std::max(scales.acceleration,
+                                   widen(body.acceleration).norm() +
+                                       Real(body.radius) * widen(body.angular_acceleration).norm());
+    scales.speed =
+        std::max(scales.speed, widen(body.velocity).norm() +
+                                   Real(body.radius) * widen(body.angular_velocity).norm());
+  }
+  scales.slip_tolerance =
+      Real(settings.slip_tolerance) + 64 * std::numeric_limits<double>::epsilon() * scales.speed;
+  return scales;
+}
+
+constexpr Real kTolerance = 1e-12L;
+
+/// The answer in doubles: each contact's force, mode, slip and rates, each body's accelerations.
+/// `clamp`: no negative normal force (the fixed-mode evaluation keeps its sign, to find where a
+/// contact lets go).
+void package(const Group& group, const Trial& trial, const std::vector<Mode>& modes,
+             const Scales& scales, bool clamp, ContactForceSolution& result) {
+  const std::size_t count = group.contactCount();
+  const Real tolerance = kTolerance;
+  const Real acceleration_scale = scales.acceleration;
+  const Real slip_tolerance = scales.slip_tolerance;
+  const std::size_t body_count = trial.response.acceleration.size();
+  result.contacts.resize(count);
+  for (std::size_t k = 0; k < count; ++k) {
+    ContactForce& out = result.contacts[k];
+    out.normal = static_cast<double>(clamp ? std::max(trial.normal_force[k], Real(0))
+                                           : trial.normal_force[k]);
+    out.tangential = trial.tangential_force[k].cast<double>();
+    out.slip = group.slip(k).cast<double>();
+    out.slip_acceleration = trial.response.slip_acceleration[k].cast<double>();
+    out.gap_acceleration = static_cast<double>(trial.response.gap_acceleration[k]);
+    if (!modes[k].pressed) {
+      out.mode = ContactMode::kSeparating;
+    } else if (modes[k].tangential == Tangential::kSlide) {
+      out.mode = ContactMode::kSliding;
+    } else if (modes[k].tangential == Tangential::kStick) {
+      out.mode = ContactMode::kSticking;
+    } else {
+      // Frictionless: it slides as soon as it slips or is about to.
+      const bool slipping = group.slip(k).norm() > slip_tolerance ||
+                            trial.response.slip_acceleration[k].norm() >
+                                tolerance * std::max(acceleration_scale, Real(1e-300));
+      out.mode = slipping ? ContactMode::kSliding : ContactMode::kSticking;
+    }
+  }
+  result.acceleration.resize(body_count);
+  result.angular_acceleration.resize(body_count);
+  // What is left of a balanced acceleration is the rounding of the long double solve (1e-19 of
+  // the accelerations at most): components below the rounding of the double inputs are 0, so a
+  // body held at rest stays exactly where it is.
+  const Real negligible = 4 * std::numeric_limits<double>::epsilon() * acceleration_scale;
+  const auto snapped = [negligible](const V3& value) {
+    Eigen::Vector3d out;
+    for (Eigen::Index c = 0; c < 3; ++c) {
+      out[c] = std::abs(value[c]) <= negligible ? 0.0 : static_cast<double>(value[c]);
+    }
+    return out;
+  };
+  for (std::size_t i = 0; i < body_count; ++i) {
+    result.acceleration[i] = snapped(trial.response.acceleration[i]);
+    result.angular_acceleration[i] = snapped(trial.response.angular_acceleration[i]);
+  }
+}
+
 }  // namespace
 
 void closeContactVelocities(std::vector<ForceBody>& bodies,
@@ -269,6 +342,33 @@ void closeContactVelocities(std::vector<ForceBody>& bodies,
   }
 }
 
+void closeContactGaps(std::vector<Eigen::Vector3d>& positions, const std::vector<ForceBody>& bodies,
+                      const std::vector<ForceContact>& contacts, const std::vector<double>& gaps) {
+  // Displacements d = w sum_k s_k mu_k n_k change gap_l by sum_k A_lk mu_k, as impulses change the
+  // normal relative velocities: the same linear map.
+  const Group group(bodies, contacts);
+  const auto size = static_cast<Eigen::Index>(contacts.size());
+  if (size == 0) return;
+  const std::vector<V3> none(contacts.size(), V3::Zero());
+  Matrix system(size, size);
+  for (Eigen::Index j = 0; j < size; ++j) {
+    std::vector<V3> pushes = none;
+    pushes[j] = group.normal(j);
+    const Response column = group.respond(pushes, false);
+    for (Eigen::Index i = 0; i < size; ++i) system(i, j) = column.gap_acceleration[i];
+  }
+  Vector target(size);
+  for (Eigen::Index i = 0; i < size; ++i) target[i] = -Real(gaps[i]);
+  const Vector solution = system.completeOrthogonalDecomposition().solve(target);
+  std::vector<V3> pushes = none;
+  for (Eigen::Index j = 0; j < size; ++j) pushes[j] = solution[j] * group.normal(j);
+  const Response change = group.respond(pushes, false);
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    if (bodies[i].inverse_mass == 0.0) continue;
+    positions[i] = (widen(positions[i]) + change.acceleration[i]).cast<double>();
+  }
+}
+
 ContactForceSolution solveContactForces(const std::vector<ForceBody>& bodies,
                                         const std::vector<ForceContact>& contacts,
                                         const ContactForceSettings& settings) {
@@ -277,19 +377,10 @@ ContactForceSolution solveContactForces(const std::vector<ForceBody>& bodies,
   std::vector<Real> friction(count);
   for (std::size_t k = 0; k < count; ++k) friction[k] = contacts[k].friction;
 
-  // Scales of the tolerances: accelerations and speeds the group has.
-  Real acceleration_scale = 0, speed_scale = 0;
-  for (const ForceBody& body : bodies) {
-    acceleration_scale = std::max(acceleration_scale,
-                                  widen(body.acceleration).norm() +
-                                      Real(body.radius) * widen(body.angular_acceleration).norm());
-    speed_scale =
-        std::max(speed_scale, widen(body.velocity).norm() +
-                                  Real(body.radius) * widen(body.angular_velocity).norm());
-  }
-  const Real tolerance = 1e-12L;
-  const Real slip_tolerance =
-      Real(settings.slip_tolerance) + 64 * std::numeric_limits<double>::epsilon() * speed_scale;
+  const Scales scales = scalesOf(bodies, settings);
+  const Real acceleration_scale = scales.acceleration;
+  const Real tolerance = kTolerance;
+  const Real slip_tolerance = scales.slip_tolerance;
 
   std::vector<Mode> modes(count);
   for (std::size_t k = 0; k < count; ++k) {
@@ -429,45 +520,33 @@ ContactForceSolution solveContactForces(const std::vector<ForceBody>& bodies,
       modes[k].pressed = false;
     }
   }
-  result.contacts.resize(count);
+  package(group, trial, modes, scales, true, result);
+  return result;
+}
+
+ContactForceSolution solveContactForcesWithModes(const std::vector<ForceBody>& bodies,
+                                                 const std::vector<ForceContact>& contacts,
+                                                 const std::vector<ContactMode>& fixed,
+                                                 const ContactForceSettings& settings) {
+  const Group group(bodies, contacts);
+  const std::size_t count = contacts.size();
+  const Scales scales = scalesOf(bodies, settings);
+  std::vector<Real> friction(count);
+  std::vector<Mode> modes(count);
   for (std::size_t k = 0; k < count; ++k) {
-    ContactForce& out = result.contacts[k];
-    out.normal = static_cast<double>(std::max(trial.normal_force[k], Real(0)));
-    out.tangential = trial.tangential_force[k].cast<double>();
-    out.slip = group.slip(k).cast<double>();
-    out.slip_acceleration = trial.response.slip_acceleration[k].cast<double>();
-    out.gap_acceleration = static_cast<double>(trial.response.gap_acceleration[k]);
-    if (!modes[k].pressed) {
-      out.mode = ContactMode::kSeparating;
-    } else if (modes[k].tangential == Tangential::kSlide) {
-      out.mode = ContactMode::kSliding;
-    } else if (modes[k].tangential == Tangential::kStick) {
-      out.mode = ContactMode::kSticking;
-    } else {
-      // Frictionless: it slides as soon as it slips or is about to.
-      const bool slipping = group.slip(k).norm() > slip_tolerance ||
-                            trial.response.slip_acceleration[k].norm() >
-                                tolerance * std::max(acceleration_scale, Real(1e-300));
-      out.mode = slipping ? ContactMode::kSliding : ContactMode::kSticking;
+    friction[k] = contacts[k].friction;
+    modes[k].pressed = fixed[k] != ContactMode::kSeparating;
+    if (!modes[k].pressed || !(friction[k] > 0)) continue;
+    if (fixed[k] == ContactMode::kSticking) {
+      modes[k].tangential = Tangential::kStick;
+    } else if (group.slip(k).norm() > 0) {
+      modes[k].tangential = Tangential::kSlide;  // along the slip it has now
+      modes[k].slide_direction = group.slip(k).normalized();
     }
   }
-  result.acceleration.resize(bodies.size());
-  result.angular_acceleration.resize(bodies.size());
-  // What is left of a balanced acceleration is the rounding of the long double solve (1e-19 of
-  // the accelerations at most): components below the rounding of the double inputs are 0, so a
-  // body held at rest stays exactly where it is.
-  const Real negligible = 4 * std::numeric_limits<double>::epsilon() * acceleration_scale;
-  const auto snapped = [negligible](const V3& value) {
-    Eigen::Vector3d out;
-    for (Eigen::Index c = 0; c < 3; ++c) {
-      out[c] = std::abs(value[c]) <= negligible ? 0.0 : static_cast<double>(value[c]);
-    }
-    return out;
-  };
-  for (std::size_t i = 0; i < bodies.size(); ++i) {
-    result.acceleration[i] = snapped(trial.response.acceleration[i]);
-    result.angular_acceleration[i] = snapped(trial.response.angular_acceleration[i]);
-  }
+  const Trial trial = solveModes(group, modes, friction);
+  ContactForceSolution result;
+  package(group, trial, modes, scales, false, result);
   return result;
 }
 

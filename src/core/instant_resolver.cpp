@@ -184,6 +184,7 @@ void storeVelocities(World& world, double time, const PreparedCluster& prepared,
     track.velocity = prepared.bodies[m].velocity;
     track.angular_velocity = prepared.bodies[m].angular_velocity;
     track.last_impact_time = time;
+    track.constrained = nullptr;
     changed.push_back(participant);
   }
 }
@@ -352,6 +353,7 @@ void resolveInelastically(World& world, double time, const std::vector<Pair>& pa
     track.velocity = solution.acceleration[i];
     if (world.spin_factor[p] != 0.0) track.angular_velocity = solution.angular_acceleration[i];
     track.last_impact_time = time;
+    track.constrained = nullptr;
     changed.push_back(p);
   }
 }

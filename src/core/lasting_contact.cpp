@@ -60,6 +60,14 @@ std::size_t newGroup(World& world) {
   return world.groups.size() - 1;
 }
 
+/// A slip slower than what integrating curved contact leaves behind (1000 times its tolerance,
+/// at least 1e-9 m/s) is none: the contact sticks, and its slip is closed.
+ContactForceSettings lastingContactSettings(const World& world) {
+  ContactForceSettings settings;
+  settings.slip_tolerance = std::max(1e-9, 1e3 * world.integration_tolerance);
+  return settings;
+}
+
 /// The instant a sliding contact's slip stops, when its rate is constant and against it (the
 /// motion of a group on planes); infinity when it does not stop.
 double slipStops(const ContactForce& force, double time) {
@@ -120,9 +128,17 @@ void solveGroup(World& world, double time, const std::vector<std::size_t>& bodie
     if (world.friction_model) contact.friction = world.frictionOf(pair);
     contacts.push_back(contact);
   }
-  // Lasting contacts neither close nor open; then the forces; then sticking ones do not slip.
+  // Lasting contacts touch: their gaps closed (overlapping ones are held where they are), their
+  // normal relative velocities closed; then the forces; then sticking ones do not slip.
+  std::vector<Eigen::Vector3d> positions;
+  for (const std::size_t p : participants) positions.push_back(positionAt<Motion>(world, p, time));
+  std::vector<double> gaps;
+  for (const auto& [pair, g] : candidates)
+    gaps.push_back(std::abs(g.gap) <= g.tolerance ? g.gap : 0.0);
+  closeContactGaps(positions, force_bodies, contacts, gaps);
   closeContactVelocities(force_bodies, contacts, std::vector<bool>(contacts.size(), false));
-  const ContactForceSolution solution = solveContactForces(force_bodies, contacts);
+  const ContactForceSolution solution =
+      solveContactForces(force_bodies, contacts, lastingContactSettings(world));
   std::vector<bool> sticking(contacts.size(), false);
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     sticking[k] = contacts[k].friction > 0 && solution.contacts[k].mode == ContactMode::kSticking;
@@ -136,6 +152,13 @@ void solveGroup(World& world, double time, const std::vector<std::size_t>& bodie
   contact_group.time = time;
   contact_group.next_event = INFINITY;
   std::vector<char> pressed_body(bodies.size(), 0);
+  std::vector<std::size_t> pressed;  // indices into candidates
+  // Curved: a pressed contact of two spheres whose line of centres turns (they move or
+  // accelerate relative to each other), or a sliding contact whose slip turns. Then the motion
+  // is integrated; otherwise the forces are constant and it is a parabola.
+  bool curved = false;
+  const double speed_tolerance = lastingContactSettings(world).slip_tolerance;
+  const double acceleration_tolerance = 1e-12 * world.gravity.norm();
   for (std::size_t k = 0; k < candidates.size(); ++k) {
     const ContactForce& force = solution.contacts[k];
     const Pair& pair = candidates[k].first;
@@ -143,11 +166,30 @@ void solveGroup(World& world, double time, const std::vector<std::size_t>& bodie
       world.contact_since.erase(pair);
       continue;
     }
+    pressed.push_back(k);
+    const ForceContact& c = contacts[k];
+    if (c.curvature > 0) {
+      const Eigen::Vector3d relative_velocity =
+          force_bodies[c.b].velocity - force_bodies[c.a].velocity;
+      const Eigen::Vector3d relative_acceleration =
+          solution.acceleration[c.b] - solution.acceleration[c.a];
+      if (relative_velocity.norm() > speed_tolerance ||
+          relative_acceleration.norm() > acceleration_tolerance) {
+        curved = true;
+      }
+    }
+    if (force.mode == ContactMode::kSliding && c.friction > 0 && force.slip.norm() > 0) {
+      const Eigen::Vector3d along = force.slip.normalized();
+      const Eigen::Vector3d rate = force.slip_acceleration;
+      if ((rate - rate.dot(along) * along).norm() >
+          1e-12 * (rate.norm() + acceleration_tolerance)) {
+        curved = true;
+      }
+    }
     GroupContact contact;
     contact.pair = pair;
     contact.normal = candidates[k].second.normal;
-    contact.point = positionAt<Motion>(world, pair.first, time) +
-                    (world.radius[pair.first] + 0.5 * candidates[k].second.gap) * contact.normal;
+    contact.point = positions[c.a] + world.radius[pair.first] * contact.normal;
     contact.force = force;
     const auto since = world.contact_since.emplace(pair, time).first;
     contact.since = since->second;
@@ -157,24 +199,68 @@ void solveGroup(World& world, double time, const std::vector<std::size_t>& bodie
     }
     world.partners[pair.first].push_back(pair.second);
     if (!world.isObstacle(pair.second)) world.partners[pair.second].push_back(pair.first);
-    if (force.mode == ContactMode::kSliding && contacts[k].friction > 0) {
+    if (force.mode == ContactMode::kSliding && c.friction > 0) {
       contact_group.next_event = std::min(contact_group.next_event, slipStops(force, time));
     }
   }
   contact_group.alive = !contact_group.contacts.empty();
+
+  std::shared_ptr<const ConstrainedStep> step;
+  std::vector<std::size_t> step_slot(participants.size(), 0);
+  if (curved) {
+    // The integrated step: the pressed bodies, then the fixed participants of pressed contacts.
+    std::vector<std::size_t> order;
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      if (pressed_body[i]) order.push_back(i);
+    }
+    const std::size_t movable = order.size();
+    for (std::size_t i = bodies.size(); i < participants.size(); ++i) order.push_back(i);
+    std::vector<ForceBody> step_bodies;
+    std::vector<Eigen::Vector3d> step_positions;
+    double guess = 0;
+    for (std::size_t j = 0; j < order.size(); ++j) {
+      step_slot[order[j]] = j;
+      step_bodies.push_back(force_bodies[order[j]]);
+      step_positions.push_back(positions[order[j]]);
+      if (j < movable)
+        guess = std::max(guess, world.tracks[participants[order[j]]].integration_step);
+    }
+    std::vector<ConstrainedContact> step_contacts;
+    for (const std::size_t k : pressed) {
+      const Pair& pair = candidates[k].first;
+      ConstrainedContact c;
+      c.a = step_slot[contacts[k].a];
+      c.b = step_slot[contacts[k].b];
+      c.plane = world.isPlane(pair.second);
+      if (c.plane) c.plane_normal = -candidates[k].second.normal;
+      c.friction = contacts[k].friction;
+      c.mode = solution.contacts[k].mode;
+      step_contacts.push_back(c);
+    }
+    step = std::make_shared<const ConstrainedStep>(step_bodies, step_positions, movable,
+                                                   step_contacts, time, world.integration_tolerance,
+                                                   guess > 0 ? guess : 1e-3, 0.1);
+    contact_group.next_event = std::min(contact_group.next_event, step->end());
+  }
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     const std::size_t body = bodies[i];
     Track& track = world.tracks[body];
-    track.position = positionAt<Motion>(world, body, time);
+    track.position = positions[i];
     track.angular_velocity = force_bodies[i].angular_velocity;
     track.time = time;
     track.velocity = force_bodies[i].velocity;
     track.acceleration = solution.acceleration[i];
     track.angular_acceleration =
         world.spin_factor[body] != 0.0 ? solution.angular_acceleration[i] : Eigen::Vector3d::Zero();
+    track.constrained = nullptr;
     if (pressed_body[i]) {
       track.group = static_cast<int>(group);
       contact_group.bodies.push_back(body);
+      if (step) {
+        track.constrained = step;
+        track.slot = step_slot[i];
+        track.integration_step = step->nextStep();
+      }
     } else {
       track.group = -1;
     }
@@ -268,13 +354,17 @@ void formGroups(World& world, double time, const std::vector<std::size_t>& seeds
       // Free: gravity alone, from here.
       for (const std::size_t body : set_bodies[root]) {
         Track& track = world.tracks[body];
-        if (track.acceleration == world.gravity && track.angular_acceleration.isZero()) continue;
+        if (track.acceleration == world.gravity && track.angular_acceleration.isZero() &&
+            !track.constrained) {
+          continue;
+        }
         track.position = positionAt<Motion>(world, body, time);
         track.velocity = velocityAt<Motion>(world, body, time);
         track.angular_velocity = angularVelocityAt<Motion>(world, body, time);
         track.time = time;
         track.acceleration = world.gravity;
         track.angular_acceleration.setZero();
+        track.constrained = nullptr;
         changed.push_back(body);
       }
       continue;

@@ -84,6 +84,7 @@ void applyStates(World& world, const std::vector<BodyStateSample>& states, StepR
     track.position = state.position;
     track.velocity = state.velocity;
     track.angular_velocity = state.angular_velocity;
+    track.constrained = nullptr;
     if (world.effects.gravity) {
       // Free until the groups of lasting contact are formed again from the new states.
       track.acceleration =
@@ -115,6 +116,7 @@ void holdEverything(World& world, double time) {
     track.angular_velocity.setZero();
     track.acceleration.setZero();
     track.angular_acceleration.setZero();
+    track.constrained = nullptr;
   }
   monitor::clearGroups(world);
 }
@@ -275,6 +277,7 @@ ImpactMonitor::ImpactMonitor(const Scene& scene, const MonitorSettings& settings
   std::sort(world.obstacles.begin(), world.obstacles.end(), by_id);
   world.effects = runnableEffects(scene.effects);
   if (world.effects.gravity) world.gravity = scene.gravity;
+  world.integration_tolerance = scene.contact_integration_tolerance;
   world.friction_model = frictionModelFor(world.effects);
 
   std::vector<std::string>& material_names = world.material_names;

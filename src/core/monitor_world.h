@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <limits>
 #include <map>
+#include <memory>
 #include <set>
 #include <string>
 #include <unordered_map>
@@ -22,6 +23,7 @@
 #include "collision_response/core/monitor.h"
 #include "collision_response/core/motion.h"
 #include "collision_response/core/scene.h"
+#include "constrained_motion.h"
 
 namespace collision_response::core::monitor {
 
@@ -43,6 +45,11 @@ struct Track {
   Eigen::Vector3d acceleration = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_acceleration = Eigen::Vector3d::Zero();  ///< rolling: from friction
   int group = -1;  ///< its group of lasting contact (World::groups), -1: none
+  /// Curved lasting contact: the integrated step its motion follows (body `slot` of it), which
+  /// replaces the parabola; null otherwise.
+  std::shared_ptr<const ConstrainedStep> constrained;
+  std::size_t slot = 0;
+  double integration_step = 0.0;  ///< the integrator's last step size, a guess for the next
   double last_state_time = kNever;
   double last_impact_time = kNever;
 };
@@ -110,6 +117,7 @@ struct World {
   std::vector<double> spin_factor;   // per body, 1/k, 0 without spin
   Effects effects;                   // what this build runs of the scene's (runnableEffects)
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  // zero without the gravity effect
+  double integration_tolerance = 1e-9;                // curved lasting contact
   FrictionModel friction_model;                       // empty without the friction effect
   std::vector<std::string> material_names;            // the scene's materials, indexed
   std::vector<std::size_t> material;                  // per participant, into restitution

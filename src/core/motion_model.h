@@ -30,18 +30,27 @@ struct StraightLine {
 
 /// Parabolas under the track's acceleration (gravity, or its part along the plane a body rests
 /// on): the gravity effect.
+/// In curved lasting contact the motion is the integrated step's instead.
 struct UnderGravity {
   static constexpr bool kAccelerates = true;
   static Eigen::Vector3d position(const Track& track, double time) {
+    if (track.constrained) return track.constrained->position(track.slot, time);
     return positionAfter(track.position, track.velocity, track.acceleration, time - track.time);
   }
   static Eigen::Vector3d velocity(const Track& track, double time) {
+    if (track.constrained) return track.constrained->velocity(track.slot, time);
     return velocityAfter(track.velocity, track.acceleration, time - track.time);
   }
   static Eigen::Vector3d angularVelocity(const Track& track, double time) {
+    if (track.constrained) return track.constrained->angularVelocity(track.slot, time);
     return velocityAfter(track.angular_velocity, track.angular_acceleration, time - track.time);
   }
 };
+
+/// The participant moves along an integrated step (curved lasting contact).
+inline bool constrained(const World& world, std::size_t participant) {
+  return !world.isObstacle(participant) && world.tracks[participant].constrained != nullptr;
+}
 
 /// A participant's position at `time`: a body along its track, an obstacle along its pose.
 template <class Motion>
@@ -111,11 +120,50 @@ Geometry geometry(const World& world, const Pair& pair, double time) {
   return result;
 }
 
+template <class Motion>
+Geometry geometry(const World& world, const Pair& pair, double time);
+
+/// The first contact of a pair one of whose bodies follows an integrated step, within it: the
+/// gap sampled along the step and the first entry (from open to closed) bisected.
+template <class Motion>
+std::optional<double> timeOfImpactAlongPaths(const World& world, const Pair& pair, double from,
+                                             double horizon) {
+  double end = from + horizon;
+  for (const std::size_t p : {pair.first, pair.second}) {
+    if (constrained(world, p)) end = std::min(end, world.tracks[p].constrained->end());
+  }
+  if (!(end > from)) return std::nullopt;
+  const auto gap = [&](double t) { return geometry<Motion>(world, pair, t).gap; };
+  constexpr int kSamples = 16;
+  double previous_time = from, previous_gap = gap(from);
+  if (previous_gap < 0) return std::nullopt;  // overlapping already: not an impact
+  for (int i = 1; i <= kSamples; ++i) {
+    const double t = from + (end - from) * i / kSamples;
+    const double g = gap(t);
+    if (previous_gap > 0 && g <= 0) {
+      double open = previous_time, closed = t;
+      while (closed - open > 1e-13 * (end - from) + 4e-16 * std::abs(closed)) {
+        const double middle = 0.5 * (open + closed);
+        (gap(middle) > 0 ? open : closed) = middle;
+      }
+      return closed - from;
+    }
+    previous_time = t;
+    previous_gap = g;
+  }
+  return std::nullopt;
+}
+
 /// The first contact of `pair` within `horizon` after `from` (time_of_impact.h's stable roots).
 template <class Motion>
 std::optional<double> timeOfImpact(const World& world, const Pair& pair, double from,
                                    double horizon) {
   const auto [a, other] = pair;
+  if constexpr (Motion::kAccelerates) {
+    if (constrained(world, a) || constrained(world, other)) {
+      return timeOfImpactAlongPaths<Motion>(world, pair, from, horizon);
+    }
+  }
   const Eigen::Vector3d relative_velocity =
       velocityAt<Motion>(world, other, from) - velocityAt<Motion>(world, a, from);
   if (world.isPlane(other)) {
@@ -147,6 +195,10 @@ std::optional<double> timeOfImpact(const World& world, const Pair& pair, double 
 /// accelerating all the way: a gap larger than this needs no root.
 template <class Motion>
 double reach(const World& world, const Pair& pair, double from, double horizon) {
+  if constexpr (Motion::kAccelerates) {
+    // An integrated step's accelerations vary: no bound, the root is looked for.
+    if (constrained(world, pair.first) || constrained(world, pair.second)) return INFINITY;
+  }
   const double speed =
       (velocityAt<Motion>(world, pair.second, from) - velocityAt<Motion>(world, pair.first, from))
           .norm();
@@ -178,16 +230,36 @@ Box sweptBox(const World& world, std::size_t body, double from, double to) {
   const Eigen::Vector3d end = positionAt<Motion>(world, body, to);
   Box box{start.cwiseMin(end), start.cwiseMax(end)};
   if constexpr (Motion::kAccelerates) {
-    // A parabola's extreme along an axis, where that axis's velocity turns.
-    const Eigen::Vector3d velocity = velocityAt<Motion>(world, body, from);
-    const Eigen::Vector3d& acceleration = world.tracks[body].acceleration;
-    for (int axis = 0; axis < 3; ++axis) {
-      if (acceleration[axis] == 0) continue;
-      const double turn = -velocity[axis] / acceleration[axis];
-      if (turn > 0 && turn < to - from) {
-        const double extreme = positionAt<Motion>(world, body, from + turn)[axis];
-        box.low[axis] = std::min(box.low[axis], extreme);
-        box.high[axis] = std::max(box.high[axis], extreme);
+    if (constrained(world, body)) {
+      // Along the integrated step, sampled; beyond its end, as far as its speed and gravity and
+      // the step's acceleration (twice) could carry it.
+      const ConstrainedStep& step = *world.tracks[body].constrained;
+      const double inside = std::clamp(to, from, step.end());
+      for (int i = 1; i <= 16; ++i) {
+        const Eigen::Vector3d point =
+            positionAt<Motion>(world, body, from + (inside - from) * i / 16);
+        box.low = box.low.cwiseMin(point);
+        box.high = box.high.cwiseMax(point);
+      }
+      const double beyond = to - inside;
+      const double distance =
+          velocityAt<Motion>(world, body, inside).norm() * beyond +
+          (world.gravity.norm() + step.initialAcceleration(world.tracks[body].slot).norm()) *
+              beyond * beyond;
+      box.low.array() -= distance;
+      box.high.array() += distance;
+    } else {
+      // A parabola's extreme along an axis, where that axis's velocity turns.
+      const Eigen::Vector3d velocity = velocityAt<Motion>(world, body, from);
+      const Eigen::Vector3d& acceleration = world.tracks[body].acceleration;
+      for (int axis = 0; axis < 3; ++axis) {
+        if (acceleration[axis] == 0) continue;
+        const double turn = -velocity[axis] / acceleration[axis];
+        if (turn > 0 && turn < to - from) {
+          const double extreme = positionAt<Motion>(world, body, from + turn)[axis];
+          box.low[axis] = std::min(box.low[axis], extreme);
+          box.high[axis] = std::max(box.high[axis], extreme);
+        }
       }
     }
   }

@@ -340,5 +340,70 @@ TEST(LastingContact, WedgedBallNeverLeavesTheGap) {
   EXPECT_NEAR(monitor.predictedState(0, 2.0)->first.z(), r, 1e-9 * r);
 }
 
+ObstacleSpec sphere(const std::string& id, const V& centre, double radius,
+                    const std::string& material) {
+  ObstacleSpec obstacle;
+  obstacle.id = id;
+  obstacle.shape = ObstacleShape::kSphere;
+  obstacle.position = centre;
+  obstacle.radius = radius;
+  obstacle.material = material;
+  return obstacle;
+}
+
+// A ball on top of a fixed sphere, nudged at v0 across it (no friction). On the sphere, with d the
+// distance of the centres, energy gives v^2 = v0^2 + 2 g d (1 - cos t) and the sphere pushes with
+// m (g cos t - v^2 / d), which is 0 at cos t = 2/3 + v0^2 / (3 g d): it leaves there, at speed
+// v^2 = g d cos t along the tangent, and flies on with the horizontal velocity it had then,
+// sqrt(g d) cos^(3/2) t. On the sphere it never goes into it.
+TEST(LastingContact, SlidesOffASphereAtTwoThirds) {
+  const double R = 1.0, r = 0.1, d = R + r, v0 = 1e-3;
+  Scene scene = gravityScene();
+  addMaterial(scene, "ice", 0.5, 0.0);
+  scene.bodies = {ball("ball", 0.1, r, "ice")};
+  scene.obstacles = {sphere("dome", V::Zero(), R, "ice")};
+  ImpactMonitor monitor(scene, longLived());
+  double deepest = -1, left = -1;
+  run(monitor, {state(monitor, "ball", V(0, 0, d), V(v0, 0, 0))}, 100, 4.0,
+      [&](double t, const StepReport& report) {
+        deepest = std::max(deepest, d - monitor.predictedState(0, t)->first.norm());
+        if (left < 0 && report.contacts.empty()) left = t;
+      });
+  ASSERT_GT(left, 0.0) << "it left the sphere";
+  const double leaves = 2.0 / 3.0 + v0 * v0 / (3 * kG * d);
+  const double horizontal = std::sqrt(kG * d) * std::pow(leaves, 1.5);
+  EXPECT_NEAR(monitor.predictedState(0, 4.0)->second.x(), horizontal, 1e-7 * horizontal);
+  EXPECT_LT(deepest, 1e-9 * d);
+}
+
+// Rolling with friction (a solid ball, spin, mu large): (7/10) v^2 = (7/10) v0^2 + g d (1 - cos t)
+// and the sphere lets go at g d cos t = v^2, so cos t = (10 + 7 v0^2 / (g d)) / 17: 10/17 for a
+// nudge of nothing. It flies on with the horizontal velocity sqrt(g d) cos^(3/2) t. (Near N = 0
+// static friction runs out and it slips for the last instant; with mu = 1e6 that moves cos t by
+// far less than the tolerance.)
+TEST(LastingContact, RollsOffASphereAtTenSeventeenths) {
+  const double R = 1.0, r = 0.1, d = R + r, v0 = 1e-3;
+  Scene scene = gravityScene(true, true);
+  addMaterial(scene, "grippy", 0.5, 1e6);
+  scene.bodies = {ball("ball", 0.1, r, "grippy")};
+  scene.obstacles = {sphere("dome", V::Zero(), R, "grippy")};
+  ImpactMonitor monitor(scene, longLived());
+  double deepest = -1;
+  bool rolled = false;
+  // Rolling: w = v / r about the axis of the turn, so that the contact point is at rest.
+  run(monitor, {state(monitor, "ball", V(0, 0, d), V(v0, 0, 0), V(0, v0 / r, 0))}, 100, 5.0,
+      [&](double t, const StepReport& report) {
+        deepest = std::max(deepest, d - monitor.predictedState(0, t)->first.norm());
+        if (!report.contacts.empty() && report.contacts[0].state == ContactState::kRolling) {
+          rolled = true;
+        }
+      });
+  EXPECT_TRUE(rolled);
+  const double leaves = (10 + 7 * v0 * v0 / (kG * d)) / 17;
+  const double horizontal = std::sqrt(kG * d) * std::pow(leaves, 1.5);
+  EXPECT_NEAR(monitor.predictedState(0, 5.0)->second.x(), horizontal, 1e-6 * horizontal);
+  EXPECT_LT(deepest, 1e-9 * d);
+}
+
 }  // namespace
 }  // namespace collision_response::core

@@ -100,11 +100,25 @@ ContactForceSolution solveContactForces(const std::vector<ForceBody>& bodies,
                                         const std::vector<ForceContact>& contacts,
                                         const ContactForceSettings& settings = {});
 
+/// The forces for modes given (each contact's: not pressed, sliding along its present slip, or
+/// sticking), without changing them: what an integrator needs while the modes hold. The normal
+/// forces keep their sign (negative: the contact would pull, so it lets go there).
+ContactForceSolution solveContactForcesWithModes(const std::vector<ForceBody>& bodies,
+                                                 const std::vector<ForceContact>& contacts,
+                                                 const std::vector<ContactMode>& modes,
+                                                 const ContactForceSettings& settings = {});
+
 /// Velocities consistent with lasting contact: the smallest change of the bodies' motion (impulses
 /// of least norm) after which every contact's normal relative velocity is 0 and, where
 /// `sticking[k]`, its slip too. Applied to the bodies' velocity and angular_velocity.
 void closeContactVelocities(std::vector<ForceBody>& bodies,
                             const std::vector<ForceContact>& contacts,
                             const std::vector<bool>& sticking);
+
+/// Positions consistent with lasting contact: the smallest displacements (mass-weighted, along the
+/// normals) that close each contact's gap to `gaps[k]` less itself, that is to 0 (pass the gaps
+/// the contacts have). Applied to `positions` of the movable bodies.
+void closeContactGaps(std::vector<Eigen::Vector3d>& positions, const std::vector<ForceBody>& bodies,
+                      const std::vector<ForceContact>& contacts, const std::vector<double>& gaps);
 
 }  // namespace collision_response::core
