@@ -83,6 +83,12 @@ std::vector<std::size_t> addReachablePairs(World& world, std::size_t body, doubl
                                            std::vector<Pair>& pairs,
                                            const std::vector<std::vector<std::size_t>>& pairs_of) {
   const Box box = sweptBox<Motion>(world, body, from, to);
+  std::vector<Box>& start_boxes = world.scratch.boxes;
+  if (world.settings.broadphase && body < start_boxes.size() && world.scratch.active[body] &&
+      (start_boxes[body].low.array() <= box.low.array()).all() &&
+      (box.high.array() <= start_boxes[body].high.array()).all()) {
+    return {};  // within the box it swept at the step's start: its pairs are candidates already
+  }
   std::vector<std::size_t>& found = world.scratch.found;
   world.scratch.hash.query(box, found);
   // Bodies changed earlier in the step are in the grid with their old boxes: test their new.

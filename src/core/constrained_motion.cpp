@@ -28,6 +28,7 @@ struct ConstrainedStep::Integration {
   using Dense = boost::numeric::odeint::result_of::make_dense_output<Stepper>::type;
   explicit Integration(double tolerance)
       : dense(boost::numeric::odeint::make_dense_output(tolerance, tolerance, Stepper())) {}
+  Integration(const Integration&) = default;
   Dense dense;
 };
 
@@ -36,14 +37,14 @@ ConstrainedStep::~ConstrainedStep() = default;
 ConstrainedStep::ConstrainedStep(const std::vector<ForceBody>& bodies,
                                  const std::vector<Eigen::Vector3d>& positions, std::size_t movable,
                                  const std::vector<ConstrainedContact>& contacts, double start,
-                                 double tolerance, double step, double longest)
+                                 double until, double tolerance, double slip_tolerance, double step)
     : bodies_(bodies),
       positions_(positions),
       movable_(movable),
       contacts_(contacts),
       start_(start),
-      end_(start),
-      integration_(std::make_unique<Integration>(tolerance)) {
+      end_(start) {
+  settings_.slip_tolerance = slip_tolerance;
   State initial(kPerBody * movable_);
   for (std::size_t i = 0; i < movable_; ++i) {
     put(initial, i, 0, positions_[i]);
@@ -53,33 +54,42 @@ ConstrainedStep::ConstrainedStep(const std::vector<ForceBody>& bodies,
   const ContactForceSolution at_start = forces(initial, start_);
   for (std::size_t k = 0; k < contacts_.size(); ++k) {
     force_scale_ = std::max(force_scale_, std::abs(at_start.contacts[k].normal));
-    const Eigen::Vector3d& slip = at_start.contacts[k].slip;
-    slip_direction_.push_back(slip.norm() > 0 ? Eigen::Vector3d(slip.normalized())
-                                              : Eigen::Vector3d::Zero());
+    slip_direction_.push_back(at_start.contacts[k].slide_direction);
   }
   initial_acceleration_.assign(at_start.acceleration.begin(),
                                at_start.acceleration.begin() + static_cast<long>(movable_));
-  integration_->dense.initialize(initial, start_, std::min(step, longest));
   const auto system = [this](const State& x, State& dxdt, double t) { derivative(x, dxdt, t); };
-  // Steps the integrator offers beyond `longest` are cut: the dense output holds within a step.
-  const std::pair<double, double> interval = integration_->dense.do_step(system);
-  end_ = std::min(interval.second, start_ + longest);
-  next_step_ = integration_->dense.current_time_step();
-  if (!(margin(stateAt(end_), end_) < 0)) return;
-  // A mode stops holding within the step: the first instant, by bisection (its margin is
-  // continuous along the step; to 1e-12 of the step, or of the time line's rounding).
-  double holds = start_, fails = end_;
-  const double resolution = 1e-12 * (end_ - start_) + 4e-16 * std::abs(end_);
-  while (fails - holds > resolution) {
-    const double middle = 0.5 * (holds + fails);
-    if (margin(stateAt(middle), middle) < 0) {
-      fails = middle;
-    } else {
-      holds = middle;
+  auto integration = std::make_unique<Integration>(tolerance);
+  integration->dense.initialize(initial, start_, std::max(step, 1e-9 * (until - start_)));
+  // A motion takes at most this many steps; a stiffer one ends there and is solved again.
+  constexpr int kMostSteps = 2000;
+  for (int taken = 0; end_ < until; ++taken) {
+    if (taken == kMostSteps) {
+      mode_changed_ = true;
+      return;
     }
+    integration->dense.do_step(system);
+    const double stepped = integration->dense.current_time();
+    next_step_ = integration->dense.current_time_step();
+    steps_.push_back(std::make_unique<Integration>(*integration));
+    end_ = std::min(stepped, until);
+    if (!(margin(stateAt(end_), end_) < 0)) continue;
+    // A mode stops holding within the step: the first instant, by bisection (its margin is
+    // continuous along the step; to 1e-12 of the step, or of the time line's rounding).
+    double holds = steps_.back()->dense.previous_time(), fails = end_;
+    const double resolution = 1e-12 * (fails - holds) + 4e-16 * std::abs(fails);
+    while (fails - holds > resolution) {
+      const double middle = 0.5 * (holds + fails);
+      if (margin(stateAt(middle), middle) < 0) {
+        fails = middle;
+      } else {
+        holds = middle;
+      }
+    }
+    end_ = fails;
+    mode_changed_ = true;
+    return;
   }
-  end_ = fails;
-  mode_changed_ = true;
 }
 
 ContactForceSolution ConstrainedStep::forces(const State& state, double time) const {
@@ -102,6 +112,7 @@ ContactForceSolution ConstrainedStep::forces(const State& state, double time) co
     contact.a = c.a;
     contact.b = c.b;
     contact.friction = c.friction;
+    contact.slide_direction = c.slide_direction;
     if (c.plane) {
       contact.normal = -c.plane_normal;
     } else {
@@ -112,7 +123,7 @@ ContactForceSolution ConstrainedStep::forces(const State& state, double time) co
     }
     modes[k] = c.mode;
   }
-  return solveContactForcesWithModes(bodies, contacts, modes);
+  return solveContactForcesWithModes(bodies, contacts, modes, settings_);
 }
 
 void ConstrainedStep::derivative(const State& state, State& rate, double time) const {
@@ -128,27 +139,52 @@ void ConstrainedStep::derivative(const State& state, State& rate, double time) c
 double ConstrainedStep::margin(const State& state, double time) const {
   const ContactForceSolution solution = forces(state, time);
   const double scale = std::max(force_scale_, 1e-300);
+  // With the solver's tolerances (solveContactForces), so that a motion starts with every margin
+  // >= 0: a force of -1e-12 of the largest does not pull, friction within 1e-12 of mu N holds.
+  constexpr double kTolerance = 1e-12;
   double least = INFINITY;
   for (std::size_t k = 0; k < contacts_.size(); ++k) {
     const ContactForce& force = solution.contacts[k];
     const ConstrainedContact& contact = contacts_[k];
-    least = std::min(least, force.normal / scale);  // it would pull: it lets go
+    least = std::min(least, force.normal / scale + kTolerance);  // it would pull: it lets go
     if (contact.friction > 0 && contact.mode == ContactMode::kSticking) {
-      least = std::min(least, (contact.friction * force.normal - force.tangential.norm()) / scale);
+      const double bound = contact.friction * force.normal;
+      least = std::min(least, (bound * (1 + kTolerance) + kTolerance * scale * contact.friction -
+                               force.tangential.norm()) /
+                                  scale);
     }
     if (contact.friction > 0 && contact.mode == ContactMode::kSliding &&
         slip_direction_[k].norm() > 0) {
-      least = std::min(least, force.slip.dot(slip_direction_[k]));  // the slip stops
+      // The slip stops (reverses by half the slip tolerance: a contact that starts to slide
+      // has a slip of rounding size in no direction of its own).
+      least = std::min(least, force.slip.dot(slip_direction_[k]) + 0.5 * settings_.slip_tolerance);
     }
   }
   return least;
 }
 
+const ConstrainedStep::Integration& ConstrainedStep::stepAt(double time) const {
+  // The first step whose end is at or after `time` (the last one past the motion's end).
+  const auto found = std::lower_bound(steps_.begin(), steps_.end(), time,
+                                      [](const std::unique_ptr<Integration>& step, double t) {
+                                        return step->dense.current_time() < t;
+                                      });
+  return found == steps_.end() ? *steps_.back() : **found;
+}
+
 ConstrainedStep::State ConstrainedStep::stateAt(double time) const {
   State state(kPerBody * movable_);
-  integration_->dense.calc_state(
-      std::clamp(time, integration_->dense.previous_time(), integration_->dense.current_time()),
-      state);
+  if (steps_.empty()) {  // no step taken yet: the start
+    for (std::size_t i = 0; i < movable_; ++i) {
+      put(state, i, 0, positions_[i]);
+      put(state, i, 1, bodies_[i].velocity);
+      put(state, i, 2, bodies_[i].angular_velocity);
+    }
+    return state;
+  }
+  const Integration& step = stepAt(time);
+  step.dense.calc_state(std::clamp(time, step.dense.previous_time(), step.dense.current_time()),
+                        state);
   return state;
 }
 

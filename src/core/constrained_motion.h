@@ -22,6 +22,8 @@ struct ConstrainedContact {
   Eigen::Vector3d plane_normal = Eigen::Vector3d::UnitZ();
   double friction = 0.0;
   ContactMode mode = ContactMode::kSticking;  ///< held over the step
+  /// Sliding: the direction of the slip it starts with (ContactForce::slide_direction).
+  Eigen::Vector3d slide_direction = Eigen::Vector3d::Zero();
 };
 
 /// One step of a group's motion: from `start` to end(), as Dormand-Prince 5(4) with error
@@ -32,19 +34,22 @@ struct ConstrainedContact {
 class ConstrainedStep {
  public:
   /// `bodies` at `start` (the movable ones first, `movable` of them; the others move at constant
-  /// velocity), their `positions` then. `tolerance`: the integrator's error per step, absolute
-  /// (m, m/s, rad/s) and relative; `step`: the size to try; `longest`: at most this long.
+  /// velocity), their `positions` then; the motion is integrated from `start` to `until` (or
+  /// the first mode change). `tolerance`: the integrator's error per step, absolute (m, m/s,
+  /// rad/s) and relative; `slip_tolerance`: slower slips are none (m/s, as the force solver's);
+  /// `step`: the size to try first.
   ConstrainedStep(const std::vector<ForceBody>& bodies,
                   const std::vector<Eigen::Vector3d>& positions, std::size_t movable,
-                  const std::vector<ConstrainedContact>& contacts, double start, double tolerance,
-                  double step, double longest);
+                  const std::vector<ConstrainedContact>& contacts, double start, double until,
+                  double tolerance, double slip_tolerance, double step);
   ~ConstrainedStep();
   ConstrainedStep(const ConstrainedStep&) = delete;
   ConstrainedStep& operator=(const ConstrainedStep&) = delete;
 
   double start() const { return start_; }
   double end() const { return end_; }
-  /// The step ended where a mode stopped holding (the group must be solved again there).
+  /// The motion ended before `until`: where a mode stopped holding, or after the most steps one
+  /// motion takes (the group must be solved again there).
   bool modeChanged() const { return mode_changed_; }
   /// The size the integrator would take next.
   double nextStep() const { return next_step_; }
@@ -66,6 +71,7 @@ class ConstrainedStep {
   /// The least margin of the modes at a state: < 0 where one stops holding.
   double margin(const State& state, double time) const;
   State stateAt(double time) const;
+  const Integration& stepAt(double time) const;
 
   std::vector<ForceBody> bodies_;
   std::vector<Eigen::Vector3d> positions_;  // at start_
@@ -77,7 +83,8 @@ class ConstrainedStep {
   double next_step_ = 0.0;
   bool mode_changed_ = false;
   double force_scale_ = 0.0;
-  std::unique_ptr<Integration> integration_;
+  ContactForceSettings settings_;
+  std::vector<std::unique_ptr<Integration>> steps_;  // each step's dense output, in time order
 };
 
 }  // namespace collision_response::core::monitor

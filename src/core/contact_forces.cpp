@@ -248,6 +248,9 @@ void package(const Group& group, const Trial& trial, const std::vector<Mode>& mo
     out.tangential = trial.tangential_force[k].cast<double>();
     out.slip = group.slip(k).cast<double>();
     out.slip_acceleration = trial.response.slip_acceleration[k].cast<double>();
+    if (modes[k].pressed && modes[k].tangential == Tangential::kSlide) {
+      out.slide_direction = modes[k].slide_direction.cast<double>();
+    }
     out.gap_acceleration = static_cast<double>(trial.response.gap_acceleration[k]);
     if (!modes[k].pressed) {
       out.mode = ContactMode::kSeparating;
@@ -762,9 +765,14 @@ ContactForceSolution solveContactForcesWithModes(const std::vector<ForceBody>& b
     if (!modes[k].pressed || !(friction[k] > 0)) continue;
     if (fixed[k] == ContactMode::kSticking) {
       modes[k].tangential = Tangential::kStick;
-    } else if (group.slip(k).norm() > 0) {
+    } else if (group.slip(k).norm() > scales.slip_tolerance ||
+               (group.slip(k).norm() > 0 && contacts[k].slide_direction.isZero())) {
       modes[k].tangential = Tangential::kSlide;  // along the slip it has now
       modes[k].slide_direction = group.slip(k).normalized();
+    } else if (!contacts[k].slide_direction.isZero()) {
+      // It starts to slide: a slip below the tolerance has no direction of its own (rounding).
+      modes[k].tangential = Tangential::kSlide;
+      modes[k].slide_direction = contacts[k].slide_direction.normalized().cast<Real>();
     }
   }
   const Trial trial = solveModes(group, modes, friction);

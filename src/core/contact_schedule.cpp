@@ -52,7 +52,7 @@ template <class Motion>
 void ContactSchedule<Motion>::schedule(std::size_t k, double from, const Geometry& g) {
   next_contact_[k] = INFINITY;
   const Pair& pair = pairs_[k];
-  if (!g.valid || world_.lasting(pair)) return;
+  if (!world_.settings.detect_impacts || !g.valid || world_.lasting(pair)) return;
   // A touching pair that does not approach (it was just resolved, or slides) never comes back
   // in a straight line; under gravity it may (a ball that bounced falls back), so its next entry
   // is looked for, except on the plane it rests on.

@@ -235,12 +235,16 @@ void solveGroup(World& world, double time, const std::vector<std::size_t>& bodie
       if (c.plane) c.plane_normal = -candidates[k].second.normal;
       c.friction = contacts[k].friction;
       c.mode = solution.contacts[k].mode;
+      c.slide_direction = solution.contacts[k].slide_direction;
       step_contacts.push_back(c);
     }
-    step = std::make_shared<const ConstrainedStep>(step_bodies, step_positions, movable,
-                                                   step_contacts, time, world.integration_tolerance,
-                                                   guess > 0 ? guess : 1e-3, 0.1);
-    contact_group.next_event = std::min(contact_group.next_event, step->end());
+    step = std::make_shared<const ConstrainedStep>(
+        step_bodies, step_positions, movable, step_contacts, time, std::max(world.step_end, time),
+        world.integration_tolerance, speed_tolerance, guess > 0 ? guess : 1e-3);
+    if (step->modeChanged()) {
+      contact_group.next_event = std::min(contact_group.next_event, step->end());
+    }
+    contact_group.curved = true;
   }
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     const std::size_t body = bodies[i];

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 
 #include "candidate_pairs.h"
 #include "collision_response/core/body.h"
@@ -131,8 +132,11 @@ void holdEverything(World& world, double time) {
 /// and the step goes on with a second budget; if that runs out too, every body is held where it
 /// is until the step's end. Both count in report.fallbacks.
 template <class Motion>
-StepReport continuousStep(World& world, double time, const std::vector<BodyStateSample>& states) {
+StepReport continuousStep(World& world, double time, const std::vector<BodyStateSample>& states,
+                          const std::vector<BodyStateSample>& imposed = {}) {
   StepReport report;
+  std::size_t next_imposed = 0;
+  world.step_end = time;
   monitor::candidatePairs<Motion>(world, world.now, time, world.scratch.pairs);
   ContactSchedule<Motion> schedule(world, time);
   const monitor::PairIndex index{world.scratch.pairs, world.scratch.pairs_of};
@@ -167,8 +171,24 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
     }
     touching_pairs.clear();
     for (const std::size_t k : touching) touching_pairs.push_back(schedule.pair(k));
-    if (!touching_pairs.empty()) {
+    if (!touching_pairs.empty() && world.settings.detect_impacts) {
       monitor::resolveInstant<Motion>(world, instant, touching_pairs, report, changed);
+    }
+    // States imposed at this instant (the impacts a playback was told of).
+    for (; next_imposed < imposed.size() && imposed[next_imposed].time <= instant; ++next_imposed) {
+      const BodyStateSample& state = imposed[next_imposed];
+      Track& track = world.tracks[state.body];
+      track.known = true;
+      track.time = state.time;
+      track.position = state.position;
+      track.velocity = state.velocity;
+      track.angular_velocity = state.angular_velocity;
+      track.acceleration =
+          world.inverse_mass[state.body] > 0 ? world.gravity : Eigen::Vector3d::Zero();
+      track.angular_acceleration.setZero();
+      track.constrained = nullptr;
+      track.last_impact_time = state.time;
+      changed.push_back(state.body);
     }
     if constexpr (Motion::kAccelerates) {
       // Lasting contact: the groups of the bodies whose motion changed (at the start, of every
@@ -181,6 +201,13 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
         for (std::size_t body = 0; body < world.bodies.size(); ++body) {
           if (world.tracks[body].known) seeds.push_back(body);
         }
+      } else if (instants == 0) {
+        // Curved groups were integrated to the last step's end: on to this one's.
+        for (const monitor::ContactGroup& group : world.groups) {
+          if (group.alive && group.curved) {
+            seeds.insert(seeds.end(), group.bodies.begin(), group.bodies.end());
+          }
+        }
       }
       if (!seeds.empty()) monitor::formGroups(world, instant, seeds, index, changed);
       std::sort(changed.begin(), changed.end());
@@ -192,17 +219,28 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
     } else {
       for (const std::size_t body : changed) schedule.reschedule(body, instant);
     }
-    // The next event: the earliest first contact, or (gravity) a group's motion changing.
+    // The next event: the earliest of a first contact, a state imposed and (gravity) a group's
+    // motion changing (at one instant: the group first, then the state, then the contact).
+    const double next_contact = schedule.earliest();
+    const double next_state = next_imposed < imposed.size() ? imposed[next_imposed].time : INFINITY;
+    double next_group_event = INFINITY;
+    std::size_t group = 0;
     if constexpr (Motion::kAccelerates) {
-      const double next_contact = schedule.earliest();
-      const auto [next_group_event, group] = monitor::nextGroupEvent(world);
-      if (next_group_event <= time && next_group_event <= next_contact) {
-        instant = next_group_event;
-        touching.clear();
-        event_bodies = world.groups[group].bodies;
-        world.groups[group].next_event = INFINITY;
-        continue;
+      std::tie(next_group_event, group) = monitor::nextGroupEvent(world);
+    }
+    const double next = std::min({next_contact, next_state, next_group_event});
+    if (!(next <= time)) break;
+    if (next_group_event == next || next_state == next) {
+      instant = next;
+      touching.clear();
+      if (next_group_event == next) {
+        monitor::ContactGroup& changing = world.groups[group];
+        changing.next_event = INFINITY;
+        // A group solved again at the very instant it was solved would do so for ever: its
+        // motion goes on as it is.
+        if (next > changing.time) event_bodies = changing.bodies;
       }
+      continue;
     }
     if (!schedule.next(instant, touching)) break;
   }
@@ -210,6 +248,7 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
   world.now = time;
   if constexpr (Motion::kAccelerates) {
     std::vector<std::size_t> formed;
+    world.step_end = time;
     monitor::formAllGroups(world, time, formed);
     monitor::reportContacts(world, time, report.contacts);
   }
@@ -399,6 +438,23 @@ std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> ImpactMonitor::predic
     using Motion = decltype(motion);
     return std::make_pair(monitor::positionAt<Motion>(world, body, time),
                           monitor::velocityAt<Motion>(world, body, time));
+  });
+}
+
+Eigen::Vector3d ImpactMonitor::predictedAngularVelocity(std::size_t body, double time) const {
+  const World& world = *world_;
+  if (!world.tracks[body].known) return Eigen::Vector3d::Zero();
+  return withMotionModel(world, [&](auto motion) {
+    return monitor::angularVelocityAt<decltype(motion)>(world, body, time);
+  });
+}
+
+StepReport ImpactMonitor::advance(double time, const std::vector<BodyStateSample>& imposed) {
+  World& world = *world_;
+  if (!world.started || time <= world.now) return StepReport{};
+  forgetStaleBodies(world, time);
+  return withMotionModel(world, [&](auto motion) {
+    return continuousStep<decltype(motion)>(world, time, {}, imposed);
   });
 }
 

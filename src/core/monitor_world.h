@@ -87,10 +87,15 @@ struct ContactGroup {
   std::vector<std::size_t> bodies;     ///< sorted
   std::vector<GroupContact> contacts;  ///< the pressed ones, in the canonical order of pairs
   double next_event = std::numeric_limits<double>::infinity();
+  bool curved = false;  ///< its motion is integrated, up to World::step_end
 };
 
-/// Working memory of a step, kept so that steps do not allocate once it has grown.
+/// Working memory of a step, kept so that steps do not allocate once it has grown. A copy of the
+/// monitor starts with none.
 struct Scratch {
+  Scratch() = default;
+  Scratch(const Scratch&) {}
+  Scratch& operator=(const Scratch&) { return *this; }
   std::vector<Pair> pairs;
   std::vector<std::vector<std::size_t>> pairs_of;
   std::vector<double> next_contact;
@@ -134,6 +139,7 @@ struct World {
   Scratch scratch;
   bool started = false;
   double now = 0.0;
+  double step_end = 0.0;  // the end of the step being taken (curved motion is integrated to it)
 
   std::size_t bodyCount() const { return bodies.size(); }
   bool isObstacle(std::size_t participant) const { return participant >= bodies.size(); }

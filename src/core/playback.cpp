@@ -1,73 +1,125 @@
 #include "collision_response/core/playback.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+
+#include "collision_response/core/motion.h"
 
 namespace collision_response::core {
+namespace {
 
-Playback::Playback(const Scene& scene, double contact_tolerance, double start)
-    : scene_(scene), contact_tolerance_(contact_tolerance) {
-  if (scene_.effects.gravity) gravity_ = scene_.gravity;
-  for (const ObstacleSpec& obstacle : scene_.obstacles) {
-    if (obstacle.shape == ObstacleShape::kPlane && obstacle.frame.empty()) {
-      fixed_planes_.push_back(Plane{obstacle.normal.normalized(), obstacle.offset});
-    }
-  }
-  for (std::size_t i = 0; i < scene_.bodies.size(); ++i) {
-    index_[scene_.bodies[i].id] = i;
-    segments_.push_back(
-        makeSegment(i, start, scene_.bodies[i].position, scene_.bodies[i].velocity, 0));
-  }
+MonitorSettings playbackSettings(double contact_tolerance) {
+  MonitorSettings settings;
+  settings.contact_tolerance = contact_tolerance;
+  settings.body_timeout = std::numeric_limits<double>::infinity();
+  settings.detect_impacts = false;
+  return settings;
 }
 
-Playback::Segment Playback::makeSegment(std::size_t body, double start,
-                                        const Eigen::Vector3d& position,
-                                        const Eigen::Vector3d& velocity, int impacts_before) const {
-  Segment segment{start, position, velocity, Eigen::Vector3d::Zero(), false, impacts_before};
-  const BodySpec& spec = scene_.bodies[body];
-  if (std::isinf(spec.mass) || gravity_ == Eigen::Vector3d::Zero()) return segment;
-  segment.acceleration = gravity_;
-  const auto plane =
-      restingPlane(position, velocity, spec.radius, fixed_planes_, gravity_, contact_tolerance_);
-  if (plane) {
-    const Eigen::Vector3d& normal = fixed_planes_[*plane].normal;
-    segment.velocity -= segment.velocity.dot(normal) * normal;
-    segment.acceleration = restingAcceleration(gravity_, normal);
-    segment.apex_reported = true;  // a slide has no apex
+}  // namespace
+
+Playback::Playback(const Scene& scene, double contact_tolerance, double start)
+    : scene_(scene),
+      committed_(scene, playbackSettings(contact_tolerance)),
+      committed_time_(start),
+      horizon_(start) {
+  scene_.detection = Detection::kContinuous;
+  if (scene_.effects.gravity) gravity_ = scene_.gravity;
+  std::vector<BodyStateSample> states;
+  for (std::size_t i = 0; i < scene_.bodies.size(); ++i) {
+    const BodySpec& body = scene_.bodies[i];
+    index_[body.id] = i;
+    model_index_.push_back(*committed_.bodyIndex(body.id));
+    BodyStateSample state;
+    state.body = model_index_.back();
+    state.time = start;
+    state.position = body.position;
+    state.velocity = body.velocity;
+    states.push_back(state);
+    flights_.push_back(Flight{start, body.position, body.velocity, false, 0});
   }
-  return segment;
+  committed_.step(start, states);
+}
+
+const ImpactMonitor& Playback::at(double time) const {
+  if (view_ && view_time_ == time) return *view_;
+  if (time > horizon_) {
+    // Asking for a later instant makes what was asked for before final.
+    if (horizon_ > committed_time_) {
+      std::vector<BodyStateSample> final_part;
+      while (!pending_.empty() && pending_.front().time <= horizon_) {
+        final_part.push_back(pending_.front());
+        pending_.erase(pending_.begin());
+      }
+      committed_.advance(horizon_, final_part);
+      committed_time_ = horizon_;
+    }
+    horizon_ = time;
+  }
+  view_ = committed_;
+  std::vector<BodyStateSample> ahead;
+  for (const BodyStateSample& state : pending_) {
+    if (state.time <= time) ahead.push_back(state);
+  }
+  view_contacts_.clear();
+  if (time > committed_time_) view_contacts_ = view_->advance(time, ahead).contacts;
+  view_time_ = time;
+  return *view_;
 }
 
 Eigen::Vector3d Playback::position(std::size_t body, double time) const {
-  const Segment& s = segments_[body];
-  return positionAfter(s.position, s.velocity, s.acceleration, time - s.start);
+  return at(time).predictedState(model_index_[body], time)->first;
 }
 
 Eigen::Vector3d Playback::velocity(std::size_t body, double time) const {
-  const Segment& s = segments_[body];
-  return velocityAfter(s.velocity, s.acceleration, time - s.start);
+  return at(time).predictedState(model_index_[body], time)->second;
+}
+
+Eigen::Vector3d Playback::angularVelocity(std::size_t body, double time) const {
+  return at(time).predictedAngularVelocity(model_index_[body], time);
+}
+
+std::vector<ContactRecord> Playback::contacts(double time) const {
+  at(time);
+  return view_contacts_;
 }
 
 bool Playback::applyImpact(std::size_t body, double time, const Eigen::Vector3d& centre,
-                           const Eigen::Vector3d& velocity_after) {
-  Segment& segment = segments_[body];
-  if (time < segment.start) return false;
-  segment = makeSegment(body, time, centre, velocity_after, segment.impacts_before + 1);
+                           const Eigen::Vector3d& velocity_after,
+                           const Eigen::Vector3d& angular_velocity_after) {
+  if (time <= committed_time_ || time < flights_[body].start) return false;
+  BodyStateSample state;
+  state.body = model_index_[body];
+  state.time = time;
+  state.position = centre;
+  state.velocity = velocity_after;
+  state.angular_velocity = angular_velocity_after;
+  const auto later = std::upper_bound(
+      pending_.begin(), pending_.end(), state,
+      [](const BodyStateSample& x, const BodyStateSample& y) { return x.time < y.time; });
+  pending_.insert(later, state);
+  view_.reset();
+  flights_[body] = Flight{time, centre, velocity_after, false, flights_[body].impacts_before + 1};
   return true;
 }
 
 void Playback::applyImpact(const ImpactMonitor& monitor, const ImpactRecord& impact,
                            bool exact_contact) {
-  const auto apply = [&](std::size_t monitor_body, double side, const Eigen::Vector3d& after) {
+  const auto apply = [&](std::size_t monitor_body, double side, const Eigen::Vector3d& after,
+                         const Eigen::Vector3d& angular_after) {
     const auto body = bodyIndex(monitor.body(monitor_body).id);
     if (!body) return;
     const double radius = scene_.bodies[*body].radius;
     const Eigen::Vector3d centre =
         exact_contact ? Eigen::Vector3d(impact.contact_point + side * radius * impact.normal)
                       : position(*body, impact.time);
-    applyImpact(*body, impact.time, centre, after);
+    applyImpact(*body, impact.time, centre, after, angular_after);
   };
-  apply(impact.body_a, -1.0, impact.velocity_a_after);
-  if (!impact.other_is_obstacle) apply(impact.other, +1.0, impact.velocity_b_after);
+  apply(impact.body_a, -1.0, impact.velocity_a_after, impact.angular_velocity_a_after);
+  if (!impact.other_is_obstacle) {
+    apply(impact.other, +1.0, impact.velocity_b_after, impact.angular_velocity_b_after);
+  }
 }
 
 std::vector<Apex> Playback::apexesUntil(double time) {
@@ -75,15 +127,17 @@ std::vector<Apex> Playback::apexesUntil(double time) {
   const double g = gravity_.norm();
   if (!(g > 0)) return apexes;
   const Eigen::Vector3d up = -gravity_ / g;
-  for (std::size_t i = 0; i < segments_.size(); ++i) {
-    Segment& segment = segments_[i];
-    const double rising = segment.velocity.dot(up);
-    if (segment.apex_reported || !(rising > 0)) continue;
-    const double apex_time = segment.start + rising / g;
+  for (std::size_t i = 0; i < flights_.size(); ++i) {
+    Flight& flight = flights_[i];
+    const double rising = flight.velocity.dot(up);
+    if (flight.apex_reported || !(rising > 0)) continue;
+    const double apex_time = flight.start + rising / g;
     if (apex_time > time) continue;
-    segment.apex_reported = true;
-    apexes.push_back(
-        Apex{i, apex_time, position(i, apex_time), velocity(i, apex_time), segment.impacts_before});
+    flight.apex_reported = true;
+    const double dt = apex_time - flight.start;
+    apexes.push_back(Apex{i, apex_time,
+                          positionAfter(flight.position, flight.velocity, gravity_, dt),
+                          velocityAfter(flight.velocity, gravity_, dt), flight.impacts_before});
   }
   return apexes;
 }

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "collision_response/core/body.h"
 #include "collision_response/core/monitor.h"
 
 namespace collision_response::core {
@@ -338,6 +339,94 @@ TEST(LastingContact, WedgedBallNeverLeavesTheGap) {
   EXPECT_GT(fallbacks, 0u);
   EXPECT_LE(outside, 1e-9 * r);
   EXPECT_NEAR(monitor.predictedState(0, 2.0)->first.z(), r, 1e-9 * r);
+}
+
+// A ball dropped from rest with its surface h above what it falls on, e = 0.5, threshold 0: it
+// meets it at t1 = sqrt(2 h / g) at v0 = g t1 and then bounces for ever in a finite time, the
+// k-th bounce lasting 2 e^k v0 / g: all of them add up to t1 + 2 e v0 / (g (1 - e)) =
+// t1 (1 + e) / (1 - e). It rests from that accumulation instant: the contact's `since`. The same
+// on the floor, on a fixed sphere, and on a held ball (an immovable body).
+TEST(LastingContact, BouncesToRestAtTheAccumulationInstant) {
+  const double h = 0.5, r = 0.05, e = 0.5;
+  const double t1 = std::sqrt(2 * h / kG), accumulation = t1 * (1 + e) / (1 - e);
+  for (const std::string support : {"floor", "dome", "held"}) {
+    Scene scene = gravityScene();
+    addMaterial(scene, "putty", e, 0.0);
+    scene.bodies = {ball("ball", 0.1, r, "putty")};
+    if (support == "floor") scene.obstacles = {plane("floor", V(0, 0, 1), 0.0, "putty")};
+    if (support == "dome") {
+      ObstacleSpec dome;
+      dome.id = "dome";
+      dome.shape = ObstacleShape::kSphere;
+      dome.radius = 0.2;
+      dome.position = V(0, 0, -0.2);
+      dome.material = "putty";
+      scene.obstacles = {dome};
+    }
+    std::vector<BodyStateSample> start;
+    if (support == "held") {
+      BodySpec held = ball("held", kImmovableMass, 0.2, "putty");
+      scene.bodies.push_back(held);
+    }
+    ImpactMonitor monitor(scene, longLived());
+    start.push_back(state(monitor, "ball", V(0, 0, h + r)));
+    if (support == "held") start.push_back(state(monitor, "held", V(0, 0, -0.2)));
+    StepReport last;
+    double deepest = -1;
+    const auto impacts = run(monitor, start, 100, 2.0, [&](double t, const StepReport& report) {
+      last = report;
+      deepest =
+          std::max(deepest, r - monitor.predictedState(*monitor.bodyIndex("ball"), t)->first.z());
+    });
+    EXPECT_LT(impacts.size(), 60u) << support;
+    EXPECT_LT(deepest, 1e-9 * r) << support;
+    ASSERT_EQ(last.contacts.size(), 1u) << support;
+    EXPECT_NEAR(last.contacts[0].since, accumulation, 1e-12 * accumulation) << support;
+    EXPECT_EQ(last.contacts[0].state, ContactState::kResting) << support;
+    EXPECT_NEAR(last.contacts[0].normal_force, 0.1 * kG, 1e-12) << support;
+  }
+}
+
+// A ball resting in the corner of an incline and a wall, struck from above and across by
+// another: the strike and the resting ball's lasting contacts are one cluster (the impulse runs
+// into both planes at once), energy does not increase, the resting ball never enters a plane,
+// and after the dust settles it rests in the corner again.
+TEST(LastingContact, BallStruckWhileRestingInACorner) {
+  const double theta = 10.0 * M_PI / 180.0, r = 0.05, wall = 0.5;
+  const V up(std::sin(theta), 0, std::cos(theta));
+  Scene scene = gravityScene();
+  addMaterial(scene, "wood", 0.5, 0.0);
+  scene.bodies = {ball("resting", 0.2, r, "wood"), ball("striker", 0.1, r, "wood")};
+  scene.obstacles = {plane("incline", up, 0.0, "wood"), plane("wall", V(-1, 0, 0), -wall, "wood")};
+  ImpactMonitor monitor(scene, longLived());
+  const double x = wall - r, z = (r - std::sin(theta) * x) / std::cos(theta);
+  const V corner(x, 0, z);
+  // The striker comes down at 45 degrees into the corner ball, touching it at t = 0.
+  const V direction = V(1, 0, -1).normalized();
+  const std::vector<BodyStateSample> start = {
+      state(monitor, "resting", corner),
+      state(monitor, "striker", corner - 2 * r * direction, 2.0 * direction)};
+  double deepest = -1;
+  std::vector<ImpactRecord> first;
+  const auto impacts = run(monitor, start, 100, 4.0, [&](double t, const StepReport& report) {
+    if (first.empty()) first = report.impacts;
+    const V centre = monitor.predictedState(0, t)->first;
+    deepest = std::max(
+        {deepest, depthInPlane(centre, r, up, 0), depthInPlane(centre, r, V(-1, 0, 0), -wall)});
+  });
+  // The strike (at t = 0, the first step) reaches both planes in the same cluster.
+  ASSERT_FALSE(first.empty());
+  bool incline = false, wall_hit = false;
+  for (const ImpactRecord& impact : first) {
+    if (impact.time != 0.0) continue;
+    incline = incline || (impact.other_is_obstacle && impact.other == 0 && impact.impulse > 0);
+    wall_hit = wall_hit || (impact.other_is_obstacle && impact.other == 1 && impact.impulse > 0);
+    EXPECT_GE(impact.energy_lost, -1e-15);
+  }
+  EXPECT_TRUE(incline);
+  EXPECT_TRUE(wall_hit);
+  EXPECT_LT(deepest, 1e-9 * r + 1e-15);
+  EXPECT_LT((monitor.predictedState(0, 4.0)->first - corner).norm(), 1e-8 * r);
 }
 
 ObstacleSpec sphere(const std::string& id, const V& centre, double radius,

@@ -33,6 +33,10 @@ struct ForceContact {
   /// move; 0 against a plane.
   double curvature = 0.0;
   double friction = 0.0;  ///< Coulomb mu; 0 frictionless (or no friction effect)
+  /// For solveContactForcesWithModes: the direction a sliding contact slips in while its slip
+  /// is below the slip tolerance (it starts to slide: the direction its mode was chosen with).
+  /// Zero: its present slip's.
+  Eigen::Vector3d slide_direction = Eigen::Vector3d::Zero();
 };
 
 /// How a contact carries its force.
@@ -53,6 +57,9 @@ struct ContactForce {
   /// m/s^2: the slip's rate of change, and the gap's second derivative (>= 0; 0 where pressed).
   Eigen::Vector3d slip_acceleration = Eigen::Vector3d::Zero();
   double gap_acceleration = 0.0;
+  /// Sliding: the unit direction of the slip friction acts against (for a contact that starts
+  /// to slide, the direction of the slip it starts; zero otherwise).
+  Eigen::Vector3d slide_direction = Eigen::Vector3d::Zero();
 };
 
 struct ContactForceSolution {
@@ -101,8 +108,9 @@ ContactForceSolution solveContactForces(const std::vector<ForceBody>& bodies,
                                         const ContactForceSettings& settings = {});
 
 /// The forces for modes given (each contact's: not pressed, sliding along its present slip, or
-/// sticking), without changing them: what an integrator needs while the modes hold. The normal
-/// forces keep their sign (negative: the contact would pull, so it lets go there).
+/// below the slip tolerance along its `slide_direction`, or sticking), without changing them: what
+/// an integrator needs while the modes hold. The normal forces keep their sign (negative: the
+/// contact would pull, so it lets go there).
 ContactForceSolution solveContactForcesWithModes(const std::vector<ForceBody>& bodies,
                                                  const std::vector<ForceContact>& contacts,
                                                  const std::vector<ContactMode>& modes,

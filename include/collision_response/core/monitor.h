@@ -31,6 +31,10 @@ struct MonitorSettings {
   /// Candidate pairs from a spatial hash of the bodies' swept boxes (about linear in the
   /// bodies); false: every pair (for tests that compare the two).
   bool broadphase = true;
+  /// false: the monitor moves its bodies (free flight, lasting contact) but looks for no
+  /// impacts; impacts come in as states imposed at their instants (advance()). What Playback
+  /// moves a scene with.
+  bool detect_impacts = true;
 };
 
 /// A body's state at one instant, in the fixed frame.
@@ -160,6 +164,11 @@ class ImpactMonitor {
   /// states after `time` are the caller's error). See the class comment.
   StepReport step(double time, const std::vector<BodyStateSample>& states);
 
+  /// Advances the monitor to `time` by its own motion, without states, imposing each of
+  /// `imposed` (a body's position and velocities at an instant in (now, time], in time order)
+  /// at its instant: the body continues from there, and its lasting contacts are formed again.
+  StepReport advance(double time, const std::vector<BodyStateSample>& imposed);
+
   /// Forgets every track and the time line (after a clock jump back).
   void reset();
 
@@ -171,6 +180,8 @@ class ImpactMonitor {
   /// A body's predicted position and velocity at `time`; empty when it is not tracked.
   std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> predictedState(std::size_t body,
                                                                             double time) const;
+  /// A body's predicted angular velocity at `time` (zero when it is not tracked).
+  Eigen::Vector3d predictedAngularVelocity(std::size_t body, double time) const;
 
  private:
   std::unique_ptr<monitor::World> world_;  // the scene, the tracks and a step's working memory

@@ -1,5 +1,6 @@
-// Playing a scene without ROS: bodies moved in closed form from their initial states, impacts
-// applied from their instants. The scene player (ROS) and the accuracy benchmark both use it.
+// Playing a scene without ROS: the bodies moved from their initial states by the monitor's own
+// model (free flight, and lasting contact: resting, sliding, rolling, stacked), the impacts it is
+// told of applied from their instants. The scene player (ROS) and the accuracy benchmark use it.
 #pragma once
 
 #include <Eigen/Core>
@@ -9,7 +10,6 @@
 #include <vector>
 
 #include "collision_response/core/monitor.h"
-#include "collision_response/core/motion.h"
 #include "collision_response/core/scene.h"
 
 namespace collision_response::core {
@@ -23,20 +23,29 @@ struct Apex {
   int impacts_before = 0;  ///< impacts the body had before this flight
 };
 
+/// A scene played forward by the monitor's model with impact detection off (impacts come from
+/// whoever watches the played states, as from the node over ROS).
+///
+/// Impacts arrive after the states that revealed them were played, so the motion is kept in two
+/// parts: what is final (committed, up to the latest instant asked for before the last one) and
+/// what is played ahead from it with the impacts applied so far. Asking for a later instant makes
+/// the earlier part final; an impact older than what is final is refused (false). Bodies are the
+/// scene's, as listed.
 class Playback {
  public:
   /// Starts every body of `scene` at `start` from its `position` and `velocity`.
   Playback(const Scene& scene, double contact_tolerance, double start);
 
-  std::size_t bodyCount() const { return segments_.size(); }
+  std::size_t bodyCount() const { return scene_.bodies.size(); }
   Eigen::Vector3d position(std::size_t body, double time) const;
   Eigen::Vector3d velocity(std::size_t body, double time) const;
+  Eigen::Vector3d angularVelocity(std::size_t body, double time) const;
 
-  /// An impact the monitor reported on `body` at `time`: from then on it moves from `centre`
-  /// at `velocity_after` (resting on a fixed plane when it touches one slowly). Impacts older
-  /// than the body's current motion are ignored (false).
+  /// An impact on `body` at `time`: from then on it moves from `centre` with the velocities after
+  /// (its lasting contacts formed again there). False when `time` is older than what is final.
   bool applyImpact(std::size_t body, double time, const Eigen::Vector3d& centre,
-                   const Eigen::Vector3d& velocity_after);
+                   const Eigen::Vector3d& velocity_after,
+                   const Eigen::Vector3d& angular_velocity_after = Eigen::Vector3d::Zero());
 
   /// Applies an impact record of `monitor` (whose bodies are indexed by id) to the bodies it
   /// names, placing them at the contact (`exact_contact`: continuous detection, where the
@@ -48,24 +57,32 @@ class Playback {
 
   std::optional<std::size_t> bodyIndex(const std::string& id) const;
 
+  /// The lasting contacts of the played motion at `time` (as the monitor reports them).
+  std::vector<ContactRecord> contacts(double time) const;
+
  private:
-  struct Segment {
+  struct Flight {
     double start = 0.0;
     Eigen::Vector3d position = Eigen::Vector3d::Zero();
     Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
-    Eigen::Vector3d acceleration = Eigen::Vector3d::Zero();
     bool apex_reported = false;
     int impacts_before = 0;
   };
-  Segment makeSegment(std::size_t body, double start, const Eigen::Vector3d& position,
-                      const Eigen::Vector3d& velocity, int impacts_before) const;
+  /// The model at `time`: the final part advanced with the impacts applied up to then.
+  const ImpactMonitor& at(double time) const;
 
   Scene scene_;
-  double contact_tolerance_;
   Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();
-  std::vector<Plane> fixed_planes_;
-  std::vector<Segment> segments_;
+  std::vector<std::size_t> model_index_;  // scene body -> the model's index
   std::map<std::string, std::size_t> index_;
+  mutable ImpactMonitor committed_;
+  mutable double committed_time_;
+  mutable std::vector<BodyStateSample> pending_;  // impacts after committed_time_, by time
+  mutable std::optional<ImpactMonitor> view_;
+  mutable double view_time_ = 0.0;
+  mutable double horizon_;  // the latest instant asked for
+  mutable std::vector<ContactRecord> view_contacts_;
+  std::vector<Flight> flights_;
 };
 
 }  // namespace collision_response::core
