@@ -51,11 +51,12 @@ struct Run {
   std::vector<ReportedImpact> impacts;  ///< ours only
   bool reports_impacts = false;         ///< true: `impacts` is the engine's own list
   bool truncated = false;               ///< the engine stopped a step early (ours: a guard)
+  std::size_t states = 0;               ///< states recorded, kept or not
 
   /// Appends the state at `time` (or replaces the last one when only the ends are kept).
   void record(const Play& play, double time, const std::vector<V>& p, const std::vector<V>& v);
   std::size_t samples() const { return times.size(); }
-  std::size_t updates() const { return times.empty() ? 0 : times.size() - 1; }
+  std::size_t updates() const { return states == 0 ? 0 : states - 1; }
   const V& position(std::size_t sample, std::size_t body) const {
     return positions[sample * bodies + body];
   }

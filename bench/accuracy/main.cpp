@@ -92,6 +92,76 @@ std::string json(const Row& row) {
   return text + "}}";
 }
 
+/// A scene (with its effects) at one rate, played by one engine setting.
+struct Case {
+  const EngineSetting* setting;
+  std::string effects;
+  double rate;
+};
+
+/// Every engine setting at every rate of the scene, then ours with the scene's extra effects.
+std::vector<Case> casesOf(const BenchScene& bench, const std::vector<EngineSetting>& settings) {
+  std::vector<Case> cases;
+  for (const EngineSetting& setting : settings) {
+    for (const double rate : bench.rates) cases.push_back({&setting, "none", rate});
+  }
+  for (const std::string& effects : bench.effect_variants) {
+    cases.push_back({&settings.front(), effects, 100.0});  // ours, continuous
+  }
+  return cases;
+}
+
+/// A short scene: played once here and measured, then timed by Google Benchmark over repeated
+/// runs.
+void addShortRun(const BenchScene& bench, const Case& c, Row& row, const References& references) {
+  const core::Scene scene = withEffects(bench, c.effects);
+  const Play play{c.rate, bench.duration, bench.record_all};
+  const Engine engine = c.setting->play;
+  const Run run = engine(scene, play);
+  row.unsupported = run.unsupported;
+  if (!run.unsupported.empty()) return;
+  row.updates = run.updates();
+  row.truncated = run.truncated;
+  row.metrics = measure(bench, c.effects, run, references);
+  benchmark::RegisterBenchmark(row.name.c_str(),
+                               [engine, scene, play](benchmark::State& state) {
+                                 for (auto _ : state) benchmark::DoNotOptimize(engine(scene, play));
+                               })
+      ->Unit(benchmark::kMillisecond)
+      ->MinTime(0.1);
+}
+
+/// A long run: played once, inside its benchmark (one iteration, which is its CPU time), and
+/// measured there, so that it is not played twice.
+void addLongRun(const BenchScene& bench, const Case& c, std::shared_ptr<std::vector<Row>> rows,
+                std::size_t index, const References& references) {
+  const core::Scene scene = withEffects(bench, c.effects);
+  const Play play{c.rate, bench.duration, bench.record_all};
+  const Engine engine = c.setting->play;
+  // A run of no time: does the engine play this scene at all (Box2D: planar ones only)?
+  const Run probe = engine(scene, Play{c.rate, 0.0, false});
+  if (!probe.unsupported.empty()) {
+    (*rows)[index].unsupported = probe.unsupported;
+    return;
+  }
+  const std::string effects = c.effects;
+  benchmark::RegisterBenchmark(
+      (*rows)[index].name.c_str(),
+      [engine, scene, play, bench, effects, rows, index, &references](benchmark::State& state) {
+        for (auto _ : state) {
+          const Run run = engine(scene, play);
+          state.PauseTiming();
+          Row& row = (*rows)[index];
+          row.updates = run.updates();
+          row.truncated = run.truncated;
+          row.metrics = measure(bench, effects, run, references);
+          state.ResumeTiming();
+        }
+      })
+      ->Unit(benchmark::kMillisecond)
+      ->Iterations(1);
+}
+
 // The float and double kernels against long double, on random impacts and times of impact.
 void kernelErrors(std::FILE* out) {
   std::mt19937_64 engine(3);
@@ -159,7 +229,6 @@ void BM_TimeOfImpactKernel(benchmark::State& state) {
 
 int main(int argc, char** argv) {
   using namespace collision_response::bench;
-  namespace core = collision_response::core;
   if (argc >= 3 && std::strcmp(argv[1], "--export-scenes") == 0) {
     exportScenes(benchScenes(), argv[2]);
     return 0;
@@ -187,73 +256,20 @@ int main(int argc, char** argv) {
   std::fprintf(out, "{\n");
   kernelErrors(out);
 
-  // Short scenes: measured once here, timed by Google Benchmark over repeated runs. Long runs:
-  // one run each, timed and measured inside its benchmark (no second long run).
   auto rows = std::make_shared<std::vector<Row>>();
   const std::vector<EngineSetting> settings = engineSettings();
   for (const BenchScene& bench : benchScenes()) {
-    struct Case {
-      const EngineSetting* setting;
-      std::string effects;
-      double rate;
-    };
-    std::vector<Case> cases;
-    for (const EngineSetting& setting : settings) {
-      for (const double rate : bench.rates) cases.push_back({&setting, "none", rate});
-    }
-    for (const std::string& effects : bench.effect_variants) {
-      cases.push_back({&settings.front(), effects, 100.0});  // ours, continuous
-    }
-    for (const Case& c : cases) {
+    for (const Case& c : casesOf(bench, settings)) {
       Row row{"", bench.name, c.setting->engine, c.setting->variant, c.effects, c.rate, 0, false,
               "", {}};
       row.name = bench.name + "/" + row.engine + "/" + row.variant + "/" + c.effects + "/" +
                  number(c.rate);
       if (!std::regex_search(row.name, filter)) continue;
-      const core::Scene scene = withEffects(bench, c.effects);
-      const Play play{c.rate, bench.duration, bench.record_all};
-      const Engine engine = c.setting->play;
-      const std::size_t index = rows->size();
       rows->push_back(row);
-      if (!bench.long_run) {
-        const Run run = engine(scene, play);
-        Row& measured = (*rows)[index];
-        measured.unsupported = run.unsupported;
-        if (!run.unsupported.empty()) continue;
-        measured.updates = run.updates();
-        measured.truncated = run.truncated;
-        measured.metrics = measure(bench, c.effects, run, references);
-        benchmark::RegisterBenchmark(row.name.c_str(),
-                                     [engine, scene, play](benchmark::State& state) {
-                                       for (auto _ : state)
-                                         benchmark::DoNotOptimize(engine(scene, play));
-                                     })
-            ->Unit(benchmark::kMillisecond)
-            ->MinTime(0.2);
+      if (bench.long_run) {
+        addLongRun(bench, c, rows, rows->size() - 1, references);
       } else {
-        // A run of no time: does the engine play this scene at all (Box2D: planar ones only)?
-        const Run probe = engine(scene, Play{c.rate, 0.0, false});
-        if (!probe.unsupported.empty()) {
-          (*rows)[index].unsupported = probe.unsupported;
-          continue;
-        }
-        const std::string effects = c.effects;
-        benchmark::RegisterBenchmark(row.name.c_str(),
-                                     [engine, scene, play, bench, effects, rows, index,
-                                      &references](benchmark::State& state) {
-                                       for (auto _ : state) {
-                                         Run run = engine(scene, play);
-                                         state.PauseTiming();
-                                         Row& measured = (*rows)[index];
-                                         measured.updates = run.updates();
-                                         measured.truncated = run.truncated;
-                                         measured.metrics =
-                                             measure(bench, effects, run, references);
-                                         state.ResumeTiming();
-                                       }
-                                     })
-            ->Unit(benchmark::kMillisecond)
-            ->Iterations(1);
+        addShortRun(bench, c, rows->back(), references);
       }
     }
   }

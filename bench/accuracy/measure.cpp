@@ -106,6 +106,17 @@ std::vector<double> apexes(const core::Scene& scene, const Run& run, std::size_t
   return tops;
 }
 
+/// Body `body`'s first impact against the reference's.
+double instantError(const std::string& name, const core::Scene& scene, const Run& run,
+                    const References& refs, std::size_t body) {
+  for (const std::vector<double>& row : refs.rows(name, "first_impact_of")) {
+    if (static_cast<std::size_t>(row.at(0)) == body) {
+      return std::abs(firstImpact(scene, run, body) - row.at(1));
+    }
+  }
+  return kNaN;
+}
+
 /// The larger, NaN (not measurable) winning: a worst case is not better for a missing value.
 double worst(double current, double value) {
   if (std::isnan(current) || std::isnan(value)) return kNaN;
@@ -126,11 +137,7 @@ Metrics dropTest(const std::string& name, const core::Scene& scene, const Run& r
         reference_rise[flight] = row.at(2) - r;
       }
     }
-    double first_of = kNaN;
-    for (const std::vector<double>& row : refs.rows(name, "first_impact_of")) {
-      if (static_cast<std::size_t>(row.at(0)) == i) first_of = row.at(1);
-    }
-    instant = worst(instant, std::abs(firstImpact(scene, run, i) - first_of));
+    instant = worst(instant, instantError(name, scene, run, refs, i));
     // No flight: the ball did not bounce (e measured 0, an error of 100 %).
     const std::vector<double> tops = apexes(scene, run, i);
     const double rise1 = tops.size() >= 1 ? tops[0] - r : 0.0;
@@ -140,17 +147,6 @@ Metrics dropTest(const std::string& name, const core::Scene& scene, const Run& r
     apex = worst(apex, std::abs(rise3 - reference_rise[3]) / reference_rise[3]);
   }
   return {{"instant", instant}, {"restitution", restitution}, {"apex", apex}};
-}
-
-/// Body `body`'s first impact against the reference's.
-double instantError(const std::string& name, const core::Scene& scene, const Run& run,
-                    const References& refs, std::size_t body) {
-  for (const std::vector<double>& row : refs.rows(name, "first_impact_of")) {
-    if (static_cast<std::size_t>(row.at(0)) == body) {
-      return std::abs(firstImpact(scene, run, body) - row.at(1));
-    }
-  }
-  return kNaN;
 }
 
 /// The final velocities against the reference's: RMS over the bodies, or the worst body (m/s);

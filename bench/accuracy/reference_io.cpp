@@ -13,6 +13,7 @@ namespace collision_response::bench {
 
 void Run::record(const Play& play, double time, const std::vector<V>& p, const std::vector<V>& v) {
   bodies = p.size();
+  ++states;
   if (!play.record_all && times.size() == 2) {
     times.back() = time;
     std::copy(p.begin(), p.end(), positions.end() - static_cast<std::ptrdiff_t>(bodies));
