@@ -1,21 +1,32 @@
 #!/usr/bin/env bash
 # What accuracy costs in time: every scene of bench/accuracy at every setting (our continuous
-# and discrete detection at 10..1000 Hz, effects on and off; Bullet with its defaults and with
-# its recommended bouncing settings; ODE), errors against exact answers and CPU time (Google
-# Benchmark), written to doc/accuracy.md and doc/accuracy.png.
+# and discrete detection, effects on and off; Bullet with its defaults and with its recommended
+# bouncing settings; ODE; MuJoCo with its default contact and with restitution through solref;
+# DART; Box2D on the planar scenes), errors against references computed outside the code under
+# test and CPU time (Google Benchmark). Writes doc/accuracy.md, doc/accuracy.png and the README's
+# accuracy section (between its accuracy markers).
 #   bash scripts/accuracy.sh
+# The references are recomputed on every run (about ten seconds) from the scenes' inputs as the
+# benchmark builds them, so that a changed scene is never measured against a stale answer; they
+# are also checked in (bench/accuracy/reference/), so that any change of an answer shows in review.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
-PACKAGES+=(libbenchmark-dev libbullet-dev libode-dev pkg-config gnuplot-nox)
+PACKAGES+=(libbenchmark-dev libbullet-dev libode-dev pkg-config libmujoco-dev libdart-dev
+  libbox2d-dev python3-mpmath python3-matplotlib)
 install_packages
-build_workspace >"$ws/build.log" 2>&1 || { tail -40 "$ws/build.log"; exit 1; }
-cmake --build "$ws/build" --target accuracy_benchmark -- -j2 >>"$ws/build.log" 2>&1 ||
+# Only the benchmark (and the core it links): the node, the messages and the tests are not needed.
+BUILD_TARGET=accuracy_benchmark build_workspace >"$ws/build.log" 2>&1 ||
   { tail -40 "$ws/build.log"; exit 1; }
+bin="$ws/devel/lib/collision_response/accuracy_benchmark"
+reference="$repo/bench/accuracy/reference"
 out="$ws/accuracy"
 mkdir -p "$out"
-echo "== running every scene at every setting (errors, then CPU time)"
-"$ws/devel/lib/collision_response/accuracy_benchmark" "$out/errors.json" \
-  --benchmark_format=json --benchmark_out="$out/timing.json" >"$out/benchmark.log" 2>&1
-/usr/bin/python3 "$repo/scripts/accuracy_report.py" "$out" "$repo/doc"
-gnuplot "$out/accuracy.gnuplot"
-echo "== wrote doc/accuracy.md and doc/accuracy.png"
+echo "== the references (bench/accuracy/reference/make_references.py, 50-digit mpmath)"
+"$bin" --export-scenes "$reference/scenes.txt"
+/usr/bin/python3 "$reference/make_references.py" "$reference/scenes.txt" "$reference/references.txt"
+echo "== every scene at every setting (errors, then CPU time; the long runs once each)"
+"$bin" "$reference/references.txt" "$out/errors.json" \
+  --benchmark_format=json --benchmark_out="$out/timing.json" >"$out/benchmark.log" 2>&1 ||
+  { tail -20 "$out/benchmark.log"; exit 1; }
+/usr/bin/python3 "$repo/scripts/accuracy_report.py" "$out" "$repo/doc" "$repo/README.md"
+echo "== wrote doc/accuracy.md, doc/accuracy.png and the README's accuracy section"

@@ -44,6 +44,7 @@ install_packages() {
   as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${PACKAGES[@]}" >/dev/null
 }
 
+# BUILD_TARGET: build only that target (default: all).
 build_workspace() {
   echo "== building in $ws"
   # catkin writes the test environment (build/catkin_generated/setup_cached.sh) when it
@@ -54,7 +55,7 @@ build_workspace() {
   cmake -S "$repo" -B "$ws/build" -DCATKIN_DEVEL_PREFIX="$ws/devel" -DPython3_EXECUTABLE=/usr/bin/python3 \
     -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DCOLLISION_RESPONSE_WERROR=ON "$@" &&
-    cmake --build "$ws/build" -- -j2
+    cmake --build "$ws/build" --target "${BUILD_TARGET:-all}" -- -j2
 }
 
 source_workspace() {

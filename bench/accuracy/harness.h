@@ -1,9 +1,15 @@
-// The accuracy-versus-cost harness: scenes with exact answers, engines that play them at a
-// state rate, and the errors of what they did. See scripts/accuracy.sh.
+// The accuracy-versus-cost harness: scenes, engines that play them at a state rate, references
+// computed outside the code under test, and the errors of what each engine did.
+// See scripts/accuracy.sh. To add a scene: a builder in scenes.cpp listed in benchScenes(), its
+// metrics in measure.cpp, its table in scripts/accuracy_report.py (SCENES); the reference
+// (reference/make_references.py) plays every exported scene without further work when it needs
+// only impacts of spheres and planes.
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -13,46 +19,116 @@ namespace collision_response::bench {
 
 using V = Eigen::Vector3d;
 
-/// What an engine did: every body's state after each update, and the instants of impact it
-/// found (engines that report them).
-struct Run {
-  std::vector<double> times;
-  std::vector<std::vector<V>> positions;   ///< [update][body], bodies as the scene lists them
-  std::vector<std::vector<V>> velocities;  ///< [update][body]
-  std::vector<double> impact_times;        ///< ours only: the instants found
-  std::size_t impacts = 0;                 ///< ours: impacts resolved (peers: not counted)
+/// How a scene is played: one state (our monitor) or one step (the peers) every 1/rate s, for
+/// `duration` s. `record_all`: keep every update's state (false: the first and the last only, for
+/// long runs whose metrics need no more).
+struct Play {
+  double rate = 100.0;
+  double duration = 1.0;
+  bool record_all = true;
 };
 
-/// Plays `scene` for `duration` s, states exchanged at `rate` Hz.
-using Engine = std::function<Run(const core::Scene& scene, double rate, double duration)>;
+/// An impact an engine reported (ours: every one, at its instant).
+struct ReportedImpact {
+  double time = 0.0;
+  std::size_t body = 0;          ///< scene index
+  V position = V::Zero();        ///< of `body`'s centre, at the instant
+  V velocity_after = V::Zero();  ///< of `body`
+  bool other_is_obstacle = false;
+  std::size_t other = 0;  ///< scene index of the other body, or obstacle index
+  V other_position = V::Zero();
+  V other_velocity_after = V::Zero();  ///< of the other body (obstacles: zero)
+};
 
-/// A scene of the benchmark and how long it is played.
+/// What an engine did: every body's state after each update (bodies as the scene lists them),
+/// and the impacts it reports (ours; the peers report none).
+struct Run {
+  std::string unsupported;  ///< non-empty: the engine cannot play the scene, and why
+  std::size_t bodies = 0;
+  std::vector<double> times;
+  std::vector<V> positions;   ///< [update * bodies + body], bodies as the scene lists them
+  std::vector<V> velocities;  ///< [update * bodies + body]
+  std::vector<ReportedImpact> impacts;  ///< ours only
+  bool reports_impacts = false;         ///< true: `impacts` is the engine's own list
+  bool truncated = false;               ///< the engine stopped a step early (ours: a guard)
+  std::size_t states = 0;               ///< states recorded, kept or not
+
+  /// Appends the state at `time` (or replaces the last one when only the ends are kept).
+  void record(const Play& play, double time, const std::vector<V>& p, const std::vector<V>& v);
+  std::size_t samples() const { return times.size(); }
+  std::size_t updates() const { return states == 0 ? 0 : states - 1; }
+  const V& position(std::size_t sample, std::size_t body) const {
+    return positions[sample * bodies + body];
+  }
+  const V& velocity(std::size_t sample, std::size_t body) const {
+    return velocities[sample * bodies + body];
+  }
+};
+
+/// Plays a scene.
+using Engine = std::function<Run(const core::Scene& scene, const Play& play)>;
+
+/// A scene of the benchmark: what is played, how long, at which rates, and how it is timed.
 struct BenchScene {
   std::string name;
   core::Scene scene;
   double duration = 1.0;
+  std::vector<double> rates;
+  /// A long run: played once per setting, timed by that single run (Google Benchmark, one
+  /// iteration), every state not kept unless `record_all`.
+  bool long_run = false;
+  bool record_all = true;
+  /// Effects turned on in extra rows (100 Hz, ours, continuous), beside the scene as it is.
+  std::vector<std::string> effect_variants;
+  /// What reference/make_references.py computes: "events" (the exact event-driven motion) or
+  /// "conservation" (only the conserved quantities: a chaotic gas's trajectory is not
+  /// reproducible beyond a few dozen impacts in any finite precision, its energy is).
+  std::string reference = "events";
 };
 
-BenchScene dropTestScene();
-BenchScene cradleScene();
-BenchScene breakScene();
-BenchScene tunnellingScene();
-BenchScene gasScene();
+/// Every scene, short ones first; names are unique. The one list: the benchmark, the exported
+/// inputs of the references and the report all follow it.
+std::vector<BenchScene> benchScenes();
 
-/// The errors of a run against the scene's exact answers (NaN where not measured).
-struct Errors {
-  double instant = NAN;         ///< s, |first impact instant - exact|
-  double velocity = NAN;        ///< m/s, after the impacts, worst body (or RMS for the break)
-  double restitution = NAN;     ///< relative, drop test: e from the first bounce's apex, worst
-  double apex = NAN;            ///< relative, drop test: the apex after 3 bounces, worst
-  double missed = 0;            ///< impacts missed (tunnelling)
-  double momentum_drift = NAN;  ///< relative
-  double energy_drift = NAN;    ///< relative
+/// The scene with the effects named in `effects` ("none", or e.g. "friction, spin") turned on.
+core::Scene withEffects(const BenchScene& bench, const std::string& effects);
+/// The name a scene variant has in the reference file: "sphere_gas", "sphere_gas+gravity".
+std::string referenceName(const BenchScene& bench, const std::string& effects);
+
+/// The exact answers of the scenes (reference/references.txt, written by
+/// reference/make_references.py): per scene, keys with rows of numbers.
+class References {
+ public:
+  /// Reads `path`; a missing or malformed file is an error (thrown, with the line).
+  static References read(const std::string& path);
+  bool has(const std::string& scene, const std::string& key) const;
+  /// The rows of `key` for `scene` (each row: the numbers after the key); throws when absent.
+  const std::vector<std::vector<double>>& rows(const std::string& scene,
+                                               const std::string& key) const;
+  double value(const std::string& scene, const std::string& key) const {
+    return rows(scene, key).front().front();
+  }
+
+ private:
+  std::map<std::string, std::map<std::string, std::vector<std::vector<double>>>> data_;
 };
-/// `scene`: the bench scene as played (with the setting's effects); `reference`: the exact
-/// answer where no closed form exists (our continuous detection, the same effects).
-Errors measure(const BenchScene& bench, const core::Scene& scene, const Run& run,
-               const Run* reference);
+
+/// Writes every scene variant's inputs (exact doubles, as C99 hex floats) for the reference.
+void exportScenes(const std::vector<BenchScene>& scenes, const std::string& path);
+
+/// The errors of a run against the scene's references: metric name -> value (NaN: not
+/// measurable, e.g. a flight with too few samples). scripts/accuracy_report.py names them.
+using Metrics = std::map<std::string, double>;
+Metrics measure(const BenchScene& bench, const std::string& effects, const Run& run,
+                const References& references);
+
+/// For engines that multiply the two bodies' coefficients of restitution (Bullet, DART): each
+/// body's and obstacle's own coefficient, such that every product is the scene's coefficient of
+/// the pair (exact when the balls share one material, or never meet).
+struct ProductRestitutions {
+  std::vector<double> bodies, obstacles;
+};
+ProductRestitutions productRestitutions(const core::Scene& scene);
 
 /// Our engine: the core's ImpactMonitor watching a core::Playback, as the node and the scene
 /// player do over ROS.
@@ -67,6 +143,22 @@ Engine bulletEngine(bool recommended);
 #ifdef COLLISION_RESPONSE_WITH_ODE
 /// ODE: dWorldStep, contact joints with bounce = e, bounce_vel = 0, mu = 0.
 Engine odeEngine();
+#endif
+#ifdef COLLISION_RESPONSE_WITH_MUJOCO
+/// MuJoCo: an MJCF model made per scene (free spheres, planes), frictionless contacts (condim 1).
+/// `restitution`: the coefficient through a negative (direct) solref per pair; otherwise MuJoCo's
+/// default soft contact.
+Engine mujocoEngine(bool restitution);
+#endif
+#ifdef COLLISION_RESPONSE_WITH_DART
+/// DART: a World with free-joint spheres, its FCL collision detector and its boxed-LCP
+/// constraint solver; the coefficient through each shape's restitution. No CCD.
+Engine dartEngine();
+#endif
+#ifdef COLLISION_RESPONSE_WITH_BOX2D
+/// Box2D 2.4: circles in a plane (planar scenes only), restitution per contact, threshold 0,
+/// bullets (continuous collision between moving bodies) on.
+Engine box2dEngine();
 #endif
 
 }  // namespace collision_response::bench

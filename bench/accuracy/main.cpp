@@ -1,15 +1,23 @@
 // The accuracy-versus-cost benchmark: every scene at every setting (ours: continuous and
-// discrete detection, state rates 10..1000 Hz, effects on and off; Bullet with its defaults and
-// its recommended bouncing settings; ODE), errors against exact answers written to a JSON file,
-// CPU time measured by Google Benchmark. scripts/accuracy.sh runs it and makes doc/accuracy.md
-// and doc/accuracy.png.
-//   accuracy_benchmark <errors.json> [Google Benchmark flags]
+// discrete detection, effects on and off; Bullet with its defaults and its recommended bouncing
+// settings; ODE; MuJoCo with its default soft contact and with restitution through solref; DART;
+// Box2D on the planar scenes), at the scene's state rates; errors against the references of
+// reference/references.txt written to a JSON file, CPU time measured by Google Benchmark.
+// scripts/accuracy.sh runs it and makes doc/accuracy.md and doc/accuracy.png.
+//   accuracy_benchmark --export-scenes <scenes.txt>
+//   accuracy_benchmark <references.txt> <errors.json> [Google Benchmark flags]
+// --benchmark_filter=<regex> also limits the runs whose errors are measured; --errors_only
+// measures the short scenes' errors and times nothing (the long runs are measured as they are
+// timed, so not at all).
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
+#include <cstring>
 #include <limits>
 #include <map>
+#include <memory>
 #include <random>
+#include <regex>
 
 #include "collision_response/core/impact.h"
 #include "collision_response/core/time_of_impact.h"
@@ -18,51 +26,140 @@
 namespace collision_response::bench {
 namespace {
 
-struct Setting {
-  std::string engine;   ///< ours, bullet, ode
-  std::string variant;  ///< continuous, discrete, default, bouncing, ...
-  std::string effects;  ///< none, or what is turned on
+/// An engine and its settings, as the report names them.
+struct EngineSetting {
+  std::string engine;   ///< ours, bullet, ode, mujoco, dart, box2d
+  std::string variant;  ///< continuous, discrete, default, bouncing, restitution, ...
   Engine play;
-  double rate;
 };
 
-std::vector<Setting> settingsFor(const BenchScene& bench) {
-  std::vector<Setting> settings;
-  for (const double rate : {10.0, 30.0, 60.0, 100.0, 300.0, 1000.0}) {
-    settings.push_back(
-        {"ours", "continuous", "none", oursEngine(core::Detection::kContinuous), rate});
-    settings.push_back({"ours", "discrete", "none", oursEngine(core::Detection::kDiscrete), rate});
+/// Every engine setting, in the order of the report's tables.
+std::vector<EngineSetting> engineSettings() {
+  std::vector<EngineSetting> settings = {
+      {"ours", "continuous", oursEngine(core::Detection::kContinuous)},
+      {"ours", "discrete", oursEngine(core::Detection::kDiscrete)},
+  };
 #ifdef COLLISION_RESPONSE_WITH_BULLET
-    settings.push_back({"bullet", "default", "none", bulletEngine(false), rate});
-    settings.push_back({"bullet", "bouncing", "none", bulletEngine(true), rate});
+  settings.push_back({"bullet", "default", bulletEngine(false)});
+  settings.push_back({"bullet", "bouncing", bulletEngine(true)});
 #endif
 #ifdef COLLISION_RESPONSE_WITH_ODE
-    settings.push_back({"ode", "default", "none", odeEngine(), rate});
+  settings.push_back({"ode", "default", odeEngine()});
 #endif
-  }
-  // Effects on, against the same scene with them off (100 Hz, continuous): friction and spin
-  // on the break, gravity on the gas.
-  if (bench.name == "billiards_break" || bench.name == "sphere_gas") {
-    const std::string effects = bench.name == "billiards_break" ? "friction, spin" : "gravity";
-    settings.push_back(
-        {"ours", "continuous", effects, oursEngine(core::Detection::kContinuous), 100.0});
-  }
+#ifdef COLLISION_RESPONSE_WITH_MUJOCO
+  settings.push_back({"mujoco", "default", mujocoEngine(false)});
+  settings.push_back({"mujoco", "restitution", mujocoEngine(true)});
+#endif
+#ifdef COLLISION_RESPONSE_WITH_DART
+  settings.push_back({"dart", "default", dartEngine()});
+#endif
+#ifdef COLLISION_RESPONSE_WITH_BOX2D
+  settings.push_back({"box2d", "default", box2dEngine()});
+#endif
   return settings;
 }
 
-core::Scene withEffects(const BenchScene& bench, const std::string& effects) {
-  core::Scene scene = bench.scene;
-  if (effects.find("friction") != std::string::npos) scene.effects.friction = true;
-  if (effects.find("spin") != std::string::npos) scene.effects.spin = true;
-  if (effects.find("gravity") != std::string::npos) scene.effects.gravity = true;
-  return scene;
-}
+/// One row of the report: a scene (with its effects) played by an engine setting at a rate.
+struct Row {
+  std::string name, scene, engine, variant, effects;
+  double rate = 0;
+  std::size_t updates = 0;
+  bool truncated = false;
+  std::string unsupported;
+  Metrics metrics;
+};
 
 std::string number(double value) {
   if (std::isnan(value)) return "null";
+  if (std::isinf(value)) return value > 0 ? "1e999" : "-1e999";
   char text[32];
   std::snprintf(text, sizeof text, "%.6g", value);
   return text;
+}
+
+std::string json(const Row& row) {
+  std::string text = "{\"name\": \"" + row.name + "\", \"scene\": \"" + row.scene +
+                     "\", \"engine\": \"" + row.engine + "\", \"variant\": \"" + row.variant +
+                     "\", \"effects\": \"" + row.effects + "\", \"rate\": " + number(row.rate) +
+                     ", \"updates\": " + std::to_string(row.updates) +
+                     ", \"truncated\": " + (row.truncated ? "true" : "false") +
+                     ", \"unsupported\": \"" + row.unsupported + "\", \"metrics\": {";
+  bool first = true;
+  for (const auto& [key, value] : row.metrics) {
+    text += (first ? "\"" : ", \"") + key + "\": " + number(value);
+    first = false;
+  }
+  return text + "}}";
+}
+
+/// A scene (with its effects) at one rate, played by one engine setting.
+struct Case {
+  const EngineSetting* setting;
+  std::string effects;
+  double rate;
+};
+
+/// Every engine setting at every rate of the scene, then ours with the scene's extra effects.
+std::vector<Case> casesOf(const BenchScene& bench, const std::vector<EngineSetting>& settings) {
+  std::vector<Case> cases;
+  for (const EngineSetting& setting : settings) {
+    for (const double rate : bench.rates) cases.push_back({&setting, "none", rate});
+  }
+  for (const std::string& effects : bench.effect_variants) {
+    cases.push_back({&settings.front(), effects, 100.0});  // ours, continuous
+  }
+  return cases;
+}
+
+/// A short scene: played once here and measured, then timed by Google Benchmark over repeated
+/// runs.
+void addShortRun(const BenchScene& bench, const Case& c, Row& row, const References& references) {
+  const core::Scene scene = withEffects(bench, c.effects);
+  const Play play{c.rate, bench.duration, bench.record_all};
+  const Engine engine = c.setting->play;
+  const Run run = engine(scene, play);
+  row.unsupported = run.unsupported;
+  if (!run.unsupported.empty()) return;
+  row.updates = run.updates();
+  row.truncated = run.truncated;
+  row.metrics = measure(bench, c.effects, run, references);
+  benchmark::RegisterBenchmark(row.name.c_str(),
+                               [engine, scene, play](benchmark::State& state) {
+                                 for (auto _ : state) benchmark::DoNotOptimize(engine(scene, play));
+                               })
+      ->Unit(benchmark::kMillisecond)
+      ->MinTime(0.1);
+}
+
+/// A long run: played once, inside its benchmark (one iteration, which is its CPU time), and
+/// measured there, so that it is not played twice.
+void addLongRun(const BenchScene& bench, const Case& c, std::shared_ptr<std::vector<Row>> rows,
+                std::size_t index, const References& references) {
+  const core::Scene scene = withEffects(bench, c.effects);
+  const Play play{c.rate, bench.duration, bench.record_all};
+  const Engine engine = c.setting->play;
+  // A run of no time: does the engine play this scene at all (Box2D: planar ones only)?
+  const Run probe = engine(scene, Play{c.rate, 0.0, false});
+  if (!probe.unsupported.empty()) {
+    (*rows)[index].unsupported = probe.unsupported;
+    return;
+  }
+  const std::string effects = c.effects;
+  benchmark::RegisterBenchmark(
+      (*rows)[index].name.c_str(),
+      [engine, scene, play, bench, effects, rows, index, &references](benchmark::State& state) {
+        for (auto _ : state) {
+          const Run run = engine(scene, play);
+          state.PauseTiming();
+          Row& row = (*rows)[index];
+          row.updates = run.updates();
+          row.truncated = run.truncated;
+          row.metrics = measure(bench, effects, run, references);
+          state.ResumeTiming();
+        }
+      })
+      ->Unit(benchmark::kMillisecond)
+      ->Iterations(1);
 }
 
 // The float and double kernels against long double, on random impacts and times of impact.
@@ -132,62 +229,64 @@ void BM_TimeOfImpactKernel(benchmark::State& state) {
 
 int main(int argc, char** argv) {
   using namespace collision_response::bench;
-  if (argc < 2) {
-    std::fprintf(stderr, "usage: %s <errors.json> [benchmark flags]\n", argv[0]);
+  if (argc >= 3 && std::strcmp(argv[1], "--export-scenes") == 0) {
+    exportScenes(benchScenes(), argv[2]);
+    return 0;
+  }
+  if (argc < 3) {
+    std::fprintf(stderr,
+                 "usage: %s --export-scenes <scenes.txt>\n"
+                 "       %s <references.txt> <errors.json> [benchmark flags]\n",
+                 argv[0], argv[0]);
     return 2;
   }
-  std::FILE* out = std::fopen(argv[1], "w");
+  const References references = References::read(argv[1]);
+  std::regex filter(".*");
+  bool errors_only = false;
+  for (int i = 3; i < argc; ++i) {
+    const std::string flag = argv[i], prefix = "--benchmark_filter=";
+    if (flag.rfind(prefix, 0) == 0) filter = std::regex(flag.substr(prefix.size()));
+    if (flag == "--errors_only") errors_only = true;
+  }
+  std::FILE* out = std::fopen(argv[2], "w");
+  if (out == nullptr) {
+    std::fprintf(stderr, "cannot write %s\n", argv[2]);
+    return 2;
+  }
   std::fprintf(out, "{\n");
   kernelErrors(out);
-  std::fprintf(out, "  \"runs\": [\n");
-  const std::vector<BenchScene> scenes = {dropTestScene(), cradleScene(), breakScene(),
-                                          tunnellingScene(), gasScene()};
-  bool first_row = true;
-  for (const BenchScene& bench : scenes) {
-    // The break's exact answer: our continuous detection, whose instants do not depend on the
-    // rate (the same answer at 10 Hz and 1 kHz to rounding), with the setting's effects.
-    std::map<std::string, Run> references;
-    for (const Setting& setting : settingsFor(bench)) {
-      const collision_response::core::Scene scene = withEffects(bench, setting.effects);
-      if (references.count(setting.effects) == 0) {
-        references[setting.effects] = oursEngine(collision_response::core::Detection::kContinuous)(
-            scene, 1000.0, bench.duration);
+
+  auto rows = std::make_shared<std::vector<Row>>();
+  const std::vector<EngineSetting> settings = engineSettings();
+  for (const BenchScene& bench : benchScenes()) {
+    for (const Case& c : casesOf(bench, settings)) {
+      Row row{"", bench.name, c.setting->engine, c.setting->variant, c.effects, c.rate, 0, false,
+              "", {}};
+      row.name = bench.name + "/" + row.engine + "/" + row.variant + "/" + c.effects + "/" +
+                 number(c.rate);
+      if (!std::regex_search(row.name, filter)) continue;
+      rows->push_back(row);
+      if (bench.long_run) {
+        addLongRun(bench, c, rows, rows->size() - 1, references);
+      } else {
+        addShortRun(bench, c, rows->back(), references);
       }
-      const Run run = setting.play(scene, setting.rate, bench.duration);
-      const Errors e = measure(bench, scene, run, &references[setting.effects]);
-      const std::string name = bench.name + "/" + setting.engine + "/" + setting.variant + "/" +
-                               setting.effects + "/" + number(setting.rate);
-      std::fprintf(
-          out,
-          "%s    {\"name\": \"%s\", \"scene\": \"%s\", \"engine\": \"%s\", \"variant\": \"%s\", "
-          "\"effects\": \"%s\", \"rate\": %s, \"updates\": %zu, \"impacts\": %zu, "
-          "\"instant\": %s, \"velocity\": %s, \"restitution\": %s, \"apex\": %s, "
-          "\"missed\": %s, \"momentum_drift\": %s, \"energy_drift\": %s}",
-          first_row ? "" : ",\n", name.c_str(), bench.name.c_str(), setting.engine.c_str(),
-          setting.variant.c_str(), setting.effects.c_str(), number(setting.rate).c_str(),
-          run.times.size() - 1, run.impacts, number(e.instant).c_str(), number(e.velocity).c_str(),
-          number(e.restitution).c_str(), number(e.apex).c_str(), number(e.missed).c_str(),
-          number(e.momentum_drift).c_str(), number(e.energy_drift).c_str());
-      first_row = false;
-      const Engine play = setting.play;
-      const double rate = setting.rate, duration = bench.duration;
-      benchmark::RegisterBenchmark(name.c_str(),
-                                   [play, scene, rate, duration](benchmark::State& state) {
-                                     for (auto _ : state)
-                                       benchmark::DoNotOptimize(play(scene, rate, duration));
-                                   })
-          ->Unit(benchmark::kMillisecond)
-          ->MinTime(0.2);
     }
   }
-  std::fprintf(out, "\n  ]\n}\n");
-  std::fclose(out);
   benchmark::RegisterBenchmark("kernel/impact/double", &BM_ImpactKernel<double>);
   benchmark::RegisterBenchmark("kernel/impact/float", &BM_ImpactKernel<float>);
   benchmark::RegisterBenchmark("kernel/time_of_impact/double", &BM_TimeOfImpactKernel<double>);
   benchmark::RegisterBenchmark("kernel/time_of_impact/float", &BM_TimeOfImpactKernel<float>);
-  int bench_argc = argc - 1;
-  benchmark::Initialize(&bench_argc, argv + 1);
-  benchmark::RunSpecifiedBenchmarks();
+  int bench_argc = argc - 2;
+  argv[2] = argv[0];
+  benchmark::Initialize(&bench_argc, argv + 2);
+  if (!errors_only) benchmark::RunSpecifiedBenchmarks();
+
+  std::fprintf(out, "  \"runs\": [\n");
+  for (std::size_t i = 0; i < rows->size(); ++i) {
+    std::fprintf(out, "%s    %s", i == 0 ? "" : ",\n", json((*rows)[i]).c_str());
+  }
+  std::fprintf(out, "\n  ]\n}\n");
+  std::fclose(out);
   return 0;
 }

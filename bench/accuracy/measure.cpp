@@ -1,154 +1,280 @@
+// The metrics: what each scene measures of a run, against reference/references.txt (answers
+// computed outside the code under test, by reference/make_references.py). One function per kind
+// of scene; measure() picks it by name.
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "harness.h"
 
 namespace collision_response::bench {
 namespace {
 
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
 /// Kinetic energy, plus the potential energy in gravity when the scene has it.
-double energy(const core::Scene& scene, const std::vector<V>& positions,
-              const std::vector<V>& velocities) {
+double energy(const core::Scene& scene, const Run& run, std::size_t sample) {
   const V g = scene.effects.gravity ? scene.gravity : V::Zero();
   double total = 0;
-  for (std::size_t i = 0; i < velocities.size(); ++i) {
-    total += 0.5 * scene.bodies[i].mass * velocities[i].squaredNorm() -
-             scene.bodies[i].mass * g.dot(positions[i]);
+  for (std::size_t i = 0; i < run.bodies; ++i) {
+    const double m = scene.bodies[i].mass;
+    total += 0.5 * m * run.velocity(sample, i).squaredNorm() - m * g.dot(run.position(sample, i));
   }
   return total;
 }
 
-V momentum(const core::Scene& scene, const std::vector<V>& velocities) {
+V momentum(const core::Scene& scene, const Run& run, std::size_t sample) {
   V total = V::Zero();
-  for (std::size_t i = 0; i < velocities.size(); ++i) total += scene.bodies[i].mass * velocities[i];
+  for (std::size_t i = 0; i < run.bodies; ++i)
+    total += scene.bodies[i].mass * run.velocity(sample, i);
   return total;
 }
 
-/// The apex of flight `flight` (1: after the first bounce) of body `body`, from three samples
-/// around its highest one: the parabola through them is the flight's, exactly when the samples
-/// lie on it. NaN when the flight has fewer than three samples.
-double apexHeight(const Run& run, std::size_t body, int flight) {
-  // Flight n: the samples after the n-th bounce (a sample falling, the next rising) up to the
-  // next bounce.
-  int bounces = 0;
-  std::vector<std::size_t> samples;
-  for (std::size_t k = 1; k < run.times.size(); ++k) {
-    if (run.velocities[k - 1][body].z() < 0 && run.velocities[k][body].z() > 0) ++bounces;
-    if (bounces > flight) break;
-    if (bounces == flight) samples.push_back(k);
-  }
-  if (samples.size() < 3) return NAN;
-  std::size_t top = 1;
-  for (std::size_t j = 1; j + 1 < samples.size(); ++j) {
-    if (run.positions[samples[j]][body].z() > run.positions[samples[top]][body].z()) top = j;
-  }
-  const std::size_t k0 = samples[top - 1], k1 = samples[top], k2 = samples[top + 1];
-  const double t0 = run.times[k0], t1 = run.times[k1], t2 = run.times[k2];
-  const double z0 = run.positions[k0][body].z(), z1 = run.positions[k1][body].z(),
-               z2 = run.positions[k2][body].z();
-  // The parabola through the three points (divided differences): its top.
-  const double d01 = (z1 - z0) / (t1 - t0), d12 = (z2 - z1) / (t2 - t1);
-  const double a = (d12 - d01) / (t2 - t0);
-  if (!(a < 0)) return std::max({z0, z1, z2});
-  const double t_top = 0.5 * (t0 + t1) - d01 / (2 * a);
-  return z0 + (t_top - t0) * (d01 + a * (t_top - t1));
+V row3(const std::vector<double>& row, std::size_t from) {
+  return V(row.at(from), row.at(from + 1), row.at(from + 2));
 }
 
-/// The first update at which `changed` holds for body `body`; its time, or NaN.
-template <typename Predicate>
-double firstTime(const Run& run, std::size_t body, Predicate changed) {
-  for (std::size_t k = 0; k < run.times.size(); ++k) {
-    if (changed(run.velocities[k][body])) return run.times[k];
+/// The reference's state of body `body` at the scene's end: position and velocity.
+std::pair<V, V> finalState(const References& refs, const std::string& scene, std::size_t body) {
+  for (const std::vector<double>& row : refs.rows(scene, "final")) {
+    if (static_cast<std::size_t>(row.at(0)) == body) return {row3(row, 1), row3(row, 4)};
   }
-  return NAN;
+  throw std::runtime_error("reference " + scene + " final: no body " + std::to_string(body));
+}
+
+/// The first instant at which an impact changed body `body`'s motion: the engine's own report
+/// (ours), or the first update whose velocity differs from the free motion of the update before
+/// (the others: the first update after the impact).
+double firstImpact(const core::Scene& scene, const Run& run, std::size_t body) {
+  if (run.reports_impacts) {
+    double first = kNaN;
+    for (const ReportedImpact& impact : run.impacts) {
+      const bool involved =
+          impact.body == body || (!impact.other_is_obstacle && impact.other == body);
+      if (involved && !(impact.time >= first)) first = impact.time;
+    }
+    return first;
+  }
+  const V g = scene.effects.gravity ? scene.gravity : V::Zero();
+  for (std::size_t k = 1; k < run.samples(); ++k) {
+    const double dt = run.times[k] - run.times[k - 1];
+    const V expected = run.velocity(k - 1, body) + g * dt;
+    if ((run.velocity(k, body) - expected).norm() > 1e-5 * expected.norm() + 1e-6) {
+      return run.times[k];
+    }
+  }
+  return kNaN;
+}
+
+/// The apex of each flight of body `body` against gravity (centre height, m), flight 1 after the
+/// first impact: what the engine's output implies. Ours reports every impact: the apex follows
+/// from the post-impact velocity at the contact, h + u^2 / 2g (the parabola the source then
+/// plays). The others report states: at the top of each flight (the last update before the
+/// upward speed turns negative) h + u^2 / 2g of that state, exact for any state on a ballistic
+/// flight. A flight shorter than an update (no state in it rising, then falling) is missing.
+std::vector<double> apexes(const core::Scene& scene, const Run& run, std::size_t body) {
+  const double g = scene.gravity.norm();
+  const V up = -scene.gravity / g;
+  std::vector<double> tops;
+  if (run.reports_impacts) {
+    double last_time = kNaN;
+    bool last_pushed = false;
+    for (const ReportedImpact& impact : run.impacts) {
+      const bool first = impact.body == body;
+      if (!first && (impact.other_is_obstacle || impact.other != body)) continue;
+      const V& position = first ? impact.position : impact.other_position;
+      const double rise = up.dot(first ? impact.velocity_after : impact.other_velocity_after);
+      // Several impacts at one instant (a cluster's rounds): the last one's velocity stays.
+      if (impact.time == last_time && last_pushed) tops.pop_back();
+      last_time = impact.time;
+      // An impact after which the body does not rise (it comes to rest) starts no flight.
+      last_pushed = rise > 0;
+      if (last_pushed) tops.push_back(up.dot(position) + rise * rise / (2 * g));
+    }
+    return tops;
+  }
+  bool rising = false;
+  for (std::size_t k = 1; k < run.samples(); ++k) {
+    const double before = up.dot(run.velocity(k - 1, body)), now = up.dot(run.velocity(k, body));
+    if (before <= 0 && now > 0) rising = true;  // a bounce
+    if (rising && before > 0 && now <= 0) {     // the top: state k - 1 is the last rising one
+      tops.push_back(up.dot(run.position(k - 1, body)) + before * before / (2 * g));
+      rising = false;
+    }
+  }
+  return tops;
+}
+
+/// Body `body`'s first impact against the reference's.
+double instantError(const std::string& name, const core::Scene& scene, const Run& run,
+                    const References& refs, std::size_t body) {
+  for (const std::vector<double>& row : refs.rows(name, "first_impact_of")) {
+    if (static_cast<std::size_t>(row.at(0)) == body) {
+      return std::abs(firstImpact(scene, run, body) - row.at(1));
+    }
+  }
+  return kNaN;
 }
 
 /// The larger, NaN (not measurable) winning: a worst case is not better for a missing value.
 double worst(double current, double value) {
-  if (std::isnan(current) || std::isnan(value)) return NAN;
+  if (std::isnan(current) || std::isnan(value)) return kNaN;
   return std::max(current, value);
 }
 
-double firstImpact(const Run& run) {
-  return run.impact_times.empty()
-             ? NAN
-             : *std::min_element(run.impact_times.begin(), run.impact_times.end());
+// The seed's drop test: e from each ball's first apex, the apex after three bounces, the instant
+// of the first impact; worst ball.
+Metrics dropTest(const std::string& name, const core::Scene& scene, const Run& run,
+                 const References& refs) {
+  double instant = 0, restitution = 0, apex = 0;
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+    const double r = scene.bodies[i].radius;
+    double reference_rise[4] = {kNaN, kNaN, kNaN, kNaN};
+    for (const std::vector<double>& row : refs.rows(name, "apex")) {
+      const auto flight = static_cast<std::size_t>(row.at(1));
+      if (static_cast<std::size_t>(row.at(0)) == i && flight <= 3) {
+        reference_rise[flight] = row.at(2) - r;
+      }
+    }
+    instant = worst(instant, instantError(name, scene, run, refs, i));
+    // No flight: the ball did not bounce (e measured 0, an error of 100 %).
+    const std::vector<double> tops = apexes(scene, run, i);
+    const double rise1 = tops.size() >= 1 ? tops[0] - r : 0.0;
+    const double rise3 = tops.size() >= 3 ? tops[2] - r : 0.0;
+    // e = sqrt(h'/h): the measured e against the exact one is sqrt(rise / exact rise).
+    restitution = worst(restitution, std::abs(std::sqrt(rise1 / reference_rise[1]) - 1));
+    apex = worst(apex, std::abs(rise3 - reference_rise[3]) / reference_rise[3]);
+  }
+  return {{"instant", instant}, {"restitution", restitution}, {"apex", apex}};
+}
+
+/// The final velocities against the reference's: RMS over the bodies, or the worst body (m/s);
+/// the positions' RMS (m).
+Metrics finalVelocities(const std::string& name, const Run& run, const References& refs, bool rms) {
+  const std::size_t last = run.samples() - 1;
+  double worst_velocity = 0, sum_velocity = 0, sum_position = 0;
+  for (std::size_t i = 0; i < run.bodies; ++i) {
+    const auto [p, v] = finalState(refs, name, i);
+    const double dv = (run.velocity(last, i) - v).norm();
+    worst_velocity = std::max(worst_velocity, dv);
+    sum_velocity += dv * dv;
+    sum_position += (run.position(last, i) - p).squaredNorm();
+  }
+  const double n = static_cast<double>(run.bodies);
+  Metrics metrics = {{"velocity", rms ? std::sqrt(sum_velocity / n) : worst_velocity},
+                     {"position", std::sqrt(sum_position / n)}};
+  if (run.reports_impacts) metrics["impacts"] = static_cast<double>(run.impacts.size());
+  return metrics;
+}
+
+double energyDrift(const std::string& name, const core::Scene& scene, const Run& run,
+                   const References& refs) {
+  const double e0 = refs.value(name, "energy0");
+  return std::abs(energy(scene, run, run.samples() - 1) - e0) / std::abs(e0);
+}
+
+// The cradle (e = 1, no obstacle): final velocities (worst ball), energy and momentum against
+// the start, the striker's first impact.
+Metrics cradle(const std::string& name, const core::Scene& scene, const Run& run,
+               const References& refs) {
+  Metrics metrics = finalVelocities(name, run, refs, false);
+  const V p0 = row3(refs.rows(name, "momentum0").front(), 0);
+  metrics["energy_drift"] = energyDrift(name, scene, run, refs);
+  metrics["momentum_drift"] = (momentum(scene, run, run.samples() - 1) - p0).norm() / p0.norm();
+  metrics["instant"] = instantError(name, scene, run, refs, 0);
+  return metrics;
+}
+
+// The break: velocities and positions after 1 s (RMS over the balls), the cue's first impact.
+Metrics billiardsBreak(const std::string& name, const core::Scene& scene, const Run& run,
+                       const References& refs) {
+  Metrics metrics = finalVelocities(name, run, refs, true);
+  metrics["instant"] = instantError(name, scene, run, refs, 0);
+  metrics["reference_impacts"] = refs.value(name, "impacts");
+  return metrics;
+}
+
+// The fast ball against the post: missed or not; its velocity after and the instant.
+Metrics tunnelling(const std::string& name, const core::Scene& scene, const Run& run,
+                   const References& refs) {
+  const std::size_t last = run.samples() - 1;
+  const bool passed = run.position(last, 0).x() > scene.obstacles.front().position.x();
+  const auto [p, v] = finalState(refs, name, 0);
+  (void)p;
+  return {{"missed", passed ? 1.0 : 0.0},
+          {"velocity", (run.velocity(last, 0) - v).norm()},
+          {"instant", passed ? kNaN : instantError(name, scene, run, refs, 0)}};
+}
+
+// Energy against the start (the gas: its reference is the conservation law).
+Metrics conservation(const std::string& name, const core::Scene& scene, const Run& run,
+                     const References& refs) {
+  const double e0 = refs.value(name, "energy0");
+  Metrics metrics = {
+      {"energy_drift", std::abs(energy(scene, run, run.samples() - 1) - e0) / std::abs(e0)}};
+  if (run.reports_impacts) metrics["impacts"] = static_cast<double>(run.impacts.size());
+  return metrics;
+}
+
+// 1,000 bounces: every bounce's apex against h e^(2k), as long as the exact bounce rises 1 nm.
+Metrics bounces(const std::string& name, const core::Scene& scene, const Run& run,
+                const References& refs) {
+  const double r = scene.bodies.front().radius;
+  std::vector<double> exact;  // exact[k - 1]: bounce k's rise above the contact
+  for (const std::vector<double>& row : refs.rows(name, "bounce")) exact.push_back(row.at(1));
+  const std::vector<double> tops = apexes(scene, run, 0);
+  const std::size_t count = exact.size();
+  const auto error = [&](std::size_t k) {  // bounce k (1-based); a missing one is off by 100 %
+    return k <= tops.size() ? std::abs((tops[k - 1] - r) - exact[k - 1]) / exact[k - 1] : 1.0;
+  };
+  std::size_t faithful = 0;
+  while (faithful < count && error(faithful + 1) <= 0.01) ++faithful;
+  double first_ten = 0;
+  for (std::size_t k = 1; k <= std::min<std::size_t>(10, count); ++k)
+    first_ten = std::max(first_ten, error(k));
+  return {{"bounces", static_cast<double>(std::min<std::size_t>(tops.size(), 1000))},
+          {"exact_bounces", static_cast<double>(count)},
+          {"faithful", static_cast<double>(faithful)},
+          {"apex_error_10", first_ten},
+          {"apex_error_last", error(count)}};
+}
+
+// The two-ball chain: the final velocities against the exact ones (m/s), energy, order kept.
+Metrics chain(const std::string& name, const core::Scene& scene, const Run& run,
+              const References& refs) {
+  Metrics metrics = finalVelocities(name, run, refs, false);
+  metrics["energy_drift"] = energyDrift(name, scene, run, refs);
+  const std::size_t last = run.samples() - 1;
+  const double light = run.position(last, 0).x(), heavy = run.position(last, 1).x();
+  const double r_light = scene.bodies[0].radius, r_heavy = scene.bodies[1].radius;
+  // Out of order: the light ball through the wall or through the heavy one (by more than its
+  // radius: an overlap still being resolved is not a pass).
+  const bool passed =
+      light < 0 || heavy < light || heavy - r_heavy < 0 || light - r_light < -r_light;
+  metrics["passed"] = passed ? 1.0 : 0.0;
+  metrics["reference_impacts"] = refs.value(name, "impacts");
+  return metrics;
 }
 
 }  // namespace
 
-Errors measure(const BenchScene& bench, const core::Scene& scene, const Run& run,
-               const Run* reference) {
-  Errors errors;
-  const std::vector<V>& v0 = run.velocities.front();
-  const std::vector<V>& v1 = run.velocities.back();
-  const std::vector<V>& p0 = run.positions.front();
-  const std::vector<V>& p1 = run.positions.back();
-  if (bench.name == "drop_test") {
-    // Every ball dropped from h = 1 m: the first impact at sqrt(2 h / g), the first bounce up
-    // to e^2 h, the third to e^6 h.
-    const double g = 9.81, h = 1.0, first = std::sqrt(2 * h / g);
-    double instant = 0, restitution = 0, apex = 0;
-    for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
-      const double e = core::seedTable()[i].restitution;
-      const double found = run.impact_times.empty()
-                               ? firstTime(run, i, [](const V& v) { return v.z() > 0; })
-                               : firstImpact(run);
-      instant = worst(instant, std::abs(found - first));
-      const double r = scene.bodies[i].radius;
-      restitution =
-          worst(restitution, std::abs(std::sqrt((apexHeight(run, i, 1) - r) / h) - e) / e);
-      const double third = std::pow(e, 6) * h;
-      apex = worst(apex, std::abs((apexHeight(run, i, 3) - r) - third) / third);
-    }
-    errors.instant = instant;
-    errors.restitution = restitution;
-    errors.apex = apex;
-  } else if (bench.name == "cradle") {
-    const double exact = 0.02;  // 0.02 m at 1 m/s
-    errors.instant = std::abs((run.impact_times.empty()
-                                   ? firstTime(run, 0, [](const V& v) { return v.x() < 1 - 1e-9; })
-                                   : firstImpact(run)) -
-                              exact);
-    double worst = 0;
-    for (std::size_t i = 0; i < v1.size(); ++i) {
-      worst = std::max(worst, (v1[i] - V(i + 1 == v1.size() ? 1.0 : 0.0, 0, 0)).norm());
-    }
-    errors.velocity = worst;
-    errors.momentum_drift =
-        (momentum(scene, v1) - momentum(scene, v0)).norm() / momentum(scene, v0).norm();
-    errors.energy_drift =
-        std::abs(energy(scene, p1, v1) - energy(scene, p0, v0)) / energy(scene, p0, v0);
-  } else if (bench.name == "billiards_break") {
-    const double r = 0.028575, exact = (1.905 - 0.635 - 2 * r) / 6.0;
-    errors.instant = std::abs((run.impact_times.empty()
-                                   ? firstTime(run, 0, [](const V& v) { return v.x() < 6 - 1e-9; })
-                                   : firstImpact(run)) -
-                              exact);
-    if (reference != nullptr) {
-      double sum = 0;
-      const std::vector<V>& ref = reference->velocities.back();
-      for (std::size_t i = 0; i < v1.size(); ++i) sum += (v1[i] - ref[i]).squaredNorm();
-      errors.velocity = std::sqrt(sum / static_cast<double>(v1.size()));
-    }
-  } else if (bench.name == "tunnelling") {
-    const double exact = (1.0 - 0.03) / 50.0;
-    const bool passed = run.positions.back()[0].x() > 1.0;
-    errors.missed = passed ? 1 : 0;
-    if (!passed) {
-      errors.instant =
-          std::abs((run.impact_times.empty()
-                        ? firstTime(run, 0, [](const V& v) { return v.x() < 50 - 1e-9; })
-                        : firstImpact(run)) -
-                   exact);
-      errors.velocity = (v1[0] - V(-0.8 * 50, 0, 0)).norm();
-    }
-  } else if (bench.name == "sphere_gas") {
-    errors.energy_drift =
-        std::abs(energy(scene, p1, v1) - energy(scene, p0, v0)) / std::abs(energy(scene, p0, v0));
+Metrics measure(const BenchScene& bench, const std::string& effects, const Run& run,
+                const References& references) {
+  const core::Scene scene = withEffects(bench, effects);
+  const std::string name = referenceName(bench, effects);
+  if (!references.has(name, "energy0")) {
+    // No reference for these effects (friction and spin): only what needs none.
+    return {{"impacts", run.reports_impacts ? static_cast<double>(run.impacts.size()) : kNaN}};
   }
-  return errors;
+  if (bench.name == "drop_test") return dropTest(name, scene, run, references);
+  if (bench.name == "billiards_break") return billiardsBreak(name, scene, run, references);
+  if (bench.name == "tunnelling") return tunnelling(name, scene, run, references);
+  if (bench.name.rfind("bounce_", 0) == 0) return bounces(name, scene, run, references);
+  if (bench.name.rfind("chain_", 0) == 0) return chain(name, scene, run, references);
+  if (bench.reference == "conservation") return conservation(name, scene, run, references);
+  if (bench.name == "cradle") return cradle(name, scene, run, references);
+  throw std::runtime_error("no metrics for scene " + bench.name + " (measure.cpp)");
 }
 
 }  // namespace collision_response::bench

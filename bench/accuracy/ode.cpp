@@ -14,7 +14,6 @@ struct OdeWorld {
   dJointGroupID contacts;
   const core::Scene* scene;
   std::map<dGeomID, std::string> material;
-  std::size_t contact_count = 0;
 };
 
 void nearCallback(void* data, dGeomID first, dGeomID second) {
@@ -31,16 +30,15 @@ void nearCallback(void* data, dGeomID first, dGeomID second) {
     const dJointID joint = dJointCreateContact(w->world, w->contacts, &contact[i]);
     dJointAttach(joint, dGeomGetBody(first), dGeomGetBody(second));
   }
-  ++w->contact_count;
 }
 
 }  // namespace
 
 Engine odeEngine() {
-  return [](const core::Scene& scene, double rate, double duration) {
+  return [](const core::Scene& scene, const Play& play) {
     static const bool initialised = (dInitODE2(0), true);
     (void)initialised;
-    OdeWorld w{dWorldCreate(), dHashSpaceCreate(nullptr), dJointGroupCreate(0), &scene, {}, 0};
+    OdeWorld w{dWorldCreate(), dHashSpaceCreate(nullptr), dJointGroupCreate(0), &scene, {}};
     const V g = scene.effects.gravity ? scene.gravity : V::Zero();
     dWorldSetGravity(w.world, g.x(), g.y(), g.z());
     std::vector<dBodyID> bodies;
@@ -70,26 +68,23 @@ Engine odeEngine() {
     }
 
     Run run;
-    const auto updates = static_cast<long>(std::llround(duration * rate));
-    const double dt = 1.0 / rate;
+    const auto updates = static_cast<long>(std::llround(play.duration * play.rate));
+    const double dt = 1.0 / play.rate;
+    std::vector<V> positions(bodies.size()), velocities(bodies.size());
     for (long k = 0; k <= updates; ++k) {
       if (k > 0) {
         dSpaceCollide(w.space, &w, &nearCallback);
         dWorldStep(w.world, dt);
         dJointGroupEmpty(w.contacts);
       }
-      run.times.push_back(static_cast<double>(k) * dt);
-      std::vector<V> positions, velocities;
-      for (const dBodyID body : bodies) {
-        const dReal* p = dBodyGetPosition(body);
-        const dReal* v = dBodyGetLinearVel(body);
-        positions.emplace_back(p[0], p[1], p[2]);
-        velocities.emplace_back(v[0], v[1], v[2]);
+      for (std::size_t i = 0; i < bodies.size(); ++i) {
+        const dReal* p = dBodyGetPosition(bodies[i]);
+        const dReal* v = dBodyGetLinearVel(bodies[i]);
+        positions[i] = V(p[0], p[1], p[2]);
+        velocities[i] = V(v[0], v[1], v[2]);
       }
-      run.positions.push_back(positions);
-      run.velocities.push_back(velocities);
+      run.record(play, static_cast<double>(k) * dt, positions, velocities);
     }
-    run.impacts = w.contact_count;
     dJointGroupDestroy(w.contacts);
     dSpaceDestroy(w.space);
     dWorldDestroy(w.world);

@@ -1,5 +1,3 @@
-#include <map>
-
 #include "collision_response/core/monitor.h"
 #include "collision_response/core/playback.h"
 #include "harness.h"
@@ -7,23 +5,28 @@
 namespace collision_response::bench {
 
 Engine oursEngine(core::Detection detection) {
-  return [detection](const core::Scene& input, double rate, double duration) {
+  return [detection](const core::Scene& input, const Play& play) {
     core::Scene scene = input;
     scene.detection = detection;
     core::MonitorSettings settings;
-    settings.body_timeout = 2 * duration + 1;
+    settings.body_timeout = 2 * play.duration + 1;
     core::ImpactMonitor monitor(scene, settings);
     core::Playback playback(scene, settings.contact_tolerance, 0.0);
-    std::vector<std::size_t> monitor_index;
-    for (const core::BodySpec& body : scene.bodies)
-      monitor_index.push_back(*monitor.bodyIndex(body.id));
+    // The monitor indexes bodies by sorted id; the run lists them as the scene does.
+    std::vector<std::size_t> monitor_index, scene_index(scene.bodies.size());
+    for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+      monitor_index.push_back(*monitor.bodyIndex(scene.bodies[i].id));
+      scene_index[monitor_index.back()] = i;
+    }
     const bool exact_contact = detection == core::Detection::kContinuous;
 
     Run run;
-    const auto updates = static_cast<long>(std::llround(duration * rate));
+    run.reports_impacts = true;
+    const auto updates = static_cast<long>(std::llround(play.duration * play.rate));
     std::vector<core::BodyStateSample> states(scene.bodies.size());
+    std::vector<V> positions(states.size()), velocities(states.size());
     for (long k = 0; k <= updates; ++k) {
-      const double t = static_cast<double>(k) / rate;
+      const double t = static_cast<double>(k) / play.rate;
       // The source publishes every body's state at t; the monitor finds the impacts since the
       // last states; the source applies them (the scene player's loop).
       for (std::size_t i = 0; i < states.size(); ++i) {
@@ -33,19 +36,30 @@ Engine oursEngine(core::Detection detection) {
         states[i].velocity = playback.velocity(i, t);
       }
       const core::StepReport report = monitor.step(t, states);
+      run.truncated = run.truncated || report.truncated;
       for (const core::ImpactRecord& impact : report.impacts) {
         playback.applyImpact(monitor, impact, exact_contact);
-        run.impact_times.push_back(impact.time);
+        ReportedImpact reported;
+        reported.time = impact.time;
+        reported.body = scene_index[impact.body_a];
+        // Where the source placed the body at the instant (continuous: at the contact).
+        reported.position = playback.position(reported.body, impact.time);
+        reported.velocity_after = impact.velocity_a_after;
+        reported.other_is_obstacle = impact.other_is_obstacle;
+        if (!impact.other_is_obstacle) {
+          reported.other = scene_index[impact.other];
+          reported.other_position = playback.position(reported.other, impact.time);
+          reported.other_velocity_after = impact.velocity_b_after;
+        } else {
+          reported.other = impact.other;
+        }
+        run.impacts.push_back(reported);
       }
-      run.impacts += report.impacts.size();
-      run.times.push_back(t);
-      std::vector<V> positions, velocities;
       for (std::size_t i = 0; i < states.size(); ++i) {
-        positions.push_back(playback.position(i, t));
-        velocities.push_back(playback.velocity(i, t));
+        positions[i] = playback.position(i, t);
+        velocities[i] = playback.velocity(i, t);
       }
-      run.positions.push_back(positions);
-      run.velocities.push_back(velocities);
+      run.record(play, t, positions, velocities);
     }
     return run;
   };

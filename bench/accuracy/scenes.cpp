@@ -6,6 +6,9 @@
 namespace collision_response::bench {
 namespace {
 
+/// The state rates of the short scenes (Hz).
+const std::vector<double> kRates = {10.0, 30.0, 60.0, 100.0, 300.0, 1000.0};
+
 core::BodySpec ball(const std::string& id, double mass, double radius, const std::string& material,
                     const V& position, const V& velocity = V::Zero()) {
   core::BodySpec body;
@@ -28,11 +31,9 @@ core::ObstacleSpec plane(const std::string& id, const V& normal, double offset,
   return obstacle;
 }
 
-}  // namespace
-
 // The seed's drop test: one ball of each material 1 m above concrete, gravity on.
 BenchScene dropTestScene() {
-  BenchScene bench{"drop_test", {}, 2.5};
+  BenchScene bench{"drop_test", {}, 2.5, kRates, false, true, {}};
   core::Scene& scene = bench.scene;
   scene.effects.gravity = true;
   int i = 0;
@@ -45,7 +46,7 @@ BenchScene dropTestScene() {
 
 // An idealised Newton's cradle: five touching balls (e = 1), the first 0.02 m away at 1 m/s.
 BenchScene cradleScene() {
-  BenchScene bench{"cradle", {}, 0.1};
+  BenchScene bench{"cradle", {}, 0.1, kRates, false, true, {}};
   core::Scene& scene = bench.scene;
   (void)scene.materials.addMaterial("polished_steel", core::Material{1.0, {}}, "m");
   scene.bodies.push_back(ball("ball_1", 0.26, 0.02, "polished_steel", V(-0.06, 0, 0), V(1, 0, 0)));
@@ -59,7 +60,7 @@ BenchScene cradleScene() {
 // The billiards break of config/scenes/billiards_break.yaml: the cue ball at 6 m/s into a rack
 // of fifteen touching balls on a 2.54 m x 1.27 m table.
 BenchScene breakScene() {
-  BenchScene bench{"billiards_break", {}, 1.0};
+  BenchScene bench{"billiards_break", {}, 1.0, kRates, false, true, {"friction, spin"}};
   core::Scene& scene = bench.scene;
   (void)scene.materials.addMaterial("cushion", core::Material{0.75, {}}, "m");
   const double r = 0.028575;
@@ -84,7 +85,7 @@ BenchScene breakScene() {
 // A fast ball (radius 0.02 m, 50 m/s) against a thin post (a fixed sphere of radius 0.01 m)
 // 1 m ahead: 2.5 cm of travel per step at 2 kHz, half a metre at 100 Hz.
 BenchScene tunnellingScene() {
-  BenchScene bench{"tunnelling", {}, 0.1};
+  BenchScene bench{"tunnelling", {}, 0.1, kRates, false, true, {}};
   core::Scene& scene = bench.scene;
   (void)scene.materials.addMaterial("hard", core::Material{0.8, {}}, "m");
   scene.bodies.push_back(ball("bullet", 0.01, 0.02, "hard", V(0, 0, 0), V(50, 0, 0)));
@@ -100,7 +101,7 @@ BenchScene tunnellingScene() {
 
 // 64 elastic balls in a closed 2 m box, random velocities up to 2 m/s: energy must stay.
 BenchScene gasScene() {
-  BenchScene bench{"sphere_gas", {}, 2.0};
+  BenchScene bench{"sphere_gas", {}, 2.0, kRates, false, true, {"gravity"}, "conservation"};
   core::Scene& scene = bench.scene;
   (void)scene.materials.addMaterial("elastic", core::Material{1.0, {}}, "m");
   std::mt19937_64 engine(7);
@@ -117,6 +118,74 @@ BenchScene gasScene() {
         plane("wall_" + std::to_string(i), normals[i], i % 2 ? -2.0 : 0.0, "elastic"));
   }
   return bench;
+}
+
+// One ball (radius 0.03 m) dropped from 1 m onto a floor, e = `restitution`, threshold 0, until
+// it has bounced 1,000 times or its bounces accumulate (e < 1: at t = sqrt(2h/g)(1 + e)/(1 - e)).
+BenchScene bounceScene(const std::string& name, double restitution, double duration) {
+  BenchScene bench{name, {}, duration, {100.0, 1000.0}, true, true, {}};
+  core::Scene& scene = bench.scene;
+  scene.effects.gravity = true;
+  (void)scene.materials.addMaterial("ball", core::Material{restitution, {}}, "m");
+  scene.bodies.push_back(ball("ball", 0.1, 0.03, "ball", V(0, 0, 1.03)));
+  scene.obstacles.push_back(plane("floor", V(0, 0, 1), 0.0, "concrete"));
+  return bench;
+}
+
+// The two-ball chain: a heavy ball (1 kg) at 1 m/s towards a light one (1/ratio kg) that rests
+// between it and a wall, on one line, e = 1. The light ball shuttles between the two; the impacts
+// end when both move away from the wall, after ceil(pi / atan(sqrt(m/M))) - 1 of them (3, 99 and
+// 3141 for ratios 1, 1e3, 1e6: G. Galperin, "Playing pool with pi", Regular and Chaotic
+// Dynamics 8 (2003)).
+BenchScene chainScene(const std::string& name, double ratio) {
+  BenchScene bench{name, {}, 3.0, {100.0, 1000.0}, true, true, {}};
+  core::Scene& scene = bench.scene;
+  (void)scene.materials.addMaterial("elastic", core::Material{1.0, {}}, "m");
+  scene.bodies.push_back(ball("light", 1.0 / ratio, 0.05, "elastic", V(0.55, 0, 0)));
+  scene.bodies.push_back(ball("heavy", 1.0, 0.05, "elastic", V(1.1, 0, 0), V(-1, 0, 0)));
+  scene.obstacles.push_back(plane("wall", V(1, 0, 0), 0.0, "elastic"));
+  return bench;
+}
+
+}  // namespace
+
+std::vector<BenchScene> benchScenes() {
+  std::vector<BenchScene> scenes = {dropTestScene(), cradleScene(), breakScene(), tunnellingScene(),
+                                    gasScene()};
+  // Long runs (restitution fidelity): 1,000 bounces; e < 1 stops where the bounces accumulate
+  // (t = 0.4515 (1 + e) / (1 - e) s), half a second later; e = 1: after the 1,000th bounce's apex.
+  scenes.push_back(bounceScene("bounce_e0.5", 0.5, 1.9));
+  scenes.push_back(bounceScene("bounce_e0.9", 0.9, 9.1));
+  scenes.push_back(bounceScene("bounce_e1", 1.0, 903.5));
+  scenes.push_back(chainScene("chain_ratio_1", 1.0));
+  scenes.push_back(chainScene("chain_ratio_1e3", 1e3));
+  scenes.push_back(chainScene("chain_ratio_1e6", 1e6));
+  BenchScene gas = gasScene();
+  gas.name = "sphere_gas_60s";
+  gas.duration = 60.0;
+  gas.rates = {100.0, 1000.0};
+  gas.long_run = true;
+  gas.record_all = false;
+  gas.effect_variants.clear();
+  scenes.push_back(gas);
+  return scenes;
+}
+
+core::Scene withEffects(const BenchScene& bench, const std::string& effects) {
+  core::Scene scene = bench.scene;
+  if (effects.find("friction") != std::string::npos) scene.effects.friction = true;
+  if (effects.find("spin") != std::string::npos) scene.effects.spin = true;
+  if (effects.find("gravity") != std::string::npos) scene.effects.gravity = true;
+  return scene;
+}
+
+std::string referenceName(const BenchScene& bench, const std::string& effects) {
+  if (effects == "none") return bench.name;
+  std::string name = bench.name;
+  for (const char* effect : {"gravity", "friction", "spin"}) {
+    if (effects.find(effect) != std::string::npos) name += std::string("+") + effect;
+  }
+  return name;
 }
 
 }  // namespace collision_response::bench

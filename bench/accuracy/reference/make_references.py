@@ -1,0 +1,488 @@
+#!/usr/bin/env python3
+"""The exact answers of the accuracy benchmark's scenes, computed outside the code under test.
+
+Reads the scenes' inputs (scenes.txt, written by `accuracy_benchmark --export-scenes`: every
+double exactly, as a C99 hex float) and writes references.txt, which the benchmark reads to
+measure every engine (ours and the peers) against the same answers.
+
+How (nothing here calls or copies the C++ code; the physics is the seed's and the README's):
+
+- every number is taken exactly from its double (mpmath.mpf(float)) and carried in mpmath with
+  50 significant digits, so the answers are exact to far below a double's rounding;
+- coefficients of restitution: the seed's table (the slide "Coefficients of Restitution of Balls
+  Bounced on a Concrete Surface", written out below and checked against the exported ones), a
+  material against concrete uses its own coefficient, any other pair the smaller of the two
+  (README, "Materials": combine rule min);
+- "events" scenes are played event by event: between impacts every body moves on its exact
+  parabola (a straight line without gravity); the next impact is the earliest exact root of
+  |p_b - p_a| = r_a + r_b (relative motion is a straight line: every body feels the same
+  gravity) or of a sphere-plane gap (a quadratic in time); at an impact the seed's combined
+  formulas act along the line of impact (immovable bodies: inverse mass 0);
+- contacts that touch at one instant (a rack, a cradle) follow the README's documented model,
+  "Simultaneous contacts": in rounds, every touching pair that approaches gets the impulses
+  J >= 0 of the joint solve of Newton's restitution (d' = -e d on every contact that receives
+  one; a contact whose impulse would pull is dropped, the most negative first, and the rest
+  solved again), until no touching pair approaches. Other models of touching contacts exist;
+  engines that follow another one differ from this reference by the model too;
+- a ball bouncing on a plane under gravity with threshold 0 bounces without end (the bounces
+  accumulate at a finite instant); the reference lets it rest once a bounce would rise less than
+  1e-30 m (REST_HEIGHT), far below anything a double can measure against metres;
+- "conservation" scenes (the gas) get their conserved quantities only: energy (kinetic, plus
+  -m g.p with gravity) and momentum from the inputs. A gas's trajectory is chaotic: no finite
+  precision reproduces it beyond a few dozen impacts.
+
+Closed forms are checked against the events where they exist (an apex after the k-th bounce is
+h e^(2k) above the contact; a drop from h meets the floor at sqrt(2 h / g); the two-ball chain
+ends after ceil(pi / atan(sqrt(m / M))) - 1 impacts) and the script stops if they disagree.
+
+Regenerate (scripts/accuracy.sh does this on every run, so a changed scene never meets a stale
+reference; the output is checked in so that a change of any answer shows in review):
+  accuracy_benchmark --export-scenes bench/accuracy/reference/scenes.txt
+  python3 bench/accuracy/reference/make_references.py \
+      bench/accuracy/reference/scenes.txt bench/accuracy/reference/references.txt
+"""
+import math
+import sys
+
+import mpmath
+from mpmath import mpf
+
+mpmath.mp.dps = 50
+
+SEED = {  # the slide "Coefficients of Restitution of Balls Bounced on a Concrete Surface"
+    "range_golf_ball": 0.858, "tennis_ball": 0.712, "billiard_ball": 0.804, "hand_ball": 0.752,
+    "wooden_ball": 0.603, "steel_ball_bearing": 0.597, "glass_marble": 0.658,
+    "rubber_band_ball": 0.828, "hollow_hard_plastic_ball": 0.688,
+}
+TOUCH = mpf("1e-12")         # surfaces within this fraction of their contact distance touch
+APPROACH = mpf("1e-30")      # m/s: slower approaches (rounding at 50 digits) are none
+REST_HEIGHT = mpf("1e-30")   # m: a bounce rising less rests on the plane
+MAX_EVENTS = 200000
+BOUNCE_FLOOR = 1e-9          # m: the bounces of the long runs counted (rising at least 1 nm)
+
+
+def vec(values):
+    return [mpf(float.fromhex(v)) for v in values]
+
+
+def dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def add(a, b, k=1):
+    return [a[0] + k * b[0], a[1] + k * b[1], a[2] + k * b[2]]
+
+
+class Body:
+    def __init__(self, name, material, mass, radius, position, velocity):
+        self.name, self.material = name, material
+        self.mass = mpf(float.fromhex(mass))
+        self.inverse_mass = 0 if mpmath.isinf(self.mass) else 1 / self.mass
+        self.radius = mpf(float.fromhex(radius))
+        self.position, self.velocity = vec(position), vec(velocity)
+        self.start = list(self.position)
+        self.resting_on = None  # plane index
+        self.impacts = 0
+
+
+class Scene:
+    def __init__(self, name, fields):
+        self.name = name
+        def after(key, count=1):
+            i = fields.index(key)
+            return fields[i + 1:i + 1 + count]
+        self.duration = mpf(float.fromhex(after("duration")[0]))
+        self.reference = after("reference")[0]
+        self.threshold = mpf(float.fromhex(after("threshold")[0]))
+        self.friction, self.spin = after("friction")[0] == "1", after("spin")[0] == "1"
+        self.has_gravity = after("gravity")[0] == "1"
+        self.gravity = vec(after("gravity", 4)[1:]) if self.has_gravity else [mpf(0)] * 3
+        if self.threshold != 0:
+            sys.exit(f"{name}: a restitution threshold is not in this reference")
+        self.own = {}       # material -> own coefficient (against concrete)
+        self.bodies, self.planes, self.spheres = [], [], []
+
+    def restitution(self, first, second):
+        if first == "concrete":
+            return self.own[second]
+        if second == "concrete":
+            return self.own[first]
+        return min(self.own[first], self.own[second])
+
+
+def read_scenes(path):
+    scenes, scene = [], None
+    for line in open(path):
+        words = line.split()
+        if not words or words[0].startswith("#"):
+            continue
+        kind = words[0]
+        if kind == "scene":
+            scene = Scene(words[1], words[2:])
+        elif kind == "material":
+            own = mpf(float.fromhex(words[2]))
+            if words[1] in SEED and own != mpf(SEED[words[1]]):
+                sys.exit(f"{scene.name}: {words[1]} has e {float(own)}, the seed's table says "
+                         f"{SEED[words[1]]}")
+            scene.own[words[1]] = own
+        elif kind == "body":
+            scene.bodies.append(Body(words[1], words[2], words[3], words[4], words[5:8],
+                                     words[8:11]))
+        elif kind == "plane":
+            scene.planes.append((words[1], words[2], vec(words[3:6]),
+                                 mpf(float.fromhex(words[6]))))
+        elif kind == "sphere":
+            scene.spheres.append((words[1], words[2], vec(words[3:6]),
+                                  mpf(float.fromhex(words[6]))))
+        elif kind == "end":
+            scenes.append(scene)
+    return scenes
+
+
+# --- motion -------------------------------------------------------------------------------------
+
+def acceleration(scene, body):
+    if not scene.has_gravity or body.inverse_mass == 0:
+        return [mpf(0)] * 3
+    g = scene.gravity
+    if body.resting_on is not None:  # slides on the plane: gravity's part along it
+        n = scene.planes[body.resting_on][2]
+        return add(g, n, -dot(g, n))
+    return g
+
+
+def advance(scene, bodies, dt):
+    for body in bodies:
+        a = acceleration(scene, body)
+        body.position = [p + v * dt + a_ * dt * dt / 2 for p, v, a_ in
+                         zip(body.position, body.velocity, a)]
+        body.velocity = [v + a_ * dt for v, a_ in zip(body.velocity, a)]
+
+
+def first_root(a, b, c):
+    """The entering root tau > 0 of a/2 tau^2 + b tau + c = 0 (c: the gap, b: its rate, a: its
+    acceleration), or None."""
+    if a == 0:
+        return -c / b if b < 0 else None
+    disc = b * b - 2 * a * c
+    if disc < 0:
+        return None
+    if a > 0 and b >= 0:
+        return None
+    tau = (-b - mpmath.sqrt(disc)) / a
+    return tau if tau > 0 else None
+
+
+# --- participants: bodies, then planes, then immovable spheres ----------------------------------
+
+def contact_geometry(scene, i, j):
+    """Gap, unit normal (i -> j), contact distance and normal rate d of body i and participant j."""
+    body = scene.bodies[i]
+    nb = len(scene.bodies)
+    if j < nb or j >= nb + len(scene.planes):
+        if j < nb:
+            other_p, other_v, other_r = scene.bodies[j].position, scene.bodies[j].velocity, \
+                scene.bodies[j].radius
+        else:
+            _, _, other_p, other_r = scene.spheres[j - nb - len(scene.planes)]
+            other_v = [mpf(0)] * 3
+        s = add(other_p, body.position, -1)
+        dist = mpmath.sqrt(dot(s, s))
+        n = [x / dist for x in s]
+        reach = body.radius + other_r
+        d = dot(add(other_v, body.velocity, -1), n)
+        return dist - reach, n, reach, d
+    _, _, normal, offset = scene.planes[j - nb]
+    gap = dot(normal, body.position) - offset - body.radius
+    n = [-x for x in normal]  # from the body into the plane
+    return gap, n, body.radius, dot(body.velocity, normal)
+
+
+def participant_velocity(scene, j):
+    nb = len(scene.bodies)
+    return scene.bodies[j].velocity if j < nb else [mpf(0)] * 3
+
+
+def inverse_mass(scene, j):
+    nb = len(scene.bodies)
+    return scene.bodies[j].inverse_mass if j < nb else 0
+
+
+def material(scene, j):
+    nb = len(scene.bodies)
+    if j < nb:
+        return scene.bodies[j].material
+    if j < nb + len(scene.planes):
+        return scene.planes[j - nb][1]
+    return scene.spheres[j - nb - len(scene.planes)][1]
+
+
+def pairs(scene):
+    nb, total = len(scene.bodies), len(scene.bodies) + len(scene.planes) + len(scene.spheres)
+    for i in range(nb):
+        for j in range(i + 1, total):
+            if inverse_mass(scene, i) == 0 and inverse_mass(scene, j) == 0:
+                continue
+            yield i, j
+
+
+def time_to_impact(scene, i, j):
+    body = scene.bodies[i]
+    nb = len(scene.bodies)
+    if nb <= j < nb + len(scene.planes):
+        if body.resting_on == j - nb:
+            return None
+        _, _, normal, offset = scene.planes[j - nb]
+        gap = dot(normal, body.position) - offset - body.radius
+        return first_root(dot(normal, acceleration(scene, body)), dot(normal, body.velocity), gap)
+    if j < nb:
+        other = scene.bodies[j]
+        rel_a = add(acceleration(scene, other), acceleration(scene, body), -1)
+        other_p, other_v, other_r = other.position, other.velocity, other.radius
+    else:
+        _, _, other_p, other_r = scene.spheres[j - nb - len(scene.planes)]
+        other_v = [mpf(0)] * 3
+        rel_a = [-x for x in acceleration(scene, body)]
+    s, v, reach = add(other_p, body.position, -1), add(other_v, body.velocity, -1), \
+        body.radius + other_r
+    if any(x != 0 for x in rel_a):
+        return accelerated_time_to_impact(s, v, rel_a, reach)
+    a, b = dot(v, v), dot(s, v)
+    if b >= 0 or a == 0:
+        return None
+    c = dot(s, s) - reach * reach
+    disc = b * b - a * c
+    if disc < 0:
+        return None
+    tau = c / (-b + mpmath.sqrt(disc))
+    return tau if tau > 0 else None
+
+
+def accelerated_time_to_impact(s, v, a, reach):
+    """|s + v tau + a tau^2 / 2| = reach (a body at rest on a plane against a falling one): the
+    smallest positive real root of the quartic, approaching; None when the motion across `a`
+    alone (a straight line) keeps them apart."""
+    along = [x / mpmath.sqrt(dot(a, a)) for x in a]
+    s_across, v_across = add(s, along, -dot(s, along)), add(v, along, -dot(v, along))
+    closest = dot(s_across, s_across)
+    if dot(v_across, v_across) > 0:
+        tau = max(mpf(0), -dot(s_across, v_across) / dot(v_across, v_across))
+        closest = dot(add(s_across, v_across, tau), add(s_across, v_across, tau))
+    if closest > reach * reach:
+        return None
+    coefficients = [dot(a, a) / 4, dot(v, a), dot(v, v) + dot(s, a), 2 * dot(s, v),
+                    dot(s, s) - reach * reach]
+    roots = mpmath.polyroots(coefficients, maxsteps=200, extraprec=200)
+    best = None
+    for root in roots:
+        if abs(mpmath.im(root)) > mpf("1e-30") or mpmath.re(root) <= 0:
+            continue
+        tau = mpmath.re(root)
+        rate = dot(add(s, add(v, a, tau / 2), tau), add(v, a, tau))
+        if rate < 0 and (best is None or tau < best):
+            best = tau
+    return best
+
+
+def resolve_instant(scene):
+    """Every touching, approaching contact, in rounds (README "Simultaneous contacts"). Returns
+    the contacts that received an impulse, and the bodies whose velocity changed."""
+    impacts, touched = 0, set()
+    for _ in range(100000):
+        contacts = []
+        for i, j in pairs(scene):
+            gap, n, reach, d = contact_geometry(scene, i, j)
+            if abs(gap) <= TOUCH * reach and d < -APPROACH:
+                contacts.append((i, j, n, d, scene.restitution(material(scene, i),
+                                                                material(scene, j))))
+        if not contacts:
+            return impacts, touched
+        active = list(range(len(contacts)))
+        while True:
+            size = len(active)
+            matrix = mpmath.matrix(size, size)
+            rhs = mpmath.matrix(size, 1)
+            for row, k in enumerate(active):
+                ik, jk, nk, dk, ek = contacts[k]
+                rhs[row] = -(1 + ek) * dk
+                for col, l in enumerate(active):
+                    il, jl, nl, _, _ = contacts[l]
+                    # d_k changes by sum over bodies of w s_ik s_il n_k.n_l J_l (s: +1 for the
+                    # second participant of a contact, -1 for the first).
+                    coupling = 0
+                    for body, s_k in ((ik, -1), (jk, 1)):
+                        for other, s_l in ((il, -1), (jl, 1)):
+                            if body == other:
+                                coupling += inverse_mass(scene, body) * s_k * s_l
+                    matrix[row, col] = coupling * dot(nk, nl)
+            impulses = mpmath.lu_solve(matrix, rhs)
+            worst = min(range(size), key=lambda r: impulses[r])
+            if impulses[worst] >= 0:
+                break
+            del active[worst]
+        for row, k in enumerate(active):
+            i, j, n, _, _ = contacts[k]
+            impulse = impulses[row]
+            if impulse <= 0:
+                continue
+            impacts += 1
+            for body, sign in ((i, -1), (j, 1)):
+                if body < len(scene.bodies) and scene.bodies[body].inverse_mass != 0:
+                    b = scene.bodies[body]
+                    b.velocity = add(b.velocity, n, sign * impulse * b.inverse_mass)
+                    touched.add(body)
+    sys.exit(f"{scene.name}: endless rounds")
+
+
+def settle(scene, touched):
+    """A body that bounced off a plane too low to leave it rests on it (gravity only)."""
+    if not scene.has_gravity:
+        return
+    for i in touched:
+        body = scene.bodies[i]
+        for p, (_, _, normal, offset) in enumerate(scene.planes):
+            gap = dot(normal, body.position) - offset - body.radius
+            toward = dot(normal, scene.gravity)
+            if abs(gap) > TOUCH * body.radius or toward >= 0:
+                continue
+            rate = dot(normal, body.velocity)
+            if rate <= 0 or rate * rate / (-2 * toward) < REST_HEIGHT:
+                body.velocity = add(body.velocity, normal, -rate)
+                body.resting_on = p
+
+
+def height(scene, body):
+    """Height against gravity (m), and the speed along it."""
+    g = scene.gravity
+    norm = mpmath.sqrt(dot(g, g))
+    up = [-x / norm for x in g]
+    return dot(up, body.position), dot(up, body.velocity), norm
+
+
+def play(scene, out):
+    """The event-driven motion of `scene` up to its duration; writes its answers."""
+    t, events, impacts = mpf(0), 0, 0
+    first = last = None
+    first_of = {}
+    apexes = []
+    flights = {i: 0 for i in range(len(scene.bodies))}
+    while True:
+        soonest = None
+        for i, j in pairs(scene):
+            tau = time_to_impact(scene, i, j)
+            if tau is not None and (soonest is None or tau < soonest):
+                soonest = tau
+        if soonest is None or t + soonest > scene.duration:
+            advance(scene, scene.bodies, scene.duration - t)
+            break
+        advance(scene, scene.bodies, soonest)
+        t += soonest
+        count, touched = resolve_instant(scene)
+        events += 1
+        if events > MAX_EVENTS:
+            sys.exit(f"{scene.name}: more than {MAX_EVENTS} instants of impact")
+        if count == 0:
+            continue  # a grazing root: nothing approached
+        impacts += count
+        last = t
+        if first is None:
+            first = t
+        for i in sorted(touched):
+            first_of.setdefault(i, t)
+        settle(scene, touched)
+        if scene.has_gravity:
+            for i in sorted(touched):
+                body = scene.bodies[i]
+                flights[i] += 1
+                z, up_speed, g = height(scene, body)
+                if body.resting_on is None and up_speed > 0:
+                    apexes.append((i, flights[i], z + up_speed * up_speed / (2 * g)))
+    out.append(f"{scene.name} impacts {impacts}")
+    out.append(f"{scene.name} instants {events}")
+    if first is not None:
+        out.append(f"{scene.name} first_impact {num(first)}")
+        out.append(f"{scene.name} last_impact {num(last)}")
+    for i in sorted(first_of):
+        out.append(f"{scene.name} first_impact_of {i} {num(first_of[i])}")
+    for i, k, z in apexes:
+        out.append(f"{scene.name} apex {i} {k} {num(z)}")
+    for i, body in enumerate(scene.bodies):
+        out.append(f"{scene.name} final {i} " + " ".join(num(x) for x in body.position) + " " +
+                   " ".join(num(x) for x in body.velocity))
+    return {"impacts": impacts, "apexes": apexes, "last": last, "first_of": first_of}
+
+
+def conserved(scene, out):
+    energy = sum(body.mass * dot(body.velocity, body.velocity) / 2 -
+                 body.mass * dot(scene.gravity, body.position) for body in scene.bodies
+                 if body.inverse_mass != 0)
+    momentum = [sum(body.mass * body.velocity[k] for body in scene.bodies
+                    if body.inverse_mass != 0) for k in range(3)]
+    out.append(f"{scene.name} energy0 {num(energy)}")
+    out.append(f"{scene.name} momentum0 " + " ".join(num(x) for x in momentum))
+
+
+def num(x):
+    return repr(float(x))
+
+
+def check(condition, message):
+    if not condition:
+        sys.exit("closed form and events disagree: " + message)
+
+
+def closed_forms(scene, result, out):
+    """The long runs' closed forms, and the events checked against them."""
+    if scene.name.startswith("bounce_") or scene.name == "drop_test":
+        g = -scene.gravity[2]
+        for i, body in enumerate(scene.bodies):
+            e = scene.restitution(body.material, "concrete")
+            h = body.start[2] - body.radius
+            found = [(k, z) for (b, k, z) in result["apexes"] if b == i]
+            for k, z in found:
+                rise = h * e ** (2 * k)
+                check(abs((z - body.radius) - rise) <= mpf("1e-40") * h,
+                      f"{scene.name} body {i} apex {k}")
+            drop = mpmath.sqrt(2 * h / g)
+            check(abs(result["first_of"][i] - drop) < mpf("1e-40"),
+                  f"{scene.name} body {i} first impact")
+            if scene.name.startswith("bounce_"):
+                # The apex of each of the first 1,000 bounces, h e^(2k) above the contact, as
+                # long as it rises at least 1 nm (e < 1 bounces endlessly, ever lower).
+                count = 0
+                for k in range(1, 1001):
+                    rise = h * e ** (2 * k)
+                    if rise < BOUNCE_FLOOR:
+                        break
+                    count = k
+                    out.append(f"{scene.name} bounce {k} {num(rise)}")
+                out.append(f"{scene.name} bounces_above_1nm {count}")
+                out.append(f"{scene.name} drop_height {num(h)}")
+    if scene.name.startswith("chain_"):
+        light, heavy = scene.bodies
+        theta = mpmath.atan(mpmath.sqrt(light.mass / heavy.mass))
+        expected = int(mpmath.ceil(mpmath.pi / theta)) - 1
+        impacts, last = result["impacts"], result["last"]
+        check(impacts == expected, f"{scene.name}: {impacts} impacts, Galperin: {expected}")
+        check(last is not None and last < scene.duration - mpf("0.3"),
+              f"{scene.name}: the last impact at {last} is too close to the end")
+
+
+def main():
+    scenes_path, out_path = sys.argv[1], sys.argv[2]
+    out = ["# The exact answers of bench/accuracy's scenes, by make_references.py (mpmath, 50 digits)",
+           "# from scenes.txt; do not edit. Rows: SCENE KEY VALUES..."]
+    for scene in read_scenes(scenes_path):
+        if scene.friction or scene.spin:
+            out.append(f"# {scene.name}: friction and spin are not in this reference")
+            continue
+        conserved(scene, out)
+        if scene.reference == "conservation":
+            continue
+        closed_forms(scene, play(scene, out), out)
+    with open(out_path, "w") as f:
+        f.write("\n".join(out) + "\n")
+
+
+if __name__ == "__main__":
+    main()
