@@ -81,26 +81,19 @@ int load(ros::NodeHandle& node, ros::NodeHandle& private_node) {
   std::vector<double> latencies;
   std::size_t impacts = 0;
   ros::Time start;
+  // The scene player's loop: each impact applied through the core (Playback::applyImpact with
+  // the monitor's indexing of the bodies).
   const bool exact_contact = scene->detection == core::Detection::kContinuous;
+  const core::ImpactMonitor indexing(*scene, core::MonitorSettings{});
   ros::Subscriber subscriber =
       node.subscribe<ImpactArray>("impacts", 100, [&](const ImpactArray::ConstPtr& message) {
         const auto sent = published.find(message->header.stamp);
         if (sent != published.end())
           latencies.push_back((ros::WallTime::now() - sent->second).toSec());
         for (const Impact& impact : message->impacts) {
-          const double t = (impact.header.stamp - start).toSec();
-          for (const auto& [id, side, after] :
-               {std::make_tuple(impact.body_a, -1.0, toEigen(impact.velocity_a_after.linear)),
-                std::make_tuple(impact.body_b, +1.0, toEigen(impact.velocity_b_after.linear))}) {
-            const auto body = playback.bodyIndex(id);
-            if (!body) continue;
-            const Eigen::Vector3d centre =
-                exact_contact
-                    ? Eigen::Vector3d(toEigen(impact.contact_point) +
-                                      side * scene->bodies[*body].radius * toEigen(impact.normal))
-                    : playback.position(*body, t);
-            playback.applyImpact(*body, t, centre, after);
-          }
+          const auto record =
+              toImpactRecord(impact, indexing, (impact.header.stamp - start).toSec());
+          if (record) playback.applyImpact(indexing, *record, exact_contact);
           ++impacts;
         }
       });
