@@ -31,6 +31,7 @@
 #include "collision_response/ros/collision_services.h"
 #include "collision_response/ros/conversions.h"
 #include "collision_response/ros/scene_loader.h"
+#include "seed_request.h"
 
 namespace {
 
@@ -189,12 +190,7 @@ int service(ros::NodeHandle& node, ros::NodeHandle& private_node) {
   if (!compute.waitForExistence(ros::Duration(20)) || !empty.waitForExistence(ros::Duration(20)))
     return 2;
   ComputeCollision collision;
-  collision.request.a.mass = 2.0;
-  collision.request.a.velocity.x = 3.0;
-  collision.request.b.mass = 1.0;
-  collision.request.b.position.x = 1.0;
-  collision.request.b.velocity.x = -1.0;
-  collision.request.restitution = 0.5;
+  collision.request = testing::seedHeadOnRequest();
   std_srvs::Empty nothing;
   std::vector<double> compute_times, empty_times;
   using Clock = std::chrono::steady_clock;
