@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <string>
 
@@ -53,8 +54,7 @@ int next_name = 0;
 /// Sets `~scene` (and whatever `extra` sets, relative to the node's name) for a fresh node
 /// name, runs `executable` under it and returns what happened.
 Outcome start(const std::string& executable, const XmlRpc::XmlRpcValue& scene_value,
-              const std::function<void(const std::string&)>& extra = nullptr,
-              int timeout = 30) {
+              const std::function<void(const std::string&)>& extra = nullptr, int timeout = 30) {
   const std::string name = "/bad_" + std::to_string(next_name++);
   ros::param::set(name + "/scene", scene_value);
   if (extra) extra(name);
@@ -90,7 +90,7 @@ TEST(StartupErrors, Item6_ABodyTopicThatIsBodyStatesStopsTheNodeByName) {
 TEST(StartupErrors, Item6_AsANodeletTheErrorNamesTheKey) {
   const Outcome result =
       start("rosrun nodelet nodelet standalone collision_response/CollisionResponseNodelet",
-            scene({ball("ball", "bad topic")}), nullptr, 15);
+            scene({ball("ball", "bad topic")}), nullptr, 10);
   EXPECT_NE(result.output.find("/scene/bodies[0]/topic: 'bad topic' is not a valid topic name"),
             std::string::npos)
       << result.output;
@@ -155,6 +155,32 @@ TEST(StartupErrors, Item8_TheScenePlayersParametersAreTypedToo) {
       start("rosrun collision_response scene_player", scene({ball("ball")}),
             [](const std::string& name) { ros::param::set(name + "/rate", "fast"); });
   expectRefused(result, "/rate", "must be a number, got a string ('fast')");
+}
+
+// The other side: every scene the package ships (config/scenes/, and the tests' own) starts the
+// node and the scene player: no shipped key or value is refused.
+TEST(StartupErrors, EveryShippedSceneStartsTheNodeAndThePlayer) {
+  for (const std::string file :
+       {"billiards_break", "cradle", "default", "drop_test", "paddle", "two_balls_oblique"}) {
+    for (const std::string& executable :
+         {kNode, std::string("rosrun collision_response scene_player")}) {
+      const std::string name = "/shipped_" + std::to_string(next_name++);
+      ASSERT_EQ(std::system(("rosparam load " + std::string(COLLISION_RESPONSE_SCENES) + "/" +
+                             file + ".yaml " + name)
+                                .c_str()),
+                0);
+      const Outcome result = run(executable + " __name:=" + name.substr(1), 5);
+      EXPECT_EQ(result.status, 124) << file << " did not keep running:\n" << result.output;
+      const bool node = executable == kNode;
+      EXPECT_NE(
+          result.output.find(node ? "collision_response: scene: fixed_frame" : "scene_player: "),
+          std::string::npos)
+          << file << " did not start:\n"
+          << result.output;
+      EXPECT_EQ(result.output.find("FATAL"), std::string::npos) << file << ":\n" << result.output;
+      EXPECT_EQ(result.output.find("terminate called"), std::string::npos) << result.output;
+    }
+  }
 }
 
 }  // namespace
