@@ -161,6 +161,7 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
                               "too many impacts at one instant or in one step; the step was cut "
                               "short"});
   }
+  update.contacts = step.contacts;
   update.impacts.header.stamp = newest;
   update.impacts.header.frame_id = scene_.fixed_frame;
   update.impacts.impacts.reserve(step.impacts.size());

@@ -18,7 +18,10 @@ void ThrottledWarning::warn(const std::string& topic, Reason reason, const std::
     entry->second.held_back += count;
     return;
   }
-  std::string line = topic + ": " + text;
+  // A warning's text quotes what a publisher sent (tf2's reason repeats a frame id whole): a
+  // line is at most kMaxLength characters.
+  std::string line =
+      topic + ": " + (text.size() > kMaxLength ? text.substr(0, kMaxLength) + "..." : text);
   if (entry->second.held_back > 0) {
     line += " (and " + std::to_string(entry->second.held_back) + " more like it in the last " +
             std::to_string((now - entry->second.last).toSec()).substr(0, 4) + " s)";

@@ -46,6 +46,9 @@ class MonitorCycle {
     double time = 0.0;     ///< s on the time line: the step's instant
     ros::Time stamp;       ///< the input's newest stamp, in its source's clock
     ImpactArray impacts;   ///< the impacts found, every number finite: to publish
+    /// The lasting contacts at the step's time, as the monitor reports them (for a contacts
+    /// topic: ImpactMonitorRos::publish is where its publisher goes).
+    std::vector<core::ContactRecord> contacts;
     /// What was dropped (states, impacts) and what else happened.
     std::vector<Report> reports;
   };

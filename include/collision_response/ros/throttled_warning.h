@@ -23,6 +23,8 @@ class ThrottledWarning {
   /// At most this many keys are kept; past it, keys idle for a period are forgotten, and if
   /// none is, the new key shares one overflow key per reason.
   static constexpr std::size_t kMaxKeys = 1024;
+  /// Characters of a warning's text, at most.
+  static constexpr std::size_t kMaxLength = 512;
 
   /// Logs "`topic`: `text`" (a warning; an error for kInternalError) unless this topic and
   /// reason logged less than a period ago (wall time); `count` events are held back then, and
