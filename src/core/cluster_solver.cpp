@@ -1,5 +1,6 @@
 #include "collision_response/core/cluster_solver.h"
 
+#include "collision_response/core/contact_forces.h"
 #include "collision_response/core/impact.h"
 
 namespace collision_response::core {
@@ -19,6 +20,78 @@ ContactResolution solveContact(ClusterBody& a, ClusterBody& b, const ClusterCont
   }
   return resolution;
 }
+
+template <bool kSpin>
+void applyFrictionJointly(std::vector<ClusterBody>& bodies,
+                          const std::vector<ClusterContact>& contacts,
+                          const std::vector<FrictionContact>& frictions,
+                          std::vector<FrictionOutcome>& outcomes) {
+  std::vector<ForceBody> force_bodies;
+  for (const ClusterBody& body : bodies) {
+    ForceBody force_body;
+    force_body.inverse_mass = body.inverse_mass;
+    force_body.radius = body.radius;
+    force_body.velocity = body.velocity;
+    if constexpr (kSpin) {
+      force_body.spin_factor = body.spin_factor;
+      force_body.angular_velocity = body.angular_velocity;
+    }
+    force_bodies.push_back(force_body);
+  }
+  std::vector<ForceContact> force_contacts;
+  std::vector<double> normal_impulses;
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    ForceContact contact;
+    contact.a = contacts[k].a;
+    contact.b = contacts[k].b;
+    contact.normal = contacts[k].normal;
+    contact.friction = frictions[k].friction;
+    force_contacts.push_back(contact);
+    normal_impulses.push_back(frictions[k].normal_impulse);
+  }
+  const ContactForceSolution solution =
+      solveFrictionImpulses(force_bodies, force_contacts, normal_impulses);
+  outcomes.assign(contacts.size(), FrictionOutcome{});
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    const ContactForce& friction = solution.contacts[k];
+    FrictionOutcome& outcome = outcomes[k];
+    outcome.impulse = friction.tangential.norm();
+    outcome.sticking = friction.mode == ContactMode::kSticking;
+    // -T.(u + u') / 2 with u' = u + du (the slip after: du in slip_acceleration).
+    outcome.energy_lost =
+        -0.5 * friction.tangential.dot(2 * friction.slip + friction.slip_acceleration);
+  }
+  // The impulses' effects, from the impulses as doubles, summed free of the contacts' order: a
+  // tangential impulse T on b (-T on a) changes b's velocity by w_b T and turns it by
+  // -(w_b / (k_b r_b)) n x T; a by -w_a T and the same turn with a's values.
+  OrderFreeSum velocity(bodies.size()), angular(bodies.size());
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    const Eigen::Vector3d& impulse = solution.contacts[k].tangential;
+    const Eigen::Vector3d& normal = contacts[k].normal;
+    for (const auto& [index, sign] : {std::pair{contacts[k].a, -1.0}, {contacts[k].b, 1.0}}) {
+      const ClusterBody& body = bodies[index];
+      if (body.inverse_mass == 0.0) continue;
+      velocity.add(index, sign * (body.inverse_mass * impulse));
+      if (kSpin && body.spin_factor != 0.0) {
+        angular.add(
+            index, -((body.inverse_mass * body.spin_factor / body.radius) * normal.cross(impulse)));
+      }
+    }
+  }
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    bodies[i].velocity = velocity.total(i, bodies[i].velocity);
+    if constexpr (kSpin) bodies[i].angular_velocity = angular.total(i, bodies[i].angular_velocity);
+  }
+}
+
+template void applyFrictionJointly<true>(std::vector<ClusterBody>&,
+                                         const std::vector<ClusterContact>&,
+                                         const std::vector<FrictionContact>&,
+                                         std::vector<FrictionOutcome>&);
+template void applyFrictionJointly<false>(std::vector<ClusterBody>&,
+                                          const std::vector<ClusterContact>&,
+                                          const std::vector<FrictionContact>&,
+                                          std::vector<FrictionOutcome>&);
 
 ClusterOutcome solveCluster(std::vector<ClusterBody>& bodies,
                             const std::vector<ClusterContact>& contacts,

@@ -342,6 +342,229 @@ void closeContactVelocities(std::vector<ForceBody>& bodies,
   }
 }
 
+ContactForceSolution solveFrictionImpulses(const std::vector<ForceBody>& bodies,
+                                           const std::vector<ForceContact>& contacts,
+                                           const std::vector<double>& normal_impulses) {
+  // Maximal dissipation: the tangential impulses x (on each contact's b, in its tangent basis)
+  // minimise the kinetic energy they leave, E(x) = x'A x / 2 + s'x (A the tangential coupling,
+  // s the slips; E is exactly the change of kinetic energy), over the discs |x_k| <= mu_k J_k.
+  // Its minimum is Coulomb's law: where the disc's inside holds it the slip stops (A x + s = 0),
+  // elsewhere the impulse is at the bound against the slip left. E(x) <= E(0) = 0: friction
+  // never adds energy. A convex problem, solved by a primal barrier method (Newton's method on
+  // t E(x) - sum log(b^2 - |x_k|^2) for t growing) in long double: all contacts at once, and
+  // where A is singular (redundant contacts) it tends to the centre of the optimal set, so the
+  // answer depends on no order.
+  const Group group(bodies, contacts);
+  const std::size_t count = contacts.size();
+  std::vector<std::size_t> active;  // contacts that can take friction
+  std::vector<Real> bound;
+  for (std::size_t k = 0; k < count; ++k) {
+    const Real b = Real(contacts[k].friction) * Real(normal_impulses[k]);
+    if (b > 0 && group.slip(k).norm() > 0) {
+      active.push_back(k);
+      bound.push_back(b);
+    }
+  }
+  const std::vector<V3> none(count, V3::Zero());
+  const auto size = static_cast<Eigen::Index>(2 * active.size());
+  std::vector<V3> impulses = none;
+  if (size > 0) {
+    const auto tangent = [&](Eigen::Index i) -> const V3& {
+      const std::size_t k = active[static_cast<std::size_t>(i / 2)];
+      return i % 2 == 0 ? group.first(k) : group.second(k);
+    };
+    Matrix coupling(size, size);
+    Vector slip(size);
+    for (Eigen::Index j = 0; j < size; ++j) {
+      std::vector<V3> unit = none;
+      unit[active[static_cast<std::size_t>(j / 2)]] = tangent(j);
+      const Response column = group.respond(unit, false);
+      for (Eigen::Index i = 0; i < size; ++i) {
+        coupling(i, j) =
+            tangent(i).dot(column.slip_acceleration[active[static_cast<std::size_t>(i / 2)]]);
+      }
+      slip[j] = tangent(j).dot(group.slip(active[static_cast<std::size_t>(j / 2)]));
+    }
+    coupling = (0.5L * (coupling + coupling.transpose())).eval();  // symmetric up to rounding
+    const auto disc = static_cast<Eigen::Index>(active.size());
+    const auto energy = [&](const Vector& x) { return 0.5L * x.dot(coupling * x) + slip.dot(x); };
+    const auto room = [&](const Vector& x, Eigen::Index k) {
+      return bound[static_cast<std::size_t>(k)] * bound[static_cast<std::size_t>(k)] -
+             x.segment<2>(2 * k).squaredNorm();
+    };
+    // The scale of the energies: what stopping every slip alone would remove.
+    Real scale = 0;
+    for (Eigen::Index i = 0; i < size; ++i) {
+      scale = std::max(scale, std::abs(slip[i]) * bound[static_cast<std::size_t>(i / 2)]);
+    }
+    // Coulomb's conditions for a given set of contacts at their disc's edge: those take the
+    // bound exactly, against the slip they leave; the others stop their slip exactly (a linear
+    // solve); repeated while the edge directions move. True (and `x` set) when they then hold.
+    const auto polish = [&](Vector& x, std::vector<char>& edge) {
+      Vector polished = x;
+      for (int round = 0; round < 8; ++round) {
+        const Vector residual = coupling * polished + slip;  // the slips left
+        for (Eigen::Index k = 0; k < disc; ++k) {
+          if (!edge[static_cast<std::size_t>(k)]) continue;
+          const Eigen::Matrix<Real, 2, 1> left = residual.segment<2>(2 * k);
+          const Real b = bound[static_cast<std::size_t>(k)];
+          if (left.norm() > 0) {
+            polished.segment<2>(2 * k) = -b * left.normalized();
+          } else if (polished.segment<2>(2 * k).norm() > b) {
+            polished.segment<2>(2 * k) *= b / polished.segment<2>(2 * k).norm();
+          }
+        }
+        std::vector<Eigen::Index> inner;
+        for (Eigen::Index i = 0; i < size; ++i) {
+          if (!edge[static_cast<std::size_t>(i / 2)]) inner.push_back(i);
+        }
+        if (!inner.empty()) {
+          const auto n = static_cast<Eigen::Index>(inner.size());
+          Matrix system(n, n);
+          Vector target(n);
+          for (Eigen::Index r = 0; r < n; ++r) {
+            target[r] = -slip[inner[r]];
+            for (Eigen::Index j = 0; j < size; ++j) {
+              if (edge[static_cast<std::size_t>(j / 2)]) {
+                target[r] -= coupling(inner[r], j) * polished[j];
+              }
+            }
+            for (Eigen::Index c = 0; c < n; ++c) system(r, c) = coupling(inner[r], inner[c]);
+          }
+          const Vector solved = system.completeOrthogonalDecomposition().solve(target);
+          for (Eigen::Index r = 0; r < n; ++r) polished[inner[r]] = solved[r];
+        }
+        const Vector left = coupling * polished + slip;
+        bool holds = true;
+        bool moved = false;
+        for (Eigen::Index k = 0; k < disc && holds; ++k) {
+          const Real b = bound[static_cast<std::size_t>(k)];
+          const Eigen::Matrix<Real, 2, 1> xk = polished.segment<2>(2 * k),
+                                          lk = left.segment<2>(2 * k);
+          if (edge[static_cast<std::size_t>(k)]) {
+            // Against the slip left (not reversing it), along it to within rounding.
+            if (lk.norm() == 0) continue;
+            holds = xk.dot(lk) <= 0;
+            if ((xk / b + lk.normalized()).norm() > 1e-15L) moved = true;
+          } else {
+            holds = xk.norm() <= b && lk.norm() <= 1e-15L * (slip.norm() + 1);
+          }
+        }
+        if (holds && !moved) {
+          x = polished;
+          return true;
+        }
+        if (!holds) break;
+      }
+      // Where a condition fails, the contact changes sides (all at once).
+      const Vector left = coupling * polished + slip;
+      bool changed = false;
+      for (Eigen::Index k = 0; k < disc; ++k) {
+        const Real b = bound[static_cast<std::size_t>(k)];
+        const Eigen::Matrix<Real, 2, 1> xk = polished.segment<2>(2 * k),
+                                        lk = left.segment<2>(2 * k);
+        char& on_edge = edge[static_cast<std::size_t>(k)];
+        if (!on_edge && xk.norm() > b) {
+          on_edge = 1;
+          changed = true;
+        } else if (on_edge && xk.dot(lk) > 0) {
+          on_edge = 0;
+          changed = true;
+        }
+      }
+      x = polished;
+      static_cast<void>(changed);
+      return false;
+    };
+    // First the exact conditions from the sticking answer (fast, and usually right at once);
+    // where they do not settle, the barrier method, then the same polish from its answer.
+    Vector x = coupling.completeOrthogonalDecomposition().solve(-slip);
+    std::vector<char> edge(static_cast<std::size_t>(disc), 0);
+    for (Eigen::Index k = 0; k < disc; ++k) {
+      edge[static_cast<std::size_t>(k)] =
+          x.segment<2>(2 * k).norm() > bound[static_cast<std::size_t>(k)];
+    }
+    bool settled = false;
+    for (int attempt = 0; attempt < 8 && !settled; ++attempt) settled = polish(x, edge);
+    if (!settled) {
+      x = Vector::Zero(size);
+      Real t = 1 / std::max(scale, Real(1e-300));
+      // To 1e-14 of the energies: nearer the discs' edges b^2 - |x|^2 loses its digits.
+      const Real gap_wanted = 1e-14L * std::max(scale, Real(1e-300));
+      for (int outer = 0; outer < 40; ++outer) {
+        for (int newton = 0; newton < 50; ++newton) {
+          Vector gradient = t * (coupling * x + slip);
+          Matrix hessian = t * coupling;
+          for (Eigen::Index k = 0; k < disc; ++k) {
+            const Real g = room(x, k);
+            const Eigen::Matrix<Real, 2, 1> xk = x.segment<2>(2 * k);
+            gradient.segment<2>(2 * k) += (2 / g) * xk;
+            hessian.block<2, 2>(2 * k, 2 * k) += (2 / g) * Eigen::Matrix<Real, 2, 2>::Identity() +
+                                                 (4 / (g * g)) * xk * xk.transpose();
+          }
+          const Vector step = -hessian.ldlt().solve(gradient);
+          const Real decrement = -gradient.dot(step);
+          if (!(decrement > 1e-20L)) break;
+          // Backtracking: inside every disc, and the barrier objective decreasing enough.
+          const auto objective = [&](const Vector& y) {
+            Real value = t * energy(y);
+            for (Eigen::Index k = 0; k < disc; ++k) value -= std::log(room(y, k));
+            return value;
+          };
+          const Real here = objective(x);
+          bool moved = false;
+          Real length = 1;
+          for (int halving = 0; halving < 60 && !moved; ++halving, length *= 0.5L) {
+            const Vector y = x + length * step;
+            bool inside = true;
+            for (Eigen::Index k = 0; k < disc && inside; ++k) inside = room(y, k) > 0;
+            if (inside && objective(y) <= here - 0.25L * length * decrement) {
+              x = y;
+              moved = true;
+            }
+          }
+          if (!moved) break;
+        }
+        if (Real(disc) / t < gap_wanted) break;
+        t *= 10;
+      }
+      for (Eigen::Index k = 0; k < disc; ++k) {
+        edge[static_cast<std::size_t>(k)] =
+            x.segment<2>(2 * k).norm() >= bound[static_cast<std::size_t>(k)] * (1 - 1e-8L);
+      }
+      Vector polished = x;
+      if (polish(polished, edge)) x = polished;
+    }
+    for (Eigen::Index j = 0; j < size; ++j) {
+      impulses[active[static_cast<std::size_t>(j / 2)]] += x[j] * tangent(j);
+    }
+  }
+  const Response change = group.respond(impulses, false);
+  ContactForceSolution result;
+  result.contacts.resize(count);
+  for (std::size_t k = 0; k < count; ++k) {
+    ContactForce& out = result.contacts[k];
+    out.tangential = impulses[k].cast<double>();
+    out.slip = group.slip(k).cast<double>();
+    out.slip_acceleration = change.slip_acceleration[k].cast<double>();
+    const auto position = std::find(active.begin(), active.end(), k);
+    if (position == active.end()) {
+      out.mode = ContactMode::kSeparating;
+    } else {
+      const Real b = bound[static_cast<std::size_t>(position - active.begin())];
+      out.mode =
+          impulses[k].norm() < b * (1 - 1e-9L) ? ContactMode::kSticking : ContactMode::kSliding;
+    }
+  }
+  result.acceleration.resize(bodies.size());
+  result.angular_acceleration.resize(bodies.size());
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    result.acceleration[i] = change.acceleration[i].cast<double>();
+    result.angular_acceleration[i] = change.angular_acceleration[i].cast<double>();
+  }
+  return result;
+}
+
 void closeContactGaps(std::vector<Eigen::Vector3d>& positions, const std::vector<ForceBody>& bodies,
                       const std::vector<ForceContact>& contacts, const std::vector<double>& gaps) {
   // Displacements d = w sum_k s_k mu_k n_k change gap_l by sum_k A_lk mu_k, as impulses change the

@@ -7,8 +7,8 @@ Effects runnableEffects(const Effects& requested) { return requested; }
 
 FrictionModel frictionModelFor(const Effects& effects) {
   if (!effects.friction) return FrictionModel{};
-  if (effects.spin) return FrictionModel{&applyFriction<true>, &applyFrictionToCluster<true>};
-  return FrictionModel{&applyFriction<false>, &applyFrictionToCluster<false>};
+  if (effects.spin) return FrictionModel{&applyFriction<true>, &applyFrictionJointly<true>};
+  return FrictionModel{&applyFriction<false>, &applyFrictionJointly<false>};
 }
 
 }  // namespace collision_response::core

@@ -1,6 +1,7 @@
 #include "collision_response/core/simultaneous.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 
 #include "collision_response/core/impact.h"
 
@@ -92,17 +93,35 @@ std::vector<ContactOutcome> resolveSimultaneous(std::vector<ClusterBody>& bodies
   impulses = impulses.cwiseMax(0.0);
 
   std::vector<ContactOutcome> outcomes(count);
+  OrderFreeSum changes(bodies.size());
   for (std::size_t k = 0; k < count; ++k) {
     const ClusterContact& contact = contacts[k];
     const double impulse = impulses[static_cast<Eigen::Index>(k)];
-    bodies[contact.a].velocity -= bodies[contact.a].inverse_mass * impulse * contact.normal;
-    bodies[contact.b].velocity += bodies[contact.b].inverse_mass * impulse * contact.normal;
+    changes.add(contact.a, -(bodies[contact.a].inverse_mass * impulse * contact.normal));
+    changes.add(contact.b, bodies[contact.b].inverse_mass * impulse * contact.normal);
     outcomes[k].impulse = impulse;
     outcomes[k].approach_speed = approach[static_cast<Eigen::Index>(k)];
     outcomes[k].energy_lost =
         0.5 * impulse * (1.0 - contact.restitution) * approach[static_cast<Eigen::Index>(k)];
   }
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    bodies[i].velocity = changes.total(i, bodies[i].velocity);
+  }
   return outcomes;
+}
+
+Eigen::Vector3d OrderFreeSum::total(std::size_t body, const Eigen::Vector3d& start) const {
+  Eigen::Vector3d sum = start;
+  std::vector<double> terms;
+  for (int c = 0; c < 3; ++c) {
+    terms.clear();
+    for (const Eigen::Vector3d& change : terms_[body]) terms.push_back(change[c]);
+    std::sort(terms.begin(), terms.end());
+    double added = 0;
+    for (const double term : terms) added += term;
+    sum[c] += added;
+  }
+  return sum;
 }
 
 }  // namespace collision_response::core

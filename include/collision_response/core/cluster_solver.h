@@ -25,6 +25,17 @@ struct FrictionModel {
   explicit operator bool() const { return contact != nullptr; }
 };
 
+/// Coulomb friction on every contact of a cluster at once (solveFrictionImpulses), its normal
+/// impulses applied already: the tangential impulses come from one joint solve, as the normal
+/// ones do, so mirror images get mirror answers and no order of the contacts matters. kSpin:
+/// angular velocities enter the slip and receive the moments. The energy each contact removes
+/// is the work of its impulse, -T.(u + u') / 2 (u, u' its slip before and after).
+template <bool kSpin>
+void applyFrictionJointly(std::vector<ClusterBody>& bodies,
+                          const std::vector<ClusterContact>& contacts,
+                          const std::vector<FrictionContact>& frictions,
+                          std::vector<FrictionOutcome>& outcomes);
+
 /// The friction `effects` call for: none (no friction effect), Coulomb friction on spheres that
 /// do not turn, or (spin) on turning ones.
 FrictionModel frictionModelFor(const Effects& effects);

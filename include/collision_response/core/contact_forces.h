@@ -108,6 +108,18 @@ ContactForceSolution solveContactForcesWithModes(const std::vector<ForceBody>& b
                                                  const std::vector<ContactMode>& modes,
                                                  const ContactForceSettings& settings = {});
 
+/// Coulomb friction at an impact whose normal impulses J_k are given (applied already to the
+/// bodies' velocities), jointly over the cluster: tangential impulses T_k with |T_k| <= mu J_k
+/// that stop every slip they can (sticking), and at mu J_k against the slip that is left where
+/// they cannot (sliding), so that friction never reverses a slip and never adds energy. The
+/// conditions are linear for an assignment of modes; they are solved jointly (long double) and
+/// every failing contact changes mode at once, so nothing depends on the order of the contacts.
+/// Returns the impulses (tangential, on b) and modes per contact, and per body the change of
+/// velocity (in `acceleration`) and of angular velocity (in `angular_acceleration`).
+ContactForceSolution solveFrictionImpulses(const std::vector<ForceBody>& bodies,
+                                           const std::vector<ForceContact>& contacts,
+                                           const std::vector<double>& normal_impulses);
+
 /// Velocities consistent with lasting contact: the smallest change of the bodies' motion (impulses
 /// of least norm) after which every contact's normal relative velocity is 0 and, where
 /// `sticking[k]`, its slip too. Applied to the bodies' velocity and angular_velocity.

@@ -90,20 +90,7 @@ struct FrictionContact {
   double normal_impulse = 0.0;  ///< N s, already applied
 };
 
-/// applyFriction on every contact of a cluster, in the cluster's (canonical) order, each with
-/// the velocities the previous ones left.
-template <bool kSpin>
-void applyFrictionToCluster(std::vector<ClusterBody>& bodies,
-                            const std::vector<ClusterContact>& contacts,
-                            const std::vector<FrictionContact>& frictions,
-                            std::vector<FrictionOutcome>& outcomes) {
-  outcomes.assign(contacts.size(), FrictionOutcome{});
-  for (std::size_t k = 0; k < contacts.size(); ++k) {
-    outcomes[k] =
-        applyFriction<kSpin>(bodies[contacts[k].a], bodies[contacts[k].b], contacts[k].normal,
-                             frictions[k].friction, frictions[k].normal_impulse);
-  }
-}
+/// A cluster's friction step: every contact's tangential impulse, given its normal one.
 using ClusterFrictionStep = void (*)(std::vector<ClusterBody>&, const std::vector<ClusterContact>&,
                                      const std::vector<FrictionContact>&,
                                      std::vector<FrictionOutcome>&);

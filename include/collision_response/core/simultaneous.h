@@ -21,6 +21,21 @@ struct ClusterBody {
   double radius = 0.0;  ///< m
 };
 
+/// Sums each body's velocity changes from several contacts in an order that does not depend on
+/// the order of the contacts: each component's terms are added smallest first (sorted by value),
+/// so that listing the contacts in another order gives the same bits, and mirror images of a
+/// cluster cancel exactly where they should (+x and -x add to 0).
+class OrderFreeSum {
+ public:
+  explicit OrderFreeSum(std::size_t bodies) : terms_(bodies) {}
+  void add(std::size_t body, const Eigen::Vector3d& change) { terms_[body].push_back(change); }
+  /// `start` plus the changes of `body`.
+  Eigen::Vector3d total(std::size_t body, const Eigen::Vector3d& start) const;
+
+ private:
+  std::vector<std::vector<Eigen::Vector3d>> terms_;
+};
+
 /// A contact of the cluster between bodies `a` and `b` (indices into the cluster's bodies).
 struct ClusterContact {
   std::size_t a = 0;
