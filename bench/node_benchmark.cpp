@@ -7,6 +7,16 @@
 //          "service" calls ~service (a compute_collision service) and the empty service alternately
 //          ~calls times
 //                    each over persistent connections and reports both round trips.
+//          "burden"  the work of one hard message (issue 13, item 9), ~kind: "stamps" publishes
+//                    every body of ~scene in one array whose states' stamps are 10 us apart
+//                    (~messages such arrays); "cluster" publishes the bodies of ~scene (a lattice
+//                    of touching balls closing on its centre) twice, 0.01 s apart. It reports
+//                    the CPU per message of the node's main thread (the monitor's; from
+//                    /proc/~pid/task/~pid/stat, until it is idle again) and the worst round trip of
+//                    ~service (compute_collision) called without pause from another thread
+//                    meanwhile.
+//          "startup" the scene loader and the monitor's construction (the node's start-up,
+//                    parameters aside) for gases of 1,000 to 30,000 bodies, in this process.
 // Results as JSON on stdout (scripts/performance.sh).
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <ros/ros.h>
@@ -14,13 +24,17 @@
 
 #include <unistd.h>
 #include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "collision_response/BodyStateArray.h"
@@ -30,7 +44,9 @@
 #include "collision_response/core/playback.h"
 #include "collision_response/ros/collision_services.h"
 #include "collision_response/ros/conversions.h"
+#include "collision_response/ros/monitor_cycle.h"
 #include "collision_response/ros/scene_loader.h"
+#include "seed_request.h"
 
 namespace {
 
@@ -42,9 +58,11 @@ double percentile(std::vector<double> values, double fraction) {
   return values[static_cast<std::size_t>(fraction * static_cast<double>(values.size() - 1))];
 }
 
-/// CPU seconds (user + system) used so far by process `pid`.
-double cpuSeconds(int pid) {
-  std::ifstream file("/proc/" + std::to_string(pid) + "/stat");
+/// CPU seconds (user + system) used so far by process `pid`, or by its thread `thread`.
+double cpuSeconds(int pid, int thread = 0) {
+  std::ifstream file(thread ? "/proc/" + std::to_string(pid) + "/task/" + std::to_string(thread) +
+                                  "/stat"
+                            : "/proc/" + std::to_string(pid) + "/stat");
   std::string line;
   std::getline(file, line);
   std::istringstream in(line.substr(line.rfind(')') + 2));
@@ -81,26 +99,19 @@ int load(ros::NodeHandle& node, ros::NodeHandle& private_node) {
   std::vector<double> latencies;
   std::size_t impacts = 0;
   ros::Time start;
+  // The scene player's loop: each impact applied through the core (Playback::applyImpact with
+  // the monitor's indexing of the bodies).
   const bool exact_contact = scene->detection == core::Detection::kContinuous;
+  const core::ImpactMonitor indexing(*scene, core::MonitorSettings{});
   ros::Subscriber subscriber =
       node.subscribe<ImpactArray>("impacts", 100, [&](const ImpactArray::ConstPtr& message) {
         const auto sent = published.find(message->header.stamp);
         if (sent != published.end())
           latencies.push_back((ros::WallTime::now() - sent->second).toSec());
         for (const Impact& impact : message->impacts) {
-          const double t = (impact.header.stamp - start).toSec();
-          for (const auto& [id, side, after] :
-               {std::make_tuple(impact.body_a, -1.0, toEigen(impact.velocity_a_after.linear)),
-                std::make_tuple(impact.body_b, +1.0, toEigen(impact.velocity_b_after.linear))}) {
-            const auto body = playback.bodyIndex(id);
-            if (!body) continue;
-            const Eigen::Vector3d centre =
-                exact_contact
-                    ? Eigen::Vector3d(toEigen(impact.contact_point) +
-                                      side * scene->bodies[*body].radius * toEigen(impact.normal))
-                    : playback.position(*body, t);
-            playback.applyImpact(*body, t, centre, after);
-          }
+          const auto record =
+              toImpactRecord(impact, indexing, (impact.header.stamp - start).toSec());
+          if (record) playback.applyImpact(indexing, *record, exact_contact);
           ++impacts;
         }
       });
@@ -196,12 +207,7 @@ int service(ros::NodeHandle& node, ros::NodeHandle& private_node) {
   if (!compute.waitForExistence(ros::Duration(20)) || !empty.waitForExistence(ros::Duration(20)))
     return 2;
   ComputeCollision collision;
-  collision.request.a.mass = 2.0;
-  collision.request.a.velocity.x = 3.0;
-  collision.request.b.mass = 1.0;
-  collision.request.b.position.x = 1.0;
-  collision.request.b.velocity.x = -1.0;
-  collision.request.restitution = 0.5;
+  collision.request = testing::seedHeadOnRequest();
   std_srvs::Empty nothing;
   std::vector<double> compute_times, empty_times;
   using Clock = std::chrono::steady_clock;
@@ -252,6 +258,189 @@ int service(ros::NodeHandle& node, ros::NodeHandle& private_node) {
   return 0;
 }
 
+/// Calls `service` (compute_collision, the seed's request) without pause until stopped, keeping
+/// the worst round trip.
+class ServiceProbe {
+ public:
+  ServiceProbe(ros::NodeHandle& node, const std::string& service)
+      : client_(node.serviceClient<ComputeCollision>(service, true)) {}
+  bool ready() { return client_.waitForExistence(ros::Duration(20)); }
+  void start() {
+    thread_ = std::thread([this] {
+      ComputeCollision call;
+      call.request = testing::seedHeadOnRequest();
+      using Clock = std::chrono::steady_clock;
+      while (!stop_) {
+        const auto t0 = Clock::now();
+        const bool ok = client_.call(call) && call.response.success;
+        const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (!ok) ++failures_;
+        worst_ = std::max(worst_, seconds);
+        ++calls_;
+      }
+    });
+  }
+  void stop() {
+    stop_ = true;
+    if (thread_.joinable()) thread_.join();
+  }
+  double worst() const { return worst_; }
+  std::size_t calls() const { return calls_; }
+  std::size_t failures() const { return failures_; }
+
+ private:
+  ros::ServiceClient client_;
+  std::thread thread_;
+  std::atomic<bool> stop_{false};
+  std::mutex mutex_;
+  double worst_ = 0.0;
+  std::size_t calls_ = 0, failures_ = 0;
+};
+
+/// Waits until the main thread of process `pid` (the monitor's: the services have a thread of
+/// their own) has used no CPU for `quiet` s; its CPU seconds then.
+double waitIdle(int pid, double quiet = 0.5, double timeout = 900.0) {
+  const auto cpuSeconds = [](int process) { return ::cpuSeconds(process, process); };
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout);
+  double last = cpuSeconds(pid);
+  ros::WallTime still = ros::WallTime::now();
+  while (ros::ok() && ros::WallTime::now() < end) {
+    ros::WallDuration(0.05).sleep();
+    ros::spinOnce();
+    const double now = cpuSeconds(pid);
+    if (now > last) {
+      last = now;
+      still = ros::WallTime::now();
+    } else if ((ros::WallTime::now() - still).toSec() >= quiet) {
+      return now;
+    }
+  }
+  return last;
+}
+
+int burden(ros::NodeHandle& node, ros::NodeHandle& private_node) {
+  XmlRpc::XmlRpcValue value;
+  if (!private_node.getParam("scene", value)) return 2;
+  auto scene = loadScene(value, private_node.resolveName("scene"));
+  if (!scene) {
+    std::fprintf(stderr, "%s\n", scene.error().message().c_str());
+    return 2;
+  }
+  const std::string kind = private_node.param<std::string>("kind", "stamps");
+  const int messages = kind == "cluster" ? 1 : private_node.param("messages", 5);
+  const int pid = private_node.param("pid", 0);
+  const std::string service =
+      private_node.param<std::string>("service", "/collision_response/compute_collision");
+  ros::Publisher states = node.advertise<BodyStateArray>("body_states", 10);
+  std::size_t impacts = 0;
+  ros::Subscriber subscriber = node.subscribe<ImpactArray>(
+      "impacts", 100, [&](const ImpactArray::ConstPtr& m) { impacts += m->impacts.size(); });
+  while (ros::ok() && states.getNumSubscribers() == 0) ros::WallDuration(0.05).sleep();
+  ros::WallDuration(1.0).sleep();
+  ServiceProbe probe(node, service);
+  if (!probe.ready() || pid == 0) return 2;
+  const core::Playback playback(*scene, 1e-9, 0.0);
+  const auto array_at = [&](const ros::Time& stamp, double t, double spacing) {
+    BodyStateArray array;
+    array.header.stamp = stamp;
+    array.states.resize(scene->bodies.size());
+    for (std::size_t i = 0; i < scene->bodies.size(); ++i) {
+      BodyState& state = array.states[i];
+      state.id = scene->bodies[i].id;
+      state.header.stamp = stamp + ros::Duration(spacing * static_cast<double>(i));
+      state.header.frame_id = scene->fixed_frame;
+      state.pose.orientation.w = 1.0;
+      const double at = t + spacing * static_cast<double>(i);
+      state.pose.position = toPointMsg(playback.position(i, at));
+      state.twist.linear = toVector3Msg(playback.velocity(i, at));
+    }
+    return array;
+  };
+  const ros::Time start = ros::Time::now();
+  if (kind == "cluster") {
+    // The tracks first (no step yet), then the step that meets the whole cluster at its start.
+    states.publish(array_at(start, 0.0, 0.0));
+    waitIdle(pid);
+  }
+  probe.start();
+  const double cpu_before = waitIdle(pid);
+  const ros::WallTime began = ros::WallTime::now();
+  for (int m = 0; m < messages; ++m) {
+    const double t = kind == "cluster" ? 0.01 : 0.5 * (m + 1);
+    states.publish(array_at(start + ros::Duration(t), t, kind == "cluster" ? 0.0 : 1e-5));
+    ros::WallDuration(0.2).sleep();
+  }
+  const double cpu_after = waitIdle(pid);
+  const double wall = (ros::WallTime::now() - began).toSec();
+  probe.stop();
+  std::printf(
+      "{\"kind\": \"%s\", \"bodies\": %zu, \"messages\": %d, \"cpu_per_message\": %g, "
+      "\"wall\": %g, \"impacts\": %zu, \"service_calls\": %zu, \"service_failures\": %zu, "
+      "\"service_worst\": %g}\n",
+      kind.c_str(), scene->bodies.size(), messages, (cpu_after - cpu_before) / messages, wall,
+      impacts, probe.calls(), probe.failures(), probe.worst());
+  return 0;
+}
+
+/// A gas of `count` bodies as the scene file would give it, with six walls.
+XmlRpc::XmlRpcValue gasScene(int count) {
+  XmlRpc::XmlRpcValue scene;
+  scene["fixed_frame"] = "world";
+  scene["materials"]["elastic"]["restitution"] = 1.0;
+  const int side = static_cast<int>(std::ceil(std::cbrt(static_cast<double>(count))));
+  for (int i = 0; i < count; ++i) {
+    XmlRpc::XmlRpcValue body;
+    body["id"] = "gas_" + std::to_string(1000000 + i);
+    body["mass"] = 0.1;
+    body["radius"] = 0.05;
+    body["material"] = "elastic";
+    body["position"][0] = 0.25 + 0.5 * (i % side);
+    body["position"][1] = 0.25 + 0.5 * ((i / side) % side);
+    body["position"][2] = 0.25 + 0.5 * (i / (side * side));
+    scene["bodies"][i] = body;
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    for (const double sign : {1.0, -1.0}) {
+      XmlRpc::XmlRpcValue wall;
+      wall["id"] = "wall_" + std::to_string(axis) + (sign > 0 ? "_low" : "_high");
+      wall["type"] = "plane";
+      for (int k = 0; k < 3; ++k) wall["normal"][k] = k == axis ? sign : 0.0;
+      wall["offset"] = sign > 0 ? 0.0 : -0.5 * side;
+      wall["material"] = "elastic";
+      scene["obstacles"][scene["obstacles"].getType() == XmlRpc::XmlRpcValue::TypeArray
+                             ? scene["obstacles"].size()
+                             : 0] = wall;
+    }
+  }
+  return scene;
+}
+
+int startup(ros::NodeHandle& private_node) {
+  const int repeats = private_node.param("repeats", 3);
+  std::printf("{\"startup\": [");
+  bool first = true;
+  for (const int count : {1000, 3000, 10000, 30000}) {
+    const XmlRpc::XmlRpcValue value = gasScene(count);
+    double best = INFINITY;
+    for (int r = 0; r < repeats; ++r) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const auto scene = loadScene(value, "/startup/scene");
+      if (!scene) {
+        std::fprintf(stderr, "%s\n", scene.error().message().c_str());
+        return 2;
+      }
+      const MonitorCycle cycle(*scene, MonitorParams{});
+      best = std::min(best,
+                      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    }
+    std::printf("%s[%d, %g]", first ? "" : ", ", count, best);
+    first = false;
+  }
+  std::printf("]}\n");
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -259,5 +448,8 @@ int main(int argc, char** argv) {
   ros::NodeHandle node;
   ros::NodeHandle private_node("~");
   const std::string mode = private_node.param<std::string>("mode", "load");
-  return mode == "service" ? service(node, private_node) : load(node, private_node);
+  if (mode == "service") return service(node, private_node);
+  if (mode == "burden") return burden(node, private_node);
+  if (mode == "startup") return startup(private_node);
+  return load(node, private_node);
 }

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# libFuzzer on the core (clang, AddressSanitizer and UndefinedBehaviorSanitizer): the impact
-# resolution and the time of impact, each checking its invariants (fuzz/*.cpp).
+# libFuzzer (clang, AddressSanitizer and UndefinedBehaviorSanitizer) on the impact resolution,
+# the time of impact, and the monitor's update cycle (the ROS layer's intake, time line and the
+# core's step, driven by fuzzed scenes, states and stamps, under an allocation cap), each
+# checking its invariants (fuzz/*.cpp).
 #   bash scripts/fuzz.sh [seconds per target, default 30]      e.g. bash scripts/fuzz.sh 600
 # Writes a JUnit result per target under .ws/build/test_results/fuzz (read by the test count);
 # the corpora grow in .ws/fuzz and are kept between runs; fuzz/regressions holds the inputs
@@ -12,9 +14,14 @@ PACKAGES+=(clang libclang-rt-14-dev)
 install_packages
 out="$ws/fuzz"
 results="$ws/build/test_results/fuzz"
-mkdir -p "$out" "$results"
+# fuzz/regressions may hold no input yet (git keeps no empty folder): libFuzzer stops on a
+# corpus folder that does not exist.
+mkdir -p "$out" "$results" "$repo/fuzz/regressions"
+# The monitor's target needs the generated message headers of a built workspace.
+[ -f "$ws/devel/include/collision_response/BodyState.h" ] || build_workspace >"$ws/fuzz-build.log" 2>&1
 flags=(-std=c++17 -O1 -g -Wall -Wextra -fsanitize=fuzzer-no-link,address,undefined
-  -fno-sanitize-recover=undefined -I "$repo/include" -isystem /usr/include/eigen3)
+  -fno-sanitize-recover=undefined -I "$repo/include" -isystem /usr/include/eigen3
+  -isystem "$ws/devel/include" -isystem /usr/include/xmlrpcpp)
 echo "== building the core with clang -fsanitize=fuzzer-no-link,address,undefined"
 mkdir -p "$out/core"
 objects=()
@@ -27,26 +34,44 @@ for source in "$repo"/src/core/*.cpp; do
     [ -z "$(find "$repo/include" "$repo/src/core" -name '*.h' -newer "$object" -print -quit)" ] ||
     clang++ "${flags[@]}" -c "$source" -o "$object" &
 done
+# The pure part of the ROS layer that the monitor's target drives (no node, no master).
+mkdir -p "$out/ros"
+for name in conversions frame_motion monitor_cycle state_intake time_line; do
+  source="$repo/src/ros/$name.cpp"
+  object="$out/ros/$name.o"
+  [ "$object" -nt "$source" ] && [ -z "$(find "$repo/include" -newer "$object" -print -quit)" ] ||
+    clang++ "${flags[@]}" -c "$source" -o "$object" &
+done
 wait
 status=0
-for target in fuzz_impact fuzz_time_of_impact; do
+for target in fuzz_impact fuzz_time_of_impact fuzz_monitor; do
   echo "== $target: building"
-  clang++ "${flags[@]}" -fsanitize=fuzzer "$repo/fuzz/$target.cpp" "${objects[@]}" -o "$out/$target"
+  extra=()
+  limits=()
+  if [ "$target" = fuzz_monitor ]; then
+    extra=("$out"/ros/*.o -ltf2 -lrostime -lcpp_common -lconsole_bridge -lxmlrpcpp)
+    # Bounded work per message: no single allocation of 256 MB, no 2 GB of memory, no input
+    # slower than 120 s (under the sanitizers; the target also caps what one message
+    # allocates, kAllocationCap).
+    limits=(-malloc_limit_mb=256 -rss_limit_mb=2048 -timeout=120)
+  fi
+  clang++ "${flags[@]}" -fsanitize=fuzzer "$repo/fuzz/$target.cpp" "${objects[@]}" "${extra[@]}" \
+    -o "$out/$target"
   mkdir -p "$out/corpus-$target"
   echo "== $target: running $seconds s"
   set +e
-  (cd "$out" && ASAN_OPTIONS=detect_leaks=1 ./"$target" -max_total_time="$seconds" \
+  (cd "$out" && ASAN_OPTIONS=detect_leaks=1 ./"$target" -max_total_time="$seconds" "${limits[@]}" \
     -print_final_stats=1 "corpus-$target" "$repo/fuzz/regressions" >"$out/$target.log" 2>&1)
   rc=$?
   set -e
-  runs=$(grep -E 'stat::number_of_executed_units' "$out/$target.log" | awk '{print $2}' | tail -1)
+  runs=$(grep -E 'stat::number_of_executed_units' "$out/$target.log" | awk '{print $2}' | tail -1 || true)
   echo "   $target: exit $rc, ${runs:-0} executions"
   if [ $rc -eq 0 ]; then
     printf '<testsuite name="fuzz"><testcase classname="fuzz" name="%s (%s s, %s executions)"/></testsuite>\n' \
       "$target" "$seconds" "${runs:-0}" >"$results/fuzz-$target.xml"
   else
     status=1
-    detail=$(grep -E 'invariant broken|ERROR|SUMMARY|crash-' "$out/$target.log" | head -5 | sed 's/[<>&"]/_/g')
+    detail=$(grep -E 'invariant broken|ERROR|SUMMARY|crash-|No such' "$out/$target.log" | head -5 | sed 's/[<>&"]/_/g' || true)
     printf '<testsuite name="fuzz"><testcase classname="fuzz" name="%s"><failure message="%s"/></testcase></testsuite>\n' \
       "$target" "$detail" >"$results/fuzz-$target.xml"
     tail -20 "$out/$target.log"

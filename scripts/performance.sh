@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # Scale: the core per update for 1k, 10k and 100k bodies beside Bullet (Google Benchmark); the
 # node over ROS with 10,000 bodies at 100 Hz (CPU share, latency, memory over a long run); the
-# collision service's round trip beside an empty service. Writes doc/performance.md.
+# collision service's round trip beside an empty service; the work of one hard message (an
+# array of 10,000 distinct stamps, a cluster of 1,000 touching balls: the monitor's CPU, and
+# the service's worst round trip meanwhile) and start-up from 1,000 to 30,000 bodies.
+# Writes doc/performance.md.
 #   bash scripts/performance.sh                    # the memory run lasts 10 minutes
 #   MEMORY_SECONDS=60 bash scripts/performance.sh  # a shorter one
 #   MEMORY_SECONDS=0 bash scripts/performance.sh   # none: the report keeps the last memory run
@@ -17,7 +20,7 @@ bin="$ws/devel/lib/collision_response"
 out="$ws/performance"
 mkdir -p "$out"
 # A run without the memory part (MEMORY_SECONDS=0) keeps the last memory run's table.
-rm -f "$out"/scale.json "$out"/service*.json "$out"/load.json
+rm -f "$out"/scale.json "$out"/service*.json "$out"/load.json "$out"/burden_*.json "$out"/startup.json
 [ "${MEMORY_SECONDS:-600}" -gt 0 ] && rm -f "$out/memory.json"
 
 echo "== core: 1k, 10k, 100k bodies, and Bullet on the same gas"
@@ -47,9 +50,15 @@ PY
 start_private_master "$out/roscore.log"
 rosparam load "$out/gas.yaml" /collision_response
 rosparam load "$out/gas.yaml" /node_benchmark
+# The node's start-up with the gas: from its launch until its service is there.
+startup_began=$(date +%s.%N)
 "$bin/collision_response_node" >"$out/node.log" 2>&1 &
 node_pid=$!
 pids+=($node_pid)
+until rosservice list 2>/dev/null | grep -q /collision_response/compute_collision; do sleep 0.05; done
+startup_ended=$(date +%s.%N)
+/usr/bin/python3 -c "import json, sys; print(json.dumps({'bodies': int(sys.argv[1]), 'seconds': float(sys.argv[3]) - float(sys.argv[2])}))" \
+  "$bodies" "$startup_began" "$startup_ended" >"$out/startup_node.json"
 # The service is measured on a second node that serves the services alone (the default scene),
 # beside the empty service; the node with the 10,000 bodies is measured under load below.
 rosparam load "$repo/config/scenes/default.yaml" /collision_response_services
@@ -85,5 +94,40 @@ if [ "$memory_seconds" -gt 0 ]; then
   "$bin/node_benchmark" _mode:=load _rate:=100 _seconds:="$memory_seconds" _memory_every:=30 \
     _pid:="$node_pid" >"$out/memory.json"
 fi
+# Issue 13, item 9: the work of one hard message, and the service meanwhile. The gas node takes
+# arrays of its 10,000 bodies whose stamps are 10 us apart; a second node a lattice of 1,000
+# touching balls closing on its centre (one joint solve: its cost is the cluster solver's).
+echo "== one hard message: 10,000 distinct stamps; a cluster of 1,000 touching balls"
+"$bin/node_benchmark" _mode:=burden _kind:=stamps _messages:=5 _pid:="$node_pid" \
+  _service:=/collision_response/compute_collision >"$out/burden_stamps.json"
+/usr/bin/python3 - "$out/cluster.yaml" <<'PY'
+import sys
+n, r = 10, 0.05
+lines = ["scene:", "  fixed_frame: world", "  detection: continuous",
+         "  materials: {clay: {restitution: 0.5}}", "  bodies:"]
+centre = (n - 1) * r
+for i in range(n):
+    for j in range(n):
+        for k in range(n):
+            p = (2 * r * i, 2 * r * j, 2 * r * k)
+            v = tuple(-(x - centre) for x in p)  # 1 m/s per m towards the centre
+            lines.append(f"    - {{id: ball_{i}{j}{k}, mass: 0.1, radius: {r}, material: clay, "
+                         f"position: [{p[0]:.17g}, {p[1]:.17g}, {p[2]:.17g}], "
+                         f"velocity: [{v[0]:.17g}, {v[1]:.17g}, {v[2]:.17g}]}}")
+open(sys.argv[1], "w").write("\n".join(lines) + "\n")
+PY
+rosparam load "$out/cluster.yaml" /collision_response_cluster
+"$bin/collision_response_node" __name:=collision_response_cluster body_states:=/cluster/body_states \
+  impacts:=/cluster/impacts >"$out/cluster_node.log" 2>&1 &
+cluster_pid=$!
+pids+=($cluster_pid)
+until rosservice list 2>/dev/null | grep -q /collision_response_cluster/compute_collision; do sleep 0.2; done
+rosparam delete /node_benchmark/scene
+rosparam load "$out/cluster.yaml" /node_benchmark
+"$bin/node_benchmark" _mode:=burden _kind:=cluster _pid:="$cluster_pid" \
+  _service:=/collision_response_cluster/compute_collision body_states:=/cluster/body_states \
+  impacts:=/cluster/impacts >"$out/burden_cluster.json"
+echo "== start-up: the loader and the monitor for 1,000 to 30,000 bodies"
+"$bin/node_benchmark" _mode:=startup >"$out/startup.json"
 /usr/bin/python3 "$repo/scripts/performance_report.py" "$out" "$repo/doc/performance.md"
 cat "$repo/doc/performance.md"

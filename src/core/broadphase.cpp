@@ -24,9 +24,19 @@ SpatialHash::Cell SpatialHash::cellOf(const Eigen::Vector3d& point) const {
 
 template <typename Visit>
 bool SpatialHash::forEachCell(const Box& box, Visit visit) const {
+  // A box with a non-finite corner covers no countable set of cells: it is kept aside.
+  if (!box.low.allFinite() || !box.high.allFinite()) return false;
   const Cell low = cellOf(box.low), high = cellOf(box.high);
-  const std::int64_t count = (high.x - low.x + 1) * (high.y - low.y + 1) * (high.z - low.z + 1);
-  if (count > static_cast<std::int64_t>(kMaxCells) || count <= 0) return false;
+  // Counted axis by axis, each against the limit before they are multiplied: the product of
+  // three spans of up to 2e15 cells overflows int64, and a wrapped count once passed the limit
+  // (a far, fast body then had the grid walk and store cells until memory ran out).
+  std::int64_t count = 1;
+  for (const auto& [from, to] :
+       {std::pair{low.x, high.x}, std::pair{low.y, high.y}, std::pair{low.z, high.z}}) {
+    if (to < from || to - from >= static_cast<std::int64_t>(kMaxCells)) return false;
+    count *= to - from + 1;  // at most kMaxCells^3: no overflow
+  }
+  if (count > static_cast<std::int64_t>(kMaxCells)) return false;
   for (std::int64_t x = low.x; x <= high.x; ++x) {
     for (std::int64_t y = low.y; y <= high.y; ++y) {
       for (std::int64_t z = low.z; z <= high.z; ++z) visit(key(x, y, z));
@@ -46,12 +56,15 @@ void SpatialHash::build(const std::vector<Box>& boxes, const std::vector<char>& 
   std::vector<double> extents;
   extents.reserve(boxes.size());
   for (std::size_t i = 0; i < boxes.size(); ++i) {
-    if (active[i]) extents.push_back((boxes[i].high - boxes[i].low).maxCoeff());
+    const double extent = (boxes[i].high - boxes[i].low).maxCoeff();
+    if (active[i] && std::isfinite(extent)) extents.push_back(extent);
   }
-  if (extents.empty()) return;
-  std::nth_element(extents.begin(), extents.begin() + extents.size() / 2, extents.end());
-  const double median = extents[extents.size() / 2];
-  cell_size_ = median > 0 && std::isfinite(median) ? median : 1.0;
+  cell_size_ = 1.0;
+  if (!extents.empty()) {
+    std::nth_element(extents.begin(), extents.begin() + extents.size() / 2, extents.end());
+    const double median = extents[extents.size() / 2];
+    if (median > 0) cell_size_ = median;
+  }
   for (std::size_t i = 0; i < boxes.size(); ++i) {
     if (!active[i]) continue;
     const std::size_t before = keyed_.size();

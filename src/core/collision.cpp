@@ -61,10 +61,7 @@ Expected<double> chooseFriction(const CollisionRequest& request, const MaterialT
     }
     return pair;
   }
-  if (!std::isfinite(request.friction) || request.friction < 0.0) {
-    return Error{"friction", "Coulomb coefficient must be a finite number >= 0, got " +
-                                 formatNumber(request.friction)};
-  }
+  if (auto status = checkFriction(request.friction, "friction"); !status) return status.error();
   return request.friction;
 }
 
@@ -143,20 +140,16 @@ Expected<CollisionOutcome> computeCollision(const CollisionRequest& request,
   }
   // Finite inputs whose answer is beyond the doubles (masses and speeds of 1e200: an energy of
   // 1e600 J) are refused by name rather than answered with an infinity.
-  const std::pair<const char*, bool> results[] = {
-      {"velocity_a", outcome.impact.velocity_a.allFinite()},
-      {"velocity_b", outcome.impact.velocity_b.allFinite()},
-      {"angular_velocity_a", outcome.angular_velocity_a.allFinite()},
-      {"angular_velocity_b", outcome.angular_velocity_b.allFinite()},
-      {"impulse", std::isfinite(outcome.impact.normal_impulse)},
-      {"friction_impulse", std::isfinite(outcome.friction_impulse)},
-      {"energy_lost", std::isfinite(outcome.impact.energy_lost)}};
-  for (const auto& [field, finite] : results) {
-    if (!finite) {
-      return Error{field,
-                   "is beyond the range of double (the masses and speeds are too large "
-                   "for the answer to be represented)"};
-    }
+  if (auto status =
+          checkRepresentable({namedResult("velocity_a", outcome.impact.velocity_a),
+                              namedResult("velocity_b", outcome.impact.velocity_b),
+                              namedResult("angular_velocity_a", outcome.angular_velocity_a),
+                              namedResult("angular_velocity_b", outcome.angular_velocity_b),
+                              namedResult("impulse", outcome.impact.normal_impulse),
+                              namedResult("friction_impulse", outcome.friction_impulse),
+                              namedResult("energy_lost", outcome.impact.energy_lost)});
+      !status) {
+    return status.error();
   }
   return outcome;
 }

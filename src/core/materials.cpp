@@ -89,9 +89,10 @@ Status MaterialTable::addMaterial(const std::string& name, const Material& mater
   if (auto status = checkRestitution(*material.restitution, field + ".restitution"); !status) {
     return status;
   }
-  if (material.friction && !(std::isfinite(*material.friction) && *material.friction >= 0.0)) {
-    return Error{field + ".friction",
-                 "must be a finite number >= 0, got " + formatNumber(*material.friction)};
+  if (material.friction) {
+    if (auto status = checkFriction(*material.friction, field + ".friction"); !status) {
+      return status;
+    }
   }
   materials_[name] = material;
   return Ok{};
@@ -99,15 +100,15 @@ Status MaterialTable::addMaterial(const std::string& name, const Material& mater
 
 Status MaterialTable::addPair(const std::string& first, const std::string& second,
                               const PairCoefficients& coefficients, const std::string& field) {
-  if (auto status = checkKnown(first, field + ".materials[0]"); !status) return status;
-  if (auto status = checkKnown(second, field + ".materials[1]"); !status) return status;
+  if (auto status = checkMaterial(first, field + ".materials[0]"); !status) return status;
+  if (auto status = checkMaterial(second, field + ".materials[1]"); !status) return status;
   if (auto status = checkRestitution(coefficients.restitution, field + ".restitution"); !status) {
     return status;
   }
-  if (coefficients.friction &&
-      !(std::isfinite(*coefficients.friction) && *coefficients.friction >= 0.0)) {
-    return Error{field + ".friction",
-                 "must be a finite number >= 0, got " + formatNumber(*coefficients.friction)};
+  if (coefficients.friction) {
+    if (auto status = checkFriction(*coefficients.friction, field + ".friction"); !status) {
+      return status;
+    }
   }
   pairs_[key(first, second)] = coefficients;
   return Ok{};
@@ -122,8 +123,8 @@ std::vector<std::string> MaterialTable::names() const {
 Expected<double> MaterialTable::restitution(const std::string& first, const std::string& second,
                                             const std::string& field_first,
                                             const std::string& field_second) const {
-  if (auto status = checkKnown(first, field_first); !status) return status.error();
-  if (auto status = checkKnown(second, field_second); !status) return status.error();
+  if (auto status = checkMaterial(first, field_first); !status) return status.error();
+  if (auto status = checkMaterial(second, field_second); !status) return status.error();
   if (const auto pair = pairs_.find(key(first, second)); pair != pairs_.end()) {
     return pair->second.restitution;
   }
@@ -140,8 +141,8 @@ Expected<double> MaterialTable::restitution(const std::string& first, const std:
 Expected<double> MaterialTable::friction(const std::string& first, const std::string& second,
                                          const std::string& field_first,
                                          const std::string& field_second) const {
-  if (auto status = checkKnown(first, field_first); !status) return status.error();
-  if (auto status = checkKnown(second, field_second); !status) return status.error();
+  if (auto status = checkMaterial(first, field_first); !status) return status.error();
+  if (auto status = checkMaterial(second, field_second); !status) return status.error();
   if (const auto pair = pairs_.find(key(first, second));
       pair != pairs_.end() && pair->second.friction) {
     return *pair->second.friction;
@@ -169,7 +170,7 @@ MaterialTable::PairKey MaterialTable::key(const std::string& first, const std::s
   return first < second ? PairKey{first, second} : PairKey{second, first};
 }
 
-Status MaterialTable::checkKnown(const std::string& name, const std::string& field) const {
+Status MaterialTable::checkMaterial(const std::string& name, const std::string& field) const {
   if (contains(name)) return Ok{};
   std::string known;
   for (const auto& entry : materials_) known += (known.empty() ? "" : ", ") + entry.first;

@@ -73,6 +73,48 @@ Status checkName(const std::string& name, const std::string& field) {
   return Ok{};
 }
 
+Status checkFrameId(const std::string& frame, const std::string& field) {
+  if (!frame.empty() && frame.front() == '/') {
+    const std::size_t name = frame.find_first_not_of('/');
+    return Error{field, "'" + frame + "' starts with '/': tf2 frame ids have none (use '" +
+                            (name == std::string::npos ? std::string() : frame.substr(name)) +
+                            "')"};
+  }
+  return checkName(frame, field);
+}
+
+Status checkFriction(double friction, const std::string& field) {
+  if (!std::isfinite(friction) || friction < 0.0) {
+    return Error{field,
+                 "Coulomb coefficient must be a finite number >= 0, got " + formatNumber(friction)};
+  }
+  return Ok{};
+}
+
+Status checkRestitutionThreshold(double threshold, const std::string& field) {
+  if (!std::isfinite(threshold) || threshold < 0.0) {
+    return Error{field, "must be a finite number >= 0 m/s, got " + formatNumber(threshold)};
+  }
+  return Ok{};
+}
+
+Status checkContactTolerance(double tolerance, const std::string& field) {
+  if (!std::isfinite(tolerance) || tolerance < 0.0 || tolerance >= 1.0) {
+    return Error{field,
+                 "must be a fraction of the contact distance in [0, 1) (surfaces closer than it "
+                 "touch), got " +
+                     formatNumber(tolerance)};
+  }
+  return Ok{};
+}
+
+Status checkRepresentable(std::initializer_list<NamedResult> results) {
+  for (const NamedResult& result : results) {
+    if (!result.finite) return Error{result.field, kBeyondDoubles};
+  }
+  return Ok{};
+}
+
 Status checkBody(const Body& body, const std::string& prefix) {
   if (auto status = checkMass(body.mass, prefix + ".mass"); !status) return status;
   if (auto status = checkRadius(body.radius, prefix + ".radius"); !status) return status;

@@ -5,6 +5,7 @@
 
 #include "collision_response/core/validation.h"
 #include "collision_response/ros/collision_services.h"
+#include "collision_response/ros/parameters.h"
 #include "collision_response/ros/scene_loader.h"
 
 namespace collision_response {
@@ -13,21 +14,47 @@ CollisionResponseNode::CollisionResponseNode(const ros::NodeHandle& node,
                                              const ros::NodeHandle& private_node)
     : node_(node), private_node_(private_node) {}
 
+CollisionResponseNode::~CollisionResponseNode() {
+  if (service_spinner_) service_spinner_->stop();
+  compute_collision_server_.shutdown();
+  estimate_restitution_server_.shutdown();
+}
+
 bool CollisionResponseNode::initialize() {
-  const std::string scene_key = private_node_.resolveName("scene");
-  XmlRpc::XmlRpcValue scene_value;
-  if (private_node_.getParam("scene", scene_value)) {
-    auto scene = loadScene(scene_value, scene_key);
+  // Nothing a parameter holds may escape as an exception (a node would abort with "terminate
+  // called", a nodelet manager only say "Failed to load"): every error is named and logged.
+  try {
+    return start();
+  } catch (const std::exception& error) {
+    ROS_FATAL_STREAM("collision_response: not started: " << error.what());
+    return false;
+  }
+}
+
+bool CollisionResponseNode::start() {
+  // The whole private namespace at once: every parameter read with its type checked, and one
+  // the node does not know refused by name (a typo would otherwise be a silent default).
+  const std::string ns = private_node_.getNamespace();
+  XmlRpc::XmlRpcValue tree;
+  if (!ros::param::get(ns, tree)) tree = XmlRpc::XmlRpcValue();
+  auto params = MonitorParams::load(tree, ns);
+  if (!params) {
+    ROS_FATAL_STREAM("collision_response: bad parameter: " << params.error().message());
+    return false;
+  }
+  if (tree.getType() == XmlRpc::XmlRpcValue::TypeStruct && tree.hasMember("scene")) {
+    auto scene = loadScene(tree["scene"], joinKey(ns, "scene"));
     if (!scene) {
       ROS_FATAL_STREAM("collision_response: bad scene: " << scene.error().message());
       return false;
     }
-    auto params = MonitorParams::load(private_node_);
-    if (!params) {
-      ROS_FATAL_STREAM("collision_response: bad parameter: " << params.error().message());
+    if (auto status = checkBodyTopics(*scene, node_.getNamespace(),
+                                      node_.resolveName("body_states"), joinKey(ns, "scene"));
+        !status) {
+      ROS_FATAL_STREAM("collision_response: bad scene: " << status.error().message());
       return false;
     }
-    materials_ = scene->materials;
+    materials_ = std::make_shared<const core::MaterialTable>(scene->materials);
     logScene(*scene, *params);
     monitor_ = std::make_unique<ImpactMonitorRos>(node_, *scene, *params);
 
@@ -49,16 +76,26 @@ bool CollisionResponseNode::initialize() {
     reconfigure_->setCallback(
         [this](MonitorConfig& config, std::uint32_t level) { onReconfigure(config, level); });
   } else {
-    ROS_WARN_STREAM("collision_response: no " << scene_key
+    ROS_WARN_STREAM("collision_response: no " << joinKey(ns, "scene")
                                               << " parameter: serving the services with the "
                                                  "seed's materials, no impact monitor");
   }
 
-  compute_collision_server_ = private_node_.advertiseService(
+  // The services on their own queue and thread: a long step of the monitor never delays them.
+  ros::NodeHandle service_node(private_node_);
+  service_node.setCallbackQueue(&service_queue_);
+  compute_collision_server_ = service_node.advertiseService(
       "compute_collision", &CollisionResponseNode::onComputeCollision, this);
-  estimate_restitution_server_ = private_node_.advertiseService(
+  estimate_restitution_server_ = service_node.advertiseService(
       "estimate_restitution", &CollisionResponseNode::onEstimateRestitution, this);
+  service_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &service_queue_);
+  service_spinner_->start();
   return true;
+}
+
+std::shared_ptr<const core::MaterialTable> CollisionResponseNode::materials() const {
+  std::lock_guard<std::mutex> lock(materials_mutex_);
+  return materials_;
 }
 
 void CollisionResponseNode::logScene(const core::Scene& scene, const MonitorParams& params) const {
@@ -75,7 +112,8 @@ void CollisionResponseNode::logScene(const core::Scene& scene, const MonitorPara
                   << params.transform_timeout << " s, frame_velocity_interval "
                   << params.frame_velocity_interval << " s, body_timeout " << params.body_timeout
                   << " s, contact_tolerance " << params.contact_tolerance << ", clock_jump_back "
-                  << params.clock_jump_back << " s, queue_size " << params.queue_size
+                  << params.clock_jump_back << " s, future_stamp_tolerance "
+                  << params.future_stamp_tolerance << " s, queue_size " << params.queue_size
                   << ", max_states " << params.max_states);
 }
 
@@ -95,11 +133,11 @@ void CollisionResponseNode::onReconfigure(MonitorConfig& config, std::uint32_t /
     config.restitution_combine = config_.restitution_combine;
     rule = core::parseCombineRule(config.restitution_combine, prefix + "restitution_combine");
   }
-  if (!std::isfinite(config.restitution_threshold) || config.restitution_threshold < 0.0) {
+  if (auto status = core::checkRestitutionThreshold(config.restitution_threshold,
+                                                    prefix + "restitution_threshold");
+      !status) {
     ROS_ERROR_STREAM("collision_response: reconfigure refused: "
-                     << prefix << "restitution_threshold: must be a finite number >= 0 m/s, got "
-                     << core::formatNumber(config.restitution_threshold) << "; kept "
-                     << config_.restitution_threshold);
+                     << status.error().message() << "; kept " << config_.restitution_threshold);
     config.restitution_threshold = config_.restitution_threshold;
   }
   if (config.detection != config_.detection ||
@@ -111,7 +149,12 @@ void CollisionResponseNode::onReconfigure(MonitorConfig& config, std::uint32_t /
                     << config.restitution_combine);
   }
   monitor_->tune(*detection, config.restitution_threshold, *rule);
-  materials_.setCombineRule(*rule);
+  if (materials()->combineRule() != *rule) {
+    auto table = std::make_shared<core::MaterialTable>(*materials());
+    table->setCombineRule(*rule);
+    std::lock_guard<std::mutex> lock(materials_mutex_);
+    materials_ = std::move(table);
+  }
   config_ = config;
 }
 
@@ -120,7 +163,7 @@ void CollisionResponseNode::onReconfigure(MonitorConfig& config, std::uint32_t /
 bool CollisionResponseNode::onComputeCollision(ComputeCollision::Request& request,
                                                ComputeCollision::Response& response) {
   try {
-    answerComputeCollision(request, materials_, response);
+    answerComputeCollision(request, *materials(), response);
   } catch (const std::exception& error) {
     response = ComputeCollision::Response();
     response.message = std::string("internal error: ") + error.what();
@@ -132,7 +175,7 @@ bool CollisionResponseNode::onComputeCollision(ComputeCollision::Request& reques
 bool CollisionResponseNode::onEstimateRestitution(EstimateRestitution::Request& request,
                                                   EstimateRestitution::Response& response) {
   try {
-    answerEstimateRestitution(request, materials_, response);
+    answerEstimateRestitution(request, *materials(), response);
   } catch (const std::exception& error) {
     response = EstimateRestitution::Response();
     response.message = std::string("internal error: ") + error.what();

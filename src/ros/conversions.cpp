@@ -2,6 +2,8 @@
 
 #include <tf2_eigen/tf2_eigen.h>
 
+#include <cstdio>
+
 namespace collision_response {
 
 Eigen::Vector3d toEigen(const geometry_msgs::Point& point) {
@@ -34,6 +36,40 @@ core::Body toCore(const collision_response::Body& msg) {
   body.velocity = toEigen(msg.velocity);
   body.angular_velocity = toEigen(msg.angular_velocity);
   return body;
+}
+
+std::optional<core::ImpactRecord> toImpactRecord(const Impact& impact,
+                                                 const core::ImpactMonitor& monitor, double time) {
+  const auto a = monitor.bodyIndex(impact.body_a);
+  if (!a) return std::nullopt;
+  core::ImpactRecord record;
+  record.time = time;
+  record.body_a = *a;
+  const auto b = monitor.bodyIndex(impact.body_b);
+  record.other_is_obstacle = !b;
+  record.other = b ? *b : 0;
+  record.contact_point = toEigen(impact.contact_point);
+  record.normal = toEigen(impact.normal);
+  record.restitution = impact.restitution;
+  record.impulse = impact.impulse;
+  record.friction_impulse = impact.friction_impulse;
+  record.energy_lost = impact.energy_lost;
+  record.oblique = impact.oblique;
+  record.velocity_a_before = toEigen(impact.velocity_a_before.linear);
+  record.velocity_a_after = toEigen(impact.velocity_a_after.linear);
+  record.velocity_b_before = toEigen(impact.velocity_b_before.linear);
+  record.velocity_b_after = toEigen(impact.velocity_b_after.linear);
+  record.angular_velocity_a_before = toEigen(impact.velocity_a_before.angular);
+  record.angular_velocity_a_after = toEigen(impact.velocity_a_after.angular);
+  record.angular_velocity_b_before = toEigen(impact.velocity_b_before.angular);
+  record.angular_velocity_b_after = toEigen(impact.velocity_b_after.angular);
+  return record;
+}
+
+std::string formatStamp(const ros::Time& stamp) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%u.%09u", stamp.sec, stamp.nsec);
+  return text;
 }
 
 }  // namespace collision_response

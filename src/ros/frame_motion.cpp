@@ -11,7 +11,7 @@ Eigen::Vector3d FrameMotion::velocity(const Eigen::Vector3d& in_frame,
   return pose.linear() * velocity_in_frame + linear_velocity + angular_velocity.cross(offset);
 }
 
-core::Expected<FrameMotion> lookupFrameMotion(const tf2_ros::Buffer& buffer,
+core::Expected<FrameMotion> lookupFrameMotion(const tf2::BufferCore& buffer,
                                               const std::string& fixed_frame,
                                               const std::string& frame, const ros::Time& stamp,
                                               const ros::Duration& interval) {

@@ -136,4 +136,25 @@ void appendImpactMarkers(const Impact& impact, int id, const MarkerParams& param
   array.markers.push_back(contact);
 }
 
+void appendSceneMarkers(const core::ImpactMonitor& monitor, double time, const std::string& frame,
+                        const ros::Time& stamp, const MarkerParams& params,
+                        visualization_msgs::MarkerArray& array) {
+  for (std::size_t i = 0; i < monitor.bodyCount(); ++i) {
+    const auto state = monitor.predictedState(i, time);
+    array.markers.push_back(bodyMarker(
+        monitor.body(i), static_cast<int>(i),
+        state ? std::optional<Eigen::Vector3d>(state->first) : std::nullopt, frame, stamp));
+  }
+  for (std::size_t i = 0; i < monitor.obstacleCount(); ++i) {
+    const auto pose = monitor.obstaclePose(i);
+    if (!pose) continue;  // a tf-attached obstacle not placed yet
+    const core::ObstacleSpec& spec = monitor.obstacle(i);
+    const Eigen::Vector3d position = spec.shape == core::ObstacleShape::kSphere
+                                         ? Eigen::Vector3d(pose->position)
+                                         : Eigen::Vector3d(pose->offset * pose->normal);
+    array.markers.push_back(
+        obstacleMarker(spec, static_cast<int>(i), position, pose->normal, frame, stamp, params));
+  }
+}
+
 }  // namespace collision_response

@@ -1,10 +1,13 @@
 #include "collision_response/ros/parameters.h"
 
-namespace collision_response {
-namespace {
+#include <cmath>
 
-const char* typeName(XmlRpc::XmlRpcValue::Type type) {
-  switch (type) {
+#include "collision_response/core/validation.h"
+
+namespace collision_response {
+
+const char* typeName(const XmlRpc::XmlRpcValue& value) {
+  switch (value.getType()) {
     case XmlRpc::XmlRpcValue::TypeBoolean:
       return "a boolean";
     case XmlRpc::XmlRpcValue::TypeInt:
@@ -22,9 +25,33 @@ const char* typeName(XmlRpc::XmlRpcValue::Type type) {
   }
 }
 
+namespace {
+
+/// What the value was, for a message: its type, and a scalar's text.
+std::string describe(const XmlRpc::XmlRpcValue& value) {
+  XmlRpc::XmlRpcValue copy = value;
+  switch (copy.getType()) {
+    case XmlRpc::XmlRpcValue::TypeString: {
+      const std::string text = copy;
+      return std::string("a string ('") + (text.size() > 40 ? text.substr(0, 40) + "..." : text) +
+             "')";
+    }
+    case XmlRpc::XmlRpcValue::TypeBoolean:
+      return std::string("a boolean (") + (static_cast<bool>(copy) ? "true" : "false") + ")";
+    case XmlRpc::XmlRpcValue::TypeInt:
+      return "an integer (" + std::to_string(static_cast<int>(copy)) + ")";
+    case XmlRpc::XmlRpcValue::TypeDouble:
+      return "a number (" + core::formatNumber(static_cast<double>(copy)) + ")";
+    case XmlRpc::XmlRpcValue::TypeArray:
+      return "a list of " + std::to_string(copy.size());
+    default:
+      return typeName(value);
+  }
+}
+
 core::Error wrongType(const XmlRpc::XmlRpcValue& value, const std::string& field,
                       const std::string& expected) {
-  return core::Error{field, "must be " + expected + ", got " + typeName(value.getType())};
+  return core::Error{field, "must be " + expected + ", got " + describe(value)};
 }
 
 }  // namespace
@@ -48,17 +75,10 @@ core::Status checkArray(const XmlRpc::XmlRpcValue& value, const std::string& fie
   return core::Ok{};
 }
 
-core::Status checkKeys(const XmlRpc::XmlRpcValue& value, const std::set<std::string>& known,
-                       const std::string& field) {
-  if (auto status = checkStruct(value, field); !status) return status;
-  for (auto it = value.begin(); it != value.end(); ++it) {
-    if (known.count(it->first) == 0) {
-      std::string list;
-      for (const std::string& key : known) list += (list.empty() ? "" : ", ") + key;
-      return core::Error{joinKey(field, it->first), "unknown key; known here: " + list};
-    }
-  }
-  return core::Ok{};
+core::Error unknownKey(const std::string& field, const std::vector<std::string>& known) {
+  std::string list;
+  for (const std::string& key : known) list += (list.empty() ? "" : ", ") + key;
+  return core::Error{field, "unknown key; known here: " + list};
 }
 
 core::Expected<double> readDouble(const XmlRpc::XmlRpcValue& value, const std::string& field) {
@@ -68,6 +88,12 @@ core::Expected<double> readDouble(const XmlRpc::XmlRpcValue& value, const std::s
   if (copy.getType() == XmlRpc::XmlRpcValue::TypeInt)
     return static_cast<double>(static_cast<int>(copy));
   return wrongType(value, field, "a number");
+}
+
+core::Expected<int> readInt(const XmlRpc::XmlRpcValue& value, const std::string& field) {
+  XmlRpc::XmlRpcValue copy = value;
+  if (copy.getType() == XmlRpc::XmlRpcValue::TypeInt) return static_cast<int>(copy);
+  return wrongType(value, field, "an integer");
 }
 
 core::Expected<std::string> readString(const XmlRpc::XmlRpcValue& value, const std::string& field) {
@@ -94,6 +120,20 @@ core::Expected<Eigen::Vector3d> readVector3(const XmlRpc::XmlRpcValue& value,
     result[i] = *component;
   }
   return result;
+}
+
+core::Status checkPositive(double value, const std::string& field) {
+  if (!std::isfinite(value) || !(value > 0.0)) {
+    return core::Error{field, "must be a finite number > 0, got " + core::formatNumber(value)};
+  }
+  return core::Ok{};
+}
+
+core::Status checkNonNegative(double value, const std::string& field) {
+  if (!std::isfinite(value) || value < 0.0) {
+    return core::Error{field, "must be a finite number >= 0, got " + core::formatNumber(value)};
+  }
+  return core::Ok{};
 }
 
 }  // namespace collision_response

@@ -1,290 +1,288 @@
 #include "collision_response/ros/scene_loader.h"
 
+#include <optional>
+#include <utility>
+
+#include "collision_response/core/validation.h"
 #include "collision_response/ros/parameters.h"
 
 namespace collision_response {
 namespace {
 
-// Every key a scene may have (DESIGN.md, "Scene").
-const std::set<std::string> kSceneKeys = {
-    "fixed_frame",         "detection", "effects", "gravity", "restitution_threshold",
-    "restitution_combine", "materials", "pairs",   "bodies",  "obstacles"};
+using core::BodySpec;
+using core::ObstacleSpec;
+using core::Scene;
 
-core::Expected<std::optional<double>> readOptionalDouble(const XmlRpc::XmlRpcValue& parent,
-                                                         const std::string& key,
-                                                         const std::string& field) {
-  if (!parent.hasMember(key)) return std::optional<double>{};
-  const auto value = readDouble(parent[key], joinKey(field, key));
-  if (!value) return value.error();
-  return std::optional<double>{*value};
+// One table per entity: the keys it may have, whether each is required, and how each is read
+// and checked. readKeys refuses any key a table does not list, so a key is accepted exactly
+// when it is read (README.md, "Scene file", documents each table; test_scene_loader.cpp checks
+// the two agree).
+
+const KeyTable<core::Material>& materialKeys() {
+  static const KeyTable<core::Material> kKeys = {
+      {"restitution", true,
+       [](const XmlRpc::XmlRpcValue& value, const std::string& field, core::Material& material) {
+         const auto number = readDouble(value, field);
+         if (!number) return core::Status(number.error());
+         if (auto status = core::checkRestitution(*number, field); !status) return status;
+         material.restitution = *number;
+         return core::Status(core::Ok{});
+       }},
+      {"friction", false,
+       [](const XmlRpc::XmlRpcValue& value, const std::string& field, core::Material& material) {
+         const auto number = readDouble(value, field);
+         if (!number) return core::Status(number.error());
+         if (auto status = core::checkFriction(*number, field); !status) return status;
+         material.friction = *number;
+         return core::Status(core::Ok{});
+       }},
+  };
+  return kKeys;
 }
 
-core::Status loadMaterialEntries(const XmlRpc::XmlRpcValue& materials, const std::string& field,
-                                 core::MaterialTable& table) {
-  if (auto status = checkStruct(materials, field); !status) return status;
-  for (auto it = materials.begin(); it != materials.end(); ++it) {
-    const std::string entry_field = joinKey(field, it->first);
-    if (auto status = checkKeys(it->second, {"restitution", "friction"}, entry_field); !status) {
-      return status;
-    }
-    const auto restitution = readOptionalDouble(it->second, "restitution", entry_field);
-    if (!restitution) return restitution.error();
-    const auto friction = readOptionalDouble(it->second, "friction", entry_field);
-    if (!friction) return friction.error();
-    if (auto status =
-            table.addMaterial(it->first, core::Material{*restitution, *friction}, entry_field);
+/// A pair as read, before it joins the table (its materials must be known by then).
+struct PairEntry {
+  std::string first, second;
+  core::PairCoefficients coefficients;
+  const core::MaterialTable* materials = nullptr;
+};
+
+const KeyTable<PairEntry>& pairKeys() {
+  static const KeyTable<PairEntry> kKeys = {
+      {"materials", true,
+       [](const XmlRpc::XmlRpcValue& value, const std::string& field, PairEntry& pair) {
+         if (value.getType() != XmlRpc::XmlRpcValue::TypeArray || value.size() != 2) {
+           return core::Status(core::Error{field, "must be a list of two material names"});
+         }
+         for (int i = 0; i < 2; ++i) {
+           const std::string item = indexKey(field, static_cast<std::size_t>(i));
+           const auto name = readString(value[i], item);
+           if (!name) return core::Status(name.error());
+           if (auto status = pair.materials->checkMaterial(*name, item); !status) return status;
+           (i == 0 ? pair.first : pair.second) = *name;
+         }
+         return core::Status(core::Ok{});
+       }},
+      {"restitution", true,
+       [](const XmlRpc::XmlRpcValue& value, const std::string& field, PairEntry& pair) {
+         const auto number = readDouble(value, field);
+         if (!number) return core::Status(number.error());
+         if (auto status = core::checkRestitution(*number, field); !status) return status;
+         pair.coefficients.restitution = *number;
+         return core::Status(core::Ok{});
+       }},
+      {"friction", false,
+       [](const XmlRpc::XmlRpcValue& value, const std::string& field, PairEntry& pair) {
+         const auto number = readDouble(value, field);
+         if (!number) return core::Status(number.error());
+         if (auto status = core::checkFriction(*number, field); !status) return status;
+         pair.coefficients.friction = *number;
+         return core::Status(core::Ok{});
+       }},
+  };
+  return kKeys;
+}
+
+const KeyTable<BodySpec>& bodyKeys() {
+  static const KeyTable<BodySpec> kKeys = {
+      textKey<BodySpec>(
+          "id", [](BodySpec& b) -> std::string& { return b.id; }, nullptr, true),
+      numberKey<BodySpec>(
+          "mass", [](BodySpec& b) -> double& { return b.mass; }, core::checkMass, true),
+      numberKey<BodySpec>(
+          "radius", [](BodySpec& b) -> double& { return b.radius; }, core::checkRadius, true),
+      textKey<BodySpec>(
+          "material", [](BodySpec& b) -> std::string& { return b.material; }, nullptr, true),
+      textKey<BodySpec>("topic", [](BodySpec& b) -> std::string& { return b.topic; }),
+      vectorKey<BodySpec>("position", [](BodySpec& b) -> Eigen::Vector3d& { return b.position; }),
+      vectorKey<BodySpec>("velocity", [](BodySpec& b) -> Eigen::Vector3d& { return b.velocity; }),
+      {"inertia", false,
+       [](const XmlRpc::XmlRpcValue& value, const std::string& field, BodySpec& body) {
+         const auto name = readString(value, field);
+         if (!name) return core::Status(name.error());
+         const auto inertia = core::parseInertia(*name, field);
+         if (!inertia) return core::Status(inertia.error());
+         body.inertia = *inertia;
+         return core::Status(core::Ok{});
+       }},
+  };
+  return kKeys;
+}
+
+/// The keys every obstacle has; `type` was read first, to choose the table.
+KeyTable<ObstacleSpec> commonObstacleKeys() {
+  return {
+      textKey<ObstacleSpec>(
+          "id", [](ObstacleSpec& o) -> std::string& { return o.id; }, nullptr, true),
+      {"type", true,
+       [](const XmlRpc::XmlRpcValue&, const std::string&, ObstacleSpec&) {
+         return core::Status(core::Ok{});  // read to choose this table
+       }},
+      textKey<ObstacleSpec>(
+          "material", [](ObstacleSpec& o) -> std::string& { return o.material; }, nullptr, true),
+      textKey<ObstacleSpec>("frame", [](ObstacleSpec& o) -> std::string& { return o.frame; }),
+  };
+}
+
+const KeyTable<ObstacleSpec>& planeKeys() {
+  static const KeyTable<ObstacleSpec> kKeys = [] {
+    KeyTable<ObstacleSpec> keys = commonObstacleKeys();
+    keys.push_back(vectorKey<ObstacleSpec>(
+        "normal", [](ObstacleSpec& o) -> Eigen::Vector3d& { return o.normal; }, true));
+    keys.push_back(
+        numberKey<ObstacleSpec>("offset", [](ObstacleSpec& o) -> double& { return o.offset; }));
+    return keys;
+  }();
+  return kKeys;
+}
+
+const KeyTable<ObstacleSpec>& sphereKeys() {
+  static const KeyTable<ObstacleSpec> kKeys = [] {
+    KeyTable<ObstacleSpec> keys = commonObstacleKeys();
+    keys.push_back(numberKey<ObstacleSpec>(
+        "radius", [](ObstacleSpec& o) -> double& { return o.radius; }, core::checkRadius, true));
+    keys.push_back(vectorKey<ObstacleSpec>(
+        "position", [](ObstacleSpec& o) -> Eigen::Vector3d& { return o.position; }));
+    return keys;
+  }();
+  return kKeys;
+}
+
+core::Status readObstacle(const XmlRpc::XmlRpcValue& entry, const std::string& field,
+                          ObstacleSpec& obstacle) {
+  if (auto status = checkStruct(entry, field); !status) return status;
+  if (!entry.hasMember("type")) return core::Error{joinKey(field, "type"), "is required"};
+  const auto type = readString(entry["type"], joinKey(field, "type"));
+  if (!type) return type.error();
+  if (*type == "plane") {
+    obstacle.shape = core::ObstacleShape::kPlane;
+    return readKeys(entry, planeKeys(), field, obstacle);
+  }
+  if (*type == "sphere") {
+    obstacle.shape = core::ObstacleShape::kSphere;
+    return readKeys(entry, sphereKeys(), field, obstacle);
+  }
+  return core::Error{joinKey(field, "type"),
+                     "unknown obstacle type '" + *type + "'; known: plane, sphere"};
+}
+
+/// A list whose every entry is read by `read_entry` into a new element of `list`.
+template <class Entry, class ReadEntry>
+core::Status readList(const XmlRpc::XmlRpcValue& value, const std::string& field,
+                      std::vector<Entry>& list, ReadEntry read_entry) {
+  if (auto status = checkArray(value, field); !status) return status;
+  list.reserve(list.size() + static_cast<std::size_t>(value.size()));
+  for (int i = 0; i < value.size(); ++i) {
+    Entry entry;
+    if (auto status = read_entry(value[i], indexKey(field, static_cast<std::size_t>(i)), entry);
         !status) {
       return status;
     }
+    list.push_back(std::move(entry));
   }
   return core::Ok{};
 }
 
-core::Status loadPairEntries(const XmlRpc::XmlRpcValue& pairs, const std::string& field,
-                             core::MaterialTable& table) {
-  if (auto status = checkArray(pairs, field); !status) return status;
-  for (int i = 0; i < pairs.size(); ++i) {
-    const std::string entry_field = indexKey(field, static_cast<std::size_t>(i));
-    const XmlRpc::XmlRpcValue& entry = pairs[i];
-    if (auto status = checkKeys(entry, {"materials", "restitution", "friction"}, entry_field);
-        !status) {
-      return status;
-    }
-    const std::string materials_field = joinKey(entry_field, "materials");
-    if (!entry.hasMember("materials") ||
-        entry["materials"].getType() != XmlRpc::XmlRpcValue::TypeArray ||
-        entry["materials"].size() != 2) {
-      return core::Error{materials_field, "must be a list of two material names"};
-    }
-    const auto first = readString(entry["materials"][0], indexKey(materials_field, 0));
-    if (!first) return first.error();
-    const auto second = readString(entry["materials"][1], indexKey(materials_field, 1));
-    if (!second) return second.error();
-    if (!entry.hasMember("restitution")) {
-      return core::Error{joinKey(entry_field, "restitution"), "is required for a pair"};
-    }
-    const auto restitution = readDouble(entry["restitution"], joinKey(entry_field, "restitution"));
-    if (!restitution) return restitution.error();
-    const auto friction = readOptionalDouble(entry, "friction", entry_field);
-    if (!friction) return friction.error();
-    if (auto status = table.addPair(*first, *second,
-                                    core::PairCoefficients{*restitution, *friction}, entry_field);
-        !status) {
-      return status;
-    }
-  }
-  return core::Ok{};
-}
-
-core::Status readBodies(const XmlRpc::XmlRpcValue& list, const std::string& field,
-                        core::Scene& scene) {
-  if (auto status = checkArray(list, field); !status) return status;
-  for (int i = 0; i < list.size(); ++i) {
-    const std::string entry_field = indexKey(field, static_cast<std::size_t>(i));
-    const XmlRpc::XmlRpcValue& entry = list[i];
-    if (auto status =
-            checkKeys(entry, {"id", "mass", "radius", "material", "topic", "position", "velocity"},
-                      entry_field);
-        !status) {
-      return status;
-    }
-    core::BodySpec body;
-    for (const char* required : {"id", "mass", "radius", "material"}) {
-      if (!entry.hasMember(required)) {
-        return core::Error{joinKey(entry_field, required), "is required"};
-      }
-    }
-    auto id = readString(entry["id"], joinKey(entry_field, "id"));
-    if (!id) return id.error();
-    body.id = *id;
-    auto mass = readDouble(entry["mass"], joinKey(entry_field, "mass"));
-    if (!mass) return mass.error();
-    body.mass = *mass;
-    auto radius = readDouble(entry["radius"], joinKey(entry_field, "radius"));
-    if (!radius) return radius.error();
-    body.radius = *radius;
-    auto material = readString(entry["material"], joinKey(entry_field, "material"));
-    if (!material) return material.error();
-    body.material = *material;
-    if (entry.hasMember("topic")) {
-      auto topic = readString(entry["topic"], joinKey(entry_field, "topic"));
-      if (!topic) return topic.error();
-      body.topic = *topic;
-    }
-    if (entry.hasMember("position")) {
-      auto position = readVector3(entry["position"], joinKey(entry_field, "position"));
-      if (!position) return position.error();
-      body.position = *position;
-    }
-    if (entry.hasMember("velocity")) {
-      auto velocity = readVector3(entry["velocity"], joinKey(entry_field, "velocity"));
-      if (!velocity) return velocity.error();
-      body.velocity = *velocity;
-    }
-    if (entry.hasMember("inertia")) {
-      const std::string key = joinKey(entry_field, "inertia");
-      auto name = readString(entry["inertia"], key);
-      if (!name) return name.error();
-      auto inertia = core::parseInertia(*name, key);
-      if (!inertia) return inertia.error();
-      body.inertia = *inertia;
-    }
-    scene.bodies.push_back(body);
-  }
-  return core::Ok{};
-}
-
-core::Status readObstacles(const XmlRpc::XmlRpcValue& list, const std::string& field,
-                           core::Scene& scene) {
-  if (auto status = checkArray(list, field); !status) return status;
-  for (int i = 0; i < list.size(); ++i) {
-    const std::string entry_field = indexKey(field, static_cast<std::size_t>(i));
-    const XmlRpc::XmlRpcValue& entry = list[i];
-    if (auto status = checkStruct(entry, entry_field); !status) return status;
-    for (const char* required : {"id", "type", "material"}) {
-      if (!entry.hasMember(required)) {
-        return core::Error{joinKey(entry_field, required), "is required"};
-      }
-    }
-    core::ObstacleSpec obstacle;
-    auto type = readString(entry["type"], joinKey(entry_field, "type"));
-    if (!type) return type.error();
-    if (*type == "plane") {
-      obstacle.shape = core::ObstacleShape::kPlane;
-      if (auto status = checkKeys(entry, {"id", "type", "material", "frame", "normal", "offset"},
-                                  entry_field);
-          !status) {
-        return status;
-      }
-      if (!entry.hasMember("normal")) {
-        return core::Error{joinKey(entry_field, "normal"), "is required for a plane"};
-      }
-      auto normal = readVector3(entry["normal"], joinKey(entry_field, "normal"));
-      if (!normal) return normal.error();
-      obstacle.normal = *normal;
-      if (entry.hasMember("offset")) {
-        auto offset = readDouble(entry["offset"], joinKey(entry_field, "offset"));
-        if (!offset) return offset.error();
-        obstacle.offset = *offset;
-      }
-    } else if (*type == "sphere") {
-      obstacle.shape = core::ObstacleShape::kSphere;
-      if (auto status = checkKeys(entry, {"id", "type", "material", "frame", "position", "radius"},
-                                  entry_field);
-          !status) {
-        return status;
-      }
-      if (!entry.hasMember("radius")) {
-        return core::Error{joinKey(entry_field, "radius"), "is required for a sphere"};
-      }
-      auto radius = readDouble(entry["radius"], joinKey(entry_field, "radius"));
-      if (!radius) return radius.error();
-      obstacle.radius = *radius;
-      if (entry.hasMember("position")) {
-        auto position = readVector3(entry["position"], joinKey(entry_field, "position"));
-        if (!position) return position.error();
-        obstacle.position = *position;
-      }
-    } else {
-      return core::Error{joinKey(entry_field, "type"),
-                         "unknown obstacle type '" + *type + "'; known: plane, sphere"};
-    }
-    auto id = readString(entry["id"], joinKey(entry_field, "id"));
-    if (!id) return id.error();
-    obstacle.id = *id;
-    auto material = readString(entry["material"], joinKey(entry_field, "material"));
-    if (!material) return material.error();
-    obstacle.material = *material;
-    if (entry.hasMember("frame")) {
-      auto frame = readString(entry["frame"], joinKey(entry_field, "frame"));
-      if (!frame) return frame.error();
-      obstacle.frame = *frame;
-    }
-    scene.obstacles.push_back(obstacle);
-  }
-  return core::Ok{};
+const KeyTable<Scene>& sceneTable() {
+  // The material keys first: bodies and pairs name materials.
+  static const KeyTable<Scene> kKeys = {
+      {"restitution_combine", false,
+       [](const XmlRpc::XmlRpcValue& value, const std::string& field, Scene& scene) {
+         const auto name = readString(value, field);
+         if (!name) return core::Status(name.error());
+         const auto rule = core::parseCombineRule(*name, field);
+         if (!rule) return core::Status(rule.error());
+         scene.materials.setCombineRule(*rule);
+         return core::Status(core::Ok{});
+       }},
+      {"materials", false,
+       [](const XmlRpc::XmlRpcValue& value, const std::string& field, Scene& scene) {
+         if (auto status = checkStruct(value, field); !status) return status;
+         for (auto it = value.begin(); it != value.end(); ++it) {
+           const std::string entry_field = joinKey(field, it->first);
+           core::Material material;
+           if (auto status = readKeys(it->second, materialKeys(), entry_field, material); !status) {
+             return status;
+           }
+           if (auto status = scene.materials.addMaterial(it->first, material, entry_field);
+               !status) {
+             return status;
+           }
+         }
+         return core::Status(core::Ok{});
+       }},
+      {"pairs", false,
+       [](const XmlRpc::XmlRpcValue& value, const std::string& field, Scene& scene) {
+         std::vector<PairEntry> pairs;
+         return readList(value, field, pairs,
+                         [&scene](const XmlRpc::XmlRpcValue& entry, const std::string& entry_field,
+                                  PairEntry& pair) {
+                           pair.materials = &scene.materials;
+                           if (auto status = readKeys(entry, pairKeys(), entry_field, pair);
+                               !status) {
+                             return status;
+                           }
+                           return scene.materials.addPair(pair.first, pair.second,
+                                                          pair.coefficients, entry_field);
+                         });
+       }},
+      textKey<Scene>("fixed_frame", [](Scene& s) -> std::string& { return s.fixed_frame; }),
+      {"detection", false,
+       [](const XmlRpc::XmlRpcValue& value, const std::string& field, Scene& scene) {
+         const auto name = readString(value, field);
+         if (!name) return core::Status(name.error());
+         const auto detection = core::parseDetection(*name, field);
+         if (!detection) return core::Status(detection.error());
+         scene.detection = *detection;
+         return core::Status(core::Ok{});
+       }},
+      {"effects", false,
+       [](const XmlRpc::XmlRpcValue& value, const std::string& field, Scene& scene) {
+         if (auto status = checkArray(value, field); !status) return status;
+         for (int i = 0; i < value.size(); ++i) {
+           const std::string item = indexKey(field, static_cast<std::size_t>(i));
+           const auto name = readString(value[i], item);
+           if (!name) return core::Status(name.error());
+           if (auto status = core::addEffect(*name, item, scene.effects); !status) return status;
+         }
+         return core::Status(core::Ok{});
+       }},
+      vectorKey<Scene>("gravity", [](Scene& s) -> Eigen::Vector3d& { return s.gravity; }),
+      numberKey<Scene>("restitution_threshold",
+                       [](Scene& s) -> double& { return s.restitution_threshold; }),
+      {"bodies", false,
+       [](const XmlRpc::XmlRpcValue& value, const std::string& field, Scene& scene) {
+         return readList(
+             value, field, scene.bodies,
+             [](const XmlRpc::XmlRpcValue& entry, const std::string& entry_field, BodySpec& body) {
+               return readKeys(entry, bodyKeys(), entry_field, body);
+             });
+       }},
+      {"obstacles", false,
+       [](const XmlRpc::XmlRpcValue& value, const std::string& field, Scene& scene) {
+         return readList(value, field, scene.obstacles, readObstacle);
+       }},
+  };
+  return kKeys;
 }
 
 }  // namespace
 
 core::Expected<core::Scene> loadScene(const XmlRpc::XmlRpcValue& value, const std::string& field) {
-  auto materials = loadMaterials(value, field);
-  if (!materials) return materials.error();
-  core::Scene scene;
-  scene.materials = std::move(materials.value());
-  if (value.hasMember("fixed_frame")) {
-    auto frame = readString(value["fixed_frame"], joinKey(field, "fixed_frame"));
-    if (!frame) return frame.error();
-    scene.fixed_frame = *frame;
-  }
-  if (value.hasMember("detection")) {
-    const std::string key = joinKey(field, "detection");
-    auto name = readString(value["detection"], key);
-    if (!name) return name.error();
-    auto detection = core::parseDetection(*name, key);
-    if (!detection) return detection.error();
-    scene.detection = *detection;
-  }
-  if (value.hasMember("effects")) {
-    const std::string key = joinKey(field, "effects");
-    if (auto status = checkArray(value["effects"], key); !status) return status.error();
-    for (int i = 0; i < value["effects"].size(); ++i) {
-      const std::string item = indexKey(key, static_cast<std::size_t>(i));
-      auto name = readString(value["effects"][i], item);
-      if (!name) return name.error();
-      if (auto status = core::addEffect(*name, item, scene.effects); !status) return status.error();
-    }
-  }
-  if (value.hasMember("gravity")) {
-    auto gravity = readVector3(value["gravity"], joinKey(field, "gravity"));
-    if (!gravity) return gravity.error();
-    scene.gravity = *gravity;
-  }
-  if (value.hasMember("restitution_threshold")) {
-    auto threshold =
-        readDouble(value["restitution_threshold"], joinKey(field, "restitution_threshold"));
-    if (!threshold) return threshold.error();
-    scene.restitution_threshold = *threshold;
-  }
-  if (value.hasMember("bodies")) {
-    if (auto status = readBodies(value["bodies"], joinKey(field, "bodies"), scene); !status) {
-      return status.error();
-    }
-  }
-  if (value.hasMember("obstacles")) {
-    if (auto status = readObstacles(value["obstacles"], joinKey(field, "obstacles"), scene);
-        !status) {
-      return status.error();
-    }
-  }
+  Scene scene;
+  if (auto status = readKeys(value, sceneTable(), field, scene); !status) return status.error();
   if (auto status = core::validateScene(scene, field); !status) return status.error();
+  core::normalizePlanes(scene);
   return scene;
 }
 
-core::Expected<core::MaterialTable> loadMaterials(const XmlRpc::XmlRpcValue& scene,
-                                                  const std::string& field) {
-  if (auto status = checkKeys(scene, kSceneKeys, field); !status) return status.error();
-  core::MaterialTable table = core::MaterialTable::seed();
-  if (scene.hasMember("restitution_combine")) {
-    const std::string rule_field = joinKey(field, "restitution_combine");
-    const auto name = readString(scene["restitution_combine"], rule_field);
-    if (!name) return name.error();
-    const auto rule = core::parseCombineRule(*name, rule_field);
-    if (!rule) return rule.error();
-    table.setCombineRule(*rule);
-  }
-  if (scene.hasMember("materials")) {
-    if (auto status = loadMaterialEntries(scene["materials"], joinKey(field, "materials"), table);
-        !status) {
-      return status.error();
-    }
-  }
-  if (scene.hasMember("pairs")) {
-    if (auto status = loadPairEntries(scene["pairs"], joinKey(field, "pairs"), table); !status) {
-      return status.error();
-    }
-  }
-  return table;
+std::map<std::string, std::vector<std::string>> sceneKeys() {
+  return {{"scene", keyNames(sceneTable())},
+          {"bodies[]", keyNames(bodyKeys())},
+          {"obstacles[] plane", keyNames(planeKeys())},
+          {"obstacles[] sphere", keyNames(sphereKeys())},
+          {"materials.<name>", keyNames(materialKeys())},
+          {"pairs[]", keyNames(pairKeys())}};
 }
 
 }  // namespace collision_response

@@ -1,8 +1,11 @@
 // Every validation error of a single collision: refused, with the field named and the reason.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "collision_response/core/collision.h"
 #include "collision_response/core/restitution.h"
@@ -175,6 +178,67 @@ TEST(Validation, NumbersInMessagesReadBack) {
   EXPECT_EQ(formatNumber(kNan), "nan");
   EXPECT_EQ(formatNumber(-kInf), "-inf");
   EXPECT_EQ(formatVector(Eigen::Vector3d(1, 2.5, -3)), "[1, 2.5, -3]");
+}
+
+// Issue 13, item 10: estimate_restitution(1e300, 1e-300) answered e = 0 (the ratio 1e-600
+// underflows, while e = 1e-300 is a double), and (1, -0) answered e = -0.
+TEST(Validation, DropTestHeightsAtTheEndsOfTheDoubles) {
+  const auto tiny = restitutionFromHeights(1e300, 1e-300);
+  ASSERT_TRUE(tiny.ok());
+  EXPECT_NEAR(*tiny, 1e-300, 2 * std::numeric_limits<double>::epsilon() * 1e-300);
+  const auto huge = restitutionFromHeights(1e-300, 1e-301);  // 1e-301 / 1e-300 = 0.1
+  ASSERT_TRUE(huge.ok());
+  EXPECT_NEAR(*huge, std::sqrt(0.1), 2 * std::numeric_limits<double>::epsilon());
+  const auto subnormal = restitutionFromHeights(4e-320, 1e-320);  // e = sqrt(1/4) = 1/2
+  ASSERT_TRUE(subnormal.ok());
+  EXPECT_NEAR(*subnormal, 0.5, 1e-3);  // the subnormals hold 3 digits
+  const auto minus_zero = restitutionFromHeights(1.0, -0.0);
+  ASSERT_TRUE(minus_zero.ok());
+  EXPECT_EQ(*minus_zero, 0.0);
+  EXPECT_FALSE(std::signbit(*minus_zero)) << "e = -0 is not a coefficient";
+  // Where the ratio is a normal double, the same bits as sqrt(h' / h).
+  for (const auto& [drop, bounce] : std::vector<std::pair<double, double>>{
+           {1.0, 0.25}, {2.0, 0.5}, {1.0, 0.712 * 0.712}, {3.7, 1.1}, {1e10, 3e9}, {0.5, 0.5}}) {
+    EXPECT_EQ(*restitutionFromHeights(drop, bounce), std::sqrt(bounce / drop))
+        << drop << " " << bounce;
+  }
+}
+
+TEST(Validation, ThresholdFrictionToleranceAndFrames) {
+  EXPECT_TRUE(checkRestitutionThreshold(0.0, "t").ok());
+  EXPECT_TRUE(checkRestitutionThreshold(5000.0, "t").ok());
+  for (const double bad : {-1.0, kInf, -kInf, kNan}) {
+    const auto status = checkRestitutionThreshold(bad, "t");
+    ASSERT_FALSE(status.ok()) << bad;
+    EXPECT_EQ(status.error().message(),
+              "t: must be a finite number >= 0 m/s, got " + formatNumber(bad));
+  }
+  EXPECT_TRUE(checkFriction(0.0, "f").ok());
+  EXPECT_FALSE(checkFriction(-0.1, "f").ok());
+  EXPECT_FALSE(checkFriction(kInf, "f").ok());
+  EXPECT_TRUE(checkContactTolerance(0.0, "c").ok());
+  EXPECT_TRUE(checkContactTolerance(0.5, "c").ok());
+  EXPECT_FALSE(checkContactTolerance(1.0, "c").ok());
+  EXPECT_FALSE(checkContactTolerance(1e6, "c").ok());
+  EXPECT_FALSE(checkContactTolerance(-1e-9, "c").ok());
+  EXPECT_TRUE(checkFrameId("world", "f").ok());
+  const auto slash = checkFrameId("/world", "f");
+  ASSERT_FALSE(slash.ok());
+  EXPECT_EQ(slash.error().message(),
+            "f: '/world' starts with '/': tf2 frame ids have none (use 'world')");
+  EXPECT_FALSE(checkFrameId("", "f").ok());
+  EXPECT_FALSE(checkFrameId("my frame", "f").ok());
+}
+
+TEST(Validation, OneRefusalForAnswersBeyondTheDoubles) {
+  EXPECT_TRUE(
+      checkRepresentable({namedResult("x", 1.0), namedResult("v", Eigen::Vector3d(1, 2, 3))}).ok());
+  const auto status =
+      checkRepresentable({namedResult("x", 1.0), namedResult("v", Eigen::Vector3d(1, kNan, 3)),
+                          namedResult("y", kInf)});
+  ASSERT_FALSE(status.ok());
+  EXPECT_EQ(status.error().field, "v");
+  EXPECT_EQ(status.error().reason, kBeyondDoubles);
 }
 
 }  // namespace

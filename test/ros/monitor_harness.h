@@ -77,10 +77,13 @@ class MonitorHarness {
     rosout_ = node_.subscribe("/rosout", 1000, &MonitorHarness::onLog, this);
   }
 
-  /// Waits until the node listens to body_states and we hear its impacts.
+  /// Waits until the node listens to body_states and we hear its impacts and /rosout.
   bool connect(double timeout = 20.0) {
     return waitFor(
-        [this] { return states_.getNumSubscribers() > 0 && impacts_.getNumPublishers() > 0; },
+        [this] {
+          return states_.getNumSubscribers() > 0 && impacts_.getNumPublishers() > 0 &&
+                 rosout_.getNumPublishers() > 0;
+        },
         timeout);
   }
 
@@ -119,21 +122,28 @@ class MonitorHarness {
   }
 
   /// A warning (or worse) from the node whose text contains every one of `words`.
-  bool waitForWarning(const std::vector<std::string>& words, double timeout = 5.0) {
-    return waitFor(
-        [&] {
-          for (const rosgraph_msgs::Log& log : logs_) {
-            bool all = log.level >= rosgraph_msgs::Log::WARN && log.name == "/collision_response";
-            for (const std::string& word : words)
-              all = all && log.msg.find(word) != std::string::npos;
-            if (all) return true;
-          }
-          return false;
-        },
-        timeout);
+  bool waitForWarning(const std::vector<std::string>& words, double timeout = 5.0,
+                      const std::string& node = "/collision_response") {
+    return waitFor([&] { return countWarnings(words, 0, node) > 0; }, timeout);
   }
 
+  /// Warnings (or worse) from `node` containing every one of `words`, among the logs received
+  /// from the `since`-th on.
+  std::size_t countWarnings(const std::vector<std::string>& words, std::size_t since = 0,
+                            const std::string& node = "/collision_response") const {
+    std::size_t count = 0;
+    for (std::size_t i = since; i < logs_.size(); ++i) {
+      const rosgraph_msgs::Log& log = logs_[i];
+      bool all = log.level >= rosgraph_msgs::Log::WARN && log.name == node;
+      for (const std::string& word : words) all = all && log.msg.find(word) != std::string::npos;
+      count += all ? 1 : 0;
+    }
+    return count;
+  }
+  std::size_t logCount() const { return logs_.size(); }
+
   std::size_t impactCount() const { return impacts_received_.size(); }
+  const std::vector<Impact>& impacts() const { return impacts_received_; }
   ros::NodeHandle& node() { return node_; }
 
  private:

@@ -5,6 +5,7 @@
 
 #include "collision_response/ComputeCollision.h"
 #include "monitor_harness.h"
+#include "seed_request.h"
 
 namespace collision_response::testing {
 namespace {
@@ -116,16 +117,11 @@ TEST_F(MonitorBadInput, ServicesStillAnswerAfterAllThat) {
       harness_.node().serviceClient<ComputeCollision>("/collision_response/compute_collision");
   ASSERT_TRUE(client.waitForExistence(ros::Duration(10.0)));
   ComputeCollision srv;
-  srv.request.a.mass = 2.0;
-  srv.request.a.velocity.x = 3.0;
-  srv.request.b.mass = 1.0;
-  srv.request.b.position.x = 1.0;
-  srv.request.b.velocity.x = -1.0;
-  srv.request.restitution = 0.5;
+  srv.request = seedHeadOnRequest();
   ASSERT_TRUE(client.call(srv));
   ASSERT_TRUE(srv.response.success) << srv.response.message;
-  EXPECT_EQ(srv.response.velocity_a.x, 1.0);
-  EXPECT_EQ(srv.response.velocity_b.x, 3.0);
+  EXPECT_EQ(srv.response.velocity_a.x, kSeedVelocityA);
+  EXPECT_EQ(srv.response.velocity_b.x, kSeedVelocityB);
 }
 
 }  // namespace

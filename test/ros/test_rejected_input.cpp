@@ -5,11 +5,13 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "collision_response/ComputeCollision.h"
 #include "collision_response/EstimateRestitution.h"
 #include "monitor_harness.h"
+#include "seed_request.h"
 
 namespace collision_response::testing {
 namespace {
@@ -17,18 +19,7 @@ namespace {
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-ComputeCollision::Request goodRequest() {
-  ComputeCollision::Request request;
-  request.a.id = "a";
-  request.a.mass = 2.0;
-  request.a.velocity.x = 3.0;
-  request.b.id = "b";
-  request.b.mass = 1.0;
-  request.b.position.x = 1.0;
-  request.b.velocity.x = -1.0;
-  request.restitution = 0.5;
-  return request;
-}
+ComputeCollision::Request goodRequest() { return seedHeadOnRequest(); }
 
 struct RequestCase {
   const char* field;  // the message must start with it
@@ -94,8 +85,8 @@ class RejectedInput : public ::testing::Test {
     srv.request = goodRequest();
     ASSERT_TRUE(compute_.call(srv));
     ASSERT_TRUE(srv.response.success) << srv.response.message;
-    EXPECT_EQ(srv.response.velocity_a.x, 1.0);
-    EXPECT_EQ(srv.response.velocity_b.x, 3.0);
+    EXPECT_EQ(srv.response.velocity_a.x, kSeedVelocityA);
+    EXPECT_EQ(srv.response.velocity_b.x, kSeedVelocityB);
   }
 
   MonitorHarness harness_;
@@ -131,6 +122,18 @@ TEST_F(RejectedInput, EstimateRestitutionCatalogue) {
     EXPECT_FALSE(srv.response.success) << field;
     EXPECT_EQ(srv.response.message.rfind(std::string(field) + ":", 0), 0u) << srv.response.message;
     EXPECT_FALSE(std::isnan(srv.response.restitution));
+  }
+  // Accepted at the ends of the doubles (issue 13, item 10): the ratio 1e-600 underflows but
+  // e = 1e-300 is a double; a bounce of -0 is a dead drop, e = +0.
+  for (const auto& [drop, bounce, restitution] :
+       std::vector<std::tuple<double, double, double>>{{1e300, 1e-300, 1e-300}, {1.0, -0.0, 0.0}}) {
+    EstimateRestitution srv;
+    srv.request.drop_height = drop;
+    srv.request.bounce_height = bounce;
+    ASSERT_TRUE(estimate_.call(srv));
+    ASSERT_TRUE(srv.response.success) << srv.response.message;
+    EXPECT_NEAR(srv.response.restitution, restitution, 1e-315) << drop << " " << bounce;
+    EXPECT_FALSE(std::signbit(srv.response.restitution));
   }
   EstimateRestitution srv;
   srv.request.drop_height = 2.0;

@@ -1,12 +1,21 @@
-// The scene's material keys as the node reads them from the parameter server (XmlRpc values,
-// built here as rosparam would from YAML). No master needed.
+// The scene file as the node reads it from the parameter server (XmlRpc values, built here as
+// rosparam would from YAML), and the README's tables of keys against the loader's own. No
+// master needed.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <limits>
+#include <map>
+#include <regex>
+#include <set>
+#include <sstream>
 #include <string>
 
 #include "collision_response/ros/scene_loader.h"
+#include "collision_response/ros/scene_player.h"
+#include "readme_tables.h"
 
 namespace collision_response {
 namespace {
@@ -26,13 +35,14 @@ XmlRpc::XmlRpcValue sceneWithRubber() {
 }
 
 std::string errorField(const XmlRpc::XmlRpcValue& scene) {
-  const auto table = loadMaterials(scene, "/collision_response/scene");
-  return table ? "" : table.error().field;
+  const auto loaded = loadScene(scene, "/collision_response/scene");
+  return loaded ? "" : loaded.error().field;
 }
 
 TEST(SceneLoader, MaterialsPairsAndRule) {
-  const auto table = loadMaterials(sceneWithRubber(), "/collision_response/scene");
-  ASSERT_TRUE(table.ok()) << table.error().message();
+  const auto scene = loadScene(sceneWithRubber(), "/collision_response/scene");
+  ASSERT_TRUE(scene.ok()) << scene.error().message();
+  const core::MaterialTable* table = &scene->materials;
   EXPECT_EQ(table->combineRule(), core::CombineRule::kMax);
   EXPECT_EQ(*table->restitution("rubber", "steel_ball_bearing"), 0.7);
   EXPECT_EQ(*table->restitution("rubber", "concrete"), 0.85);
@@ -43,9 +53,9 @@ TEST(SceneLoader, MaterialsPairsAndRule) {
 TEST(SceneLoader, IntegersAreNumbers) {
   XmlRpc::XmlRpcValue scene = sceneWithRubber();
   scene["materials"]["rubber"]["restitution"] = 1;  // YAML "1"
-  const auto table = loadMaterials(scene, "s");
-  ASSERT_TRUE(table.ok()) << table.error().message();
-  EXPECT_EQ(*table->restitution("rubber", "concrete"), 1.0);
+  const auto loaded = loadScene(scene, "s");
+  ASSERT_TRUE(loaded.ok()) << loaded.error().message();
+  EXPECT_EQ(*loaded->materials.restitution("rubber", "concrete"), 1.0);
 }
 
 TEST(SceneLoader, ErrorsNameTheKey) {
@@ -59,7 +69,7 @@ TEST(SceneLoader, ErrorsNameTheKey) {
 
   scene = sceneWithRubber();
   scene["materials"]["rubber"]["restitution"] = 1.2;
-  EXPECT_EQ(errorField(scene), "/collision_response/scene/materials/rubber.restitution");
+  EXPECT_EQ(errorField(scene), "/collision_response/scene/materials/rubber/restitution");
 
   scene = sceneWithRubber();
   scene["materials"]["rubber"]["hardness"] = 3.0;
@@ -71,7 +81,7 @@ TEST(SceneLoader, ErrorsNameTheKey) {
 
   scene = sceneWithRubber();
   scene["pairs"][0]["materials"][1] = "adamantium";
-  EXPECT_EQ(errorField(scene), "/collision_response/scene/pairs[0].materials[1]");
+  EXPECT_EQ(errorField(scene), "/collision_response/scene/pairs[0]/materials[1]");
 
   scene = sceneWithRubber();
   scene["pairs"][0]["restitution"] = "high";
@@ -192,6 +202,256 @@ TEST(SceneLoader, SceneErrorsNameTheKey) {
   scene = fullScene();
   scene["bodies"][0]["material"] = "concrete";
   EXPECT_EQ(sceneErrorField(scene), "~scene/bodies[0]/material");
+}
+
+// --- The README's keys against the loader's tables ----------------------------------------------
+
+/// A documented key split into its entity (as sceneKeys() names it) and its name.
+std::pair<std::string, std::string> entityAndKey(const std::string& documented) {
+  const std::size_t dot = documented.rfind('.');
+  if (dot == std::string::npos) return {"scene", documented};
+  return {documented.substr(0, dot), documented.substr(dot + 1)};
+}
+
+XmlRpc::XmlRpcValue list3(double x, double y, double z) {
+  XmlRpc::XmlRpcValue value;
+  value[0] = x;
+  value[1] = y;
+  value[2] = z;
+  return value;
+}
+
+/// A valid value for every key a scene may have, by entity and key: the test of "every
+/// documented key loads" needs one for each documented key (a key without one fails it).
+std::map<std::string, std::map<std::string, XmlRpc::XmlRpcValue>> examples() {
+  std::map<std::string, std::map<std::string, XmlRpc::XmlRpcValue>> values;
+  XmlRpc::XmlRpcValue effects;
+  effects[0] = "gravity";
+  values["scene"] = {{"fixed_frame", "world"},
+                     {"detection", "discrete"},
+                     {"effects", effects},
+                     {"gravity", list3(0, 0, -9.8)},
+                     {"restitution_threshold", 0.25},
+                     {"restitution_combine", "max"}};
+  values["materials.<name>"] = {{"restitution", 0.85}, {"friction", 0.9}};
+  XmlRpc::XmlRpcValue pair;
+  pair[0] = "rubber";
+  pair[1] = "steel_ball_bearing";
+  values["pairs[]"] = {{"materials", pair}, {"restitution", 0.7}, {"friction", 0.4}};
+  values["bodies[]"] = {{"id", "ball"},
+                        {"mass", 0.057},
+                        {"radius", 0.033},
+                        {"material", "tennis_ball"},
+                        {"topic", "/ball/state"},
+                        {"position", list3(1, 2, 3)},
+                        {"velocity", list3(4, 5, 6)},
+                        {"inertia", "hollow"}};
+  values["obstacles[] plane"] = {
+      {"id", "floor"},         {"type", "plane"},          {"material", "concrete"},
+      {"frame", "floor_link"}, {"normal", list3(0, 0, 2)}, {"offset", 0.5}};
+  values["obstacles[] sphere"] = {{"id", "post"},           {"type", "sphere"},
+                                  {"material", "concrete"}, {"frame", "post_link"},
+                                  {"radius", 0.1},          {"position", list3(1, 1, 1)}};
+  values["player.frames[]"] = {{"frame", "paddle_link"},
+                               {"parent", "world"},
+                               {"position", list3(1, 0, 0)},
+                               {"velocity", list3(-0.5, 0, 0)}};
+  return values;
+}
+
+/// The containers: documented as keys of the scene, filled by the entries of their entity.
+const std::set<std::string> kContainers = {"materials", "pairs", "bodies", "obstacles"};
+
+TEST(SceneKeys, EveryDocumentedKeyIsReadAndEveryReadKeyDocumented) {
+  const auto tables = testing::readmeTables("### Scene file");
+  ASSERT_FALSE(tables.empty()) << "README.md: no table under '### Scene file'";
+  const auto read = sceneKeys();
+  std::set<std::pair<std::string, std::string>> documented;
+  for (const auto& row : tables.front()) {
+    ASSERT_FALSE(row.empty()) << "a row of the scene key table names no key";
+    auto [entity, key] = entityAndKey(row.front());
+    if (entity == "obstacles[]") {
+      const auto& plane = read.at("obstacles[] plane");
+      const auto& sphere = read.at("obstacles[] sphere");
+      const bool in_plane = std::find(plane.begin(), plane.end(), key) != plane.end();
+      const bool in_sphere = std::find(sphere.begin(), sphere.end(), key) != sphere.end();
+      EXPECT_TRUE(in_plane || in_sphere) << row.front() << " is documented but not read";
+      if (in_plane) documented.emplace("obstacles[] plane", key);
+      if (in_sphere) documented.emplace("obstacles[] sphere", key);
+      continue;
+    }
+    documented.emplace(entity, key);
+    if (entity == "player.frames[]") continue;  // the scene player's: below
+    ASSERT_EQ(read.count(entity), 1u) << row.front() << ": no such entity in the loader";
+    const auto& keys = read.at(entity);
+    EXPECT_NE(std::find(keys.begin(), keys.end(), key), keys.end())
+        << row.front() << " is documented but the loader does not read it";
+  }
+  for (const auto& [entity, keys] : read) {
+    for (const std::string& key : keys) {
+      EXPECT_EQ(documented.count({entity, key}), 1u)
+          << entity << " key '" << key << "' is read but not documented in README.md";
+    }
+  }
+}
+
+TEST(SceneKeys, EveryDocumentedKeyLoadsWithItsValue) {
+  const auto tables = testing::readmeTables("### Scene file");
+  ASSERT_FALSE(tables.empty());
+  const auto values = examples();
+  const auto read = sceneKeys();
+  XmlRpc::XmlRpcValue scene, body, plane, sphere, material, pair, frame;
+  const auto put = [&](XmlRpc::XmlRpcValue& target, const std::string& entity,
+                       const std::string& key) {
+    const auto found = values.find(entity);
+    ASSERT_TRUE(found != values.end() && found->second.count(key))
+        << "no example value for the documented key " << entity << " " << key;
+    target[key] = found->second.at(key);
+  };
+  for (const auto& row : tables.front()) {
+    const auto [entity, key] = entityAndKey(row.front());
+    if (entity == "scene" && kContainers.count(key)) continue;
+    if (entity == "scene") put(scene, entity, key);
+    if (entity == "bodies[]") put(body, entity, key);
+    if (entity == "materials.<name>") put(material, entity, key);
+    if (entity == "pairs[]") put(pair, entity, key);
+    if (entity == "player.frames[]") put(frame, entity, key);
+    if (entity == "obstacles[]") {
+      const auto& plane_keys = read.at("obstacles[] plane");
+      if (std::find(plane_keys.begin(), plane_keys.end(), key) != plane_keys.end()) {
+        put(plane, "obstacles[] plane", key);
+      }
+      const auto& sphere_keys = read.at("obstacles[] sphere");
+      if (std::find(sphere_keys.begin(), sphere_keys.end(), key) != sphere_keys.end()) {
+        put(sphere, "obstacles[] sphere", key);
+      }
+    }
+  }
+  scene["materials"]["rubber"] = material;
+  scene["pairs"][0] = pair;
+  scene["bodies"][0] = body;
+  scene["obstacles"][0] = plane;
+  scene["obstacles"][1] = sphere;
+  const auto loaded = loadScene(scene, "~scene");
+  ASSERT_TRUE(loaded.ok()) << "a documented key is refused: " << loaded.error().message();
+  // Each value arrived where it belongs.
+  EXPECT_EQ(loaded->detection, core::Detection::kDiscrete);
+  EXPECT_TRUE(loaded->effects.gravity);
+  EXPECT_EQ(loaded->gravity, Eigen::Vector3d(0, 0, -9.8));
+  EXPECT_EQ(loaded->restitution_threshold, 0.25);
+  EXPECT_EQ(loaded->materials.combineRule(), core::CombineRule::kMax);
+  EXPECT_EQ(*loaded->materials.restitution("rubber", "concrete"), 0.85);
+  EXPECT_EQ(*loaded->materials.friction("rubber", "concrete"), 0.9);
+  EXPECT_EQ(*loaded->materials.restitution("rubber", "steel_ball_bearing"), 0.7);
+  EXPECT_EQ(*loaded->materials.friction("rubber", "steel_ball_bearing"), 0.4);
+  ASSERT_EQ(loaded->bodies.size(), 1u);
+  const core::BodySpec& ball = loaded->bodies[0];
+  EXPECT_EQ(ball.id, "ball");
+  EXPECT_EQ(ball.mass, 0.057);
+  EXPECT_EQ(ball.radius, 0.033);
+  EXPECT_EQ(ball.material, "tennis_ball");
+  EXPECT_EQ(ball.topic, "/ball/state");
+  EXPECT_EQ(ball.position, Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(ball.velocity, Eigen::Vector3d(4, 5, 6));
+  EXPECT_EQ(ball.inertia, core::Inertia::kHollow);  // once refused as an unknown key
+  ASSERT_EQ(loaded->obstacles.size(), 2u);
+  EXPECT_EQ(loaded->obstacles[0].frame, "floor_link");
+  EXPECT_EQ(loaded->obstacles[0].normal, Eigen::Vector3d(0, 0, 1));  // scaled to unit length
+  EXPECT_EQ(loaded->obstacles[0].offset, 0.5);
+  EXPECT_EQ(loaded->obstacles[1].shape, core::ObstacleShape::kSphere);
+  EXPECT_EQ(loaded->obstacles[1].radius, 0.1);
+  EXPECT_EQ(loaded->obstacles[1].position, Eigen::Vector3d(1, 1, 1));
+
+  // The scene player's part of the file.
+  XmlRpc::XmlRpcValue tree;
+  tree["scene"] = scene;
+  tree["player"]["frames"][0] = frame;
+  const auto player = ScenePlayerParams::load(tree, "/scene_player");
+  ASSERT_TRUE(player.ok()) << "a documented key is refused: " << player.error().message();
+  ASSERT_EQ(player->frames.size(), 1u);
+  EXPECT_EQ(player->frames[0].frame, "paddle_link");
+  EXPECT_EQ(player->frames[0].parent, "world");
+  EXPECT_EQ(player->frames[0].position, Eigen::Vector3d(1, 0, 0));
+  EXPECT_EQ(player->frames[0].velocity, Eigen::Vector3d(-0.5, 0, 0));
+}
+
+// Issue 13, item 7: a plane normal "of any length" is one, also 1e-200 and 1e200 long (where
+// normalising once under- and overflowed and the plane was never hit).
+TEST(SceneLoader, PlaneNormalsOfAnyLengthAreUnitAfterLoading) {
+  for (const double length : {1e-200, 1e-310, 1e200, 1.7e308}) {
+    auto scene = fullScene();
+    scene["obstacles"][0]["normal"] = list3(0, 0, length);
+    const auto loaded = loadScene(scene, "~scene");
+    ASSERT_TRUE(loaded.ok()) << length << ": " << loaded.error().message();
+    EXPECT_EQ(loaded->obstacles[0].normal, Eigen::Vector3d(0, 0, 1)) << length;
+  }
+  auto scene = fullScene();
+  scene["obstacles"][0]["normal"] = list3(3e200, 0, 4e200);
+  const auto loaded = loadScene(scene, "~scene");
+  ASSERT_TRUE(loaded.ok());
+  EXPECT_NEAR(loaded->obstacles[0].normal.x(), 0.6, 2.5e-16);
+  EXPECT_NEAR(loaded->obstacles[0].normal.z(), 0.8, 2.5e-16);
+}
+
+// Issue 13, item 7: `fixed_frame: /world` was accepted, then every state naming a frame was
+// dropped (tf2 frame ids have no leading slash).
+TEST(SceneLoader, FramesWithALeadingSlashAreRefused) {
+  auto scene = fullScene();
+  scene["fixed_frame"] = "/world";
+  const auto loaded = loadScene(scene, "~scene");
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_EQ(loaded.error().field, "~scene/fixed_frame");
+  EXPECT_NE(loaded.error().reason.find("use 'world'"), std::string::npos)
+      << loaded.error().message();
+  scene = fullScene();
+  scene["obstacles"][1]["frame"] = "/paddle_link";
+  EXPECT_EQ(sceneErrorField(scene), "~scene/obstacles[1]/frame");
+}
+
+TEST(SceneLoader, WrongTypesNameTheKeyAndTheValue) {
+  auto scene = fullScene();
+  scene["bodies"][0]["mass"] = "heavy";
+  const auto loaded = loadScene(scene, "~scene");
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_EQ(loaded.error().message(),
+            "~scene/bodies[0]/mass: must be a number, got a string ('heavy')");
+  scene = fullScene();
+  scene["bodies"][0]["inertia"] = "cube";
+  EXPECT_EQ(sceneErrorField(scene), "~scene/bodies[0]/inertia");
+  scene = fullScene();
+  scene["bodies"][0].clear();
+  scene["bodies"][0]["mass"] = 1.0;
+  EXPECT_EQ(sceneErrorField(scene), "~scene/bodies[0]/id");  // required, first in the table
+}
+
+// Start-up once grew with the square of the bodies (every pair of bodies checked for a
+// coefficient): the check is per pair of materials now, and still finds the first bad pair
+// where a check of every pair would.
+TEST(SceneLoader, AMissingCoefficientIsFoundAtTheFirstPairThatNeedsIt) {
+  XmlRpc::XmlRpcValue scene;
+  for (int i = 0; i < 5; ++i) {
+    XmlRpc::XmlRpcValue ball;
+    ball["id"] = "b" + std::to_string(i);
+    ball["mass"] = 1.0;
+    ball["radius"] = 0.1;
+    ball["material"] = i == 3 ? "concrete" : "tennis_ball";
+    scene["bodies"][i] = ball;
+  }
+  // concrete against concrete has no coefficient: bodies[3] against itself comes first.
+  auto loaded = loadScene(scene, "s");
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_EQ(loaded.error().field, "s/bodies[3]/material");
+  EXPECT_NE(loaded.error().reason.find("against 'b3'"), std::string::npos);
+  // With a concrete floor, bodies[3] meets it only after meeting itself; a concrete body
+  // before every other meets the floor... after itself too.
+  scene["obstacles"][0]["id"] = "floor";
+  scene["obstacles"][0]["type"] = "plane";
+  scene["obstacles"][0]["normal"] = list3(0, 0, 1);
+  scene["obstacles"][0]["material"] = "concrete";
+  loaded = loadScene(scene, "s");
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_EQ(loaded.error().field, "s/bodies[3]/material");
+  EXPECT_NE(loaded.error().reason.find("against 'b3'"), std::string::npos);
 }
 
 }  // namespace

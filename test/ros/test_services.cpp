@@ -9,6 +9,7 @@
 
 #include "collision_response/ComputeCollision.h"
 #include "collision_response/EstimateRestitution.h"
+#include "seed_request.h"
 
 namespace {
 
@@ -35,26 +36,15 @@ class Services : public ::testing::Test {
     return srv.response;
   }
 
-  // The seed's 2 kg at 3 m/s against 1 kg at -1 m/s along x, e = 0.5:
-  // v_a' = (6 - 1 + 0.5 * 1 * (-4)) / 3 = 1, v_b' = (5 + 0.5 * 2 * 4) / 3 = 3.
   static ComputeCollision::Request seedRequest() {
-    ComputeCollision::Request request;
-    request.a.id = "a";
-    request.a.mass = 2.0;
-    request.a.velocity.x = 3.0;
-    request.b.id = "b";
-    request.b.mass = 1.0;
-    request.b.position.x = 1.0;
-    request.b.velocity.x = -1.0;
-    request.restitution = 0.5;
-    return request;
+    return collision_response::testing::seedHeadOnRequest();
   }
 
   void expectSeedAnswer() {
     const auto response = call(seedRequest());
     ASSERT_TRUE(response.success) << response.message;
-    EXPECT_DOUBLE_EQ(response.velocity_a.x, 1.0);
-    EXPECT_DOUBLE_EQ(response.velocity_b.x, 3.0);
+    EXPECT_DOUBLE_EQ(response.velocity_a.x, collision_response::testing::kSeedVelocityA);
+    EXPECT_DOUBLE_EQ(response.velocity_b.x, collision_response::testing::kSeedVelocityB);
   }
 
   void expectRefused(const ComputeCollision::Request& request, const std::string& field) {
@@ -75,14 +65,13 @@ class Services : public ::testing::Test {
 TEST_F(Services, SeedCombinedFormulas) {
   const auto response = call(seedRequest());
   ASSERT_TRUE(response.success) << response.message;
-  EXPECT_EQ(response.velocity_a.x, 1.0);
-  EXPECT_EQ(response.velocity_b.x, 3.0);
+  EXPECT_EQ(response.velocity_a.x, collision_response::testing::kSeedVelocityA);
+  EXPECT_EQ(response.velocity_b.x, collision_response::testing::kSeedVelocityB);
   EXPECT_EQ(response.normal.x, 1.0);  // derived from the positions
   EXPECT_TRUE(response.approaching);
   EXPECT_FALSE(response.oblique);
-  // J = m_a (v_a - v_a') = 2 * 2 = 4; lost (1/2) mu (1 - e^2) d^2 = 0.5 * 2/3 * 0.75 * 16 = 4.
-  EXPECT_DOUBLE_EQ(response.impulse, 4.0);
-  EXPECT_DOUBLE_EQ(response.energy_lost, 4.0);
+  EXPECT_DOUBLE_EQ(response.impulse, collision_response::testing::kSeedImpulse);
+  EXPECT_DOUBLE_EQ(response.energy_lost, collision_response::testing::kSeedEnergyLost);
 }
 
 TEST_F(Services, ObliqueImpactChangesOnlyTheNormalComponent) {

@@ -70,6 +70,9 @@ class MaterialTable {
   CombineRule combineRule() const { return combine_rule_; }
 
   bool contains(const std::string& name) const { return materials_.count(name) != 0; }
+  /// Ok for a known material; otherwise the error naming `field`, with the known names: the
+  /// one unknown-material message of the scene file and the service.
+  Status checkMaterial(const std::string& name, const std::string& field) const;
   /// Every material name, sorted.
   std::vector<std::string> names() const;
 
@@ -92,7 +95,6 @@ class MaterialTable {
  private:
   using PairKey = std::pair<std::string, std::string>;  // sorted
   static PairKey key(const std::string& first, const std::string& second);
-  Status checkKnown(const std::string& name, const std::string& field) const;
 
   std::map<std::string, Material> materials_;
   std::map<PairKey, PairCoefficients> pairs_;

@@ -75,6 +75,11 @@ struct Scene {
 /// Every value and cross-reference of a scene: ids unique among bodies and obstacles, masses,
 /// radii, known materials, finite vectors, nonzero plane normals. Fields are named as scene file
 /// keys under `prefix` ("~scene/bodies[2]/mass").
+/// Start-up cost: O(n log n) in the bodies, plus one check per pair of distinct materials.
 Status validateScene(const Scene& scene, const std::string& prefix);
+
+/// Scales every plane's normal to unit length without under- or overflow (a normal of length
+/// 1e-200 or 1e200 is as good as any other nonzero one). For a scene validateScene accepted.
+void normalizePlanes(Scene& scene);
 
 }  // namespace collision_response::core

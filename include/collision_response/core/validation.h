@@ -2,6 +2,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
+#include <initializer_list>
 #include <string>
 
 #include "collision_response/core/body.h"
@@ -24,6 +26,33 @@ Status checkMass(double mass, const std::string& field);
 Status checkRadius(double radius, const std::string& field);
 /// A material or body id: not empty, no whitespace or control characters.
 Status checkName(const std::string& name, const std::string& field);
+/// A tf2 frame id: a name (checkName) without the leading '/' that tf2 refuses.
+Status checkFrameId(const std::string& frame, const std::string& field);
+/// Coulomb mu: a finite number >= 0.
+Status checkFriction(double friction, const std::string& field);
+/// The restitution threshold, m/s: a finite number >= 0 (an approach at or above it bounces).
+Status checkRestitutionThreshold(double threshold, const std::string& field);
+/// Surfaces within this fraction of their contact distance touch: finite, >= 0 and < 1.
+Status checkContactTolerance(double tolerance, const std::string& field);
+
+/// One number (or vector) of an answer, named as the answer's field.
+struct NamedResult {
+  const char* field;
+  bool finite;
+};
+inline NamedResult namedResult(const char* field, double value) {
+  return {field, std::isfinite(value)};
+}
+inline NamedResult namedResult(const char* field, const Eigen::Vector3d& value) {
+  return {field, value.allFinite()};
+}
+/// Why an answer from finite inputs is refused when a number of it is not finite.
+inline constexpr const char* kBeyondDoubles =
+    "is beyond the range of double (the masses and speeds are too large for the answer to be "
+    "represented)";
+/// The first result that is not finite, refused by name (kBeyondDoubles): the one check of
+/// every output, the service's answers and the monitor's impacts alike.
+Status checkRepresentable(std::initializer_list<NamedResult> results);
 
 /// Mass, radius, position, velocity and angular velocity of one body; `prefix` names it ("a").
 Status checkBody(const Body& body, const std::string& prefix);

@@ -1,20 +1,29 @@
-// The collision_response node: loads the scene, serves the collision services and runs the
-// impact monitor on the scene's bodies.
+// The collision_response node: loads the scene and the parameters, serves the collision services
+// and runs the impact monitor on the scene's bodies.
+//
+// Threads: the monitor (its subscriptions, queue, diagnostics and live tuning) runs on the
+// callback queue of `node`; the two services are served from a callback queue of their own by a
+// spinner thread, so that a long step never delays an answer. The services read only the
+// material table, which they take as an immutable snapshot (a shared pointer swapped under a
+// mutex when live tuning changes the combine rule); they never touch the monitor.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <dynamic_reconfigure/server.h>
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
 
 #include <boost/thread/recursive_mutex.hpp>
 
 #include <memory>
+#include <mutex>
 
 #include "collision_response/ComputeCollision.h"
 #include "collision_response/EstimateRestitution.h"
 #include "collision_response/MonitorConfig.h"
 #include "collision_response/core/materials.h"
 #include "collision_response/ros/impact_monitor_ros.h"
+#include "collision_response/ros/monitor_params.h"
 
 namespace collision_response {
 
@@ -22,13 +31,15 @@ class CollisionResponseNode {
  public:
   /// `node` resolves topics (relative names), `private_node` the `~` parameters and services.
   CollisionResponseNode(const ros::NodeHandle& node, const ros::NodeHandle& private_node);
+  ~CollisionResponseNode();
 
-  /// Reads and validates `~scene` and the monitor's parameters, advertises the services and
-  /// starts the monitor. On a bad parameter it logs the error (naming the parameter and the
-  /// reason) and returns false.
+  /// Reads and validates the private parameters (`~scene` and the monitor's), advertises the
+  /// services and starts the monitor. On a bad parameter it logs the error (naming the
+  /// parameter and the reason) and returns false; it never throws.
   bool initialize();
 
  private:
+  bool start();
   bool onComputeCollision(ComputeCollision::Request& request, ComputeCollision::Response& response);
   bool onEstimateRestitution(EstimateRestitution::Request& request,
                              EstimateRestitution::Response& response);
@@ -36,18 +47,24 @@ class CollisionResponseNode {
   /// dynamic_reconfigure: checks each value as the scene file's; a refused value is put back
   /// to the one in use (in `config`, which the server then reports) with an error naming it.
   void onReconfigure(MonitorConfig& config, std::uint32_t level);
+  std::shared_ptr<const core::MaterialTable> materials() const;
 
   ros::NodeHandle node_;
   ros::NodeHandle private_node_;
-  core::MaterialTable materials_ = core::MaterialTable::seed();
+  mutable std::mutex materials_mutex_;
+  std::shared_ptr<const core::MaterialTable> materials_ =
+      std::make_shared<const core::MaterialTable>(core::MaterialTable::seed());
   std::unique_ptr<ImpactMonitorRos> monitor_;
-  ros::ServiceServer compute_collision_server_;
-  ros::ServiceServer estimate_restitution_server_;
   std::unique_ptr<diagnostic_updater::Updater> diagnostics_;
   ros::WallTimer diagnostics_timer_;
   boost::recursive_mutex reconfigure_mutex_;  ///< the server's, so updateConfig is safe
   std::unique_ptr<dynamic_reconfigure::Server<MonitorConfig>> reconfigure_;
   MonitorConfig config_;  ///< the values in use
+  // The services' own queue and thread; declared last so that the thread stops first.
+  ros::CallbackQueue service_queue_;
+  ros::ServiceServer compute_collision_server_;
+  ros::ServiceServer estimate_restitution_server_;
+  std::unique_ptr<ros::AsyncSpinner> service_spinner_;
 };
 
 }  // namespace collision_response

@@ -3,10 +3,16 @@
 
 #include <geometry_msgs/Point.h>
 #include <geometry_msgs/Vector3.h>
+#include <ros/time.h>
+
 #include <Eigen/Core>
+#include <optional>
+#include <string>
 
 #include "collision_response/Body.h"
+#include "collision_response/Impact.h"
 #include "collision_response/core/body.h"
+#include "collision_response/core/monitor.h"
 
 namespace collision_response {
 
@@ -17,5 +23,14 @@ geometry_msgs::Point toPointMsg(const Eigen::Vector3d& point);
 
 /// Copies every field; validation is the core's (core::checkBody).
 core::Body toCore(const collision_response::Body& msg);
+
+/// The record of an impact message, indexed as `monitor` indexes its bodies, at `time` on the
+/// caller's time line: what core::Playback::applyImpact takes. Empty when body_a is not one of
+/// the monitor's bodies; body_b may be an obstacle (or anything else that is not a body).
+std::optional<core::ImpactRecord> toImpactRecord(const Impact& impact,
+                                                 const core::ImpactMonitor& monitor, double time);
+
+/// "1712345678.000000001": seconds and nanoseconds, exact.
+std::string formatStamp(const ros::Time& stamp);
 
 }  // namespace collision_response

@@ -2,7 +2,7 @@
 #pragma once
 
 #include <ros/time.h>
-#include <tf2_ros/buffer.h>
+#include <tf2/buffer_core.h>
 
 #include <Eigen/Geometry>
 #include <string>
@@ -29,7 +29,7 @@ struct FrameMotion {
 /// finite difference: exact for a frame moving at constant velocity, as tf interpolates linearly
 /// between its samples). A frame equal to the fixed frame, or empty, is the identity at rest.
 /// The error says which frames and why (not yet available, not connected, ...).
-core::Expected<FrameMotion> lookupFrameMotion(const tf2_ros::Buffer& buffer,
+core::Expected<FrameMotion> lookupFrameMotion(const tf2::BufferCore& buffer,
                                               const std::string& fixed_frame,
                                               const std::string& frame, const ros::Time& stamp,
                                               const ros::Duration& interval);

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "collision_response/Impact.h"
+#include "collision_response/core/monitor.h"
 #include "collision_response/core/scene.h"
 
 namespace collision_response {
@@ -50,5 +51,11 @@ visualization_msgs::Marker obstacleMarker(const core::ObstacleSpec& obstacle, in
 /// both with id `id` in their namespaces and the lifetime `impact_lifetime`.
 void appendImpactMarkers(const Impact& impact, int id, const MarkerParams& params,
                          visualization_msgs::MarkerArray& array);
+
+/// The monitor's bodies (where it predicts them at `time`; deleted while not tracked) and its
+/// placed obstacles, appended to `array`.
+void appendSceneMarkers(const core::ImpactMonitor& monitor, double time, const std::string& frame,
+                        const ros::Time& stamp, const MarkerParams& params,
+                        visualization_msgs::MarkerArray& array);
 
 }  // namespace collision_response

@@ -3,22 +3,25 @@
 
 #include <XmlRpcValue.h>
 
+#include <map>
 #include <string>
+#include <vector>
 
 #include "collision_response/core/expected.h"
-#include "collision_response/core/materials.h"
 #include "collision_response/core/scene.h"
 
 namespace collision_response {
 
-/// The material part of a scene: `restitution_combine`, `materials` and `pairs`, on top of the
-/// seed's table. `scene` is the value of the `~scene` parameter; `field` its name for messages.
-/// Unknown keys, unknown materials, duplicate names and out-of-range coefficients are errors.
-core::Expected<core::MaterialTable> loadMaterials(const XmlRpc::XmlRpcValue& scene,
-                                                  const std::string& field);
-
-/// The whole scene (keys in README.md, "Scene file"), validated (core::validateScene). Every
-/// error names the parameter (`field`/bodies[2]/mass) and the reason.
+/// The whole scene (keys in README.md, "Scene file"), validated (core::validateScene), its
+/// planes' normals scaled to unit length. Every error names the parameter
+/// (`field`/bodies[2]/mass) and the reason: an unknown key, a wrong type, a missing required
+/// key, an unknown material, effect, detection or obstacle type, a duplicate name, a value out
+/// of range.
 core::Expected<core::Scene> loadScene(const XmlRpc::XmlRpcValue& scene, const std::string& field);
+
+/// The keys loadScene reads, by entity, as the README's tables name them: "scene", "bodies[]",
+/// "obstacles[] plane", "obstacles[] sphere", "materials.<name>", "pairs[]". These are the key
+/// tables the loader reads and checks with: a key is accepted exactly when it is listed here.
+std::map<std::string, std::vector<std::string>> sceneKeys();
 
 }  // namespace collision_response

@@ -1,7 +1,9 @@
 // The scene player: moves the scene's bodies, publishes their states, applies the impacts it
-// receives. It closes the loop with the monitor over real topics.
+// receives. It closes the loop with the monitor over real topics. The motion is the core's
+// (core::Playback); this class only reads its parameters, keeps time, and publishes.
 #pragma once
 
+#include <XmlRpcValue.h>
 #include <ros/ros.h>
 #include <tf2_ros/transform_broadcaster.h>
 
@@ -11,25 +13,43 @@
 #include <vector>
 
 #include "collision_response/ImpactArray.h"
+#include "collision_response/core/monitor.h"
 #include "collision_response/core/playback.h"
 #include "collision_response/core/scene.h"
+#include "collision_response/ros/parameters.h"
 
 namespace collision_response {
 
 /// A frame the player moves in a straight line (for tf-attached obstacles: a paddle).
 struct MovingFrame {
   std::string frame;
-  std::string parent;
+  std::string parent;                                  ///< empty: the scene's fixed frame
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< m, at the start, in parent
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< m/s, in parent
+};
+
+/// The scene player's private parameters, with their defaults (README.md, "The scene player").
+struct ScenePlayerParams {
+  double rate = 100.0;              ///< Hz: states published this often
+  double duration = 0.0;            ///< s played, then the player stops; 0: until stopped
+  double start_delay = 1.0;         ///< s waited before the first state
+  double contact_tolerance = 1e-9;  ///< as the node's: resting on a plane
+  bool report_restitution = false;  ///< print e = sqrt(h'/h) of each first bounce
+  std::vector<MovingFrame> frames;  ///< `~player/frames`
+
+  /// Every private parameter the player reads (`scene` is loadScene's).
+  static const KeyTable<ScenePlayerParams>& keys();
+  /// Reads the player's private namespace `tree` (named `ns`): a wrong type, a value out of
+  /// range or an unknown parameter is an error naming the key.
+  static core::Expected<ScenePlayerParams> load(const XmlRpc::XmlRpcValue& tree,
+                                                const std::string& ns);
 };
 
 class ScenePlayer {
  public:
   ScenePlayer(const ros::NodeHandle& node, const ros::NodeHandle& private_node);
 
-  /// Reads `~scene`, `~player/frames`, `~rate`, `~duration`, `~start_delay`,
-  /// `~contact_tolerance`, `~report_restitution`; false (logged) on a bad value.
+  /// Reads `~scene` and the parameters above; false (logged, naming the key) on a bad value.
   bool initialize();
 
  private:
@@ -44,14 +64,12 @@ class ScenePlayer {
   ros::NodeHandle node_;
   ros::NodeHandle private_node_;
   core::Scene scene_;
-  std::vector<MovingFrame> frames_;
-  double rate_ = 100.0;
-  double duration_ = 0.0;
-  double start_delay_ = 1.0;
-  double contact_tolerance_ = 1e-9;
-  bool report_restitution_ = false;
+  ScenePlayerParams params_;
   ros::Time created_;
   ros::Time start_;
+  /// The monitor's indexing of the scene (bodies by sorted id): the impacts it publishes are
+  /// applied through Playback::applyImpact(monitor, record, exact_contact), as the core does.
+  std::unique_ptr<core::ImpactMonitor> indexing_;
   std::unique_ptr<core::Playback> playback_;  ///< from the start on (the bodies' motion)
   ros::Publisher state_publisher_;
   ros::Publisher apex_publisher_;

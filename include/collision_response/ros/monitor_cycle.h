@@ -1,0 +1,93 @@
+// The monitor's update cycle: one input (the states of one message) in, one update out: the
+// impacts it revealed, each checked finite, and everything dropped or worth saying, by reason.
+// It reads tf from a tf2::BufferCore and needs no node and no master (unit-tested, fuzzed);
+// ImpactMonitorRos subscribes, queues, calls it and publishes what it returns.
+//
+// One input is one step: the monitor advances once, to the input's newest stamp, and each state
+// enters at its own stamp (its track starts there). So the work per message is one step however
+// many distinct stamps it holds: impacts between its states' stamps are found from the tracks
+// before it, as for a message of one stamp.
+#pragma once
+
+#include <ros/time.h>
+#include <tf2/buffer_core.h>
+
+#include <cstdint>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "collision_response/BodyState.h"
+#include "collision_response/ImpactArray.h"
+#include "collision_response/core/monitor.h"
+#include "collision_response/core/scene.h"
+#include "collision_response/ros/monitor_params.h"
+#include "collision_response/ros/state_intake.h"
+#include "collision_response/ros/time_line.h"
+
+namespace collision_response {
+
+class MonitorCycle {
+ public:
+  MonitorCycle(const core::Scene& scene, const MonitorParams& params);
+
+  struct Input {
+    const std::vector<BodyState>* states = nullptr;
+    std::string topic;      ///< where it came from, resolved
+    std::string publisher;  ///< the node that published it (its clock is the source's)
+    std::string own_body;   ///< on a body's own topic, its id; empty on body_states
+  };
+
+  struct Update {
+    /// A transform (of a state's frame or a tf-attached obstacle) is not there yet and the
+    /// input may wait: nothing was done; process it again later.
+    bool waiting = false;
+    bool stepped = false;  ///< the monitor advanced (some state was usable)
+    double time = 0.0;     ///< s on the time line: the step's instant
+    ros::Time stamp;       ///< the input's newest stamp, in its source's clock
+    ImpactArray impacts;   ///< the impacts found, every number finite: to publish
+    /// The lasting contacts at the step's time, as the monitor reports them (for a contacts
+    /// topic: ImpactMonitorRos::publish is where its publisher goes).
+    std::vector<core::ContactRecord> contacts;
+    /// What was dropped (states, impacts) and what else happened.
+    std::vector<Report> reports;
+  };
+
+  /// `clock`: the node's clock now (ros::Time::now(); zero when unknown); `may_wait`: a missing
+  /// transform makes the input wait rather than drop. Never throws on any message content.
+  Update process(const Input& input, const ros::Time& clock, bool may_wait,
+                 const tf2::BufferCore& tf);
+
+  /// Live tuning (dynamic_reconfigure), validated by the caller: see core::ImpactMonitor::tune.
+  void tune(core::Detection detection, double restitution_threshold, core::CombineRule rule);
+
+  const core::ImpactMonitor& monitor() const { return monitor_; }
+  const core::Scene& scene() const { return scene_; }
+  const TimeLine& timeLine() const { return time_line_; }
+  const MonitorParams& params() const { return params_; }
+  /// Steps taken so far: one per input that had a usable state.
+  std::uint64_t steps() const { return steps_; }
+
+ private:
+  /// Places the tf-attached obstacles at `stamp` (line time `time`).
+  void updateObstacles(const ros::Time& stamp, double time, const tf2::BufferCore& tf,
+                       Update& update);
+
+  core::Scene scene_;
+  MonitorParams params_;
+  core::ImpactMonitor monitor_;
+  StateIntake intake_;
+  TimeLine time_line_;
+  std::set<std::size_t> placed_obstacles_;  ///< tf-attached obstacles placed at least once
+  std::vector<StampedSample> samples_;      ///< working memory, kept between inputs
+  std::vector<core::BodyStateSample> timed_;
+  std::uint64_t steps_ = 0;
+};
+
+/// The impact message of a monitor's record, its stamp `stamp`; or the error naming the first
+/// field the doubles cannot hold (the service's refusal, core::checkRepresentable).
+core::Expected<Impact> toImpactMessage(const core::ImpactRecord& record,
+                                       const core::ImpactMonitor& monitor, const ros::Time& stamp,
+                                       const std::string& fixed_frame);
+
+}  // namespace collision_response

@@ -1,0 +1,52 @@
+// The monitor's status for /diagnostics: what it received, did and dropped, by reason, since the
+// last report and in total. Counters are keyed by Reason (a fixed set), never by what a
+// publisher sent.
+#pragma once
+
+#include <diagnostic_updater/DiagnosticStatusWrapper.h>
+#include <ros/time.h>
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <string>
+
+#include "collision_response/ros/monitor_cycle.h"
+#include "collision_response/ros/state_intake.h"
+
+namespace collision_response {
+
+class MonitorDiagnostics {
+ public:
+  void received(std::size_t states) {
+    ++period_.messages;
+    period_.states += states;
+  }
+  void count(Reason reason, std::size_t events = 1) {
+    totals_[static_cast<std::size_t>(reason)] += events;
+  }
+  /// A processed input: the step's processing time and the arrival-to-publication latency (s).
+  void stepped(double step_seconds, double latency_seconds, std::size_t impacts_published);
+
+  std::uint64_t total(Reason reason) const { return totals_[static_cast<std::size_t>(reason)]; }
+  std::uint64_t impactsPublished() const { return impacts_published_; }
+
+  /// Fills `status` (the summary: WARN while states or impacts are dropped, with the reasons
+  /// and counts of the period; OK otherwise) and starts a new period.
+  void report(diagnostic_updater::DiagnosticStatusWrapper& status, const MonitorCycle& cycle,
+              std::size_t waiting);
+
+ private:
+  struct Period {
+    ros::WallTime start = ros::WallTime::now();
+    std::uint64_t messages = 0, states = 0, steps = 0, impacts = 0;
+    double step_seconds = 0.0, step_seconds_max = 0.0;
+    double latency_seconds = 0.0, latency_seconds_max = 0.0;  ///< arrival to publication
+    std::array<std::uint64_t, kReasonCount> totals{};         ///< totals_ at its start
+  };
+  Period period_;
+  std::array<std::uint64_t, kReasonCount> totals_{};
+  std::uint64_t impacts_published_ = 0;
+};
+
+}  // namespace collision_response

@@ -1,0 +1,111 @@
+// The state intake: BodyState messages in, samples in the fixed frame out, and every state that
+// cannot be used dropped with a named reason. No node and no master: it reads tf from a
+// tf2::BufferCore (the node's tf2_ros::Buffer, or one a test fills by hand).
+#pragma once
+
+#include <ros/time.h>
+#include <tf2/buffer_core.h>
+
+#include <cstdint>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "collision_response/BodyState.h"
+#include "collision_response/core/monitor.h"
+
+namespace collision_response {
+
+/// Why the monitor dropped a state, a message or an impact, or what else it has to tell: each
+/// reason is one counter in diagnostics and one throttled warning per input topic, so the
+/// warnings' key space is these reasons times the node's topics, whatever a publisher sends.
+enum class Reason {
+  kEmptyId,            ///< a state with no id
+  kUnknownId,          ///< an id that is not one of the scene's bodies
+  kIdMismatch,         ///< on a body's own topic, another body's id
+  kDuplicateId,        ///< the same body twice in one message
+  kZeroStamp,          ///< header.stamp zero
+  kStampAhead,         ///< header.stamp too far ahead of the node's clock
+  kNonFinite,          ///< a NaN or infinite number
+  kTransformMissing,   ///< no transform from the state's frame, after waiting
+  kStale,              ///< not newer than the body's last state
+  kTooManyStates,      ///< a message with more than ~max_states states
+  kQueueFull,          ///< the oldest waiting input, dropped for a new one
+  kInternalError,      ///< an exception while processing a message
+  kImpactNotFinite,    ///< an impact whose numbers the doubles cannot hold: not published
+  kClockJumpedBack,    ///< a source's stamps went back: every track reset
+  kClockOffset,        ///< a source's stamps lag the time line: shifted onto it
+  kStepTruncated,      ///< a guard of the monitor cut a step short
+  kObstacleTransform,  ///< a tf-attached obstacle keeps its last known motion
+};
+inline constexpr int kReasonCount = static_cast<int>(Reason::kObstacleTransform) + 1;
+
+/// The counter's name, as diagnostics shows it: "dropped: unknown id", "clock jumped back", ...
+const char* counterName(Reason reason);
+/// Whether the reason drops input (a state or a message) or output (an impact).
+bool isDrop(Reason reason);
+
+/// One thing to report: its reason and the text of its warning (which names the state, the
+/// field and why: "the state of 'ball': header.stamp: ...").
+struct Report {
+  Reason reason;
+  std::string text;
+  std::size_t count = 1;  ///< how many events it stands for (states dropped, say)
+  bool warn = true;       ///< false: counted only (an obstacle's first instants, say)
+  /// Tells apart warnings of one reason that are throttled apart, from a fixed small set (the
+  /// field of a non-finite number: 13 of them).
+  int variant = 0;
+};
+
+/// A state, in the fixed frame, with its own stamp (the time line places it later).
+struct StampedSample {
+  ros::Time stamp;
+  core::BodyStateSample sample;
+};
+
+/// What the intake needs to know; from MonitorParams.
+struct IntakeSettings {
+  std::string fixed_frame = "world";
+  double frame_velocity_interval = 0.01;  ///< s: finite difference of a moving frame's velocity
+  double transform_timeout = 0.1;         ///< s: for the warning's text
+  double future_stamp_tolerance = 300.0;  ///< s: a stamp further ahead of the clock is dropped
+};
+
+class StateIntake {
+ public:
+  /// `body_ids`: the monitor's bodies, by index (ImpactMonitor::body(i).id).
+  StateIntake(std::vector<std::string> body_ids, IntakeSettings settings);
+
+  enum class Outcome {
+    kDone,  ///< every state converted or dropped
+    kWait,  ///< a transform is not there yet and the input may wait: nothing was consumed
+  };
+
+  /// Converts the states of one input. `own_body`: on a body's own topic, that body's id (an
+  /// empty id means it); empty for `body_states`. `clock` is the node's clock now (zero: not
+  /// known yet, sim time before the first /clock): a stamp more than future_stamp_tolerance
+  /// ahead of it is dropped. `may_wait`: a missing transform makes the input wait (kWait)
+  /// rather than drop its states. Each state is converted or dropped (reported), in order.
+  Outcome convert(const std::vector<BodyState>& states, const std::string& own_body,
+                  const ros::Time& clock, bool may_wait, const tf2::BufferCore& tf,
+                  std::vector<StampedSample>& samples, std::vector<Report>& reports);
+
+  const IntakeSettings& settings() const { return settings_; }
+
+ private:
+  /// The body's index, or a report of why there is none.
+  bool lookUp(const BodyState& state, std::size_t place, std::size_t& index,
+              std::vector<Report>& reports);
+
+  std::vector<std::string> body_ids_;
+  std::unordered_map<std::string, std::size_t> index_of_;
+  IntakeSettings settings_;
+  std::vector<std::size_t> index_hints_;  ///< body index of each place of the last input
+  /// Duplicate ids in one input: the input that last saw each body, and where in it.
+  std::vector<std::uint64_t> seen_in_input_;
+  std::vector<std::size_t> seen_at_place_;
+  std::vector<std::size_t> seen_at_sample_;
+  std::uint64_t input_serial_ = 0;
+};
+
+}  // namespace collision_response

@@ -1,0 +1,230 @@
+#include "collision_response/ros/monitor_cycle.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "collision_response/core/validation.h"
+#include "collision_response/ros/conversions.h"
+#include "collision_response/ros/frame_motion.h"
+
+namespace collision_response {
+namespace {
+
+std::vector<std::string> bodyIds(const core::ImpactMonitor& monitor) {
+  std::vector<std::string> ids;
+  ids.reserve(monitor.bodyCount());
+  for (std::size_t i = 0; i < monitor.bodyCount(); ++i) ids.push_back(monitor.body(i).id);
+  return ids;
+}
+
+IntakeSettings intakeSettings(const core::Scene& scene, const MonitorParams& params) {
+  IntakeSettings settings;
+  settings.fixed_frame = scene.fixed_frame;
+  settings.frame_velocity_interval = params.frame_velocity_interval;
+  settings.transform_timeout = params.transform_timeout;
+  settings.future_stamp_tolerance = params.future_stamp_tolerance;
+  return settings;
+}
+
+std::int64_t nanoseconds(const ros::Time& stamp) {
+  return static_cast<std::int64_t>(stamp.sec) * 1000000000 + static_cast<std::int64_t>(stamp.nsec);
+}
+
+geometry_msgs::Twist toTwist(const Eigen::Vector3d& linear, const Eigen::Vector3d& angular) {
+  geometry_msgs::Twist twist;
+  twist.linear = toVector3Msg(linear);
+  twist.angular = toVector3Msg(angular);
+  return twist;
+}
+
+}  // namespace
+
+core::Expected<Impact> toImpactMessage(const core::ImpactRecord& record,
+                                       const core::ImpactMonitor& monitor, const ros::Time& stamp,
+                                       const std::string& fixed_frame) {
+  using core::namedResult;
+  if (auto status = core::checkRepresentable(
+          {namedResult("contact_point", record.contact_point), namedResult("normal", record.normal),
+           namedResult("restitution", record.restitution), namedResult("impulse", record.impulse),
+           namedResult("friction_impulse", record.friction_impulse),
+           namedResult("velocity_a_before", record.velocity_a_before),
+           namedResult("velocity_a_before", record.angular_velocity_a_before),
+           namedResult("velocity_a_after", record.velocity_a_after),
+           namedResult("velocity_a_after", record.angular_velocity_a_after),
+           namedResult("velocity_b_before", record.velocity_b_before),
+           namedResult("velocity_b_before", record.angular_velocity_b_before),
+           namedResult("velocity_b_after", record.velocity_b_after),
+           namedResult("velocity_b_after", record.angular_velocity_b_after),
+           namedResult("energy_lost", record.energy_lost)});
+      !status) {
+    return status.error();
+  }
+  Impact impact;
+  impact.header.stamp = stamp;
+  impact.header.frame_id = fixed_frame;
+  impact.body_a = monitor.body(record.body_a).id;
+  impact.body_b =
+      record.other_is_obstacle ? monitor.obstacle(record.other).id : monitor.body(record.other).id;
+  impact.contact_point = toPointMsg(record.contact_point);
+  impact.normal = toVector3Msg(record.normal);
+  impact.restitution = record.restitution;
+  impact.impulse = record.impulse;
+  impact.friction_impulse = record.friction_impulse;
+  impact.oblique = record.oblique;
+  impact.velocity_a_before = toTwist(record.velocity_a_before, record.angular_velocity_a_before);
+  impact.velocity_a_after = toTwist(record.velocity_a_after, record.angular_velocity_a_after);
+  impact.velocity_b_before = toTwist(record.velocity_b_before, record.angular_velocity_b_before);
+  impact.velocity_b_after = toTwist(record.velocity_b_after, record.angular_velocity_b_after);
+  impact.energy_lost = record.energy_lost;
+  return impact;
+}
+
+MonitorCycle::MonitorCycle(const core::Scene& scene, const MonitorParams& params)
+    : scene_(scene),
+      params_(params),
+      monitor_(scene, core::MonitorSettings{params.contact_tolerance, params.body_timeout}),
+      intake_(bodyIds(monitor_), intakeSettings(scene, params)),
+      time_line_(params.clock_jump_back) {}
+
+MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& clock,
+                                           bool may_wait, const tf2::BufferCore& tf) {
+  Update update;
+  samples_.clear();
+  if (intake_.convert(*input.states, input.own_body, clock, may_wait, tf, samples_,
+                      update.reports) == StateIntake::Outcome::kWait) {
+    update.waiting = true;
+    return update;
+  }
+  if (samples_.empty()) return update;
+  const ros::Time newest =
+      std::max_element(samples_.begin(), samples_.end(), [](const auto& x, const auto& y) {
+        return x.stamp < y.stamp;
+      })->stamp;
+  // The tf-attached obstacles must be known up to the newest stamp as well.
+  if (may_wait) {
+    for (const core::ObstacleSpec& obstacle : scene_.obstacles) {
+      if (!obstacle.frame.empty() &&
+          !lookupFrameMotion(tf, scene_.fixed_frame, obstacle.frame, newest,
+                             ros::Duration(params_.frame_velocity_interval))) {
+        update.waiting = true;
+        update.reports.clear();
+        return update;
+      }
+    }
+  }
+
+  // The input's newest stamp places it on the time line; its other states keep their distance
+  // from it (integer nanoseconds).
+  const std::string source = input.topic + " from " + input.publisher;
+  const TimeLine::Placed placed = time_line_.place(source, newest, monitor_.now());
+  if (placed.event == TimeLine::Event::kJumpedBack) {
+    update.reports.push_back(
+        {Reason::kClockJumpedBack,
+         "time jumped back: " + source + " sent header.stamp " + formatStamp(newest) +
+             ", more than ~clock_jump_back (" + core::formatNumber(params_.clock_jump_back) +
+             " s) before its last (a bag played with --loop? a simulator restarted?): every "
+             "track is reset and the time line starts again there"});
+    monitor_.reset();
+    placed_obstacles_.clear();
+  } else if (placed.event == TimeLine::Event::kOffsetChanged) {
+    update.reports.push_back(
+        {Reason::kClockOffset,
+         source + "'s stamps are " + core::formatNumber(time_line_.offset(source)) +
+             " s behind the time line, which " + time_line_.firstSource() +
+             " started: its clock differs. Its states are shifted onto the line by that much "
+             "(instants across the two are as good as that alignment; synchronise the clocks "
+             "for exact ones)"});
+  }
+  update.stamp = newest;
+  update.time = placed.time;
+  timed_.clear();
+  timed_.reserve(samples_.size());
+  const std::int64_t newest_ns = nanoseconds(newest);
+  for (const StampedSample& item : samples_) {
+    core::BodyStateSample sample = item.sample;
+    sample.time = placed.time - static_cast<double>(newest_ns - nanoseconds(item.stamp)) * 1e-9;
+    timed_.push_back(sample);
+  }
+
+  updateObstacles(newest, placed.time, tf, update);
+  const core::StepReport step = monitor_.step(placed.time, timed_);
+  update.stepped = true;
+  ++steps_;
+  if (step.stale_states > 0) {
+    update.reports.push_back({Reason::kStale,
+                              "dropped " + std::to_string(step.stale_states) +
+                                  " state(s) not newer than their body's last state",
+                              step.stale_states});
+  }
+  if (step.truncated) {
+    update.reports.push_back({Reason::kStepTruncated,
+                              "too many impacts at one instant or in one step; the step was cut "
+                              "short"});
+  }
+  update.contacts = step.contacts;
+  update.impacts.header.stamp = newest;
+  update.impacts.header.frame_id = scene_.fixed_frame;
+  update.impacts.impacts.reserve(step.impacts.size());
+  for (const core::ImpactRecord& record : step.impacts) {
+    ros::Time stamp;
+    const bool stamped = time_line_.stampOf(record.time, stamp);
+    auto impact = toImpactMessage(record, monitor_, stamp, scene_.fixed_frame);
+    if (impact && stamped) {
+      update.impacts.impacts.push_back(std::move(impact.value()));
+      continue;
+    }
+    const std::string a = monitor_.body(record.body_a).id;
+    const std::string b = record.other_is_obstacle ? monitor_.obstacle(record.other).id
+                                                   : monitor_.body(record.other).id;
+    const std::string why =
+        impact ? "header.stamp: the instant is not a valid ros::Time" : impact.error().message();
+    update.reports.push_back({Reason::kImpactNotFinite,
+                              "did not publish the impact of '" + a + "' and '" + b + "': " + why +
+                                  "; the states were finite, the answer is not"});
+  }
+  return update;
+}
+
+void MonitorCycle::updateObstacles(const ros::Time& stamp, double time, const tf2::BufferCore& tf,
+                                   Update& update) {
+  for (std::size_t i = 0; i < monitor_.obstacleCount(); ++i) {
+    const core::ObstacleSpec& spec = monitor_.obstacle(i);
+    if (spec.frame.empty()) continue;
+    const auto motion = lookupFrameMotion(tf, scene_.fixed_frame, spec.frame, stamp,
+                                          ros::Duration(params_.frame_velocity_interval));
+    if (!motion) {
+      // Before its first placement, tf has no history yet for its velocity: counted only.
+      Report item{
+          Reason::kObstacleTransform,
+          "obstacle '" + spec.id + "' keeps its last known motion: " + motion.error().message()};
+      item.warn = placed_obstacles_.count(i) != 0;
+      update.reports.push_back(std::move(item));
+      continue;
+    }
+    placed_obstacles_.insert(i);
+    core::ObstaclePose pose;
+    pose.time = time;
+    pose.angular_velocity = motion->angular_velocity;
+    if (spec.shape == core::ObstacleShape::kSphere) {
+      pose.position = motion->point(spec.position);
+      pose.velocity = motion->velocity(spec.position, Eigen::Vector3d::Zero());
+    } else {
+      const Eigen::Vector3d unit_normal = spec.normal.stableNormalized();
+      pose.normal = motion->pose.linear() * unit_normal;
+      pose.position = motion->point(unit_normal * spec.offset);  // a point of the plane
+      pose.offset = pose.normal.dot(pose.position);
+      pose.velocity = motion->velocity(unit_normal * spec.offset, Eigen::Vector3d::Zero());
+    }
+    monitor_.setObstaclePose(i, pose);
+  }
+}
+
+void MonitorCycle::tune(core::Detection detection, double restitution_threshold,
+                        core::CombineRule rule) {
+  scene_.detection = detection;
+  scene_.restitution_threshold = restitution_threshold;
+  scene_.materials.setCombineRule(rule);
+  monitor_.tune(detection, restitution_threshold, scene_.materials);
+}
+
+}  // namespace collision_response

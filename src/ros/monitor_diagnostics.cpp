@@ -1,0 +1,78 @@
+#include "collision_response/ros/monitor_diagnostics.h"
+
+#include <algorithm>
+
+#include "collision_response/core/validation.h"
+
+namespace collision_response {
+
+void MonitorDiagnostics::stepped(double step_seconds, double latency_seconds,
+                                 std::size_t impacts_published) {
+  ++period_.steps;
+  period_.step_seconds += step_seconds;
+  period_.step_seconds_max = std::max(period_.step_seconds_max, step_seconds);
+  period_.latency_seconds += latency_seconds;
+  period_.latency_seconds_max = std::max(period_.latency_seconds_max, latency_seconds);
+  period_.impacts += impacts_published;
+  impacts_published_ += impacts_published;
+}
+
+void MonitorDiagnostics::report(diagnostic_updater::DiagnosticStatusWrapper& status,
+                                const MonitorCycle& cycle, std::size_t waiting) {
+  const core::ImpactMonitor& monitor = cycle.monitor();
+  const core::Scene& scene = cycle.scene();
+  const double seconds = std::max((ros::WallTime::now() - period_.start).toSec(), 1e-9);
+  std::string dropped;  // in this period, by reason
+  for (int i = 0; i < kReasonCount; ++i) {
+    const Reason reason = static_cast<Reason>(i);
+    const std::uint64_t events = totals_[i] - period_.totals[i];
+    if (events == 0 || !isDrop(reason)) continue;
+    const std::string name = counterName(reason);
+    dropped += (dropped.empty() ? "" : "; ") + name.substr(name.find(": ") + 2) + " (" +
+               std::to_string(events) + ")";
+  }
+  const std::uint64_t impacts_dropped =
+      totals_[static_cast<std::size_t>(Reason::kImpactNotFinite)] -
+      period_.totals[static_cast<std::size_t>(Reason::kImpactNotFinite)];
+  if (!dropped.empty()) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                   std::string(impacts_dropped > 0 ? "dropped: " : "states dropped: ") + dropped);
+  } else if (period_.messages == 0) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::OK,
+                   "no states received in the last " + core::formatNumber(seconds) + " s");
+  } else {
+    status.summary(diagnostic_msgs::DiagnosticStatus::OK,
+                   std::to_string(monitor.trackedBodies()) + " bodies tracked");
+  }
+  const auto steps = static_cast<double>(period_.steps);
+  status.add("detection", core::toString(scene.detection));
+  status.add("restitution threshold (m/s)", scene.restitution_threshold);
+  status.add("combine rule", core::toString(scene.materials.combineRule()));
+  status.add("bodies in the scene", monitor.bodyCount());
+  status.add("bodies tracked", monitor.trackedBodies());
+  status.add("input messages per second", static_cast<double>(period_.messages) / seconds);
+  status.add("states per second", static_cast<double>(period_.states) / seconds);
+  status.add("impacts per second", static_cast<double>(period_.impacts) / seconds);
+  status.add("updates", period_.steps);
+  status.add("processing time per update, mean (ms)",
+             period_.steps ? 1e3 * period_.step_seconds / steps : 0.0);
+  status.add("processing time per update, max (ms)", 1e3 * period_.step_seconds_max);
+  status.add("arrival to publication, mean (ms)",
+             period_.steps ? 1e3 * period_.latency_seconds / steps : 0.0);
+  status.add("arrival to publication, max (ms)", 1e3 * period_.latency_seconds_max);
+  status.add("messages waiting for transforms", waiting);
+  status.add("transforms missing (states dropped, total)", total(Reason::kTransformMissing));
+  status.add("obstacle transforms missing (total)", total(Reason::kObstacleTransform));
+  for (const auto& [source, offset] : cycle.timeLine().offsets()) {
+    if (offset != 0.0) status.add("clock offset of " + source + " (s)", offset);
+  }
+  for (int i = 0; i < kReasonCount; ++i) {
+    if (totals_[i] > 0)
+      status.add(std::string(counterName(static_cast<Reason>(i))) + " (total)", totals_[i]);
+  }
+  status.add("impacts published (total)", impacts_published_);
+  period_ = Period{};
+  period_.totals = totals_;
+}
+
+}  // namespace collision_response

@@ -1,0 +1,397 @@
+// The monitor's update cycle and its parts (the state intake, the time line, the throttle),
+// without a master: messages built here, tf from a tf2::BufferCore filled by hand. The attacks
+// of issue 13 that need no node are here, each a named test with the attack's numbers.
+//
+// The two-ball closed form used throughout: 1 kg, radius 0.1 m, e = 0.5; a at x = t moving
+// +1 m/s, b at x = 1.06 - t moving -1 m/s: the gap 0.86 m closes at 2 m/s, contact at t = 0.43
+// s; equal masses: v_a' = -0.5, v_b' = +0.5, impulse 1.5 N s, energy lost 0.75 J.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "collision_response/ros/monitor_cycle.h"
+#include "collision_response/ros/throttled_warning.h"
+
+namespace collision_response {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+core::Scene twoBallScene(double mass = 1.0, int extra_bodies = 0) {
+  core::Scene scene;
+  scene.materials.addMaterial("test_half", core::Material{0.5, std::nullopt}, "materials");
+  for (const char* id : {"a", "b"}) {
+    core::BodySpec body;
+    body.id = id;
+    body.mass = mass;
+    body.radius = 0.1;
+    body.material = "test_half";
+    scene.bodies.push_back(body);
+  }
+  for (int i = 0; i < extra_bodies; ++i) {
+    core::BodySpec body = scene.bodies[0];
+    body.id = "extra_" + std::to_string(100000 + i);
+    scene.bodies.push_back(body);
+  }
+  return scene;
+}
+
+BodyState state(const std::string& id, const ros::Time& stamp, const Eigen::Vector3d& position,
+                const Eigen::Vector3d& velocity, const std::string& frame = "world") {
+  BodyState s;
+  s.header.stamp = stamp;
+  s.header.frame_id = frame;
+  s.id = id;
+  s.pose.position.x = position.x();
+  s.pose.position.y = position.y();
+  s.pose.position.z = position.z();
+  s.pose.orientation.w = 1.0;
+  s.twist.linear.x = velocity.x();
+  s.twist.linear.y = velocity.y();
+  s.twist.linear.z = velocity.z();
+  return s;
+}
+
+ros::Time at(const ros::Time& start, double seconds) { return start + ros::Duration(seconds); }
+
+class Cycle : public ::testing::Test {
+ protected:
+  explicit Cycle(const core::Scene& scene = twoBallScene()) : cycle_(scene, MonitorParams{}) {}
+
+  MonitorCycle::Update send(const std::vector<BodyState>& states,
+                            const std::string& publisher = "/source",
+                            const std::string& topic = "/body_states",
+                            const std::string& own_body = "") {
+    inputs_.push_back(states);
+    MonitorCycle::Input input{&inputs_.back(), topic, publisher, own_body};
+    MonitorCycle::Update update = cycle_.process(input, clock_, false, tf_);
+    for (const Impact& impact : update.impacts.impacts) impacts_.push_back(impact);
+    for (const Report& report : update.reports) reports_.push_back(report);
+    return update;
+  }
+
+  /// The two-ball case at 10 Hz from `start`, both bodies in one array a message.
+  void playTwoBalls(const ros::Time& start) {
+    for (int k = 0; k <= 10; ++k) {
+      const double t = 0.1 * k;
+      const ros::Time stamp = start + ros::Duration(0, 100000000 * k);
+      send({state("a", stamp, {t, 0, 0}, {1, 0, 0}),
+            state("b", stamp, {1.06 - t, 0, 0}, {-1, 0, 0})});
+    }
+  }
+
+  void expectTwoBallImpactOnce(const ros::Time& start) {
+    ASSERT_EQ(impacts_.size(), 1u);
+    const Impact& impact = impacts_[0];
+    EXPECT_EQ(impact.body_a, "a");
+    EXPECT_EQ(impact.body_b, "b");
+    EXPECT_NEAR((impact.header.stamp - start).toSec(), 0.43, 1e-9);
+    EXPECT_NEAR(impact.velocity_a_after.linear.x, -0.5, 1e-9);
+    EXPECT_NEAR(impact.velocity_b_after.linear.x, 0.5, 1e-9);
+    EXPECT_NEAR(impact.impulse, 1.5, 1e-9);
+    EXPECT_NEAR(impact.energy_lost, 0.75, 1e-9);
+  }
+
+  std::size_t reportsOf(Reason reason) const {
+    std::size_t count = 0;
+    for (const Report& report : reports_) count += report.reason == reason ? report.count : 0;
+    return count;
+  }
+  const Report* firstReport(Reason reason) const {
+    for (const Report& report : reports_) {
+      if (report.reason == reason) return &report;
+    }
+    return nullptr;
+  }
+
+  MonitorCycle cycle_;
+  tf2::BufferCore tf_;
+  ros::Time clock_{1000, 0};
+  std::deque<std::vector<BodyState>> inputs_;  // kept alive: the cycle reads them in place
+  std::vector<Impact> impacts_;
+  std::vector<Report> reports_;
+};
+
+TEST_F(Cycle, TwoBallsHitBetweenSamples) {
+  const ros::Time start(1000, 0);
+  playTwoBalls(start);
+  expectTwoBallImpactOnce(start);
+  EXPECT_TRUE(reports_.empty());
+}
+
+// Issue 13, item 1: the first state ever stamped secs 4294967295 set the time line there, and
+// every later valid message was dropped with "Duration is out of dual 32-bit range", forever.
+TEST_F(Cycle, Item1_AFirstStampAtTheEndOfTimeIsDroppedByNameAndTheMonitorLivesOn) {
+  send({state("a", ros::Time(4294967295u, 0), {0, 0, 0}, {1, 0, 0})});
+  ASSERT_EQ(reportsOf(Reason::kStampAhead), 1u);
+  const std::string& text = firstReport(Reason::kStampAhead)->text;
+  EXPECT_NE(text.find("header.stamp: 4294967295.000000000"), std::string::npos) << text;
+  EXPECT_NE(text.find("ahead of this node's clock"), std::string::npos) << text;
+  EXPECT_FALSE(cycle_.timeLine().started()) << "a dropped state does not start the time line";
+  reports_.clear();
+  const ros::Time start(1000, 0);
+  playTwoBalls(start);
+  expectTwoBallImpactOnce(start);
+  EXPECT_TRUE(reports_.empty());
+}
+
+// Issue 13, item 1, mid-stream: the same stamp was dropped without naming header.stamp.
+TEST_F(Cycle, Item1_AStampAtTheEndOfTimeMidStreamIsDroppedByName) {
+  const ros::Time start(1000, 0);
+  for (int k = 0; k <= 10; ++k) {
+    const double t = 0.1 * k;
+    const ros::Time stamp = start + ros::Duration(0, 100000000 * k);
+    send(
+        {state("a", stamp, {t, 0, 0}, {1, 0, 0}), state("b", stamp, {1.06 - t, 0, 0}, {-1, 0, 0})});
+    if (k == 2) send({state("b", ros::Time(4294967295u, 999999999), {0, 0, 0}, {0, 0, 0})});
+  }
+  EXPECT_EQ(reportsOf(Reason::kStampAhead), 1u);
+  EXPECT_EQ(reportsOf(Reason::kClockJumpedBack), 0u) << "one bad stamp does not reset the line";
+  expectTwoBallImpactOnce(start);
+}
+
+// Without a clock (sim time before the first /clock) the stamp cannot be judged: it starts the
+// line, and the next valid state, its source's clock going back, restarts it. One reset, then
+// the monitor is right again: no exception, whatever the stamps.
+TEST_F(Cycle, Item1_WithoutAClockAFarStampCostsOneReset) {
+  clock_ = ros::Time();
+  send({state("a", ros::Time(4294967295u, 999999999), {0, 0, 0}, {1, 0, 0})});
+  const ros::Time start(1000, 0);
+  playTwoBalls(start);
+  EXPECT_EQ(reportsOf(Reason::kClockJumpedBack), 1u);
+  EXPECT_EQ(reportsOf(Reason::kInternalError), 0u);
+  expectTwoBallImpactOnce(start);
+}
+
+// Issue 13, item 2: bodies of 1e200 kg meeting at 1e110 m/s published `impulse: inf` and
+// `energy_lost: nan`; the service refuses such answers by name, and so does the monitor now:
+// nothing that is not finite is published, and the refusal names the field.
+class HeavyCycle : public Cycle {
+ protected:
+  HeavyCycle() : Cycle(twoBallScene(1e200)) {}
+};
+
+TEST_F(HeavyCycle, Item2_AnImpactBeyondTheDoublesIsNotPublished) {
+  const ros::Time start(1000, 0);
+  // Closing at 2e110 m/s from 0.86 m apart: contact 4.3e-111 s after the first state.
+  send({state("a", start, {0, 0, 0}, {1e110, 0, 0}),
+        state("b", start, {1.06, 0, 0}, {-1e110, 0, 0})});
+  send({state("a", at(start, 0.1), {1e109, 0, 0}, {1e110, 0, 0}),
+        state("b", at(start, 0.1), {1.06 - 1e109, 0, 0}, {-1e110, 0, 0})});
+  EXPECT_TRUE(impacts_.empty()) << "impulse " << impacts_.front().impulse;
+  ASSERT_EQ(reportsOf(Reason::kImpactNotFinite), 1u);
+  const std::string& text = firstReport(Reason::kImpactNotFinite)->text;
+  EXPECT_NE(text.find("'a' and 'b'"), std::string::npos) << text;
+  EXPECT_NE(text.find(": is beyond the range of double"), std::string::npos) << text;
+}
+
+// Issue 13, item 2: touching balls at 1.3e308 m/s published NaN velocities. Here the line of
+// impact is (0.6, 0.8, 0) and a moves at 1.3e308 along x and y: its normal speed 1.8e308 is
+// beyond the doubles.
+TEST_F(Cycle, Item2_TouchingBallsAtTheTopOfTheDoublesPublishNoNaN) {
+  const ros::Time start(1000, 0);
+  const Eigen::Vector3d fast(1.3e308, 1.3e308, 0);
+  send({state("a", start, {0, 0, 0}, fast), state("b", start, {0.12, 0.16, 0}, {0, 0, 0})});
+  send({state("a", at(start, 0.1), {0, 0, 0}, fast),
+        state("b", at(start, 0.1), {0.12, 0.16, 0}, {0, 0, 0})});
+  for (const Impact& impact : impacts_) {
+    EXPECT_TRUE(std::isfinite(impact.velocity_a_after.linear.x)) << "a NaN was published";
+    EXPECT_TRUE(std::isfinite(impact.velocity_a_after.linear.y)) << "a NaN was published";
+    EXPECT_TRUE(std::isfinite(impact.energy_lost));
+  }
+  ASSERT_GE(reportsOf(Reason::kImpactNotFinite), 1u);
+  EXPECT_NE(firstReport(Reason::kImpactNotFinite)->text.find("is beyond the range of double"),
+            std::string::npos);
+  // And the monitor goes on: the ordinary case afterwards (the tracks start again from states).
+  impacts_.clear();
+  const ros::Time later = at(start, 10.0);
+  playTwoBalls(later);
+  EXPECT_EQ(reportsOf(Reason::kInternalError), 0u);
+  expectTwoBallImpactOnce(later);
+}
+
+// Issue 13, item 3: a finite state far away and fast overflowed the grid's int64 cell count,
+// which wrapped past the guard; the node walked and stored cells until memory ran out.
+class FarFastCycle : public Cycle {
+ protected:
+  FarFastCycle() : Cycle(twoBallScene(1.0, 2)) {}
+};
+
+TEST_F(FarFastCycle, Item3_AFarFastStateIsBoundedWork) {
+  const ros::Time start(1000, 0);
+  const auto others = [&](const ros::Time& stamp) {
+    return std::vector<BodyState>{state("a", stamp, {0, 0, 0}, {0, 0, 0}),
+                                  state("b", stamp, {1, 0, 0}, {0, 0, 0}),
+                                  state("extra_100001", stamp, {2, 0, 0}, {0, 0, 0})};
+  };
+  auto first = others(start);
+  first.push_back(state("extra_100000", start, {5, -1.76e13, 5}, {1.05e8, 7.04e13, 0}));
+  send(first);
+  auto second = others(at(start, 0.5));
+  second.push_back(state("extra_100000", at(start, 0.5),
+                         {5 + 0.5 * 1.05e8, -1.76e13 + 0.5 * 7.04e13, 5}, {1.05e8, 7.04e13, 0}));
+  send(second);  // before the fix: gigabytes and minutes here
+  EXPECT_TRUE(impacts_.empty());
+  EXPECT_TRUE(reports_.empty());
+  EXPECT_EQ(cycle_.monitor().trackedBodies(), 4u);
+}
+
+// Issue 13, item 5: two sources whose clocks differ by 5 s gave a "time jumped back" warning
+// per message and reset every track each time: no impact was ever found. The lagging source is
+// shifted onto the line once, said once, and the impact is found.
+TEST_F(Cycle, Item5_TwoSourcesWhoseClocksDifferBy5s) {
+  const ros::Time start(1000, 0);
+  for (int k = 0; k <= 10; ++k) {
+    const double t = 0.1 * k;
+    const ros::Time stamp = start + ros::Duration(0, 100000000 * k);
+    send({state("a", stamp, {t, 0, 0}, {1, 0, 0})}, "/tracker_a");
+    send({state("", stamp - ros::Duration(5.0), {1.06 - t, 0, 0}, {-1, 0, 0})}, "/tracker_b",
+         "/b/state", "b");
+  }
+  EXPECT_EQ(reportsOf(Reason::kClockJumpedBack), 0u);
+  ASSERT_EQ(reportsOf(Reason::kClockOffset), 1u) << "said once";
+  const std::string& text = firstReport(Reason::kClockOffset)->text;
+  EXPECT_NE(text.find("/b/state from /tracker_b"), std::string::npos) << text;
+  EXPECT_NE(text.find("5 s behind"), std::string::npos) << text;
+  EXPECT_NE(text.find("/body_states from /tracker_a"), std::string::npos) << text;
+  EXPECT_EQ(cycle_.timeLine().offset("/b/state from /tracker_b"), 5.0);
+  expectTwoBallImpactOnce(start);
+}
+
+// A bag played with --loop: the source's own stamps go back; every track is reset, once.
+TEST_F(Cycle, ASourceWhoseOwnClockGoesBackRestartsTheLine) {
+  playTwoBalls(ros::Time(1000, 0));
+  impacts_.clear();
+  const ros::Time again(900, 0);
+  playTwoBalls(again);
+  EXPECT_EQ(reportsOf(Reason::kClockJumpedBack), 1u);
+  EXPECT_NE(firstReport(Reason::kClockJumpedBack)->text.find("jumped back"), std::string::npos);
+  expectTwoBallImpactOnce(again);
+}
+
+// Issue 13, item 7: the same id twice in one array was dropped as "not newer" without naming
+// the id or the duplicate.
+TEST_F(Cycle, Item7_TheSameIdTwiceInOneArrayIsNamed) {
+  const ros::Time start(1000, 0);
+  send({state("a", start, {0, 0, 0}, {1, 0, 0}), state("b", start, {1, 0, 0}, {0, 0, 0}),
+        state("a", at(start, 0.001), {0.001, 0, 0}, {1, 0, 0})});
+  ASSERT_EQ(reportsOf(Reason::kDuplicateId), 1u);
+  const std::string& text = firstReport(Reason::kDuplicateId)->text;
+  EXPECT_NE(text.find("states[0]"), std::string::npos) << text;  // the older one, dropped
+  EXPECT_NE(text.find("states[2]"), std::string::npos) << text;  // the newer, kept
+  EXPECT_NE(text.find("'a'"), std::string::npos) << text;
+  // The newer state is the track: a at 0.001 m at the array's newest stamp (the line's now).
+  const auto track =
+      cycle_.monitor().predictedState(*cycle_.monitor().bodyIndex("a"), cycle_.monitor().now());
+  ASSERT_TRUE(track);
+  EXPECT_EQ(track->first.x(), 0.001);
+  EXPECT_EQ(reportsOf(Reason::kStale), 0u);
+}
+
+// Issue 13, item 9: one array of 10,000 states with distinct stamps 10 us apart took one full
+// step per stamp (23 s, the service blocked meanwhile). It is one step now, each state entering
+// at its own stamp.
+class ManyBodies : public Cycle {
+ protected:
+  ManyBodies() : Cycle(twoBallScene(1.0, 9998)) {}
+};
+
+TEST_F(ManyBodies, Item9_AnArrayOfDistinctStampsIsOneStep) {
+  const ros::Time start(1000, 0);
+  const auto& monitor = cycle_.monitor();
+  std::vector<BodyState> array;
+  for (std::size_t i = 0; i < monitor.bodyCount(); ++i) {
+    const ros::Time stamp = start + ros::Duration(0, static_cast<std::int32_t>(10000 * i));
+    array.push_back(
+        state(monitor.body(i).id, stamp, {2.0 * static_cast<double>(i), 5, 0}, {0, 1, 0}));
+  }
+  send(array);
+  const std::uint64_t before = cycle_.steps();
+  for (auto& s : array) s.header.stamp += ros::Duration(1.0);
+  send(array);
+  EXPECT_EQ(cycle_.steps(), before + 1) << "one step for the whole array";
+  EXPECT_TRUE(reports_.empty());
+  EXPECT_EQ(monitor.trackedBodies(), monitor.bodyCount());
+  // Each track starts at its own state's stamp: at the array's newest instant, body i has
+  // moved 1 m/s for the 10 us x (n - 1 - i) between its stamp and the newest.
+  const double newest = monitor.now();
+  for (const std::size_t i : {std::size_t{0}, std::size_t{1234}, monitor.bodyCount() - 1}) {
+    const auto track = monitor.predictedState(i, newest);
+    ASSERT_TRUE(track);
+    const double lag = 1e-5 * static_cast<double>(monitor.bodyCount() - 1 - i);
+    EXPECT_NEAR(track->first.y(), 5.0 + lag, 2e-9) << i;
+  }
+}
+
+// Issue 13, item 4: 1,000 distinct unknown ids a message gave one warning each, and the
+// throttle's map kept every id for ever. The intake quotes an id at most 64 characters long,
+// the throttle's key is (topic, reason), and its map has a hard cap.
+TEST_F(Cycle, Item4_UnknownIdsAreOneReasonAndTheThrottleIsBounded) {
+  std::vector<BodyState> array;
+  for (int i = 0; i < 1000; ++i) {
+    array.push_back(
+        state("ghost_" + std::to_string(i) + std::string(500, 'x'), clock_, {0, 0, 0}, {0, 0, 0}));
+  }
+  send(array);
+  EXPECT_EQ(reportsOf(Reason::kUnknownId), 1000u);
+  for (const Report& report : reports_) EXPECT_LT(report.text.size(), 200u);
+  // The throttle logs the first of each key: quietly here.
+  ros::console::set_logger_level(ROSCONSOLE_DEFAULT_NAME, ros::console::levels::Error);
+  ros::console::notifyLoggerLevelsChanged();
+  ThrottledWarning warnings(1.0);
+  for (int i = 0; i < 100000; ++i) {
+    warnings.warn("/body_states", Reason::kUnknownId,
+                  reports_[static_cast<std::size_t>(i % 1000)].text);
+  }
+  EXPECT_EQ(warnings.keys(), 1u);
+  for (int i = 0; i < 1100; ++i) {
+    warnings.warn("/topic_" + std::to_string(i), Reason::kUnknownId, "text");
+  }
+  EXPECT_LE(warnings.keys(), ThrottledWarning::kMaxKeys + kReasonCount);
+}
+
+TEST_F(Cycle, StatesInAStaticFrameAreTransformed) {
+  geometry_msgs::TransformStamped camera;
+  camera.header.frame_id = "world";
+  camera.child_frame_id = "camera";
+  camera.transform.translation.x = 10.0;
+  camera.transform.rotation.w = 1.0;
+  tf_.setTransform(camera, "test", /*is_static=*/true);
+  const ros::Time start(1000, 0);
+  for (int k = 0; k <= 10; ++k) {
+    const double t = 0.1 * k;
+    const ros::Time stamp = start + ros::Duration(0, 100000000 * k);
+    send({state("a", stamp, {t, 0, 0}, {1, 0, 0}),
+          state("b", stamp, {1.06 - t - 10.0, 0, 0}, {-1, 0, 0}, "camera")});
+  }
+  expectTwoBallImpactOnce(start);
+}
+
+TEST_F(Cycle, AMissingTransformMakesTheInputWaitThenDropsItsStateByName) {
+  std::vector<BodyState> states = {state("a", clock_, {0, 0, 0}, {0, 0, 0}, "nowhere")};
+  MonitorCycle::Input input{&states, "/body_states", "/source", ""};
+  EXPECT_TRUE(cycle_.process(input, clock_, true, tf_).waiting);
+  const MonitorCycle::Update update = cycle_.process(input, clock_, false, tf_);
+  EXPECT_FALSE(update.waiting);
+  ASSERT_EQ(update.reports.size(), 1u);
+  EXPECT_EQ(update.reports[0].reason, Reason::kTransformMissing);
+  EXPECT_NE(update.reports[0].text.find("header.frame_id: nowhere"), std::string::npos)
+      << update.reports[0].text;
+}
+
+TEST_F(Cycle, EveryReasonHasItsOwnCounter) {
+  std::set<std::string> names;
+  for (int i = 0; i < kReasonCount; ++i) names.insert(counterName(static_cast<Reason>(i)));
+  EXPECT_EQ(names.size(), static_cast<std::size_t>(kReasonCount));
+  EXPECT_EQ(std::string(counterName(Reason::kUnknownId)), "dropped: unknown id");
+  EXPECT_TRUE(isDrop(Reason::kImpactNotFinite));
+  EXPECT_FALSE(isDrop(Reason::kClockJumpedBack));
+}
+
+}  // namespace
+}  // namespace collision_response
