@@ -8,21 +8,16 @@ repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 ws="$repo/.ws"
 mkdir -p "$ws"
 
-# Debian 12 packages: ROS 1 (catkin, roscpp, messages, tf2, rostest), Eigen, gtest, and what the
-# benchmarks and fuzzers use.
-PACKAGES=(
-  build-essential cmake catkin
-  libroscpp-dev rosout ros-message-generation ros-message-runtime
-  libstd-msgs-dev ros-std-msgs libgeometry-msgs-dev ros-geometry-msgs
-  libtf2-dev libtf2-ros-dev libtf2-eigen-dev libeigen3-dev
-  librostest-dev python3-rostest python3-roslaunch python3-rosmaster python3-rosservice
-  rosbash python3-rostopic python3-rosnode python3-rosparam tf2-tools
-  libnodelet-dev libnodeletlib-dev libnodeletlib-tools pluginlib-dev
-  libvisualization-msgs-dev ros-visualization-msgs
-  libdiagnostic-updater-dev libdiagnostic-msgs-dev ros-diagnostic-msgs
-  libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
-  python3-rospy python3-genpy python3-geometry-msgs catkin-lint
-  googletest libgtest-dev clang libclang-rt-14-dev
+# Debian 12 packages: the package's own dependencies, read from package.xml
+# (scripts/install_dependencies.sh, the command the README gives for one's own workspace), and
+# the tools the scripts and the README's commands use: ROS's command-line tools, catkin_lint,
+# and clang with its sanitizer and fuzzer runtimes.
+source "$repo/scripts/install_dependencies.sh"
+mapfile -t PACKAGES < <(package_debian_packages "$repo/package.xml")
+package_debian_packages "$repo/package.xml" >/dev/null || exit 1
+PACKAGES+=(
+  rosbash python3-rostopic python3-rosnode python3-rosparam python3-rosservice
+  catkin-lint clang libclang-rt-14-dev
 )
 
 as_root() {
