@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # What each effect costs: Google Benchmark CPU time per impact and per state update, effects on
 # versus off; and instructions (valgrind callgrind, free of timing noise) of the same workload
-# with every effect off, in this build and in the core compiled without effects.
+# with every effect off, in this build and in the core built so that no effect can run
+# (effect_selection_none.cpp instead of effect_selection.cpp).
 # Writes doc/effects.md.
 #   bash scripts/bench_effects.sh
 set -euo pipefail

@@ -17,16 +17,21 @@ flags=(-std=c++17 -O1 -g -Wall -Wextra -fsanitize=fuzzer-no-link,address,undefin
   -fno-sanitize-recover=undefined -I "$repo/include" -isystem /usr/include/eigen3)
 echo "== building the core with clang -fsanitize=fuzzer-no-link,address,undefined"
 mkdir -p "$out/core"
+objects=()
 for source in "$repo"/src/core/*.cpp; do
+  # The product's core: effect_selection_none.cpp is the benchmark's reference build instead.
+  [ "$(basename "$source")" = effect_selection_none.cpp ] && continue
   object="$out/core/$(basename "$source" .cpp).o"
-  [ "$object" -nt "$source" ] && [ -z "$(find "$repo/include" -newer "$object" -print -quit)" ] ||
+  objects+=("$object")
+  [ "$object" -nt "$source" ] &&
+    [ -z "$(find "$repo/include" "$repo/src/core" -name '*.h' -newer "$object" -print -quit)" ] ||
     clang++ "${flags[@]}" -c "$source" -o "$object" &
 done
 wait
 status=0
 for target in fuzz_impact fuzz_time_of_impact; do
   echo "== $target: building"
-  clang++ "${flags[@]}" -fsanitize=fuzzer "$repo/fuzz/$target.cpp" "$out"/core/*.o -o "$out/$target"
+  clang++ "${flags[@]}" -fsanitize=fuzzer "$repo/fuzz/$target.cpp" "${objects[@]}" -o "$out/$target"
   mkdir -p "$out/corpus-$target"
   echo "== $target: running $seconds s"
   set +e

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "collision_response/core/cluster_solver.h"
 #include "collision_response/core/friction.h"
 #include "collision_response/core/scene.h"
 #include "collision_response/core/validation.h"
@@ -67,6 +68,18 @@ Expected<double> chooseFriction(const CollisionRequest& request, const MaterialT
   return request.friction;
 }
 
+/// A body of the request as the cluster solver sees it (with spin, its moment of inertia).
+ClusterBody clusterBody(const Body& body, bool spin) {
+  ClusterBody cluster_body;
+  cluster_body.inverse_mass = inverseMass(body);
+  cluster_body.velocity = body.velocity;
+  cluster_body.angular_velocity = body.angular_velocity;
+  cluster_body.radius = body.radius;
+  if (spin)
+    cluster_body.spin_factor = spinFactor(cluster_body.inverse_mass, body.radius, body.inertia);
+  return cluster_body;
+}
+
 }  // namespace
 
 Expected<CollisionOutcome> computeCollision(const CollisionRequest& request,
@@ -97,40 +110,37 @@ Expected<CollisionOutcome> computeCollision(const CollisionRequest& request,
       effects->friction ? chooseFriction(request, materials) : Expected<double>(0.0);
   if (!friction) return friction.error();
 
+  // A cluster of one contact, through the monitor's solver: friction and spin are chosen in one
+  // place (frictionModelFor), and one contact alone is resolveImpact, exact to the last bit.
+  const Effects runnable = runnableEffects(*effects);
+  ClusterBody a = clusterBody(request.a, runnable.spin);
+  ClusterBody b = clusterBody(request.b, runnable.spin);
+  ClusterContact contact;
+  contact.a = 0;
+  contact.b = 1;
+  contact.normal = *line_of_impact;
+  contact.restitution = *restitution;
+  const ContactResolution solved =
+      solveContact(a, b, contact, *friction, frictionModelFor(runnable));
+
   CollisionOutcome outcome;
   outcome.line_of_impact = *line_of_impact;
   outcome.restitution = *restitution;
-  outcome.impact = resolveImpact(inverseMass(request.a), request.a.velocity, inverseMass(request.b),
-                                 request.b.velocity, outcome.line_of_impact, outcome.restitution);
+  outcome.impact.velocity_a = a.velocity;
+  outcome.impact.velocity_b = b.velocity;
+  outcome.impact.normal_impulse = solved.normal.impulse;
+  outcome.impact.approach_speed = solved.normal.approach_speed;
+  outcome.impact.approaching = solved.normal.approach_speed > 0;
+  outcome.impact.energy_lost = solved.normal.energy_lost;
   outcome.oblique = hasObliqueComponent(request.a.velocity, outcome.line_of_impact) ||
                     hasObliqueComponent(request.b.velocity, outcome.line_of_impact);
-  outcome.angular_velocity_a = request.a.angular_velocity;
-  outcome.angular_velocity_b = request.b.angular_velocity;
-#ifndef COLLISION_RESPONSE_NO_EFFECTS
-  if (effects->friction) {
-    ClusterBody a{inverseMass(request.a), outcome.impact.velocity_a, request.a.angular_velocity,
-                  0.0, request.a.radius};
-    ClusterBody b{inverseMass(request.b), outcome.impact.velocity_b, request.b.angular_velocity,
-                  0.0, request.b.radius};
-    FrictionOutcome friction_outcome;
-    if (effects->spin) {
-      a.spin_factor = spinFactor(a.inverse_mass, request.a.radius, request.a.inertia);
-      b.spin_factor = spinFactor(b.inverse_mass, request.b.radius, request.b.inertia);
-      friction_outcome = applyFriction<true>(a, b, outcome.line_of_impact, *friction,
-                                             outcome.impact.normal_impulse);
-    } else {
-      friction_outcome = applyFriction<false>(a, b, outcome.line_of_impact, *friction,
-                                              outcome.impact.normal_impulse);
-    }
-    outcome.impact.velocity_a = a.velocity;
-    outcome.impact.velocity_b = b.velocity;
-    outcome.angular_velocity_a = a.angular_velocity;
-    outcome.angular_velocity_b = b.angular_velocity;
-    outcome.friction_impulse = friction_outcome.impulse;
-    outcome.sticking = friction_outcome.sticking;
-    outcome.impact.energy_lost += friction_outcome.energy_lost;
+  outcome.angular_velocity_a = a.angular_velocity;
+  outcome.angular_velocity_b = b.angular_velocity;
+  if (runnable.friction) {
+    outcome.friction_impulse = solved.friction.impulse;
+    outcome.sticking = solved.friction.sticking;
+    outcome.impact.energy_lost += solved.friction.energy_lost;
   }
-#endif
   // Finite inputs whose answer is beyond the doubles (masses and speeds of 1e200: an energy of
   // 1e600 J) are refused by name rather than answered with an infinity.
   const std::pair<const char*, bool> results[] = {

@@ -1,232 +1,61 @@
+// The impact monitor: the public API and the step, which reads as the algorithm. The stages it
+// runs are in their own files: candidate_pairs (which pairs to look at), contact_schedule (the
+// event queue of first contacts), instant_resolver (what happens at an instant of impact); the
+// motion models and their small kernels in motion_model.h.
 #include "collision_response/core/monitor.h"
 
 #include <algorithm>
 #include <cmath>
 
+#include "candidate_pairs.h"
 #include "collision_response/core/body.h"
-#include "collision_response/core/friction.h"
+#include "collision_response/core/cluster_solver.h"
+#include "contact_schedule.h"
+#include "instant_resolver.h"
+#include "lasting_contact.h"
+#include "monitor_world.h"
+#include "motion_model.h"
 
 namespace collision_response::core {
 
-// The motion-dependent members live in monitor_straight.cpp and monitor_gravity.cpp (see
-// monitor_motion.h); here they are only called.
-extern template Eigen::Vector3d ImpactMonitor::positionAt<ImpactMonitor::StraightLine>(
-    std::size_t, double) const;
-extern template Eigen::Vector3d ImpactMonitor::velocityAt<ImpactMonitor::StraightLine>(
-    std::size_t, double) const;
-extern template ImpactMonitor::Geometry ImpactMonitor::geometry<ImpactMonitor::StraightLine>(
-    const Pair&, double) const;
-extern template StepReport ImpactMonitor::stepContinuous<ImpactMonitor::StraightLine>(
-    double, const std::vector<BodyStateSample>&);
-extern template StepReport ImpactMonitor::stepDiscrete<ImpactMonitor::StraightLine>(
-    double, const std::vector<BodyStateSample>&);
-#ifndef COLLISION_RESPONSE_NO_EFFECTS
-extern template Eigen::Vector3d ImpactMonitor::positionAt<ImpactMonitor::UnderGravity>(
-    std::size_t, double) const;
-extern template Eigen::Vector3d ImpactMonitor::velocityAt<ImpactMonitor::UnderGravity>(
-    std::size_t, double) const;
-extern template ImpactMonitor::Geometry ImpactMonitor::geometry<ImpactMonitor::UnderGravity>(
-    const Pair&, double) const;
-extern template StepReport ImpactMonitor::stepContinuous<ImpactMonitor::UnderGravity>(
-    double, const std::vector<BodyStateSample>&);
-extern template StepReport ImpactMonitor::stepDiscrete<ImpactMonitor::UnderGravity>(
-    double, const std::vector<BodyStateSample>&);
-#endif
+using monitor::ContactSchedule;
+using monitor::Geometry;
+using monitor::Pair;
+using monitor::StraightLine;
+using monitor::Track;
+using monitor::UnderGravity;
+using monitor::World;
 
-ImpactMonitor::ImpactMonitor(const Scene& scene, const MonitorSettings& settings)
-    : settings_(settings),
-      detection_(scene.detection),
-      restitution_threshold_(scene.restitution_threshold),
-      bodies_(scene.bodies),
-      obstacles_(scene.obstacles),
-      effects_(scene.effects) {
-  const auto by_id = [](const auto& x, const auto& y) { return x.id < y.id; };
-  std::sort(bodies_.begin(), bodies_.end(), by_id);
-  std::sort(obstacles_.begin(), obstacles_.end(), by_id);
-#ifdef COLLISION_RESPONSE_NO_EFFECTS
-  // The benchmark's reference build: the effects compiled out, to show what "off" costs.
-  effects_ = Effects{};
-#endif
-  if (effects_.gravity) gravity_ = scene.gravity;
-  if (effects_.friction) {
-#ifndef COLLISION_RESPONSE_NO_EFFECTS
-    friction_step_ = effects_.spin ? &applyFrictionToCluster<true> : &applyFrictionToCluster<false>;
-#endif
-  }
+namespace {
 
-  std::vector<std::string>& material_names = material_names_;
-  const auto material_index = [&material_names](const std::string& name) {
-    const auto found = std::find(material_names.begin(), material_names.end(), name);
-    if (found != material_names.end())
-      return static_cast<std::size_t>(found - material_names.begin());
-    material_names.push_back(name);
-    return material_names.size() - 1;
-  };
-  for (std::size_t i = 0; i < bodies_.size(); ++i) {
-    body_index_[bodies_[i].id] = i;
-    radius_.push_back(bodies_[i].radius);
-    inverse_mass_.push_back(inverseMass(bodies_[i].mass));
-    spin_factor_.push_back(
-        effects_.spin ? spinFactor(inverse_mass_.back(), bodies_[i].radius, bodies_[i].inertia)
-                      : 0.0);
-    material_.push_back(material_index(bodies_[i].material));
-  }
-  for (const ObstacleSpec& obstacle : obstacles_) {
-    radius_.push_back(obstacle.shape == ObstacleShape::kSphere ? obstacle.radius : 0.0);
-    material_.push_back(material_index(obstacle.material));
-  }
-  // The pair coefficients, once: impacts look them up by index. Pairs that cannot meet (two
-  // obstacles) or have no coefficient (validateScene refuses scenes where such a pair can meet)
-  // hold NaN.
-  computePairCoefficients(scene.materials);
-
-  tracks_.resize(bodies_.size());
-  obstacle_tracks_.resize(obstacles_.size());
-  for (std::size_t i = 0; i < obstacles_.size(); ++i) {
-    const ObstacleSpec& obstacle = obstacles_[i];
-    if (!obstacle.frame.empty()) continue;  // placed by setObstaclePose from tf
-    ObstaclePose pose;
-    pose.position = obstacle.position;
-    pose.normal = obstacle.normal.normalized();
-    pose.offset = obstacle.offset;
-    obstacle_tracks_[i] = ObstacleTrack{true, pose};
-    if (obstacle.shape == ObstacleShape::kPlane) {
-      fixed_planes_.push_back(Plane{pose.normal, pose.offset});
-      fixed_plane_obstacle_.push_back(i);
-    }
-  }
+/// Calls `f` with the motion model the scene's effects call for: the one place it is chosen.
+template <class F>
+auto withMotionModel(const World& world, F&& f) {
+  return world.effects.gravity ? f(UnderGravity{}) : f(StraightLine{});
 }
 
-void ImpactMonitor::computePairCoefficients(const MaterialTable& materials) {
-  const std::size_t count = material_names_.size();
-  restitution_.assign(count, std::vector<double>(count, NAN));
-  friction_.assign(count, std::vector<double>(count, NAN));
+/// Fills the restitution and friction tables from the materials: impacts look them up by index.
+/// Pairs that cannot meet (two obstacles) or have no coefficient (validateScene refuses scenes
+/// where such a pair can meet) hold NaN.
+void computePairCoefficients(World& world, const MaterialTable& materials) {
+  const std::size_t count = world.material_names.size();
+  world.restitution.assign(count, std::vector<double>(count, NAN));
+  world.friction.assign(count, std::vector<double>(count, NAN));
   for (std::size_t i = 0; i < count; ++i) {
     for (std::size_t j = 0; j < count; ++j) {
-      if (const auto value = materials.restitution(material_names_[i], material_names_[j])) {
-        restitution_[i][j] = *value;
-      }
-      if (const auto value = materials.friction(material_names_[i], material_names_[j])) {
-        friction_[i][j] = *value;
-      }
+      const std::string& first = world.material_names[i];
+      const std::string& second = world.material_names[j];
+      if (const auto value = materials.restitution(first, second)) world.restitution[i][j] = *value;
+      if (const auto value = materials.friction(first, second)) world.friction[i][j] = *value;
     }
   }
 }
 
-void ImpactMonitor::tune(Detection detection, double restitution_threshold,
-                         const MaterialTable& materials) {
-  if (detection != detection_) overlapping_.clear();
-  detection_ = detection;
-  restitution_threshold_ = restitution_threshold;
-  computePairCoefficients(materials);
-}
-
-std::optional<ObstaclePose> ImpactMonitor::obstaclePose(std::size_t obstacle) const {
-  if (!obstacle_tracks_[obstacle].known) return std::nullopt;
-  return obstacle_tracks_[obstacle].pose;
-}
-
-std::optional<std::size_t> ImpactMonitor::bodyIndex(const std::string& id) const {
-  const auto found = body_index_.find(id);
-  if (found == body_index_.end()) return std::nullopt;
-  return found->second;
-}
-
-void ImpactMonitor::setObstaclePose(std::size_t obstacle, const ObstaclePose& pose) {
-  obstacle_tracks_[obstacle] = ObstacleTrack{true, pose};
-}
-
-void ImpactMonitor::reset() {
-  for (Track& track : tracks_) track = Track{};
-  for (std::size_t i = 0; i < obstacles_.size(); ++i) {
-    if (!obstacles_[i].frame.empty()) obstacle_tracks_[i] = ObstacleTrack{};
-  }
-  overlapping_.clear();
-  started_ = false;
-  now_ = 0.0;
-}
-
-std::size_t ImpactMonitor::trackedBodies() const {
-  return static_cast<std::size_t>(
-      std::count_if(tracks_.begin(), tracks_.end(), [](const Track& t) { return t.known; }));
-}
-
-std::optional<std::size_t> ImpactMonitor::restingOn(std::size_t body) const {
-  if (!tracks_[body].known || tracks_[body].resting_on < 0) return std::nullopt;
-  return static_cast<std::size_t>(tracks_[body].resting_on);
-}
-
-std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> ImpactMonitor::predictedState(
-    std::size_t body, double time) const {
-  if (!tracks_[body].known) return std::nullopt;
-#ifndef COLLISION_RESPONSE_NO_EFFECTS
-  if (effects_.gravity) {
-    return std::make_pair(positionAt<UnderGravity>(body, time),
-                          velocityAt<UnderGravity>(body, time));
-  }
-#endif
-  return std::make_pair(positionAt<StraightLine>(body, time), velocityAt<StraightLine>(body, time));
-}
-
-bool ImpactMonitor::isPlane(std::size_t participant) const {
-  return isObstacle(participant) &&
-         obstacles_[participant - bodies_.size()].shape == ObstacleShape::kPlane;
-}
-
-bool ImpactMonitor::known(std::size_t participant) const {
-  return isObstacle(participant) ? obstacle_tracks_[participant - bodies_.size()].known
-                                 : tracks_[participant].known;
-}
-
-double ImpactMonitor::inverseMassOf(std::size_t participant) const {
-  return isObstacle(participant) ? 0.0 : inverse_mass_[participant];
-}
-
-Eigen::Vector3d ImpactMonitor::angularVelocityOf(std::size_t participant) const {
-  return isObstacle(participant)
-             ? obstacle_tracks_[participant - bodies_.size()].pose.angular_velocity
-             : tracks_[participant].angular_velocity;
-}
-
-double ImpactMonitor::restitutionOf(const Pair& pair) const {
-  return restitution_[material_[pair.first]][material_[pair.second]];
-}
-
-bool ImpactMonitor::resting(const Pair& pair) const {
-  return isObstacle(pair.second) &&
-         tracks_[pair.first].resting_on == static_cast<int>(pair.second - bodies_.size());
-}
-
-void ImpactMonitor::updateResting(std::size_t body) {
-  Track& track = tracks_[body];
-  track.resting_on = -1;
-  track.acceleration = inverse_mass_[body] > 0 ? gravity_ : Eigen::Vector3d::Zero();
-  if (!effects_.gravity || inverse_mass_[body] == 0.0) return;
-  const auto plane = restingPlane(track.position, track.velocity, radius_[body], fixed_planes_,
-                                  gravity_, settings_.contact_tolerance);
-  if (!plane) return;
-  const Eigen::Vector3d& normal = fixed_planes_[*plane].normal;
-  track.resting_on = static_cast<int>(fixed_plane_obstacle_[*plane]);
-  track.velocity -= track.velocity.dot(normal) * normal;  // along the plane
-  track.acceleration = restingAcceleration(gravity_, normal);
-}
-
-void ImpactMonitor::candidatePairs(std::vector<Pair>& pairs) const {
-  pairs.clear();
-  for (std::size_t a = 0; a < bodies_.size(); ++a) {
-    if (!tracks_[a].known) continue;
-    for (std::size_t b = a + 1; b < bodies_.size(); ++b) {
-      if (!tracks_[b].known || inverse_mass_[a] + inverse_mass_[b] == 0.0) continue;
-      pairs.emplace_back(a, b);
-    }
-    if (inverse_mass_[a] == 0.0) continue;
-    for (std::size_t o = 0; o < obstacles_.size(); ++o) {
-      if (obstacle_tracks_[o].known) pairs.emplace_back(a, bodies_.size() + o);
-    }
-  }
-}
-
-void ImpactMonitor::applyStates(const std::vector<BodyStateSample>& states, StepReport& report) {
+/// Takes the received states as the bodies' tracks, oldest first: a state not newer than its
+/// body's last one is stale (counted, dropped); a state older than the track, or the first after
+/// an impact the monitor applied to the body, does not replace the track (the monitor's
+/// post-impact motion is the newer knowledge).
+void applyStates(World& world, const std::vector<BodyStateSample>& states, StepReport& report) {
   const auto earlier = [](const BodyStateSample& x, const BodyStateSample& y) {
     return x.time < y.time || (x.time == y.time && x.body < y.body);
   };
@@ -240,7 +69,7 @@ void ImpactMonitor::applyStates(const std::vector<BodyStateSample>& states, Step
     ordered = &sorted;
   }
   for (const BodyStateSample& state : *ordered) {
-    Track& track = tracks_[state.body];
+    Track& track = world.tracks[state.body];
     if (state.time <= track.last_state_time) {
       ++report.stale_states;
       continue;
@@ -255,51 +84,343 @@ void ImpactMonitor::applyStates(const std::vector<BodyStateSample>& states, Step
     track.position = state.position;
     track.velocity = state.velocity;
     track.angular_velocity = state.angular_velocity;
-    if (effects_.gravity) updateResting(state.body);
+    track.constrained = nullptr;
+    if (world.effects.gravity) {
+      // Free until the groups of lasting contact are formed again from the new states.
+      track.acceleration =
+          world.inverse_mass[state.body] > 0 ? world.gravity : Eigen::Vector3d::Zero();
+      track.angular_acceleration.setZero();
+      world.groups_current = false;
+    }
   }
 }
 
-void ImpactMonitor::forgetStaleBodies(double time) {
-  for (Track& track : tracks_) {
-    if (track.known && time - track.last_state_time > settings_.body_timeout) track.known = false;
+void forgetStaleBodies(World& world, double time) {
+  for (Track& track : world.tracks) {
+    if (track.known && time - track.last_state_time > world.settings.body_timeout) {
+      track.known = false;
+    }
   }
+}
+
+/// Every tracked movable body stops where it is at `time` for the rest of the step: the last
+/// fallback when a step's work runs out twice (nothing moves, so nothing goes into anything).
+template <class Motion>
+void holdEverything(World& world, double time) {
+  for (std::size_t body = 0; body < world.bodies.size(); ++body) {
+    Track& track = world.tracks[body];
+    if (!track.known || world.inverse_mass[body] == 0.0) continue;
+    track.position = monitor::positionAt<Motion>(world, body, time);
+    track.time = time;
+    track.velocity.setZero();
+    track.angular_velocity.setZero();
+    track.acceleration.setZero();
+    track.angular_acceleration.setZero();
+    track.constrained = nullptr;
+  }
+  monitor::clearGroups(world);
+}
+
+/// Continuous detection: from the last states, the first contact of every candidate pair,
+/// earliest first, and (gravity) the events of the groups of lasting contact; at each instant of
+/// contact the touching contacts are resolved, the groups of the bodies whose motion changed
+/// are formed again and their pairs scheduled again; then the states at `time` are taken.
+///
+/// When the step's instants run out (a ball wedged in a gap bouncing ever faster), every pair
+/// struck in the step is resolved at once as one inelastic cluster, so none of them approaches,
+/// and the step goes on with a second budget; if that runs out too, every body is held where it
+/// is until the step's end. Both count in report.fallbacks.
+template <class Motion>
+StepReport continuousStep(World& world, double time, const std::vector<BodyStateSample>& states) {
+  StepReport report;
+  monitor::candidatePairs<Motion>(world, world.now, time, world.scratch.pairs);
+  ContactSchedule<Motion> schedule(world, time);
+  const monitor::PairIndex index{world.scratch.pairs, world.scratch.pairs_of};
+  double instant = world.now;
+  std::vector<std::size_t> touching;
+  schedule.touchingAtStart(instant, touching);
+  std::vector<Pair> touching_pairs;
+  std::vector<std::size_t> changed;
+  std::vector<std::size_t> event_bodies;  // a group event's bodies: their groups form again
+  int budget = world.settings.max_instants_per_step;
+  bool fell_back = false;
+  for (int instants = 0;; ++instants) {
+    changed.clear();
+    if (instants >= budget) {
+      report.truncated = true;
+      ++report.fallbacks;
+      if (fell_back) {
+        holdEverything<Motion>(world, instant);
+        break;
+      }
+      fell_back = true;
+      budget += world.settings.max_instants_per_step;
+      std::vector<Pair> struck;
+      for (const ImpactRecord& impact : report.impacts) {
+        struck.emplace_back(impact.body_a, impact.other_is_obstacle
+                                               ? impact.other + world.bodyCount()
+                                               : impact.other);
+      }
+      std::sort(struck.begin(), struck.end());
+      struck.erase(std::unique(struck.begin(), struck.end()), struck.end());
+      monitor::resolveInelastically<Motion>(world, instant, struck, report, changed);
+    }
+    touching_pairs.clear();
+    for (const std::size_t k : touching) touching_pairs.push_back(schedule.pair(k));
+    if (!touching_pairs.empty()) {
+      monitor::resolveInstant<Motion>(world, instant, touching_pairs, report, changed);
+    }
+    if constexpr (Motion::kAccelerates) {
+      // Lasting contact: the groups of the bodies whose motion changed (at the start, of every
+      // body, unless the groups hold already for these tracks).
+      std::vector<std::size_t> seeds = changed;
+      seeds.insert(seeds.end(), event_bodies.begin(), event_bodies.end());
+      if (instants == 0 && !world.groups_current) {
+        monitor::clearGroups(world);
+        seeds.clear();
+        for (std::size_t body = 0; body < world.bodies.size(); ++body) {
+          if (world.tracks[body].known) seeds.push_back(body);
+        }
+      }
+      if (!seeds.empty()) monitor::formGroups(world, instant, seeds, index, changed);
+      std::sort(changed.begin(), changed.end());
+      changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
+    }
+    event_bodies.clear();
+    if (instants == 0) {
+      schedule.scheduleAll(instant);
+    } else {
+      for (const std::size_t body : changed) schedule.reschedule(body, instant);
+    }
+    // The next event: the earliest first contact, or (gravity) a group's motion changing.
+    if constexpr (Motion::kAccelerates) {
+      const double next_contact = schedule.earliest();
+      const auto [next_group_event, group] = monitor::nextGroupEvent(world);
+      if (next_group_event <= time && next_group_event <= next_contact) {
+        instant = next_group_event;
+        touching.clear();
+        event_bodies = world.groups[group].bodies;
+        world.groups[group].next_event = INFINITY;
+        continue;
+      }
+    }
+    if (!schedule.next(instant, touching)) break;
+  }
+  applyStates(world, states, report);
+  world.now = time;
+  if constexpr (Motion::kAccelerates) {
+    std::vector<std::size_t> formed;
+    monitor::formAllGroups(world, time, formed);
+    monitor::reportContacts(world, time, report.contacts);
+  }
+  return report;
+}
+
+/// Discrete detection: the states at `time` are taken, then the pairs that overlap then (and did
+/// not at the previous step) and approach are resolved.
+template <class Motion>
+StepReport discreteStep(World& world, double time, const std::vector<BodyStateSample>& states) {
+  StepReport report;
+  applyStates(world, states, report);
+  world.now = time;
+  std::vector<Pair>& pairs = world.scratch.pairs;
+  monitor::candidatePairs<Motion>(world, time, time, pairs);
+  std::vector<Pair> touching;
+  for (const Pair& pair : pairs) {
+    const Geometry g = monitor::geometry<Motion>(world, pair, time);
+    if (g.valid && g.gap <= g.tolerance && world.overlapping.count(pair) == 0) {
+      touching.push_back(pair);
+    }
+  }
+  std::vector<std::size_t> changed;
+  monitor::resolveInstant<Motion>(world, time, touching, report, changed);
+  world.overlapping.clear();
+  for (const Pair& pair : pairs) {
+    const Geometry g = monitor::geometry<Motion>(world, pair, time);
+    if (g.valid && g.gap < -g.tolerance) world.overlapping.insert(pair);
+  }
+  if constexpr (Motion::kAccelerates) {
+    std::vector<std::size_t> formed;
+    monitor::formAllGroups(world, time, formed);
+    monitor::reportContacts(world, time, report.contacts);
+  }
+  return report;
+}
+
+/// The first states: taken as the tracks and the time line started; in discrete detection the
+/// pairs that overlap already are remembered (an impact is found when contact begins).
+template <class Motion>
+void start(World& world, double time) {
+  world.started = true;
+  world.now = time;
+  if (world.detection != Detection::kDiscrete) return;
+  std::vector<Pair>& pairs = world.scratch.pairs;
+  monitor::allCandidatePairs(world, pairs);
+  for (const Pair& pair : pairs) {
+    const Geometry g = monitor::geometry<Motion>(world, pair, time);
+    if (g.valid && g.gap < -g.tolerance) world.overlapping.insert(pair);
+  }
+}
+
+}  // namespace
+
+ImpactMonitor::ImpactMonitor(const Scene& scene, const MonitorSettings& settings)
+    : world_(std::make_unique<World>()) {
+  World& world = *world_;
+  world.settings = settings;
+  world.detection = scene.detection;
+  world.restitution_threshold = scene.restitution_threshold;
+  world.bodies = scene.bodies;
+  world.obstacles = scene.obstacles;
+  const auto by_id = [](const auto& x, const auto& y) { return x.id < y.id; };
+  std::sort(world.bodies.begin(), world.bodies.end(), by_id);
+  std::sort(world.obstacles.begin(), world.obstacles.end(), by_id);
+  world.effects = runnableEffects(scene.effects);
+  if (world.effects.gravity) world.gravity = scene.gravity;
+  world.integration_tolerance = scene.contact_integration_tolerance;
+  world.friction_model = frictionModelFor(world.effects);
+
+  std::vector<std::string>& material_names = world.material_names;
+  const auto material_index = [&material_names](const std::string& name) {
+    const auto found = std::find(material_names.begin(), material_names.end(), name);
+    if (found != material_names.end()) {
+      return static_cast<std::size_t>(found - material_names.begin());
+    }
+    material_names.push_back(name);
+    return material_names.size() - 1;
+  };
+  for (std::size_t i = 0; i < world.bodies.size(); ++i) {
+    const BodySpec& body = world.bodies[i];
+    world.body_index[body.id] = i;
+    world.radius.push_back(body.radius);
+    world.inverse_mass.push_back(inverseMass(body.mass));
+    world.spin_factor.push_back(
+        world.effects.spin ? spinFactor(world.inverse_mass.back(), body.radius, body.inertia)
+                           : 0.0);
+    world.material.push_back(material_index(body.material));
+  }
+  for (const ObstacleSpec& obstacle : world.obstacles) {
+    world.radius.push_back(obstacle.shape == ObstacleShape::kSphere ? obstacle.radius : 0.0);
+    world.material.push_back(material_index(obstacle.material));
+  }
+  computePairCoefficients(world, scene.materials);
+
+  world.tracks.resize(world.bodies.size());
+  world.obstacle_tracks.resize(world.obstacles.size());
+  for (std::size_t i = 0; i < world.obstacles.size(); ++i) {
+    const ObstacleSpec& obstacle = world.obstacles[i];
+    if (!obstacle.frame.empty()) continue;  // placed by setObstaclePose from tf
+    ObstaclePose pose;
+    pose.position = obstacle.position;
+    pose.normal = obstacle.normal.normalized();
+    pose.offset = obstacle.offset;
+    world.obstacle_tracks[i] = monitor::ObstacleTrack{true, pose};
+  }
+  world.partners.assign(world.bodies.size(), {});
+}
+
+ImpactMonitor::ImpactMonitor(const ImpactMonitor& other)
+    : world_(std::make_unique<World>(*other.world_)) {}
+ImpactMonitor& ImpactMonitor::operator=(const ImpactMonitor& other) {
+  if (this != &other) world_ = std::make_unique<World>(*other.world_);
+  return *this;
+}
+ImpactMonitor::ImpactMonitor(ImpactMonitor&&) noexcept = default;
+ImpactMonitor& ImpactMonitor::operator=(ImpactMonitor&&) noexcept = default;
+ImpactMonitor::~ImpactMonitor() = default;
+
+std::size_t ImpactMonitor::bodyCount() const { return world_->bodies.size(); }
+std::size_t ImpactMonitor::obstacleCount() const { return world_->obstacles.size(); }
+const BodySpec& ImpactMonitor::body(std::size_t index) const { return world_->bodies[index]; }
+const ObstacleSpec& ImpactMonitor::obstacle(std::size_t index) const {
+  return world_->obstacles[index];
+}
+bool ImpactMonitor::started() const { return world_->started; }
+double ImpactMonitor::now() const { return world_->now; }
+
+void ImpactMonitor::tune(Detection detection, double restitution_threshold,
+                         const MaterialTable& materials) {
+  World& world = *world_;
+  if (detection != world.detection) world.overlapping.clear();
+  world.groups_current = false;  // friction coefficients may have changed
+  world.detection = detection;
+  world.restitution_threshold = restitution_threshold;
+  computePairCoefficients(world, materials);
+}
+
+std::optional<ObstaclePose> ImpactMonitor::obstaclePose(std::size_t obstacle) const {
+  if (!world_->obstacle_tracks[obstacle].known) return std::nullopt;
+  return world_->obstacle_tracks[obstacle].pose;
+}
+
+std::optional<std::size_t> ImpactMonitor::bodyIndex(const std::string& id) const {
+  const auto found = world_->body_index.find(id);
+  if (found == world_->body_index.end()) return std::nullopt;
+  return found->second;
+}
+
+void ImpactMonitor::setObstaclePose(std::size_t obstacle, const ObstaclePose& pose) {
+  world_->obstacle_tracks[obstacle] = monitor::ObstacleTrack{true, pose};
+  world_->groups_current = false;
+}
+
+void ImpactMonitor::reset() {
+  World& world = *world_;
+  for (Track& track : world.tracks) track = Track{};
+  for (std::size_t i = 0; i < world.obstacles.size(); ++i) {
+    if (!world.obstacles[i].frame.empty()) world.obstacle_tracks[i] = monitor::ObstacleTrack{};
+  }
+  world.overlapping.clear();
+  monitor::clearGroups(world);
+  world.contact_since.clear();
+  world.started = false;
+  world.now = 0.0;
+}
+
+std::size_t ImpactMonitor::trackedBodies() const {
+  return static_cast<std::size_t>(std::count_if(world_->tracks.begin(), world_->tracks.end(),
+                                                [](const Track& t) { return t.known; }));
+}
+
+std::optional<std::size_t> ImpactMonitor::restingOn(std::size_t body) const {
+  const World& world = *world_;
+  if (!world.tracks[body].known || world.partners.empty()) return std::nullopt;
+  for (const std::size_t other : world.partners[body]) {
+    if (world.isObstacle(other)) return other - world.bodyCount();
+  }
+  return std::nullopt;
+}
+
+std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> ImpactMonitor::predictedState(
+    std::size_t body, double time) const {
+  const World& world = *world_;
+  if (!world.tracks[body].known) return std::nullopt;
+  return withMotionModel(world, [&](auto motion) {
+    using Motion = decltype(motion);
+    return std::make_pair(monitor::positionAt<Motion>(world, body, time),
+                          monitor::velocityAt<Motion>(world, body, time));
+  });
 }
 
 StepReport ImpactMonitor::step(double time, const std::vector<BodyStateSample>& states) {
-  if (!started_ || time <= now_) {
+  World& world = *world_;
+  if (!world.started || time <= world.now) {
     StepReport report;
-    applyStates(states, report);
-    if (!started_) {
-      started_ = true;
-      now_ = time;
-      if (detection_ == Detection::kDiscrete) {
-        candidatePairs(scratch_.pairs);
-        for (const Pair& pair : scratch_.pairs) {
-#ifndef COLLISION_RESPONSE_NO_EFFECTS
-          const Geometry g = effects_.gravity ? geometry<UnderGravity>(pair, time)
-                                              : geometry<StraightLine>(pair, time);
-#else
-          const Geometry g = geometry<StraightLine>(pair, time);
-#endif
-          if (g.valid && g.gap < -g.tolerance) overlapping_.insert(pair);
-        }
-      }
+    applyStates(world, states, report);
+    if (!world.started) {
+      withMotionModel(world, [&](auto motion) {
+        start<decltype(motion)>(world, time);
+        return 0;
+      });
     }
     return report;
   }
-  forgetStaleBodies(time);
-  // The motion model is chosen here, once per step, not in the per-pair loops.
-#ifdef COLLISION_RESPONSE_NO_EFFECTS
-  return detection_ == Detection::kContinuous ? stepContinuous<StraightLine>(time, states)
-                                              : stepDiscrete<StraightLine>(time, states);
-#else
-  if (detection_ == Detection::kContinuous) {
-    return effects_.gravity ? stepContinuous<UnderGravity>(time, states)
-                            : stepContinuous<StraightLine>(time, states);
-  }
-  return effects_.gravity ? stepDiscrete<UnderGravity>(time, states)
-                          : stepDiscrete<StraightLine>(time, states);
-#endif
+  forgetStaleBodies(world, time);
+  return withMotionModel(world, [&](auto motion) {
+    using Motion = decltype(motion);
+    return world.detection == Detection::kContinuous ? continuousStep<Motion>(world, time, states)
+                                                     : discreteStep<Motion>(world, time, states);
+  });
 }
 
 }  // namespace collision_response::core

@@ -3,22 +3,18 @@
 
 #include <Eigen/Core>
 #include <cstddef>
-#include <limits>
-#include <map>
+#include <memory>
 #include <optional>
-#include <set>
 #include <string>
-#include <unordered_map>
-#include <unordered_set>
 #include <utility>
 #include <vector>
 
-#include "collision_response/core/broadphase.h"
-#include "collision_response/core/motion.h"
 #include "collision_response/core/scene.h"
-#include "collision_response/core/simultaneous.h"
 
 namespace collision_response::core {
+namespace monitor {
+struct World;
+}  // namespace monitor
 
 struct MonitorSettings {
   /// Two surfaces closer than this fraction of their contact distance (r_a + r_b, or r against a
@@ -74,10 +70,39 @@ struct ImpactRecord {
   Eigen::Vector3d angular_velocity_b_before, angular_velocity_b_after;
 };
 
+/// How a lasting contact carries its force.
+enum class ContactState {
+  kResting,  ///< no slip and no relative motion
+  kSliding,  ///< the surfaces slip (frictionless contacts slide as soon as they move)
+  kRolling,  ///< no slip at the contact point while the bodies move (static friction)
+};
+const char* toString(ContactState state);
+
+/// A contact that lasts (gravity): a body rests, slides or rolls on another or on an obstacle.
+struct ContactRecord {
+  double time = 0.0;       ///< s, the instant the forces below hold
+  std::size_t body_a = 0;  ///< a body index
+  std::size_t other = 0;   ///< a body index, or an obstacle index when other_is_obstacle
+  bool other_is_obstacle = false;
+  Eigen::Vector3d contact_point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();         ///< unit, a -> other
+  double normal_force = 0.0;                                 ///< N, >= 0, on other along the normal
+  Eigen::Vector3d friction_force = Eigen::Vector3d::Zero();  ///< N, on other (a: opposite)
+  ContactState state = ContactState::kResting;
+  double since = 0.0;  ///< s, the instant the contact began to last
+};
+
 struct StepReport {
   std::vector<ImpactRecord> impacts;
+  /// The lasting contacts at the step's time (with the gravity effect), in the order of their
+  /// pairs.
+  std::vector<ContactRecord> contacts;
   std::size_t stale_states = 0;  ///< states not newer than their body's last one: dropped
-  bool truncated = false;        ///< a guard of MonitorSettings stopped the step
+  /// A guard of MonitorSettings ran out (rounds at an instant, instants in the step).
+  bool truncated = false;
+  /// What the fallbacks did when a guard ran out, so that no body goes into another: a cluster
+  /// resolved as one inelastic cluster, or the step's bodies held where they were.
+  std::size_t fallbacks = 0;
 };
 
 /// Watches the scene's bodies and obstacles and finds their impacts.
@@ -108,11 +133,16 @@ struct StepReport {
 class ImpactMonitor {
  public:
   ImpactMonitor(const Scene& scene, const MonitorSettings& settings);
+  ImpactMonitor(const ImpactMonitor& other);
+  ImpactMonitor& operator=(const ImpactMonitor& other);
+  ImpactMonitor(ImpactMonitor&&) noexcept;
+  ImpactMonitor& operator=(ImpactMonitor&&) noexcept;
+  ~ImpactMonitor();
 
-  std::size_t bodyCount() const { return bodies_.size(); }
-  std::size_t obstacleCount() const { return obstacles_.size(); }
-  const BodySpec& body(std::size_t index) const { return bodies_[index]; }
-  const ObstacleSpec& obstacle(std::size_t index) const { return obstacles_[index]; }
+  std::size_t bodyCount() const;
+  std::size_t obstacleCount() const;
+  const BodySpec& body(std::size_t index) const;
+  const ObstacleSpec& obstacle(std::size_t index) const;
   std::optional<std::size_t> bodyIndex(const std::string& id) const;
 
   /// Where a tf-attached obstacle is, from `pose.time` on. Fixed obstacles are set from the scene.
@@ -133,8 +163,8 @@ class ImpactMonitor {
   /// Forgets every track and the time line (after a clock jump back).
   void reset();
 
-  bool started() const { return started_; }
-  double now() const { return now_; }
+  bool started() const;
+  double now() const;
   std::size_t trackedBodies() const;
   /// The plane obstacle a body rests on (gravity), if any.
   std::optional<std::size_t> restingOn(std::size_t body) const;
@@ -143,131 +173,7 @@ class ImpactMonitor {
                                                                             double time) const;
 
  private:
-  static constexpr double kNever = -std::numeric_limits<double>::infinity();
-
-  struct Track {
-    bool known = false;
-    double time = 0.0;
-    Eigen::Vector3d position = Eigen::Vector3d::Zero();
-    Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
-    Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
-    Eigen::Vector3d acceleration = Eigen::Vector3d::Zero();  ///< gravity, or its part along a plane
-    int resting_on = -1;                                     ///< obstacle index, -1: none
-    double last_state_time = kNever;
-    double last_impact_time = kNever;
-  };
-  /// Motion models, chosen once per step: no per-pair branch on gravity.
-  struct StraightLine {
-    static constexpr bool kAccelerates = false;
-  };
-  struct UnderGravity {
-    static constexpr bool kAccelerates = true;
-  };
-  struct ObstacleTrack {
-    bool known = false;
-    ObstaclePose pose;
-  };
-  /// A body (index < bodyCount) and another participant: a body, or obstacle index + bodyCount.
-  using Pair = std::pair<std::size_t, std::size_t>;
-  struct Geometry {
-    Eigen::Vector3d normal;  ///< unit, a -> other
-    double gap = 0.0;        ///< m, surface to surface along the normal; < 0 overlapping
-    double tolerance = 0.0;  ///< m, |gap| within it is touching
-    bool valid = false;      ///< false: coincident centres and no approach: no line of impact
-  };
-
-  bool isObstacle(std::size_t participant) const { return participant >= bodies_.size(); }
-  bool isPlane(std::size_t participant) const;
-  bool known(std::size_t participant) const;
-  double inverseMassOf(std::size_t participant) const;
-  template <class Motion>
-  Eigen::Vector3d positionAt(std::size_t participant, double time) const;
-  template <class Motion>
-  Eigen::Vector3d velocityAt(std::size_t participant, double time) const;
-  Eigen::Vector3d angularVelocityOf(std::size_t participant) const;
-  template <class Motion>
-  Geometry geometry(const Pair& pair, double time) const;
-  template <class Motion>
-  std::optional<double> timeOfImpact(const Pair& pair, double from, double horizon) const;
-  template <class Motion>
-  bool approaching(const Pair& pair, const Eigen::Vector3d& normal, double time) const;
-  double restitutionOf(const Pair& pair) const;
-  bool resting(const Pair& pair) const;
-  /// After a body's velocity changed: does it now rest on a fixed plane (gravity)?
-  void updateResting(std::size_t body);
-
-  /// Pairs worth testing in (from, to]: both tracked, not both immovable.
-  void candidatePairs(std::vector<Pair>& pairs) const;
-  /// The same, those whose boxes swept over [from, to] overlap (the broadphase), sorted.
-  template <class Motion>
-  void broadphasePairs(double from, double to, std::vector<Pair>& pairs);
-  /// After `body` changed at `from`: pairs its new motion over [from, to] may form that are
-  /// not candidates yet, appended to `pairs`; their indices.
-  template <class Motion>
-  std::vector<std::size_t> addReachablePairs(std::size_t body, double from, double to,
-                                             std::vector<Pair>& pairs,
-                                             const std::vector<std::vector<std::size_t>>& pairs_of);
-  /// Whether a body's swept box may reach a (fixed) obstacle; moving obstacles always may.
-  template <class Motion>
-  bool mayReachObstacle(const Box& box, std::size_t obstacle) const;
-  /// The box a body sweeps over [from, to], padded by its radius.
-  template <class Motion>
-  Box sweptBox(std::size_t body, double from, double to) const;
-
-  /// Resolves, in rounds, the pairs of `touching` that approach at `time`; the bodies whose
-  /// motion changed are added to `changed`.
-  template <class Motion>
-  bool resolveInstant(double time, const std::vector<Pair>& touching, StepReport& report,
-                      std::vector<std::size_t>& changed);
-  void applyStates(const std::vector<BodyStateSample>& states, StepReport& report);
-  void forgetStaleBodies(double time);
-  template <class Motion>
-  StepReport stepContinuous(double time, const std::vector<BodyStateSample>& states);
-  template <class Motion>
-  StepReport stepDiscrete(double time, const std::vector<BodyStateSample>& states);
-
-  MonitorSettings settings_;
-  Detection detection_;
-  double restitution_threshold_;
-  std::vector<BodySpec> bodies_;         // sorted by id
-  std::vector<ObstacleSpec> obstacles_;  // sorted by id
-  std::unordered_map<std::string, std::size_t> body_index_;
-  std::vector<double> radius_;        // per participant
-  std::vector<double> inverse_mass_;  // per body
-  std::vector<double> spin_factor_;   // per body, 1/k, 0 without spin
-  Effects effects_;
-  Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();  // zero without the gravity effect
-  ClusterFrictionStep friction_step_ = nullptr;        // null without the friction effect
-  std::vector<Plane> fixed_planes_;                    // for resting, with their obstacles:
-  std::vector<std::size_t> fixed_plane_obstacle_;
-  /// Fills restitution_ and friction_ from the materials' table.
-  void computePairCoefficients(const MaterialTable& materials);
-
-  std::vector<std::string> material_names_;       // the scene's materials, indexed
-  std::vector<std::size_t> material_;             // per participant, into restitution_
-  std::vector<std::vector<double>> restitution_;  // material x material
-  std::vector<std::vector<double>> friction_;     // material x material
-  std::vector<Track> tracks_;
-  std::vector<ObstacleTrack> obstacle_tracks_;
-  std::set<Pair> overlapping_;  // discrete: pairs overlapping at the previous step
-  /// Working memory of a step, kept so that steps do not allocate.
-  struct Scratch {
-    std::vector<Pair> pairs;
-    std::vector<std::vector<std::size_t>> pairs_of;
-    std::vector<double> next_contact;
-    std::vector<Geometry> geometry;
-    std::vector<char> queued;
-    std::vector<Box> boxes;
-    std::vector<char> active;
-    SpatialHash hash;
-    std::vector<std::pair<std::size_t, std::size_t>> body_pairs;
-    std::vector<std::pair<double, std::size_t>> events;
-    std::vector<std::pair<std::size_t, Box>> changed_boxes;
-    std::vector<std::size_t> found;
-  };
-  Scratch scratch_;
-  bool started_ = false;
-  double now_ = 0.0;
+  std::unique_ptr<monitor::World> world_;  // the scene, the tracks and a step's working memory
 };
 
 }  // namespace collision_response::core

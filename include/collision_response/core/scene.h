@@ -64,6 +64,9 @@ struct Scene {
   Effects effects;
   Eigen::Vector3d gravity = Eigen::Vector3d(0.0, 0.0, -9.81);  ///< m/s^2, with the effect only
   double restitution_threshold = 0.0;  ///< m/s: slower approaches do not bounce (e = 0)
+  /// Curved lasting contact (a ball rolling on a sphere) is integrated: the error allowed per
+  /// integrator step, absolute (m, m/s, rad/s) and relative.
+  double contact_integration_tolerance = 1e-9;
   MaterialTable materials = MaterialTable::seed();
   std::vector<BodySpec> bodies;
   std::vector<ObstacleSpec> obstacles;

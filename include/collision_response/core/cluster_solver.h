@@ -1,0 +1,57 @@
+// Everything a cluster of contacts receives at one instant: the joint normal solve, then the
+// friction the scene's effects call for. The one place the service (computeCollision: a cluster
+// of one contact) and the monitor (every cluster) resolve impacts.
+#pragma once
+
+#include <vector>
+
+#include "collision_response/core/friction.h"
+#include "collision_response/core/scene.h"
+#include "collision_response/core/simultaneous.h"
+
+namespace collision_response::core {
+
+/// The effects this build can run of `requested`: all of them in the product; none in the
+/// benchmark's reference build, which links effect_selection_none.cpp instead of
+/// effect_selection.cpp (scripts/bench_effects.sh counts instructions against it).
+Effects runnableEffects(const Effects& requested);
+
+/// Coulomb friction as the effects call for it, for one contact and for a cluster. Empty (no
+/// friction effect): bodies slide freely. Chosen once, by frictionModelFor.
+struct FrictionModel {
+  FrictionOutcome (*contact)(ClusterBody& a, ClusterBody& b, const Eigen::Vector3d& normal,
+                             double friction, double normal_impulse) = nullptr;
+  ClusterFrictionStep cluster = nullptr;
+  explicit operator bool() const { return contact != nullptr; }
+};
+
+/// The friction `effects` call for: none (no friction effect), Coulomb friction on spheres that
+/// do not turn, or (spin) on turning ones.
+FrictionModel frictionModelFor(const Effects& effects);
+
+/// What one contact received.
+struct ContactResolution {
+  ContactOutcome normal;
+  FrictionOutcome friction;  ///< zero without a friction model
+};
+
+/// A cluster of one contact between `a` and `b`: resolveImpact (exact to the last bit), then the
+/// model's friction with coefficient `friction`.
+ContactResolution solveContact(ClusterBody& a, ClusterBody& b, const ClusterContact& contact,
+                               double friction, const FrictionModel& friction_model);
+
+struct ClusterOutcome {
+  std::vector<ContactOutcome> normal;     ///< per contact
+  std::vector<FrictionOutcome> friction;  ///< per contact; zero without a friction model
+};
+
+/// Resolves a cluster: the normal impulses of resolveSimultaneous, then the model's friction
+/// with each contact's coefficient in `friction_coefficients` (read only with a model). The
+/// bodies' velocities (and with spin their angular velocities) are updated. A cluster of one
+/// contact is solveContact.
+ClusterOutcome solveCluster(std::vector<ClusterBody>& bodies,
+                            const std::vector<ClusterContact>& contacts,
+                            const std::vector<double>& friction_coefficients,
+                            const FrictionModel& friction_model);
+
+}  // namespace collision_response::core

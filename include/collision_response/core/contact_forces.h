@@ -1,0 +1,124 @@
+// Lasting contact: the forces with which bodies that rest, slide or roll on each other and on
+// obstacles press on each other, and the accelerations those forces leave them.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <vector>
+
+namespace collision_response::core {
+
+/// A body of a contact group. An obstacle or an immovable body has inverse_mass 0 (and moves
+/// with constant velocity, acceleration 0).
+struct ForceBody {
+  double inverse_mass = 0.0;  ///< 1/kg; 0: immovable
+  /// 1/k of the moment of inertia I = k m r^2 (5/2 a solid sphere, 3/2 a hollow one); 0: the
+  /// body does not turn (no spin effect, an obstacle, a point).
+  double spin_factor = 0.0;
+  double radius = 0.0;  ///< m; 0 for a plane
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
+  /// m/s^2 without contact forces: gravity for a movable body, 0 for an immovable one.
+  Eigen::Vector3d acceleration = Eigen::Vector3d::Zero();
+  /// rad/s^2 without contact forces (0; see solveContactForces for its use with impulses).
+  Eigen::Vector3d angular_acceleration = Eigen::Vector3d::Zero();
+};
+
+/// A touching pair of the group: b rests on a, or a on b (indices into the bodies).
+struct ForceContact {
+  std::size_t a = 0;
+  std::size_t b = 0;
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();  ///< unit, from a towards b
+  /// 1 / (distance between the centres) for two spheres, whose line of centres turns as they
+  /// move; 0 against a plane.
+  double curvature = 0.0;
+  double friction = 0.0;  ///< Coulomb mu; 0 frictionless (or no friction effect)
+};
+
+/// How a contact carries its force.
+enum class ContactMode {
+  kSeparating,  ///< no force: the bodies move apart (or stay touching without pressing)
+  kSliding,     ///< the surfaces slip: friction -mu N along the slip
+  kSticking,    ///< no slip (resting, or rolling): static friction within mu N
+};
+
+struct ContactForce {
+  ContactMode mode = ContactMode::kSeparating;
+  double normal = 0.0;  ///< N, >= 0: on b along the normal, on a against it
+  /// N, on b (on a the opposite), perpendicular to the normal: friction.
+  Eigen::Vector3d tangential = Eigen::Vector3d::Zero();
+  /// m/s: the slip, b's surface relative to a's at the contact point, perpendicular to the
+  /// normal (0 while sticking).
+  Eigen::Vector3d slip = Eigen::Vector3d::Zero();
+  /// m/s^2: the slip's rate of change, and the gap's second derivative (>= 0; 0 where pressed).
+  Eigen::Vector3d slip_acceleration = Eigen::Vector3d::Zero();
+  double gap_acceleration = 0.0;
+};
+
+struct ContactForceSolution {
+  std::vector<ContactForce> contacts;
+  std::vector<Eigen::Vector3d> acceleration;          ///< per body, m/s^2
+  std::vector<Eigen::Vector3d> angular_acceleration;  ///< per body, rad/s^2
+  /// false: the modes did not settle within the iterations (the last ones are kept, clamped so
+  /// that no contact pulls and no friction exceeds mu N).
+  bool converged = true;
+};
+
+/// Slower slips than this count as none (static friction): m/s.
+struct ContactForceSettings {
+  double slip_tolerance = 1e-9;
+  int max_iterations = 64;
+};
+
+/// The contact forces of a group of touching bodies: every contact force is >= 0 and acts only
+/// where the gap's acceleration is 0, and the gap's acceleration is >= 0 everywhere (Baraff,
+/// "Fast contact force computation for nonpenetrating rigid bodies", SIGGRAPH 1994); with
+/// friction, Coulomb's law: a sliding contact's friction is mu N against the slip, a sticking
+/// one's is whatever keeps the slip at 0 as long as it is within mu N, and beyond it the contact
+/// starts to slide.
+///
+/// For each assignment of modes (pressed or not; sticking or sliding) the conditions are linear
+/// in the unknown forces: gap accelerations of pressed contacts 0, slip accelerations of sticking
+/// ones 0. They are solved jointly (long double, minimum norm where contacts are redundant) and
+/// the modes are changed where a condition fails (a pressed contact that would pull, a free one
+/// that would close, a sticking one beyond mu N, a sliding one whose slip would reverse), all
+/// failing contacts at once, until none fails. Nothing depends on the order of the bodies or
+/// contacts.
+///
+/// The gap of two spheres accelerates by n.(a_b - a_a) + |v_perp|^2 / d (the line of centres
+/// turns); the slip u = v_b - v_a - (r_a w_a + r_b w_b) x n changes at
+/// a_b - a_a - (r_a al_a + r_b al_b) x n - (r_a w_a + r_b w_b) x n', n' = v_perp / d. A force F on
+/// b at the contact (b's point is -r_b n from its centre) turns b at -(w_b / (k_b r_b)) n x F
+/// (I = k m r^2), and a (its point r_a n, its force -F) at the same -(w_a / (k_a r_a)) n x F.
+///
+/// The same problem one level down is the inelastic impact of touching bodies: impulses J >= 0
+/// with no contact approaching afterwards and J = 0 where it separates (friction stopping the
+/// slip within mu J). Pass each body's velocities as its `acceleration` and
+/// `angular_acceleration`, zero `velocity` and `angular_velocity`, curvature 0: the forces are
+/// then the impulses, the accelerations the velocities after.
+ContactForceSolution solveContactForces(const std::vector<ForceBody>& bodies,
+                                        const std::vector<ForceContact>& contacts,
+                                        const ContactForceSettings& settings = {});
+
+/// The forces for modes given (each contact's: not pressed, sliding along its present slip, or
+/// sticking), without changing them: what an integrator needs while the modes hold. The normal
+/// forces keep their sign (negative: the contact would pull, so it lets go there).
+ContactForceSolution solveContactForcesWithModes(const std::vector<ForceBody>& bodies,
+                                                 const std::vector<ForceContact>& contacts,
+                                                 const std::vector<ContactMode>& modes,
+                                                 const ContactForceSettings& settings = {});
+
+/// Velocities consistent with lasting contact: the smallest change of the bodies' motion (impulses
+/// of least norm) after which every contact's normal relative velocity is 0 and, where
+/// `sticking[k]`, its slip too. Applied to the bodies' velocity and angular_velocity.
+void closeContactVelocities(std::vector<ForceBody>& bodies,
+                            const std::vector<ForceContact>& contacts,
+                            const std::vector<bool>& sticking);
+
+/// Positions consistent with lasting contact: the smallest displacements (mass-weighted, along the
+/// normals) that close each contact's gap to `gaps[k]` less itself, that is to 0 (pass the gaps
+/// the contacts have). Applied to `positions` of the movable bodies.
+void closeContactGaps(std::vector<Eigen::Vector3d>& positions, const std::vector<ForceBody>& bodies,
+                      const std::vector<ForceContact>& contacts, const std::vector<double>& gaps);
+
+}  // namespace collision_response::core

@@ -1,0 +1,131 @@
+#include "candidate_pairs.h"
+
+#include "motion_model.h"
+
+namespace collision_response::core::monitor {
+
+void allCandidatePairs(const World& world, std::vector<Pair>& pairs) {
+  pairs.clear();
+  for (std::size_t a = 0; a < world.bodies.size(); ++a) {
+    if (!world.tracks[a].known) continue;
+    for (std::size_t b = a + 1; b < world.bodies.size(); ++b) {
+      if (!world.tracks[b].known || world.inverse_mass[a] + world.inverse_mass[b] == 0.0) continue;
+      pairs.emplace_back(a, b);
+    }
+    if (world.inverse_mass[a] == 0.0) continue;
+    for (std::size_t o = 0; o < world.obstacles.size(); ++o) {
+      if (world.obstacle_tracks[o].known) pairs.emplace_back(a, world.bodies.size() + o);
+    }
+  }
+}
+
+bool mayReachObstacle(const World& world, const Box& box, std::size_t obstacle) {
+  const ObstacleSpec& spec = world.obstacles[obstacle];
+  if (!spec.frame.empty()) return true;  // a moving obstacle: always a candidate
+  const ObstaclePose& pose = world.obstacle_tracks[obstacle].pose;
+  if (spec.shape == ObstacleShape::kPlane) {
+    // The box's lowest point along the normal: does it reach the plane?
+    const Eigen::Vector3d centre = 0.5 * (box.low + box.high);
+    const Eigen::Vector3d half = 0.5 * (box.high - box.low);
+    return pose.normal.dot(centre) - pose.normal.cwiseAbs().dot(half) <= pose.offset;
+  }
+  const Box post{pose.position.array() - spec.radius, pose.position.array() + spec.radius};
+  return post.overlaps(box);
+}
+
+namespace {
+
+template <class Motion>
+void broadphasePairs(World& world, double from, double to, std::vector<Pair>& pairs) {
+  std::vector<Box>& boxes = world.scratch.boxes;
+  std::vector<char>& active = world.scratch.active;
+  boxes.resize(world.bodies.size());
+  active.assign(world.bodies.size(), 0);
+  for (std::size_t i = 0; i < world.bodies.size(); ++i) {
+    if (!world.tracks[i].known) continue;
+    active[i] = 1;
+    boxes[i] = sweptBox<Motion>(world, i, from, to);
+  }
+  world.scratch.hash.build(boxes, active);
+  world.scratch.hash.overlappingPairs(world.scratch.body_pairs);
+  pairs.clear();
+  std::size_t next = 0;
+  const std::vector<std::pair<std::size_t, std::size_t>>& body_pairs = world.scratch.body_pairs;
+  for (std::size_t a = 0; a < world.bodies.size(); ++a) {
+    for (; next < body_pairs.size() && body_pairs[next].first == a; ++next) {
+      if (world.inverse_mass[a] + world.inverse_mass[body_pairs[next].second] > 0) {
+        pairs.push_back(body_pairs[next]);
+      }
+    }
+    if (!active[a] || world.inverse_mass[a] == 0.0) continue;
+    for (std::size_t o = 0; o < world.obstacles.size(); ++o) {
+      if (world.obstacle_tracks[o].known && mayReachObstacle(world, boxes[a], o)) {
+        pairs.emplace_back(a, world.bodies.size() + o);
+      }
+    }
+  }
+  world.scratch.changed_boxes.clear();
+}
+
+}  // namespace
+
+template <class Motion>
+void candidatePairs(World& world, double from, double to, std::vector<Pair>& pairs) {
+  if (world.settings.broadphase) {
+    broadphasePairs<Motion>(world, from, to, pairs);
+  } else {
+    allCandidatePairs(world, pairs);
+  }
+}
+
+template <class Motion>
+std::vector<std::size_t> addReachablePairs(World& world, std::size_t body, double from, double to,
+                                           std::vector<Pair>& pairs,
+                                           const std::vector<std::vector<std::size_t>>& pairs_of) {
+  const Box box = sweptBox<Motion>(world, body, from, to);
+  std::vector<std::size_t>& found = world.scratch.found;
+  world.scratch.hash.query(box, found);
+  // Bodies changed earlier in the step are in the grid with their old boxes: test their new.
+  for (const auto& [other, other_box] : world.scratch.changed_boxes) {
+    if (other_box.overlaps(box)) found.push_back(other);
+  }
+  world.scratch.changed_boxes.emplace_back(body, box);
+  const auto known_pair = [&](const Pair& pair) {
+    for (const std::size_t k : pairs_of[body]) {
+      if (pairs[k] == pair) return true;
+    }
+    return false;
+  };
+  std::vector<std::size_t> added;
+  const auto add = [&](const Pair& pair) {
+    if (known_pair(pair)) return;
+    pairs.push_back(pair);
+    added.push_back(pairs.size() - 1);
+  };
+  for (const std::size_t other : found) {
+    if (other == body || !world.tracks[other].known ||
+        world.inverse_mass[body] + world.inverse_mass[other] == 0.0) {
+      continue;
+    }
+    add(Pair(std::min(body, other), std::max(body, other)));
+  }
+  if (world.inverse_mass[body] > 0) {
+    for (std::size_t o = 0; o < world.obstacles.size(); ++o) {
+      if (world.obstacle_tracks[o].known && mayReachObstacle(world, box, o)) {
+        add(Pair(body, world.bodies.size() + o));
+      }
+    }
+  }
+  return added;
+}
+
+template void candidatePairs<StraightLine>(World&, double, double, std::vector<Pair>&);
+template void candidatePairs<UnderGravity>(World&, double, double, std::vector<Pair>&);
+template std::vector<std::size_t> addReachablePairs<StraightLine>(
+    World&, std::size_t, double, double, std::vector<Pair>&,
+    const std::vector<std::vector<std::size_t>>&);
+template std::vector<std::size_t> addReachablePairs<UnderGravity>(
+    World&, std::size_t, double, double, std::vector<Pair>&,
+    const std::vector<std::vector<std::size_t>>&);
+
+}  // namespace collision_response::core::monitor

@@ -1,0 +1,167 @@
+#include "constrained_motion.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <boost/numeric/odeint.hpp>
+#include <cmath>
+
+namespace collision_response::core::monitor {
+namespace {
+
+constexpr std::size_t kPerBody = 9;  // position, velocity, angular velocity
+
+Eigen::Vector3d slice(const std::vector<double>& state, std::size_t body, std::size_t part) {
+  const std::size_t at = kPerBody * body + 3 * part;
+  return Eigen::Vector3d(state[at], state[at + 1], state[at + 2]);
+}
+
+void put(std::vector<double>& state, std::size_t body, std::size_t part,
+         const Eigen::Vector3d& value) {
+  const std::size_t at = kPerBody * body + 3 * part;
+  for (int c = 0; c < 3; ++c) state[at + c] = value[c];
+}
+
+}  // namespace
+
+struct ConstrainedStep::Integration {
+  using Stepper = boost::numeric::odeint::runge_kutta_dopri5<State>;
+  using Dense = boost::numeric::odeint::result_of::make_dense_output<Stepper>::type;
+  explicit Integration(double tolerance)
+      : dense(boost::numeric::odeint::make_dense_output(tolerance, tolerance, Stepper())) {}
+  Dense dense;
+};
+
+ConstrainedStep::~ConstrainedStep() = default;
+
+ConstrainedStep::ConstrainedStep(const std::vector<ForceBody>& bodies,
+                                 const std::vector<Eigen::Vector3d>& positions, std::size_t movable,
+                                 const std::vector<ConstrainedContact>& contacts, double start,
+                                 double tolerance, double step, double longest)
+    : bodies_(bodies),
+      positions_(positions),
+      movable_(movable),
+      contacts_(contacts),
+      start_(start),
+      end_(start),
+      integration_(std::make_unique<Integration>(tolerance)) {
+  State initial(kPerBody * movable_);
+  for (std::size_t i = 0; i < movable_; ++i) {
+    put(initial, i, 0, positions_[i]);
+    put(initial, i, 1, bodies_[i].velocity);
+    put(initial, i, 2, bodies_[i].angular_velocity);
+  }
+  const ContactForceSolution at_start = forces(initial, start_);
+  for (std::size_t k = 0; k < contacts_.size(); ++k) {
+    force_scale_ = std::max(force_scale_, std::abs(at_start.contacts[k].normal));
+    const Eigen::Vector3d& slip = at_start.contacts[k].slip;
+    slip_direction_.push_back(slip.norm() > 0 ? Eigen::Vector3d(slip.normalized())
+                                              : Eigen::Vector3d::Zero());
+  }
+  initial_acceleration_.assign(at_start.acceleration.begin(),
+                               at_start.acceleration.begin() + static_cast<long>(movable_));
+  integration_->dense.initialize(initial, start_, std::min(step, longest));
+  const auto system = [this](const State& x, State& dxdt, double t) { derivative(x, dxdt, t); };
+  // Steps the integrator offers beyond `longest` are cut: the dense output holds within a step.
+  const std::pair<double, double> interval = integration_->dense.do_step(system);
+  end_ = std::min(interval.second, start_ + longest);
+  next_step_ = integration_->dense.current_time_step();
+  if (!(margin(stateAt(end_), end_) < 0)) return;
+  // A mode stops holding within the step: the first instant, by bisection (its margin is
+  // continuous along the step; to 1e-12 of the step, or of the time line's rounding).
+  double holds = start_, fails = end_;
+  const double resolution = 1e-12 * (end_ - start_) + 4e-16 * std::abs(end_);
+  while (fails - holds > resolution) {
+    const double middle = 0.5 * (holds + fails);
+    if (margin(stateAt(middle), middle) < 0) {
+      fails = middle;
+    } else {
+      holds = middle;
+    }
+  }
+  end_ = fails;
+  mode_changed_ = true;
+}
+
+ContactForceSolution ConstrainedStep::forces(const State& state, double time) const {
+  std::vector<ForceBody> bodies = bodies_;
+  std::vector<Eigen::Vector3d> positions(bodies.size());
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    if (i < movable_) {
+      positions[i] = slice(state, i, 0);
+      bodies[i].velocity = slice(state, i, 1);
+      bodies[i].angular_velocity = slice(state, i, 2);
+    } else {
+      positions[i] = positions_[i] + bodies[i].velocity * (time - start_);
+    }
+  }
+  std::vector<ForceContact> contacts(contacts_.size());
+  std::vector<ContactMode> modes(contacts_.size());
+  for (std::size_t k = 0; k < contacts_.size(); ++k) {
+    const ConstrainedContact& c = contacts_[k];
+    ForceContact& contact = contacts[k];
+    contact.a = c.a;
+    contact.b = c.b;
+    contact.friction = c.friction;
+    if (c.plane) {
+      contact.normal = -c.plane_normal;
+    } else {
+      const Eigen::Vector3d centres = positions[c.b] - positions[c.a];
+      const double distance = centres.norm();
+      contact.normal = centres / distance;
+      contact.curvature = 1.0 / distance;
+    }
+    modes[k] = c.mode;
+  }
+  return solveContactForcesWithModes(bodies, contacts, modes);
+}
+
+void ConstrainedStep::derivative(const State& state, State& rate, double time) const {
+  const ContactForceSolution solution = forces(state, time);
+  rate.resize(state.size());
+  for (std::size_t i = 0; i < movable_; ++i) {
+    put(rate, i, 0, slice(state, i, 1));
+    put(rate, i, 1, solution.acceleration[i]);
+    put(rate, i, 2, solution.angular_acceleration[i]);
+  }
+}
+
+double ConstrainedStep::margin(const State& state, double time) const {
+  const ContactForceSolution solution = forces(state, time);
+  const double scale = std::max(force_scale_, 1e-300);
+  double least = INFINITY;
+  for (std::size_t k = 0; k < contacts_.size(); ++k) {
+    const ContactForce& force = solution.contacts[k];
+    const ConstrainedContact& contact = contacts_[k];
+    least = std::min(least, force.normal / scale);  // it would pull: it lets go
+    if (contact.friction > 0 && contact.mode == ContactMode::kSticking) {
+      least = std::min(least, (contact.friction * force.normal - force.tangential.norm()) / scale);
+    }
+    if (contact.friction > 0 && contact.mode == ContactMode::kSliding &&
+        slip_direction_[k].norm() > 0) {
+      least = std::min(least, force.slip.dot(slip_direction_[k]));  // the slip stops
+    }
+  }
+  return least;
+}
+
+ConstrainedStep::State ConstrainedStep::stateAt(double time) const {
+  State state(kPerBody * movable_);
+  integration_->dense.calc_state(
+      std::clamp(time, integration_->dense.previous_time(), integration_->dense.current_time()),
+      state);
+  return state;
+}
+
+Eigen::Vector3d ConstrainedStep::position(std::size_t body, double time) const {
+  return slice(stateAt(time), body, 0);
+}
+
+Eigen::Vector3d ConstrainedStep::velocity(std::size_t body, double time) const {
+  return slice(stateAt(time), body, 1);
+}
+
+Eigen::Vector3d ConstrainedStep::angularVelocity(std::size_t body, double time) const {
+  return slice(stateAt(time), body, 2);
+}
+
+}  // namespace collision_response::core::monitor

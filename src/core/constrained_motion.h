@@ -1,0 +1,83 @@
+// Lasting contact that curves (a ball on a sphere, on another ball whose line of centres turns)
+// has no closed form: its motion is integrated, one error-controlled step at a time, with the
+// contacts' modes held over the step and the instant a mode stops holding found by bisection.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include "collision_response/core/contact_forces.h"
+
+namespace collision_response::core::monitor {
+
+/// A contact of a group being integrated: between participants a and b (indices into the
+/// step's participants); against a plane b, the plane's outward normal (the contact's normal is
+/// its opposite), otherwise two spheres whose line of centres is the normal.
+struct ConstrainedContact {
+  std::size_t a = 0;
+  std::size_t b = 0;
+  bool plane = false;
+  Eigen::Vector3d plane_normal = Eigen::Vector3d::UnitZ();
+  double friction = 0.0;
+  ContactMode mode = ContactMode::kSticking;  ///< held over the step
+};
+
+/// One step of a group's motion: from `start` to end(), as Dormand-Prince 5(4) with error
+/// control (Boost.Odeint) gives it, or to the first instant within it where a mode stops
+/// holding (a pressed contact would pull, a sticking one needs more than mu N, a sliding one's
+/// slip stops), found by bisection on the step's dense output. The state of every movable
+/// participant (position, velocity, angular velocity) is known at any instant of the step.
+class ConstrainedStep {
+ public:
+  /// `bodies` at `start` (the movable ones first, `movable` of them; the others move at constant
+  /// velocity), their `positions` then. `tolerance`: the integrator's error per step, absolute
+  /// (m, m/s, rad/s) and relative; `step`: the size to try; `longest`: at most this long.
+  ConstrainedStep(const std::vector<ForceBody>& bodies,
+                  const std::vector<Eigen::Vector3d>& positions, std::size_t movable,
+                  const std::vector<ConstrainedContact>& contacts, double start, double tolerance,
+                  double step, double longest);
+  ~ConstrainedStep();
+  ConstrainedStep(const ConstrainedStep&) = delete;
+  ConstrainedStep& operator=(const ConstrainedStep&) = delete;
+
+  double start() const { return start_; }
+  double end() const { return end_; }
+  /// The step ended where a mode stopped holding (the group must be solved again there).
+  bool modeChanged() const { return mode_changed_; }
+  /// The size the integrator would take next.
+  double nextStep() const { return next_step_; }
+
+  Eigen::Vector3d position(std::size_t body, double time) const;
+  Eigen::Vector3d velocity(std::size_t body, double time) const;
+  Eigen::Vector3d angularVelocity(std::size_t body, double time) const;
+  /// The acceleration at the step's start (for bounds).
+  const Eigen::Vector3d& initialAcceleration(std::size_t body) const {
+    return initial_acceleration_[body];
+  }
+
+ private:
+  using State = std::vector<double>;
+  struct Integration;  // Boost.Odeint's dense-output stepper, kept out of this header
+
+  void derivative(const State& state, State& rate, double time) const;
+  ContactForceSolution forces(const State& state, double time) const;
+  /// The least margin of the modes at a state: < 0 where one stops holding.
+  double margin(const State& state, double time) const;
+  State stateAt(double time) const;
+
+  std::vector<ForceBody> bodies_;
+  std::vector<Eigen::Vector3d> positions_;  // at start_
+  std::size_t movable_;
+  std::vector<ConstrainedContact> contacts_;
+  std::vector<Eigen::Vector3d> slip_direction_;  // sliding contacts: the slip's at the start
+  std::vector<Eigen::Vector3d> initial_acceleration_;
+  double start_, end_;
+  double next_step_ = 0.0;
+  bool mode_changed_ = false;
+  double force_scale_ = 0.0;
+  std::unique_ptr<Integration> integration_;
+};
+
+}  // namespace collision_response::core::monitor

@@ -1,0 +1,370 @@
+#include "instant_resolver.h"
+
+#include <algorithm>
+#include <map>
+#include <numeric>
+#include <utility>
+
+#include "collision_response/core/cluster_solver.h"
+#include "collision_response/core/contact_forces.h"
+#include "collision_response/core/impact.h"
+#include "motion_model.h"
+
+namespace collision_response::core::monitor {
+namespace {
+
+/// A touching contact at the instant: positions do not change during an instant, so its
+/// geometry is computed once.
+struct InstantContact {
+  Pair pair;
+  Geometry geometry;
+};
+
+/// A cluster ready for the solver: its participants (local index = position in `members`), its
+/// bodies and contacts in the solver's terms, and each contact's friction coefficient.
+struct PreparedCluster {
+  std::vector<std::size_t> members;
+  std::vector<ClusterBody> bodies;
+  std::vector<ClusterContact> contacts;
+  std::vector<double> friction;  ///< per contact, with the friction effect only
+};
+
+/// The contacts (indices into `contacts`) whose pair approaches at `time`. A lasting contact
+/// (gravity) strikes only when it closes faster than a lasting contact may (restSpeed in its
+/// touching band): what its resting forces leave by rounding is not an impact.
+template <class Motion>
+std::vector<std::size_t> findStriking(const World& world, double time,
+                                      const std::vector<InstantContact>& contacts) {
+  std::vector<std::size_t> striking;
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    const Pair& pair = contacts[k].pair;
+    const Geometry& g = contacts[k].geometry;
+    if (!approaching<Motion>(world, pair, g.normal, time)) continue;
+    if constexpr (Motion::kAccelerates) {
+      if (world.lasting(pair)) {
+        const double closing = (velocityAt<Motion>(world, pair.first, time) -
+                                velocityAt<Motion>(world, pair.second, time))
+                                   .dot(g.normal);
+        if (closing <= restSpeed(world.gravity.norm(), g.tolerance)) continue;
+      }
+    }
+    striking.push_back(k);
+  }
+  return striking;
+}
+
+/// Clusters: striking contacts that share a movable body are solved together (a union-find over
+/// the participants of the striking contacts only, numbered in sorted order). In the order of
+/// each cluster's first striking contact.
+std::vector<std::vector<std::size_t>> formClusters(const World& world,
+                                                   const std::vector<InstantContact>& contacts,
+                                                   const std::vector<std::size_t>& striking) {
+  std::vector<std::size_t> involved;
+  for (const std::size_t k : striking) {
+    involved.push_back(contacts[k].pair.first);
+    involved.push_back(contacts[k].pair.second);
+  }
+  std::sort(involved.begin(), involved.end());
+  involved.erase(std::unique(involved.begin(), involved.end()), involved.end());
+  const auto slot_of = [&involved](std::size_t participant) {
+    return static_cast<std::size_t>(
+        std::lower_bound(involved.begin(), involved.end(), participant) - involved.begin());
+  };
+  std::vector<std::size_t> parent(involved.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto find = [&parent](std::size_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (const std::size_t k : striking) {
+    const auto [a, other] = contacts[k].pair;
+    if (world.inverseMassOf(a) > 0 && world.inverseMassOf(other) > 0) {
+      parent[find(slot_of(a))] = find(slot_of(other));
+    }
+  }
+  const auto cluster_of = [&](std::size_t k) {
+    const auto [a, other] = contacts[k].pair;
+    return world.inverseMassOf(a) > 0 ? find(slot_of(a)) : find(slot_of(other));
+  };
+  std::vector<std::vector<std::size_t>> clusters;
+  std::map<std::size_t, std::size_t> cluster_slot;
+  for (const std::size_t k : striking) {
+    const auto [slot, inserted] = cluster_slot.emplace(cluster_of(k), clusters.size());
+    if (inserted) clusters.emplace_back();
+    clusters[slot->second].push_back(k);
+  }
+  return clusters;
+}
+
+/// The coefficient of restitution a striking contact uses: the pair's, unless its approach is
+/// slower than the restitution threshold (then it rests: 0), or (gravity) its bounce would not
+/// leave the touching band (the rest rule, restSpeed). Such a bounce starts an endless series of
+/// ever smaller ones under the pressing acceleration g: the k-th after it leaves at e^k e u (u
+/// the approach speed) and lands 2 e^k e u / g later, so they add up to 2 e u / (g (1 - e)). The
+/// contact rests from that accumulation instant on (its `since`); in between every bounce stays
+/// within the band, so the body moves as resting from now.
+template <class Motion>
+double contactRestitution(World& world, double time, const InstantContact& contact,
+                          double approach_speed) {
+  const double restitution =
+      approach_speed >= world.restitution_threshold ? world.restitutionOf(contact.pair) : 0.0;
+  if constexpr (Motion::kAccelerates) {
+    const auto [a, other] = contact.pair;
+    const Eigen::Vector3d& normal = contact.geometry.normal;
+    // What presses the pair together along the normal: gravity, or what the bodies' supports
+    // leave of it, less the turning of the line of centres (|v_perp|^2 / d).
+    double pressing =
+        -normal.dot(accelerationOf<Motion>(world, other) - accelerationOf<Motion>(world, a));
+    if (!world.isPlane(other)) {
+      const Eigen::Vector3d relative =
+          velocityAt<Motion>(world, other, time) - velocityAt<Motion>(world, a, time);
+      const Eigen::Vector3d across = relative - relative.dot(normal) * normal;
+      pressing -=
+          across.squaredNorm() / (contact.geometry.gap + world.radius[a] + world.radius[other]);
+    }
+    if (pressing > 0 &&
+        restitution * approach_speed <= restSpeed(pressing, contact.geometry.tolerance)) {
+      world.contact_since[contact.pair] =
+          restitution < 1 ? time + 2 * restitution * approach_speed / (pressing * (1 - restitution))
+                          : time;
+      return 0.0;
+    }
+  }
+  return restitution;
+}
+
+template <class Motion>
+PreparedCluster prepareCluster(World& world, double time,
+                               const std::vector<InstantContact>& contacts,
+                               const std::vector<std::size_t>& cluster) {
+  PreparedCluster prepared;
+  std::vector<std::size_t>& members = prepared.members;
+  const auto local = [&members](std::size_t participant) {
+    const auto found = std::find(members.begin(), members.end(), participant);
+    if (found != members.end()) return static_cast<std::size_t>(found - members.begin());
+    members.push_back(participant);
+    return members.size() - 1;
+  };
+  for (const std::size_t k : cluster) {
+    const InstantContact& instant_contact = contacts[k];
+    const Pair& pair = instant_contact.pair;
+    ClusterContact contact;
+    contact.a = local(pair.first);
+    contact.b = local(pair.second);
+    contact.normal = instant_contact.geometry.normal;
+    const double approach_speed =
+        (velocityAt<Motion>(world, pair.first, time) - velocityAt<Motion>(world, pair.second, time))
+            .dot(contact.normal);
+    contact.restitution = contactRestitution<Motion>(world, time, instant_contact, approach_speed);
+    prepared.contacts.push_back(contact);
+    if (world.friction_model) prepared.friction.push_back(world.frictionOf(pair));
+  }
+  for (const std::size_t participant : members) {
+    ClusterBody body;
+    body.inverse_mass = world.inverseMassOf(participant);
+    body.velocity = velocityAt<Motion>(world, participant, time);
+    body.angular_velocity = angularVelocityAt<Motion>(world, participant, time);
+    body.spin_factor = world.isObstacle(participant) ? 0.0 : world.spin_factor[participant];
+    body.radius = world.radius[participant];
+    prepared.bodies.push_back(body);
+  }
+  return prepared;
+}
+
+/// The cluster's movable bodies continue from `time` with their new velocities.
+template <class Motion>
+void storeVelocities(World& world, double time, const PreparedCluster& prepared,
+                     std::vector<std::size_t>& changed) {
+  for (std::size_t m = 0; m < prepared.members.size(); ++m) {
+    const std::size_t participant = prepared.members[m];
+    if (world.isObstacle(participant) || world.inverseMassOf(participant) == 0.0) continue;
+    Track& track = world.tracks[participant];
+    track.position = positionAt<Motion>(world, participant, time);  // before the velocity changes
+    track.time = time;
+    track.velocity = prepared.bodies[m].velocity;
+    track.angular_velocity = prepared.bodies[m].angular_velocity;
+    track.last_impact_time = time;
+    track.constrained = nullptr;
+    changed.push_back(participant);
+  }
+}
+
+template <class Motion>
+void recordImpacts(const World& world, double time, const std::vector<InstantContact>& contacts,
+                   const std::vector<std::size_t>& cluster, const PreparedCluster& prepared,
+                   const std::vector<ClusterBody>& before, const ClusterOutcome& outcome,
+                   StepReport& report) {
+  for (std::size_t c = 0; c < cluster.size(); ++c) {
+    const auto& [pair, g] = contacts[cluster[c]];
+    const ClusterContact& contact = prepared.contacts[c];
+    const std::vector<ClusterBody>& after = prepared.bodies;
+    ImpactRecord record;
+    record.time = time;
+    record.body_a = pair.first;
+    record.other_is_obstacle = world.isObstacle(pair.second);
+    record.other = record.other_is_obstacle ? pair.second - world.bodyCount() : pair.second;
+    record.normal = g.normal;
+    record.contact_point = positionAt<Motion>(world, pair.first, time) +
+                           (world.radius[pair.first] + 0.5 * g.gap) * g.normal;
+    record.restitution = contact.restitution;
+    record.impulse = outcome.normal[c].impulse;
+    record.friction_impulse = outcome.friction[c].impulse;
+    record.energy_lost = outcome.normal[c].energy_lost + outcome.friction[c].energy_lost;
+    record.velocity_a_before = before[contact.a].velocity;
+    record.velocity_b_before = before[contact.b].velocity;
+    record.velocity_a_after = after[contact.a].velocity;
+    record.velocity_b_after = after[contact.b].velocity;
+    record.angular_velocity_a_before = before[contact.a].angular_velocity;
+    record.angular_velocity_b_before = before[contact.b].angular_velocity;
+    record.angular_velocity_a_after = after[contact.a].angular_velocity;
+    record.angular_velocity_b_after = after[contact.b].angular_velocity;
+    record.oblique = hasObliqueComponent(record.velocity_a_before, g.normal) ||
+                     hasObliqueComponent(record.velocity_b_before, g.normal);
+    report.impacts.push_back(record);
+  }
+}
+
+}  // namespace
+
+template <class Motion>
+void resolveInstant(World& world, double time, const std::vector<Pair>& touching,
+                    StepReport& report, std::vector<std::size_t>& changed) {
+  std::vector<InstantContact> contacts;
+  for (const Pair& pair : touching) {
+    const Geometry g = geometry<Motion>(world, pair, time);
+    if (g.valid) contacts.push_back(InstantContact{pair, g});
+  }
+  for (int round = 0; round < world.settings.max_rounds_per_instant; ++round) {
+    const std::vector<std::size_t> striking = findStriking<Motion>(world, time, contacts);
+    if (striking.empty()) return;
+    for (const std::vector<std::size_t>& cluster : formClusters(world, contacts, striking)) {
+      PreparedCluster prepared = prepareCluster<Motion>(world, time, contacts, cluster);
+      const std::vector<ClusterBody> before = prepared.bodies;
+      const ClusterOutcome outcome =
+          solveCluster(prepared.bodies, prepared.contacts, prepared.friction, world.friction_model);
+      storeVelocities<Motion>(world, time, prepared, changed);
+      recordImpacts<Motion>(world, time, contacts, cluster, prepared, before, outcome, report);
+    }
+  }
+  if (findStriking<Motion>(world, time, contacts).empty()) return;
+  report.truncated = true;
+  ++report.fallbacks;
+  std::vector<Pair> pairs;
+  for (const InstantContact& contact : contacts) pairs.push_back(contact.pair);
+  resolveInelastically<Motion>(world, time, pairs, report, changed);
+}
+
+template <class Motion>
+void resolveInelastically(World& world, double time, const std::vector<Pair>& pairs,
+                          StepReport& report, std::vector<std::size_t>& changed) {
+  // The participants in sorted order; the solver sees velocities as its "accelerations".
+  std::vector<std::size_t> participants;
+  for (const Pair& pair : pairs) {
+    participants.push_back(pair.first);
+    participants.push_back(pair.second);
+  }
+  std::sort(participants.begin(), participants.end());
+  participants.erase(std::unique(participants.begin(), participants.end()), participants.end());
+  const auto slot = [&](std::size_t participant) {
+    return static_cast<std::size_t>(
+        std::lower_bound(participants.begin(), participants.end(), participant) -
+        participants.begin());
+  };
+  std::vector<ForceBody> bodies;
+  for (const std::size_t p : participants) {
+    ForceBody body;
+    body.inverse_mass = world.inverseMassOf(p);
+    body.radius = world.radius[p];
+    body.acceleration = velocityAt<Motion>(world, p, time);
+    body.angular_acceleration = angularVelocityAt<Motion>(world, p, time);
+    if (!world.isObstacle(p)) body.spin_factor = world.spin_factor[p];
+    bodies.push_back(body);
+  }
+  std::vector<ForceContact> contacts;
+  std::vector<Geometry> geometries;
+  for (const Pair& pair : pairs) {
+    const Geometry g = geometry<Motion>(world, pair, time);
+    if (!g.valid) continue;
+    ForceContact contact;
+    contact.a = slot(pair.first);
+    contact.b = slot(pair.second);
+    contact.normal = g.normal;
+    if (world.friction_model) contact.friction = world.frictionOf(pair);
+    contacts.push_back(contact);
+    geometries.push_back(g);
+  }
+  const ContactForceSolution solution = solveContactForces(bodies, contacts);
+  std::size_t k = 0;
+  for (const Pair& pair : pairs) {
+    const Geometry g = geometry<Motion>(world, pair, time);
+    if (!g.valid) continue;
+    const ContactForce& impulse = solution.contacts[k];
+    const ForceContact& contact = contacts[k];
+    ++k;
+    if (impulse.mode == ContactMode::kSeparating) continue;
+    ImpactRecord record;
+    record.time = time;
+    record.body_a = pair.first;
+    record.other_is_obstacle = world.isObstacle(pair.second);
+    record.other = record.other_is_obstacle ? pair.second - world.bodyCount() : pair.second;
+    record.normal = g.normal;
+    record.contact_point = positionAt<Motion>(world, pair.first, time) +
+                           (world.radius[pair.first] + 0.5 * g.gap) * g.normal;
+    record.restitution = 0.0;
+    record.impulse = impulse.normal;
+    record.friction_impulse = impulse.tangential.norm();
+    record.velocity_a_before = bodies[contact.a].acceleration;
+    record.velocity_b_before = bodies[contact.b].acceleration;
+    record.angular_velocity_a_before = bodies[contact.a].angular_acceleration;
+    record.angular_velocity_b_before = bodies[contact.b].angular_acceleration;
+    record.velocity_a_after = world.isObstacle(pair.first) || bodies[contact.a].inverse_mass == 0
+                                  ? record.velocity_a_before
+                                  : solution.acceleration[contact.a];
+    record.velocity_b_after = bodies[contact.b].inverse_mass == 0
+                                  ? record.velocity_b_before
+                                  : solution.acceleration[contact.b];
+    record.angular_velocity_a_after = solution.angular_acceleration[contact.a];
+    record.angular_velocity_b_after = solution.angular_acceleration[contact.b];
+    // The work of the impulse F on b (-F on a) over the change of the contact points' relative
+    // velocity w: -F.(w_before + w_after) / 2.
+    const auto contact_velocity = [&](const Eigen::Vector3d& va, const Eigen::Vector3d& wa,
+                                      const Eigen::Vector3d& vb, const Eigen::Vector3d& wb) {
+      return Eigen::Vector3d(
+          vb - va -
+          (world.radius[pair.first] * wa + world.radius[pair.second] * wb).cross(g.normal));
+    };
+    const Eigen::Vector3d force = impulse.normal * g.normal + impulse.tangential;
+    record.energy_lost =
+        -0.5 *
+        force.dot(contact_velocity(record.velocity_a_before, record.angular_velocity_a_before,
+                                   record.velocity_b_before, record.angular_velocity_b_before) +
+                  contact_velocity(record.velocity_a_after, record.angular_velocity_a_after,
+                                   record.velocity_b_after, record.angular_velocity_b_after));
+    record.oblique = hasObliqueComponent(record.velocity_a_before, g.normal) ||
+                     hasObliqueComponent(record.velocity_b_before, g.normal);
+    report.impacts.push_back(record);
+  }
+  for (std::size_t i = 0; i < participants.size(); ++i) {
+    const std::size_t p = participants[i];
+    if (world.isObstacle(p) || world.inverseMassOf(p) == 0.0) continue;
+    Track& track = world.tracks[p];
+    track.position = positionAt<Motion>(world, p, time);
+    track.time = time;
+    track.velocity = solution.acceleration[i];
+    if (world.spin_factor[p] != 0.0) track.angular_velocity = solution.angular_acceleration[i];
+    track.last_impact_time = time;
+    track.constrained = nullptr;
+    changed.push_back(p);
+  }
+}
+
+template void resolveInstant<StraightLine>(World&, double, const std::vector<Pair>&, StepReport&,
+                                           std::vector<std::size_t>&);
+template void resolveInstant<UnderGravity>(World&, double, const std::vector<Pair>&, StepReport&,
+                                           std::vector<std::size_t>&);
+template void resolveInelastically<StraightLine>(World&, double, const std::vector<Pair>&,
+                                                 StepReport&, std::vector<std::size_t>&);
+template void resolveInelastically<UnderGravity>(World&, double, const std::vector<Pair>&,
+                                                 StepReport&, std::vector<std::size_t>&);
+
+}  // namespace collision_response::core::monitor

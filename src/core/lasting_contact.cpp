@@ -1,0 +1,438 @@
+#include "lasting_contact.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "candidate_pairs.h"
+#include "motion_model.h"
+
+namespace collision_response::core {
+
+const char* toString(ContactState state) {
+  switch (state) {
+    case ContactState::kResting:
+      return "resting";
+    case ContactState::kSliding:
+      return "sliding";
+    case ContactState::kRolling:
+      return "rolling";
+  }
+  return "resting";
+}
+
+namespace monitor {
+namespace {
+
+using Motion = UnderGravity;  // lasting contact needs a steady force: the gravity effect
+
+/// A candidate of lasting contact: touching (or overlapping: then it is held where it is) and
+/// neither approaching nor separating faster than a body falls within the touching band.
+bool lastingCandidate(const World& world, const Pair& pair, double time, const Geometry& g) {
+  if (!g.valid || g.gap > g.tolerance) return false;
+  const Eigen::Vector3d velocity_a = velocityAt<Motion>(world, pair.first, time);
+  const Eigen::Vector3d velocity_other = velocityAt<Motion>(world, pair.second, time);
+  const double normal_speed = (velocity_other - velocity_a).dot(g.normal);
+  const double scale =
+      velocity_a.lpNorm<Eigen::Infinity>() + velocity_other.lpNorm<Eigen::Infinity>();
+  return std::abs(normal_speed) <=
+         restSpeed(world.gravity.norm(), g.tolerance) + kApproachTolerance * scale;
+}
+
+void dissolve(World& world, std::size_t group, std::vector<std::size_t>& members) {
+  ContactGroup& dissolved = world.groups[group];
+  dissolved.alive = false;
+  for (const std::size_t body : dissolved.bodies) {
+    world.tracks[body].group = -1;
+    world.partners[body].clear();
+    members.push_back(body);
+  }
+  dissolved.bodies.clear();
+  dissolved.contacts.clear();
+}
+
+std::size_t newGroup(World& world) {
+  for (std::size_t g = 0; g < world.groups.size(); ++g) {
+    if (!world.groups[g].alive) return g;
+  }
+  world.groups.emplace_back();
+  return world.groups.size() - 1;
+}
+
+/// A slip slower than what integrating curved contact leaves behind (1000 times its tolerance,
+/// at least 1e-9 m/s) is none: the contact sticks, and its slip is closed.
+ContactForceSettings lastingContactSettings(const World& world) {
+  ContactForceSettings settings;
+  settings.slip_tolerance = std::max(1e-9, 1e3 * world.integration_tolerance);
+  return settings;
+}
+
+/// The instant a sliding contact's slip stops, when its rate is constant and against it (the
+/// motion of a group on planes); infinity when it does not stop.
+double slipStops(const ContactForce& force, double time) {
+  const double slip = force.slip.norm();
+  if (!(slip > 0)) return INFINITY;
+  const Eigen::Vector3d direction = force.slip / slip;
+  const double rate = force.slip_acceleration.dot(direction);
+  if (!(rate < 0)) return INFINITY;
+  return time + slip / -rate;
+}
+
+/// One connected set of candidates: solve, and give its bodies their motion.
+void solveGroup(World& world, double time, const std::vector<std::size_t>& bodies,
+                const std::vector<std::pair<Pair, Geometry>>& candidates,
+                std::vector<std::size_t>& changed) {
+  // The solver's bodies: the group's (0..n-1, sorted), then the fixed participants (obstacles,
+  // immovable bodies) in sorted order.
+  std::vector<std::size_t> participants = bodies;
+  std::vector<std::size_t> fixed;
+  for (const auto& [pair, g] : candidates) {
+    for (const std::size_t p : {pair.first, pair.second}) {
+      if (world.inverseMassOf(p) == 0.0) fixed.push_back(p);
+    }
+  }
+  std::sort(fixed.begin(), fixed.end());
+  fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
+  participants.insert(participants.end(), fixed.begin(), fixed.end());
+  const auto slot = [&](std::size_t participant) {
+    const auto movable = std::lower_bound(bodies.begin(), bodies.end(), participant);
+    if (movable != bodies.end() && *movable == participant) {
+      return static_cast<std::size_t>(movable - bodies.begin());
+    }
+    return bodies.size() +
+           static_cast<std::size_t>(std::lower_bound(fixed.begin(), fixed.end(), participant) -
+                                    fixed.begin());
+  };
+  std::vector<ForceBody> force_bodies;
+  for (const std::size_t p : participants) {
+    ForceBody body;
+    body.inverse_mass = world.inverseMassOf(p);
+    body.radius = world.radius[p];
+    body.velocity = velocityAt<Motion>(world, p, time);
+    body.angular_velocity = angularVelocityAt<Motion>(world, p, time);
+    if (body.inverse_mass > 0) {
+      body.spin_factor = world.spin_factor[p];
+      body.acceleration = world.gravity;
+    }
+    force_bodies.push_back(body);
+  }
+  std::vector<ForceContact> contacts;
+  for (const auto& [pair, g] : candidates) {
+    ForceContact contact;
+    contact.a = slot(pair.first);
+    contact.b = slot(pair.second);
+    contact.normal = g.normal;
+    if (!world.isPlane(pair.second))
+      contact.curvature = 1.0 / (g.gap + world.radius[pair.first] + world.radius[pair.second]);
+    if (world.friction_model) contact.friction = world.frictionOf(pair);
+    contacts.push_back(contact);
+  }
+  // Lasting contacts touch: their gaps closed (overlapping ones are held where they are), their
+  // normal relative velocities closed; then the forces; then sticking ones do not slip.
+  std::vector<Eigen::Vector3d> positions;
+  for (const std::size_t p : participants) positions.push_back(positionAt<Motion>(world, p, time));
+  std::vector<double> gaps;
+  for (const auto& [pair, g] : candidates)
+    gaps.push_back(std::abs(g.gap) <= g.tolerance ? g.gap : 0.0);
+  closeContactGaps(positions, force_bodies, contacts, gaps);
+  closeContactVelocities(force_bodies, contacts, std::vector<bool>(contacts.size(), false));
+  const ContactForceSolution solution =
+      solveContactForces(force_bodies, contacts, lastingContactSettings(world));
+  std::vector<bool> sticking(contacts.size(), false);
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    sticking[k] = contacts[k].friction > 0 && solution.contacts[k].mode == ContactMode::kSticking;
+  }
+  if (std::find(sticking.begin(), sticking.end(), true) != sticking.end()) {
+    closeContactVelocities(force_bodies, contacts, sticking);
+  }
+
+  const std::size_t group = newGroup(world);
+  ContactGroup& contact_group = world.groups[group];
+  contact_group.time = time;
+  contact_group.next_event = INFINITY;
+  std::vector<char> pressed_body(bodies.size(), 0);
+  std::vector<std::size_t> pressed;  // indices into candidates
+  // Curved: a pressed contact of two spheres whose line of centres turns (they move or
+  // accelerate relative to each other), or a sliding contact whose slip turns. Then the motion
+  // is integrated; otherwise the forces are constant and it is a parabola.
+  bool curved = false;
+  const double speed_tolerance = lastingContactSettings(world).slip_tolerance;
+  const double acceleration_tolerance = 1e-12 * world.gravity.norm();
+  for (std::size_t k = 0; k < candidates.size(); ++k) {
+    const ContactForce& force = solution.contacts[k];
+    const Pair& pair = candidates[k].first;
+    if (force.mode == ContactMode::kSeparating) {
+      world.contact_since.erase(pair);
+      continue;
+    }
+    pressed.push_back(k);
+    const ForceContact& c = contacts[k];
+    if (c.curvature > 0) {
+      const Eigen::Vector3d relative_velocity =
+          force_bodies[c.b].velocity - force_bodies[c.a].velocity;
+      const Eigen::Vector3d relative_acceleration =
+          solution.acceleration[c.b] - solution.acceleration[c.a];
+      if (relative_velocity.norm() > speed_tolerance ||
+          relative_acceleration.norm() > acceleration_tolerance) {
+        curved = true;
+      }
+    }
+    if (force.mode == ContactMode::kSliding && c.friction > 0 && force.slip.norm() > 0) {
+      const Eigen::Vector3d along = force.slip.normalized();
+      const Eigen::Vector3d rate = force.slip_acceleration;
+      if ((rate - rate.dot(along) * along).norm() >
+          1e-12 * (rate.norm() + acceleration_tolerance)) {
+        curved = true;
+      }
+    }
+    GroupContact contact;
+    contact.pair = pair;
+    contact.normal = candidates[k].second.normal;
+    contact.point = positions[c.a] + world.radius[pair.first] * contact.normal;
+    contact.force = force;
+    const auto since = world.contact_since.emplace(pair, time).first;
+    contact.since = since->second;
+    contact_group.contacts.push_back(contact);
+    for (const std::size_t p : {pair.first, pair.second}) {
+      if (world.inverseMassOf(p) > 0) pressed_body[slot(p)] = 1;
+    }
+    world.partners[pair.first].push_back(pair.second);
+    if (!world.isObstacle(pair.second)) world.partners[pair.second].push_back(pair.first);
+    if (force.mode == ContactMode::kSliding && c.friction > 0) {
+      contact_group.next_event = std::min(contact_group.next_event, slipStops(force, time));
+    }
+  }
+  contact_group.alive = !contact_group.contacts.empty();
+
+  std::shared_ptr<const ConstrainedStep> step;
+  std::vector<std::size_t> step_slot(participants.size(), 0);
+  if (curved) {
+    // The integrated step: the pressed bodies, then the fixed participants of pressed contacts.
+    std::vector<std::size_t> order;
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      if (pressed_body[i]) order.push_back(i);
+    }
+    const std::size_t movable = order.size();
+    for (std::size_t i = bodies.size(); i < participants.size(); ++i) order.push_back(i);
+    std::vector<ForceBody> step_bodies;
+    std::vector<Eigen::Vector3d> step_positions;
+    double guess = 0;
+    for (std::size_t j = 0; j < order.size(); ++j) {
+      step_slot[order[j]] = j;
+      step_bodies.push_back(force_bodies[order[j]]);
+      step_positions.push_back(positions[order[j]]);
+      if (j < movable)
+        guess = std::max(guess, world.tracks[participants[order[j]]].integration_step);
+    }
+    std::vector<ConstrainedContact> step_contacts;
+    for (const std::size_t k : pressed) {
+      const Pair& pair = candidates[k].first;
+      ConstrainedContact c;
+      c.a = step_slot[contacts[k].a];
+      c.b = step_slot[contacts[k].b];
+      c.plane = world.isPlane(pair.second);
+      if (c.plane) c.plane_normal = -candidates[k].second.normal;
+      c.friction = contacts[k].friction;
+      c.mode = solution.contacts[k].mode;
+      step_contacts.push_back(c);
+    }
+    step = std::make_shared<const ConstrainedStep>(step_bodies, step_positions, movable,
+                                                   step_contacts, time, world.integration_tolerance,
+                                                   guess > 0 ? guess : 1e-3, 0.1);
+    contact_group.next_event = std::min(contact_group.next_event, step->end());
+  }
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const std::size_t body = bodies[i];
+    Track& track = world.tracks[body];
+    track.position = positions[i];
+    track.angular_velocity = force_bodies[i].angular_velocity;
+    track.time = time;
+    track.velocity = force_bodies[i].velocity;
+    track.acceleration = solution.acceleration[i];
+    track.angular_acceleration =
+        world.spin_factor[body] != 0.0 ? solution.angular_acceleration[i] : Eigen::Vector3d::Zero();
+    track.constrained = nullptr;
+    if (pressed_body[i]) {
+      track.group = static_cast<int>(group);
+      contact_group.bodies.push_back(body);
+      if (step) {
+        track.constrained = step;
+        track.slot = step_slot[i];
+        track.integration_step = step->nextStep();
+      }
+    } else {
+      track.group = -1;
+    }
+    changed.push_back(body);
+  }
+}
+
+}  // namespace
+
+void clearGroups(World& world) {
+  world.groups.clear();
+  for (Track& track : world.tracks) track.group = -1;
+  world.partners.assign(world.bodies.size(), {});
+  world.groups_current = false;
+}
+
+void formGroups(World& world, double time, const std::vector<std::size_t>& seeds,
+                const PairIndex& index, std::vector<std::size_t>& changed) {
+  if (world.partners.size() != world.bodies.size()) world.partners.assign(world.bodies.size(), {});
+  std::vector<char> visited(world.bodies.size(), 0);
+  std::vector<std::size_t> members;  // the bodies reached, in the order reached
+  std::vector<std::size_t> dissolved;
+  const auto visit = [&](std::size_t body) {
+    if (visited[body] || !world.tracks[body].known || world.inverse_mass[body] == 0.0) return;
+    visited[body] = 1;
+    members.push_back(body);
+    const int group = world.tracks[body].group;
+    if (group >= 0) {
+      dissolved.clear();
+      dissolve(world, static_cast<std::size_t>(group), dissolved);
+      for (const std::size_t member : dissolved) {
+        if (!visited[member]) {
+          visited[member] = 1;
+          members.push_back(member);
+        }
+      }
+    }
+  };
+  for (const std::size_t seed : seeds) visit(seed);
+  std::vector<std::pair<Pair, Geometry>> candidates;
+  std::vector<char> seen(index.pairs.size(), 0);
+  for (std::size_t i = 0; i < members.size(); ++i) {
+    const std::size_t body = members[i];
+    for (const std::size_t k : index.of[body]) {
+      if (seen[k]) continue;
+      seen[k] = 1;
+      const Pair& pair = index.pairs[k];
+      const Geometry g = geometry<Motion>(world, pair, time);
+      if (!lastingCandidate(world, pair, time, g)) {
+        world.contact_since.erase(pair);
+        continue;
+      }
+      candidates.emplace_back(pair, g);
+      const std::size_t other = pair.first == body ? pair.second : pair.first;
+      if (!world.isObstacle(other)) visit(other);
+    }
+  }
+  // Connected sets of movable bodies (union-find over the members, in sorted order).
+  std::sort(members.begin(), members.end());
+  std::vector<std::size_t> parent(members.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto slot = [&](std::size_t body) {
+    return static_cast<std::size_t>(std::lower_bound(members.begin(), members.end(), body) -
+                                    members.begin());
+  };
+  const auto find = [&parent](std::size_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (const auto& [pair, g] : candidates) {
+    if (world.inverseMassOf(pair.first) > 0 && world.inverseMassOf(pair.second) > 0) {
+      const std::size_t x = find(slot(pair.first)), y = find(slot(pair.second));
+      parent[std::max(x, y)] = std::min(x, y);
+    }
+  }
+  std::sort(candidates.begin(), candidates.end(),
+            [](const auto& x, const auto& y) { return x.first < y.first; });
+  // Each set: its bodies (sorted) and its candidates (in the order of their pairs).
+  std::vector<std::vector<std::size_t>> set_bodies(members.size());
+  std::vector<std::vector<std::pair<Pair, Geometry>>> set_candidates(members.size());
+  for (std::size_t i = 0; i < members.size(); ++i) set_bodies[find(i)].push_back(members[i]);
+  for (const auto& candidate : candidates) {
+    const std::size_t body = world.inverseMassOf(candidate.first.first) > 0
+                                 ? candidate.first.first
+                                 : candidate.first.second;
+    set_candidates[find(slot(body))].push_back(candidate);
+  }
+  for (std::size_t root = 0; root < members.size(); ++root) {
+    if (set_bodies[root].empty()) continue;
+    if (set_candidates[root].empty()) {
+      // Free: gravity alone, from here.
+      for (const std::size_t body : set_bodies[root]) {
+        Track& track = world.tracks[body];
+        if (track.acceleration == world.gravity && track.angular_acceleration.isZero() &&
+            !track.constrained) {
+          continue;
+        }
+        track.position = positionAt<Motion>(world, body, time);
+        track.velocity = velocityAt<Motion>(world, body, time);
+        track.angular_velocity = angularVelocityAt<Motion>(world, body, time);
+        track.time = time;
+        track.acceleration = world.gravity;
+        track.angular_acceleration.setZero();
+        track.constrained = nullptr;
+        changed.push_back(body);
+      }
+      continue;
+    }
+    solveGroup(world, time, set_bodies[root], set_candidates[root], changed);
+  }
+}
+
+void formAllGroups(World& world, double time, std::vector<std::size_t>& changed) {
+  clearGroups(world);
+  std::vector<Pair> pairs;
+  candidatePairs<Motion>(world, time, time, pairs);
+  std::vector<std::vector<std::size_t>> of(world.bodies.size());
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    of[pairs[k].first].push_back(k);
+    if (!world.isObstacle(pairs[k].second)) of[pairs[k].second].push_back(k);
+  }
+  std::vector<std::size_t> seeds;
+  for (std::size_t body = 0; body < world.bodies.size(); ++body) {
+    if (world.tracks[body].known) seeds.push_back(body);
+  }
+  formGroups(world, time, seeds, PairIndex{pairs, of}, changed);
+  world.groups_current = true;
+}
+
+std::pair<double, std::size_t> nextGroupEvent(const World& world) {
+  std::pair<double, std::size_t> next{INFINITY, 0};
+  for (std::size_t g = 0; g < world.groups.size(); ++g) {
+    if (world.groups[g].alive && world.groups[g].next_event < next.first) {
+      next = {world.groups[g].next_event, g};
+    }
+  }
+  return next;
+}
+
+void reportContacts(const World& world, double time, std::vector<ContactRecord>& contacts) {
+  for (const ContactGroup& group : world.groups) {
+    if (!group.alive) continue;
+    for (const GroupContact& contact : group.contacts) {
+      const auto [a, other] = contact.pair;
+      ContactRecord record;
+      record.time = time;
+      record.body_a = a;
+      record.other_is_obstacle = world.isObstacle(other);
+      record.other = record.other_is_obstacle ? other - world.bodyCount() : other;
+      record.contact_point = contact.point;
+      record.normal = contact.normal;
+      record.normal_force = contact.force.normal;
+      record.friction_force = contact.force.tangential;
+      record.since = contact.since;
+      const Eigen::Vector3d relative =
+          velocityAt<Motion>(world, other, time) - velocityAt<Motion>(world, a, time);
+      const Eigen::Vector3d turning =
+          angularVelocityAt<Motion>(world, other, time) - angularVelocityAt<Motion>(world, a, time);
+      const double moving = relative.norm() + world.radius[a] * turning.norm();
+      if (contact.force.mode == ContactMode::kSliding) {
+        record.state = ContactState::kSliding;
+      } else {
+        record.state = moving > 1e-9 ? ContactState::kRolling : ContactState::kResting;
+      }
+      contacts.push_back(record);
+    }
+  }
+  std::sort(contacts.begin(), contacts.end(), [](const ContactRecord& x, const ContactRecord& y) {
+    return std::tie(x.body_a, x.other_is_obstacle, x.other) <
+           std::tie(y.body_a, y.other_is_obstacle, y.other);
+  });
+}
+
+}  // namespace monitor
+}  // namespace collision_response::core

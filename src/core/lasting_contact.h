@@ -1,0 +1,42 @@
+// Lasting contact (gravity): bodies that touch without approaching form groups; their contact
+// forces (solveContactForces) give them the motion they rest, slide or roll with, and the
+// instants that motion changes (a slip that stops) are the groups' events.
+#pragma once
+
+#include <cstddef>
+#include <utility>
+#include <vector>
+
+#include "collision_response/core/monitor.h"
+#include "monitor_world.h"
+
+namespace collision_response::core::monitor {
+
+/// The candidate pairs of a search, and each body's pairs among them.
+struct PairIndex {
+  const std::vector<Pair>& pairs;
+  const std::vector<std::vector<std::size_t>>& of;
+};
+
+/// Lasting contact at `time` for the bodies of `seeds`: every body that touches one of them
+/// without approaching or separating (faster than restSpeed of gravity in the touching band)
+/// joins them, transitively, and so do the groups they were in. Each connected set solves its
+/// contact forces; the pressed contacts last, and their bodies' tracks continue from `time`
+/// with the accelerations the forces leave (their normal relative velocities set to 0, so they
+/// stay in contact). Every body whose track was set is appended to `changed`.
+void formGroups(World& world, double time, const std::vector<std::size_t>& seeds,
+                const PairIndex& index, std::vector<std::size_t>& changed);
+
+/// Every tracked body at `time`, with candidate pairs from the broadphase at that instant.
+void formAllGroups(World& world, double time, std::vector<std::size_t>& changed);
+
+/// The earliest event of any group and that group; {infinity, 0} when there is none.
+std::pair<double, std::size_t> nextGroupEvent(const World& world);
+
+/// The lasting contacts as the groups hold them at `time`.
+void reportContacts(const World& world, double time, std::vector<ContactRecord>& contacts);
+
+/// Forgets every group (the tracks keep their motion).
+void clearGroups(World& world);
+
+}  // namespace collision_response::core::monitor

@@ -1,0 +1,168 @@
+// The monitor's data, shared by the stages of a step: what the scene is (participants and their
+// coefficients), what is known of each body (its track), and the step's working memory. Plain
+// data with a few lookups; the stages (candidate_pairs, contact_schedule, instant_resolver) are
+// functions over it, and monitor.cpp runs them in order.
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cstddef>
+#include <limits>
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "collision_response/core/broadphase.h"
+#include "collision_response/core/cluster_solver.h"
+#include "collision_response/core/contact_forces.h"
+#include "collision_response/core/friction.h"
+#include "collision_response/core/monitor.h"
+#include "collision_response/core/motion.h"
+#include "collision_response/core/scene.h"
+#include "constrained_motion.h"
+
+namespace collision_response::core::monitor {
+
+inline constexpr double kEps = std::numeric_limits<double>::epsilon();
+inline constexpr double kNever = -std::numeric_limits<double>::infinity();
+/// A pair approaches when its normal relative velocity is below -64 ulps of the speeds: what a
+/// resolved impact leaves behind by rounding (e = 0 gives d' = 0 only up to a few ulps) must not
+/// count as a new approach.
+inline constexpr double kApproachTolerance = 64 * kEps;
+
+/// What the monitor knows of a body: a state from which its motion is predicted.
+struct Track {
+  bool known = false;
+  double time = 0.0;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
+  /// Gravity, or (in lasting contact) what gravity and the contact forces leave.
+  Eigen::Vector3d acceleration = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_acceleration = Eigen::Vector3d::Zero();  ///< rolling: from friction
+  int group = -1;  ///< its group of lasting contact (World::groups), -1: none
+  /// Curved lasting contact: the integrated step its motion follows (body `slot` of it), which
+  /// replaces the parabola; null otherwise.
+  std::shared_ptr<const ConstrainedStep> constrained;
+  std::size_t slot = 0;
+  double integration_step = 0.0;  ///< the integrator's last step size, a guess for the next
+  double last_state_time = kNever;
+  double last_impact_time = kNever;
+};
+
+struct ObstacleTrack {
+  bool known = false;
+  ObstaclePose pose;
+};
+
+/// A body (index < bodyCount) and another participant: a body, or obstacle index + bodyCount.
+using Pair = std::pair<std::size_t, std::size_t>;
+
+/// Where two participants are relative to each other at one instant.
+struct Geometry {
+  Eigen::Vector3d normal;  ///< unit, a -> other
+  double gap = 0.0;        ///< m, surface to surface along the normal; < 0 overlapping
+  double tolerance = 0.0;  ///< m, |gap| within it is touching
+  bool valid = false;      ///< false: coincident centres and no approach: no line of impact
+};
+
+/// A contact that lasts: the pair presses with a steady force (ContactForce), at `time`.
+struct GroupContact {
+  Pair pair;
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();  ///< unit, a -> other
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  ContactForce force;
+  double since = 0.0;  ///< s, the instant it began to last
+};
+
+/// Bodies that rest, slide or roll on each other and on obstacles (lasting contact), and the
+/// motion their contact forces give them from `time` on, until `next_event` (a slip that stops).
+struct ContactGroup {
+  bool alive = false;
+  double time = 0.0;
+  std::vector<std::size_t> bodies;     ///< sorted
+  std::vector<GroupContact> contacts;  ///< the pressed ones, in the canonical order of pairs
+  double next_event = std::numeric_limits<double>::infinity();
+};
+
+/// Working memory of a step, kept so that steps do not allocate once it has grown.
+struct Scratch {
+  std::vector<Pair> pairs;
+  std::vector<std::vector<std::size_t>> pairs_of;
+  std::vector<double> next_contact;
+  std::vector<Geometry> geometry;
+  std::vector<char> queued;
+  std::vector<Box> boxes;
+  std::vector<char> active;
+  SpatialHash hash;
+  std::vector<std::pair<std::size_t, std::size_t>> body_pairs;
+  std::vector<std::pair<double, std::size_t>> events;
+  std::vector<std::pair<std::size_t, Box>> changed_boxes;
+  std::vector<std::size_t> found;
+};
+
+struct World {
+  MonitorSettings settings;
+  Detection detection = Detection::kContinuous;
+  double restitution_threshold = 0.0;
+  std::vector<BodySpec> bodies;         // sorted by id
+  std::vector<ObstacleSpec> obstacles;  // sorted by id
+  std::unordered_map<std::string, std::size_t> body_index;
+  std::vector<double> radius;        // per participant
+  std::vector<double> inverse_mass;  // per body
+  std::vector<double> spin_factor;   // per body, 1/k, 0 without spin
+  Effects effects;                   // what this build runs of the scene's (runnableEffects)
+  Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  // zero without the gravity effect
+  double integration_tolerance = 1e-9;                // curved lasting contact
+  FrictionModel friction_model;                       // empty without the friction effect
+  std::vector<std::string> material_names;            // the scene's materials, indexed
+  std::vector<std::size_t> material;                  // per participant, into restitution
+  std::vector<std::vector<double>> restitution;       // material x material
+  std::vector<std::vector<double>> friction;          // material x material
+  std::vector<Track> tracks;
+  std::vector<ObstacleTrack> obstacle_tracks;
+  std::set<Pair> overlapping;        // discrete: pairs overlapping at the previous step
+  std::vector<ContactGroup> groups;  // lasting contact (gravity)
+  std::vector<std::vector<std::size_t>> partners;  // per body: its lasting contacts' others
+  std::map<Pair, double> contact_since;            // every lasting pair's start, and those the
+                                                   // rest rule set to begin at an instant
+  bool groups_current = false;                     // the groups hold for the tracks at `now`
+  Scratch scratch;
+  bool started = false;
+  double now = 0.0;
+
+  std::size_t bodyCount() const { return bodies.size(); }
+  bool isObstacle(std::size_t participant) const { return participant >= bodies.size(); }
+  bool isPlane(std::size_t participant) const {
+    return isObstacle(participant) &&
+           obstacles[participant - bodies.size()].shape == ObstacleShape::kPlane;
+  }
+  const ObstaclePose& obstaclePose(std::size_t participant) const {
+    return obstacle_tracks[participant - bodies.size()].pose;
+  }
+  bool known(std::size_t participant) const {
+    return isObstacle(participant) ? obstacle_tracks[participant - bodies.size()].known
+                                   : tracks[participant].known;
+  }
+  double inverseMassOf(std::size_t participant) const {
+    return isObstacle(participant) ? 0.0 : inverse_mass[participant];
+  }
+  double restitutionOf(const Pair& pair) const {
+    return restitution[material[pair.first]][material[pair.second]];
+  }
+  double frictionOf(const Pair& pair) const {
+    return friction[material[pair.first]][material[pair.second]];
+  }
+  /// The pair is a lasting contact: its motion keeps it touching (no first contact to look for).
+  bool lasting(const Pair& pair) const {
+    if (partners.empty()) return false;
+    const std::vector<std::size_t>& others = partners[pair.first];
+    return std::find(others.begin(), others.end(), pair.second) != others.end();
+  }
+};
+
+}  // namespace collision_response::core::monitor

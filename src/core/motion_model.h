@@ -1,0 +1,274 @@
+// The motion models of the monitor and the small kernels that depend on them: where a
+// participant is at an instant and how fast it moves, where two participants are relative to
+// each other, when they first touch, and the box a body sweeps. The model is a template
+// parameter chosen once per step (monitor.cpp, withMotionModel): no per-pair branch on gravity.
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "collision_response/core/broadphase.h"
+#include "collision_response/core/motion.h"
+#include "collision_response/core/time_of_impact.h"
+#include "monitor_world.h"
+
+namespace collision_response::core::monitor {
+
+/// Free flight in a straight line: no effect moves the bodies between impacts.
+struct StraightLine {
+  static constexpr bool kAccelerates = false;
+  static Eigen::Vector3d position(const Track& track, double time) {
+    return track.position + track.velocity * (time - track.time);
+  }
+  static Eigen::Vector3d velocity(const Track& track, double /*time*/) { return track.velocity; }
+  static Eigen::Vector3d angularVelocity(const Track& track, double /*time*/) {
+    return track.angular_velocity;
+  }
+};
+
+/// Parabolas under the track's acceleration (gravity, or its part along the plane a body rests
+/// on): the gravity effect.
+/// In curved lasting contact the motion is the integrated step's instead.
+struct UnderGravity {
+  static constexpr bool kAccelerates = true;
+  static Eigen::Vector3d position(const Track& track, double time) {
+    if (track.constrained) return track.constrained->position(track.slot, time);
+    return positionAfter(track.position, track.velocity, track.acceleration, time - track.time);
+  }
+  static Eigen::Vector3d velocity(const Track& track, double time) {
+    if (track.constrained) return track.constrained->velocity(track.slot, time);
+    return velocityAfter(track.velocity, track.acceleration, time - track.time);
+  }
+  static Eigen::Vector3d angularVelocity(const Track& track, double time) {
+    if (track.constrained) return track.constrained->angularVelocity(track.slot, time);
+    return velocityAfter(track.angular_velocity, track.angular_acceleration, time - track.time);
+  }
+};
+
+/// The participant moves along an integrated step (curved lasting contact).
+inline bool constrained(const World& world, std::size_t participant) {
+  return !world.isObstacle(participant) && world.tracks[participant].constrained != nullptr;
+}
+
+/// A participant's position at `time`: a body along its track, an obstacle along its pose.
+template <class Motion>
+Eigen::Vector3d positionAt(const World& world, std::size_t participant, double time) {
+  if (world.isObstacle(participant)) {
+    const ObstaclePose& pose = world.obstaclePose(participant);
+    return pose.position + pose.velocity * (time - pose.time);
+  }
+  return Motion::position(world.tracks[participant], time);
+}
+
+template <class Motion>
+Eigen::Vector3d velocityAt(const World& world, std::size_t participant, double time) {
+  if (world.isObstacle(participant)) return world.obstaclePose(participant).velocity;
+  return Motion::velocity(world.tracks[participant], time);
+}
+
+template <class Motion>
+Eigen::Vector3d angularVelocityAt(const World& world, std::size_t participant, double time) {
+  if (world.isObstacle(participant)) return world.obstaclePose(participant).angular_velocity;
+  return Motion::angularVelocity(world.tracks[participant], time);
+}
+
+/// The acceleration the model gives a participant (obstacles move in straight lines).
+template <class Motion>
+Eigen::Vector3d accelerationOf(const World& world, std::size_t participant) {
+  if (!Motion::kAccelerates || world.isObstacle(participant)) return Eigen::Vector3d::Zero();
+  return world.tracks[participant].acceleration;
+}
+
+/// Where the two participants of `pair` are relative to each other at `time`.
+template <class Motion>
+Geometry geometry(const World& world, const Pair& pair, double time) {
+  const auto [a, other] = pair;
+  const Eigen::Vector3d position_a = positionAt<Motion>(world, a, time);
+  Geometry result;
+  if (world.isPlane(other)) {
+    const ObstaclePose& plane = world.obstaclePose(other);
+    const double offset = plane.offset + plane.normal.dot(plane.velocity) * (time - plane.time);
+    result.normal = -plane.normal;  // from the body into the plane
+    result.gap = plane.normal.dot(position_a) - offset - world.radius[a];
+    result.tolerance =
+        touchingBand(world.radius[a], world.settings.contact_tolerance, position_a, offset);
+    result.valid = true;
+    return result;
+  }
+  const Eigen::Vector3d position_other = positionAt<Motion>(world, other, time);
+  const Eigen::Vector3d separation = position_other - position_a;
+  const double distance = separation.norm();
+  const double contact_distance = world.radius[a] + world.radius[other];
+  if (!(distance > 0)) {
+    // Coincident centres (a sample caught one body right through the other): no line of
+    // centres; the line of impact is the direction of approach, if there is one.
+    const Eigen::Vector3d approach =
+        velocityAt<Motion>(world, a, time) - velocityAt<Motion>(world, other, time);
+    if (!(approach.norm() > 0)) return result;
+    result.normal = approach.normalized();
+  } else {
+    result.normal = separation / distance;
+  }
+  result.gap = distance - contact_distance;
+  result.tolerance = world.settings.contact_tolerance * contact_distance +
+                     16 * kEps *
+                         (position_a.lpNorm<Eigen::Infinity>() +
+                          position_other.lpNorm<Eigen::Infinity>() + contact_distance);
+  result.valid = true;
+  return result;
+}
+
+template <class Motion>
+Geometry geometry(const World& world, const Pair& pair, double time);
+
+/// The first contact of a pair one of whose bodies follows an integrated step, within it: the
+/// gap sampled along the step and the first entry (from open to closed) bisected.
+template <class Motion>
+std::optional<double> timeOfImpactAlongPaths(const World& world, const Pair& pair, double from,
+                                             double horizon) {
+  double end = from + horizon;
+  for (const std::size_t p : {pair.first, pair.second}) {
+    if (constrained(world, p)) end = std::min(end, world.tracks[p].constrained->end());
+  }
+  if (!(end > from)) return std::nullopt;
+  const auto gap = [&](double t) { return geometry<Motion>(world, pair, t).gap; };
+  constexpr int kSamples = 16;
+  double previous_time = from, previous_gap = gap(from);
+  if (previous_gap < 0) return std::nullopt;  // overlapping already: not an impact
+  for (int i = 1; i <= kSamples; ++i) {
+    const double t = from + (end - from) * i / kSamples;
+    const double g = gap(t);
+    if (previous_gap > 0 && g <= 0) {
+      double open = previous_time, closed = t;
+      while (closed - open > 1e-13 * (end - from) + 4e-16 * std::abs(closed)) {
+        const double middle = 0.5 * (open + closed);
+        (gap(middle) > 0 ? open : closed) = middle;
+      }
+      return closed - from;
+    }
+    previous_time = t;
+    previous_gap = g;
+  }
+  return std::nullopt;
+}
+
+/// The first contact of `pair` within `horizon` after `from` (time_of_impact.h's stable roots).
+template <class Motion>
+std::optional<double> timeOfImpact(const World& world, const Pair& pair, double from,
+                                   double horizon) {
+  const auto [a, other] = pair;
+  if constexpr (Motion::kAccelerates) {
+    if (constrained(world, a) || constrained(world, other)) {
+      return timeOfImpactAlongPaths<Motion>(world, pair, from, horizon);
+    }
+  }
+  const Eigen::Vector3d relative_velocity =
+      velocityAt<Motion>(world, other, from) - velocityAt<Motion>(world, a, from);
+  if (world.isPlane(other)) {
+    const ObstaclePose& plane = world.obstaclePose(other);
+    const Geometry g = geometry<Motion>(world, pair, from);
+    const double rate = -plane.normal.dot(relative_velocity);
+    if constexpr (Motion::kAccelerates) {
+      return timeOfImpactPlaneBallistic(g.gap, rate, plane.normal.dot(world.tracks[a].acceleration),
+                                        horizon);
+    } else {
+      return timeOfImpactPlane(g.gap, rate, horizon);
+    }
+  }
+  const Eigen::Vector3d separation =
+      positionAt<Motion>(world, other, from) - positionAt<Motion>(world, a, from);
+  const double contact_distance = world.radius[a] + world.radius[other];
+  if constexpr (Motion::kAccelerates) {
+    // Two bodies under the same gravity keep the straight-line relative problem.
+    return timeOfImpactSpheresAccelerated(
+        separation, relative_velocity,
+        accelerationOf<Motion>(world, other) - world.tracks[a].acceleration, contact_distance,
+        horizon);
+  } else {
+    return timeOfImpactSpheres<double>(separation, relative_velocity, contact_distance, horizon);
+  }
+}
+
+/// How far apart the pair's surfaces can close within `horizon` from `from`, head-on and
+/// accelerating all the way: a gap larger than this needs no root.
+template <class Motion>
+double reach(const World& world, const Pair& pair, double from, double horizon) {
+  if constexpr (Motion::kAccelerates) {
+    // An integrated step's accelerations vary: no bound, the root is looked for.
+    if (constrained(world, pair.first) || constrained(world, pair.second)) return INFINITY;
+  }
+  const double speed =
+      (velocityAt<Motion>(world, pair.second, from) - velocityAt<Motion>(world, pair.first, from))
+          .norm();
+  double distance = speed * horizon;
+  if constexpr (Motion::kAccelerates) {
+    distance += 0.5 *
+                (accelerationOf<Motion>(world, pair.second) - world.tracks[pair.first].acceleration)
+                    .norm() *
+                horizon * horizon;
+  }
+  return distance;
+}
+
+/// The pair closes along `normal` at `time` faster than rounding explains.
+template <class Motion>
+bool approaching(const World& world, const Pair& pair, const Eigen::Vector3d& normal, double time) {
+  const Eigen::Vector3d velocity_a = velocityAt<Motion>(world, pair.first, time);
+  const Eigen::Vector3d velocity_other = velocityAt<Motion>(world, pair.second, time);
+  const double relative_normal = (velocity_other - velocity_a).dot(normal);
+  const double scale =
+      velocity_a.lpNorm<Eigen::Infinity>() + velocity_other.lpNorm<Eigen::Infinity>();
+  return relative_normal < -kApproachTolerance * scale;
+}
+
+/// The box a body sweeps over [from, to], padded by its radius.
+template <class Motion>
+Box sweptBox(const World& world, std::size_t body, double from, double to) {
+  const Eigen::Vector3d start = positionAt<Motion>(world, body, from);
+  const Eigen::Vector3d end = positionAt<Motion>(world, body, to);
+  Box box{start.cwiseMin(end), start.cwiseMax(end)};
+  if constexpr (Motion::kAccelerates) {
+    if (constrained(world, body)) {
+      // Along the integrated step, sampled; beyond its end, as far as its speed and gravity and
+      // the step's acceleration (twice) could carry it.
+      const ConstrainedStep& step = *world.tracks[body].constrained;
+      const double inside = std::clamp(to, from, step.end());
+      for (int i = 1; i <= 16; ++i) {
+        const Eigen::Vector3d point =
+            positionAt<Motion>(world, body, from + (inside - from) * i / 16);
+        box.low = box.low.cwiseMin(point);
+        box.high = box.high.cwiseMax(point);
+      }
+      const double beyond = to - inside;
+      const double distance =
+          velocityAt<Motion>(world, body, inside).norm() * beyond +
+          (world.gravity.norm() + step.initialAcceleration(world.tracks[body].slot).norm()) *
+              beyond * beyond;
+      box.low.array() -= distance;
+      box.high.array() += distance;
+    } else {
+      // A parabola's extreme along an axis, where that axis's velocity turns.
+      const Eigen::Vector3d velocity = velocityAt<Motion>(world, body, from);
+      const Eigen::Vector3d& acceleration = world.tracks[body].acceleration;
+      for (int axis = 0; axis < 3; ++axis) {
+        if (acceleration[axis] == 0) continue;
+        const double turn = -velocity[axis] / acceleration[axis];
+        if (turn > 0 && turn < to - from) {
+          const double extreme = positionAt<Motion>(world, body, from + turn)[axis];
+          box.low[axis] = std::min(box.low[axis], extreme);
+          box.high[axis] = std::max(box.high[axis], extreme);
+        }
+      }
+    }
+  }
+  // The body's size, with room for the touching band and the rounding of the positions.
+  const double pad = world.radius[body] * (1 + 2 * world.settings.contact_tolerance) +
+                     64 * kEps * (box.low.cwiseAbs().maxCoeff() + box.high.cwiseAbs().maxCoeff());
+  box.low.array() -= pad;
+  box.high.array() += pad;
+  return box;
+}
+
+}  // namespace collision_response::core::monitor

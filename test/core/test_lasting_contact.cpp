@@ -1,0 +1,409 @@
+// Lasting contact in the monitor: bodies that rest, slide, roll and stack under gravity, each
+// against a closed form (derived in the comment above its test), and never inside anything.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "collision_response/core/monitor.h"
+
+namespace collision_response::core {
+namespace {
+
+using V = Eigen::Vector3d;
+constexpr double kG = 9.81;
+
+/// A scene with gravity (0, 0, -g) and the given effects.
+Scene gravityScene(bool friction = false, bool spin = false) {
+  Scene scene;
+  scene.effects.gravity = true;
+  scene.effects.friction = friction;
+  scene.effects.spin = spin;
+  scene.gravity = V(0, 0, -kG);
+  return scene;
+}
+
+void addMaterial(Scene& scene, const std::string& name, double restitution, double friction) {
+  ASSERT_TRUE(scene.materials.addMaterial(name, Material{restitution, friction}, "m").ok());
+}
+
+BodySpec ball(const std::string& id, double mass, double radius, const std::string& material) {
+  BodySpec body;
+  body.id = id;
+  body.mass = mass;
+  body.radius = radius;
+  body.material = material;
+  return body;
+}
+
+ObstacleSpec plane(const std::string& id, const V& normal, double offset,
+                   const std::string& material) {
+  ObstacleSpec obstacle;
+  obstacle.id = id;
+  obstacle.normal = normal;
+  obstacle.offset = offset;
+  obstacle.material = material;
+  return obstacle;
+}
+
+MonitorSettings longLived() {
+  MonitorSettings settings;
+  settings.body_timeout = 1e9;  // the monitor moves the bodies itself: no states after the first
+  return settings;
+}
+
+/// Runs the monitor on its own motion (no states after the first) at `rate` until `end`,
+/// calling `check(time)` after every step; returns every impact.
+template <class Check>
+std::vector<ImpactRecord> run(ImpactMonitor& monitor, const std::vector<BodyStateSample>& start,
+                              double rate, double end, Check check) {
+  std::vector<ImpactRecord> impacts;
+  monitor.step(0.0, start);
+  const int steps = static_cast<int>(std::lround(end * rate));
+  for (int k = 1; k <= steps; ++k) {
+    const double t = k / rate;
+    const StepReport report = monitor.step(t, {});
+    impacts.insert(impacts.end(), report.impacts.begin(), report.impacts.end());
+    check(t, report);
+  }
+  return impacts;
+}
+
+BodyStateSample state(const ImpactMonitor& monitor, const std::string& id, const V& position,
+                      const V& velocity = V::Zero(), const V& angular = V::Zero()) {
+  BodyStateSample sample;
+  sample.body = *monitor.bodyIndex(id);
+  sample.position = position;
+  sample.velocity = velocity;
+  sample.angular_velocity = angular;
+  return sample;
+}
+
+/// How far a ball is inside a plane (> 0: inside).
+double depthInPlane(const V& centre, double radius, const V& normal, double offset) {
+  return offset + radius - normal.normalized().dot(centre);
+}
+
+// A frictionless incline at theta through the origin, descending towards +x (normal (sin t, 0,
+// cos t)). A ball released at rest touching it slides down at g sin t: its centre moves by
+// x(t) = 1/2 g sin t t^2 along (cos t, 0, -sin t), and it stays on the plane.
+TEST(LastingContact, SlidesDownAFrictionlessIncline) {
+  const double theta = 10.0 * M_PI / 180.0, r = 0.05;
+  const V up(std::sin(theta), 0, std::cos(theta)), down(std::cos(theta), 0, -std::sin(theta));
+  Scene scene = gravityScene();
+  addMaterial(scene, "ice", 0.5, 0.0);
+  scene.bodies = {ball("ball", 0.2, r, "ice")};
+  scene.obstacles = {plane("incline", up, 0.0, "ice")};
+  ImpactMonitor monitor(scene, longLived());
+  const V start = r * up;
+  double worst = 0;
+  const auto impacts =
+      run(monitor, {state(monitor, "ball", start)}, 100, 2.0, [&](double t, const StepReport&) {
+        const V expected = start + 0.5 * kG * std::sin(theta) * t * t * down;
+        worst = std::max(worst, (monitor.predictedState(0, t)->first - expected).norm());
+      });
+  EXPECT_TRUE(impacts.empty());
+  EXPECT_LT(worst, 1e-13);
+  const StepReport report = monitor.step(2.01, {});
+  ASSERT_EQ(report.contacts.size(), 1u);
+  EXPECT_EQ(report.contacts[0].state, ContactState::kSliding);
+  EXPECT_NEAR(report.contacts[0].normal_force, 0.2 * kG * std::cos(theta), 1e-12);
+  EXPECT_EQ(report.contacts[0].since, 0.0);
+}
+
+// With friction and spin a solid ball rolls: a = 5/7 g sin t (mu = 0.5 >= 2/7 tan t), and it
+// turns at w = v / r about the axis up x down, the contact point at rest.
+TEST(LastingContact, RollsDownARoughInclineAtFiveSevenths) {
+  const double theta = 20.0 * M_PI / 180.0, r = 0.05;
+  const V up(std::sin(theta), 0, std::cos(theta)), down(std::cos(theta), 0, -std::sin(theta));
+  Scene scene = gravityScene(true, true);
+  addMaterial(scene, "rubber", 0.5, 0.5);
+  scene.bodies = {ball("ball", 0.2, r, "rubber")};
+  scene.obstacles = {plane("incline", up, 0.0, "rubber")};
+  ImpactMonitor monitor(scene, longLived());
+  const V start = r * up;
+  double worst = 0;
+  run(monitor, {state(monitor, "ball", start)}, 100, 1.0, [&](double t, const StepReport& report) {
+    const V expected = start + 0.5 * 5.0 / 7.0 * kG * std::sin(theta) * t * t * down;
+    worst = std::max(worst, (monitor.predictedState(0, t)->first - expected).norm());
+    ASSERT_EQ(report.contacts.size(), 1u);
+    EXPECT_EQ(report.contacts[0].state, ContactState::kRolling);
+    EXPECT_NEAR(report.contacts[0].friction_force.norm(), 2.0 / 7.0 * 0.2 * kG * std::sin(theta),
+                1e-12);
+  });
+  EXPECT_LT(worst, 1e-12);
+}
+
+// Without spin a ball on a rough incline is a block. Launched up the slope at v0 with
+// tan t < mu, it slides up decelerating at g (sin t + mu cos t), stops after
+// t_s = v0 / (g (sin t + mu cos t)) at s = v0^2 / (2 g (sin t + mu cos t)) up the slope, and
+// static friction holds it there.
+TEST(LastingContact, StopsOnARoughInclineBelowTheFrictionAngle) {
+  const double theta = 15.0 * M_PI / 180.0, r = 0.05, mu = 0.6, v0 = 2.0;
+  ASSERT_LT(std::tan(theta), mu);
+  const V up(std::sin(theta), 0, std::cos(theta)), down(std::cos(theta), 0, -std::sin(theta));
+  Scene scene = gravityScene(true, false);
+  addMaterial(scene, "felt", 0.2, mu);
+  scene.bodies = {ball("ball", 0.2, r, "felt")};
+  scene.obstacles = {plane("incline", up, 0.0, "felt")};
+  ImpactMonitor monitor(scene, longLived());
+  const V start = r * up;
+  const double deceleration = kG * (std::sin(theta) + mu * std::cos(theta));
+  const double stop_time = v0 / deceleration;
+  const V rest = start - v0 * v0 / (2 * deceleration) * down;
+  run(monitor, {state(monitor, "ball", start, -v0 * down)}, 100, 1.0,
+      [&](double t, const StepReport& report) {
+        const V expected =
+            t < stop_time ? V(start - (v0 * t - 0.5 * deceleration * t * t) * down) : rest;
+        EXPECT_LT((monitor.predictedState(0, t)->first - expected).norm(), 1e-12) << t;
+        if (t > stop_time) {
+          ASSERT_EQ(report.contacts.size(), 1u);
+          EXPECT_EQ(report.contacts[0].state, ContactState::kResting);
+          EXPECT_NEAR(report.contacts[0].friction_force.norm(), 0.2 * kG * std::sin(theta), 1e-12);
+        }
+      });
+  EXPECT_LT(monitor.predictedState(0, 1.0)->second.norm(), 1e-15);
+}
+
+// A centred stack of three balls on the floor, released at rest touching: it stays, and each
+// contact carries the weight above it: (m1 + m2 + m3) g, (m2 + m3) g, m3 g.
+TEST(LastingContact, CentredStackOfThreeHolds) {
+  const double r = 0.05;
+  Scene scene = gravityScene();
+  addMaterial(scene, "wood", 0.6, 0.0);
+  scene.bodies = {ball("a", 0.3, r, "wood"), ball("b", 0.2, r, "wood"), ball("c", 0.1, r, "wood")};
+  scene.obstacles = {plane("floor", V(0, 0, 1), 0.0, "wood")};
+  ImpactMonitor monitor(scene, longLived());
+  const std::vector<BodyStateSample> start = {state(monitor, "a", V(0, 0, r)),
+                                              state(monitor, "b", V(0, 0, 3 * r)),
+                                              state(monitor, "c", V(0, 0, 5 * r))};
+  StepReport last;
+  const auto impacts =
+      run(monitor, start, 100, 2.0, [&](double, const StepReport& report) { last = report; });
+  EXPECT_TRUE(impacts.empty());
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR((monitor.predictedState(i, 2.0)->first - V(0, 0, (2 * i + 1) * r)).norm(), 0.0,
+                1e-15);
+  }
+  ASSERT_EQ(last.contacts.size(), 3u);
+  // In the order of pairs: a-b, a-floor, b-c.
+  EXPECT_NEAR(last.contacts[0].normal_force, 0.3 * kG, 1e-13);
+  EXPECT_NEAR(last.contacts[1].normal_force, 0.6 * kG, 1e-13);
+  EXPECT_NEAR(last.contacts[2].normal_force, 0.1 * kG, 1e-13);
+}
+
+// A putty ball (e = 0.2) dropped centred from 0.2 m onto a ball resting on the floor bounces to
+// rest on it, after finitely many impacts; it never goes into it, and ends with its centre 2 r
+// above the other's.
+TEST(LastingContact, PuttyDroppedOnAStackRestsOnTop) {
+  const double r = 0.05;
+  Scene scene = gravityScene();
+  addMaterial(scene, "putty", 0.2, 0.0);
+  scene.bodies = {ball("lower", 0.3, r, "putty"), ball("upper", 0.1, r, "putty")};
+  scene.obstacles = {plane("floor", V(0, 0, 1), 0.0, "putty")};
+  ImpactMonitor monitor(scene, longLived());
+  const std::vector<BodyStateSample> start = {state(monitor, "lower", V(0, 0, r)),
+                                              state(monitor, "upper", V(0, 0, 3 * r + 0.2))};
+  double deepest = -1;
+  const auto impacts = run(monitor, start, 100, 3.0, [&](double t, const StepReport&) {
+    const V lower = monitor.predictedState(0, t)->first,
+            upper = monitor.predictedState(1, t)->first;
+    deepest = std::max(deepest, 2 * r - (upper - lower).norm());
+    deepest = std::max(deepest, r - lower.z());
+  });
+  EXPECT_LT(impacts.size(), 200u);
+  EXPECT_LT(deepest, 1e-9 * r + 1e-15);
+  EXPECT_NEAR(monitor.predictedState(1, 3.0)->first.z() - monitor.predictedState(0, 3.0)->first.z(),
+              2 * r, 1e-9 * 2 * r);
+  EXPECT_NEAR(monitor.predictedState(0, 3.0)->first.z(), r, 1e-9 * r);
+}
+
+// A ball dropped into a V-groove of two planes tilted by b either way ends at rest touching both,
+// each pushing N = m g / (2 cos b).
+TEST(LastingContact, ComesToRestInAVGroove) {
+  const double b = 30.0 * M_PI / 180.0, r = 0.05, m = 0.2;
+  const V left(std::sin(b), 0, std::cos(b)), right(-std::sin(b), 0, std::cos(b));
+  Scene scene = gravityScene();
+  addMaterial(scene, "steel", 0.5, 0.0);
+  scene.bodies = {ball("ball", m, r, "steel")};
+  scene.obstacles = {plane("left", left, 0.0, "steel"), plane("right", right, 0.0, "steel")};
+  ImpactMonitor monitor(scene, longLived());
+  double deepest = -1;
+  StepReport last;
+  run(monitor, {state(monitor, "ball", V(0.01, 0, 0.3))}, 100, 4.0,
+      [&](double t, const StepReport& report) {
+        const V centre = monitor.predictedState(0, t)->first;
+        deepest = std::max(
+            {deepest, depthInPlane(centre, r, left, 0), depthInPlane(centre, r, right, 0)});
+        last = report;
+      });
+  EXPECT_LT(deepest, 1e-9 * r + 1e-15);
+  const V bottom(0, 0, r / std::cos(b));
+  EXPECT_LT((monitor.predictedState(0, 4.0)->first - bottom).norm(), 1e-8 * r);
+  ASSERT_EQ(last.contacts.size(), 2u);
+  EXPECT_NEAR(last.contacts[0].normal_force, m * kG / (2 * std::cos(b)), 1e-9);
+  EXPECT_NEAR(last.contacts[1].normal_force, m * kG / (2 * std::cos(b)), 1e-9);
+}
+
+// A ball slides down a frictionless incline into a wall at its foot (normal -x): with e = 0 it
+// stops in the corner at once; with e = 0.5 it bounces in the corner to rest. Either way it
+// never enters either plane, and at rest the incline pushes m g / cos t, the wall m g tan t.
+TEST(LastingContact, ComesToRestInTheCornerOfAnInclineAndAWall) {
+  for (const double e : {0.0, 0.5}) {
+    const double theta = 10.0 * M_PI / 180.0, r = 0.05, m = 0.2, wall = 0.5;
+    const V up(std::sin(theta), 0, std::cos(theta));
+    Scene scene = gravityScene();
+    addMaterial(scene, "ice", e, 0.0);
+    scene.bodies = {ball("ball", m, r, "ice")};
+    scene.obstacles = {plane("incline", up, 0.0, "ice"), plane("wall", V(-1, 0, 0), -wall, "ice")};
+    ImpactMonitor monitor(scene, longLived());
+    double deepest = -1;
+    StepReport last;
+    run(monitor, {state(monitor, "ball", r * up)}, 100, 5.0,
+        [&](double t, const StepReport& report) {
+          const V centre = monitor.predictedState(0, t)->first;
+          deepest = std::max({deepest, depthInPlane(centre, r, up, 0),
+                              depthInPlane(centre, r, V(-1, 0, 0), -wall)});
+          last = report;
+        });
+    EXPECT_LT(deepest, 1e-9 * r + 1e-15) << e;
+    // The corner: x = wall - r, and on the incline: sin t x + cos t z = r.
+    const double x = wall - r, z = (r - std::sin(theta) * x) / std::cos(theta);
+    EXPECT_LT((monitor.predictedState(0, 5.0)->first - V(x, 0, z)).norm(), 1e-8 * r) << e;
+    ASSERT_EQ(last.contacts.size(), 2u) << e;
+    EXPECT_NEAR(last.contacts[0].normal_force, m * kG / std::cos(theta), 1e-9) << e;
+    EXPECT_NEAR(last.contacts[1].normal_force, m * kG * std::tan(theta), 1e-9) << e;
+  }
+}
+
+// A pyramid between walls: two balls on the floor against the walls at x = +-(c + r) (apart by
+// 2 c, c = 1.2 r, not touching), one on top touching both. It holds; the top ball's contacts
+// lean by phi, sin phi = c / 2 r = 0.6, and carry m_t g / 1.6 each, the walls 0.375 m_t g, the
+// floor m_b g + m_t g / 2 under each.
+TEST(LastingContact, PyramidHeldBetweenWalls) {
+  const double r = 0.05, c = 1.2 * r, mb = 0.3, mt = 0.2;
+  const double height = std::sqrt(4 * r * r - c * c);
+  Scene scene = gravityScene();
+  addMaterial(scene, "wood", 0.6, 0.0);
+  scene.bodies = {ball("left", mb, r, "wood"), ball("right", mb, r, "wood"),
+                  ball("top", mt, r, "wood")};
+  scene.obstacles = {plane("floor", V(0, 0, 1), 0.0, "wood"),
+                     plane("wall_left", V(1, 0, 0), -(c + r), "wood"),
+                     plane("wall_right", V(-1, 0, 0), -(c + r), "wood")};
+  ImpactMonitor monitor(scene, longLived());
+  const std::vector<BodyStateSample> start = {state(monitor, "left", V(-c, 0, r)),
+                                              state(monitor, "right", V(c, 0, r)),
+                                              state(monitor, "top", V(0, 0, r + height))};
+  StepReport last;
+  const auto impacts =
+      run(monitor, start, 100, 1.0, [&](double, const StepReport& report) { last = report; });
+  EXPECT_TRUE(impacts.empty());
+  EXPECT_LT((monitor.predictedState(2, 1.0)->first - V(0, 0, r + height)).norm(), 1e-14);
+  // Pairs in order: left-top, left-floor, left-wall_left, right-top, right-floor,
+  // right-wall_right (obstacles sorted by id: floor, wall_left, wall_right).
+  ASSERT_EQ(last.contacts.size(), 6u);
+  EXPECT_NEAR(last.contacts[0].normal_force, mt * kG / 1.6, 1e-12);
+  EXPECT_NEAR(last.contacts[1].normal_force, mb * kG + mt * kG / 2, 1e-12);
+  EXPECT_NEAR(last.contacts[2].normal_force, 0.375 * mt * kG, 1e-12);
+  EXPECT_EQ(last.contacts[0].normal_force, last.contacts[3].normal_force) << "mirror images";
+  EXPECT_EQ(last.contacts[2].normal_force, last.contacts[5].normal_force) << "mirror images";
+}
+
+// An elastic ball (e = 1) between two walls 1e-5 m wider than it, moving across at 1 m/s while
+// it falls onto a floor: it would strike the walls 50,000 times a second, beyond any step's
+// budget. The fallback keeps it in the gap: it never enters a wall, and it lands on the floor.
+TEST(LastingContact, WedgedBallNeverLeavesTheGap) {
+  const double r = 0.05, clearance = 1e-5;
+  Scene scene = gravityScene();
+  addMaterial(scene, "elastic", 1.0, 0.0);
+  addMaterial(scene, "sand", 0.5, 0.0);  // the floor: min(1, 0.5), the ball bounces to rest
+  scene.bodies = {ball("ball", 0.1, r, "elastic")};
+  scene.obstacles = {plane("floor", V(0, 0, 1), 0.0, "sand"),
+                     plane("left", V(1, 0, 0), -(r + clearance / 2), "elastic"),
+                     plane("right", V(-1, 0, 0), -(r + clearance / 2), "elastic")};
+  MonitorSettings settings = longLived();
+  settings.max_instants_per_step = 1000;
+  ImpactMonitor monitor(scene, settings);
+  double outside = 0;
+  std::size_t fallbacks = 0;
+  run(monitor, {state(monitor, "ball", V(0, 0, 0.5), V(1, 0, 0))}, 100, 2.0,
+      [&](double t, const StepReport& report) {
+        fallbacks += report.fallbacks;
+        outside =
+            std::max(outside, std::abs(monitor.predictedState(0, t)->first.x()) - clearance / 2);
+      });
+  EXPECT_GT(fallbacks, 0u);
+  EXPECT_LE(outside, 1e-9 * r);
+  EXPECT_NEAR(monitor.predictedState(0, 2.0)->first.z(), r, 1e-9 * r);
+}
+
+ObstacleSpec sphere(const std::string& id, const V& centre, double radius,
+                    const std::string& material) {
+  ObstacleSpec obstacle;
+  obstacle.id = id;
+  obstacle.shape = ObstacleShape::kSphere;
+  obstacle.position = centre;
+  obstacle.radius = radius;
+  obstacle.material = material;
+  return obstacle;
+}
+
+// A ball on top of a fixed sphere, nudged at v0 across it (no friction). On the sphere, with d the
+// distance of the centres, energy gives v^2 = v0^2 + 2 g d (1 - cos t) and the sphere pushes with
+// m (g cos t - v^2 / d), which is 0 at cos t = 2/3 + v0^2 / (3 g d): it leaves there, at speed
+// v^2 = g d cos t along the tangent, and flies on with the horizontal velocity it had then,
+// sqrt(g d) cos^(3/2) t. On the sphere it never goes into it.
+TEST(LastingContact, SlidesOffASphereAtTwoThirds) {
+  const double R = 1.0, r = 0.1, d = R + r, v0 = 1e-3;
+  Scene scene = gravityScene();
+  addMaterial(scene, "ice", 0.5, 0.0);
+  scene.bodies = {ball("ball", 0.1, r, "ice")};
+  scene.obstacles = {sphere("dome", V::Zero(), R, "ice")};
+  ImpactMonitor monitor(scene, longLived());
+  double deepest = -1, left = -1;
+  run(monitor, {state(monitor, "ball", V(0, 0, d), V(v0, 0, 0))}, 100, 4.0,
+      [&](double t, const StepReport& report) {
+        deepest = std::max(deepest, d - monitor.predictedState(0, t)->first.norm());
+        if (left < 0 && report.contacts.empty()) left = t;
+      });
+  ASSERT_GT(left, 0.0) << "it left the sphere";
+  const double leaves = 2.0 / 3.0 + v0 * v0 / (3 * kG * d);
+  const double horizontal = std::sqrt(kG * d) * std::pow(leaves, 1.5);
+  EXPECT_NEAR(monitor.predictedState(0, 4.0)->second.x(), horizontal, 1e-7 * horizontal);
+  EXPECT_LT(deepest, 1e-9 * d);
+}
+
+// Rolling with friction (a solid ball, spin, mu large): (7/10) v^2 = (7/10) v0^2 + g d (1 - cos t)
+// and the sphere lets go at g d cos t = v^2, so cos t = (10 + 7 v0^2 / (g d)) / 17: 10/17 for a
+// nudge of nothing. It flies on with the horizontal velocity sqrt(g d) cos^(3/2) t. (Near N = 0
+// static friction runs out and it slips for the last instant; with mu = 1e6 that moves cos t by
+// far less than the tolerance.)
+TEST(LastingContact, RollsOffASphereAtTenSeventeenths) {
+  const double R = 1.0, r = 0.1, d = R + r, v0 = 1e-3;
+  Scene scene = gravityScene(true, true);
+  addMaterial(scene, "grippy", 0.5, 1e6);
+  scene.bodies = {ball("ball", 0.1, r, "grippy")};
+  scene.obstacles = {sphere("dome", V::Zero(), R, "grippy")};
+  ImpactMonitor monitor(scene, longLived());
+  double deepest = -1;
+  bool rolled = false;
+  // Rolling: w = v / r about the axis of the turn, so that the contact point is at rest.
+  run(monitor, {state(monitor, "ball", V(0, 0, d), V(v0, 0, 0), V(0, v0 / r, 0))}, 100, 5.0,
+      [&](double t, const StepReport& report) {
+        deepest = std::max(deepest, d - monitor.predictedState(0, t)->first.norm());
+        if (!report.contacts.empty() && report.contacts[0].state == ContactState::kRolling) {
+          rolled = true;
+        }
+      });
+  EXPECT_TRUE(rolled);
+  const double leaves = (10 + 7 * v0 * v0 / (kG * d)) / 17;
+  const double horizontal = std::sqrt(kG * d) * std::pow(leaves, 1.5);
+  EXPECT_NEAR(monitor.predictedState(0, 5.0)->second.x(), horizontal, 1e-6 * horizontal);
+  EXPECT_LT(deepest, 1e-9 * d);
+}
+
+}  // namespace
+}  // namespace collision_response::core
