@@ -3,8 +3,8 @@
 # and discrete detection, effects on and off; Bullet with its defaults and with its recommended
 # bouncing settings; ODE; MuJoCo with its default contact and with restitution through solref;
 # DART; Box2D on the planar scenes), errors against references computed outside the code under
-# test and CPU time (Google Benchmark). Writes doc/accuracy.md, doc/accuracy.png and the README's
-# accuracy section (between its accuracy markers).
+# test and CPU time (Google Benchmark). Writes doc/accuracy.md, doc/accuracy.png and the
+# accuracy section of doc/measurements.md (between its markers).
 #   bash scripts/accuracy.sh
 # The references are recomputed on every run (about ten seconds) from the scenes' inputs as the
 # benchmark builds them, so that a changed scene is never measured against a stale answer; they
@@ -28,5 +28,5 @@ echo "== every scene at every setting (errors, then CPU time; the long runs once
 "$bin" "$reference/references.txt" "$out/errors.json" \
   --benchmark_format=json --benchmark_out="$out/timing.json" >"$out/benchmark.log" 2>&1 ||
   { tail -20 "$out/benchmark.log"; exit 1; }
-/usr/bin/python3 "$repo/scripts/accuracy_report.py" "$out" "$repo/doc" "$repo/README.md"
-echo "== wrote doc/accuracy.md, doc/accuracy.png and the README's accuracy section"
+/usr/bin/python3 "$repo/scripts/accuracy_report.py" "$out" "$repo/doc" "$repo/doc/measurements.md"
+echo "== wrote doc/accuracy.md, doc/accuracy.png and the accuracy section of doc/measurements.md"

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Turns the accuracy benchmark's output (scripts/accuracy.sh) into doc/accuracy.md, the plot
-doc/accuracy.png and the README's accuracy section (between its accuracy markers).
+doc/accuracy.png and the accuracy section of `doc/measurements.md` (between its accuracy markers).
 
-usage: accuracy_report.py OUT_DIR DOC_DIR README
+usage: accuracy_report.py OUT_DIR DOC_DIR PAGE (doc/measurements.md: the section between its accuracy markers)
 
 OUT_DIR holds errors.json (the benchmark's measured errors) and timing.json (Google Benchmark's
 CPU times). What is measured and how each reference is made: bench/accuracy/ (measure.cpp and
@@ -482,7 +482,7 @@ def plot(results, path):
     figure.savefig(path, dpi=80)
 
 
-# --- the README's section ------------------------------------------------------------------------
+# --- the section of doc/measurements.md ------------------------------------------------------------------------
 
 def readme_section(results):
     rows = ["| scene | measure | reference | ours, continuous, 100 Hz | its CPU | best peer: setting "
@@ -516,14 +516,14 @@ def readme_section(results):
     tunnel = [f"{name} ({', '.join(str(rate) for rate in rates)} Hz)"
               for name, rates in caught.items()]
     lines = [
-        "![error against CPU time, one panel per scene](doc/accuracy.png)", "",
+        "![error against CPU time, one panel per scene](accuracy.png)", "",
         "Each panel is one scene: the error of its headline measure (y, log) against the CPU time "
         "per simulated second (x, log) for every engine setting (colour) at every state rate "
         "(marker); an error of exactly 0 sits on the dashed line marked 'exact'. Each panel "
         "names its reference, computed outside the code under test "
         "(`bench/accuracy/reference/make_references.py`: closed forms, or the exact "
         "event-driven motion in 50-digit arithmetic; the gas: its conserved energy). Full "
-        "tables, every setting and the key ratios against each peer: `doc/accuracy.md`.", "",
+        "tables, every setting and the key ratios against each peer: [accuracy.md](accuracy.md).", "",
         "Key rows, from the last run (one shared 2-core machine; ratios within one run hold "
         "better than absolute times):", ""] + rows + [""]
     lines += detection_ratios(results)
@@ -557,7 +557,7 @@ def main():
         "# What accuracy costs in time", "",
         "Regenerate: `bash scripts/accuracy.sh` (it builds, installs what it needs, computes the "
         "references, runs every setting and writes this page, `doc/accuracy.png` and the "
-        "README's accuracy section). Errors are against references computed outside the code "
+        "accuracy section of `doc/measurements.md`). Errors are against references computed outside the code "
         "under test, by `bench/accuracy/reference/make_references.py` (mpmath, 50 digits, from "
         "the scenes' inputs taken exactly): closed forms where they exist, otherwise the exact "
         "event-driven motion, and for the gas its conserved energy; each table names its "

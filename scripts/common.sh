@@ -8,21 +8,16 @@ repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 ws="$repo/.ws"
 mkdir -p "$ws"
 
-# Debian 12 packages: ROS 1 (catkin, roscpp, messages, tf2, rostest), Eigen, gtest, and what the
-# benchmarks and fuzzers use.
-PACKAGES=(
-  build-essential cmake catkin
-  libroscpp-dev rosout ros-message-generation ros-message-runtime
-  libstd-msgs-dev ros-std-msgs libgeometry-msgs-dev ros-geometry-msgs
-  libtf2-dev libtf2-ros-dev libtf2-eigen-dev libeigen3-dev
-  librostest-dev python3-rostest python3-roslaunch python3-rosmaster python3-rosservice
-  rosbash python3-rostopic python3-rosnode python3-rosparam tf2-tools
-  libnodelet-dev libnodeletlib-dev libnodeletlib-tools pluginlib-dev
-  libvisualization-msgs-dev ros-visualization-msgs
-  libdiagnostic-updater-dev libdiagnostic-msgs-dev ros-diagnostic-msgs
-  libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
-  python3-rospy python3-genpy python3-geometry-msgs catkin-lint
-  googletest libgtest-dev clang libclang-rt-14-dev
+# Debian 12 packages: the package's own dependencies, read from package.xml
+# (scripts/install_dependencies.sh, the command the README gives for one's own workspace), and
+# the tools the scripts and the README's commands use: ROS's command-line tools, catkin_lint,
+# and clang with its sanitizer and fuzzer runtimes.
+source "$repo/scripts/install_dependencies.sh"
+mapfile -t PACKAGES < <(package_debian_packages "$repo/package.xml")
+package_debian_packages "$repo/package.xml" >/dev/null || exit 1
+PACKAGES+=(
+  rosbash python3-rostopic python3-rosnode python3-rosparam python3-rosservice
+  catkin-lint clang libclang-rt-14-dev
 )
 
 as_root() {
@@ -46,16 +41,37 @@ install_packages() {
 
 # BUILD_TARGET: build only that target (default: all).
 build_workspace() {
-  echo "== building in $ws"
   # catkin writes the test environment (build/catkin_generated/setup_cached.sh) when it
   # configures, with only the devel folders that exist then: made first, so that a first build
   # puts the generated Python messages on the tests' PYTHONPATH (rospy tests need them).
   mkdir -p "$ws/devel/lib/python3/dist-packages" "$ws/devel/lib/pkgconfig"
+  echo "== configuring with cmake (build space $ws/build, devel space $ws/devel)"
   # /usr/bin/python3: a python3 earlier on PATH (pyenv) may lack catkin_pkg.
   cmake -S "$repo" -B "$ws/build" -DCATKIN_DEVEL_PREFIX="$ws/devel" -DPython3_EXECUTABLE=/usr/bin/python3 \
     -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    -DCOLLISION_RESPONSE_WERROR=ON "$@" &&
-    cmake --build "$ws/build" --target "${BUILD_TARGET:-all}" -- -j2
+    -DCOLLISION_RESPONSE_WERROR=ON "$@" || return
+  echo "== compiling (2 jobs)"
+  cmake --build "$ws/build" --target "${BUILD_TARGET:-all}" -- -j2
+}
+
+# build_workspace with its whole output in .ws/build.log, saying on the terminal what it does:
+# the log's place, each stage, and the progress every tenth of the way (a first build takes
+# about 5 minutes on 2 cores, a rebuild seconds). On failure, the log's last lines.
+build_package() {
+  local log="$ws/build.log" status=0
+  echo "== building collision_response in $ws (first build about 5 minutes; log: $log)"
+  build_workspace "$@" 2>&1 | tee "$log" | awk '
+    /^== / { print "  " substr($0, 4); fflush(); next }
+    match($0, /^\[ *[0-9]+%\]/) {
+      percent = substr($0, 2, RLENGTH - 3) + 0
+      if (percent >= shown + 10) { shown = percent - percent % 10; print "  " $0; fflush() }
+    }' || status=$?
+  if [ "$status" -ne 0 ]; then
+    tail -40 "$log"
+    echo "build failed (log: $log)"
+    return 1
+  fi
+  echo "== built"
 }
 
 source_workspace() {
@@ -73,15 +89,66 @@ free_port() {
   /usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("localhost", 0)); print(s.getsockname()[1])'
 }
 
-# A private ROS master on a free port (ROS_MASTER_URI exported), stopped with every process in
-# `pids` when the script exits. usage: start_private_master LOG_FILE
+# The process id of the master that answers at ROS_MASTER_URI within 1 s (nothing if none).
+master_pid() {
+  /usr/bin/python3 -c 'import os, socket, xmlrpc.client
+socket.setdefaulttimeout(1.0)
+try:
+    print(xmlrpc.client.ServerProxy(os.environ["ROS_MASTER_URI"]).getPid("/")[2])
+except Exception:
+    pass' 2>/dev/null
+}
+
+# Stops one process: SIGINT (ROS's clean shutdown), SIGTERM after 5 s, SIGKILL after 10 s.
+stop_process() {
+  local signal
+  for signal in INT TERM KILL; do
+    kill -"$signal" "$1" 2>/dev/null || return 0
+    for _ in $(seq 50); do
+      kill -0 "$1" 2>/dev/null || { wait "$1" 2>/dev/null || true; return 0; }
+      sleep 0.1
+    done
+  done
+}
+
+# Every process in `pids` is stopped when the script exits, the last started first.
 pids=()
+stop_started() {
+  local i
+  for ((i = ${#pids[@]} - 1; i >= 0; i--)); do stop_process "${pids[i]}"; done
+}
+trap stop_started EXIT
+
+# A private ROS master on a free port (ROS_MASTER_URI exported), stopped when the script exits.
+# The port is free when free_port looks, but another process (another master, any server) can
+# take it before roscore binds it: then roscore fails, or a master that is not ours answers.
+# So the master is ours only when the one answering is the child of our roscore; otherwise
+# another port is tried.   usage: start_private_master LOG_FILE
 start_private_master() {
-  local port
-  port=$(free_port)
-  export ROS_MASTER_URI="http://localhost:$port"
-  trap 'for pid in "${pids[@]}"; do kill -INT "$pid" 2>/dev/null || true; done; wait 2>/dev/null || true' EXIT
-  roscore -p "$port" >"$1" 2>&1 &
-  pids+=($!)
-  until rosparam list >/dev/null 2>&1; do sleep 0.2; done
+  local log=$1 attempt port roscore_pid answering deadline
+  for attempt in 1 2 3 4 5; do
+    port=$(free_port)
+    export ROS_MASTER_URI="http://localhost:$port"
+    roscore -p "$port" >"$log" 2>&1 &
+    roscore_pid=$!
+    deadline=$((SECONDS + 20))
+    while [ "$SECONDS" -lt "$deadline" ]; do
+      kill -0 "$roscore_pid" 2>/dev/null || break
+      answering=$(master_pid)
+      if [ -n "$answering" ]; then
+        # /proc/PID/stat: "pid (name) state ppid ..."
+        if [ "$(cut -d' ' -f4 "/proc/$answering/stat" 2>/dev/null)" = "$roscore_pid" ]; then
+          pids+=("$roscore_pid")
+          return 0
+        fi
+        break # someone else's master on this port
+      fi
+      sleep 0.1
+    done
+    stop_process "$roscore_pid"
+    echo "== port $port was taken before the master could bind it (attempt $attempt of 5); another port"
+  done
+  echo "could not start a ROS master (last log: $log):"
+  tail -5 "$log"
+  return 1
 }

@@ -4,6 +4,8 @@
 # print each impact as one line, and stop everything it started.
 #   bash scripts/demo.sh [scene] [duration_s]     e.g. bash scripts/demo.sh cradle 2
 #   RVIZ=1 bash scripts/demo.sh billiards_break 30  also installs rviz and opens it on the markers
+# Exits 0 only when the scene played and at least one impact was printed; otherwise it says
+# what failed and where the log is, and exits 1.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 scene="${1:-billiards_break}"
@@ -15,23 +17,43 @@ duration="${2:-3}"
 rviz="${RVIZ:-0}"
 [ "$rviz" = 1 ] && PACKAGES+=(rviz)
 install_packages
-build_workspace >"$ws/build.log" 2>&1 || { tail -40 "$ws/build.log"; echo "build failed (log: $ws/build.log)"; exit 1; }
+build_package
 source_workspace
-export ROS_MASTER_URI="http://localhost:$(free_port)"
 
+log="$ws/demo.log"
+printed="$ws/demo.out"
+# Our own master first, on a port that is ours (start_private_master checks, and tries another
+# port if one was taken in the meantime); roslaunch then uses it and starts no other.
+start_private_master "$ws/roscore.log"
 rviz_arg=false
 [ "$rviz" = 1 ] && rviz_arg=true
 echo "== roslaunch collision_response demo.launch scene:=$scene duration:=$duration rviz:=$rviz_arg"
 echo "   (a private master at $ROS_MASTER_URI; the scene's file: config/scenes/$scene.yaml)"
-# roslaunch starts the master, the node, the player and the printer, and stops them all when
-# the player has played the scene. Only the printer's lines are shown; the rest is in the log.
+# roslaunch starts the node, the player and the printer, and stops them all when the player has
+# played the scene. Only the printer's and player's lines are shown; the rest is in the log.
 roslaunch collision_response demo.launch scene:="$scene" duration:="$duration" rviz:="$rviz_arg" \
-  >"$ws/demo.log" 2>&1 &
+  >"$log" 2>&1 &
 launch_pid=$!
-trap 'kill -INT $launch_pid 2>/dev/null || true' EXIT
-tail -n +1 --pid=$launch_pid -f "$ws/demo.log" | grep --line-buffered -E '^(impact|restitution|done)' || true
-wait $launch_pid 2>/dev/null || true
-if grep -q -E 'FATAL|ERROR' "$ws/demo.log"; then
-  echo "== errors from the nodes (full log: $ws/demo.log):"
-  grep -E 'FATAL|ERROR' "$ws/demo.log" | head -5
+pids+=("$launch_pid")
+tail -n +1 --pid="$launch_pid" -f "$log" | grep --line-buffered -E '^(impact|restitution|done)' |
+  tee "$printed" || true
+launch_status=0
+wait "$launch_pid" || launch_status=$?
+
+# What went wrong, if anything: roslaunch's own failure, a node that died (a bad scene stops
+# the node at once), or a scene played without a single impact.
+plain_log() { sed 's/\x1b\[[0-9;]*m//g; s/\x1b\]2;[^\x07]*\x07//g' "$log"; }
+problems=()
+[ "$launch_status" -eq 0 ] || problems+=("roslaunch exited with status $launch_status")
+died=$(plain_log | grep -m1 'process has died' || true)
+[ -z "$died" ] || problems+=("a node died: $died")
+impacts=$(grep -c '^impact' "$printed" || true)
+[ "$impacts" -gt 0 ] ||
+  problems+=("no impact was printed (do the scene's bodies meet within $duration s?)")
+if [ ${#problems[@]} -gt 0 ]; then
+  echo "== demo failed:"
+  printf '   %s\n' "${problems[@]}"
+  plain_log | grep -E 'FATAL|ERROR' | head -5 || true
+  echo "   (full log: $log; the master's: $ws/roscore.log)"
+  exit 1
 fi

@@ -1,12 +1,21 @@
 #!/usr/bin/env python3
 """Draws a recorded scene: each body's path (from /body_states) and each impact (from /impacts).
 
-usage: plot_bag.py BAG PNG [TITLE]
+usage: plot_bag.py BAG PNG [TITLE] [--scene SCENE_YAML]
 
 The two axes along which the bodies moved most are drawn (x-y for a table, x-z for a drop).
-Impacts are marked at their contact points, with a short line along the normal.
+Each body has its own colour (and, past ten bodies, a dashed line) in both panels, a label at
+the end of its path, and an entry in the legend beside the speeds; a body whose speeds are those
+of another (a mirror image in a symmetric scene) is dotted over that body's speed line, and its
+legend entry names the other. With the scene file, each
+body is drawn at its start and its end as a disc of its radius, and the fixed obstacles are
+drawn too: a plane across the drawing plane as a line (the billiards table's cushions, the drop
+test's floor), a sphere as a circle. Impacts are marked at their contact points, with a short
+line along the normal.
 """
+import argparse
 import collections
+import math
 import sys
 
 import matplotlib
@@ -14,11 +23,29 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import rosbag  # noqa: E402
+import yaml  # noqa: E402
+
+AXES = "xyz"
 
 
-def main():
-    bag_path, png_path = sys.argv[1], sys.argv[2]
-    title = sys.argv[3] if len(sys.argv) > 3 else bag_path
+def body_styles(ids):
+    """A colour and line style for each body: tab20's ten dark shades, then its ten light ones
+    dashed, so that a light shade is never mistaken for its dark twin."""
+    palette = plt.get_cmap("tab20").colors
+    colours = list(palette[0::2]) + list(palette[1::2])
+    return {body: (colours[i % 20], "-" if i % 20 < 10 else "--") for i, body in enumerate(ids)}
+
+
+def same_speeds(speeds, drawn):
+    """The id of a drawn body whose speeds are these (to 1e-9 of the largest), or None."""
+    scale = 1e-9 * max(max(speeds), 1.0)
+    for body, other in drawn.items():
+        if len(other) == len(speeds) and all(abs(a - b) <= scale for a, b in zip(other, speeds)):
+            return body
+    return None
+
+
+def read_bag(bag_path):
     paths = collections.defaultdict(list)  # id -> [(t, x, y, z, speed)]
     impacts = []
     with rosbag.Bag(bag_path) as bag:
@@ -26,43 +53,150 @@ def main():
             if topic == "/body_states":
                 for state in message.states:
                     p, v = state.pose.position, state.twist.linear
-                    speed = (v.x ** 2 + v.y ** 2 + v.z ** 2) ** 0.5
+                    speed = math.sqrt(v.x ** 2 + v.y ** 2 + v.z ** 2)
                     paths[state.id].append((state.header.stamp.to_sec(), p.x, p.y, p.z, speed))
             else:
                 impacts.extend(message.impacts)
+    return paths, impacts
+
+
+def read_scene(scene_path):
+    if not scene_path:
+        return {}, []
+    with open(scene_path) as stream:
+        scene = (yaml.safe_load(stream) or {}).get("scene", {})
+    radii = {body["id"]: float(body["radius"]) for body in scene.get("bodies", [])}
+    return radii, scene.get("obstacles", [])
+
+
+def view_box(paths, axes, radii, obstacles):
+    """The drawn region: every path with its discs, and the planes close to it."""
+    lows, highs = [], []
+    for k in axes:
+        values = [p[k + 1] for path in paths.values() for p in path]
+        pad = max(radii.values(), default=0.0)
+        lows.append(min(values) - pad)
+        highs.append(max(values) + pad)
+    for obstacle in obstacles:
+        if obstacle.get("type") != "plane":
+            continue
+        normal, offset = [float(c) for c in obstacle["normal"]], float(obstacle.get("offset", 0.0))
+        length = math.sqrt(sum(c * c for c in normal))
+        in_plane = [normal[k] / length for k in axes]
+        for i in range(2):
+            # A plane facing along one drawn axis is a line at offset along it: kept in view
+            # when it is within a span of the paths.
+            if abs(in_plane[i]) == 1.0:
+                position = offset / in_plane[i]
+                span = highs[i] - lows[i]
+                if lows[i] - span <= position <= highs[i] + span:
+                    lows[i], highs[i] = min(lows[i], position), max(highs[i], position)
+    margins = [0.05 * max(highs[i] - lows[i], 1e-3) for i in range(2)]
+    return [(lows[i] - margins[i], highs[i] + margins[i]) for i in range(2)]
+
+
+def draw_obstacles(plane, obstacles, axes, box):
+    (u0, u1), (v0, v1) = box
+    for obstacle in obstacles:
+        kind, name = obstacle.get("type"), obstacle.get("id", "")
+        if kind == "plane":
+            normal = [float(c) for c in obstacle["normal"]]
+            length = math.sqrt(sum(c * c for c in normal))
+            nu, nv = normal[axes[0]] / length, normal[axes[1]] / length
+            offset = float(obstacle.get("offset", 0.0))  # along the unit normal
+            if math.hypot(nu, nv) < 1e-9:
+                continue  # parallel to the drawing plane
+            # The points with nu u + nv v = offset, across the box.
+            if abs(nv) >= abs(nu):
+                us = [u0, u1]
+                vs = [(offset - nu * u) / nv for u in us]
+            else:
+                vs = [v0, v1]
+                us = [(offset - nv * v) / nu for v in vs]
+            plane.plot(us, vs, color="saddlebrown", lw=4, solid_capstyle="butt", zorder=1)
+            # The name on the free side, where the normal points.
+            mu, mv = (us[0] + us[1]) / 2, (vs[0] + vs[1]) / 2
+            shift = 0.02 * max(u1 - u0, v1 - v0)
+            plane.text(mu + nu * shift, mv + nv * shift, name, fontsize=7, color="saddlebrown",
+                       ha="center", va="center", rotation=0 if abs(nv) >= abs(nu) else 90)
+        elif kind == "sphere" and not obstacle.get("frame"):
+            centre = [float(c) for c in obstacle.get("position", [0, 0, 0])]
+            plane.add_patch(plt.Circle((centre[axes[0]], centre[axes[1]]),
+                                       float(obstacle["radius"]), color="saddlebrown", alpha=0.4))
+            plane.text(centre[axes[0]], centre[axes[1]], name, fontsize=7, ha="center")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("bag")
+    parser.add_argument("png")
+    parser.add_argument("title", nargs="?")
+    parser.add_argument("--scene", help="the scene file: bodies' radii and fixed obstacles")
+    args = parser.parse_args()
+    paths, impacts = read_bag(args.bag)
     if not paths:
-        sys.exit(f"{bag_path}: no /body_states recorded")
+        sys.exit(f"{args.bag}: no /body_states recorded")
+    radii, obstacles = read_scene(args.scene)
+    title = args.title or args.bag
     points = [p for path in paths.values() for p in path]
     spread = [max(p[k] for p in points) - min(p[k] for p in points) for k in (1, 2, 3)]
     axes = sorted(sorted(range(3), key=lambda k: -spread[k])[:2])
-    names = "xyz"
     start = min(p[0] for p in points)
+    ids = sorted(paths)
+    styles = body_styles(ids)
+    box = view_box(paths, axes, radii, obstacles)
 
-    figure, (plane, timeline) = plt.subplots(1, 2, figsize=(13, 5.5),
-                                             gridspec_kw={"width_ratios": [1.3, 1]})
-    for body, path in sorted(paths.items()):
-        plane.plot([p[axes[0] + 1] for p in path], [p[axes[1] + 1] for p in path], lw=1.2,
-                   label=body)
-        timeline.plot([p[0] - start for p in path], [p[4] for p in path], lw=1.0)
+    figure, (plane, timeline) = plt.subplots(1, 2, figsize=(15, 6),
+                                             gridspec_kw={"width_ratios": [1.4, 1]})
+    draw_obstacles(plane, obstacles, axes, box)
+    drawn = {}  # id -> speeds, of the speed lines drawn so far
+    for body in ids:
+        path, (colour, style) = paths[body], styles[body]
+        us, vs = [p[axes[0] + 1] for p in path], [p[axes[1] + 1] for p in path]
+        plane.plot(us, vs, color=colour, ls=style, lw=1.3, zorder=2)
+        if body in radii:
+            plane.add_patch(plt.Circle((us[0], vs[0]), radii[body], color=colour, alpha=0.35,
+                                       zorder=2))
+            plane.add_patch(plt.Circle((us[-1], vs[-1]), radii[body], color=colour, zorder=3))
+        else:
+            plane.plot([us[-1]], [vs[-1]], "o", color=colour, ms=5, zorder=3)
+        plane.annotate(body, (us[-1], vs[-1]), xytext=(4, 4), textcoords="offset points",
+                       fontsize=7, color=colour, zorder=4)
+        speeds = [p[4] for p in path]
+        twin = same_speeds(speeds, drawn)
+        if twin is None:
+            timeline.plot([p[0] - start for p in path], speeds, color=colour, ls=style, lw=1.2,
+                          label=body)
+            drawn[body] = speeds
+        else:
+            # A mirror image of a body already drawn (a symmetric break): dotted over its line,
+            # so both colours show.
+            timeline.plot([p[0] - start for p in path], speeds, color=colour, ls=(0, (2, 2)),
+                          lw=1.8, label=f"{body} (= {twin})")
+    tick = 0.015 * max(box[0][1] - box[0][0], box[1][1] - box[1][0])
     for impact in impacts:
         c, n = impact.contact_point, impact.normal
-        cx, cy = (c.x, c.y, c.z)[axes[0]], (c.x, c.y, c.z)[axes[1]]
-        nx, ny = (n.x, n.y, n.z)[axes[0]], (n.x, n.y, n.z)[axes[1]]
-        plane.plot([cx], [cy], "kx", ms=6)
-        plane.plot([cx, cx + 0.05 * nx], [cy, cy + 0.05 * ny], "k-", lw=1.5)
-        timeline.axvline(impact.header.stamp.to_sec() - start, color="0.8", lw=0.6, zorder=0)
-    plane.set_xlabel(f"{names[axes[0]]} (m)")
-    plane.set_ylabel(f"{names[axes[1]]} (m)")
+        cu, cv = (c.x, c.y, c.z)[axes[0]], (c.x, c.y, c.z)[axes[1]]
+        nu, nv = (n.x, n.y, n.z)[axes[0]], (n.x, n.y, n.z)[axes[1]]
+        plane.plot([cu], [cv], "kx", ms=4, mew=0.8, zorder=5)
+        plane.plot([cu, cu + tick * nu], [cv, cv + tick * nv], "k-", lw=0.8, zorder=5)
+        timeline.axvline(impact.header.stamp.to_sec() - start, color="0.85", lw=0.6, zorder=0)
+    plane.set_xlim(*box[0])
+    plane.set_ylim(*box[1])
+    plane.set_xlabel(f"{AXES[axes[0]]} (m)")
+    plane.set_ylabel(f"{AXES[axes[1]]} (m)")
     plane.set_aspect("equal", adjustable="datalim")
-    plane.set_title(f"{title}: paths, and impacts (x, normal)")
-    if len(paths) <= 16:
-        plane.legend(fontsize=7, ncol=2, loc="best")
+    shown = "; discs at start (pale) and end" if radii else ""
+    plane.set_title(f"{title}: paths{shown}; impacts (x, normal)", fontsize=10)
     timeline.set_xlabel("time (s)")
     timeline.set_ylabel("speed (m/s)")
-    timeline.set_title(f"speeds; {len(impacts)} impacts (grey lines)")
+    timeline.set_title(f"speeds; {len(impacts)} impacts (grey lines)", fontsize=10)
+    timeline.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0,
+                    title="body", title_fontsize=8)
     figure.tight_layout()
-    figure.savefig(png_path, dpi=90)
-    print(f"{png_path}: {len(paths)} bodies, {len(impacts)} impacts, axes {names[axes[0]]}-{names[axes[1]]}")
+    figure.savefig(args.png, dpi=90)
+    print(f"{args.png}: {len(paths)} bodies, {len(impacts)} impacts, "
+          f"axes {AXES[axes[0]]}-{AXES[axes[1]]}")
 
 
 if __name__ == "__main__":

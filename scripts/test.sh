@@ -4,15 +4,14 @@
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 install_packages
-if ! build_workspace >"$ws/build.log" 2>&1; then
-  tail -60 "$ws/build.log"
-  echo "build failed (log: $ws/build.log)"
+if ! build_package; then
   echo "0 passed, 1 failed"
   exit 1
 fi
 source_workspace
 rm -rf "$ws/build/test_results"
 status=0
+echo "== building and running the tests (about 10 minutes on 2 cores; log: $ws/test.log)"
 cmake --build "$ws/build" --target run_tests -- -j2 >"$ws/test.log" 2>&1 || status=$?
 grep -E '^\[ *(RUN|OK|FAILED|PASSED) *\]|FAILURE|ERROR|^\[(ROS)?TEST\]' "$ws/test.log" | grep -v -E '^\[ *(RUN|OK) ' || true
 if [ "$status" -ne 0 ]; then

@@ -1,6 +1,7 @@
 // Hard cases that must stay numerically stable, each a named test. Expected values come from
 // test/exact/make_hard_cases.py (exact rational arithmetic, outside the code under test) or from
-// closed forms worked out in the comments. The README's "Hard cases" lists what each guarantees.
+// closed forms worked out in the comments. doc/development.md, "Hard cases", lists what each
+// guarantees.
 #include <gtest/gtest.h>
 
 #include <algorithm>
