@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <set>
 
 namespace collision_response::core {
@@ -65,9 +66,52 @@ class Group {
       // The normal turns at n' = v_perp / d: the slip changes by -(r_a w_a + r_b w_b) x n'.
       turning_term_.push_back(-turning.cross(curvature * across));
     }
+    incident_.resize(bodies_.size());
+    for (std::size_t k = 0; k < contacts_.size(); ++k) {
+      incident_[contacts_[k].a].push_back(k);
+      incident_[contacts_[k].b].push_back(k);
+    }
   }
 
   std::size_t contactCount() const { return contacts_.size(); }
+
+  /// What a force `force` on contact j's b (and -force on its a) alone does, without the free
+  /// terms: visit(k, gap acceleration, slip acceleration) for each contact k that shares a
+  /// movable body with j, the only ones it changes; the values are respond()'s to the bit (the
+  /// other forces' zeros add nothing). A column of the conditions' matrix in O(its nonzeros).
+  template <class Visit>
+  void respondToOne(std::size_t j, const V3& force, Visit visit) const {
+    const ForceContact& source = contacts_[j];
+    Response r;
+    r.acceleration.assign(2, V3::Zero());
+    r.angular_acceleration.assign(2, V3::Zero());
+    const std::size_t moved[2] = {source.a, source.b};
+    pushAt(r, 1, source.b, force, -normal_[j]);
+    pushAt(r, 0, source.a, -force, normal_[j]);
+    const auto local = [&](std::size_t body, const std::vector<V3>& values) -> V3 {
+      if (body == moved[0]) return values[0];
+      if (body == moved[1]) return values[1];
+      return V3::Zero();
+    };
+    for (int side = 0; side < 2; ++side) {
+      const std::size_t body = moved[side];
+      if (bodies_[body].inverse_mass == 0.0) continue;
+      for (const std::size_t k : incident_[body]) {
+        const ForceContact& contact = contacts_[k];
+        if (side == 1 && (contact.a == moved[0] || contact.b == moved[0]) &&
+            bodies_[moved[0]].inverse_mass != 0.0) {
+          continue;  // visited from a's side
+        }
+        const V3 relative = local(contact.b, r.acceleration) - local(contact.a, r.acceleration);
+        const Real gap = normal_[k].dot(relative);
+        const V3 slip =
+            relative - (Real(bodies_[contact.a].radius) * local(contact.a, r.angular_acceleration) +
+                        Real(bodies_[contact.b].radius) * local(contact.b, r.angular_acceleration))
+                           .cross(normal_[k]);
+        visit(k, gap, V3(slip - slip.dot(normal_[k]) * normal_[k]));
+      }
+    }
+  }
   const V3& normal(std::size_t k) const { return normal_[k]; }
   const V3& first(std::size_t k) const { return first_[k]; }
   const V3& second(std::size_t k) const { return second_[k]; }
@@ -112,12 +156,17 @@ class Group {
   /// Force `force` on body `i` at its contact point, r `lever` from its centre (lever +n for a,
   /// -n for b).
   void push(Response& r, std::size_t i, const V3& force, const V3& lever) const {
+    pushAt(r, i, i, force, lever);
+  }
+  /// push() into slot `slot` of `r` for body `i`.
+  void pushAt(Response& r, std::size_t slot, std::size_t i, const V3& force,
+              const V3& lever) const {
     const ForceBody& body = bodies_[i];
     if (body.inverse_mass == 0.0) return;
-    r.acceleration[i] += Real(body.inverse_mass) * force;
+    r.acceleration[slot] += Real(body.inverse_mass) * force;
     if (body.spin_factor != 0.0 && body.radius > 0.0) {
       // Moment r lever x F about the centre; angular acceleration moment / I, 1/I = w / (k r^2).
-      r.angular_acceleration[i] +=
+      r.angular_acceleration[slot] +=
           (Real(body.inverse_mass) * Real(body.spin_factor) / Real(body.radius)) *
           lever.cross(force);
     }
@@ -127,6 +176,7 @@ class Group {
   const std::vector<ForceContact>& contacts_;
   std::vector<V3> normal_, first_, second_, slip_, turning_term_;
   std::vector<Real> centripetal_;
+  std::vector<std::vector<std::size_t>> incident_;  // per body: the contacts it is in
 };
 
 /// The force pattern of one unknown: the force on each contact's b per unit of the unknown.
@@ -142,6 +192,68 @@ struct Trial {
   std::vector<V3> tangential_force;  // per contact
   Response response;
 };
+
+/// One nonzero entry of a conditions' matrix.
+struct Entry {
+  Eigen::Index row, column;
+  Real value;
+};
+
+/// The minimum-norm least-squares solution of A x = target, A of `size` x `size` given by its
+/// nonzero entries, block by block: the unknowns fall into connected sets (i and j connected
+/// where A(i, j) or A(j, i) is not 0: their contacts share a movable body, directly or through
+/// others), and a block-diagonal system's minimum-norm solution is each block's (a complete
+/// orthogonal decomposition each). Exact, and independent of the order of the blocks; a group
+/// whose contacts barely interact (balls side by side on a floor) is many small solves, not one
+/// dense solve of every unknown.
+Vector solveMinimumNorm(Eigen::Index size, const std::vector<Entry>& entries,
+                        const Vector& target) {
+  std::vector<Eigen::Index> parent(static_cast<std::size_t>(size));
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto at = [&parent](Eigen::Index x) -> Eigen::Index& {
+    return parent[static_cast<std::size_t>(x)];
+  };
+  const auto find = [&at](Eigen::Index x) {
+    while (at(x) != x) x = at(x) = at(at(x));
+    return x;
+  };
+  for (const Entry& entry : entries) {
+    if (entry.value == 0) continue;
+    const Eigen::Index x = find(entry.row), y = find(entry.column);
+    at(std::max(x, y)) = std::min(x, y);
+  }
+  // Each unknown's block and its place in it.
+  std::vector<std::vector<Eigen::Index>> members(static_cast<std::size_t>(size));
+  std::vector<Eigen::Index> place(static_cast<std::size_t>(size));
+  for (Eigen::Index i = 0; i < size; ++i) {
+    std::vector<Eigen::Index>& block = members[static_cast<std::size_t>(find(i))];
+    place[static_cast<std::size_t>(i)] = static_cast<Eigen::Index>(block.size());
+    block.push_back(i);
+  }
+  std::vector<Matrix> parts(static_cast<std::size_t>(size));
+  for (Eigen::Index root = 0; root < size; ++root) {
+    const auto n = static_cast<Eigen::Index>(members[static_cast<std::size_t>(root)].size());
+    if (n > 0) parts[static_cast<std::size_t>(root)] = Matrix::Zero(n, n);
+  }
+  for (const Entry& entry : entries) {
+    if (entry.value == 0) continue;
+    parts[static_cast<std::size_t>(find(entry.row))](
+        place[static_cast<std::size_t>(entry.row)], place[static_cast<std::size_t>(entry.column)]) =
+        entry.value;
+  }
+  Vector solution = Vector::Zero(size);
+  for (Eigen::Index root = 0; root < size; ++root) {
+    const std::vector<Eigen::Index>& block = members[static_cast<std::size_t>(root)];
+    if (block.empty()) continue;
+    const auto n = static_cast<Eigen::Index>(block.size());
+    Vector right(n);
+    for (Eigen::Index i = 0; i < n; ++i) right[i] = target[block[static_cast<std::size_t>(i)]];
+    const Vector x =
+        parts[static_cast<std::size_t>(root)].completeOrthogonalDecomposition().solve(right);
+    for (Eigen::Index i = 0; i < n; ++i) solution[block[static_cast<std::size_t>(i)]] = x[i];
+  }
+  return solution;
+}
 
 Trial solveModes(const Group& group, const std::vector<Mode>& modes,
                  const std::vector<Real>& friction) {
@@ -179,18 +291,28 @@ Trial solveModes(const Group& group, const std::vector<Mode>& modes,
   const auto size = static_cast<Eigen::Index>(unknowns.size());
   Vector solution = Vector::Zero(size);
   if (size > 0) {
-    Matrix system(size, size);
-    Vector target(size);
+    std::vector<std::vector<Eigen::Index>> rows_of(count);
+    for (Eigen::Index i = 0; i < size; ++i)
+      rows_of[rows[static_cast<std::size_t>(i)].contact].push_back(i);
+    std::vector<Entry> entries;
     for (Eigen::Index j = 0; j < size; ++j) {
-      std::vector<V3> forces = no_forces;
-      forces[unknowns[j].contact] = unknowns[j].pattern;
-      const Response column = group.respond(forces, false);
-      for (Eigen::Index i = 0; i < size; ++i) system(i, j) = condition(column, rows[i]);
+      const Unknown& unknown = unknowns[static_cast<std::size_t>(j)];
+      group.respondToOne(
+          unknown.contact, unknown.pattern, [&](std::size_t k, Real gap, const V3& slip) {
+            for (const Eigen::Index i : rows_of[k]) {
+              const Row& row = rows[static_cast<std::size_t>(i)];
+              const Real value = row.kind == 0
+                                     ? gap
+                                     : (row.kind == 1 ? group.first(k) : group.second(k)).dot(slip);
+              entries.push_back(Entry{i, j, value});
+            }
+          });
     }
+    Vector target(size);
     for (Eigen::Index i = 0; i < size; ++i) target[i] = -condition(free, rows[i]);
     // Minimum-norm least squares: also right where contacts are redundant (a ball in a corner
     // of three planes that a pair of them already holds).
-    solution = system.completeOrthogonalDecomposition().solve(target);
+    solution = solveMinimumNorm(size, entries, target);
   }
   Trial trial;
   trial.forces.assign(count, V3::Zero());
@@ -316,22 +438,38 @@ void closeContactVelocities(std::vector<ForceBody>& bodies,
   }
   const auto size = static_cast<Eigen::Index>(conditions.size());
   if (size == 0) return;
+  // Relative velocities within the rounding of the velocities need no closing.
+  Real speed = 0, widest = 0;
+  for (const ForceBody& body : bodies) {
+    speed = std::max(speed, Real(body.velocity.lpNorm<Eigen::Infinity>() +
+                                 body.radius * body.angular_velocity.lpNorm<Eigen::Infinity>()));
+  }
+  for (const Real target : targets) widest = std::max(widest, std::abs(target));
+  if (widest <= std::numeric_limits<double>::epsilon() * speed) return;
   const auto measure = [&](const Response& response, const Condition& condition) -> Real {
     return condition.normal
                ? response.gap_acceleration[condition.contact]
                : condition.direction.dot(response.slip_acceleration[condition.contact]);
   };
   const std::vector<V3> no_impulses(count, V3::Zero());
-  Matrix system(size, size);
+  std::vector<std::vector<Eigen::Index>> conditions_of(count);
+  for (Eigen::Index i = 0; i < size; ++i) {
+    conditions_of[conditions[static_cast<std::size_t>(i)].contact].push_back(i);
+  }
+  std::vector<Entry> entries;
   for (Eigen::Index j = 0; j < size; ++j) {
-    std::vector<V3> impulses = no_impulses;
-    impulses[conditions[j].contact] = conditions[j].direction;
-    const Response column = group.respond(impulses, false);
-    for (Eigen::Index i = 0; i < size; ++i) system(i, j) = measure(column, conditions[i]);
+    const Condition& source = conditions[static_cast<std::size_t>(j)];
+    group.respondToOne(
+        source.contact, source.direction, [&](std::size_t k, Real gap, const V3& slip) {
+          for (const Eigen::Index i : conditions_of[k]) {
+            const Condition& condition = conditions[static_cast<std::size_t>(i)];
+            entries.push_back(Entry{i, j, condition.normal ? gap : condition.direction.dot(slip)});
+          }
+        });
   }
   Vector target(size);
   for (Eigen::Index i = 0; i < size; ++i) target[i] = targets[i];
-  const Vector solution = system.completeOrthogonalDecomposition().solve(target);
+  const Vector solution = solveMinimumNorm(size, entries, target);
   std::vector<V3> impulses = no_impulses;
   for (Eigen::Index j = 0; j < size; ++j) {
     impulses[conditions[j].contact] += solution[j] * conditions[j].direction;
@@ -572,20 +710,28 @@ void closeContactGaps(std::vector<Eigen::Vector3d>& positions, const std::vector
                       const std::vector<ForceContact>& contacts, const std::vector<double>& gaps) {
   // Displacements d = w sum_k s_k mu_k n_k change gap_l by sum_k A_lk mu_k, as impulses change the
   // normal relative velocities: the same linear map.
-  const Group group(bodies, contacts);
   const auto size = static_cast<Eigen::Index>(contacts.size());
   if (size == 0) return;
+  // Gaps within the rounding of the positions need no closing: the displacements would be
+  // below an ulp of the positions they are added to.
+  double reach = 0.0, widest = 0.0;
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    reach = std::max(reach, positions[i].lpNorm<Eigen::Infinity>() + bodies[i].radius);
+  }
+  for (const double gap : gaps) widest = std::max(widest, std::abs(gap));
+  if (widest <= std::numeric_limits<double>::epsilon() * reach) return;
+  const Group group(bodies, contacts);
   const std::vector<V3> none(contacts.size(), V3::Zero());
-  Matrix system(size, size);
+  std::vector<Entry> entries;
   for (Eigen::Index j = 0; j < size; ++j) {
-    std::vector<V3> pushes = none;
-    pushes[j] = group.normal(j);
-    const Response column = group.respond(pushes, false);
-    for (Eigen::Index i = 0; i < size; ++i) system(i, j) = column.gap_acceleration[i];
+    group.respondToOne(static_cast<std::size_t>(j), group.normal(static_cast<std::size_t>(j)),
+                       [&](std::size_t k, Real gap, const V3&) {
+                         entries.push_back(Entry{static_cast<Eigen::Index>(k), j, gap});
+                       });
   }
   Vector target(size);
   for (Eigen::Index i = 0; i < size; ++i) target[i] = -Real(gaps[i]);
-  const Vector solution = system.completeOrthogonalDecomposition().solve(target);
+  const Vector solution = solveMinimumNorm(size, entries, target);
   std::vector<V3> pushes = none;
   for (Eigen::Index j = 0; j < size; ++j) pushes[j] = solution[j] * group.normal(j);
   const Response change = group.respond(pushes, false);
@@ -609,7 +755,16 @@ ContactForceSolution solveContactForces(const std::vector<ForceBody>& bodies,
   const Real slip_tolerance = scales.slip_tolerance;
 
   std::vector<Mode> modes(count);
+  // The first guess: pressed where the gap would close with no contact force at all (the
+  // floor under a ball), free where it would not (two balls side by side that fall together);
+  // the iteration below corrects it. A good guess keeps the first solve small.
+  const Response unpressed = group.respond(std::vector<V3>(count, V3::Zero()), true);
   for (std::size_t k = 0; k < count; ++k) {
+    modes[k].pressed =
+        unpressed.gap_acceleration[k] < -tolerance * std::max(acceleration_scale, Real(1e-300));
+  }
+  for (std::size_t k = 0; k < count; ++k) {
+    if (!modes[k].pressed) continue;
     if (friction[k] > 0) {
       const V3& slip = group.slip(k);
       if (slip.norm() > slip_tolerance) {

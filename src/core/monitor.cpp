@@ -469,6 +469,14 @@ StepReport ImpactMonitor::step(double time, const std::vector<BodyStateSample>& 
         return 0;
       });
     }
+    if (world.effects.gravity) {
+      // The bodies these states put in contact rest, slide or roll from now: a ball given at
+      // rest on the floor is held there, not let fall into it until the next step.
+      std::vector<std::size_t> formed;
+      world.step_end = world.now;
+      monitor::formAllGroups(world, world.now, formed);
+      monitor::reportContacts(world, world.now, report.contacts);
+    }
     return report;
   }
   forgetStaleBodies(world, time);
