@@ -31,6 +31,7 @@ declare -A DEBIAN_PACKAGES=(
   [tf2_eigen]="libtf2-eigen-dev"
   [tf2_geometry_msgs]="libtf2-geometry-msgs-dev python3-tf2-geometry-msgs"
   [eigen]="libeigen3-dev"
+  [boost]="libboost-dev"
   [rostest]="librostest-dev python3-rostest python3-rosmaster"
   [rosunit]="python3-rosunit"
   [gtest]="googletest libgtest-dev"

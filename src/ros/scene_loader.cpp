@@ -250,6 +250,8 @@ const KeyTable<Scene>& sceneTable() {
       vectorKey<Scene>("gravity", [](Scene& s) -> Eigen::Vector3d& { return s.gravity; }),
       numberKey<Scene>("restitution_threshold",
                        [](Scene& s) -> double& { return s.restitution_threshold; }),
+      numberKey<Scene>("contact_integration_tolerance",
+                       [](Scene& s) -> double& { return s.contact_integration_tolerance; }),
       {"bodies", false,
        [](const XmlRpc::XmlRpcValue& value, const std::string& field, Scene& scene) {
          return readList(

@@ -198,6 +198,13 @@ TEST(SceneLoader, SceneErrorsNameTheKey) {
   scene["restitution_threshold"] = -1.0;
   EXPECT_EQ(sceneErrorField(scene), "~scene/restitution_threshold");
 
+  // The integrator's tolerance: an error per step of 1 cm would open contacts; 0 cannot be met.
+  for (const double tolerance : {1e-2, 0.0, 1e-300}) {
+    scene = fullScene();
+    scene["contact_integration_tolerance"] = tolerance;
+    EXPECT_EQ(sceneErrorField(scene), "~scene/contact_integration_tolerance") << tolerance;
+  }
+
   // A concrete ball on a concrete floor: that pair was never measured.
   scene = fullScene();
   scene["bodies"][0]["material"] = "concrete";
@@ -232,6 +239,7 @@ std::map<std::string, std::map<std::string, XmlRpc::XmlRpcValue>> examples() {
                      {"effects", effects},
                      {"gravity", list3(0, 0, -9.8)},
                      {"restitution_threshold", 0.25},
+                     {"contact_integration_tolerance", 1e-6},
                      {"restitution_combine", "max"}};
   values["materials.<name>"] = {{"restitution", 0.85}, {"friction", 0.9}};
   XmlRpc::XmlRpcValue pair;
@@ -339,6 +347,7 @@ TEST(SceneKeys, EveryDocumentedKeyLoadsWithItsValue) {
   EXPECT_TRUE(loaded->effects.gravity);
   EXPECT_EQ(loaded->gravity, Eigen::Vector3d(0, 0, -9.8));
   EXPECT_EQ(loaded->restitution_threshold, 0.25);
+  EXPECT_EQ(loaded->contact_integration_tolerance, 1e-6);
   EXPECT_EQ(loaded->materials.combineRule(), core::CombineRule::kMax);
   EXPECT_EQ(*loaded->materials.restitution("rubber", "concrete"), 0.85);
   EXPECT_EQ(*loaded->materials.friction("rubber", "concrete"), 0.9);
