@@ -157,9 +157,13 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
                               step.stale_states});
   }
   if (step.truncated) {
-    update.reports.push_back({Reason::kStepTruncated,
-                              "too many impacts at one instant or in one step; the step was cut "
-                              "short"});
+    // What remained was resolved by a fallback that puts no body into another (README,
+    // "Lasting contact"): as one inelastic cluster, or the step's bodies held.
+    update.reports.push_back(
+        {Reason::kStepTruncated,
+         "too many impacts at one instant or in one step; " + std::to_string(step.fallbacks) +
+             " fallback(s) resolved the rest inelastically or held the bodies, outside each "
+             "other"});
   }
   update.contacts = step.contacts;
   update.impacts.header.stamp = newest;

@@ -465,6 +465,32 @@ TEST(LastingContact, SlidesOffASphereAtTwoThirds) {
   EXPECT_LT(deepest, 1e-9 * d);
 }
 
+// The same ball, the dome standing on a floor (z = -R): it leaves the dome at cos t = 2/3, falls
+// onto the floor, bounces (e = 0.5) to rest on it and slides away along it (no friction) with
+// the horizontal velocity it left with. It never goes into the dome or the floor (the case of
+// issue 12 went centimetres into the floor), and ends with its centre r above the floor.
+TEST(LastingContact, FallsOffASphereOntoTheFloorAndNeverIntoIt) {
+  const double R = 1.0, r = 0.1, d = R + r, v0 = 1e-3;
+  Scene scene = gravityScene();
+  addMaterial(scene, "ice", 0.5, 0.0);
+  scene.bodies = {ball("ball", 0.1, r, "ice")};
+  scene.obstacles = {sphere("dome", V::Zero(), R, "ice"), plane("floor", V(0, 0, 1), -R, "ice")};
+  ImpactMonitor monitor(scene, longLived());
+  double into_dome = -1, into_floor = -1;
+  run(monitor, {state(monitor, "ball", V(0, 0, d), V(v0, 0, 0))}, 100, 6.0,
+      [&](double t, const StepReport&) {
+        const V p = monitor.predictedState(0, t)->first;
+        into_dome = std::max(into_dome, d - p.norm());
+        into_floor = std::max(into_floor, -R + r - p.z());
+      });
+  EXPECT_LT(into_dome, 1e-9 * d);
+  EXPECT_LT(into_floor, 1e-9 * r);
+  EXPECT_NEAR(monitor.predictedState(0, 6.0)->first.z(), -R + r, 1e-9 * r);
+  const double leaves = 2.0 / 3.0 + v0 * v0 / (3 * kG * d);
+  const double horizontal = std::sqrt(kG * d) * std::pow(leaves, 1.5);
+  EXPECT_NEAR(monitor.predictedState(0, 6.0)->second.x(), horizontal, 1e-7 * horizontal);
+}
+
 // Rolling with friction (a solid ball, spin, mu large): (7/10) v^2 = (7/10) v0^2 + g d (1 - cos t)
 // and the sphere lets go at g d cos t = v^2, so cos t = (10 + 7 v0^2 / (g d)) / 17: 10/17 for a
 // nudge of nothing. It flies on with the horizontal velocity sqrt(g d) cos^(3/2) t. (Near N = 0

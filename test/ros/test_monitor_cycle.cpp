@@ -384,6 +384,52 @@ TEST_F(Cycle, AMissingTransformMakesTheInputWaitThenDropsItsStateByName) {
       << update.reports[0].text;
 }
 
+// Issue 12, item 3: an elastic ball between two walls 1e-5 m wider than it, crossing at 1 m/s,
+// strikes a wall every 1e-5 s: a 1 s message interval asks for 100,000 impacts, beyond the
+// step's budget (10,000 instants). The fallback is counted by name in diagnostics, and every
+// impact it published has the ball in the gap: its contact point is on a wall, never beyond.
+core::Scene wedgedBallScene() {
+  core::Scene scene;
+  scene.materials.addMaterial("test_elastic", core::Material{1.0, std::nullopt}, "materials");
+  core::BodySpec ball;
+  ball.id = "a";
+  ball.mass = 0.1;
+  ball.radius = 0.05;
+  ball.material = "test_elastic";
+  scene.bodies.push_back(ball);
+  const double wall = 0.05 + 0.5e-5;  // each wall's distance from the gap's middle
+  for (const double side : {1.0, -1.0}) {
+    core::ObstacleSpec plane;
+    plane.id = side > 0 ? "left" : "right";
+    plane.material = "test_elastic";
+    plane.normal = Eigen::Vector3d(side, 0, 0);
+    plane.offset = -wall;
+    scene.obstacles.push_back(plane);
+  }
+  return scene;
+}
+
+class WedgedCycle : public Cycle {
+ protected:
+  WedgedCycle() : Cycle(wedgedBallScene()) {}
+};
+
+TEST_F(WedgedCycle, Item12_AStepWhoseBudgetRunsOutIsCountedAndKeepsTheBallInTheGap) {
+  const ros::Time start(1000, 0);
+  send({state("a", start, {0, 0, 0}, {1, 0, 0})});
+  send({state("a", at(start, 1.0), {0, 0, 0}, {1, 0, 0})});
+  ASSERT_GE(reportsOf(Reason::kStepTruncated), 1u);
+  const std::string& text = firstReport(Reason::kStepTruncated)->text;
+  EXPECT_NE(text.find("fallback"), std::string::npos) << text;
+  EXPECT_STREQ(counterName(Reason::kStepTruncated), "steps truncated");
+  ASSERT_FALSE(impacts_.empty());
+  for (const Impact& impact : impacts_) {
+    // The contact point of a ball on a wall is on the wall: |x| = 0.05 + 0.5e-5.
+    EXPECT_LE(std::abs(impact.contact_point.x), 0.05 + 0.5e-5 + 1e-12);
+    EXPECT_TRUE(std::isfinite(impact.velocity_a_after.linear.x));
+  }
+}
+
 TEST_F(Cycle, EveryReasonHasItsOwnCounter) {
   std::set<std::string> names;
   for (int i = 0; i < kReasonCount; ++i) names.insert(counterName(static_cast<Reason>(i)));
