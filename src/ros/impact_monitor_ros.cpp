@@ -21,6 +21,7 @@ ImpactMonitorRos::ImpactMonitorRos(ros::NodeHandle node, const core::Scene& scen
         }));
   }
   impact_publisher_ = node_.advertise<ImpactArray>("impacts", 100);
+  contact_publisher_ = node_.advertise<ContactArray>("contacts", 100);
   marker_publisher_ = node_.advertise<visualization_msgs::MarkerArray>("markers", 10);
   // Retries inputs that wait for transforms; it runs only while some input waits.
   queue_timer_ = node_.createWallTimer(
@@ -114,6 +115,10 @@ bool ImpactMonitorRos::processHead() {
 
 void ImpactMonitorRos::publish(const MonitorCycle::Update& update) {
   if (!update.impacts.impacts.empty()) impact_publisher_.publish(update.impacts);
+  // At each input while contacts last, and one empty array when the last one ends.
+  const bool contacts = !update.contacts.contacts.empty();
+  if (contacts || contacts_published_) contact_publisher_.publish(update.contacts);
+  contacts_published_ = contacts;
   if (marker_publisher_.getNumSubscribers() > 0) publishMarkers(update);
 }
 
@@ -128,6 +133,12 @@ void ImpactMonitorRos::publishMarkers(const MonitorCycle::Update& update) {
     last_scene_markers_ = now;
     appendSceneMarkers(cycle_.monitor(), update.time, cycle_.scene().fixed_frame, update.stamp,
                        params_.markers, markers);
+    appendContactMarkers(update.contacts, contact_markers_, params_.markers, markers);
+    contact_markers_ = update.contacts.contacts.size();
+  } else if (update.contacts.contacts.size() < contact_markers_) {
+    // A contact ended: its markers go at once, not at the next scene markers.
+    appendContactMarkers(update.contacts, contact_markers_, params_.markers, markers);
+    contact_markers_ = update.contacts.contacts.size();
   }
   if (!markers.markers.empty()) marker_publisher_.publish(markers);
 }

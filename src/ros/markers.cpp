@@ -136,6 +136,45 @@ void appendImpactMarkers(const Impact& impact, int id, const MarkerParams& param
   array.markers.push_back(contact);
 }
 
+void appendContactMarkers(const ContactArray& contacts, std::size_t drawn_before,
+                          const MarkerParams& params, visualization_msgs::MarkerArray& array) {
+  const std::string& frame = contacts.header.frame_id;
+  const ros::Time& stamp = contacts.header.stamp;
+  for (std::size_t k = 0; k < contacts.contacts.size(); ++k) {
+    const Contact& contact = contacts.contacts[k];
+    const int id = static_cast<int>(k);
+    // As an impact's arrow (appendImpactMarkers), with the force in place of the impulse.
+    visualization_msgs::Marker arrow =
+        base(kContactForcesNamespace, id, visualization_msgs::Marker::ARROW, frame, stamp);
+    const Eigen::Vector3d from = toEigen(contact.contact_point);
+    const Eigen::Vector3d to =
+        from + params.force_scale * contact.normal_force * toEigen(contact.normal);
+    arrow.points = {toPointMsg(from), toPointMsg(to)};
+    const double shaft = 0.5 * params.contact_diameter;
+    arrow.scale.x = shaft;
+    arrow.scale.y = 2.0 * shaft;
+    arrow.scale.z = 0.0;
+    arrow.color = rgba(0.2f, 0.4f, 1.0f);
+    arrow.text = contact.body_a + " -> " + contact.body_b + " (" + contact.state + ")";
+    array.markers.push_back(arrow);
+
+    visualization_msgs::Marker point =
+        base(kLastingContactsNamespace, id, visualization_msgs::Marker::SPHERE, frame, stamp);
+    point.pose.position = contact.contact_point;
+    point.scale.x = point.scale.y = point.scale.z = params.contact_diameter;
+    point.color = rgba(0.0f, 0.9f, 0.9f);
+    array.markers.push_back(point);
+  }
+  for (std::size_t k = contacts.contacts.size(); k < drawn_before; ++k) {
+    for (const char* ns : {kContactForcesNamespace, kLastingContactsNamespace}) {
+      visualization_msgs::Marker gone =
+          base(ns, static_cast<int>(k), visualization_msgs::Marker::SPHERE, frame, stamp);
+      gone.action = visualization_msgs::Marker::DELETE;
+      array.markers.push_back(gone);
+    }
+  }
+}
+
 void appendSceneMarkers(const core::ImpactMonitor& monitor, double time, const std::string& frame,
                         const ros::Time& stamp, const MarkerParams& params,
                         visualization_msgs::MarkerArray& array) {

@@ -37,6 +37,13 @@ geometry_msgs::Twist toTwist(const Eigen::Vector3d& linear, const Eigen::Vector3
   return twist;
 }
 
+/// "'a' and 'b'": the two sides of an impact or a contact, for a warning.
+std::string sides(const core::ImpactMonitor& monitor, std::size_t body_a, std::size_t other,
+                  bool other_is_obstacle) {
+  return "'" + monitor.body(body_a).id + "' and '" +
+         (other_is_obstacle ? monitor.obstacle(other).id : monitor.body(other).id) + "'";
+}
+
 }  // namespace
 
 core::Expected<Impact> toImpactMessage(const core::ImpactRecord& record,
@@ -77,6 +84,30 @@ core::Expected<Impact> toImpactMessage(const core::ImpactRecord& record,
   impact.velocity_b_after = toTwist(record.velocity_b_after, record.angular_velocity_b_after);
   impact.energy_lost = record.energy_lost;
   return impact;
+}
+
+core::Expected<Contact> toContactMessage(const core::ContactRecord& record,
+                                         const core::ImpactMonitor& monitor,
+                                         const ros::Time& since) {
+  using core::namedResult;
+  if (auto status = core::checkRepresentable(
+          {namedResult("contact_point", record.contact_point), namedResult("normal", record.normal),
+           namedResult("normal_force", record.normal_force),
+           namedResult("friction_force", record.friction_force)});
+      !status) {
+    return status.error();
+  }
+  Contact contact;
+  contact.body_a = monitor.body(record.body_a).id;
+  contact.body_b =
+      record.other_is_obstacle ? monitor.obstacle(record.other).id : monitor.body(record.other).id;
+  contact.contact_point = toPointMsg(record.contact_point);
+  contact.normal = toVector3Msg(record.normal);
+  contact.normal_force = record.normal_force;
+  contact.friction_force = toVector3Msg(record.friction_force);
+  contact.state = core::toString(record.state);
+  contact.since = since;
+  return contact;
 }
 
 MonitorCycle::MonitorCycle(const core::Scene& scene, const MonitorParams& params)
@@ -165,7 +196,25 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
              " fallback(s) resolved the rest inelastically or held the bodies, outside each "
              "other"});
   }
-  update.contacts = step.contacts;
+  update.contacts.header.stamp = newest;
+  update.contacts.header.frame_id = scene_.fixed_frame;
+  update.contacts.contacts.reserve(step.contacts.size());
+  for (const core::ContactRecord& record : step.contacts) {
+    ros::Time since;
+    const bool stamped = time_line_.stampOf(record.since, since);
+    auto contact = toContactMessage(record, monitor_, since);
+    if (contact && stamped) {
+      update.contacts.contacts.push_back(std::move(contact.value()));
+      continue;
+    }
+    const std::string why =
+        contact ? "since: the instant is not a valid ros::Time" : contact.error().message();
+    update.reports.push_back(
+        {Reason::kContactNotFinite,
+         "did not publish the contact of " +
+             sides(monitor_, record.body_a, record.other, record.other_is_obstacle) + ": " + why +
+             "; the states were finite, the answer is not"});
+  }
   update.impacts.header.stamp = newest;
   update.impacts.header.frame_id = scene_.fixed_frame;
   update.impacts.impacts.reserve(step.impacts.size());
@@ -177,14 +226,13 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
       update.impacts.impacts.push_back(std::move(impact.value()));
       continue;
     }
-    const std::string a = monitor_.body(record.body_a).id;
-    const std::string b = record.other_is_obstacle ? monitor_.obstacle(record.other).id
-                                                   : monitor_.body(record.other).id;
     const std::string why =
         impact ? "header.stamp: the instant is not a valid ros::Time" : impact.error().message();
-    update.reports.push_back({Reason::kImpactNotFinite,
-                              "did not publish the impact of '" + a + "' and '" + b + "': " + why +
-                                  "; the states were finite, the answer is not"});
+    update.reports.push_back(
+        {Reason::kImpactNotFinite,
+         "did not publish the impact of " +
+             sides(monitor_, record.body_a, record.other, record.other_is_obstacle) + ": " + why +
+             "; the states were finite, the answer is not"});
   }
   return update;
 }

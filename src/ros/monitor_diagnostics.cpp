@@ -31,12 +31,15 @@ void MonitorDiagnostics::report(diagnostic_updater::DiagnosticStatusWrapper& sta
     dropped += (dropped.empty() ? "" : "; ") + name.substr(name.find(": ") + 2) + " (" +
                std::to_string(events) + ")";
   }
-  const std::uint64_t impacts_dropped =
-      totals_[static_cast<std::size_t>(Reason::kImpactNotFinite)] -
-      period_.totals[static_cast<std::size_t>(Reason::kImpactNotFinite)];
+  const auto inPeriod = [this](Reason reason) {
+    return totals_[static_cast<std::size_t>(reason)] -
+           period_.totals[static_cast<std::size_t>(reason)];
+  };
+  const std::uint64_t outputs_dropped =
+      inPeriod(Reason::kImpactNotFinite) + inPeriod(Reason::kContactNotFinite);
   if (!dropped.empty()) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
-                   std::string(impacts_dropped > 0 ? "dropped: " : "states dropped: ") + dropped);
+                   std::string(outputs_dropped > 0 ? "dropped: " : "states dropped: ") + dropped);
   } else if (period_.messages == 0) {
     status.summary(diagnostic_msgs::DiagnosticStatus::OK,
                    "no states received in the last " + core::formatNumber(seconds) + " s");

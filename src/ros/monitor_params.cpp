@@ -60,6 +60,9 @@ const KeyTable<MonitorParams>& MonitorParams::keys() {
           "impulse_marker_scale", [](P& p) -> double& { return p.markers.impulse_scale; },
           checkPositive),
       numberKey<P>(
+          "force_marker_scale", [](P& p) -> double& { return p.markers.force_scale; },
+          checkPositive),
+      numberKey<P>(
           "plane_marker_size", [](P& p) -> double& { return p.markers.plane_size; }, checkPositive),
       numberKey<P>(
           "contact_marker_diameter", [](P& p) -> double& { return p.markers.contact_diameter; },

@@ -80,6 +80,8 @@ const char* counterName(Reason reason) {
       return "dropped: internal error";
     case Reason::kImpactNotFinite:
       return "impacts dropped: not finite";
+    case Reason::kContactNotFinite:
+      return "contacts dropped: not finite";
     case Reason::kClockJumpedBack:
       return "clock jumped back";
     case Reason::kClockOffset:
@@ -92,7 +94,7 @@ const char* counterName(Reason reason) {
   return "unknown";
 }
 
-bool isDrop(Reason reason) { return reason <= Reason::kImpactNotFinite; }
+bool isDrop(Reason reason) { return reason <= Reason::kContactNotFinite; }
 
 StateIntake::StateIntake(std::vector<std::string> body_ids, IntakeSettings settings)
     : body_ids_(std::move(body_ids)),

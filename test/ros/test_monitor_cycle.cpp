@@ -430,6 +430,55 @@ TEST_F(WedgedCycle, Item12_AStepWhoseBudgetRunsOutIsCountedAndKeepsTheBallInTheG
   }
 }
 
+// Lasting contact (README, "Topics": `contacts`): two balls resting on a floor under gravity, a
+// light one (1 kg, r = 0.1 m, at rest touching: the floor carries m g = 9.81 N) and one of
+// 1e308 kg, whose weight 9.81e308 N is beyond the doubles: that contact is not published, named
+// and counted (as an impact beyond the doubles is), and the light one's is.
+core::Scene floorScene() {
+  core::Scene scene = twoBallScene();
+  scene.bodies[1].id = "heavy";
+  scene.bodies[1].mass = 1e308;
+  scene.bodies[0].id = "light";
+  scene.effects.gravity = true;
+  scene.gravity = Eigen::Vector3d(0, 0, -9.81);
+  core::ObstacleSpec floor;
+  floor.id = "floor";
+  floor.normal = Eigen::Vector3d::UnitZ();
+  floor.material = "test_half";
+  scene.obstacles.push_back(floor);
+  return scene;
+}
+
+class FloorCycle : public Cycle {
+ protected:
+  FloorCycle() : Cycle(floorScene()) {}
+};
+
+TEST_F(FloorCycle, ContactsArePublishedFiniteAndNamed) {
+  const ros::Time start(1000, 0);
+  MonitorCycle::Update update;
+  for (int k = 0; k <= 5; ++k) {
+    update = send({state("light", at(start, 0.1 * k), {0, 0, 0.1}, {0, 0, 0}),
+                   state("heavy", at(start, 0.1 * k), {10, 0, 0.1}, {0, 0, 0})});
+  }
+  EXPECT_EQ(update.contacts.header.stamp, at(start, 0.5));
+  EXPECT_EQ(update.contacts.header.frame_id, "world");
+  ASSERT_EQ(update.contacts.contacts.size(), 1u);
+  const Contact& contact = update.contacts.contacts[0];
+  EXPECT_EQ(contact.body_a, "light");
+  EXPECT_EQ(contact.body_b, "floor");
+  EXPECT_NEAR(contact.normal_force, 9.81, 1e-12);
+  EXPECT_EQ(contact.state, "resting");
+  EXPECT_NEAR(contact.normal.z, -1.0, 1e-15);  // from the ball into the floor
+  EXPECT_NEAR(contact.contact_point.z, 0.0, 1e-12);
+  EXPECT_LE(contact.since, at(start, 0.5));
+  EXPECT_GE(contact.since, start);
+  ASSERT_GE(reportsOf(Reason::kContactNotFinite), 1u);
+  const std::string& text = firstReport(Reason::kContactNotFinite)->text;
+  EXPECT_NE(text.find("'heavy' and 'floor'"), std::string::npos) << text;
+  EXPECT_TRUE(isDrop(Reason::kContactNotFinite));
+}
+
 TEST_F(Cycle, EveryReasonHasItsOwnCounter) {
   std::set<std::string> names;
   for (int i = 0; i < kReasonCount; ++i) names.insert(counterName(static_cast<Reason>(i)));

@@ -46,6 +46,7 @@ std::map<std::string, XmlRpc::XmlRpcValue> nodeExamples() {
           {"marker_rate", 10.0},
           {"impact_marker_lifetime", 1.5},
           {"impulse_marker_scale", 0.3},
+          {"force_marker_scale", 0.05},
           {"plane_marker_size", 2.0},
           {"contact_marker_diameter", 0.05},
           {"diagnostic_period", 0.5},

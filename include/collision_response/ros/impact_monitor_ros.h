@@ -1,6 +1,7 @@
 // The impact monitor on ROS: a thin wrapper that subscribes to the body states, queues the
 // inputs whose transforms are not there yet, hands each input to the update cycle
-// (MonitorCycle) and publishes what it returns: impacts, markers, warnings and diagnostics.
+// (MonitorCycle) and publishes what it returns: impacts, lasting contacts, markers, warnings and
+// diagnostics.
 //
 // Threads: every callback of this class, and every use of the cycle, runs on the callback queue
 // of the node handle it is given (the node's global queue, or a nodelet's single-threaded one),
@@ -32,7 +33,7 @@ namespace collision_response {
 class ImpactMonitorRos {
  public:
   /// Subscribes `body_states` and the bodies' own topics (checked by checkBodyTopics first),
-  /// advertises `impacts` and `markers`.
+  /// advertises `impacts`, `contacts` and `markers`.
   ImpactMonitorRos(ros::NodeHandle node, const core::Scene& scene, const MonitorParams& params);
 
   /// Live tuning (dynamic_reconfigure), validated by the caller: see core::ImpactMonitor::tune.
@@ -76,7 +77,13 @@ class ImpactMonitorRos {
   std::string array_topic_;
   std::vector<ros::Subscriber> body_subscribers_;
   ros::Publisher impact_publisher_;
+  ros::Publisher contact_publisher_;
   ros::Publisher marker_publisher_;
+  /// Whether the last `contacts` published held some: one empty array is published when the
+  /// last contact ends, then nothing until contacts exist again (README, "Topics").
+  bool contacts_published_ = false;
+  /// Lasting-contact markers drawn last (ids 0 .. n-1): the ids past a new count are deleted.
+  std::size_t contact_markers_ = 0;
   ros::WallTime last_scene_markers_;
   int next_impact_marker_ = 0;
   ros::WallTimer queue_timer_;

@@ -1,12 +1,15 @@
-// rviz markers of the monitor's scene: bodies, obstacles, impacts and contact points.
+// rviz markers of the monitor's scene: bodies, obstacles, impacts and contact points, and the
+// lasting contacts with their normal forces.
 #pragma once
 
 #include <visualization_msgs/MarkerArray.h>
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <optional>
 #include <string>
 
+#include "collision_response/ContactArray.h"
 #include "collision_response/Impact.h"
 #include "collision_response/core/monitor.h"
 #include "collision_response/core/scene.h"
@@ -18,16 +21,20 @@ struct MarkerParams {
   double rate = 30.0;              ///< Hz: bodies and obstacles at most this often
   double impact_lifetime = 0.5;    ///< s: how long an impact's arrow and contact point stay
   double impulse_scale = 0.2;      ///< m per N s: an impact's arrow length per unit impulse
+  double force_scale = 0.02;       ///< m per N: a lasting contact's arrow length per unit force
   double plane_size = 4.0;         ///< m: the side of the square drawn for a plane obstacle
   double contact_diameter = 0.02;  ///< m: the sphere drawn at a contact point
 };
 
 /// Marker namespaces. Ids are stable: a body's and an obstacle's is its index among the
-/// scene's bodies (obstacles) sorted by id; impacts count up and wrap at kImpactIds.
+/// scene's bodies (obstacles) sorted by id; impacts count up and wrap at kImpactIds; a lasting
+/// contact's is its index in the `contacts` array drawn.
 inline constexpr const char* kBodiesNamespace = "bodies";
 inline constexpr const char* kObstaclesNamespace = "obstacles";
 inline constexpr const char* kImpactsNamespace = "impacts";
 inline constexpr const char* kContactsNamespace = "contacts";
+inline constexpr const char* kLastingContactsNamespace = "lasting_contacts";
+inline constexpr const char* kContactForcesNamespace = "contact_forces";
 inline constexpr int kImpactIds = 10000;
 
 /// The colour of a material: the seed's materials have their own; any other material a
@@ -51,6 +58,14 @@ visualization_msgs::Marker obstacleMarker(const core::ObstacleSpec& obstacle, in
 /// both with id `id` in their namespaces and the lifetime `impact_lifetime`.
 void appendImpactMarkers(const Impact& impact, int id, const MarkerParams& params,
                          visualization_msgs::MarkerArray& array);
+
+/// The lasting contacts of `contacts`: a sphere at each contact point (namespace
+/// lasting_contacts) and an arrow from it along the normal (towards body_b, the direction of the
+/// normal force on body_b), force_scale m per N long (contact_forces), both with id = the
+/// contact's index and no lifetime; the ids from contacts.size() up to `drawn_before` (those of
+/// contacts that ended) deleted in both namespaces.
+void appendContactMarkers(const ContactArray& contacts, std::size_t drawn_before,
+                          const MarkerParams& params, visualization_msgs::MarkerArray& array);
 
 /// The monitor's bodies (where it predicts them at `time`; deleted while not tracked) and its
 /// placed obstacles, appended to `array`.

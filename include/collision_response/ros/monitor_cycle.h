@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "collision_response/BodyState.h"
+#include "collision_response/ContactArray.h"
 #include "collision_response/ImpactArray.h"
 #include "collision_response/core/monitor.h"
 #include "collision_response/core/scene.h"
@@ -46,9 +47,9 @@ class MonitorCycle {
     double time = 0.0;     ///< s on the time line: the step's instant
     ros::Time stamp;       ///< the input's newest stamp, in its source's clock
     ImpactArray impacts;   ///< the impacts found, every number finite: to publish
-    /// The lasting contacts at the step's time, as the monitor reports them (for a contacts
-    /// topic: ImpactMonitorRos::publish is where its publisher goes).
-    std::vector<core::ContactRecord> contacts;
+    /// The lasting contacts at the step's time (gravity), every number finite, stamped with the
+    /// input's newest stamp: to publish on `contacts` (README, "Topics").
+    ContactArray contacts;
     /// What was dropped (states, impacts) and what else happened.
     std::vector<Report> reports;
   };
@@ -89,5 +90,11 @@ class MonitorCycle {
 core::Expected<Impact> toImpactMessage(const core::ImpactRecord& record,
                                        const core::ImpactMonitor& monitor, const ros::Time& stamp,
                                        const std::string& fixed_frame);
+
+/// The contact message of a monitor's lasting contact, `since` stamped `since`; or the error
+/// naming the first field the doubles cannot hold (as toImpactMessage).
+core::Expected<Contact> toContactMessage(const core::ContactRecord& record,
+                                         const core::ImpactMonitor& monitor,
+                                         const ros::Time& since);
 
 }  // namespace collision_response

@@ -33,6 +33,7 @@ enum class Reason {
   kQueueFull,          ///< the oldest waiting input, dropped for a new one
   kInternalError,      ///< an exception while processing a message
   kImpactNotFinite,    ///< an impact whose numbers the doubles cannot hold: not published
+  kContactNotFinite,   ///< a lasting contact whose numbers the doubles cannot hold: not published
   kClockJumpedBack,    ///< a source's stamps went back: every track reset
   kClockOffset,        ///< a source's stamps lag the time line: shifted onto it
   kStepTruncated,      ///< a guard of the monitor cut a step short
@@ -42,7 +43,7 @@ inline constexpr int kReasonCount = static_cast<int>(Reason::kObstacleTransform)
 
 /// The counter's name, as diagnostics shows it: "dropped: unknown id", "clock jumped back", ...
 const char* counterName(Reason reason);
-/// Whether the reason drops input (a state or a message) or output (an impact).
+/// Whether the reason drops input (a state or a message) or output (an impact, a contact).
 bool isDrop(Reason reason);
 
 /// One thing to report: its reason and the text of its warning (which names the state, the
