@@ -446,11 +446,6 @@ void closeContactVelocities(std::vector<ForceBody>& bodies,
   }
   for (const Real target : targets) widest = std::max(widest, std::abs(target));
   if (widest <= std::numeric_limits<double>::epsilon() * speed) return;
-  const auto measure = [&](const Response& response, const Condition& condition) -> Real {
-    return condition.normal
-               ? response.gap_acceleration[condition.contact]
-               : condition.direction.dot(response.slip_acceleration[condition.contact]);
-  };
   const std::vector<V3> no_impulses(count, V3::Zero());
   std::vector<std::vector<Eigen::Index>> conditions_of(count);
   for (Eigen::Index i = 0; i < size; ++i) {
