@@ -83,7 +83,13 @@ struct BenchScene {
   /// What reference/make_references.py computes: "events" (the exact event-driven motion) or
   /// "conservation" (only the conserved quantities: a chaotic gas's trajectory is not
   /// reproducible beyond a few dozen impacts in any finite precision, its energy is).
+  /// "lasting" (contact that lasts, under gravity): closed forms of where the motion ends.
   std::string reference = "events";
+  /// Ours (continuous, 100 Hz, the scene's effects and each of its effect variants) again at
+  /// each of these Scene::contact_integration_tolerance values: error against CPU.
+  std::vector<double> integration_tolerances = {};
+  /// The engines that play the scene (empty: every one); e.g. a pile too large for some.
+  std::vector<std::string> engines = {};
 };
 
 /// Every scene, short ones first; names are unique. The one list: the benchmark, the exported

@@ -34,6 +34,8 @@ Engine oursEngine(core::Detection detection) {
         states[i].time = t;
         states[i].position = playback.position(i, t);
         states[i].velocity = playback.velocity(i, t);
+        // With spin, a rolling ball's spin is part of its state (zero would say it slips).
+        states[i].angular_velocity = playback.angularVelocity(i, t);
       }
       const core::StepReport report = monitor.step(t, states);
       run.truncated = run.truncated || report.truncated;
