@@ -26,13 +26,17 @@ struct Play {
   double rate = 100.0;
   double duration = 1.0;
   bool record_all = true;
+  /// Ours: where the source placed the bodies at each impact (ReportedImpact positions, for the
+  /// apexes). A query of the source at a past instant costs it a replay: scenes that use no
+  /// impact positions (lasting contact, piles of thousands of impacts) leave them out.
+  bool impact_positions = true;
 };
 
 /// An impact an engine reported (ours: every one, at its instant).
 struct ReportedImpact {
   double time = 0.0;
   std::size_t body = 0;          ///< scene index
-  V position = V::Zero();        ///< of `body`'s centre, at the instant
+  V position = V::Zero();        ///< of `body`'s centre, at the instant (Play::impact_positions)
   V velocity_after = V::Zero();  ///< of `body`
   bool other_is_obstacle = false;
   std::size_t other = 0;  ///< scene index of the other body, or obstacle index
