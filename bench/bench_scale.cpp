@@ -1,18 +1,25 @@
 // Scale: pair responses per second, and one state update of a gas of 1k, 10k and 100k spheres
 // in a box (every body's state each update, as a source that applies the responses sends
-// them), with Bullet's btDbvtBroadphase and solver on the same gas in the same run.
+// them), with Bullet's btDbvtBroadphase and solver on the same gas in the same run; and one
+// update of a pile of 1,000 balls at rest on a floor (lasting contact under gravity), against
+// the same pile with gravity off and against Bullet on the same pile.
 // scripts/performance.sh runs it and writes doc/performance.md.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "box_walls.h"
 #include "collision_response/core/impact.h"
 #include "collision_response/core/monitor.h"
+#include "collision_response/core/playback.h"
 #ifdef COLLISION_RESPONSE_WITH_BULLET
 #include <btBulletDynamicsCommon.h>
 #endif
@@ -97,6 +104,118 @@ void BM_GasUpdate(benchmark::State& state) {
   state.counters["bodies"] = static_cast<double>(states.size());
 }
 
+/// A pile at rest: `columns` x `rows` balls (radius 0.05 m, 0.1 kg, e = 0.5, frictionless) on a
+/// floor in a square lattice, `gap` apart (0: each touching its neighbours), walls around the
+/// lattice. With gravity it is at rest exactly (each ball on the floor, no force between
+/// neighbours): every ball has a lasting contact with the floor.
+constexpr double kPileRadius = 0.05;
+
+core::Scene makePile(int columns, int rows, double gap, bool gravity) {
+  core::Scene scene;
+  scene.effects.gravity = gravity;
+  (void)scene.materials.addMaterial("pile", core::Material{0.5, {}}, "m");
+  const double r = kPileRadius, pitch = 2 * r + gap;
+  for (int i = 0; i < columns * rows; ++i) {
+    core::BodySpec body;
+    char id[16];
+    std::snprintf(id, sizeof id, "ball_%04d", i);
+    body.id = id;
+    body.mass = 0.1;
+    body.radius = r;
+    body.material = "pile";
+    body.position = V(r + pitch * (i % columns), r + pitch * (i / columns), r);
+    scene.bodies.push_back(body);
+  }
+  const double length = pitch * columns - gap, width = pitch * rows - gap;
+  const std::pair<V, double> walls[] = {{V(0, 0, 1), 0.0},
+                                        {V(1, 0, 0), 0.0},
+                                        {V(-1, 0, 0), -length},
+                                        {V(0, 1, 0), 0.0},
+                                        {V(0, -1, 0), -width}};
+  int w = 0;
+  for (const auto& [normal, offset] : walls) {
+    core::ObstacleSpec wall;
+    wall.id = "wall_" + std::to_string(w++);
+    wall.material = "pile";
+    wall.normal = normal;
+    wall.offset = offset;
+    scene.obstacles.push_back(wall);
+  }
+  return scene;
+}
+
+/// The pile of a benchmark's arguments: columns, rows, gap (um), gravity (1) or not (0).
+core::Scene pileOf(const benchmark::State& state) {
+  return makePile(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)),
+                  1e-6 * static_cast<double>(state.range(2)), state.range(3) != 0);
+}
+
+/// One update of the pile at 100 Hz, the monitor's step alone: every body's state from a source
+/// that follows the monitor, as the scene player and the accuracy benchmark do (core::Playback,
+/// which moves the bodies by the monitor's model, resting contact included, and applies the
+/// impacts reported). The source's own time per update is the counter source_ms (not timed).
+void BM_PileUpdate(benchmark::State& state) {
+  const core::Scene scene = pileOf(state);
+  core::MonitorSettings settings;
+  core::ImpactMonitor monitor(scene, settings);
+  core::Playback source(scene, settings.contact_tolerance, 0.0);
+  std::vector<core::BodyStateSample> states(scene.bodies.size());
+  const auto sample = [&](double time) {
+    for (std::size_t i = 0; i < states.size(); ++i) {
+      states[i].time = time;
+      states[i].position = source.position(i, time);
+      states[i].velocity = source.velocity(i, time);
+      states[i].angular_velocity = source.angularVelocity(i, time);
+    }
+  };
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    states[i].body = *monitor.bodyIndex(scene.bodies[i].id);
+  }
+  sample(0.0);
+  monitor.step(0.0, states);
+  double time = 0.0, source_seconds = 0.0;
+  std::size_t impacts = 0, contacts = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    time += 0.01;
+    const auto began = std::chrono::steady_clock::now();
+    sample(time);
+    source_seconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+    state.ResumeTiming();
+    const core::StepReport report = monitor.step(time, states);
+    state.PauseTiming();
+    impacts += report.impacts.size();
+    contacts += report.contacts.size();
+    for (const core::ImpactRecord& impact : report.impacts)
+      source.applyImpact(monitor, impact, true);
+    state.ResumeTiming();
+  }
+  double drift = 0;
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    drift = std::max(drift, (states[i].position - scene.bodies[i].position).norm());
+  }
+  const auto updates = static_cast<double>(state.iterations());
+  state.counters["impacts/update"] = static_cast<double>(impacts) / updates;
+  state.counters["contacts/update"] = static_cast<double>(contacts) / updates;
+  state.counters["source_ms"] = 1e3 * source_seconds / updates;
+  state.counters["drift_m"] = drift;  // the farthest any centre moved from the lattice
+  state.counters["bodies"] = static_cast<double>(states.size());
+}
+
+/// The piles: 1,000 balls 1 mm apart (gravity on and off), and touching lattices of 25, 100 and
+/// 225 (the core's cost grows steeply with touching neighbours: 1,000 touching is out of reach).
+void pileArguments(benchmark::internal::Benchmark* bench, bool with_gravity_off) {
+  bench->ArgNames({"columns", "rows", "gap_um", "gravity"});
+  bench->Args({40, 25, 1000, 1});
+  if (with_gravity_off) bench->Args({40, 25, 1000, 0});
+  for (const int side : {5, 10, 15}) bench->Args({side, side, 0, 1});
+}
+BENCHMARK(BM_PileUpdate)
+    ->Apply([](benchmark::internal::Benchmark* bench) { pileArguments(bench, true); })
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0);
+
 #ifdef COLLISION_RESPONSE_WITH_BULLET
 btScalar bt(double value) { return static_cast<btScalar>(value); }
 
@@ -143,6 +262,65 @@ void BM_BulletGasUpdate(benchmark::State& state) {
   state.counters["bodies"] = static_cast<double>(gas.scene.bodies.size());
   for (const auto& body : bodies) world.removeRigidBody(body.get());
 }
+/// Bullet on the same piles, gravity on: one stepSimulation of 0.01 s per update, restitution
+/// sqrt(0.5) on every body and wall (Bullet multiplies the two), friction 0, no sleeping (every
+/// ball simulated, as ours watches every ball).
+void BM_BulletPileUpdate(benchmark::State& state) {
+  const core::Scene scene = pileOf(state);
+  btDefaultCollisionConfiguration configuration;
+  btCollisionDispatcher dispatcher(&configuration);
+  btDbvtBroadphase broadphase;
+  btSequentialImpulseConstraintSolver solver;
+  btDiscreteDynamicsWorld world(&dispatcher, &broadphase, &solver, &configuration);
+  const V g = scene.effects.gravity ? scene.gravity : V::Zero();
+  world.setGravity(btVector3(bt(g.x()), bt(g.y()), bt(g.z())));
+  const btScalar restitution = bt(std::sqrt(0.5));
+  btSphereShape sphere(bt(kPileRadius));
+  btVector3 inertia(0, 0, 0);
+  sphere.calculateLocalInertia(bt(0.1), inertia);
+  std::vector<std::unique_ptr<btDefaultMotionState>> motions;
+  std::vector<std::unique_ptr<btRigidBody>> bodies;
+  std::vector<std::unique_ptr<btCollisionShape>> planes;
+  for (const core::BodySpec& spec : scene.bodies) {
+    btTransform start;
+    start.setIdentity();
+    start.setOrigin(btVector3(bt(spec.position.x()), bt(spec.position.y()), bt(spec.position.z())));
+    motions.push_back(std::make_unique<btDefaultMotionState>(start));
+    btRigidBody::btRigidBodyConstructionInfo info(bt(0.1), motions.back().get(), &sphere, inertia);
+    info.m_restitution = restitution;
+    info.m_friction = 0;
+    bodies.push_back(std::make_unique<btRigidBody>(info));
+    bodies.back()->setActivationState(DISABLE_DEACTIVATION);
+    world.addRigidBody(bodies.back().get());
+  }
+  const std::size_t balls = bodies.size();
+  for (const core::ObstacleSpec& wall : scene.obstacles) {
+    planes.push_back(std::make_unique<btStaticPlaneShape>(
+        btVector3(bt(wall.normal.x()), bt(wall.normal.y()), bt(wall.normal.z())), bt(wall.offset)));
+    btTransform identity;
+    identity.setIdentity();
+    motions.push_back(std::make_unique<btDefaultMotionState>(identity));
+    btRigidBody::btRigidBodyConstructionInfo info(0, motions.back().get(), planes.back().get());
+    info.m_restitution = restitution;
+    info.m_friction = 0;
+    bodies.push_back(std::make_unique<btRigidBody>(info));
+    world.addRigidBody(bodies.back().get());
+  }
+  for (auto _ : state) world.stepSimulation(bt(0.01), 1, bt(0.01));
+  double drift = 0;
+  for (std::size_t i = 0; i < balls; ++i) {
+    const btVector3 p = bodies[i]->getCenterOfMassPosition();
+    drift = std::max(drift, (V(p.x(), p.y(), p.z()) - scene.bodies[i].position).norm());
+  }
+  state.counters["drift_m"] = drift;
+  state.counters["bodies"] = static_cast<double>(balls);
+  for (const auto& body : bodies) world.removeRigidBody(body.get());
+}
+BENCHMARK(BM_BulletPileUpdate)
+    ->Apply([](benchmark::internal::Benchmark* bench) { pileArguments(bench, false); })
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0);
+
 BENCHMARK(BM_BulletGasUpdate)
     ->Arg(1000)
     ->Arg(10000)

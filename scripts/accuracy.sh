@@ -2,7 +2,8 @@
 # What accuracy costs in time: every scene of bench/accuracy at every setting (our continuous
 # and discrete detection, effects on and off; Bullet with its defaults and with its recommended
 # bouncing settings; ODE; MuJoCo with its default contact and with restitution through solref;
-# DART; Box2D on the planar scenes), errors against references computed outside the code under
+# DART; Box2D on the planar scenes; lasting contact under gravity: a ball into a corner, off a
+# fixed sphere, a stack of three, piles settling in a box), errors against references computed outside the code under
 # test and CPU time (Google Benchmark). Writes doc/accuracy.md, doc/accuracy.png and the
 # accuracy section of doc/measurements.md (between its markers).
 #   bash scripts/accuracy.sh

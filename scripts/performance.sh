@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Scale: the core per update for 1k, 10k and 100k bodies beside Bullet (Google Benchmark); the
+# Scale: the core per update for 1k, 10k and 100k bodies beside Bullet, and a pile of balls at
+# rest on a floor (lasting contact) with gravity on and off, beside Bullet (Google Benchmark); the
 # node over ROS with 10,000 bodies at 100 Hz (CPU share, latency, memory over a long run); the
 # collision service's round trip beside an empty service; the work of one hard message (an
 # array of 10,000 distinct stamps, a cluster of 1,000 touching balls: the monitor's CPU, and
@@ -8,6 +9,10 @@
 #   bash scripts/performance.sh                    # the memory run lasts 10 minutes
 #   MEMORY_SECONDS=60 bash scripts/performance.sh  # a shorter one
 #   MEMORY_SECONDS=0 bash scripts/performance.sh   # none: the report keeps the last memory run
+# The pile's section alone (about 2 minutes), into the existing doc/performance.md:
+#   .ws/devel/lib/collision_response/bench_scale --benchmark_filter=Pile \
+#     --benchmark_format=json --benchmark_out=.ws/pile.json
+#   python3 scripts/performance_report.py --pile-only .ws/pile.json doc/performance.md
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 PACKAGES+=(libbenchmark-dev libbullet-dev libstd-srvs-dev ros-std-srvs linux-perf)
@@ -23,7 +28,7 @@ mkdir -p "$out"
 rm -f "$out"/scale.json "$out"/service*.json "$out"/load.json "$out"/burden_*.json "$out"/startup.json
 [ "${MEMORY_SECONDS:-600}" -gt 0 ] && rm -f "$out/memory.json"
 
-echo "== core: 1k, 10k, 100k bodies, and Bullet on the same gas"
+echo "== core: 1k, 10k, 100k bodies, and Bullet on the same gas; a pile at rest, gravity on and off"
 "$bin/bench_scale" --benchmark_format=json --benchmark_out="$out/scale.json" >"$out/scale.log" 2>&1
 
 echo "== the node over ROS"

@@ -1,17 +1,111 @@
 #!/usr/bin/env python3
-"""Turns scripts/performance.sh's output into doc/performance.md."""
+"""Turns scripts/performance.sh's output into doc/performance.md.
+
+usage: performance_report.py OUT_DIR doc/performance.md
+       performance_report.py --pile-only SCALE_JSON doc/performance.md   (the pile's section
+       alone, from a run of `bench_scale --benchmark_filter=Pile`)
+"""
 import json
+import math
 import pathlib
 import platform
 import sys
 
 
-def main():
-    out, target = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
+PILE_TITLE = "## A pile at rest (lasting contact)"
+
+
+def read_scale(path):
+    """Google Benchmark's rows by name (options such as /min_time cut off): (CPU s, row)."""
     scale = {}
-    for row in json.loads((out / "scale.json").read_text())["benchmarks"]:
+    for row in json.loads(path.read_text())["benchmarks"]:
         unit = {"ns": 1e-9, "us": 1e-6, "ms": 1e-3, "s": 1.0}[row["time_unit"]]
         scale[row["name"].split("/min_time")[0]] = (row["cpu_time"] * unit, row)
+    return scale
+
+
+def pile_section(scale):
+    """BM_PileUpdate beside BM_BulletPileUpdate: a pile of balls at rest on a floor."""
+    def name(kind, columns, rows, gap, gravity=None):
+        text = f"{kind}/columns:{columns}/rows:{rows}/gap_um:{gap}"
+        return text + (f"/gravity:{gravity}" if gravity is not None else "/gravity:1")
+
+    def ms(value):
+        if value is None:
+            return "n/a"
+        return f"{value:.3g} s" if value >= 1 else f"{value * 1e3:.3g} ms"
+
+    cases = [(40, 25, 1000), (5, 5, 0), (10, 10, 0), (15, 15, 0)]
+    if not any(name("BM_PileUpdate", *c) in scale for c in cases):
+        return []
+    lines = [
+        PILE_TITLE, "",
+        "Balls (radius 0.05 m, 0.1 kg, e = 0.5, frictionless) at rest on a floor in a square "
+        "lattice, walls around it, at 100 Hz: every body's state each update from a source that "
+        "follows the monitor (`core::Playback`, the scene player's and the accuracy benchmark's "
+        "loop: it moves the bodies by the monitor's model, resting contact included). Timed: "
+        "the monitor's step alone; the source's own time per update beside it. Gravity on: "
+        "every ball has a lasting contact with the floor; gravity off: the same balls at rest "
+        "with no force. Bullet: the same pile, gravity on, one `stepSimulation` of 0.01 s per "
+        "update, no sleeping. `bench_scale --benchmark_filter=Pile` (one run).", "",
+        "| pile | ours, gravity on | ours, gravity off | gravity on / off | source per update "
+        "| lasting contacts | Bullet | ours / Bullet |",
+        "|---|---|---|---|---|---|---|---|"]
+    for columns, rows, gap in cases:
+        on = scale.get(name("BM_PileUpdate", columns, rows, gap, 1))
+        off = scale.get(name("BM_PileUpdate", columns, rows, gap, 0))
+        bullet = scale.get(name("BM_BulletPileUpdate", columns, rows, gap, 1))
+        if on is None:
+            continue
+        spacing = "touching" if gap == 0 else f"{gap / 1000:g} mm apart"
+        lines.append(
+            f"| {columns * rows:,} balls, {spacing} | {ms(on[0])} | {ms(off[0] if off else None)} | "
+            f"{f'{on[0] / off[0]:.2f}' if off else 'n/a'} | {ms(on[1].get('source_ms', 0) / 1e3)} | "
+            f"{on[1].get('contacts/update', 0):.0f} | {ms(bullet[0] if bullet else None)} | "
+            f"{f'{on[0] / bullet[0]:.2f}' if bullet else 'n/a'} |")
+    lines += [
+        "",
+        "Drift (the farthest any centre moved from the lattice, from the run's last states): "
+        + "; ".join(f"{kind} {columns * rows:,}{' touching' if gap == 0 else ''}: "
+                    f"{scale[name(bench, columns, rows, gap, 1)][1].get('drift_m', 0):.2g} m"
+                    for bench, kind in (("BM_PileUpdate", "ours"), ("BM_BulletPileUpdate", "Bullet"))
+                    for columns, rows, gap in cases if name(bench, columns, rows, gap, 1) in scale)
+        + ".",
+        ""]
+    touching = [(c * r, scale[name("BM_PileUpdate", c, r, 0, 1)][0]) for c, r, g in cases
+                if g == 0 and name("BM_PileUpdate", c, r, 0, 1) in scale]
+    if len(touching) >= 2:
+        (n1, t1), (n2, t2) = touching[-2], touching[-1]
+        exponent = math.log(t2 / t1) / math.log(n2 / n1)
+        lines += [
+            f"The pile of 1,000 is 1 mm apart. Touching, every ball of a lattice is in one "
+            f"cluster, and the monitor's step grows as the {exponent:.1f}th power of the balls "
+            f"between {n1:,} and {n2:,} (the source's likewise); extrapolated, 1,000 touching "
+            f"balls would take about {t2 * (1000 / n2) ** exponent:.0f} s per update, which is "
+            "why the benchmark stops at 225.", ""]
+    return lines
+
+
+def replace_pile_section(target, lines):
+    """Writes the pile's section into an existing doc/performance.md (before the node's)."""
+    text = target.read_text()
+    if PILE_TITLE in text:
+        head, rest = text.split(PILE_TITLE, 1)
+        tail = rest[rest.index("\n## "):] if "\n## " in rest else ""
+        text = head + "\n".join(lines) + tail.lstrip("\n")
+    else:
+        head, tail = text.split("## The node over ROS", 1)
+        text = head + "\n".join(lines) + "\n## The node over ROS" + tail
+    target.write_text(text)
+
+
+def main():
+    if sys.argv[1] == "--pile-only":
+        # Only the pile's benchmark was run: its section of the existing page.
+        replace_pile_section(pathlib.Path(sys.argv[3]), pile_section(read_scale(pathlib.Path(sys.argv[2]))))
+        return
+    out, target = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
+    scale = read_scale(out / "scale.json")
     rounds = [json.loads(path.read_text()) for path in sorted(out.glob("service*.json"))]
     ratio_p50 = sorted(r["compute_p50"] / r["empty_p50"] for r in rounds)
     ratio_mean = sorted(r["compute_mean"] / r["empty_mean"] for r in rounds)
@@ -71,8 +165,8 @@ def main():
         lines.append(f"| {n:,} | {ours[0] * 1e3:.2f} ms | {ours[1].get('impacts/update', 0):.0f} | "
                      f"{bullet[0] * 1e3:.2f} ms | {ratio} |" if bullet else
                      f"| {n:,} | {ours[0] * 1e3:.2f} ms | {ours[1].get('impacts/update', 0):.0f} | n/a | n/a |")
+    lines += [""] + pile_section(scale)
     lines += [
-        "",
         "## The node over ROS",
         "",
         f"{load['bodies']:,} bodies in one `BodyStateArray` at {load['rate']:g} Hz for "

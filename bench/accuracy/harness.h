@@ -26,13 +26,17 @@ struct Play {
   double rate = 100.0;
   double duration = 1.0;
   bool record_all = true;
+  /// Ours: where the source placed the bodies at each impact (ReportedImpact positions, for the
+  /// apexes). A query of the source at a past instant costs it a replay: scenes that use no
+  /// impact positions (lasting contact, piles of thousands of impacts) leave them out.
+  bool impact_positions = true;
 };
 
 /// An impact an engine reported (ours: every one, at its instant).
 struct ReportedImpact {
   double time = 0.0;
   std::size_t body = 0;          ///< scene index
-  V position = V::Zero();        ///< of `body`'s centre, at the instant
+  V position = V::Zero();        ///< of `body`'s centre, at the instant (Play::impact_positions)
   V velocity_after = V::Zero();  ///< of `body`
   bool other_is_obstacle = false;
   std::size_t other = 0;  ///< scene index of the other body, or obstacle index
@@ -83,7 +87,13 @@ struct BenchScene {
   /// What reference/make_references.py computes: "events" (the exact event-driven motion) or
   /// "conservation" (only the conserved quantities: a chaotic gas's trajectory is not
   /// reproducible beyond a few dozen impacts in any finite precision, its energy is).
+  /// "lasting" (contact that lasts, under gravity): closed forms of where the motion ends.
   std::string reference = "events";
+  /// Ours (continuous, 100 Hz, the scene's effects and each of its effect variants) again at
+  /// each of these Scene::contact_integration_tolerance values: error against CPU.
+  std::vector<double> integration_tolerances = {};
+  /// The engines that play the scene (empty: every one); e.g. a pile too large for some.
+  std::vector<std::string> engines = {};
 };
 
 /// Every scene, short ones first; names are unique. The one list: the benchmark, the exported

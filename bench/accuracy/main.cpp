@@ -11,6 +11,7 @@
 // timed, so not at all).
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <limits>
@@ -63,6 +64,7 @@ std::vector<EngineSetting> engineSettings() {
 struct Row {
   std::string name, scene, engine, variant, effects;
   double rate = 0;
+  double tolerance = 0;  ///< the integration tolerance set for the run; 0: the scene's own
   std::size_t updates = 0;
   bool truncated = false;
   std::string unsupported;
@@ -81,6 +83,7 @@ std::string json(const Row& row) {
   std::string text = "{\"name\": \"" + row.name + "\", \"scene\": \"" + row.scene +
                      "\", \"engine\": \"" + row.engine + "\", \"variant\": \"" + row.variant +
                      "\", \"effects\": \"" + row.effects + "\", \"rate\": " + number(row.rate) +
+                     ", \"tolerance\": " + (row.tolerance > 0 ? number(row.tolerance) : "null") +
                      ", \"updates\": " + std::to_string(row.updates) +
                      ", \"truncated\": " + (row.truncated ? "true" : "false") +
                      ", \"unsupported\": \"" + row.unsupported + "\", \"metrics\": {";
@@ -97,25 +100,45 @@ struct Case {
   const EngineSetting* setting;
   std::string effects;
   double rate;
+  double tolerance = 0;  ///< Scene::contact_integration_tolerance; 0: the scene's own
 };
 
-/// Every engine setting at every rate of the scene, then ours with the scene's extra effects.
+/// Every engine setting (of the scene's engines) at every rate of the scene, then ours with the
+/// scene's extra effects, then ours at each integration tolerance of the scene.
 std::vector<Case> casesOf(const BenchScene& bench, const std::vector<EngineSetting>& settings) {
   std::vector<Case> cases;
   for (const EngineSetting& setting : settings) {
+    const bool plays = bench.engines.empty() ||
+                       std::find(bench.engines.begin(), bench.engines.end(), setting.engine) !=
+                           bench.engines.end();
+    if (!plays) continue;
     for (const double rate : bench.rates) cases.push_back({&setting, "none", rate});
   }
   for (const std::string& effects : bench.effect_variants) {
     cases.push_back({&settings.front(), effects, 100.0});  // ours, continuous
   }
+  std::vector<std::string> all_effects = {"none"};
+  all_effects.insert(all_effects.end(), bench.effect_variants.begin(), bench.effect_variants.end());
+  for (const std::string& effects : all_effects) {
+    for (const double tolerance : bench.integration_tolerances) {
+      cases.push_back({&settings.front(), effects, 100.0, tolerance});
+    }
+  }
   return cases;
+}
+
+/// The scene a case plays: the effects turned on, the integration tolerance set.
+core::Scene sceneOf(const BenchScene& bench, const Case& c) {
+  core::Scene scene = withEffects(bench, c.effects);
+  if (c.tolerance > 0) scene.contact_integration_tolerance = c.tolerance;
+  return scene;
 }
 
 /// A short scene: played once here and measured, then timed by Google Benchmark over repeated
 /// runs.
 void addShortRun(const BenchScene& bench, const Case& c, Row& row, const References& references) {
-  const core::Scene scene = withEffects(bench, c.effects);
-  const Play play{c.rate, bench.duration, bench.record_all};
+  const core::Scene scene = sceneOf(bench, c);
+  const Play play{c.rate, bench.duration, bench.record_all, bench.reference != "lasting"};
   const Engine engine = c.setting->play;
   const Run run = engine(scene, play);
   row.unsupported = run.unsupported;
@@ -135,8 +158,8 @@ void addShortRun(const BenchScene& bench, const Case& c, Row& row, const Referen
 /// measured there, so that it is not played twice.
 void addLongRun(const BenchScene& bench, const Case& c, std::shared_ptr<std::vector<Row>> rows,
                 std::size_t index, const References& references) {
-  const core::Scene scene = withEffects(bench, c.effects);
-  const Play play{c.rate, bench.duration, bench.record_all};
+  const core::Scene scene = sceneOf(bench, c);
+  const Play play{c.rate, bench.duration, bench.record_all, bench.reference != "lasting"};
   const Engine engine = c.setting->play;
   // A run of no time: does the engine play this scene at all (Box2D: planar ones only)?
   const Run probe = engine(scene, Play{c.rate, 0.0, false});
@@ -260,8 +283,18 @@ int main(int argc, char** argv) {
   const std::vector<EngineSetting> settings = engineSettings();
   for (const BenchScene& bench : benchScenes()) {
     for (const Case& c : casesOf(bench, settings)) {
-      Row row{"", bench.name, c.setting->engine, c.setting->variant, c.effects, c.rate, 0, false,
-              "", {}};
+      Row row{"",
+              bench.name,
+              c.setting->engine,
+              c.setting->variant,
+              c.effects,
+              c.rate,
+              c.tolerance,
+              0,
+              false,
+              "",
+              {}};
+      if (c.tolerance > 0) row.variant = "tolerance_" + number(c.tolerance);
       row.name = bench.name + "/" + row.engine + "/" + row.variant + "/" + c.effects + "/" +
                  number(c.rate);
       if (!std::regex_search(row.name, filter)) continue;

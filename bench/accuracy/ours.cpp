@@ -34,6 +34,8 @@ Engine oursEngine(core::Detection detection) {
         states[i].time = t;
         states[i].position = playback.position(i, t);
         states[i].velocity = playback.velocity(i, t);
+        // With spin, a rolling ball's spin is part of its state (zero would say it slips).
+        states[i].angular_velocity = playback.angularVelocity(i, t);
       }
       const core::StepReport report = monitor.step(t, states);
       run.truncated = run.truncated || report.truncated;
@@ -43,12 +45,15 @@ Engine oursEngine(core::Detection detection) {
         reported.time = impact.time;
         reported.body = scene_index[impact.body_a];
         // Where the source placed the body at the instant (continuous: at the contact).
-        reported.position = playback.position(reported.body, impact.time);
+        if (play.impact_positions)
+          reported.position = playback.position(reported.body, impact.time);
         reported.velocity_after = impact.velocity_a_after;
         reported.other_is_obstacle = impact.other_is_obstacle;
         if (!impact.other_is_obstacle) {
           reported.other = scene_index[impact.other];
-          reported.other_position = playback.position(reported.other, impact.time);
+          if (play.impact_positions) {
+            reported.other_position = playback.position(reported.other, impact.time);
+          }
           reported.other_velocity_after = impact.velocity_b_after;
         } else {
           reported.other = impact.other;

@@ -42,9 +42,11 @@ void exportScenes(const std::vector<BenchScene>& scenes, const std::string& path
   if (!out) throw std::runtime_error("cannot write " + path);
   out << "# The inputs of every scene of bench/accuracy (scenes.cpp), for make_references.py.\n"
          "# Written by `accuracy_benchmark --export-scenes`; numbers are C99 hex floats (exact).\n"
-         "# scene NAME duration T gravity G gx gy gz threshold S reference events|conservation\n"
+         "# scene NAME duration T gravity G gx gy gz threshold S reference "
+         "events|conservation|lasting\n"
          "#   friction F spin S   (1: the effect is on)\n"
-         "# material NAME E   (E: its own coefficient, that is, against concrete)\n"
+         "# material NAME E MU   (E: its own coefficient, that is, against concrete; MU: its\n"
+         "#   Coulomb friction against itself)\n"
          "# body ID MATERIAL MASS RADIUS px py pz vx vy vz\n"
          "# plane ID MATERIAL nx ny nz OFFSET   (free side: where n points)\n"
          "# sphere ID MATERIAL px py pz RADIUS  (an immovable sphere)\n";
@@ -68,7 +70,8 @@ void exportScenes(const std::vector<BenchScene>& scenes, const std::string& path
       for (const std::string& material : materials) {
         if (material == "concrete") continue;
         out << "material " << material << " "
-            << hex(*scene.materials.restitution(material, "concrete")) << "\n";
+            << hex(*scene.materials.restitution(material, "concrete")) << " "
+            << hex(*scene.materials.friction(material, material)) << "\n";
       }
       for (const core::BodySpec& body : scene.bodies) {
         out << "body " << body.id << " " << body.material << " " << hex(body.mass) << " "

@@ -100,6 +100,7 @@ class Scene:
         if self.threshold != 0:
             sys.exit(f"{name}: a restitution threshold is not in this reference")
         self.own = {}       # material -> own coefficient (against concrete)
+        self.own_friction = {}  # material -> Coulomb mu against itself
         self.bodies, self.planes, self.spheres = [], [], []
 
     def restitution(self, first, second):
@@ -125,6 +126,8 @@ def read_scenes(path):
                 sys.exit(f"{scene.name}: {words[1]} has e {float(own)}, the seed's table says "
                          f"{SEED[words[1]]}")
             scene.own[words[1]] = own
+            if len(words) > 3:
+                scene.own_friction[words[1]] = mpf(float.fromhex(words[3]))
         elif kind == "body":
             scene.bodies.append(Body(words[1], words[2], words[3], words[4], words[5:8],
                                      words[8:11]))
@@ -468,11 +471,148 @@ def closed_forms(scene, result, out):
               f"{scene.name}: the last impact at {last} is too close to the end")
 
 
+# --- lasting contact: closed forms of where the motion goes -------------------------------------
+
+def cross(a, b):
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
+def bisect(f, low, high, steps=200):
+    """The root of f in [low, high], f(low) and f(high) of opposite signs."""
+    f_low = f(low)
+    check(f_low * f(high) < 0, "no sign change to bisect")
+    for _ in range(steps):
+        middle = (low + high) / 2
+        if (f(middle) < 0) == (f_low < 0):
+            low = middle
+        else:
+            high = middle
+    return (low + high) / 2
+
+
+def potential(scene, body, position):
+    return -body.mass * dot(scene.gravity, position)
+
+
+def ball_corner(scene, out):
+    """At rest in the corner of the two planes: touching both, not moved along their line (gravity
+    has no part along it)."""
+    (body,) = scene.bodies
+    (_, _, n1, o1), (_, _, n2, o2) = scene.planes
+    line = cross(n1, n2)
+    check(abs(dot(line, scene.gravity)) < mpf("1e-40"), f"{scene.name}: gravity along the corner")
+    matrix = mpmath.matrix([n1, n2, line])
+    rhs = mpmath.matrix([o1 + body.radius, o2 + body.radius, dot(line, body.position)])
+    rest = mpmath.lu_solve(matrix, rhs)
+    rest = [rest[0], rest[1], rest[2]]
+    out.append(f"{scene.name} rest 0 " + " ".join(num(x) for x in rest))
+    out.append(f"{scene.name} energy_rest {num(potential(scene, body, rest))}")
+    # The slide to the wall (for the record): d along the incline at g sin(theta), or 5/7 of it
+    # rolling (a solid ball, I = 2/5 m r^2).
+    g = mpmath.sqrt(dot(scene.gravity, scene.gravity))
+    sin_incline = mpmath.sqrt(1 - n1[2] ** 2)
+    downhill = [n1[2], 0, -n1[0]]  # along the incline, in the x-z plane
+    gap = dot(n2, body.position) - o2 - body.radius  # to the wall, across it
+    slide = -gap / dot(n2, downhill)
+    a = g * sin_incline * (mpf(5) / 7 if scene.friction and scene.spin else 1)
+    out.append(f"{scene.name} wall_arrival {num(mpmath.sqrt(2 * slide / a))}")
+
+
+def ball_off_sphere(scene, out):
+    """The angle at which a ball nudged on top of a fixed sphere leaves it. With v^2 = w(theta)
+    (theta from the top, rho = R + r, n = g cos(theta) - w / rho the normal force per mass):
+    - frictionless: w = v0^2 + 2 g rho (1 - cos(theta)); it leaves where n = 0:
+      cos(theta) = (2 + v0^2 / g rho) / 3;
+    - friction mu and spin (a solid ball): it starts slipping (no spin), friction mu n backwards
+      on the centre and spinning it up (I w' = mu n m r): dw/dtheta - 2 mu w =
+      2 g rho (sin - mu cos), solved in closed form; it rolls from where v = r omega (omega's
+      integral, by quadrature), w = w1 + (10/7) g rho (cos(theta1) - cos(theta)), as long as the
+      friction rolling needs, (2/7) g sin(theta), is at most mu n; then slips again (the same
+      linear equation) until n = 0. Without the limit of mu (rolling to the end, v0 -> 0):
+      cos(theta) = 10/17."""
+    (body,) = scene.bodies
+    (_, _, centre, big) = scene.spheres[0]
+    g = mpmath.sqrt(dot(scene.gravity, scene.gravity))
+    rho, r = big + body.radius, body.radius
+    v0_squared = dot(body.velocity, body.velocity)
+    top = add(body.position, centre, -1)
+    # On the top, at the contact distance, to the doubles' rounding of the inputs.
+    check(abs(dot(top, scene.gravity) / (rho * g) + 1) < mpf("1e-15"), "not on the top")
+    if not scene.friction:
+        leave = (2 + v0_squared / (g * rho)) / 3
+        # The same from w's root, as a check.
+        root = bisect(lambda t: g * mpmath.cos(t) - (v0_squared + 2 * g * rho *
+                                                      (1 - mpmath.cos(t))) / rho, 0, mpmath.pi / 2)
+        check(abs(mpmath.cos(root) - leave) < mpf("1e-40"), f"{scene.name}: leaving angle")
+        out.append(f"{scene.name} leave_cos {num(leave)}")
+        return
+    mu = scene.own_friction[body.material]
+    a = -2 * mu
+
+    def slipping(theta_s, w_s):
+        def integral(t):  # of e^(a t) (sin t - mu cos t)
+            return mpmath.exp(a * t) * ((a * mpmath.sin(t) - mpmath.cos(t)) -
+                                        mu * (a * mpmath.cos(t) + mpmath.sin(t))) / (a * a + 1)
+        return lambda t: mpmath.exp(-a * t) * (w_s * mpmath.exp(a * theta_s) +
+                                               2 * g * rho * (integral(t) - integral(theta_s)))
+
+    def normal(t, w):
+        return g * mpmath.cos(t) - w(t) / rho
+
+    w_top = slipping(mpf(0), v0_squared)
+    check(abs(mpmath.diff(w_top, mpf("0.1")) + a * w_top(mpf("0.1")) -
+              2 * g * rho * (mpmath.sin(mpf("0.1")) - mu * mpmath.cos(mpf("0.1")))) < mpf("1e-25"),
+          "the slipping solution")
+
+    def spin(t):  # omega(t), from 0 at the top: d omega / d theta = (5/2) mu n rho / (r v)
+        return mpmath.quad(lambda p: mpf(5) / 2 * mu * normal(p, w_top) * rho /
+                           (r * mpmath.sqrt(w_top(p))), [0, t])
+
+    # Rolling from theta1: the slip v - r omega reaches 0 (within a small angle of the top).
+    high = mpf("1e-6")
+    while mpmath.sqrt(w_top(high)) - r * spin(high) > 0:
+        high *= 2
+    theta1 = bisect(lambda t: mpmath.sqrt(w_top(t)) - r * spin(t), mpf(0), high, 120)
+    w1 = w_top(theta1)
+
+    def w_rolling(t):
+        return w1 + mpf(10) / 7 * g * rho * (mpmath.cos(theta1) - mpmath.cos(t))
+
+    theta2 = bisect(lambda t: mu * normal(t, w_rolling) - mpf(2) / 7 * g * mpmath.sin(t), theta1,
+                    mpmath.pi / 2)
+    w_slip = slipping(theta2, w_rolling(theta2))
+    leave_angle = bisect(lambda t: normal(t, w_slip), theta2, mpmath.pi / 2)
+    out.append(f"{scene.name} leave_cos {num(mpmath.cos(leave_angle))}")
+    out.append(f"{scene.name} rolling_from {num(theta1)}")
+    out.append(f"{scene.name} slipping_from_cos {num(mpmath.cos(theta2))}")
+    out.append(f"{scene.name} leave_cos_rolling_limit {num(mpf(10) / 17)}")
+
+
+def lasting(scene, out):
+    """The closed forms of the lasting-contact scenes (where they come to rest, or leave)."""
+    base = scene.name.split("+")[0]
+    if base == "ball_corner":
+        ball_corner(scene, out)
+    elif base == "ball_off_sphere":
+        ball_off_sphere(scene, out)
+    elif base == "ball_stack":
+        # At rest where they are: each centre on the one below (r, 3r, 5r): the inputs.
+        for i, body in enumerate(scene.bodies):
+            check(abs(body.position[2] - (2 * i + 1) * body.radius) < mpf("1e-15"),
+                  f"{scene.name}: ball {i} not at {2 * i + 1} r")
+            out.append(f"{scene.name} rest {i} " + " ".join(num(x) for x in body.position))
+    # the pile: its conserved energy only (at rest, its kinetic energy is 0)
+
+
 def main():
     scenes_path, out_path = sys.argv[1], sys.argv[2]
     out = ["# The exact answers of bench/accuracy's scenes, by make_references.py (mpmath, 50 digits)",
            "# from scenes.txt; do not edit. Rows: SCENE KEY VALUES..."]
     for scene in read_scenes(scenes_path):
+        if scene.reference == "lasting":
+            conserved(scene, out)
+            lasting(scene, out)
+            continue
         if scene.friction or scene.spin:
             out.append(f"# {scene.name}: friction and spin are not in this reference")
             continue
