@@ -188,6 +188,8 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
       track.angular_acceleration.setZero();
       track.constrained = nullptr;
       track.last_impact_time = state.time;
+      // It is a state too: one given later at its own instant is newer than it.
+      track.last_state_time = std::max(track.last_state_time, state.time);
       changed.push_back(state.body);
     }
     if constexpr (Motion::kAccelerates) {

@@ -88,19 +88,25 @@ std::vector<ContactRecord> Playback::contacts(double time) const {
 bool Playback::applyImpact(std::size_t body, double time, const Eigen::Vector3d& centre,
                            const Eigen::Vector3d& velocity_after,
                            const Eigen::Vector3d& angular_velocity_after) {
-  if (time <= committed_time_ || time < flights_[body].start) return false;
+  if (time < committed_time_ || time < flights_[body].start) return false;
   BodyStateSample state;
   state.body = model_index_[body];
   state.time = time;
   state.position = centre;
   state.velocity = velocity_after;
   state.angular_velocity = angular_velocity_after;
+  view_.reset();
+  flights_[body] = Flight{time, centre, velocity_after, false, flights_[body].impacts_before + 1};
+  if (time == committed_time_) {
+    // An impact at the instant the model was committed to (two bodies that touch exactly at a
+    // sample, found by the next step): taken at that instant.
+    committed_.step(time, {state});
+    return true;
+  }
   const auto later = std::upper_bound(
       pending_.begin(), pending_.end(), state,
       [](const BodyStateSample& x, const BodyStateSample& y) { return x.time < y.time; });
   pending_.insert(later, state);
-  view_.reset();
-  flights_[body] = Flight{time, centre, velocity_after, false, flights_[body].impacts_before + 1};
   return true;
 }
 
