@@ -79,10 +79,10 @@ def pile_section(scale):
         exponent = math.log(t2 / t1) / math.log(n2 / n1)
         lines += [
             f"The pile of 1,000 is 1 mm apart. Touching, every ball of a lattice is in one "
-            f"cluster, and the monitor's step grows as the {exponent:.1f}th power of the balls "
-            f"between {n1:,} and {n2:,} (the source's likewise); extrapolated, 1,000 touching "
-            f"balls would take about {t2 * (1000 / n2) ** exponent:.0f} s per update, which is "
-            "why the benchmark stops at 225.", ""]
+            f"group of lasting contact (its forces solved block by block), and the monitor's step "
+            f"grows as the {exponent:.1f}th power of the balls between {n1:,} and {n2:,}; "
+            f"extrapolated, 1,000 touching balls would take about "
+            f"{1e3 * t2 * (1000 / n2) ** exponent:.3g} ms per update.", ""]
     return lines
 
 
