@@ -1,6 +1,6 @@
-// Each slide of the seed (../shared/seed/collisions-slides.txt) as tests of the core. Expected
-// values come from test/exact/make_seed_cases.py (exact rational arithmetic, independent of the
-// code under test) or from closed forms worked out in the comments.
+// Each slide of the seed (collisions-slides, whose physics the README, "What it is", lists) as
+// tests of the core. Expected values come from test/exact/make_seed_cases.py (exact rational
+// arithmetic, independent of the code under test) or from closed forms worked out in the comments.
 #include <gtest/gtest.h>
 
 #include <cmath>

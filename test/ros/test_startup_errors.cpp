@@ -101,7 +101,7 @@ TEST(StartupErrors, Item6_AsANodeletTheErrorNamesTheKey) {
 // then warned as belonging to the other one.
 TEST(StartupErrors, Item7_TwoBodiesOnOneTopicStopTheNodeByName) {
   const Outcome result =
-      start(kNode, scene({ball("one", "/shared/state"), ball("two", "/shared/state")}));
+      start(kNode, scene({ball("one", "/common/state"), ball("two", "/common/state")}));
   expectRefused(result, "/scene/bodies[1]/topic", "is already the topic of 'one'");
 }
 

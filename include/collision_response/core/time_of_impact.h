@@ -1,4 +1,5 @@
-// The instant two bodies moving in straight lines first touch: the stable roots of DESIGN.md.
+// The instant two bodies moving in straight lines first touch: the stable roots of the README,
+// "Detection" (derived in doc/development.md, "The physics, and how it is made exact").
 #pragma once
 
 #include <Eigen/Core>
