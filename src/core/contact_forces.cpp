@@ -199,15 +199,42 @@ struct Entry {
   Real value;
 };
 
+/// Among the least-squares solutions of a x = b, given the one of minimum norm `x`: the one
+/// whose unknowns marked in `least_first` have the least norm, and among those the least norm of
+/// all. The solutions are x + Z y, Z an orthonormal basis of a's kernel, and x is orthogonal to
+/// it, so |x + Z y|^2 = |x|^2 + |y|^2: the minimum-norm y of (S Z) y = -S x (S the marked rows)
+/// is both. When a has no kernel, x is the only solution.
+Vector leastFirst(const Matrix& a, const Vector& x, const std::vector<char>& least_first) {
+  const Eigen::Index n = a.cols();
+  std::vector<Eigen::Index> marked;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (least_first[static_cast<std::size_t>(i)]) marked.push_back(i);
+  }
+  if (marked.empty()) return x;
+  const Eigen::JacobiSVD<Matrix> svd(a, Eigen::ComputeFullV);
+  const Eigen::Index rank = svd.rank();
+  if (rank == n) return x;
+  const Matrix kernel = svd.matrixV().rightCols(n - rank);
+  const auto m = static_cast<Eigen::Index>(marked.size());
+  Matrix selected(m, n - rank);
+  Vector shift(m);
+  for (Eigen::Index r = 0; r < m; ++r) {
+    selected.row(r) = kernel.row(marked[static_cast<std::size_t>(r)]);
+    shift[r] = -x[marked[static_cast<std::size_t>(r)]];
+  }
+  return x + kernel * selected.completeOrthogonalDecomposition().solve(shift);
+}
+
 /// The minimum-norm least-squares solution of A x = target, A of `size` x `size` given by its
 /// nonzero entries, block by block: the unknowns fall into connected sets (i and j connected
 /// where A(i, j) or A(j, i) is not 0: their contacts share a movable body, directly or through
 /// others), and a block-diagonal system's minimum-norm solution is each block's (a complete
 /// orthogonal decomposition each). Exact, and independent of the order of the blocks; a group
 /// whose contacts barely interact (balls side by side on a floor) is many small solves, not one
-/// dense solve of every unknown.
-Vector solveMinimumNorm(Eigen::Index size, const std::vector<Entry>& entries,
-                        const Vector& target) {
+/// dense solve of every unknown. With `least_first` (one flag per unknown), where a block has
+/// many solutions the marked unknowns' norm is the least first (leastFirst).
+Vector solveMinimumNorm(Eigen::Index size, const std::vector<Entry>& entries, const Vector& target,
+                        const std::vector<char>& least_first = {}) {
   std::vector<Eigen::Index> parent(static_cast<std::size_t>(size));
   std::iota(parent.begin(), parent.end(), 0);
   const auto at = [&parent](Eigen::Index x) -> Eigen::Index& {
@@ -248,8 +275,16 @@ Vector solveMinimumNorm(Eigen::Index size, const std::vector<Entry>& entries,
     const auto n = static_cast<Eigen::Index>(block.size());
     Vector right(n);
     for (Eigen::Index i = 0; i < n; ++i) right[i] = target[block[static_cast<std::size_t>(i)]];
-    const Vector x =
-        parts[static_cast<std::size_t>(root)].completeOrthogonalDecomposition().solve(right);
+    const Matrix& part = parts[static_cast<std::size_t>(root)];
+    Vector x = part.completeOrthogonalDecomposition().solve(right);
+    if (!least_first.empty()) {
+      std::vector<char> marked(static_cast<std::size_t>(n));
+      for (Eigen::Index i = 0; i < n; ++i) {
+        marked[static_cast<std::size_t>(i)] =
+            least_first[static_cast<std::size_t>(block[static_cast<std::size_t>(i)])];
+      }
+      x = leastFirst(part, x, marked);
+    }
     for (Eigen::Index i = 0; i < n; ++i) solution[block[static_cast<std::size_t>(i)]] = x[i];
   }
   return solution;
@@ -311,8 +346,17 @@ Trial solveModes(const Group& group, const std::vector<Mode>& modes,
     Vector target(size);
     for (Eigen::Index i = 0; i < size; ++i) target[i] = -condition(free, rows[i]);
     // Minimum-norm least squares: also right where contacts are redundant (a ball in a corner
-    // of three planes that a pair of them already holds).
-    solution = solveMinimumNorm(size, entries, target);
+    // of three planes that a pair of them already holds). Where sticking contacts are redundant
+    // (a ball held by friction in the corner of an incline and a wall), static friction is
+    // indeterminate: every solution gives the same accelerations, but the one of minimum norm
+    // may pull at a contact (README, "Lasting contact"). The least static friction is taken
+    // first: where normal forces alone can hold the group (the frictionless corner's
+    // m g / cos t and m g tan t), friction takes nothing and no contact pulls.
+    std::vector<char> static_friction(static_cast<std::size_t>(size));
+    for (Eigen::Index i = 0; i < size; ++i) {
+      static_friction[static_cast<std::size_t>(i)] = rows[static_cast<std::size_t>(i)].kind != 0;
+    }
+    solution = solveMinimumNorm(size, entries, target, static_friction);
   }
   Trial trial;
   trial.forces.assign(count, V3::Zero());

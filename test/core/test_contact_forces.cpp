@@ -143,6 +143,39 @@ TEST(ContactForces, CornerOfAnInclineAndAWall) {
   EXPECT_NEAR(solution.acceleration[0].norm(), 0.0, 1e-14);
 }
 
+// The same corner with friction (mu = 1) and a solid ball (spin), at rest: both contacts stick.
+// Statics leaves the forces indeterminate: six components (N and a tangential force at each
+// contact) against the net force and torque (-r n_i x T_i - r n_w x T_w; the normal forces pass
+// through the centre), six conditions of which five are independent: in the plane of the
+// normals, the torque gives both frictions one magnitude t (opposite moments), and the net force
+// two equations for N_i, N_w and t. A one-parameter family whose members all give the same
+// accelerations, 0. Determined: no contact pulls, the contacts' forces on the ball sum to
+// its weight, and the ball stays (acceleration, angular acceleration 0). The solver takes the
+// least static friction (README, "Lasting contact"): the frictionless N = m g / cos t and
+// m g tan t with no friction lie in the family, so that is the answer. (The family's
+// minimum-norm member, friction 0.288 N at each contact, has the wall pull: N_w = -0.17 N.)
+TEST(ContactForces, RoughCornerWithSpinHoldsWithoutPulling) {
+  const double theta = 10.0 * M_PI / 180.0, m = 0.1, mu = 1.0;
+  const V up(std::sin(theta), 0, std::cos(theta)), wall(-1, 0, 0);
+  const auto solution = solveContactForces({ball(m, 0.05, true), fixed(), fixed()},
+                                           {onPlane(0, 1, up, mu), onPlane(0, 2, wall, mu)});
+  ASSERT_TRUE(solution.converged);
+  V on_ball = V::Zero();
+  for (std::size_t k = 0; k < 2; ++k) {
+    const ContactForce& force = solution.contacts[k];
+    EXPECT_EQ(force.mode, ContactMode::kSticking) << k;
+    EXPECT_GE(force.normal, 0.0) << k;
+    EXPECT_LE(force.tangential.norm(), mu * force.normal) << k;
+    on_ball -= force.normal * -(k == 0 ? up : wall) + force.tangential;
+  }
+  EXPECT_LT((on_ball - V(0, 0, m * kG)).norm(), 1e-13);
+  EXPECT_EQ(solution.acceleration[0].norm(), 0.0);
+  EXPECT_EQ(solution.angular_acceleration[0].norm(), 0.0);
+  EXPECT_NEAR(solution.contacts[0].normal, m * kG / std::cos(theta), 1e-13);
+  EXPECT_NEAR(solution.contacts[1].normal, m * kG * std::tan(theta), 1e-13);
+  EXPECT_LT(solution.contacts[0].tangential.norm() + solution.contacts[1].tangential.norm(), 1e-13);
+}
+
 // A V-groove of two planes tilted by b either way: by symmetry N = m g / (2 cos b) each.
 TEST(ContactForces, VGrooveSharesTheWeight) {
   const double b = 35.0 * M_PI / 180.0, m = 0.2;
