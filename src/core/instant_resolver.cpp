@@ -102,7 +102,11 @@ std::vector<std::vector<std::size_t>> formClusters(const World& world,
 /// ever smaller ones under the pressing acceleration g: the k-th after it leaves at e^k e u (u
 /// the approach speed) and lands 2 e^k e u / g later, so they add up to 2 e u / (g (1 - e)). The
 /// contact rests from that accumulation instant on (its `since`); in between every bounce stays
-/// within the band, so the body moves as resting from now.
+/// within the band, so the body moves as resting from now. A contact found overlapping (discrete
+/// detection finds impacts by overlap at the samples) has the overlap as its band
+/// (Geometry::band): a bounce that would not rise out of it would fall back in deeper, a pair
+/// that overlapped at the sample before (so no new impact), and no contact would hold the body;
+/// so it rests there, held where it is (README, "Detection").
 template <class Motion>
 double contactRestitution(World& world, double time, const InstantContact& contact,
                           double approach_speed) {
@@ -123,7 +127,7 @@ double contactRestitution(World& world, double time, const InstantContact& conta
           across.squaredNorm() / (contact.geometry.gap + world.radius[a] + world.radius[other]);
     }
     if (pressing > 0 &&
-        restitution * approach_speed <= restSpeed(pressing, contact.geometry.tolerance)) {
+        restitution * approach_speed <= restSpeed(pressing, contact.geometry.band())) {
       world.contact_since[contact.pair] =
           restitution < 1 ? time + 2 * restitution * approach_speed / (pressing * (1 - restitution))
                           : time;

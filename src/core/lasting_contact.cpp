@@ -28,7 +28,9 @@ namespace {
 using Motion = UnderGravity;  // lasting contact needs a steady force: the gravity effect
 
 /// A candidate of lasting contact: touching (or overlapping: then it is held where it is) and
-/// neither approaching nor separating faster than a body falls within the touching band.
+/// neither approaching nor separating faster than a body falls within the touching band, or
+/// within the overlap of an overlapping pair (Geometry::band): a separation too slow to leave
+/// the overlap would fall back into it, where no impact is found again.
 bool lastingCandidate(const World& world, const Pair& pair, double time, const Geometry& g) {
   if (!g.valid || g.gap > g.tolerance) return false;
   const Eigen::Vector3d velocity_a = velocityAt<Motion>(world, pair.first, time);
@@ -37,7 +39,7 @@ bool lastingCandidate(const World& world, const Pair& pair, double time, const G
   const double scale =
       velocity_a.lpNorm<Eigen::Infinity>() + velocity_other.lpNorm<Eigen::Infinity>();
   return std::abs(normal_speed) <=
-         restSpeed(world.gravity.norm(), g.tolerance) + kApproachTolerance * scale;
+         restSpeed(world.gravity.norm(), g.band()) + kApproachTolerance * scale;
 }
 
 void dissolve(World& world, std::size_t group, std::vector<std::size_t>& members) {

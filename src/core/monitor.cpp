@@ -257,11 +257,51 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
   return report;
 }
 
-/// Discrete detection: the states at `time` are taken, then the pairs that overlap then (and did
-/// not at the previous step) and approach are resolved.
+/// Lasting contact between the samples of discrete detection: the groups' own events in
+/// (now, time] (a slip that stops, a curved step's mode that changes), each group formed again at
+/// its instant as continuous detection does between impacts; curved groups integrated on to
+/// `time`. Lasting contact is the model of motion under either detection: without this, a
+/// sliding contact's friction would act past the instant its slip stops, to the next sample.
+template <class Motion>
+void advanceLastingContact(World& world, double time) {
+  world.step_end = time;
+  if (!world.groups_current) return;  // none for these tracks: formed after the states at `time`
+  std::vector<Pair>& pairs = world.scratch.pairs;
+  monitor::candidatePairs<Motion>(world, world.now, time, pairs);
+  std::vector<std::vector<std::size_t>>& pairs_of = world.scratch.pairs_of;
+  pairs_of.assign(world.bodies.size(), {});
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    pairs_of[pairs[k].first].push_back(k);
+    if (!world.isObstacle(pairs[k].second)) pairs_of[pairs[k].second].push_back(k);
+  }
+  const monitor::PairIndex index{pairs, pairs_of};
+  std::vector<std::size_t> seeds, changed;
+  for (const monitor::ContactGroup& group : world.groups) {
+    if (group.alive && group.curved)
+      seeds.insert(seeds.end(), group.bodies.begin(), group.bodies.end());
+  }
+  if (!seeds.empty()) monitor::formGroups(world, world.now, seeds, index, changed);
+  for (int events = 0; events < world.settings.max_instants_per_step; ++events) {
+    const auto [when, group] = monitor::nextGroupEvent(world);
+    if (!(when <= time)) break;
+    monitor::ContactGroup& changing = world.groups[group];
+    changing.next_event = INFINITY;
+    // A group solved again at the very instant it was solved would do so for ever.
+    if (!(when > changing.time)) continue;
+    seeds = changing.bodies;
+    monitor::formGroups(world, when, seeds, index, changed);
+  }
+}
+
+/// Discrete detection: the groups' events up to `time` (advanceLastingContact), the states at
+/// `time` taken, then the pairs that overlap then (and did not at the previous step, unless they
+/// are lasting contacts) and approach are resolved. A lasting contact held overlapping (where its
+/// impact was found) is a contact, not a new detection: an impulse on a resting body runs into
+/// its supports, as under continuous detection.
 template <class Motion>
 StepReport discreteStep(World& world, double time, const std::vector<BodyStateSample>& states) {
   StepReport report;
+  if constexpr (Motion::kAccelerates) advanceLastingContact<Motion>(world, time);
   applyStates(world, states, report);
   world.now = time;
   std::vector<Pair>& pairs = world.scratch.pairs;
@@ -269,7 +309,8 @@ StepReport discreteStep(World& world, double time, const std::vector<BodyStateSa
   std::vector<Pair> touching;
   for (const Pair& pair : pairs) {
     const Geometry g = monitor::geometry<Motion>(world, pair, time);
-    if (g.valid && g.gap <= g.tolerance && world.overlapping.count(pair) == 0) {
+    if (g.valid && g.gap <= g.tolerance &&
+        (world.overlapping.count(pair) == 0 || world.lasting(pair))) {
       touching.push_back(pair);
     }
   }

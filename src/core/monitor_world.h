@@ -68,6 +68,10 @@ struct Geometry {
   double gap = 0.0;        ///< m, surface to surface along the normal; < 0 overlapping
   double tolerance = 0.0;  ///< m, |gap| within it is touching
   bool valid = false;      ///< false: coincident centres and no approach: no line of impact
+  /// m: the band a bounce or a separation must rise out of under the pressing acceleration
+  /// (restSpeed): the touching band, or the overlap where the pair overlaps deeper (a contact
+  /// held where it is, or an impact that discrete detection found by overlap).
+  double band() const { return std::max(tolerance, -gap); }
 };
 
 /// A contact that lasts: the pair presses with a steady force (ContactForce), at `time`.

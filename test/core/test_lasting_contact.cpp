@@ -352,6 +352,57 @@ TEST(LastingContact, StaysAtRestInARoughCornerWithSpin) {
   EXPECT_LT((forceOnBody(last.contacts) - V(0, 0, CornerScene::kM * kG)).norm(), 1e-9);
 }
 
+// Discrete detection finds an impact by overlap at a sample, so a body meets a plane up to
+// speed x period inside it (README, "Detection"); lasting contact must then hold it there, not
+// let it go through. The corner under discrete detection at 100 Hz, frictionless and with
+// friction and spin: the largest speed is what the fall to the wall gives without rolling,
+// v = sqrt(2 g s sin t) = 0.825 m/s, so the ball is never more than v / 100 Hz inside a plane;
+// it ends at rest touching both (within that depth), by 2 s, and stays for 3 s. The contacts'
+// forces on it sum to its weight; frictionless they are the corner's m g / cos t and m g tan t
+// (the planes' normals, however deep the ball is held).
+TEST(LastingContact, DiscreteDetectionHoldsABallInTheCorner) {
+  const CornerScene corner;
+  const double rate = 100;
+  const double bound =
+      std::sqrt(2 * kG * CornerScene::kSlide * std::sin(CornerScene::kTheta)) / rate;
+  for (const bool rough : {false, true}) {
+    ImpactMonitor monitor(corner.scene(rough, Detection::kDiscrete), longLived());
+    double deepest = -1, rest_since = INFINITY;
+    int moved_at_rest = 0;
+    V rest = V::Constant(NAN);
+    StepReport last;
+    run(monitor, {state(monitor, "ball", corner.start)}, rate, 5.0,
+        [&](double t, const StepReport& report) {
+          const auto [centre, velocity] = *monitor.predictedState(0, t);
+          deepest = std::max(deepest, corner.depth(centre));
+          const bool still = velocity.norm() <= 1e-15 &&
+                             monitor.predictedAngularVelocity(0, t).norm() <= 1e-15 &&
+                             report.contacts.size() == 2;
+          if (still && rest_since == INFINITY) {
+            rest_since = t;
+            rest = centre;
+          }
+          if (rest_since < t && (!still || centre != rest)) ++moved_at_rest;
+          last = report;
+        });
+    EXPECT_LT(deepest, bound) << rough;
+    EXPECT_LE(rest_since, 2.0) << rough;
+    EXPECT_EQ(moved_at_rest, 0) << rough;
+    // At rest it touches both planes: inside each by no more than the bound, away by none.
+    EXPECT_GT(depthInPlane(rest, CornerScene::kR, corner.up, 0.0), -1e-9 * CornerScene::kR);
+    EXPECT_GT(depthInPlane(rest, CornerScene::kR, corner.wall_normal, corner.wall_offset),
+              -1e-9 * CornerScene::kR);
+    ASSERT_EQ(last.contacts.size(), 2u) << rough;
+    EXPECT_LT((forceOnBody(last.contacts) - V(0, 0, CornerScene::kM * kG)).norm(), 1e-9) << rough;
+    if (!rough) {
+      EXPECT_NEAR(last.contacts[0].normal_force,
+                  CornerScene::kM * kG / std::cos(CornerScene::kTheta), 1e-9);
+      EXPECT_NEAR(last.contacts[1].normal_force,
+                  CornerScene::kM * kG * std::tan(CornerScene::kTheta), 1e-9);
+    }
+  }
+}
+
 // A pyramid between walls: two balls on the floor against the walls at x = +-(c + r) (apart by
 // 2 c, c = 1.2 r, not touching), one on top touching both. It holds; the top ball's contacts
 // lean by phi, sin phi = c / 2 r = 0.6, and carry m_t g / 1.6 each, the walls 0.375 m_t g, the
