@@ -199,22 +199,22 @@ struct Entry {
   Real value;
 };
 
-/// Among the least-squares solutions of a x = b, given the one of minimum norm `x`: the one
-/// whose unknowns marked in `least_first` have the least norm, and among those the least norm of
-/// all. The solutions are x + Z y, Z an orthonormal basis of a's kernel, and x is orthogonal to
-/// it, so |x + Z y|^2 = |x|^2 + |y|^2: the minimum-norm y of (S Z) y = -S x (S the marked rows)
-/// is both. When a has no kernel, x is the only solution.
-Vector leastFirst(const Matrix& a, const Vector& x, const std::vector<char>& least_first) {
-  const Eigen::Index n = a.cols();
+/// Among the least-squares solutions of a x = b, given the one of minimum norm `x` from a's
+/// complete orthogonal decomposition a P = Q [T 0; 0 0] Z (rank r): the one whose unknowns
+/// marked in `least_first` have the least norm, and among those the least norm of all. The
+/// solutions are x + K y, K = P Z^T's last n - r columns an orthonormal basis of a's kernel,
+/// and x is orthogonal to it, so |x + K y|^2 = |x|^2 + |y|^2: the minimum-norm y of
+/// (S K) y = -S x (S the marked rows) is both.
+Vector leastFirst(const Eigen::CompleteOrthogonalDecomposition<Matrix>& decomposition,
+                  const Vector& x, const std::vector<char>& least_first) {
+  const Eigen::Index n = decomposition.cols(), rank = decomposition.rank();
   std::vector<Eigen::Index> marked;
   for (Eigen::Index i = 0; i < n; ++i) {
     if (least_first[static_cast<std::size_t>(i)]) marked.push_back(i);
   }
-  if (marked.empty()) return x;
-  const Eigen::JacobiSVD<Matrix> svd(a, Eigen::ComputeFullV);
-  const Eigen::Index rank = svd.rank();
-  if (rank == n) return x;
-  const Matrix kernel = svd.matrixV().rightCols(n - rank);
+  if (rank == n || marked.empty()) return x;
+  const Matrix kernel =
+      decomposition.colsPermutation() * decomposition.matrixZ().bottomRows(n - rank).transpose();
   const auto m = static_cast<Eigen::Index>(marked.size());
   Matrix selected(m, n - rank);
   Vector shift(m);
@@ -275,15 +275,16 @@ Vector solveMinimumNorm(Eigen::Index size, const std::vector<Entry>& entries, co
     const auto n = static_cast<Eigen::Index>(block.size());
     Vector right(n);
     for (Eigen::Index i = 0; i < n; ++i) right[i] = target[block[static_cast<std::size_t>(i)]];
-    const Matrix& part = parts[static_cast<std::size_t>(root)];
-    Vector x = part.completeOrthogonalDecomposition().solve(right);
-    if (!least_first.empty()) {
+    const Eigen::CompleteOrthogonalDecomposition<Matrix> decomposition(
+        parts[static_cast<std::size_t>(root)]);
+    Vector x = decomposition.solve(right);
+    if (!least_first.empty() && decomposition.rank() < n) {
       std::vector<char> marked(static_cast<std::size_t>(n));
       for (Eigen::Index i = 0; i < n; ++i) {
         marked[static_cast<std::size_t>(i)] =
             least_first[static_cast<std::size_t>(block[static_cast<std::size_t>(i)])];
       }
-      x = leastFirst(part, x, marked);
+      x = leastFirst(decomposition, x, marked);
     }
     for (Eigen::Index i = 0; i < n; ++i) solution[block[static_cast<std::size_t>(i)]] = x[i];
   }
