@@ -355,8 +355,9 @@ TEST(LastingContact, StaysAtRestInARoughCornerWithSpin) {
 // Discrete detection finds an impact by overlap at a sample, so a body meets a plane up to
 // speed x period inside it (README, "Detection"); lasting contact must then hold it there, not
 // let it go through. The corner under discrete detection at 100 Hz, frictionless and with
-// friction and spin: the largest speed is what the fall to the wall gives without rolling,
-// v = sqrt(2 g s sin t) = 0.825 m/s, so the ball is never more than v / 100 Hz inside a plane;
+// friction and spin: the fastest arrival is what the fall to the wall gives without rolling,
+// v = sqrt(2 g s sin t) = 0.825 m/s, and a body is found at most one period after it arrives,
+// so the ball is never more than (v + g / rate) / rate inside a plane;
 // it ends at rest touching both (within that depth), by 2 s, and stays for 3 s. The contacts'
 // forces on it sum to its weight; frictionless they are the corner's m g / cos t and m g tan t
 // (the planes' normals, however deep the ball is held).
@@ -364,7 +365,7 @@ TEST(LastingContact, DiscreteDetectionHoldsABallInTheCorner) {
   const CornerScene corner;
   const double rate = 100;
   const double bound =
-      std::sqrt(2 * kG * CornerScene::kSlide * std::sin(CornerScene::kTheta)) / rate;
+      (std::sqrt(2 * kG * CornerScene::kSlide * std::sin(CornerScene::kTheta)) + kG / rate) / rate;
   for (const bool rough : {false, true}) {
     ImpactMonitor monitor(corner.scene(rough, Detection::kDiscrete), longLived());
     double deepest = -1, rest_since = INFINITY;
@@ -401,6 +402,36 @@ TEST(LastingContact, DiscreteDetectionHoldsABallInTheCorner) {
                   CornerScene::kM * kG * std::tan(CornerScene::kTheta), 1e-9);
     }
   }
+}
+
+// A ball (e = 0.6) dropped from 1 m onto a floor under discrete detection at 100 Hz: it arrives
+// at v = sqrt(2 g h) = 4.43 m/s, the fastest of its arrivals, and is found at most one period
+// later, so never more than (v + g / rate) / rate inside; its bounces shrink until one cannot
+// leave the overlap it was found in, and by 10 s it rests there, touching the floor (within
+// that depth), pressing with m g.
+TEST(LastingContact, DiscreteDetectionBouncesToRestOnTheFloor) {
+  const double r = 0.05, h = 1.0, rate = 100;
+  Scene scene = gravityScene();
+  scene.detection = Detection::kDiscrete;
+  addMaterial(scene, "rubber", 0.6, 0.0);
+  scene.bodies = {ball("ball", 0.1, r, "rubber")};
+  scene.obstacles = {plane("floor", V(0, 0, 1), 0.0, "rubber")};
+  ImpactMonitor monitor(scene, longLived());
+  const double bound = (std::sqrt(2 * kG * h) + kG / rate) / rate;
+  double deepest = -1;
+  StepReport last;
+  run(monitor, {state(monitor, "ball", V(0, 0, r + h))}, rate, 10.0,
+      [&](double t, const StepReport& report) {
+        deepest = std::max(deepest, r - monitor.predictedState(0, t)->first.z());
+        last = report;
+      });
+  EXPECT_LT(deepest, bound);
+  const auto [centre, velocity] = *monitor.predictedState(0, 10.0);
+  EXPECT_EQ(velocity.norm(), 0.0);
+  EXPECT_GT(r - centre.z(), -1e-9 * r);
+  ASSERT_EQ(last.contacts.size(), 1u);
+  EXPECT_EQ(last.contacts[0].state, ContactState::kResting);
+  EXPECT_NEAR(last.contacts[0].normal_force, 0.1 * kG, 1e-12);
 }
 
 // A pyramid between walls: two balls on the floor against the walls at x = +-(c + r) (apart by
