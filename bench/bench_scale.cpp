@@ -2,7 +2,8 @@
 // in a box (every body's state each update, as a source that applies the responses sends
 // them), with Bullet's btDbvtBroadphase and solver on the same gas in the same run; and one
 // update of a pile of 1,000 balls at rest on a floor (lasting contact under gravity), against
-// the same pile with gravity off and against Bullet on the same pile.
+// the same pile with gravity off and against Bullet on the same pile; and the friction of one
+// cluster of up to 1,000 touching, spinning balls (the joint tangential solve alone).
 // scripts/performance.sh runs it and writes doc/performance.md.
 #include <benchmark/benchmark.h>
 
@@ -17,6 +18,7 @@
 #include <vector>
 
 #include "box_walls.h"
+#include "collision_response/core/cluster_solver.h"
 #include "collision_response/core/impact.h"
 #include "collision_response/core/monitor.h"
 #include "collision_response/core/playback.h"
@@ -215,6 +217,71 @@ BENCHMARK(BM_PileUpdate)
     ->Apply([](benchmark::internal::Benchmark* bench) { pileArguments(bench, true); })
     ->Unit(benchmark::kMillisecond)
     ->MinTime(1.0);
+
+/// A frictional cluster: side^3 touching balls (radius 0.05 m, 0.1 kg, solid: I = 2/5 m r^2) on
+/// a cubic lattice, closing on its centre at 1 m/s per m, swirling about z at 1 rad/s and each
+/// spinning at up to 10 rad/s about an axis of its own; e = 0.5 and mu = 0.3 on every contact.
+/// The normal impulses (resolveSimultaneous) are computed once; each iteration times the
+/// friction alone: applyFrictionJointly with spin, the friction and spin effects' cluster step.
+void BM_FrictionCluster(benchmark::State& state) {
+  const int side = static_cast<int>(state.range(0));
+  const double r = 0.05;
+  std::vector<core::ClusterBody> bodies;
+  std::vector<core::ClusterContact> contacts;
+  std::mt19937_64 engine(3);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  const V centre = V::Constant(r * (side - 1));
+  const auto index = [side](int i, int j, int k) {
+    return static_cast<std::size_t>((i * side + j) * side + k);
+  };
+  for (int i = 0; i < side; ++i) {
+    for (int j = 0; j < side; ++j) {
+      for (int k = 0; k < side; ++k) {
+        const V offset = V(2 * r * i, 2 * r * j, 2 * r * k) - centre;
+        core::ClusterBody body;
+        body.inverse_mass = 10.0;
+        body.radius = r;
+        body.spin_factor = 2.5;
+        body.velocity = -offset + V::UnitZ().cross(offset);
+        body.angular_velocity = 10 * V(unit(engine), unit(engine), unit(engine));
+        bodies.push_back(body);
+        for (int axis = 0; axis < 3; ++axis) {
+          int next[3] = {i, j, k};
+          if (++next[axis] == side) continue;
+          core::ClusterContact contact;
+          contact.a = index(i, j, k);
+          contact.b = index(next[0], next[1], next[2]);
+          contact.normal = V::Unit(axis);
+          contact.restitution = 0.5;
+          contacts.push_back(contact);
+        }
+      }
+    }
+  }
+  const std::vector<core::ContactOutcome> normal = core::resolveSimultaneous(bodies, contacts);
+  std::vector<core::FrictionContact> frictions;
+  for (const core::ContactOutcome& outcome : normal) {
+    frictions.push_back(core::FrictionContact{0.3, outcome.impulse});
+  }
+  std::vector<core::FrictionOutcome> outcomes;
+  for (auto _ : state) {
+    std::vector<core::ClusterBody> struck = bodies;
+    core::applyFrictionJointly<true>(struck, contacts, frictions, outcomes);
+    benchmark::DoNotOptimize(struck.data());
+  }
+  std::size_t sticking = 0;
+  for (const core::FrictionOutcome& outcome : outcomes) sticking += outcome.sticking ? 1 : 0;
+  state.counters["bodies"] = static_cast<double>(bodies.size());
+  state.counters["contacts"] = static_cast<double>(contacts.size());
+  state.counters["sticking"] = static_cast<double>(sticking);
+}
+BENCHMARK(BM_FrictionCluster)
+    ->ArgName("side")
+    ->DenseRange(3, 6)
+    ->Arg(8)
+    ->Arg(10)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.5);
 
 #ifdef COLLISION_RESPONSE_WITH_BULLET
 btScalar bt(double value) { return static_cast<btScalar>(value); }

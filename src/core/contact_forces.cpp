@@ -5,6 +5,9 @@
 #include <cmath>
 #include <numeric>
 #include <set>
+#include <utility>
+
+#include "order_free.h"
 
 namespace collision_response::core {
 namespace {
@@ -235,58 +238,45 @@ Vector leastFirst(const Eigen::CompleteOrthogonalDecomposition<Matrix>& decompos
 /// many solutions the marked unknowns' norm is the least first (leastFirst).
 Vector solveMinimumNorm(Eigen::Index size, const std::vector<Entry>& entries, const Vector& target,
                         const std::vector<char>& least_first = {}) {
-  std::vector<Eigen::Index> parent(static_cast<std::size_t>(size));
-  std::iota(parent.begin(), parent.end(), 0);
-  const auto at = [&parent](Eigen::Index x) -> Eigen::Index& {
-    return parent[static_cast<std::size_t>(x)];
-  };
-  const auto find = [&at](Eigen::Index x) {
-    while (at(x) != x) x = at(x) = at(at(x));
-    return x;
-  };
+  const auto unknown = [](Eigen::Index i) { return static_cast<std::size_t>(i); };
+  ConnectedSets connected(unknown(size));
   for (const Entry& entry : entries) {
-    if (entry.value == 0) continue;
-    const Eigen::Index x = find(entry.row), y = find(entry.column);
-    at(std::max(x, y)) = std::min(x, y);
+    if (entry.value != 0) connected.link(unknown(entry.row), unknown(entry.column));
   }
+  const std::vector<std::vector<std::size_t>> blocks = connected.sets();
   // Each unknown's block and its place in it.
-  std::vector<std::vector<Eigen::Index>> members(static_cast<std::size_t>(size));
-  std::vector<Eigen::Index> place(static_cast<std::size_t>(size));
-  for (Eigen::Index i = 0; i < size; ++i) {
-    std::vector<Eigen::Index>& block = members[static_cast<std::size_t>(find(i))];
-    place[static_cast<std::size_t>(i)] = static_cast<Eigen::Index>(block.size());
-    block.push_back(i);
-  }
-  std::vector<Matrix> parts(static_cast<std::size_t>(size));
-  for (Eigen::Index root = 0; root < size; ++root) {
-    const auto n = static_cast<Eigen::Index>(members[static_cast<std::size_t>(root)].size());
-    if (n > 0) parts[static_cast<std::size_t>(root)] = Matrix::Zero(n, n);
+  std::vector<std::size_t> block_of(unknown(size)), place(unknown(size));
+  std::vector<Matrix> parts(blocks.size());
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    for (std::size_t i = 0; i < blocks[b].size(); ++i) {
+      block_of[blocks[b][i]] = b;
+      place[blocks[b][i]] = i;
+    }
+    const auto n = static_cast<Eigen::Index>(blocks[b].size());
+    parts[b] = Matrix::Zero(n, n);
   }
   for (const Entry& entry : entries) {
     if (entry.value == 0) continue;
-    parts[static_cast<std::size_t>(find(entry.row))](
-        place[static_cast<std::size_t>(entry.row)], place[static_cast<std::size_t>(entry.column)]) =
+    parts[block_of[unknown(entry.row)]](static_cast<Eigen::Index>(place[unknown(entry.row)]),
+                                        static_cast<Eigen::Index>(place[unknown(entry.column)])) =
         entry.value;
   }
   Vector solution = Vector::Zero(size);
-  for (Eigen::Index root = 0; root < size; ++root) {
-    const std::vector<Eigen::Index>& block = members[static_cast<std::size_t>(root)];
-    if (block.empty()) continue;
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    const std::vector<std::size_t>& block = blocks[b];
     const auto n = static_cast<Eigen::Index>(block.size());
     Vector right(n);
-    for (Eigen::Index i = 0; i < n; ++i) right[i] = target[block[static_cast<std::size_t>(i)]];
-    const Eigen::CompleteOrthogonalDecomposition<Matrix> decomposition(
-        parts[static_cast<std::size_t>(root)]);
+    for (Eigen::Index i = 0; i < n; ++i)
+      right[i] = target[static_cast<Eigen::Index>(block[unknown(i)])];
+    const Eigen::CompleteOrthogonalDecomposition<Matrix> decomposition(parts[b]);
     Vector x = decomposition.solve(right);
     if (!least_first.empty() && decomposition.rank() < n) {
-      std::vector<char> marked(static_cast<std::size_t>(n));
-      for (Eigen::Index i = 0; i < n; ++i) {
-        marked[static_cast<std::size_t>(i)] =
-            least_first[static_cast<std::size_t>(block[static_cast<std::size_t>(i)])];
-      }
+      std::vector<char> marked(block.size());
+      for (std::size_t i = 0; i < block.size(); ++i) marked[i] = least_first[block[i]];
       x = leastFirst(decomposition, x, marked);
     }
-    for (Eigen::Index i = 0; i < n; ++i) solution[block[static_cast<std::size_t>(i)]] = x[i];
+    for (Eigen::Index i = 0; i < n; ++i)
+      solution[static_cast<Eigen::Index>(block[unknown(i)])] = x[i];
   }
   return solution;
 }
@@ -523,6 +513,294 @@ void closeContactVelocities(std::vector<ForceBody>& bodies,
   }
 }
 
+namespace {
+
+/// The friction impulses x (each contact's, in its tangent basis: x[2 k], x[2 k + 1]) of a block
+/// small enough for dense algebra: the minimum of E(x) = x'A x / 2 + s'x over the discs
+/// |x_k| <= b_k (`coupling` A, `slip` s, `bound` b). First Coulomb's conditions solved exactly
+/// from the sticking answer; where they do not settle, a primal barrier method (Newton's method
+/// on t E(x) - sum log(b^2 - |x_k|^2) for t growing, in long double), then the same exact
+/// conditions from its answer. Where A is singular (redundant contacts) the barrier tends to the
+/// centre of the optimal set, so the answer depends on no order.
+Vector frictionByBarrier(const Matrix& coupling, const Vector& slip,
+                         const std::vector<Real>& bound) {
+  const Eigen::Index size = slip.size();
+  const Eigen::Index disc = size / 2;
+  const auto energy = [&](const Vector& x) { return 0.5L * x.dot(coupling * x) + slip.dot(x); };
+  const auto room = [&](const Vector& x, Eigen::Index k) {
+    return bound[static_cast<std::size_t>(k)] * bound[static_cast<std::size_t>(k)] -
+           x.segment<2>(2 * k).squaredNorm();
+  };
+  // The scale of the energies: what stopping every slip alone would remove.
+  Real scale = 0;
+  for (Eigen::Index i = 0; i < size; ++i) {
+    scale = std::max(scale, std::abs(slip[i]) * bound[static_cast<std::size_t>(i / 2)]);
+  }
+  // Coulomb's conditions for a given set of contacts at their disc's edge: those take the
+  // bound exactly, against the slip they leave; the others stop their slip exactly (a linear
+  // solve); repeated while the edge directions move. True (and `x` set) when they then hold.
+  const auto polish = [&](Vector& x, std::vector<char>& edge) {
+    Vector polished = x;
+    for (int round = 0; round < 8; ++round) {
+      const Vector residual = coupling * polished + slip;  // the slips left
+      for (Eigen::Index k = 0; k < disc; ++k) {
+        if (!edge[static_cast<std::size_t>(k)]) continue;
+        const Eigen::Matrix<Real, 2, 1> left = residual.segment<2>(2 * k);
+        const Real b = bound[static_cast<std::size_t>(k)];
+        if (left.norm() > 0) {
+          polished.segment<2>(2 * k) = -b * left.normalized();
+        } else if (polished.segment<2>(2 * k).norm() > b) {
+          polished.segment<2>(2 * k) *= b / polished.segment<2>(2 * k).norm();
+        }
+      }
+      std::vector<Eigen::Index> inner;
+      for (Eigen::Index i = 0; i < size; ++i) {
+        if (!edge[static_cast<std::size_t>(i / 2)]) inner.push_back(i);
+      }
+      if (!inner.empty()) {
+        const auto n = static_cast<Eigen::Index>(inner.size());
+        Matrix system(n, n);
+        Vector target(n);
+        for (Eigen::Index r = 0; r < n; ++r) {
+          target[r] = -slip[inner[r]];
+          for (Eigen::Index j = 0; j < size; ++j) {
+            if (edge[static_cast<std::size_t>(j / 2)]) {
+              target[r] -= coupling(inner[r], j) * polished[j];
+            }
+          }
+          for (Eigen::Index c = 0; c < n; ++c) system(r, c) = coupling(inner[r], inner[c]);
+        }
+        const Vector solved = system.completeOrthogonalDecomposition().solve(target);
+        for (Eigen::Index r = 0; r < n; ++r) polished[inner[r]] = solved[r];
+      }
+      const Vector left = coupling * polished + slip;
+      bool holds = true;
+      bool moved = false;
+      for (Eigen::Index k = 0; k < disc && holds; ++k) {
+        const Real b = bound[static_cast<std::size_t>(k)];
+        const Eigen::Matrix<Real, 2, 1> xk = polished.segment<2>(2 * k),
+                                        lk = left.segment<2>(2 * k);
+        if (edge[static_cast<std::size_t>(k)]) {
+          // Against the slip left (not reversing it), along it to within rounding.
+          if (lk.norm() == 0) continue;
+          holds = xk.dot(lk) <= 0;
+          if ((xk / b + lk.normalized()).norm() > 1e-15L) moved = true;
+        } else {
+          holds = xk.norm() <= b && lk.norm() <= 1e-15L * (slip.norm() + 1);
+        }
+      }
+      if (holds && !moved) {
+        x = polished;
+        return true;
+      }
+      if (!holds) break;
+    }
+    // Where a condition fails, the contact changes sides (all at once).
+    const Vector left = coupling * polished + slip;
+    bool changed = false;
+    for (Eigen::Index k = 0; k < disc; ++k) {
+      const Real b = bound[static_cast<std::size_t>(k)];
+      const Eigen::Matrix<Real, 2, 1> xk = polished.segment<2>(2 * k), lk = left.segment<2>(2 * k);
+      char& on_edge = edge[static_cast<std::size_t>(k)];
+      if (!on_edge && xk.norm() > b) {
+        on_edge = 1;
+        changed = true;
+      } else if (on_edge && xk.dot(lk) > 0) {
+        on_edge = 0;
+        changed = true;
+      }
+    }
+    x = polished;
+    static_cast<void>(changed);
+    return false;
+  };
+  // First the exact conditions from the sticking answer (fast, and usually right at once);
+  // where they do not settle, the barrier method, then the same polish from its answer.
+  Vector x = coupling.completeOrthogonalDecomposition().solve(-slip);
+  std::vector<char> edge(static_cast<std::size_t>(disc), 0);
+  for (Eigen::Index k = 0; k < disc; ++k) {
+    edge[static_cast<std::size_t>(k)] =
+        x.segment<2>(2 * k).norm() > bound[static_cast<std::size_t>(k)];
+  }
+  bool settled = false;
+  for (int attempt = 0; attempt < 8 && !settled; ++attempt) settled = polish(x, edge);
+  if (!settled) {
+    x = Vector::Zero(size);
+    Real t = 1 / std::max(scale, Real(1e-300));
+    // To 1e-14 of the energies: nearer the discs' edges b^2 - |x|^2 loses its digits.
+    const Real gap_wanted = 1e-14L * std::max(scale, Real(1e-300));
+    for (int outer = 0; outer < 40; ++outer) {
+      for (int newton = 0; newton < 50; ++newton) {
+        Vector gradient = t * (coupling * x + slip);
+        Matrix hessian = t * coupling;
+        for (Eigen::Index k = 0; k < disc; ++k) {
+          const Real g = room(x, k);
+          const Eigen::Matrix<Real, 2, 1> xk = x.segment<2>(2 * k);
+          gradient.segment<2>(2 * k) += (2 / g) * xk;
+          hessian.block<2, 2>(2 * k, 2 * k) +=
+              (2 / g) * Eigen::Matrix<Real, 2, 2>::Identity() + (4 / (g * g)) * xk * xk.transpose();
+        }
+        const Vector step = -hessian.ldlt().solve(gradient);
+        const Real decrement = -gradient.dot(step);
+        if (!(decrement > 1e-20L)) break;
+        // Backtracking: inside every disc, and the barrier objective decreasing enough.
+        const auto objective = [&](const Vector& y) {
+          Real value = t * energy(y);
+          for (Eigen::Index k = 0; k < disc; ++k) value -= std::log(room(y, k));
+          return value;
+        };
+        const Real here = objective(x);
+        bool moved = false;
+        Real length = 1;
+        for (int halving = 0; halving < 60 && !moved; ++halving, length *= 0.5L) {
+          const Vector y = x + length * step;
+          bool inside = true;
+          for (Eigen::Index k = 0; k < disc && inside; ++k) inside = room(y, k) > 0;
+          if (inside && objective(y) <= here - 0.25L * length * decrement) {
+            x = y;
+            moved = true;
+          }
+        }
+        if (!moved) break;
+      }
+      if (Real(disc) / t < gap_wanted) break;
+      t *= 10;
+    }
+    for (Eigen::Index k = 0; k < disc; ++k) {
+      edge[static_cast<std::size_t>(k)] =
+          x.segment<2>(2 * k).norm() >= bound[static_cast<std::size_t>(k)] * (1 - 1e-8L);
+    }
+    Vector polished = x;
+    if (polish(polished, edge)) x = polished;
+  }
+  return x;
+}
+
+/// A block's tangential coupling row by row: for each unknown (a contact's first or second
+/// tangent: 2 k and 2 k + 1 in the block's numbering), its nonzero (column, A_ij).
+using CouplingRows = std::vector<std::vector<std::pair<Eigen::Index, Real>>>;
+
+/// Relative to the largest slip, the projected-gradient residual at which the iterative friction
+/// solve stops (README, "Work per message, and threads").
+constexpr Real kFrictionResidual = 1e-12L;
+/// The iterative friction solve's iterations at most.
+constexpr int kFrictionIterations = 10000;
+
+/// The friction impulses of a block too large for dense algebra (more than kDenseBlockContacts
+/// contacts): the minimum of E(x) = x'A x / 2 + s'x over the discs |x_k| <= b_k by an
+/// accelerated projected gradient (Beck and Teboulle, "A fast iterative shrinkage-thresholding
+/// algorithm for linear inverse problems", SIAM J. Imaging Sci. 2009), its momentum restarted
+/// wherever it points against the step taken (O'Donoghue and Candes, "Adaptive restart for
+/// accelerated gradient schemes", Found. Comput. Math. 2015). The step is 1/L with
+/// L = max_i sum_j |A_ij|, at least A's largest eigenvalue (Gershgorin). A x is built row by row
+/// from A's nonzeros: an iteration costs O(the block's nonzeros).
+///
+/// Every iterate is a projection onto the discs, so whatever the iteration reaches, |x_k| <= b_k
+/// (to the rounding of one scaling). It stops where the projected-gradient residual
+/// L |x - P(x - (A x + s) / L)| (per contact; 0 exactly where x is the minimum: Coulomb's law,
+/// the slip stopped inside the disc, at the bound against the slip left on its edge) is at most
+/// kFrictionResidual of the largest slip, returning true; else at a fixed point of the rounded
+/// step or after kFrictionIterations, returning false. The last iterate is returned where its
+/// energy is at most E(0) = 0 (friction adds no energy), else the iterate of the lowest energy
+/// (x = 0 at worst), returning false. Every sum (rows of A x, the energy, dot products, the
+/// bound) is order-free and sign-symmetric (orderFreeSum), so renaming the bodies or mirroring
+/// the cluster changes no bit.
+bool frictionByProjectedGradient(const CouplingRows& rows, const Vector& slip,
+                                 const std::vector<Real>& bound, Vector& solution) {
+  const Eigen::Index size = slip.size();
+  const Eigen::Index discs = size / 2;
+  std::vector<Real> terms;
+  const auto apply = [&](const Vector& v) {
+    Vector out(size);
+    for (Eigen::Index i = 0; i < size; ++i) {
+      terms.clear();
+      for (const auto& [j, value] : rows[static_cast<std::size_t>(i)]) {
+        terms.push_back(value * v[j]);
+      }
+      out[i] = orderFreeSum(terms);
+    }
+    return out;
+  };
+  const auto energy = [&](const Vector& v, const Vector& coupled) {  // E(v), A v given
+    terms.clear();
+    for (Eigen::Index i = 0; i < size; ++i) terms.push_back(v[i] * (0.5L * coupled[i] + slip[i]));
+    return orderFreeSum(terms);
+  };
+  const auto dot = [&](const Vector& u, const Vector& v) {
+    terms.clear();
+    for (Eigen::Index i = 0; i < size; ++i) terms.push_back(u[i] * v[i]);
+    return orderFreeSum(terms);
+  };
+  const auto project = [&](Vector& v) {
+    for (Eigen::Index k = 0; k < discs; ++k) {
+      const Real length = v.segment<2>(2 * k).norm(), b = bound[static_cast<std::size_t>(k)];
+      if (length > b) v.segment<2>(2 * k) *= b / length;
+    }
+  };
+  Real lipschitz = 0, largest_slip = 0;
+  for (Eigen::Index i = 0; i < size; ++i) {
+    terms.clear();
+    for (const auto& entry : rows[static_cast<std::size_t>(i)]) {
+      terms.push_back(std::abs(entry.second));
+    }
+    lipschitz = std::max(lipschitz, orderFreeSum(terms));
+  }
+  for (Eigen::Index k = 0; k < discs; ++k) {
+    largest_slip = std::max(largest_slip, slip.segment<2>(2 * k).norm());
+  }
+  solution = Vector::Zero(size);
+  if (!(lipschitz > 0)) return false;  // no contact moves a body: no impulse does anything
+  const Real tolerance = kFrictionResidual * largest_slip;
+  // The residual at v, A v given.
+  const auto residual = [&](const Vector& v, const Vector& coupled) {
+    Vector step = v - (coupled + slip) / lipschitz;
+    project(step);
+    Real worst = 0;
+    for (Eigen::Index k = 0; k < discs; ++k) {
+      worst = std::max(worst, lipschitz * (v.segment<2>(2 * k) - step.segment<2>(2 * k)).norm());
+    }
+    return worst;
+  };
+  Vector x = Vector::Zero(size), coupled_x = Vector::Zero(size);  // the last iterate, A x
+  Vector y = x, coupled_y = coupled_x;  // where the next step starts (x plus momentum), A y
+  Vector lowest = x;                    // the iterate of the lowest energy so far
+  Real lowest_energy = 0, energy_x = 0, momentum = 1;
+  bool settled = false;
+  int iteration = 0;
+  for (; iteration < kFrictionIterations && !settled; ++iteration) {
+    Vector z = y - (coupled_y + slip) / lipschitz;
+    project(z);
+    const Vector coupled_z = apply(z);
+    energy_x = energy(z, coupled_z);
+    if (energy_x <= lowest_energy) {
+      lowest = z;
+      lowest_energy = energy_x;
+    }
+    settled = residual(z, coupled_z) <= tolerance || z == x;  // or a fixed point of the rounding
+    if (dot(y - z, z - x) > 0) {  // the momentum points against the step: restart it
+      y = z;
+      coupled_y = coupled_z;
+      momentum = 1;
+    } else {
+      const Real next = (1 + std::sqrt(1 + 4 * momentum * momentum)) / 2;
+      const Real carried = (momentum - 1) / next;
+      y = z + carried * (z - x);
+      coupled_y = coupled_z + carried * (coupled_z - coupled_x);  // A y, by linearity
+      momentum = next;
+    }
+    x = std::move(z);
+    coupled_x = coupled_z;
+  }
+  if (energy_x <= 0) {
+    solution = x;
+    return residual(x, coupled_x) <= tolerance;
+  }
+  solution = lowest;
+  return false;
+}
+
+}  // namespace
+
 ContactForceSolution solveFrictionImpulses(const std::vector<ForceBody>& bodies,
                                            const std::vector<ForceContact>& contacts,
                                            const std::vector<double>& normal_impulses) {
@@ -531,208 +809,132 @@ ContactForceSolution solveFrictionImpulses(const std::vector<ForceBody>& bodies,
   // s the slips; E is exactly the change of kinetic energy), over the discs |x_k| <= mu_k J_k.
   // Its minimum is Coulomb's law: where the disc's inside holds it the slip stops (A x + s = 0),
   // elsewhere the impulse is at the bound against the slip left. E(x) <= E(0) = 0: friction
-  // never adds energy. A convex problem, solved by a primal barrier method (Newton's method on
-  // t E(x) - sum log(b^2 - |x_k|^2) for t growing) in long double: all contacts at once, and
-  // where A is singular (redundant contacts) it tends to the centre of the optimal set, so the
-  // answer depends on no order.
+  // never adds energy. A_kl = 0 unless contacts k and l share a movable body, so E is a sum over
+  // the blocks of contacts connected through shared movable bodies, each minimised on its own
+  // (exact): by dense algebra up to kDenseBlockContacts contacts (frictionByBarrier), above by
+  // an accelerated projected gradient to a documented residual (frictionByProjectedGradient).
+  // A is built column by column from each unknown's response (Group::respondToOne), in
+  // O(its nonzeros).
   const Group group(bodies, contacts);
   const std::size_t count = contacts.size();
   std::vector<std::size_t> active;  // contacts that can take friction
   std::vector<Real> bound;
+  std::vector<long> slot(count, -1);  // each contact's place in `active`, -1 if not there
   for (std::size_t k = 0; k < count; ++k) {
     const Real b = Real(contacts[k].friction) * Real(normal_impulses[k]);
     if (b > 0 && group.slip(k).norm() > 0) {
+      slot[k] = static_cast<long>(active.size());
       active.push_back(k);
       bound.push_back(b);
     }
   }
-  const std::vector<V3> none(count, V3::Zero());
-  const auto size = static_cast<Eigen::Index>(2 * active.size());
-  std::vector<V3> impulses = none;
-  if (size > 0) {
-    const auto tangent = [&](Eigen::Index i) -> const V3& {
-      const std::size_t k = active[static_cast<std::size_t>(i / 2)];
-      return i % 2 == 0 ? group.first(k) : group.second(k);
+  const auto tangent = [&](std::size_t k, Eigen::Index t) -> const V3& {
+    return t == 0 ? group.first(k) : group.second(k);
+  };
+  // Per active contact l: what a unit impulse along each of its tangents does to the slips of
+  // the active contacts m it shares a movable body with, C(m, l) (row: m's tangents; column:
+  // l's), sorted by m.
+  using Block = Eigen::Matrix<Real, 2, 2>;
+  std::vector<std::vector<std::pair<std::size_t, Block>>> columns(active.size());
+  ConnectedSets connected(active.size());
+  for (std::size_t l = 0; l < active.size(); ++l) {
+    for (Eigen::Index t = 0; t < 2; ++t) {
+      std::size_t visited = 0;  // respondToOne visits in the same order for either force
+      group.respondToOne(active[l], tangent(active[l], t),
+                         [&](std::size_t k, Real, const V3& slip_change) {
+                           if (slot[k] < 0) return;
+                           const auto m = static_cast<std::size_t>(slot[k]);
+                           if (t == 0) {
+                             columns[l].emplace_back(m, Block::Zero());
+                             connected.link(l, m);
+                           }
+                           Block& entry = columns[l][visited++].second;
+                           entry(0, t) = group.first(k).dot(slip_change);
+                           entry(1, t) = group.second(k).dot(slip_change);
+                         });
+    }
+    std::sort(columns[l].begin(), columns[l].end(),
+              [](const auto& p, const auto& q) { return p.first < q.first; });
+  }
+  // The symmetric coupling A(m, l) = (C(m, l) + C(l, m)') / 2: symmetric up to rounding.
+  const auto coupling = [&](std::size_t m, std::size_t l, Eigen::Index r, Eigen::Index c) {
+    const auto& column = columns[l];
+    const auto& row = columns[m];
+    const auto at = [](const std::vector<std::pair<std::size_t, Block>>& list, std::size_t key) {
+      return std::lower_bound(list.begin(), list.end(), key,
+                              [](const auto& p, std::size_t value) { return p.first < value; });
     };
-    Matrix coupling(size, size);
-    Vector slip(size);
-    for (Eigen::Index j = 0; j < size; ++j) {
-      std::vector<V3> unit = none;
-      unit[active[static_cast<std::size_t>(j / 2)]] = tangent(j);
-      const Response column = group.respond(unit, false);
-      for (Eigen::Index i = 0; i < size; ++i) {
-        coupling(i, j) =
-            tangent(i).dot(column.slip_acceleration[active[static_cast<std::size_t>(i / 2)]]);
+    const auto forward = at(column, m);
+    const auto backward = at(row, l);
+    const Real there = forward != column.end() && forward->first == m ? forward->second(r, c) : 0;
+    const Real back = backward != row.end() && backward->first == l ? backward->second(c, r) : 0;
+    return 0.5L * (there + back);
+  };
+  std::vector<V3> impulses(count, V3::Zero());
+  bool converged = true;
+  std::vector<Eigen::Index> place(active.size(), -1);  // each contact's place in its block
+  for (const std::vector<std::size_t>& block : connected.sets()) {
+    const auto n = static_cast<Eigen::Index>(block.size());
+    std::vector<Real> block_bound(block.size());
+    Vector slip(2 * n);
+    for (Eigen::Index p = 0; p < n; ++p) {
+      const std::size_t l = block[static_cast<std::size_t>(p)];
+      place[l] = p;
+      block_bound[static_cast<std::size_t>(p)] = bound[l];
+      for (Eigen::Index t = 0; t < 2; ++t) {
+        slip[2 * p + t] = tangent(active[l], t).dot(group.slip(active[l]));
       }
-      slip[j] = tangent(j).dot(group.slip(active[static_cast<std::size_t>(j / 2)]));
     }
-    coupling = (0.5L * (coupling + coupling.transpose())).eval();  // symmetric up to rounding
-    const auto disc = static_cast<Eigen::Index>(active.size());
-    const auto energy = [&](const Vector& x) { return 0.5L * x.dot(coupling * x) + slip.dot(x); };
-    const auto room = [&](const Vector& x, Eigen::Index k) {
-      return bound[static_cast<std::size_t>(k)] * bound[static_cast<std::size_t>(k)] -
-             x.segment<2>(2 * k).squaredNorm();
-    };
-    // The scale of the energies: what stopping every slip alone would remove.
-    Real scale = 0;
-    for (Eigen::Index i = 0; i < size; ++i) {
-      scale = std::max(scale, std::abs(slip[i]) * bound[static_cast<std::size_t>(i / 2)]);
-    }
-    // Coulomb's conditions for a given set of contacts at their disc's edge: those take the
-    // bound exactly, against the slip they leave; the others stop their slip exactly (a linear
-    // solve); repeated while the edge directions move. True (and `x` set) when they then hold.
-    const auto polish = [&](Vector& x, std::vector<char>& edge) {
-      Vector polished = x;
-      for (int round = 0; round < 8; ++round) {
-        const Vector residual = coupling * polished + slip;  // the slips left
-        for (Eigen::Index k = 0; k < disc; ++k) {
-          if (!edge[static_cast<std::size_t>(k)]) continue;
-          const Eigen::Matrix<Real, 2, 1> left = residual.segment<2>(2 * k);
-          const Real b = bound[static_cast<std::size_t>(k)];
-          if (left.norm() > 0) {
-            polished.segment<2>(2 * k) = -b * left.normalized();
-          } else if (polished.segment<2>(2 * k).norm() > b) {
-            polished.segment<2>(2 * k) *= b / polished.segment<2>(2 * k).norm();
+    Vector x;
+    if (block.size() <= kDenseBlockContacts) {
+      Matrix dense = Matrix::Zero(2 * n, 2 * n);
+      for (Eigen::Index q = 0; q < n; ++q) {
+        const std::size_t l = block[static_cast<std::size_t>(q)];
+        for (const auto& entry : columns[l]) {
+          for (Eigen::Index r = 0; r < 2; ++r) {
+            for (Eigen::Index c = 0; c < 2; ++c) {
+              dense(2 * place[entry.first] + r, 2 * q + c) = coupling(entry.first, l, r, c);
+            }
           }
         }
-        std::vector<Eigen::Index> inner;
-        for (Eigen::Index i = 0; i < size; ++i) {
-          if (!edge[static_cast<std::size_t>(i / 2)]) inner.push_back(i);
-        }
-        if (!inner.empty()) {
-          const auto n = static_cast<Eigen::Index>(inner.size());
-          Matrix system(n, n);
-          Vector target(n);
-          for (Eigen::Index r = 0; r < n; ++r) {
-            target[r] = -slip[inner[r]];
-            for (Eigen::Index j = 0; j < size; ++j) {
-              if (edge[static_cast<std::size_t>(j / 2)]) {
-                target[r] -= coupling(inner[r], j) * polished[j];
+      }
+      x = frictionByBarrier(dense, slip, block_bound);
+    } else {
+      CouplingRows rows(static_cast<std::size_t>(2 * n));
+      for (Eigen::Index q = 0; q < n; ++q) {
+        const std::size_t l = block[static_cast<std::size_t>(q)];
+        for (const auto& entry : columns[l]) {
+          for (Eigen::Index r = 0; r < 2; ++r) {
+            for (Eigen::Index c = 0; c < 2; ++c) {
+              const Real value = coupling(entry.first, l, r, c);
+              if (value != 0) {
+                rows[static_cast<std::size_t>(2 * place[entry.first] + r)].emplace_back(2 * q + c,
+                                                                                        value);
               }
             }
-            for (Eigen::Index c = 0; c < n; ++c) system(r, c) = coupling(inner[r], inner[c]);
-          }
-          const Vector solved = system.completeOrthogonalDecomposition().solve(target);
-          for (Eigen::Index r = 0; r < n; ++r) polished[inner[r]] = solved[r];
-        }
-        const Vector left = coupling * polished + slip;
-        bool holds = true;
-        bool moved = false;
-        for (Eigen::Index k = 0; k < disc && holds; ++k) {
-          const Real b = bound[static_cast<std::size_t>(k)];
-          const Eigen::Matrix<Real, 2, 1> xk = polished.segment<2>(2 * k),
-                                          lk = left.segment<2>(2 * k);
-          if (edge[static_cast<std::size_t>(k)]) {
-            // Against the slip left (not reversing it), along it to within rounding.
-            if (lk.norm() == 0) continue;
-            holds = xk.dot(lk) <= 0;
-            if ((xk / b + lk.normalized()).norm() > 1e-15L) moved = true;
-          } else {
-            holds = xk.norm() <= b && lk.norm() <= 1e-15L * (slip.norm() + 1);
           }
         }
-        if (holds && !moved) {
-          x = polished;
-          return true;
-        }
-        if (!holds) break;
       }
-      // Where a condition fails, the contact changes sides (all at once).
-      const Vector left = coupling * polished + slip;
-      bool changed = false;
-      for (Eigen::Index k = 0; k < disc; ++k) {
-        const Real b = bound[static_cast<std::size_t>(k)];
-        const Eigen::Matrix<Real, 2, 1> xk = polished.segment<2>(2 * k),
-                                        lk = left.segment<2>(2 * k);
-        char& on_edge = edge[static_cast<std::size_t>(k)];
-        if (!on_edge && xk.norm() > b) {
-          on_edge = 1;
-          changed = true;
-        } else if (on_edge && xk.dot(lk) > 0) {
-          on_edge = 0;
-          changed = true;
-        }
-      }
-      x = polished;
-      static_cast<void>(changed);
-      return false;
-    };
-    // First the exact conditions from the sticking answer (fast, and usually right at once);
-    // where they do not settle, the barrier method, then the same polish from its answer.
-    Vector x = coupling.completeOrthogonalDecomposition().solve(-slip);
-    std::vector<char> edge(static_cast<std::size_t>(disc), 0);
-    for (Eigen::Index k = 0; k < disc; ++k) {
-      edge[static_cast<std::size_t>(k)] =
-          x.segment<2>(2 * k).norm() > bound[static_cast<std::size_t>(k)];
+      converged = frictionByProjectedGradient(rows, slip, block_bound, x) && converged;
     }
-    bool settled = false;
-    for (int attempt = 0; attempt < 8 && !settled; ++attempt) settled = polish(x, edge);
-    if (!settled) {
-      x = Vector::Zero(size);
-      Real t = 1 / std::max(scale, Real(1e-300));
-      // To 1e-14 of the energies: nearer the discs' edges b^2 - |x|^2 loses its digits.
-      const Real gap_wanted = 1e-14L * std::max(scale, Real(1e-300));
-      for (int outer = 0; outer < 40; ++outer) {
-        for (int newton = 0; newton < 50; ++newton) {
-          Vector gradient = t * (coupling * x + slip);
-          Matrix hessian = t * coupling;
-          for (Eigen::Index k = 0; k < disc; ++k) {
-            const Real g = room(x, k);
-            const Eigen::Matrix<Real, 2, 1> xk = x.segment<2>(2 * k);
-            gradient.segment<2>(2 * k) += (2 / g) * xk;
-            hessian.block<2, 2>(2 * k, 2 * k) += (2 / g) * Eigen::Matrix<Real, 2, 2>::Identity() +
-                                                 (4 / (g * g)) * xk * xk.transpose();
-          }
-          const Vector step = -hessian.ldlt().solve(gradient);
-          const Real decrement = -gradient.dot(step);
-          if (!(decrement > 1e-20L)) break;
-          // Backtracking: inside every disc, and the barrier objective decreasing enough.
-          const auto objective = [&](const Vector& y) {
-            Real value = t * energy(y);
-            for (Eigen::Index k = 0; k < disc; ++k) value -= std::log(room(y, k));
-            return value;
-          };
-          const Real here = objective(x);
-          bool moved = false;
-          Real length = 1;
-          for (int halving = 0; halving < 60 && !moved; ++halving, length *= 0.5L) {
-            const Vector y = x + length * step;
-            bool inside = true;
-            for (Eigen::Index k = 0; k < disc && inside; ++k) inside = room(y, k) > 0;
-            if (inside && objective(y) <= here - 0.25L * length * decrement) {
-              x = y;
-              moved = true;
-            }
-          }
-          if (!moved) break;
-        }
-        if (Real(disc) / t < gap_wanted) break;
-        t *= 10;
-      }
-      for (Eigen::Index k = 0; k < disc; ++k) {
-        edge[static_cast<std::size_t>(k)] =
-            x.segment<2>(2 * k).norm() >= bound[static_cast<std::size_t>(k)] * (1 - 1e-8L);
-      }
-      Vector polished = x;
-      if (polish(polished, edge)) x = polished;
-    }
-    for (Eigen::Index j = 0; j < size; ++j) {
-      impulses[active[static_cast<std::size_t>(j / 2)]] += x[j] * tangent(j);
+    for (Eigen::Index j = 0; j < 2 * n; ++j) {
+      const std::size_t k = active[block[static_cast<std::size_t>(j / 2)]];
+      impulses[k] += x[j] * tangent(k, j % 2);
     }
   }
   const Response change = group.respond(impulses, false);
   ContactForceSolution result;
+  result.converged = converged;
   result.contacts.resize(count);
   for (std::size_t k = 0; k < count; ++k) {
     ContactForce& out = result.contacts[k];
     out.tangential = impulses[k].cast<double>();
     out.slip = group.slip(k).cast<double>();
     out.slip_acceleration = change.slip_acceleration[k].cast<double>();
-    const auto position = std::find(active.begin(), active.end(), k);
-    if (position == active.end()) {
+    if (slot[k] < 0) {
       out.mode = ContactMode::kSeparating;
     } else {
-      const Real b = bound[static_cast<std::size_t>(position - active.begin())];
+      const Real b = bound[static_cast<std::size_t>(slot[k])];
       out.mode =
           impulses[k].norm() < b * (1 - 1e-9L) ? ContactMode::kSticking : ContactMode::kSliding;
     }

@@ -39,12 +39,21 @@ void ContactSchedule<Motion>::index(std::size_t k) {
 }
 
 template <class Motion>
+bool ContactSchedule<Motion>::touches(const Pair& pair, const Geometry& g) const {
+  if (!g.valid) return false;
+  // A lasting contact whose integrated motion has drifted past the touching band (curved
+  // contact, to its integration tolerance) still touches: a blow on one of its bodies reaches
+  // the other.
+  return std::abs(g.gap) <= g.tolerance || (g.gap < 0 && world_.lasting(pair));
+}
+
+template <class Motion>
 void ContactSchedule<Motion>::touchingAtStart(double instant, std::vector<std::size_t>& touching) {
   start_geometry_.resize(pairs_.size());
   for (std::size_t k = 0; k < pairs_.size(); ++k) {
     start_geometry_[k] = geometry<Motion>(world_, pairs_[k], instant);
     const Geometry& g = start_geometry_[k];
-    if (g.valid && std::abs(g.gap) <= g.tolerance) touching.push_back(k);
+    if (touches(pairs_[k], g)) touching.push_back(k);
   }
 }
 
@@ -133,7 +142,7 @@ bool ContactSchedule<Motion>::next(double& instant, std::vector<std::size_t>& to
     for (const std::size_t k : pairs_of_[body]) {
       if (std::find(touching.begin(), touching.end(), k) != touching.end()) continue;
       const Geometry g = geometry<Motion>(world_, pairs_[k], instant);
-      if (!g.valid || std::abs(g.gap) > g.tolerance) continue;
+      if (!touches(pairs_[k], g)) continue;
       touching.push_back(k);
       visit(pairs_[k].first == body ? pairs_[k].second : pairs_[k].first);
     }

@@ -40,6 +40,8 @@ class ContactSchedule {
   /// The next first contact of pair k from `from`, given its geometry then.
   void schedule(std::size_t k, double from, const Geometry& g);
   void index(std::size_t k);
+  /// The pair touches at the instant of `g` (within its touching band, or a lasting contact).
+  bool touches(const Pair& pair, const Geometry& g) const;
 
   World& world_;
   double end_;

@@ -137,10 +137,12 @@ double contactRestitution(World& world, double time, const InstantContact& conta
   return restitution;
 }
 
+/// `joined`: 2 for a plastic contact of an earlier round that joins this one (e = 0).
 template <class Motion>
 PreparedCluster prepareCluster(World& world, double time,
                                const std::vector<InstantContact>& contacts,
-                               const std::vector<std::size_t>& cluster) {
+                               const std::vector<std::size_t>& cluster,
+                               const std::vector<char>& joined) {
   PreparedCluster prepared;
   std::vector<std::size_t>& members = prepared.members;
   const auto local = [&members](std::size_t participant) {
@@ -159,7 +161,9 @@ PreparedCluster prepareCluster(World& world, double time,
     const double approach_speed =
         (velocityAt<Motion>(world, pair.first, time) - velocityAt<Motion>(world, pair.second, time))
             .dot(contact.normal);
-    contact.restitution = contactRestitution<Motion>(world, time, instant_contact, approach_speed);
+    contact.restitution =
+        joined[k] == 2 ? 0.0
+                       : contactRestitution<Motion>(world, time, instant_contact, approach_speed);
     prepared.contacts.push_back(contact);
     if (world.friction_model) prepared.friction.push_back(world.frictionOf(pair));
   }
@@ -197,8 +201,10 @@ template <class Motion>
 void recordImpacts(const World& world, double time, const std::vector<InstantContact>& contacts,
                    const std::vector<std::size_t>& cluster, const PreparedCluster& prepared,
                    const std::vector<ClusterBody>& before, const ClusterOutcome& outcome,
-                   StepReport& report) {
+                   const std::vector<char>& joined, StepReport& report) {
   for (std::size_t c = 0; c < cluster.size(); ++c) {
+    // A plastic contact that joined the round and took no impulse had no impact.
+    if (joined[cluster[c]] == 2 && !(outcome.normal[c].impulse > 0)) continue;
     const auto& [pair, g] = contacts[cluster[c]];
     const ClusterContact& contact = prepared.contacts[c];
     const std::vector<ClusterBody>& after = prepared.bodies;
@@ -238,16 +244,34 @@ void resolveInstant(World& world, double time, const std::vector<Pair>& touching
     const Geometry g = geometry<Motion>(world, pair, time);
     if (g.valid) contacts.push_back(InstantContact{pair, g});
   }
+  // Contacts resolved plastically (e = 0) in an earlier round of this instant: they join every
+  // later round that strikes while they do not separate, so the rounds' plastic limit is reached
+  // at once instead of by ever smaller rounds.
+  std::vector<char> plastic(contacts.size(), 0);
   for (int round = 0; round < world.settings.max_rounds_per_instant; ++round) {
-    const std::vector<std::size_t> striking = findStriking<Motion>(world, time, contacts);
+    std::vector<std::size_t> striking = findStriking<Motion>(world, time, contacts);
     if (striking.empty()) return;
+    std::vector<char> joined(contacts.size(), 0);
+    for (const std::size_t k : striking) joined[k] = 1;
+    for (std::size_t k = 0; k < contacts.size(); ++k) {
+      if (plastic[k] && !joined[k] &&
+          !separating<Motion>(world, contacts[k].pair, contacts[k].geometry.normal, time)) {
+        striking.push_back(k);
+        joined[k] = 2;
+      }
+    }
+    std::sort(striking.begin(), striking.end());
     for (const std::vector<std::size_t>& cluster : formClusters(world, contacts, striking)) {
-      PreparedCluster prepared = prepareCluster<Motion>(world, time, contacts, cluster);
+      PreparedCluster prepared = prepareCluster<Motion>(world, time, contacts, cluster, joined);
       const std::vector<ClusterBody> before = prepared.bodies;
       const ClusterOutcome outcome =
           solveCluster(prepared.bodies, prepared.contacts, prepared.friction, world.friction_model);
       storeVelocities<Motion>(world, time, prepared, changed);
-      recordImpacts<Motion>(world, time, contacts, cluster, prepared, before, outcome, report);
+      recordImpacts<Motion>(world, time, contacts, cluster, prepared, before, outcome, joined,
+                            report);
+      for (std::size_t c = 0; c < cluster.size(); ++c) {
+        if (prepared.contacts[c].restitution == 0.0) plastic[cluster[c]] = 1;
+      }
     }
   }
   if (findStriking<Motion>(world, time, contacts).empty()) return;

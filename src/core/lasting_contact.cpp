@@ -135,8 +135,14 @@ void solveGroup(World& world, double time, const std::vector<std::size_t>& bodie
   std::vector<Eigen::Vector3d> positions;
   for (const std::size_t p : participants) positions.push_back(positionAt<Motion>(world, p, time));
   std::vector<double> gaps;
-  for (const auto& [pair, g] : candidates)
-    gaps.push_back(std::abs(g.gap) <= g.tolerance ? g.gap : 0.0);
+  for (const auto& [pair, g] : candidates) {
+    // Within the band, or (continuous detection) a lasting contact whose integrated motion
+    // drifted past it: closed. An overlap the states gave, or one discrete detection found an
+    // impact in, is held where it is.
+    const bool drifted = world.detection == Detection::kContinuous && g.gap < 0 &&
+                         world.contact_since.count(pair) > 0;
+    gaps.push_back(std::abs(g.gap) <= g.tolerance || drifted ? g.gap : 0.0);
+  }
   closeContactGaps(positions, force_bodies, contacts, gaps);
   closeContactVelocities(force_bodies, contacts, std::vector<bool>(contacts.size(), false));
   const ContactForceSolution solution =

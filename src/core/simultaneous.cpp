@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "collision_response/core/impact.h"
+#include "order_free.h"
 
 namespace collision_response::core {
 namespace {
@@ -24,23 +25,13 @@ std::vector<ContactOutcome> resolveOne(std::vector<ClusterBody>& bodies,
   return {ContactOutcome{response.normal_impulse, response.approach_speed, response.energy_lost}};
 }
 
-/// Blocks of more contacts than this are solved by conjugate gradients (README, "Work per
-/// message"): a dense solve costs the cube of the contacts (a lattice of 1,000 touching balls
-/// closing on its centre, 2,700 contacts, took a minute).
-constexpr std::size_t kDenseContacts = 128;
+// Blocks of more than kDenseBlockContacts contacts are solved by conjugate gradients (README,
+// "Work per message"): a dense solve costs the cube of the contacts (a lattice of 1,000 touching
+// balls closing on its centre, 2,700 contacts, took a minute).
 
 using RealL = long double;
 using MatrixL = Eigen::Matrix<RealL, Eigen::Dynamic, Eigen::Dynamic>;
 using VectorL = Eigen::Matrix<RealL, Eigen::Dynamic, 1>;
-
-/// A sum whose value does not depend on the order of its terms: they are added in the order of
-/// their values. (Renaming bodies reorders contacts; the answer must not change.)
-RealL orderFreeSum(std::vector<RealL>& terms) {
-  std::sort(terms.begin(), terms.end());
-  RealL sum = 0;
-  for (const RealL term : terms) sum += term;
-  return sum;
-}
 
 /// A block's coupling: for each of its contacts, the (column, A_kl) of the contacts it shares a
 /// movable body with (itself included), columns in the block's numbering.
@@ -108,7 +99,7 @@ std::vector<double> solveBlock(const SparseRows& rows, const std::vector<RealL>&
     VectorL right(size);
     for (Eigen::Index i = 0; i < size; ++i) right[i] = target[kept[static_cast<std::size_t>(i)]];
     Eigen::VectorXd solution;
-    if (count <= kDenseContacts) {
+    if (count <= kDenseBlockContacts) {
       // Solved in long double (11 more bits) and rounded once: the impulses are the doubles
       // nearest the exact solution, so contacts that are mirror images of each other receive the
       // same impulse to the bit, whatever order the solver visits them in.
@@ -188,24 +179,13 @@ std::vector<ContactOutcome> resolveSimultaneous(std::vector<ClusterBody>& bodies
   }
   // Blocks: contacts connected through shared movable bodies. Each is solved on its own (the
   // system is block-diagonal: exact).
-  std::vector<std::size_t> parent(count);
-  for (std::size_t k = 0; k < count; ++k) parent[k] = k;
-  const auto find = [&parent](std::size_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
+  ConnectedSets connected(count);
   for (std::size_t k = 0; k < count; ++k) {
-    for (const std::size_t l : neighbours[k]) {
-      const std::size_t x = find(k), y = find(l);
-      parent[std::max(x, y)] = std::min(x, y);
-    }
+    for (const std::size_t l : neighbours[k]) connected.link(k, l);
   }
-  std::vector<std::vector<std::size_t>> blocks(count);
-  for (std::size_t k = 0; k < count; ++k) blocks[find(k)].push_back(k);
   Eigen::VectorXd impulses = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(count));
   std::vector<std::size_t> place(count);
-  for (const std::vector<std::size_t>& block : blocks) {
-    if (block.empty()) continue;
+  for (const std::vector<std::size_t>& block : connected.sets()) {
     for (std::size_t i = 0; i < block.size(); ++i) place[block[i]] = i;
     SparseRows rows(block.size());
     std::vector<RealL> target(block.size());
@@ -244,10 +224,7 @@ Eigen::Vector3d OrderFreeSum::total(std::size_t body, const Eigen::Vector3d& sta
   for (int c = 0; c < 3; ++c) {
     terms.clear();
     for (const Eigen::Vector3d& change : terms_[body]) terms.push_back(change[c]);
-    std::sort(terms.begin(), terms.end());
-    double added = 0;
-    for (const double term : terms) added += term;
-    sum[c] += added;
+    sum[c] += orderFreeSum(terms);
   }
   return sum;
 }

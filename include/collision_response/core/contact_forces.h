@@ -119,11 +119,15 @@ ContactForceSolution solveContactForcesWithModes(const std::vector<ForceBody>& b
 /// Coulomb friction at an impact whose normal impulses J_k are given (applied already to the
 /// bodies' velocities), jointly over the cluster: tangential impulses T_k with |T_k| <= mu J_k
 /// that stop every slip they can (sticking), and at mu J_k against the slip that is left where
-/// they cannot (sliding), so that friction never reverses a slip and never adds energy. The
-/// conditions are linear for an assignment of modes; they are solved jointly (long double) and
-/// every failing contact changes mode at once, so nothing depends on the order of the contacts.
-/// Returns the impulses (tangential, on b) and modes per contact, and per body the change of
-/// velocity (in `acceleration`) and of angular velocity (in `angular_acceleration`).
+/// they cannot (sliding), so that friction never reverses a slip and never adds energy: the
+/// minimum of the kinetic energy left over the discs |T_k| <= mu J_k. It is solved block by block
+/// (contacts connected through shared movable bodies; exact), in long double: a block of up to
+/// 128 contacts by dense algebra, a larger one iteratively to a projected-gradient residual of
+/// 1e-12 of its largest slip (`converged` false where a block stops short of it: the bounds and
+/// the energy still hold). Nothing depends on the order of the contacts (README, "Work per
+/// message, and threads"). Returns the impulses (tangential, on b) and modes per contact, and per
+/// body the change of velocity (in `acceleration`) and of angular velocity (in
+/// `angular_acceleration`).
 ContactForceSolution solveFrictionImpulses(const std::vector<ForceBody>& bodies,
                                            const std::vector<ForceContact>& contacts,
                                            const std::vector<double>& normal_impulses);

@@ -22,9 +22,10 @@ struct ClusterBody {
 };
 
 /// Sums each body's velocity changes from several contacts in an order that does not depend on
-/// the order of the contacts: each component's terms are added smallest first (sorted by value),
-/// so that listing the contacts in another order gives the same bits, and mirror images of a
-/// cluster cancel exactly where they should (+x and -x add to 0).
+/// the order of the contacts: each component's positive terms are added smallest first, its
+/// negative ones smallest in magnitude first, then the two sums, so that listing the contacts in
+/// another order gives the same bits, a mirror image of a cluster the mirrored bits, and mirror
+/// images cancel exactly where they should (+x and -x add to 0).
 class OrderFreeSum {
  public:
   explicit OrderFreeSum(std::size_t bodies) : terms_(bodies) {}
