@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 #include "collision_response/core/impact.h"
@@ -25,6 +26,7 @@ Scalar powerOfTwoBelow(Scalar value) {
 /// contact: |s + v t| = R with s = p_b - p_a and v = v_b - v_a at t = 0 and R = r_a + r_b.
 /// Empty when they do not close (s.v >= 0), overlap already at t = 0 (they came into contact
 /// before; an impact is found once, when it begins), pass each other, or touch after horizon.
+/// Closing spheres whose gap is within the rounding of |s| (4 eps |s|) touch at t = 0.
 ///
 /// |s + v t|^2 = R^2 is a t^2 + 2 b t + c = 0 with a = v.v, b = s.v, c = s.s - R^2. Both ways of
 /// losing digits are avoided:
@@ -52,6 +54,9 @@ std::optional<Scalar> timeOfImpactSpheres(const Vector3<Scalar>& separation,
   const Scalar distance = s.norm();
   const Scalar gap = distance - radius;
   if (gap < 0) return std::nullopt;
+  // A gap within the rounding of the distance is contact now: whether closing spheres would
+  // touch later (a graze) depends on digits the positions do not have.
+  if (gap <= 4 * std::numeric_limits<Scalar>::epsilon() * distance) return Scalar(0);
   const Scalar speed = v.norm();
   // Too far to close the gap within the horizon even head-on (one unit of scaled time is
   // length_unit / speed_unit seconds).
