@@ -33,13 +33,8 @@ using Motion = UnderGravity;  // lasting contact needs a steady force: the gravi
 /// the overlap would fall back into it, where no impact is found again.
 bool lastingCandidate(const World& world, const Pair& pair, double time, const Geometry& g) {
   if (!g.valid || g.gap > g.tolerance) return false;
-  const Eigen::Vector3d velocity_a = velocityAt<Motion>(world, pair.first, time);
-  const Eigen::Vector3d velocity_other = velocityAt<Motion>(world, pair.second, time);
-  const double normal_speed = (velocity_other - velocity_a).dot(g.normal);
-  const double scale =
-      velocity_a.lpNorm<Eigen::Infinity>() + velocity_other.lpNorm<Eigen::Infinity>();
-  return std::abs(normal_speed) <=
-         restSpeed(world.gravity.norm(), g.band()) + kApproachTolerance * scale;
+  const NormalMotion motion = normalMotion<Motion>(world, pair, g.normal, time);
+  return std::abs(motion.speed) <= restSpeed(world.gravity.norm(), g.band()) + motion.rounding;
 }
 
 void dissolve(World& world, std::size_t group, std::vector<std::size_t>& members) {

@@ -247,26 +247,33 @@ double reach(const World& world, const Pair& pair, double from, double horizon) 
   return distance;
 }
 
+/// The pair's relative velocity along `normal` at `time` (> 0: opening) and what rounding
+/// explains of it (kApproachTolerance of the speeds).
+struct NormalMotion {
+  double speed = 0.0, rounding = 0.0;
+};
+template <class Motion>
+NormalMotion normalMotion(const World& world, const Pair& pair, const Eigen::Vector3d& normal,
+                          double time) {
+  const Eigen::Vector3d velocity_a = velocityAt<Motion>(world, pair.first, time);
+  const Eigen::Vector3d velocity_other = velocityAt<Motion>(world, pair.second, time);
+  return NormalMotion{(velocity_other - velocity_a).dot(normal),
+                      kApproachTolerance * (velocity_a.lpNorm<Eigen::Infinity>() +
+                                            velocity_other.lpNorm<Eigen::Infinity>())};
+}
+
 /// The pair closes along `normal` at `time` faster than rounding explains.
 template <class Motion>
 bool approaching(const World& world, const Pair& pair, const Eigen::Vector3d& normal, double time) {
-  const Eigen::Vector3d velocity_a = velocityAt<Motion>(world, pair.first, time);
-  const Eigen::Vector3d velocity_other = velocityAt<Motion>(world, pair.second, time);
-  const double relative_normal = (velocity_other - velocity_a).dot(normal);
-  const double scale =
-      velocity_a.lpNorm<Eigen::Infinity>() + velocity_other.lpNorm<Eigen::Infinity>();
-  return relative_normal < -kApproachTolerance * scale;
+  const NormalMotion motion = normalMotion<Motion>(world, pair, normal, time);
+  return motion.speed < -motion.rounding;
 }
 
 /// The pair opens along `normal` at `time` faster than rounding explains.
 template <class Motion>
 bool separating(const World& world, const Pair& pair, const Eigen::Vector3d& normal, double time) {
-  const Eigen::Vector3d velocity_a = velocityAt<Motion>(world, pair.first, time);
-  const Eigen::Vector3d velocity_other = velocityAt<Motion>(world, pair.second, time);
-  const double relative_normal = (velocity_other - velocity_a).dot(normal);
-  const double scale =
-      velocity_a.lpNorm<Eigen::Infinity>() + velocity_other.lpNorm<Eigen::Infinity>();
-  return relative_normal > kApproachTolerance * scale;
+  const NormalMotion motion = normalMotion<Motion>(world, pair, normal, time);
+  return motion.speed > motion.rounding;
 }
 
 /// The box a body sweeps over [from, to], padded by its radius.
