@@ -121,13 +121,17 @@ std::optional<Scalar> timeOfImpactPlaneBallistic(Scalar gap, Scalar rate, Scalar
   const Scalar q = std::max(std::abs(rate), root) < std::numeric_limits<Scalar>::max() / 4
                        ? -(rate + std::copysign(root, rate)) / 2
                        : -(rate / 2 + std::copysign(root / 2, rate));
-  const Scalar half_acceleration = acceleration / 2;
+  // q / (a / 2) as 2 q / a where 2 q cannot overflow: halving a subnormal acceleration would
+  // round away its last bits.
+  const Scalar first_root = std::abs(q) < std::numeric_limits<Scalar>::max() / 2
+                                ? 2 * q / acceleration
+                                : q / (acceleration / 2);
   std::optional<Scalar> best;
   const auto consider = [&](Scalar time) {
     const bool entering = rate + acceleration * time < 0;
     if (time >= 0 && time <= horizon && entering && (!best || time < *best)) best = time;
   };
-  consider(q / half_acceleration);
+  consider(first_root);
   if (q != 0) consider(gap / q);
   return best;
 }
