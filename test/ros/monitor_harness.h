@@ -10,6 +10,7 @@
 #include <tf2_ros/transform_broadcaster.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <functional>
 #include <string>
 #include <vector>
@@ -77,14 +78,37 @@ class MonitorHarness {
     rosout_ = node_.subscribe("/rosout", 1000, &MonitorHarness::onLog, this);
   }
 
-  /// Waits until the node listens to body_states and we hear its impacts and /rosout.
-  bool connect(double timeout = 20.0) {
+  /// Waits until the node listens to body_states and we hear its impacts and its /rosout. Any
+  /// publisher of /rosout (this test node's own log is one) is not enough: a warning the node
+  /// logs before our link to it is up is lost, so every publisher the master names must be
+  /// linked, the node among them.
+  bool connect(double timeout = 20.0, const std::string& node = "/collision_response") {
     return waitFor(
-        [this] {
+        [&] {
+          const std::vector<std::string> loggers = publishersOf("/rosout");
+          const bool node_logs =
+              std::find(loggers.begin(), loggers.end(), node) != loggers.end();
           return states_.getNumSubscribers() > 0 && impacts_.getNumPublishers() > 0 &&
-                 rosout_.getNumPublishers() > 0;
+                 node_logs && rosout_.getNumPublishers() >= loggers.size();
         },
         timeout);
+  }
+
+  /// The nodes the master lists as publishing `topic` (empty when it cannot be asked).
+  static std::vector<std::string> publishersOf(const std::string& topic) {
+    XmlRpc::XmlRpcValue args, result, payload;
+    args[0] = ros::this_node::getName();
+    std::vector<std::string> nodes;
+    if (!ros::master::execute("getSystemState", args, result, payload, false)) return nodes;
+    if (payload.getType() != XmlRpc::XmlRpcValue::TypeArray || payload.size() < 1) return nodes;
+    XmlRpc::XmlRpcValue& publications = payload[0];
+    for (int i = 0; i < publications.size(); ++i) {
+      if (static_cast<std::string>(publications[i][0]) != topic) continue;
+      for (int j = 0; j < publications[i][1].size(); ++j) {
+        nodes.push_back(static_cast<std::string>(publications[i][1][j]));
+      }
+    }
+    return nodes;
   }
 
   void publish(const ros::Time& stamp, const std::vector<StateSpec>& specs) {
