@@ -103,10 +103,11 @@ std::vector<std::vector<std::size_t>> formClusters(const World& world,
 /// the approach speed) and lands 2 e^k e u / g later, so they add up to 2 e u / (g (1 - e)). The
 /// contact rests from that accumulation instant on (its `since`); in between every bounce stays
 /// within the band, so the body moves as resting from now. A contact found overlapping (discrete
-/// detection finds impacts by overlap at the samples) has the overlap as its band
-/// (Geometry::band): a bounce that would not rise out of it would fall back in deeper, a pair
-/// that overlapped at the sample before (so no new impact), and no contact would hold the body;
-/// so it rests there, held where it is (README, "Detection").
+/// detection finds impacts by overlap at the samples) has the overlap as its band, widened so
+/// that the bounce must stay out of it for a sample period (World::riseBand): one that would not
+/// would fall back in deeper, a pair that overlapped at the sample before (so no new impact),
+/// and no contact would hold the body; so it rests there, held where it is (README,
+/// "Detection").
 template <class Motion>
 double contactRestitution(World& world, double time, const InstantContact& contact,
                           double approach_speed) {
@@ -126,8 +127,8 @@ double contactRestitution(World& world, double time, const InstantContact& conta
       pressing -=
           across.squaredNorm() / (contact.geometry.gap + world.radius[a] + world.radius[other]);
     }
-    if (pressing > 0 &&
-        restitution * approach_speed <= restSpeed(pressing, contact.geometry.band())) {
+    if (pressing > 0 && restitution * approach_speed <=
+                            restSpeed(pressing, world.riseBand(contact.geometry, pressing))) {
       world.contact_since[contact.pair] =
           restitution < 1 ? time + 2 * restitution * approach_speed / (pressing * (1 - restitution))
                           : time;

@@ -29,12 +29,15 @@ using Motion = UnderGravity;  // lasting contact needs a steady force: the gravi
 
 /// A candidate of lasting contact: touching (or overlapping: then it is held where it is) and
 /// neither approaching nor separating faster than a body falls within the touching band, or
-/// within the overlap of an overlapping pair (Geometry::band): a separation too slow to leave
-/// the overlap would fall back into it, where no impact is found again.
+/// within the overlap of an overlapping pair, widened under discrete detection by a sample
+/// period's arc (World::riseBand): a separation too slow to leave the overlap, or to stay out of
+/// it until a sample sees it out, would fall back into it, where no impact is found again.
 bool lastingCandidate(const World& world, const Pair& pair, double time, const Geometry& g) {
   if (!g.valid || g.gap > g.tolerance) return false;
   const NormalMotion motion = normalMotion<Motion>(world, pair, g.normal, time);
-  return std::abs(motion.speed) <= restSpeed(world.gravity.norm(), g.band()) + motion.rounding;
+  const double pressing = world.gravity.norm();
+  return std::abs(motion.speed) <=
+         restSpeed(pressing, world.riseBand(g, pressing)) + motion.rounding;
 }
 
 void dissolve(World& world, std::size_t group, std::vector<std::size_t>& members) {

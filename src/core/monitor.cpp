@@ -305,6 +305,7 @@ void advanceLastingContact(World& world, double time) {
 template <class Motion>
 StepReport discreteStep(World& world, double time, const std::vector<BodyStateSample>& states) {
   StepReport report;
+  world.sample_period = time - world.now;
   if constexpr (Motion::kAccelerates) advanceLastingContact<Motion>(world, time);
   applyStates(world, states, report);
   world.now = time;

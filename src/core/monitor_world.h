@@ -144,6 +144,7 @@ struct World {
   bool started = false;
   double now = 0.0;
   double step_end = 0.0;  // the end of the step being taken (curved motion is integrated to it)
+  double sample_period = 0.0;  // discrete: the time from the step before to this one
 
   std::size_t bodyCount() const { return bodies.size(); }
   bool isObstacle(std::size_t participant) const { return participant >= bodies.size(); }
@@ -166,6 +167,17 @@ struct World {
   }
   double frictionOf(const Pair& pair) const {
     return friction[material[pair.first]][material[pair.second]];
+  }
+  /// m: the band a bounce or a separation of the pair of `g` must rise out of under the
+  /// pressing acceleration `pressing` not to be held (restSpeed): the pair's band
+  /// (Geometry::band), and under discrete detection also the rise of an arc that stays out of it
+  /// for one sample period T, pressing T^2 / 8. A bounce from the overlap at w is out of it for
+  /// 2 sqrt(w^2 - 2 a band) / a; shorter than T, no sample may see it out, and it falls back in
+  /// deeper, a pair that overlapped at the sample before (no new impact): so it rests.
+  double riseBand(const Geometry& g, double pressing) const {
+    const double arc =
+        detection == Detection::kDiscrete ? pressing * sample_period * sample_period / 8 : 0.0;
+    return g.band() + arc;
   }
   /// The pair is a lasting contact: its motion keeps it touching (no first contact to look for).
   bool lasting(const Pair& pair) const {
