@@ -175,8 +175,9 @@ struct World {
   /// 2 sqrt(w^2 - 2 a band) / a; shorter than T, no sample may see it out, and it falls back in
   /// deeper, a pair that overlapped at the sample before (no new impact): so it rests.
   double riseBand(const Geometry& g, double pressing) const {
-    const double arc =
-        detection == Detection::kDiscrete ? pressing * sample_period * sample_period / 8 : 0.0;
+    const double arc = detection == Detection::kDiscrete && pressing > 0
+                           ? pressing * sample_period * sample_period / 8
+                           : 0.0;
     return g.band() + arc;
   }
   /// The pair is a lasting contact: its motion keeps it touching (no first contact to look for).
