@@ -188,16 +188,25 @@ ConstrainedStep::State ConstrainedStep::stateAt(double time) const {
   return state;
 }
 
+const ConstrainedStep::State& ConstrainedStep::queriedStateAt(double time) const {
+  // The steps are all taken once the constructor returns, so a state once found stays right.
+  if (!(time == queried_time_)) {
+    queried_state_ = stateAt(time);
+    queried_time_ = time;
+  }
+  return queried_state_;
+}
+
 Eigen::Vector3d ConstrainedStep::position(std::size_t body, double time) const {
-  return slice(stateAt(time), body, 0);
+  return slice(queriedStateAt(time), body, 0);
 }
 
 Eigen::Vector3d ConstrainedStep::velocity(std::size_t body, double time) const {
-  return slice(stateAt(time), body, 1);
+  return slice(queriedStateAt(time), body, 1);
 }
 
 Eigen::Vector3d ConstrainedStep::angularVelocity(std::size_t body, double time) const {
-  return slice(stateAt(time), body, 2);
+  return slice(queriedStateAt(time), body, 2);
 }
 
 }  // namespace collision_response::core::monitor

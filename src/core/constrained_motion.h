@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstddef>
 #include <memory>
 #include <vector>
@@ -71,6 +72,9 @@ class ConstrainedStep {
   /// The least margin of the modes at a state: < 0 where one stops holding.
   double margin(const State& state, double time) const;
   State stateAt(double time) const;
+  /// stateAt for the public queries, which come a body and a quantity at a time (a pair's
+  /// positions, then its velocities) at one instant: the last instant's state is kept.
+  const State& queriedStateAt(double time) const;
   const Integration& stepAt(double time) const;
 
   std::vector<ForceBody> bodies_;
@@ -85,6 +89,8 @@ class ConstrainedStep {
   double force_scale_ = 0.0;
   ContactForceSettings settings_;
   std::vector<std::unique_ptr<Integration>> steps_;  // each step's dense output, in time order
+  mutable double queried_time_ = NAN;                // queriedStateAt's last instant
+  mutable State queried_state_;
 };
 
 }  // namespace collision_response::core::monitor
