@@ -26,8 +26,8 @@ void update(benchmark::State& state, bool gravity, bool friction, bool spin) {
 
 // The updates of one run: its first 2 s, as the instruction count's workload
 // (effects_instructions.cpp). The motion changes from update to update, so the count is fixed
-// rather than chosen by the library (with every effect on, later updates cost far more: the
-// balls gather and roll in contact, see doc/effects.md).
+// rather than chosen by the library (with every effect on, later updates cost more: the balls
+// gather and roll in contact, see doc/effects.md).
 constexpr int kUpdates = 200;
 
 void BM_ImpactNone(benchmark::State& s) { impact(s, {}); }

@@ -75,6 +75,7 @@ class BoxRun {
       sample.time = time_;
       sample.position = predicted->first;
       sample.velocity = predicted->second;
+      sample.angular_velocity = monitor_.predictedAngularVelocity(sample.body, time_);
     }
     return monitor_.step(time_, states_).impacts.size();
   }
