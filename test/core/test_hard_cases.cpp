@@ -11,6 +11,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "collision_response/core/collision.h"
@@ -514,6 +515,25 @@ TEST(FuzzFindings, BallisticRootWithAHugeRate) {
   // Deep inside with a subnormal acceleration: gap / scale overflowed to a bogus root at -0.
   EXPECT_FALSE(timeOfImpactPlaneBallistic(-5.4861293007693085e+303, -1.9999847412109375e-235,
                                           3.9525251667299724e-323, 8.0));
+}
+
+// Rates and sqrt(2 a gap) near the doubles' largest: sqrt(D) overflowed, the root came out
+// 0 (a contact 1e308 m away) or none. gap 1e308, rate -1.5e308, a = -1e308: t^2 + 3 t - 2 = 0;
+// gap 1e308, rate -1.7e308, a = -1.7e308: 0.85 t^2 + 1.7 t - 1 = 0 (sqrt(2) u overflowed too).
+TEST(FuzzFindings, BallisticRootPastTheDoubles) {
+  // Divided by a: t^2 / 2 + r t + g = 0 with r = rate / a, g = gap / a (in long double, from
+  // the doubles given); the entering root is -r + sqrt(r^2 - 2 g).
+  const auto exact = [](double gap, double rate, double acceleration) {
+    const long double r = static_cast<long double>(rate) / acceleration,
+                      g = static_cast<long double>(gap) / acceleration;
+    return static_cast<double>(-r + std::sqrt(r * r - 2 * g));
+  };
+  for (const auto& [gap, rate, acceleration] :
+       {std::tuple{1e308, -1.5e308, -1e308}, std::tuple{1e308, -1.7e308, -1.7e308}}) {
+    const auto t = timeOfImpactPlaneBallistic(gap, rate, acceleration, 10.0);
+    ASSERT_TRUE(t) << rate;
+    EXPECT_NEAR(*t, exact(gap, rate, acceleration), 8 * kEps) << rate;
+  }
 }
 
 // A subnormal rate (3.2e-319 m/s, leaving) falling back under 1.2e-45 m/s^2: t = 2 rate / |a|,

@@ -107,7 +107,9 @@ std::optional<Scalar> timeOfImpactPlaneBallistic(Scalar gap, Scalar rate, Scalar
   // overflows (rates of 1e155 and beyond) nor underflows: with u = sqrt|a| sqrt|gap| (no
   // overflow), 2 a gap / scale^2 = 2 sign(a gap) (u / scale)^2, at most 1 in size.
   const Scalar geometric = std::sqrt(std::abs(acceleration)) * std::sqrt(std::abs(gap));
-  const Scalar scale = std::max(std::abs(rate), std::sqrt(Scalar(2)) * geometric);
+  Scalar scale = std::max(std::abs(rate), std::sqrt(Scalar(2)) * geometric);
+  // sqrt(2) u past the doubles: u itself is the scale (2 a gap / scale^2 is then at most 2).
+  if (!std::isfinite(scale)) scale = std::max(std::abs(rate), geometric);
   if (!(scale > 0) || !std::isfinite(scale)) return std::nullopt;
   const Scalar scaled_rate = rate / scale;
   const Scalar scaled_geometric = geometric / scale;
@@ -115,7 +117,23 @@ std::optional<Scalar> timeOfImpactPlaneBallistic(Scalar gap, Scalar rate, Scalar
   const Scalar scaled_discriminant =
       scaled_rate * scaled_rate - 2 * sign * scaled_geometric * scaled_geometric;
   if (scaled_discriminant < 0) return std::nullopt;
-  const Scalar root = std::sqrt(scaled_discriminant) * scale;
+  const Scalar scaled_root = std::sqrt(scaled_discriminant);
+  const Scalar root = scaled_root * scale;
+  std::optional<Scalar> best;
+  const auto consider = [&](Scalar time) {
+    const bool entering = rate + acceleration * time < 0;
+    if (time >= 0 && time <= horizon && entering && (!best || time < *best)) best = time;
+  };
+  if (!std::isfinite(root)) {
+    // sqrt(D) is beyond the doubles (a rate and a sqrt(2 a gap) near their largest): q in units
+    // of `scale`, q_s = -(B / scale + sign(B) sqrt(D) / scale) / 2, at least 1/2 in size (one of
+    // |B| / scale and sqrt(2 |a gap|) / scale is 1), and the roots from it: 2 q_s scale / a and
+    // (gap / scale) / q_s.
+    const Scalar scaled_q = -(scaled_rate + std::copysign(scaled_root, scaled_rate)) / 2;
+    consider(2 * scaled_q * (scale / acceleration));
+    consider(gap / scale / scaled_q);
+    return best;
+  }
   // Summed before halving where that cannot overflow: halving a subnormal rate first would
   // round away its last bits.
   const Scalar q = std::max(std::abs(rate), root) < std::numeric_limits<Scalar>::max() / 4
@@ -126,11 +144,6 @@ std::optional<Scalar> timeOfImpactPlaneBallistic(Scalar gap, Scalar rate, Scalar
   const Scalar first_root = std::abs(q) < std::numeric_limits<Scalar>::max() / 2
                                 ? 2 * q / acceleration
                                 : q / (acceleration / 2);
-  std::optional<Scalar> best;
-  const auto consider = [&](Scalar time) {
-    const bool entering = rate + acceleration * time < 0;
-    if (time >= 0 && time <= horizon && entering && (!best || time < *best)) best = time;
-  };
   consider(first_root);
   if (q != 0) consider(gap / q);
   return best;
