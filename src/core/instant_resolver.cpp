@@ -13,6 +13,10 @@
 namespace collision_response::core::monitor {
 namespace {
 
+/// Relative to a contact's fastest approach in the rounds of one instant, the approach below which
+/// it strikes again plastically (README, "Simultaneous contacts").
+constexpr double kRepeatStrikeResolution = 1e-12;
+
 /// A touching contact at the instant: positions do not change during an instant, so its
 /// geometry is computed once.
 struct InstantContact {
@@ -249,11 +253,65 @@ void resolveInstant(World& world, double time, const std::vector<Pair>& touching
   // later round that strikes while they do not separate, so the rounds' plastic limit is reached
   // at once instead of by ever smaller rounds.
   std::vector<char> plastic(contacts.size(), 0);
+  // The fastest approach of each contact in the rounds of this instant so far (0: not struck).
+  std::vector<double> fastest(contacts.size(), 0.0);
+  // What decides a round (the movable participants' velocities, `plastic`, `fastest`) after each
+  // of the last few rounds: a round that ends where one of them did repeats them for ever (seen
+  // where a joint solve cannot stop a body 1e70 times heavier than its neighbour: its impulse is
+  // below its velocity's last bit), so the rounds end at once and what remains is resolved as
+  // at their budget's end.
+  std::vector<std::size_t> movable;
+  for (const InstantContact& contact : contacts) {
+    for (const std::size_t participant : {contact.pair.first, contact.pair.second}) {
+      if (!world.isObstacle(participant) && world.inverseMassOf(participant) > 0) {
+        movable.push_back(participant);
+      }
+    }
+  }
+  std::sort(movable.begin(), movable.end());
+  movable.erase(std::unique(movable.begin(), movable.end()), movable.end());
+  const auto decisive = [&]() {
+    std::vector<double> state;
+    for (const std::size_t body : movable) {
+      const Eigen::Vector3d v = velocityAt<Motion>(world, body, time);
+      const Eigen::Vector3d w = angularVelocityAt<Motion>(world, body, time);
+      state.insert(state.end(), {v.x(), v.y(), v.z(), w.x(), w.y(), w.z()});
+    }
+    state.insert(state.end(), fastest.begin(), fastest.end());
+    state.insert(state.end(), plastic.begin(), plastic.end());
+    return state;
+  };
+  constexpr std::size_t kRoundsRemembered = 4;
+  std::vector<std::vector<double>> recent;
+  // A round in which every contact was plastic leaves none of them approaching, to rounding; where
+  // only contacts of that round strike again, the joint solve could not stop them (a velocity
+  // change below a heavy body's last bit, the velocities drifting by an ulp a round): after
+  // kStaleRounds such rounds in a row the rounds end, as above.
+  constexpr int kStaleRounds = 8;
+  int stale_rounds = 0;
+  std::vector<std::size_t> previous;  // the last round's contacts, sorted
+  bool previous_plastic = false;      // ... every one of them plastic
   for (int round = 0; round < world.settings.max_rounds_per_instant; ++round) {
     std::vector<std::size_t> striking = findStriking<Motion>(world, time, contacts);
     if (striking.empty()) return;
+    const bool stale = previous_plastic && std::includes(previous.begin(), previous.end(),
+                                                         striking.begin(), striking.end());
+    stale_rounds = stale ? stale_rounds + 1 : 0;
+    if (stale_rounds >= kStaleRounds) break;
     std::vector<char> joined(contacts.size(), 0);
-    for (const std::size_t k : striking) joined[k] = 1;
+    for (const std::size_t k : striking) {
+      joined[k] = 1;
+      // A contact that strikes again slower than kRepeatStrikeResolution of its fastest approach
+      // at this instant strikes plastically: the rest of its series of ever smaller bounces
+      // (a ball wedged between a heavy ball and the floor: e^k of its speed, a round each) is
+      // below that fraction of its speed, and would spend thousands of rounds on it.
+      const Pair& pair = contacts[k].pair;
+      const double approach = (velocityAt<Motion>(world, pair.first, time) -
+                               velocityAt<Motion>(world, pair.second, time))
+                                  .dot(contacts[k].geometry.normal);
+      if (fastest[k] > 0 && approach <= kRepeatStrikeResolution * fastest[k]) joined[k] = 2;
+      fastest[k] = std::max(fastest[k], approach);
+    }
     for (std::size_t k = 0; k < contacts.size(); ++k) {
       if (plastic[k] && !joined[k] &&
           !separating<Motion>(world, contacts[k].pair, contacts[k].geometry.normal, time)) {
@@ -262,6 +320,8 @@ void resolveInstant(World& world, double time, const std::vector<Pair>& touching
       }
     }
     std::sort(striking.begin(), striking.end());
+    previous = striking;
+    previous_plastic = true;
     for (const std::vector<std::size_t>& cluster : formClusters(world, contacts, striking)) {
       PreparedCluster prepared = prepareCluster<Motion>(world, time, contacts, cluster, joined);
       const std::vector<ClusterBody> before = prepared.bodies;
@@ -271,9 +331,17 @@ void resolveInstant(World& world, double time, const std::vector<Pair>& touching
       recordImpacts<Motion>(world, time, contacts, cluster, prepared, before, outcome, joined,
                             report);
       for (std::size_t c = 0; c < cluster.size(); ++c) {
-        if (prepared.contacts[c].restitution == 0.0) plastic[cluster[c]] = 1;
+        if (prepared.contacts[c].restitution == 0.0) {
+          plastic[cluster[c]] = 1;
+        } else {
+          previous_plastic = false;
+        }
       }
     }
+    std::vector<double> state = decisive();
+    if (std::find(recent.begin(), recent.end(), state) != recent.end()) break;
+    if (recent.size() == kRoundsRemembered) recent.erase(recent.begin());
+    recent.push_back(std::move(state));
   }
   if (findStriking<Motion>(world, time, contacts).empty()) return;
   report.truncated = true;

@@ -375,6 +375,44 @@ TEST(HardCases, PlasticCradleEndsInOneCommonVelocity) {
   }
 }
 
+// A ball touching two parallel walls at once (no gravity), moving at 1 m/s, e = 0.5: at one
+// instant it strikes them in turn at 1, 1/2, 1/4, ... m/s (powers of two: exact). A wall struck
+// again slower than 1e-12 of its first strike takes it plastically: the right wall at its 21st
+// strike, at 2^-40 = 9.1e-13 m/s (the left one's 20th, 2^-39, is above 1e-12 x 1/2), so the
+// instant ends after 41 impacts with the ball at rest, exactly, every joule dissipated. (The
+// exact series would go on to the doubles' underflow, 2^-1074: 1,075 rounds.)
+TEST(HardCases, WedgedBallStopsOnceItsBouncesAreBelowRounding) {
+  Scene scene;
+  ASSERT_TRUE(scene.materials.addMaterial("rubber", Material{0.5, {}}, "m").ok());
+  BodySpec body;
+  body.id = "ball";
+  body.mass = 2.0;
+  body.radius = 0.05;
+  body.material = "rubber";
+  scene.bodies = {body};
+  for (const double side : {1.0, -1.0}) {
+    ObstacleSpec wall;
+    wall.id = side > 0 ? "left" : "right";
+    wall.material = "rubber";
+    wall.normal = V(side, 0, 0);
+    wall.offset = -body.radius;  // touching the ball at x = 0
+    scene.obstacles.push_back(wall);
+  }
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  BodyStateSample start;
+  start.velocity = V(1, 0, 0);
+  monitor.step(0.0, {start});
+  const StepReport report = monitor.step(0.01, {});
+  EXPECT_FALSE(report.truncated);
+  ASSERT_EQ(report.impacts.size(), 41u);
+  EXPECT_EQ(report.impacts.back().restitution, 0.0);
+  EXPECT_EQ(report.impacts.back().velocity_a_before.x(), std::ldexp(1.0, -40));
+  EXPECT_EQ(monitor.predictedState(0, 0.01)->second, V::Zero());
+  double dissipated = 0;
+  for (const ImpactRecord& impact : report.impacts) dissipated += impact.energy_lost;
+  EXPECT_NEAR(dissipated, 0.5 * body.mass * 1.0, 8 * kEps);
+}
+
 TEST(HardCases, TwoBallsStrikeAMiddleOneSymmetrically) {
   // e = 1 and e = 0.5: the middle ball stays, the outer ones leave at -e v and +e v; the two
   // answers mirror each other to the bit.
@@ -574,6 +612,65 @@ TEST(FuzzFindings, FrictionOnAHugeSpinningBall) {
   EXPECT_TRUE(outcome->sticking);
   EXPECT_NEAR(outcome->impact.velocity_b.x(), 15.0 / 7.0, 8 * kEps * 3);
   EXPECT_NEAR(outcome->angular_velocity_b.y() * 1e145, 15.0 / 7.0, 1e-12);  // rolls: w r = v
+}
+
+// Found by the monitor's fuzzer: a 1.5e175 kg ball caught between the floor and a ball 1e70 or
+// 1e100 times heavier (discrete detection, gravity, friction). The joint solve cannot stop the
+// heavy ball (its impulse is below its velocity's last bit), so every plastic round ended where
+// the one before did (1e70), or a last bit away from it (1e100): 10,000 rounds (15,326 and
+// 19,950 impacts, 2.5 s) before the fallback. A round that ends where one of the last few did,
+// or the eighth plastic round in a row in which only its own contacts strike again, ends the
+// rounds.
+TEST(FuzzFindings, RoundsThatRepeatEndAtOnce) {
+  Scene scene;
+  scene.detection = Detection::kDiscrete;
+  scene.effects.gravity = true;
+  scene.effects.friction = true;
+  for (const auto& [heavy_mass, heavy_radius] :
+       {std::pair{1.4506683349609377e+245, 1.185089111328125e+240},
+        std::pair{1.1850738525390624e+275, 1.372589111328125e+240}}) {
+    BodySpec heavy;
+    heavy.id = "b0";
+    heavy.mass = heavy_mass;
+    heavy.radius = heavy_radius;
+    heavy.material = "billiard_ball";
+    BodySpec light;
+    light.id = "b1";
+    light.mass = 1.4509735107421873e+175;
+    light.radius = 1.380645751953125e-235;
+    light.material = "hand_ball";
+    scene.bodies = {heavy, light};
+    ObstacleSpec floor;
+    floor.id = "floor";
+    floor.material = "concrete";
+    floor.normal = V(1, -4.7259604762489261e-180, 5.8823125076715362e-180);
+    floor.offset = -4.125;
+    ObstacleSpec post;
+    post.id = "post";
+    post.shape = ObstacleShape::kSphere;
+    post.material = "wooden_ball";
+    post.position = V(12431335449.21875, -4.125, 1.2442169189453123e-240);
+    post.radius = 1.5215606689453124e-240;
+    scene.obstacles = {floor, post};
+    ASSERT_TRUE(validateScene(scene, "scene").ok());
+    normalizePlanes(scene);
+    ImpactMonitor monitor(scene, MonitorSettings{});
+    BodyStateSample first;
+    first.body = *monitor.bodyIndex("b1");
+    first.position =
+        V(-1.5215606689453124e-240, -1.5215606689453124e-240, -1.5215606689453124e-240);
+    first.velocity = V(-15215606689.453125, -4.125, -1.5686187744140626e-125);
+    monitor.step(0.0, {first});
+    BodyStateSample second;
+    second.body = *monitor.bodyIndex("b0");
+    second.time = 0.447;
+    const StepReport report = monitor.step(0.447, {second});
+    EXPECT_LT(report.impacts.size(), 1000u) << heavy_mass;
+    EXPECT_EQ(report.fallbacks, 1u) << heavy_mass;
+    for (const std::size_t body : {0u, 1u}) {
+      EXPECT_TRUE(monitor.predictedState(body, 0.447)->second.allFinite()) << body;
+    }
+  }
 }
 
 }  // namespace
