@@ -574,6 +574,18 @@ TEST(FuzzFindings, BallisticRootPastTheDoubles) {
   }
 }
 
+// A subnormal gap under a subnormal acceleration (7.3e-313 m, 1.2e-319 m/s^2, from rest):
+// sqrt|a| sqrt|gap| fell among the subnormals and the root came out 1 % early. From rest,
+// t = sqrt(2 gap / |a|).
+TEST(FuzzFindings, BallisticRootAmongTheSubnormals) {
+  const double gap = 7.2945696177e-313, acceleration = -1.17627e-319;
+  const auto t = timeOfImpactPlaneBallistic(gap, 0.0, acceleration, 1e255);
+  ASSERT_TRUE(t);
+  const double exact =
+      static_cast<double>(std::sqrt(2 * static_cast<long double>(gap) / -acceleration));
+  EXPECT_NEAR(*t, exact, 8 * kEps * exact);
+}
+
 // A subnormal rate (3.2e-319 m/s, leaving) falling back under 1.2e-45 m/s^2: t = 2 rate / |a|,
 // which halving the rate before summing lost to rounding.
 TEST(FuzzFindings, BallisticReturnWithASubnormalRate) {

@@ -103,6 +103,18 @@ std::optional<Scalar> timeOfImpactPlaneBallistic(Scalar gap, Scalar rate, Scalar
     if (!(time <= horizon)) return std::nullopt;
     return time;
   }
+  // A gap and an acceleration so small that sqrt|a| sqrt|gap| would fall among the subnormals
+  // (and lose its digits: 7e-313 m under 1.2e-319 m/s^2 came out 1 % early) are scaled up with
+  // the rate by a power of two, 2^k (gap + rate t + a t^2 / 2) having the same roots; not so far
+  // that the rate overflows (a rate that large leaves the product negligible anyway).
+  if (gap != 0 && std::ilogb(acceleration) + std::ilogb(gap) < -1000) {
+    int k = -(std::ilogb(acceleration) + std::ilogb(gap)) / 2;
+    if (rate != 0) k = std::min(k, 1000 - std::ilogb(rate));
+    if (k > 0) {
+      return timeOfImpactPlaneBallistic(std::ldexp(gap, k), std::ldexp(rate, k),
+                                        std::ldexp(acceleration, k), horizon);
+    }
+  }
   // Scaled by the larger of |rate| and sqrt(|2 a gap|), so that rate^2 - 2 a gap neither
   // overflows (rates of 1e155 and beyond) nor underflows: with u = sqrt|a| sqrt|gap| (no
   // overflow), 2 a gap / scale^2 = 2 sign(a gap) (u / scale)^2, at most 1 in size.
