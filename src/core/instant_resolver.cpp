@@ -289,6 +289,15 @@ void resolveInstant(World& world, double time, const std::vector<Pair>& touching
   // kStaleRounds such rounds in a row the rounds end, as above.
   constexpr int kStaleRounds = 8;
   int stale_rounds = 0;
+  // A moving body whose velocity an impulse leaves unchanged to the bit is beyond the joint
+  // solve's reach (a mass ratio past the doubles); where it strikes a contact again no slower
+  // than before, it drives a series that never decays (a light ball squeezed between it and a
+  // fixed post: the same approach every round). After kUndecayedRounds such rounds with no
+  // contact struck again slower in between, the rounds end, as above.
+  constexpr int kUndecayedRounds = 64;
+  int undecayed_rounds = 0;
+  std::vector<double> last_approach(contacts.size(), 0.0);  // at its previous strike
+  std::vector<char> undecayed(contacts.size(), 0);
   std::vector<std::size_t> previous;  // the last round's contacts, sorted
   bool previous_plastic = false;      // ... every one of them plastic
   for (int round = 0; round < world.settings.max_rounds_per_instant; ++round) {
@@ -299,6 +308,7 @@ void resolveInstant(World& world, double time, const std::vector<Pair>& touching
     stale_rounds = stale ? stale_rounds + 1 : 0;
     if (stale_rounds >= kStaleRounds) break;
     std::vector<char> joined(contacts.size(), 0);
+    bool decayed = false;  // a contact struck again slower than before
     for (const std::size_t k : striking) {
       joined[k] = 1;
       // A contact that strikes again slower than kRepeatStrikeResolution of its fastest approach
@@ -311,6 +321,9 @@ void resolveInstant(World& world, double time, const std::vector<Pair>& touching
                                   .dot(contacts[k].geometry.normal);
       if (fastest[k] > 0 && approach <= kRepeatStrikeResolution * fastest[k]) joined[k] = 2;
       fastest[k] = std::max(fastest[k], approach);
+      undecayed[k] = last_approach[k] > 0 && approach >= (1 - 1e-6) * last_approach[k];
+      decayed = decayed || (last_approach[k] > 0 && !undecayed[k]);
+      last_approach[k] = approach;
     }
     for (std::size_t k = 0; k < contacts.size(); ++k) {
       if (plastic[k] && !joined[k] &&
@@ -322,11 +335,20 @@ void resolveInstant(World& world, double time, const std::vector<Pair>& touching
     std::sort(striking.begin(), striking.end());
     previous = striking;
     previous_plastic = true;
+    bool driven = false;  // an unmoved body struck a contact that did not decay
     for (const std::vector<std::size_t>& cluster : formClusters(world, contacts, striking)) {
       PreparedCluster prepared = prepareCluster<Motion>(world, time, contacts, cluster, joined);
       const std::vector<ClusterBody> before = prepared.bodies;
       const ClusterOutcome outcome =
           solveCluster(prepared.bodies, prepared.contacts, prepared.friction, world.friction_model);
+      for (std::size_t c = 0; c < cluster.size(); ++c) {
+        if (!undecayed[cluster[c]] || !(outcome.normal[c].impulse > 0)) continue;
+        for (const std::size_t m : {prepared.contacts[c].a, prepared.contacts[c].b}) {
+          driven =
+              driven || (prepared.bodies[m].inverse_mass > 0 && !before[m].velocity.isZero(0.0) &&
+                         prepared.bodies[m].velocity == before[m].velocity);
+        }
+      }
       storeVelocities<Motion>(world, time, prepared, changed);
       recordImpacts<Motion>(world, time, contacts, cluster, prepared, before, outcome, joined,
                             report);
@@ -338,6 +360,12 @@ void resolveInstant(World& world, double time, const std::vector<Pair>& touching
         }
       }
     }
+    if (decayed) {
+      undecayed_rounds = 0;
+    } else if (driven) {
+      ++undecayed_rounds;
+    }
+    if (undecayed_rounds >= kUndecayedRounds) break;
     std::vector<double> state = decisive();
     if (std::find(recent.begin(), recent.end(), state) != recent.end()) break;
     if (recent.size() == kRoundsRemembered) recent.erase(recent.begin());
