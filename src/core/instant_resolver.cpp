@@ -290,10 +290,11 @@ void resolveInstant(World& world, double time, const std::vector<Pair>& touching
   constexpr int kStaleRounds = 8;
   int stale_rounds = 0;
   // A moving body whose velocity an impulse leaves unchanged to the bit is beyond the joint
-  // solve's reach (a mass ratio past the doubles); where it strikes a contact again no slower
-  // than before, it drives a series that never decays (a light ball squeezed between it and a
-  // fixed post: the same approach every round). After kUndecayedRounds such rounds with no
-  // contact struck again slower in between, the rounds end, as above.
+  // solve's reach (a mass ratio past the doubles), as an immovable one is; where such a body's
+  // contact is struck again no slower than before, the series does not decay (a light ball
+  // squeezed between it and a fixed post: the same approach every round; a ball sliding in a
+  // wedge of a floor and a post whose normals are 1e-11 rad from opposite). After kUndecayedRounds
+  // such rounds with no contact struck again slower in between, the rounds end, as above.
   constexpr int kUndecayedRounds = 64;
   int undecayed_rounds = 0;
   std::vector<double> last_approach(contacts.size(), 0.0);  // at its previous strike
@@ -335,7 +336,7 @@ void resolveInstant(World& world, double time, const std::vector<Pair>& touching
     std::sort(striking.begin(), striking.end());
     previous = striking;
     previous_plastic = true;
-    bool driven = false;  // an unmoved body struck a contact that did not decay
+    bool driven = false;  // a contact of an unmoved body did not decay
     for (const std::vector<std::size_t>& cluster : formClusters(world, contacts, striking)) {
       PreparedCluster prepared = prepareCluster<Motion>(world, time, contacts, cluster, joined);
       const std::vector<ClusterBody> before = prepared.bodies;
@@ -344,9 +345,9 @@ void resolveInstant(World& world, double time, const std::vector<Pair>& touching
       for (std::size_t c = 0; c < cluster.size(); ++c) {
         if (!undecayed[cluster[c]] || !(outcome.normal[c].impulse > 0)) continue;
         for (const std::size_t m : {prepared.contacts[c].a, prepared.contacts[c].b}) {
-          driven =
-              driven || (prepared.bodies[m].inverse_mass > 0 && !before[m].velocity.isZero(0.0) &&
-                         prepared.bodies[m].velocity == before[m].velocity);
+          driven = driven || prepared.bodies[m].inverse_mass == 0 ||
+                   (!before[m].velocity.isZero(0.0) &&
+                    prepared.bodies[m].velocity == before[m].velocity);
         }
       }
       storeVelocities<Motion>(world, time, prepared, changed);
