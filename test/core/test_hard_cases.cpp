@@ -695,5 +695,63 @@ TEST(FuzzFindings, RoundsThatCannotConvergeEndEarly) {
   }
 }
 
+// Found by the monitor's fuzzer (a slow unit: 42 s under the sanitizers): a 1.5e-235 kg ball
+// sliding at 1.07 m/s in a wedge of the floor and a post whose normals are 1e-11 rad from
+// opposite. The post was struck at the same approach every round (the plastic floor removing
+// only its own component): 10,000 rounds and 10,002 impacts. Both are immovable, and a contact
+// of an immovable body struck again no slower than before, for 64 rounds with none struck
+// again slower, ends the rounds.
+TEST(FuzzFindings, RoundsInAWedgeOfNearlyOppositeNormalsEndEarly) {
+  Scene scene;
+  scene.detection = Detection::kDiscrete;
+  scene.effects.gravity = true;
+  scene.effects.friction = true;
+  BodySpec b0;
+  b0.id = "b0";
+  b0.mass = 1.4506683349609375e-235;
+  b0.radius = 1.9999847412109377e+240;
+  b0.material = "billiard_ball";
+  BodySpec b1;
+  b1.id = "b1";
+  b1.mass = 1.4492340087890625e+175;
+  b1.radius = 1.380645751953125e-235;
+  b1.material = "hand_ball";
+  scene.bodies = {b0, b1};
+  ObstacleSpec floor;
+  floor.id = "floor";
+  floor.material = "concrete";
+  floor.normal = V(1, -4.9761418564375631e-180, 6.1937084808850516e-180);
+  floor.offset = -4.125;
+  ObstacleSpec post;
+  post.id = "post";
+  post.shape = ObstacleShape::kSphere;
+  post.material = "wooden_ball";
+  post.position = V(12431335449.21875, -4.125, 1.2442169189453123e-240);
+  post.radius = 1.5215606689453127e-295;
+  scene.obstacles = {floor, post};
+  ASSERT_TRUE(validateScene(scene, "scene").ok());
+  normalizePlanes(scene);
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  BodyStateSample first;
+  first.body = *monitor.bodyIndex("b1");
+  first.position = V(-1.5215606689453124e-235, -1.5215606689453124e-240, -1.5215606689453124e-240);
+  first.velocity = V(-1.5215606689453124e-240, 1.168914794921875e-180, -15669403076.171875);
+  monitor.step(0.0, {first});
+  const double now = 184000000 * 1e-9;  // the time line's nanoseconds, as the node takes them
+  BodyStateSample b1_later;
+  b1_later.body = first.body;
+  b1_later.time = now;
+  b1_later.position = V(1.848175048828125e-180, 1.997039794921875e-235, -12538909912.109375);
+  BodyStateSample b0_state;
+  b0_state.body = *monitor.bodyIndex("b0");
+  b0_state.time = 39000000 * 1e-9;
+  const StepReport report = monitor.step(now, {b1_later, b0_state});
+  EXPECT_LT(report.impacts.size(), 1000u);
+  EXPECT_EQ(report.fallbacks, 1u);
+  for (const std::size_t body : {0u, 1u}) {
+    EXPECT_TRUE(monitor.predictedState(body, now)->second.allFinite()) << body;
+  }
+}
+
 }  // namespace
 }  // namespace collision_response::core
