@@ -239,6 +239,141 @@ void recordImpacts(const World& world, double time, const std::vector<InstantCon
   }
 }
 
+/// The movable bodies among the contacts' participants, sorted.
+std::vector<std::size_t> movableParticipants(const World& world,
+                                             const std::vector<InstantContact>& contacts) {
+  std::vector<std::size_t> movable;
+  for (const InstantContact& contact : contacts) {
+    for (const std::size_t participant : {contact.pair.first, contact.pair.second}) {
+      if (!world.isObstacle(participant) && world.inverseMassOf(participant) > 0) {
+        movable.push_back(participant);
+      }
+    }
+  }
+  std::sort(movable.begin(), movable.end());
+  movable.erase(std::unique(movable.begin(), movable.end()), movable.end());
+  return movable;
+}
+
+/// The linear and angular velocities of `bodies` at `time`, one after the other.
+template <class Motion>
+std::vector<double> velocitiesOf(const World& world, double time,
+                                 const std::vector<std::size_t>& bodies) {
+  std::vector<double> velocities;
+  for (const std::size_t body : bodies) {
+    const Eigen::Vector3d v = velocityAt<Motion>(world, body, time);
+    const Eigen::Vector3d w = angularVelocityAt<Motion>(world, body, time);
+    velocities.insert(velocities.end(), {v.x(), v.y(), v.z(), w.x(), w.y(), w.z()});
+  }
+  return velocities;
+}
+
+/// Whether the rounds of one instant still converge (README, "Simultaneous contacts"). Rounds
+/// that converge are left alone; these end them, and what remains is resolved as at the rounds'
+/// budget's end (the inelastic fallback):
+///  - a contact that strikes again slower than kRepeatStrikeResolution of its fastest approach
+///    at this instant strikes plastically (strikes() is false): the rest of its series of ever
+///    smaller bounces (a ball touching two walls: e^k of its speed, a round each) is below that
+///    fraction of its speed;
+///  - a round that ends where one of the last kRoundsRemembered did (velocities, plastic and
+///    fastest approaches) repeats for ever (a joint solve that cannot stop a body 1e70 times
+///    heavier than its neighbour: its impulse is below its velocity's last bit);
+///  - a round in which every contact was plastic leaves none of them approaching, to rounding:
+///    where only its own contacts strike again, the solve could not stop them (the velocities
+///    drifting by an ulp a round, at 1e100), and kStaleRounds such rounds in a row end them;
+///  - a body the solve cannot move (immovable, or moving with a velocity an impulse leaves
+///    unchanged to the bit, a mass ratio past the doubles) keeps a contact it strikes again no
+///    slower than before struck without end (a light ball squeezed between it and a fixed post;
+///    a ball sliding in a wedge of the floor and a post whose normals are 1e-11 rad from
+///    opposite): kUndecayedRounds such rounds, with no contact struck again slower in between,
+///    end them. A series decaying slower than kUndecayedRate a strike would need millions of
+///    rounds, past the budget anyway.
+class RoundProgress {
+ public:
+  RoundProgress(std::size_t contacts, std::vector<std::size_t> movable)
+      : movable_(std::move(movable)),
+        fastest_(contacts, 0.0),
+        last_approach_(contacts, 0.0),
+        undecayed_(contacts, 0) {}
+
+  const std::vector<std::size_t>& movable() const { return movable_; }
+
+  /// Before a round: true where the last round was all plastic and only its own contacts
+  /// (`striking`, sorted) strike again, for the kStaleRounds-th time in a row.
+  bool onlyStaleStrikesAgain(const std::vector<std::size_t>& striking) {
+    const bool stale = previous_plastic_ && std::includes(previous_.begin(), previous_.end(),
+                                                          striking.begin(), striking.end());
+    stale_rounds_ = stale ? stale_rounds_ + 1 : 0;
+    decayed_ = false;
+    driven_ = false;
+    return stale_rounds_ >= kStaleRounds;
+  }
+
+  /// Contact k strikes at `approach` (m/s): false where it strikes plastically instead.
+  bool strikes(std::size_t k, double approach) {
+    const bool plastically = fastest_[k] > 0 && approach <= kRepeatStrikeResolution * fastest_[k];
+    fastest_[k] = std::max(fastest_[k], approach);
+    undecayed_[k] = last_approach_[k] > 0 && approach >= (1 - kUndecayedRate) * last_approach_[k];
+    decayed_ = decayed_ || (last_approach_[k] > 0 && !undecayed_[k]);
+    last_approach_[k] = approach;
+    return !plastically;
+  }
+
+  /// The round's contacts, sorted (with the plastic ones that joined it).
+  void beginRound(const std::vector<std::size_t>& contacts) {
+    previous_ = contacts;
+    previous_plastic_ = true;
+  }
+
+  /// One cluster of the round solved: `cluster` (indices of the instant's contacts) as the
+  /// solver's `contacts`, its bodies `before` and `after`.
+  void solved(const std::vector<std::size_t>& cluster, const std::vector<ClusterContact>& contacts,
+              const std::vector<ClusterBody>& before, const std::vector<ClusterBody>& after,
+              const ClusterOutcome& outcome) {
+    for (std::size_t c = 0; c < cluster.size(); ++c) {
+      if (contacts[c].restitution != 0.0) previous_plastic_ = false;
+      if (!undecayed_[cluster[c]] || !(outcome.normal[c].impulse > 0)) continue;
+      for (const std::size_t m : {contacts[c].a, contacts[c].b}) {
+        driven_ = driven_ || after[m].inverse_mass == 0 ||
+                  (!before[m].velocity.isZero(0.0) && after[m].velocity == before[m].velocity);
+      }
+    }
+  }
+
+  /// After a round, with the movable bodies' velocities (velocitiesOf movable()) and the
+  /// contacts resolved plastically so far: true where the rounds would not converge.
+  bool endsWithoutConverging(std::vector<double> state, const std::vector<char>& plastic) {
+    if (decayed_) {
+      undecayed_rounds_ = 0;
+    } else if (driven_) {
+      ++undecayed_rounds_;
+    }
+    if (undecayed_rounds_ >= kUndecayedRounds) return true;
+    state.insert(state.end(), fastest_.begin(), fastest_.end());
+    state.insert(state.end(), plastic.begin(), plastic.end());
+    if (std::find(recent_.begin(), recent_.end(), state) != recent_.end()) return true;
+    if (recent_.size() == kRoundsRemembered) recent_.erase(recent_.begin());
+    recent_.push_back(std::move(state));
+    return false;
+  }
+
+ private:
+  static constexpr std::size_t kRoundsRemembered = 4;
+  static constexpr int kStaleRounds = 8;
+  static constexpr int kUndecayedRounds = 64;
+  static constexpr double kUndecayedRate = 1e-6;
+
+  std::vector<std::size_t> movable_;
+  std::vector<double> fastest_;        // per contact: its fastest approach so far (0: none)
+  std::vector<double> last_approach_;  // per contact: at its previous strike
+  std::vector<char> undecayed_;        // per contact: struck again no slower than before
+  std::vector<std::vector<double>> recent_;
+  std::vector<std::size_t> previous_;
+  bool previous_plastic_ = false;
+  bool decayed_ = false, driven_ = false;
+  int stale_rounds_ = 0, undecayed_rounds_ = 0;
+};
+
 }  // namespace
 
 template <class Motion>
@@ -253,78 +388,18 @@ void resolveInstant(World& world, double time, const std::vector<Pair>& touching
   // later round that strikes while they do not separate, so the rounds' plastic limit is reached
   // at once instead of by ever smaller rounds.
   std::vector<char> plastic(contacts.size(), 0);
-  // The fastest approach of each contact in the rounds of this instant so far (0: not struck).
-  std::vector<double> fastest(contacts.size(), 0.0);
-  // What decides a round (the movable participants' velocities, `plastic`, `fastest`) after each
-  // of the last few rounds: a round that ends where one of them did repeats them for ever (seen
-  // where a joint solve cannot stop a body 1e70 times heavier than its neighbour: its impulse is
-  // below its velocity's last bit), so the rounds end at once and what remains is resolved as
-  // at their budget's end.
-  std::vector<std::size_t> movable;
-  for (const InstantContact& contact : contacts) {
-    for (const std::size_t participant : {contact.pair.first, contact.pair.second}) {
-      if (!world.isObstacle(participant) && world.inverseMassOf(participant) > 0) {
-        movable.push_back(participant);
-      }
-    }
-  }
-  std::sort(movable.begin(), movable.end());
-  movable.erase(std::unique(movable.begin(), movable.end()), movable.end());
-  const auto decisive = [&]() {
-    std::vector<double> state;
-    for (const std::size_t body : movable) {
-      const Eigen::Vector3d v = velocityAt<Motion>(world, body, time);
-      const Eigen::Vector3d w = angularVelocityAt<Motion>(world, body, time);
-      state.insert(state.end(), {v.x(), v.y(), v.z(), w.x(), w.y(), w.z()});
-    }
-    state.insert(state.end(), fastest.begin(), fastest.end());
-    state.insert(state.end(), plastic.begin(), plastic.end());
-    return state;
-  };
-  constexpr std::size_t kRoundsRemembered = 4;
-  std::vector<std::vector<double>> recent;
-  // A round in which every contact was plastic leaves none of them approaching, to rounding; where
-  // only contacts of that round strike again, the joint solve could not stop them (a velocity
-  // change below a heavy body's last bit, the velocities drifting by an ulp a round): after
-  // kStaleRounds such rounds in a row the rounds end, as above.
-  constexpr int kStaleRounds = 8;
-  int stale_rounds = 0;
-  // A moving body whose velocity an impulse leaves unchanged to the bit is beyond the joint
-  // solve's reach (a mass ratio past the doubles), as an immovable one is; where such a body's
-  // contact is struck again no slower than before, the series does not decay (a light ball
-  // squeezed between it and a fixed post: the same approach every round; a ball sliding in a
-  // wedge of a floor and a post whose normals are 1e-11 rad from opposite). After kUndecayedRounds
-  // such rounds with no contact struck again slower in between, the rounds end, as above.
-  constexpr int kUndecayedRounds = 64;
-  int undecayed_rounds = 0;
-  std::vector<double> last_approach(contacts.size(), 0.0);  // at its previous strike
-  std::vector<char> undecayed(contacts.size(), 0);
-  std::vector<std::size_t> previous;  // the last round's contacts, sorted
-  bool previous_plastic = false;      // ... every one of them plastic
+  RoundProgress progress(contacts.size(), movableParticipants(world, contacts));
   for (int round = 0; round < world.settings.max_rounds_per_instant; ++round) {
     std::vector<std::size_t> striking = findStriking<Motion>(world, time, contacts);
     if (striking.empty()) return;
-    const bool stale = previous_plastic && std::includes(previous.begin(), previous.end(),
-                                                         striking.begin(), striking.end());
-    stale_rounds = stale ? stale_rounds + 1 : 0;
-    if (stale_rounds >= kStaleRounds) break;
+    if (progress.onlyStaleStrikesAgain(striking)) break;
     std::vector<char> joined(contacts.size(), 0);
-    bool decayed = false;  // a contact struck again slower than before
     for (const std::size_t k : striking) {
-      joined[k] = 1;
-      // A contact that strikes again slower than kRepeatStrikeResolution of its fastest approach
-      // at this instant strikes plastically: the rest of its series of ever smaller bounces
-      // (a ball wedged between a heavy ball and the floor: e^k of its speed, a round each) is
-      // below that fraction of its speed, and would spend thousands of rounds on it.
       const Pair& pair = contacts[k].pair;
       const double approach = (velocityAt<Motion>(world, pair.first, time) -
                                velocityAt<Motion>(world, pair.second, time))
                                   .dot(contacts[k].geometry.normal);
-      if (fastest[k] > 0 && approach <= kRepeatStrikeResolution * fastest[k]) joined[k] = 2;
-      fastest[k] = std::max(fastest[k], approach);
-      undecayed[k] = last_approach[k] > 0 && approach >= (1 - 1e-6) * last_approach[k];
-      decayed = decayed || (last_approach[k] > 0 && !undecayed[k]);
-      last_approach[k] = approach;
+      joined[k] = progress.strikes(k, approach) ? 1 : 2;
     }
     for (std::size_t k = 0; k < contacts.size(); ++k) {
       if (plastic[k] && !joined[k] &&
@@ -334,43 +409,24 @@ void resolveInstant(World& world, double time, const std::vector<Pair>& touching
       }
     }
     std::sort(striking.begin(), striking.end());
-    previous = striking;
-    previous_plastic = true;
-    bool driven = false;  // a contact of an unmoved body did not decay
+    progress.beginRound(striking);
     for (const std::vector<std::size_t>& cluster : formClusters(world, contacts, striking)) {
       PreparedCluster prepared = prepareCluster<Motion>(world, time, contacts, cluster, joined);
       const std::vector<ClusterBody> before = prepared.bodies;
       const ClusterOutcome outcome =
           solveCluster(prepared.bodies, prepared.contacts, prepared.friction, world.friction_model);
-      for (std::size_t c = 0; c < cluster.size(); ++c) {
-        if (!undecayed[cluster[c]] || !(outcome.normal[c].impulse > 0)) continue;
-        for (const std::size_t m : {prepared.contacts[c].a, prepared.contacts[c].b}) {
-          driven = driven || prepared.bodies[m].inverse_mass == 0 ||
-                   (!before[m].velocity.isZero(0.0) &&
-                    prepared.bodies[m].velocity == before[m].velocity);
-        }
-      }
+      progress.solved(cluster, prepared.contacts, before, prepared.bodies, outcome);
       storeVelocities<Motion>(world, time, prepared, changed);
       recordImpacts<Motion>(world, time, contacts, cluster, prepared, before, outcome, joined,
                             report);
       for (std::size_t c = 0; c < cluster.size(); ++c) {
-        if (prepared.contacts[c].restitution == 0.0) {
-          plastic[cluster[c]] = 1;
-        } else {
-          previous_plastic = false;
-        }
+        if (prepared.contacts[c].restitution == 0.0) plastic[cluster[c]] = 1;
       }
     }
-    if (decayed) {
-      undecayed_rounds = 0;
-    } else if (driven) {
-      ++undecayed_rounds;
+    if (progress.endsWithoutConverging(velocitiesOf<Motion>(world, time, progress.movable()),
+                                       plastic)) {
+      break;
     }
-    if (undecayed_rounds >= kUndecayedRounds) break;
-    std::vector<double> state = decisive();
-    if (std::find(recent.begin(), recent.end(), state) != recent.end()) break;
-    if (recent.size() == kRoundsRemembered) recent.erase(recent.begin());
-    recent.push_back(std::move(state));
   }
   if (findStriking<Motion>(world, time, contacts).empty()) return;
   report.truncated = true;
