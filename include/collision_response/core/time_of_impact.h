@@ -107,7 +107,8 @@ std::optional<Scalar> timeOfImpactPlaneBallistic(Scalar gap, Scalar rate, Scalar
   // (and lose its digits: 7e-313 m under 1.2e-319 m/s^2 came out 1 % early) are scaled up with
   // the rate by a power of two, 2^k (gap + rate t + a t^2 / 2) having the same roots; not so far
   // that the rate overflows (a rate that large leaves the product negligible anyway).
-  if (gap != 0 && std::ilogb(acceleration) + std::ilogb(gap) < -1000) {
+  if (gap != 0 && std::isfinite(gap) && std::isfinite(rate) && std::isfinite(acceleration) &&
+      std::ilogb(acceleration) + std::ilogb(gap) < -1000) {
     int k = -(std::ilogb(acceleration) + std::ilogb(gap)) / 2;
     if (rate != 0) k = std::min(k, 1000 - std::ilogb(rate));
     if (k > 0) {
