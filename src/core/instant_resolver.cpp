@@ -285,16 +285,17 @@ std::vector<double> velocitiesOf(const World& world, double time,
 ///    unchanged to the bit, a mass ratio past the doubles) keeps a contact it strikes again no
 ///    slower than before struck without end (a light ball squeezed between it and a fixed post;
 ///    a ball sliding in a wedge of the floor and a post whose normals are 1e-11 rad from
-///    opposite): kUndecayedRounds such rounds, with no contact struck again slower in between,
-///    end them. A series decaying slower than kUndecayedRate a strike would need millions of
-///    rounds, past the budget anyway.
+///    opposite): a contact struck so kUndecayedStrikes times in a row (none of them slower than
+///    the one before) ends them. A series decaying slower than kUndecayedRate a strike would need
+///    millions of rounds, past the budget anyway.
 class RoundProgress {
  public:
   RoundProgress(std::size_t contacts, std::vector<std::size_t> movable)
       : movable_(std::move(movable)),
         fastest_(contacts, 0.0),
         last_approach_(contacts, 0.0),
-        undecayed_(contacts, 0) {}
+        undecayed_(contacts, 0),
+        driven_strikes_(contacts, 0) {}
 
   const std::vector<std::size_t>& movable() const { return movable_; }
 
@@ -304,8 +305,6 @@ class RoundProgress {
     const bool stale = previous_plastic_ && std::includes(previous_.begin(), previous_.end(),
                                                           striking.begin(), striking.end());
     stale_rounds_ = stale ? stale_rounds_ + 1 : 0;
-    decayed_ = false;
-    driven_ = false;
     return stale_rounds_ >= kStaleRounds;
   }
 
@@ -314,7 +313,7 @@ class RoundProgress {
     const bool plastically = fastest_[k] > 0 && approach <= kRepeatStrikeResolution * fastest_[k];
     fastest_[k] = std::max(fastest_[k], approach);
     undecayed_[k] = last_approach_[k] > 0 && approach >= (1 - kUndecayedRate) * last_approach_[k];
-    decayed_ = decayed_ || (last_approach_[k] > 0 && !undecayed_[k]);
+    if (last_approach_[k] > 0 && !undecayed_[k]) driven_strikes_[k] = 0;  // it decays
     last_approach_[k] = approach;
     return !plastically;
   }
@@ -332,23 +331,21 @@ class RoundProgress {
               const ClusterOutcome& outcome) {
     for (std::size_t c = 0; c < cluster.size(); ++c) {
       if (contacts[c].restitution != 0.0) previous_plastic_ = false;
-      if (!undecayed_[cluster[c]] || !(outcome.normal[c].impulse > 0)) continue;
+      const std::size_t k = cluster[c];
+      if (!undecayed_[k] || !(outcome.normal[c].impulse > 0)) continue;
+      bool driven = false;
       for (const std::size_t m : {contacts[c].a, contacts[c].b}) {
-        driven_ = driven_ || after[m].inverse_mass == 0 ||
-                  (!before[m].velocity.isZero(0.0) && after[m].velocity == before[m].velocity);
+        driven = driven || after[m].inverse_mass == 0 ||
+                 (!before[m].velocity.isZero(0.0) && after[m].velocity == before[m].velocity);
       }
+      if (driven && ++driven_strikes_[k] >= kUndecayedStrikes) undriven_ = false;
     }
   }
 
   /// After a round, with the movable bodies' velocities (velocitiesOf movable()) and the
   /// contacts resolved plastically so far: true where the rounds would not converge.
   bool endsWithoutConverging(std::vector<double> state, const std::vector<char>& plastic) {
-    if (decayed_) {
-      undecayed_rounds_ = 0;
-    } else if (driven_) {
-      ++undecayed_rounds_;
-    }
-    if (undecayed_rounds_ >= kUndecayedRounds) return true;
+    if (!undriven_) return true;
     state.insert(state.end(), fastest_.begin(), fastest_.end());
     state.insert(state.end(), plastic.begin(), plastic.end());
     if (std::find(recent_.begin(), recent_.end(), state) != recent_.end()) return true;
@@ -360,18 +357,19 @@ class RoundProgress {
  private:
   static constexpr std::size_t kRoundsRemembered = 4;
   static constexpr int kStaleRounds = 8;
-  static constexpr int kUndecayedRounds = 64;
+  static constexpr int kUndecayedStrikes = 64;
   static constexpr double kUndecayedRate = 1e-6;
 
   std::vector<std::size_t> movable_;
   std::vector<double> fastest_;        // per contact: its fastest approach so far (0: none)
   std::vector<double> last_approach_;  // per contact: at its previous strike
   std::vector<char> undecayed_;        // per contact: struck again no slower than before
+  std::vector<int> driven_strikes_;    // per contact: such strikes by an unmoved body, in a row
   std::vector<std::vector<double>> recent_;
   std::vector<std::size_t> previous_;
   bool previous_plastic_ = false;
-  bool decayed_ = false, driven_ = false;
-  int stale_rounds_ = 0, undecayed_rounds_ = 0;
+  bool undriven_ = true;  // no contact has reached kUndecayedStrikes
+  int stale_rounds_ = 0;
 };
 
 }  // namespace
