@@ -626,57 +626,77 @@ TEST(FuzzFindings, FrictionOnAHugeSpinningBall) {
   EXPECT_NEAR(outcome->angular_velocity_b.y() * 1e145, 15.0 / 7.0, 1e-12);  // rolls: w r = v
 }
 
-// Found by the monitor's fuzzer: a 1.5e175 kg ball "b1" and a ball "b0" caught with it between
-// the floor and a post (discrete detection, gravity, friction), at mass ratios past what a joint
-// solve can resolve. b0 1e70 times heavier: the solve cannot stop it (its impulse is below its
-// velocity's last bit), so every plastic round ended where the one before did; 1e100 heavier:
-// the same, a last bit away each round; 1e410 lighter: b1 drives b0 against the post and is not
-// slowed at all, b0's approach the same every round. Each spent the instant's 10,000 rounds
-// (15,413, 19,950 and 15,000 impacts, 2.5 s to 15 s) before the fallback. Now a round that ends
-// where one of the last few did, the eighth plastic round in a row in which only its own
-// contacts strike again, or the 64th in which a body an impulse leaves unchanged drives a
-// contact that does not decay, ends the rounds.
+/// The monitor fuzzer's scene of the rounds findings (discrete detection, gravity, friction): a
+/// ball "b0" and a 1.5e175 kg ball "b1" between a floor of normal (1, floor_y, floor_z) at
+/// x = -4.125 and a post at x = post_x, with the fuzzed masses and radii as they came.
+struct FloorAndPost {
+  double b0_mass, b0_radius, b1_mass, floor_y, floor_z, post_x, post_radius;
+};
+Scene floorAndPostScene(const FloorAndPost& v) {
+  Scene scene;
+  scene.detection = Detection::kDiscrete;
+  scene.effects.gravity = true;
+  scene.effects.friction = true;
+  BodySpec b0;
+  b0.id = "b0";
+  b0.mass = v.b0_mass;
+  b0.radius = v.b0_radius;
+  b0.material = "billiard_ball";
+  BodySpec b1;
+  b1.id = "b1";
+  b1.mass = v.b1_mass;
+  b1.radius = 1.380645751953125e-235;
+  b1.material = "hand_ball";
+  scene.bodies = {b0, b1};
+  ObstacleSpec floor;
+  floor.id = "floor";
+  floor.material = "concrete";
+  floor.normal = V(1, v.floor_y, v.floor_z);
+  floor.offset = -4.125;
+  ObstacleSpec post;
+  post.id = "post";
+  post.shape = ObstacleShape::kSphere;
+  post.material = "wooden_ball";
+  post.position = V(v.post_x, -4.125, 1.2442169189453123e-240);
+  post.radius = v.post_radius;
+  scene.obstacles = {floor, post};
+  EXPECT_TRUE(validateScene(scene, "scene").ok());
+  normalizePlanes(scene);
+  return scene;
+}
+
+/// The step's rounds ended early: under 1,000 impacts (each input took 10,000 rounds before),
+/// one fallback, and both balls' velocities finite.
+void expectRoundsEndedEarly(const ImpactMonitor& monitor, const StepReport& report, double now,
+                            double b0_mass) {
+  EXPECT_LT(report.impacts.size(), 1000u) << b0_mass;
+  EXPECT_EQ(report.fallbacks, 1u) << b0_mass;
+  for (const std::size_t body : {0u, 1u}) {
+    EXPECT_TRUE(monitor.predictedState(body, now)->second.allFinite()) << b0_mass << " " << body;
+  }
+}
+
+// Found by the monitor's fuzzer: b1 and b0 caught between the floor and the post at mass ratios
+// past what a joint solve can resolve. b0 1e70 times heavier: the solve cannot stop it (its
+// impulse is below its velocity's last bit), so every plastic round ended where the one before
+// did; 1e100 heavier: the same, a last bit away each round; 1e410 lighter: b1 drives b0 against
+// the post and is not slowed at all, b0's approach the same every round. Each spent the
+// instant's 10,000 rounds (15,413, 19,950 and 15,000 impacts, 2.5 s to 15 s) before the
+// fallback. Now a round that ends where one of the last few did, the eighth plastic round in a
+// row in which only its own contacts strike again, or a contact of a body an impulse leaves
+// unchanged struck 64 times in a row no slower than before, ends the rounds.
 TEST(FuzzFindings, RoundsThatCannotConvergeEndEarly) {
-  struct Variant {
-    double b0_mass, b0_radius, floor_y, floor_z, post_x;
-  };
-  for (const Variant& variant :
-       {Variant{1.4506683349609377e+245, 1.185089111328125e+240, -4.7259604762489261e-180,
-                5.8823125076715362e-180, 12431335449.21875},
-        Variant{1.1850738525390624e+275, 1.372589111328125e+240, -4.7259604762489261e-180,
-                5.8823125076715362e-180, 12431335449.21875},
-        Variant{1.4506683349609375e-235, 1.9999847412109377e+240, -4.9761418564375631e-180,
-                6.1937084808850516e-180, 12118835449.21875}}) {
-    Scene scene;
-    scene.detection = Detection::kDiscrete;
-    scene.effects.gravity = true;
-    scene.effects.friction = true;
-    BodySpec b0;
-    b0.id = "b0";
-    b0.mass = variant.b0_mass;
-    b0.radius = variant.b0_radius;
-    b0.material = "billiard_ball";
-    BodySpec b1;
-    b1.id = "b1";
-    b1.mass = 1.4509735107421873e+175;
-    b1.radius = 1.380645751953125e-235;
-    b1.material = "hand_ball";
-    scene.bodies = {b0, b1};
-    ObstacleSpec floor;
-    floor.id = "floor";
-    floor.material = "concrete";
-    floor.normal = V(1, variant.floor_y, variant.floor_z);
-    floor.offset = -4.125;
-    ObstacleSpec post;
-    post.id = "post";
-    post.shape = ObstacleShape::kSphere;
-    post.material = "wooden_ball";
-    post.position = V(variant.post_x, -4.125, 1.2442169189453123e-240);
-    post.radius = 1.5215606689453124e-240;
-    scene.obstacles = {floor, post};
-    ASSERT_TRUE(validateScene(scene, "scene").ok());
-    normalizePlanes(scene);
-    ImpactMonitor monitor(scene, MonitorSettings{});
+  for (const FloorAndPost& variant :
+       {FloorAndPost{1.4506683349609377e+245, 1.185089111328125e+240, 1.4509735107421873e+175,
+                     -4.7259604762489261e-180, 5.8823125076715362e-180, 12431335449.21875,
+                     1.5215606689453124e-240},
+        FloorAndPost{1.1850738525390624e+275, 1.372589111328125e+240, 1.4509735107421873e+175,
+                     -4.7259604762489261e-180, 5.8823125076715362e-180, 12431335449.21875,
+                     1.5215606689453124e-240},
+        FloorAndPost{1.4506683349609375e-235, 1.9999847412109377e+240, 1.4509735107421873e+175,
+                     -4.9761418564375631e-180, 6.1937084808850516e-180, 12118835449.21875,
+                     1.5215606689453124e-240}}) {
+    ImpactMonitor monitor(floorAndPostScene(variant), MonitorSettings{});
     BodyStateSample first;
     first.body = *monitor.bodyIndex("b1");
     first.position =
@@ -686,12 +706,7 @@ TEST(FuzzFindings, RoundsThatCannotConvergeEndEarly) {
     BodyStateSample second;
     second.body = *monitor.bodyIndex("b0");
     second.time = 0.447;
-    const StepReport report = monitor.step(0.447, {second});
-    EXPECT_LT(report.impacts.size(), 1000u) << variant.b0_mass;
-    EXPECT_EQ(report.fallbacks, 1u) << variant.b0_mass;
-    for (const std::size_t body : {0u, 1u}) {
-      EXPECT_TRUE(monitor.predictedState(body, 0.447)->second.allFinite()) << body;
-    }
+    expectRoundsEndedEarly(monitor, monitor.step(0.447, {second}), 0.447, variant.b0_mass);
   }
 }
 
@@ -699,39 +714,13 @@ TEST(FuzzFindings, RoundsThatCannotConvergeEndEarly) {
 // sliding at 1.07 m/s in a wedge of the floor and a post whose normals are 1e-11 rad from
 // opposite. The post was struck at the same approach every round (the plastic floor removing
 // only its own component): 10,000 rounds and 10,002 impacts. Both are immovable, and a contact
-// of an immovable body struck again no slower than before, for 64 rounds with none struck
-// again slower, ends the rounds.
+// of an immovable body struck 64 times in a row no slower than before ends the rounds.
 TEST(FuzzFindings, RoundsInAWedgeOfNearlyOppositeNormalsEndEarly) {
-  Scene scene;
-  scene.detection = Detection::kDiscrete;
-  scene.effects.gravity = true;
-  scene.effects.friction = true;
-  BodySpec b0;
-  b0.id = "b0";
-  b0.mass = 1.4506683349609375e-235;
-  b0.radius = 1.9999847412109377e+240;
-  b0.material = "billiard_ball";
-  BodySpec b1;
-  b1.id = "b1";
-  b1.mass = 1.4492340087890625e+175;
-  b1.radius = 1.380645751953125e-235;
-  b1.material = "hand_ball";
-  scene.bodies = {b0, b1};
-  ObstacleSpec floor;
-  floor.id = "floor";
-  floor.material = "concrete";
-  floor.normal = V(1, -4.9761418564375631e-180, 6.1937084808850516e-180);
-  floor.offset = -4.125;
-  ObstacleSpec post;
-  post.id = "post";
-  post.shape = ObstacleShape::kSphere;
-  post.material = "wooden_ball";
-  post.position = V(12431335449.21875, -4.125, 1.2442169189453123e-240);
-  post.radius = 1.5215606689453127e-295;
-  scene.obstacles = {floor, post};
-  ASSERT_TRUE(validateScene(scene, "scene").ok());
-  normalizePlanes(scene);
-  ImpactMonitor monitor(scene, MonitorSettings{});
+  const FloorAndPost wedge{1.4506683349609375e-235, 1.9999847412109377e+240,
+                           1.4492340087890625e+175, -4.9761418564375631e-180,
+                           6.1937084808850516e-180, 12431335449.21875,
+                           1.5215606689453127e-295};
+  ImpactMonitor monitor(floorAndPostScene(wedge), MonitorSettings{});
   BodyStateSample first;
   first.body = *monitor.bodyIndex("b1");
   first.position = V(-1.5215606689453124e-235, -1.5215606689453124e-240, -1.5215606689453124e-240);
@@ -745,12 +734,7 @@ TEST(FuzzFindings, RoundsInAWedgeOfNearlyOppositeNormalsEndEarly) {
   BodyStateSample b0_state;
   b0_state.body = *monitor.bodyIndex("b0");
   b0_state.time = 39000000 * 1e-9;
-  const StepReport report = monitor.step(now, {b1_later, b0_state});
-  EXPECT_LT(report.impacts.size(), 1000u);
-  EXPECT_EQ(report.fallbacks, 1u);
-  for (const std::size_t body : {0u, 1u}) {
-    EXPECT_TRUE(monitor.predictedState(body, now)->second.allFinite()) << body;
-  }
+  expectRoundsEndedEarly(monitor, monitor.step(now, {b1_later, b0_state}), now, wedge.b0_mass);
 }
 
 }  // namespace
