@@ -305,6 +305,7 @@ class RoundProgress {
     const bool stale = previous_plastic_ && std::includes(previous_.begin(), previous_.end(),
                                                           striking.begin(), striking.end());
     stale_rounds_ = stale ? stale_rounds_ + 1 : 0;
+    std::fill(undecayed_.begin(), undecayed_.end(), 0);  // strikes() marks this round's
     return stale_rounds_ >= kStaleRounds;
   }
 
@@ -363,7 +364,7 @@ class RoundProgress {
   std::vector<std::size_t> movable_;
   std::vector<double> fastest_;        // per contact: its fastest approach so far (0: none)
   std::vector<double> last_approach_;  // per contact: at its previous strike
-  std::vector<char> undecayed_;        // per contact: struck again no slower than before
+  std::vector<char> undecayed_;        // per contact: struck again no slower, this round
   std::vector<int> driven_strikes_;    // per contact: such strikes by an unmoved body, in a row
   std::vector<std::vector<double>> recent_;
   std::vector<std::size_t> previous_;
