@@ -7,6 +7,7 @@
 
 #include "candidate_pairs.h"
 #include "motion_model.h"
+#include "stepped_clusters.h"
 
 namespace collision_response::core {
 
@@ -294,7 +295,11 @@ void formGroups(World& world, double time, const std::vector<std::size_t>& seeds
   std::vector<std::size_t> members;  // the bodies reached, in the order reached
   std::vector<std::size_t> dissolved;
   const auto visit = [&](std::size_t body) {
-    if (visited[body] || !world.tracks[body].known || world.inverse_mass[body] == 0.0) return;
+    // A body of a stepped cluster moves with its cluster (stepped_clusters.h).
+    if (visited[body] || !world.tracks[body].known || world.inverse_mass[body] == 0.0 ||
+        world.stepped(body)) {
+      return;
+    }
     visited[body] = 1;
     members.push_back(body);
     const int group = world.tracks[body].group;
@@ -318,6 +323,7 @@ void formGroups(World& world, double time, const std::vector<std::size_t>& seeds
       if (seen[k]) continue;
       seen[k] = 1;
       const Pair& pair = index.pairs[k];
+      if (world.steppedPair(pair)) continue;  // kept apart by the stepped cluster's sub-steps
       const Geometry g = geometry<Motion>(world, pair, time);
       if (!lastingCandidate(world, pair, time, g)) {
         world.contact_since.erase(pair);
@@ -438,6 +444,7 @@ void reportContacts(const World& world, double time, std::vector<ContactRecord>&
       contacts.push_back(record);
     }
   }
+  reportSteppedContacts(world, time, contacts);
   std::sort(contacts.begin(), contacts.end(), [](const ContactRecord& x, const ContactRecord& y) {
     return std::tie(x.body_a, x.other_is_obstacle, x.other) <
            std::tie(y.body_a, y.other_is_obstacle, y.other);

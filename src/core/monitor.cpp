@@ -16,6 +16,7 @@
 #include "lasting_contact.h"
 #include "monitor_world.h"
 #include "motion_model.h"
+#include "stepped_clusters.h"
 
 namespace collision_response::core {
 
@@ -87,10 +88,14 @@ void applyStates(World& world, const std::vector<BodyStateSample>& states, StepR
     track.angular_velocity = state.angular_velocity;
     track.constrained = nullptr;
     if (world.effects.gravity) {
-      // Free until the groups of lasting contact are formed again from the new states.
+      // Free until the groups of lasting contact are formed again from the new states; a body
+      // of a stepped cluster goes on in its sub-step's straight line from the state, and its
+      // cluster is solved again from there.
+      const bool stepped = track.stepped >= 0;
       track.acceleration =
-          world.inverse_mass[state.body] > 0 ? world.gravity : Eigen::Vector3d::Zero();
+          world.inverse_mass[state.body] > 0 && !stepped ? world.gravity : Eigen::Vector3d::Zero();
       track.angular_acceleration.setZero();
+      if (stepped) world.stepping.clusters[static_cast<std::size_t>(track.stepped)].stale = true;
       world.groups_current = false;
     }
   }
@@ -108,6 +113,7 @@ void forgetStaleBodies(World& world, double time) {
 /// fallback when a step's work runs out twice (nothing moves, so nothing goes into anything).
 template <class Motion>
 void holdEverything(World& world, double time) {
+  monitor::clearStepped(world, time);
   for (std::size_t body = 0; body < world.bodies.size(); ++body) {
     Track& track = world.tracks[body];
     if (!track.known || world.inverse_mass[body] == 0.0) continue;
@@ -148,6 +154,7 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
   StepReport report;
   std::size_t next_imposed = 0;
   world.step_end = time;
+  world.stepping.beginStep(world.now, time);
   monitor::candidatePairs<Motion>(world, world.now, time, world.scratch.pairs);
   ContactSchedule<Motion> schedule(world, time);
   const monitor::PairIndex index{world.scratch.pairs, world.scratch.pairs_of};
@@ -157,6 +164,7 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
   std::vector<Pair> touching_pairs;
   std::vector<std::size_t> changed;
   std::vector<std::size_t> event_bodies;  // a group event's bodies: their groups form again
+  bool stepped_due = false;               // the stepped clusters have an event at the instant
   int budget = world.settings.max_instants_per_step;
   bool fell_back = false;
   for (int instants = 0;; ++instants) {
@@ -181,7 +189,10 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
       monitor::resolveInelastically<Motion>(world, instant, struck, report, changed);
     }
     touching_pairs.clear();
-    for (const std::size_t k : touching) touching_pairs.push_back(schedule.pair(k));
+    for (const std::size_t k : touching) {
+      // A pair with a body of a stepped cluster is the cluster's to keep apart.
+      if (!world.steppedPair(schedule.pair(k))) touching_pairs.push_back(schedule.pair(k));
+    }
     if (!touching_pairs.empty() && world.settings.detect_impacts) {
       monitor::resolveInstant<Motion>(world, instant, touching_pairs, report, changed);
     }
@@ -194,8 +205,12 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
       track.position = state.position;
       track.velocity = state.velocity;
       track.angular_velocity = state.angular_velocity;
+      // A body of a stepped cluster goes on in a straight line, its cluster solved again.
+      const bool stepped = track.stepped >= 0;
       track.acceleration =
-          world.inverse_mass[state.body] > 0 ? world.gravity : Eigen::Vector3d::Zero();
+          world.inverse_mass[state.body] > 0 && !stepped ? world.gravity : Eigen::Vector3d::Zero();
+      if (stepped) world.stepping.clusters[static_cast<std::size_t>(track.stepped)].stale = true;
+      stepped_due = stepped_due || stepped;
       track.angular_acceleration.setZero();
       track.constrained = nullptr;
       track.last_impact_time = state.time;
@@ -204,6 +219,20 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
       changed.push_back(state.body);
     }
     if constexpr (Motion::kAccelerates) {
+      // Stepped clusters: the grid's sub-steps, a sub-step that ended early, or a cluster whose
+      // members' states were replaced (at the start: what the last step left due).
+      if (stepped_due || instants == 0) {
+        std::vector<std::size_t> released;
+        monitor::advanceStepped(world, instant, changed, released, report);
+        // A body a cluster let go of may be closing on what it touches (its last sub-step
+        // brought it there): that is an impact of the exact model, at this instant.
+        if (!released.empty() && world.settings.detect_impacts) {
+          monitor::resolveInstant<Motion>(world, instant,
+                                          monitor::touchingPairsOf(world, instant, released, index),
+                                          report, changed);
+        }
+      }
+      stepped_due = false;
       // Lasting contact: the groups of the bodies whose motion changed (at the start, of every
       // body, unless the groups hold already for these tracks).
       std::vector<std::size_t> seeds = changed;
@@ -223,6 +252,9 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
         }
       }
       if (!seeds.empty()) monitor::formGroups(world, instant, seeds, index, changed);
+      // Bodies whose exact motion changed may now reach a stepped cluster within its sub-step.
+      const std::vector<std::size_t> moved = changed;
+      monitor::joinStepped(world, instant, moved, changed, report);
       std::sort(changed.begin(), changed.end());
       changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
     }
@@ -236,14 +268,15 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
     // motion changing (at one instant: the group first, then the state, then the contact).
     const double next_contact = schedule.earliest();
     const double next_state = next_imposed < imposed.size() ? imposed[next_imposed].time : INFINITY;
-    double next_group_event = INFINITY;
+    double next_group_event = INFINITY, next_stepped = INFINITY;
     std::size_t group = 0;
     if constexpr (Motion::kAccelerates) {
       std::tie(next_group_event, group) = monitor::nextGroupEvent(world);
+      next_stepped = monitor::nextSteppedEvent(world, time);
     }
-    const double next = std::min({next_contact, next_state, next_group_event});
+    const double next = std::min({next_contact, next_state, next_group_event, next_stepped});
     if (!(next <= time)) break;
-    if (next_group_event == next || next_state == next) {
+    if (next_group_event == next || next_state == next || next_stepped == next) {
       instant = next;
       touching.clear();
       if (next_group_event == next) {
@@ -251,6 +284,7 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
         changing.next_event = INFINITY;
         if (solvesAgain(changing, next, time - world.now)) event_bodies = changing.bodies;
       }
+      stepped_due = next_stepped == next;
       continue;
     }
     if (!schedule.next(instant, touching)) break;
@@ -262,6 +296,7 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
     world.step_end = time;
     monitor::formAllGroups(world, time, formed);
     monitor::reportContacts(world, time, report.contacts);
+    report.stepped_bodies = monitor::steppedBodies(world);
   }
   return report;
 }
@@ -272,9 +307,12 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
 /// `time`. Lasting contact is the model of motion under either detection: without this, a
 /// sliding contact's friction would act past the instant its slip stops, to the next sample.
 template <class Motion>
-void advanceLastingContact(World& world, double time) {
+void advanceLastingContact(World& world, double time, StepReport& report) {
   world.step_end = time;
-  if (!world.groups_current) return;  // none for these tracks: formed after the states at `time`
+  world.stepping.beginStep(world.now, time);
+  // Without groups for these tracks, they are formed after the states at `time`; the stepped
+  // clusters move on regardless.
+  const bool lasting = world.groups_current;
   std::vector<Pair>& pairs = world.scratch.pairs;
   monitor::candidatePairs<Motion>(world, world.now, time, pairs);
   std::vector<std::vector<std::size_t>>& pairs_of = world.scratch.pairs_of;
@@ -285,20 +323,53 @@ void advanceLastingContact(World& world, double time) {
   }
   const monitor::PairIndex index{pairs, pairs_of};
   std::vector<std::size_t> seeds, changed;
-  for (const monitor::ContactGroup& group : world.groups) {
-    if (group.alive && group.curved)
-      seeds.insert(seeds.end(), group.bodies.begin(), group.bodies.end());
+  if (lasting) {
+    for (const monitor::ContactGroup& group : world.groups) {
+      if (group.alive && group.curved)
+        seeds.insert(seeds.end(), group.bodies.begin(), group.bodies.end());
+    }
   }
   if (!seeds.empty()) monitor::formGroups(world, world.now, seeds, index, changed);
+  // The stepped clusters' events and the groups' (at one instant, the cluster first), each
+  // followed by the groups of the bodies whose motion changed and the clusters they now reach.
+  const auto settle = [&](double when) {
+    if (lasting && !changed.empty()) {
+      const std::vector<std::size_t> changed_seeds = changed;
+      monitor::formGroups(world, when, changed_seeds, index, changed);
+    }
+    const std::vector<std::size_t> moved = changed;
+    monitor::joinStepped(world, when, moved, changed, report);
+  };
+  // A body a cluster let go of may be closing on what it touches: an impact, at that instant.
+  const auto step_clusters = [&](double when) {
+    std::vector<std::size_t> released;
+    monitor::advanceStepped(world, when, changed, released, report);
+    if (!released.empty() && world.settings.detect_impacts) {
+      monitor::resolveInstant<Motion>(
+          world, when, monitor::touchingPairsOf(world, when, released, index), report, changed);
+    }
+  };
+  changed.clear();
+  step_clusters(world.now);
+  settle(world.now);
   for (int events = 0; events < world.settings.max_instants_per_step; ++events) {
-    const auto [when, group] = monitor::nextGroupEvent(world);
-    if (!(when <= time)) break;
+    auto [when, group] =
+        lasting ? monitor::nextGroupEvent(world) : std::pair<double, std::size_t>{INFINITY, 0};
+    const double stepped = monitor::nextSteppedEvent(world, time);
+    if (!(std::min(when, stepped) <= time)) break;
+    changed.clear();
+    if (stepped <= when) {
+      step_clusters(stepped);
+      settle(stepped);
+      continue;
+    }
     monitor::ContactGroup& changing = world.groups[group];
     changing.next_event = INFINITY;
     if (!solvesAgain(changing, when, time - world.now)) continue;
     seeds = changing.bodies;
-    changed.clear();  // nothing reads it here: kept from growing with the events
     monitor::formGroups(world, when, seeds, index, changed);
+    const std::vector<std::size_t> moved = changed;
+    monitor::joinStepped(world, when, moved, changed, report);
   }
 }
 
@@ -311,7 +382,7 @@ template <class Motion>
 StepReport discreteStep(World& world, double time, const std::vector<BodyStateSample>& states) {
   StepReport report;
   world.sample_period = time - world.now;
-  if constexpr (Motion::kAccelerates) advanceLastingContact<Motion>(world, time);
+  if constexpr (Motion::kAccelerates) advanceLastingContact<Motion>(world, time, report);
   applyStates(world, states, report);
   world.now = time;
   std::vector<Pair>& pairs = world.scratch.pairs;
@@ -319,6 +390,7 @@ StepReport discreteStep(World& world, double time, const std::vector<BodyStateSa
   std::vector<Pair> touching;
   for (const Pair& pair : pairs) {
     const Geometry g = monitor::geometry<Motion>(world, pair, time);
+    if (world.steppedPair(pair)) continue;  // its stepped cluster keeps it apart
     if (g.valid && g.gap <= g.tolerance &&
         (world.overlapping.count(pair) == 0 || world.lasting(pair))) {
       touching.push_back(pair);
@@ -326,8 +398,13 @@ StepReport discreteStep(World& world, double time, const std::vector<BodyStateSa
   }
   std::vector<std::size_t> changed;
   monitor::resolveInstant<Motion>(world, time, touching, report, changed);
+  if constexpr (Motion::kAccelerates) {
+    const std::vector<std::size_t> moved = changed;
+    monitor::joinStepped(world, time, moved, changed, report);
+  }
   world.overlapping.clear();
   for (const Pair& pair : pairs) {
+    if (world.steppedPair(pair)) continue;
     const Geometry g = monitor::geometry<Motion>(world, pair, time);
     if (g.valid && g.gap < -g.tolerance) world.overlapping.insert(pair);
   }
@@ -335,6 +412,7 @@ StepReport discreteStep(World& world, double time, const std::vector<BodyStateSa
     std::vector<std::size_t> formed;
     monitor::formAllGroups(world, time, formed);
     monitor::reportContacts(world, time, report.contacts);
+    report.stepped_bodies = monitor::steppedBodies(world);
   }
   return report;
 }
@@ -370,6 +448,10 @@ ImpactMonitor::ImpactMonitor(const Scene& scene, const MonitorSettings& settings
   world.effects = runnableEffects(scene.effects);
   if (world.effects.gravity) world.gravity = scene.gravity;
   world.integration_tolerance = scene.contact_integration_tolerance;
+  if (world.effects.gravity) {
+    world.stepping.min_bodies = static_cast<std::size_t>(scene.stepped_cluster_min_bodies);
+    world.stepping.time_step = scene.stepped_cluster_time_step;
+  }
   world.friction_model = frictionModelFor(world.effects);
 
   std::vector<std::string>& material_names = world.material_names;
@@ -463,6 +545,7 @@ void ImpactMonitor::reset() {
     if (!world.obstacles[i].frame.empty()) world.obstacle_tracks[i] = monitor::ObstacleTrack{};
   }
   world.overlapping.clear();
+  monitor::clearStepped(world, world.now);
   monitor::clearGroups(world);
   world.contact_since.clear();
   world.started = false;
@@ -476,7 +559,18 @@ std::size_t ImpactMonitor::trackedBodies() const {
 
 std::optional<std::size_t> ImpactMonitor::restingOn(std::size_t body) const {
   const World& world = *world_;
-  if (!world.tracks[body].known || world.partners.empty()) return std::nullopt;
+  if (!world.tracks[body].known) return std::nullopt;
+  if (world.stepped(body)) {
+    const auto& cluster =
+        world.stepping.clusters[static_cast<std::size_t>(world.tracks[body].stepped)];
+    for (const monitor::SteppedClusterContact& contact : cluster.contacts) {
+      if (contact.pair.first == body && world.isObstacle(contact.pair.second)) {
+        return contact.pair.second - world.bodyCount();
+      }
+    }
+    return std::nullopt;
+  }
+  if (world.partners.empty()) return std::nullopt;
   for (const std::size_t other : world.partners[body]) {
     if (world.isObstacle(other)) return other - world.bodyCount();
   }

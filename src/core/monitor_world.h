@@ -50,6 +50,12 @@ struct Track {
   std::shared_ptr<const ConstrainedStep> constrained;
   std::size_t slot = 0;
   double integration_step = 0.0;  ///< the integrator's last step size, a guess for the next
+  /// Its stepped cluster (World::stepping), -1: none. Its motion is then a straight line over
+  /// the cluster's sub-step (acceleration 0: gravity is given as a velocity at the sub-step's
+  /// start, stepped_contact.h).
+  int stepped = -1;
+  /// s: the end of the sub-step whose gravity its velocity holds already.
+  double kicked_until = kNever;
   double last_state_time = kNever;
   double last_impact_time = kNever;
 };
@@ -94,6 +100,64 @@ struct ContactGroup {
   bool curved = false;  ///< its motion is integrated, up to World::step_end
 };
 
+/// A contact of a stepped cluster over its sub-step.
+struct SteppedClusterContact {
+  Pair pair;
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();  ///< unit, a -> other
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  double keeping_impulse = 0.0;   ///< N s over the sub-step: a force of impulse / its length
+  double friction_impulse = 0.0;  ///< N s, on other along friction_direction
+  Eigen::Vector3d friction_direction = Eigen::Vector3d::Zero();
+  bool sticking = false;
+};
+
+/// Bodies near each other advanced together by time steps (stepped_contact.h): from `start`,
+/// each moves in a straight line until `end`, the next instant of the grid, or earlier where
+/// the solve fell short (then it is solved again there).
+struct SteppedCluster {
+  std::vector<std::size_t> bodies;              ///< sorted
+  std::vector<SteppedClusterContact> contacts;  ///< in the canonical order of their pairs
+  double start = 0.0;
+  double end = 0.0;
+  bool stale = false;  ///< a member's state was replaced within the sub-step: solve again
+};
+
+/// The stepped clusters (README, "Lasting contact"): with gravity, at the start of every step
+/// and every `time_step` at most within it (the step's interval split into equal sub-steps, so
+/// that a source stepping at the same instants, the scene player, moves its clusters by the
+/// same sub-steps), the bodies near each other (within what they can move in a sub-step) form
+/// connected sets; a set of at least `min_bodies` is advanced by a sub-step of
+/// solveSteppedSubstep, the others stay with the exact model.
+struct Stepping {
+  std::size_t min_bodies = 0;  ///< 0: never
+  double time_step = 0.01;     ///< s, the longest sub-step
+  /// The step being taken: [begin, end] in `substeps` equal sub-steps; `next` the sub-step to
+  /// start next (0 at the step's start). The instant `end` starts the next step's first one.
+  double begin = 0.0, end = 0.0;
+  long substeps = 0, next = 0;
+  std::vector<SteppedCluster> clusters;
+  /// Per pair, the force that kept its gap over its last sub-step: the next one starts there.
+  std::map<Pair, double> keeping_force;
+  /// Sub-steps whose solve could not keep the gaps at all (every body held still).
+  std::size_t held = 0;
+
+  bool enabled() const { return min_bodies > 0; }
+  /// Sub-step k's start (k = substeps: the step's end).
+  double instant(long k) const {
+    return k >= substeps
+               ? end
+               : begin + (end - begin) * static_cast<double>(k) / static_cast<double>(substeps);
+  }
+  /// Starts a step over [from, to].
+  void beginStep(double from, double to) {
+    begin = from;
+    end = to;
+    substeps = static_cast<long>(std::ceil((to - from) / time_step * (1 - 1e-12)));
+    substeps = std::max(substeps, 1L);
+    next = 0;
+  }
+};
+
 /// Working memory of a step, kept so that steps do not allocate once it has grown. A copy of the
 /// monitor starts with none.
 struct Scratch {
@@ -136,6 +200,7 @@ struct World {
   std::vector<ObstacleTrack> obstacle_tracks;
   std::set<Pair> overlapping;        // discrete: pairs overlapping at the previous step
   std::vector<ContactGroup> groups;  // lasting contact (gravity)
+  Stepping stepping;                 // stepped clusters (gravity)
   std::vector<std::vector<std::size_t>> partners;  // per body: its lasting contacts' others
   std::map<Pair, double> contact_since;            // every lasting pair's start, and those the
                                                    // rest rule set to begin at an instant
@@ -180,8 +245,15 @@ struct World {
                            : 0.0;
     return g.band() + arc;
   }
-  /// The pair is a lasting contact: its motion keeps it touching (no first contact to look for).
+  bool stepped(std::size_t participant) const {
+    return !isObstacle(participant) && tracks[participant].stepped >= 0;
+  }
+  /// A body of the pair is in a stepped cluster: its cluster's sub-steps keep the pair apart.
+  bool steppedPair(const Pair& pair) const { return stepped(pair.first) || stepped(pair.second); }
+  /// The pair is a lasting contact: its motion keeps it touching (no first contact to look for),
+  /// or a stepped cluster keeps it apart.
   bool lasting(const Pair& pair) const {
+    if (steppedPair(pair)) return true;
     if (partners.empty()) return false;
     const std::vector<std::size_t>& others = partners[pair.first];
     return std::find(others.begin(), others.end(), pair.second) != others.end();

@@ -75,6 +75,17 @@ Status validateScene(const Scene& scene, const std::string& prefix) {
         prefix + "/contact_integration_tolerance",
         "must be in [1e-14, 1e-3], got " + formatNumber(scene.contact_integration_tolerance)};
   }
+  // Stepped clusters: a count of bodies (0: never), and a sub-step from 0.1 ms (far above the
+  // resolution of a time line of ROS stamps, 2.4e-7 s in 2026) to a second.
+  if (!(scene.stepped_cluster_min_bodies >= 0)) {
+    return Error{prefix + "/stepped_cluster_min_bodies",
+                 "must be 0 (never) or a number of bodies, got " +
+                     std::to_string(scene.stepped_cluster_min_bodies)};
+  }
+  if (!(scene.stepped_cluster_time_step >= 1e-4 && scene.stepped_cluster_time_step <= 1.0)) {
+    return Error{prefix + "/stepped_cluster_time_step",
+                 "must be in [1e-4, 1] s, got " + formatNumber(scene.stepped_cluster_time_step)};
+  }
   std::set<std::string> ids;
   for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
     const BodySpec& body = scene.bodies[i];

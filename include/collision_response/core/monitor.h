@@ -105,8 +105,11 @@ struct StepReport {
   /// A guard of MonitorSettings ran out (rounds at an instant, instants in the step).
   bool truncated = false;
   /// What the fallbacks did when a guard ran out, so that no body goes into another: a cluster
-  /// resolved as one inelastic cluster, or the step's bodies held where they were.
+  /// resolved as one inelastic cluster, the step's bodies held where they were, or a stepped
+  /// cluster held still over a sub-step its solve could not keep the gaps of.
   std::size_t fallbacks = 0;
+  /// Bodies in stepped clusters at the step's end (README, "Lasting contact").
+  std::size_t stepped_bodies = 0;
 };
 
 /// Watches the scene's bodies and obstacles and finds their impacts.

@@ -1,0 +1,548 @@
+#include "stepped_clusters.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <set>
+
+#include "collision_response/core/broadphase.h"
+#include "collision_response/core/stepped_contact.h"
+#include "motion_model.h"
+#include "order_free.h"
+
+namespace collision_response::core::monitor {
+namespace {
+
+using Motion = UnderGravity;  // stepped clusters need a steady force: the gravity effect
+
+/// The closure of a solve (new near pairs found with the solved velocities) is looked for at
+/// most this many times; each time the contact set only grows, so it ends anyway, but a scene
+/// that needs more is resolved with what it has (counted, never silent: the solve's own
+/// tolerance check still ends the sub-step before a contact it does not hold closes).
+constexpr int kMaxClosures = 16;
+
+/// What a body of a solve starts from at its instant.
+struct Start {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d kick = Eigen::Vector3d::Zero();  ///< the gravity of the sub-step, if not given
+};
+
+/// How far a body's surface may move over `span` from `time`, before its sub-step is solved: at
+/// its speed plus the gravity a sub-step gives (a stepped body's motion), or along its own
+/// motion at its speed and acceleration bound (any other's), whichever is farther.
+double reachBefore(const World& world, std::size_t body, double time, double span) {
+  const double speed = velocityAt<Motion>(world, body, time).norm();
+  if (world.inverse_mass[body] == 0.0) return speed * span;
+  const double acceleration = world.stepped(body) ? 0.0 : accelerationBound<Motion>(world, body);
+  return (speed + world.gravity.norm() * span) * span + 0.5 * acceleration * span * span;
+}
+
+/// Every pair of tracked participants whose surfaces are within their reaches of each other at
+/// `time` (body pairs through a grid of their boxes; each movable body with every obstacle), in
+/// the canonical order.
+std::vector<Pair> nearPairs(const World& world, double time, double span,
+                            const std::vector<double>& reach) {
+  const std::size_t n = world.bodies.size();
+  std::vector<Box> boxes(n);
+  std::vector<char> active(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!world.tracks[i].known) continue;
+    active[i] = 1;
+    const Eigen::Vector3d centre = positionAt<Motion>(world, i, time);
+    const double half = world.radius[i] * (1 + 2 * world.settings.contact_tolerance) + reach[i] +
+                        64 * kEps * centre.lpNorm<Eigen::Infinity>();
+    boxes[i] = Box{centre.array() - half, centre.array() + half};
+  }
+  SpatialHash hash;
+  hash.build(boxes, active);
+  std::vector<std::pair<std::size_t, std::size_t>> overlapping;
+  hash.overlappingPairs(overlapping);
+  std::vector<Pair> pairs;
+  for (const auto& [a, b] : overlapping) {
+    if (world.inverse_mass[a] + world.inverse_mass[b] == 0.0) continue;
+    const Geometry g = geometry<Motion>(world, Pair(a, b), time);
+    if (g.valid && g.gap <= reach[a] + reach[b] + g.tolerance) pairs.emplace_back(a, b);
+  }
+  for (std::size_t a = 0; a < n; ++a) {
+    if (!active[a] || world.inverse_mass[a] == 0.0) continue;
+    for (std::size_t o = 0; o < world.obstacles.size(); ++o) {
+      if (!world.obstacle_tracks[o].known) continue;
+      const Pair pair(a, n + o);
+      const Geometry g = geometry<Motion>(world, pair, time);
+      const double moving = world.obstaclePose(n + o).velocity.norm() * span;
+      if (g.valid && g.gap <= reach[a] + moving + g.tolerance) pairs.push_back(pair);
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  return pairs;
+}
+
+/// A component's solve: its members (sorted) and their sub-step.
+struct Component {
+  std::vector<std::size_t> members;
+  std::vector<Pair> pairs;  ///< its contacts, canonical order
+  SteppedOutcome outcome;
+  std::vector<std::size_t> participants;  ///< members, then the fixed participants
+};
+
+/// The solve of one component from `starts` over `span`.
+void solveComponent(World& world, double time, double span, const std::vector<Start>& starts,
+                    bool warm_start, Component& component) {
+  std::vector<std::size_t>& participants = component.participants;
+  participants = component.members;
+  std::vector<std::size_t> fixed;
+  for (const Pair& pair : component.pairs) {
+    for (const std::size_t p : {pair.first, pair.second}) {
+      if (world.inverseMassOf(p) == 0.0) fixed.push_back(p);
+    }
+  }
+  std::sort(fixed.begin(), fixed.end());
+  fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
+  participants.insert(participants.end(), fixed.begin(), fixed.end());
+  const auto slot = [&](std::size_t p) {
+    const auto movable = std::lower_bound(component.members.begin(), component.members.end(), p);
+    if (movable != component.members.end() && *movable == p) {
+      return static_cast<std::size_t>(movable - component.members.begin());
+    }
+    return component.members.size() +
+           static_cast<std::size_t>(std::lower_bound(fixed.begin(), fixed.end(), p) -
+                                    fixed.begin());
+  };
+  std::vector<SteppedBody> bodies;
+  for (const std::size_t p : participants) {
+    SteppedBody body;
+    body.inverse_mass = world.inverseMassOf(p);
+    body.radius = world.radius[p];
+    if (body.inverse_mass > 0) {
+      const Start& start = starts[p];
+      body.velocity = start.velocity;
+      body.angular_velocity = start.angular_velocity;
+      body.kick = start.kick;
+      body.spin_factor = world.spin_factor[p];
+    } else {
+      body.velocity = velocityAt<Motion>(world, p, time);
+      body.angular_velocity = angularVelocityAt<Motion>(world, p, time);
+    }
+    bodies.push_back(body);
+  }
+  std::vector<SteppedContact> contacts;
+  std::vector<double> warm;
+  std::vector<Pair> kept;
+  for (const Pair& pair : component.pairs) {
+    const Geometry g = geometry<Motion>(world, pair, time);
+    if (!g.valid) continue;  // coincident centres and no approach: no line to keep apart along
+    SteppedContact contact;
+    contact.a = slot(pair.first);
+    contact.b = slot(pair.second);
+    contact.normal = g.normal;
+    contact.point =
+        positionAt<Motion>(world, pair.first, time) + world.radius[pair.first] * g.normal;
+    contact.gap = g.gap;
+    contact.band = g.tolerance;
+    contact.restitution = world.restitutionOf(pair);
+    if (world.friction_model) contact.friction = world.frictionOf(pair);
+    contacts.push_back(contact);
+    // At the grid, the last sub-step's forces; within a sub-step (whose gravity its members have
+    // already), only what changed is solved for.
+    const auto force = world.stepping.keeping_force.find(pair);
+    const bool known = warm_start && force != world.stepping.keeping_force.end();
+    warm.push_back(known ? force->second * span : 0.0);
+    kept.push_back(pair);
+  }
+  component.pairs = kept;
+  SteppedSettings settings;
+  settings.duration = span;
+  settings.restitution_threshold = world.restitution_threshold;
+  if (world.friction_model) settings.friction = world.friction_model.cluster;
+  component.outcome = solveSteppedSubstep(bodies, contacts, settings, warm);
+}
+
+/// Takes a lasting group apart: its bodies leave it (to be formed again by the caller).
+void leaveLastingGroup(World& world, std::size_t body, std::vector<std::size_t>& changed) {
+  const int group = world.tracks[body].group;
+  if (group < 0) return;
+  ContactGroup& dissolved = world.groups[static_cast<std::size_t>(group)];
+  dissolved.alive = false;
+  for (const std::size_t member : dissolved.bodies) {
+    world.tracks[member].group = -1;
+    if (member < world.partners.size()) world.partners[member].clear();
+    changed.push_back(member);
+  }
+  dissolved.bodies.clear();
+  dissolved.contacts.clear();
+}
+
+/// Numbers the clusters' bodies again (Track::stepped) after clusters were added or removed.
+void indexClusters(World& world) {
+  for (std::size_t c = 0; c < world.stepping.clusters.size(); ++c) {
+    for (const std::size_t body : world.stepping.clusters[c].bodies) {
+      world.tracks[body].stepped = static_cast<int>(c);
+    }
+  }
+}
+
+/// Solves the bodies of `region` (and every body their sub-steps bring near them) from `time`
+/// to `end`, in connected components of near pairs, and makes them the clusters `replaced` was.
+/// `grid`: every tracked body is looked at and only components of at least min_bodies are
+/// stepped (region: empty, found here); otherwise every component of the region is.
+void solveRegion(World& world, double time, double end, std::vector<char> member, bool grid,
+                 std::vector<std::size_t>& changed, std::vector<std::size_t>& released,
+                 StepReport& report) {
+  Stepping& stepping = world.stepping;
+  const std::size_t n = world.bodies.size();
+  const double span = end - time;
+  std::vector<double> reach(n, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (world.tracks[i].known) reach[i] = reachBefore(world, i, time, span);
+  }
+  std::vector<Pair> near = nearPairs(world, time, span, reach);
+  const auto movable = [&](std::size_t p) {
+    return !world.isObstacle(p) && world.inverse_mass[p] > 0;
+  };
+  if (grid) {
+    ConnectedSets sets(n);
+    for (const Pair& pair : near) {
+      if (movable(pair.first) && movable(pair.second)) sets.link(pair.first, pair.second);
+    }
+    member.assign(n, 0);
+    for (const std::vector<std::size_t>& set : sets.sets()) {
+      if (set.size() < stepping.min_bodies || !movable(set.front())) continue;
+      for (const std::size_t body : set) member[body] = world.tracks[body].known ? 1 : 0;
+    }
+  }
+  // A body that is in a cluster not being solved again joins with its whole cluster.
+  const auto add_cluster_of = [&](std::size_t body) {
+    const int cluster = world.tracks[body].stepped;
+    if (cluster < 0 || grid) return;
+    for (const std::size_t other : stepping.clusters[static_cast<std::size_t>(cluster)].bodies) {
+      member[other] = 1;
+    }
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    if (member[i]) add_cluster_of(i);
+  }
+
+  std::vector<Start> starts(n);
+  std::vector<char> started(n, 0);
+  const auto start_members = [&] {
+    for (std::size_t body = 0; body < n; ++body) {
+      if (!member[body] || started[body]) continue;
+      started[body] = 1;
+      Start& start = starts[body];
+      start.position = positionAt<Motion>(world, body, time);
+      start.velocity = velocityAt<Motion>(world, body, time);
+      start.angular_velocity = angularVelocityAt<Motion>(world, body, time);
+      // Gravity once per sub-step: a body of a cluster solved again within its sub-step has it.
+      const bool given = world.stepped(body) && world.tracks[body].kicked_until >= end;
+      start.kick = given ? Eigen::Vector3d::Zero() : Eigen::Vector3d(world.gravity * span);
+    }
+  };
+  std::set<Pair> contact_pairs;
+  // The near pairs with a member: their outsiders join (an immovable body stays a fixed
+  // participant), and the pairs are contacts of the solve. True when anything was added.
+  const auto take_near = [&](const std::vector<Pair>& pairs) {
+    bool grown = false;
+    for (const Pair& pair : pairs) {
+      const bool in_first = member[pair.first] != 0;
+      const bool in_second = !world.isObstacle(pair.second) && member[pair.second] != 0;
+      if (!in_first && !in_second) continue;
+      for (const std::size_t p : {pair.first, pair.second}) {
+        if (movable(p) && !member[p]) {
+          member[p] = 1;
+          add_cluster_of(p);
+          grown = true;
+        }
+      }
+      grown = contact_pairs.insert(pair).second || grown;
+    }
+    start_members();
+    return grown;
+  };
+  take_near(near);
+
+  std::vector<Component> components;
+  for (int closure = 0;; ++closure) {
+    ConnectedSets sets(n);
+    for (const Pair& pair : contact_pairs) {
+      if (movable(pair.first) && movable(pair.second)) sets.link(pair.first, pair.second);
+    }
+    components.clear();
+    std::vector<long> component_of(n, -1);
+    for (const std::vector<std::size_t>& set : sets.sets()) {
+      if (!member[set.front()]) continue;
+      component_of[set.front()] = static_cast<long>(components.size());
+      components.emplace_back();
+      components.back().members = set;
+      for (const std::size_t body : set) component_of[body] = component_of[set.front()];
+    }
+    for (const Pair& pair : contact_pairs) {
+      const std::size_t body = movable(pair.first) ? pair.first : pair.second;
+      components[static_cast<std::size_t>(component_of[body])].pairs.push_back(pair);
+    }
+    for (Component& component : components) {
+      solveComponent(world, time, span, starts, grid, component);
+    }
+    if (closure + 1 >= kMaxClosures) break;
+    // The solved velocities may carry a member farther than its reach before: near pairs again.
+    for (const Component& component : components) {
+      for (std::size_t i = 0; i < component.members.size(); ++i) {
+        reach[component.members[i]] =
+            std::max(reach[component.members[i]],
+                     component.outcome.velocity[i].norm() * component.outcome.duration);
+      }
+    }
+    if (!take_near(nearPairs(world, time, span, reach))) break;
+  }
+
+  // The clusters that were: those whose bodies are solved now are replaced (all, at the grid).
+  std::vector<SteppedCluster> kept;
+  for (SteppedCluster& cluster : stepping.clusters) {
+    bool replaced = grid;
+    for (const std::size_t body : cluster.bodies) replaced = replaced || member[body];
+    if (!replaced) {
+      kept.push_back(std::move(cluster));
+      continue;
+    }
+    for (const std::size_t body : cluster.bodies) {
+      if (member[body]) continue;
+      // Out of every cluster: back to the exact model, from where it is, under gravity.
+      Track& track = world.tracks[body];
+      track.position = positionAt<Motion>(world, body, time);
+      track.velocity = velocityAt<Motion>(world, body, time);
+      track.time = time;
+      track.acceleration = world.gravity;
+      track.angular_acceleration.setZero();
+      track.stepped = -1;
+      changed.push_back(body);
+      released.push_back(body);
+    }
+    for (const SteppedClusterContact& contact : cluster.contacts) {
+      if (!member[contact.pair.first] &&
+          (world.isObstacle(contact.pair.second) || !member[contact.pair.second])) {
+        world.contact_since.erase(contact.pair);
+      }
+    }
+  }
+  stepping.clusters = std::move(kept);
+
+  for (const Component& component : components) {
+    const SteppedOutcome& outcome = component.outcome;
+    SteppedCluster cluster;
+    cluster.bodies = component.members;
+    cluster.start = time;
+    cluster.end = time + outcome.duration;
+    if (outcome.held) {
+      ++stepping.held;
+      ++report.fallbacks;
+    }
+    for (std::size_t i = 0; i < component.members.size(); ++i) {
+      const std::size_t body = component.members[i];
+      leaveLastingGroup(world, body, changed);
+      Track& track = world.tracks[body];
+      track.position = starts[body].position;
+      track.velocity = outcome.velocity[i];
+      track.angular_velocity = outcome.angular_velocity[i];
+      track.acceleration.setZero();
+      track.angular_acceleration.setZero();
+      track.time = time;
+      track.constrained = nullptr;
+      track.kicked_until = end;
+      track.stepped = 0;  // numbered by indexClusters
+      changed.push_back(body);
+    }
+    for (std::size_t k = 0; k < component.pairs.size(); ++k) {
+      const Pair& pair = component.pairs[k];
+      const SteppedContactOutcome& received = outcome.contacts[k];
+      if (received.keeping_impulse > 0 || received.bounce_impulse > 0) {
+        stepping.keeping_force[pair] = received.keeping_impulse / outcome.duration;
+      } else {
+        stepping.keeping_force.erase(pair);
+      }
+      if (!(received.keeping_impulse > 0)) {
+        world.contact_since.erase(pair);
+        continue;
+      }
+      const Geometry g = geometry<Motion>(world, pair, time);
+      SteppedClusterContact contact;
+      contact.pair = pair;
+      contact.normal = g.normal;
+      contact.point =
+          positionAt<Motion>(world, pair.first, time) + world.radius[pair.first] * g.normal;
+      contact.keeping_impulse = received.keeping_impulse;
+      contact.friction_impulse = received.friction_impulse;
+      contact.friction_direction = received.friction_direction;
+      contact.sticking = received.sticking;
+      world.contact_since.emplace(pair, time);
+      cluster.contacts.push_back(contact);
+    }
+    stepping.clusters.push_back(std::move(cluster));
+  }
+  indexClusters(world);
+}
+
+}  // namespace
+
+double nextSteppedEvent(const World& world, double time) {
+  const Stepping& stepping = world.stepping;
+  if (!stepping.enabled()) return INFINITY;
+  // The step's end starts the next step's first sub-step.
+  double next = stepping.next < stepping.substeps ? stepping.instant(stepping.next) : INFINITY;
+  for (const SteppedCluster& cluster : stepping.clusters) next = std::min(next, cluster.end);
+  return next < time ? next : INFINITY;
+}
+
+void advanceStepped(World& world, double time, std::vector<std::size_t>& changed,
+                    std::vector<std::size_t>& released, StepReport& report) {
+  Stepping& stepping = world.stepping;
+  if (!stepping.enabled()) return;
+  if (stepping.next < stepping.substeps && stepping.instant(stepping.next) <= time) {
+    ++stepping.next;
+    std::size_t tracked = 0;
+    for (std::size_t i = 0; i < world.bodies.size(); ++i) {
+      tracked += world.tracks[i].known && world.inverse_mass[i] > 0 ? 1 : 0;
+    }
+    // Fewer bodies than a cluster needs and no cluster: nothing to look at (the exact model's
+    // scenes pay nothing for the sub-steps).
+    if (tracked < stepping.min_bodies && stepping.clusters.empty()) return;
+    solveRegion(world, time, stepping.instant(stepping.next), {}, true, changed, released, report);
+    return;
+  }
+  std::vector<char> member(world.bodies.size(), 0);
+  bool any = false;
+  for (SteppedCluster& cluster : stepping.clusters) {
+    if (!(cluster.end <= time) && !cluster.stale) continue;
+    cluster.stale = false;
+    for (const std::size_t body : cluster.bodies) member[body] = 1;
+    any = true;
+  }
+  const double end = stepping.instant(stepping.next);
+  if (any && end > time) {
+    solveRegion(world, time, end, member, false, changed, released, report);
+  }
+}
+
+void joinStepped(World& world, double time, const std::vector<std::size_t>& moved,
+                 std::vector<std::size_t>& changed, StepReport& report) {
+  Stepping& stepping = world.stepping;
+  if (stepping.clusters.empty() || moved.empty()) return;
+  const double end = stepping.instant(stepping.next);
+  const double span = end - time;
+  if (!(span > 0)) return;  // the sub-step ends now: the body is looked at with the next
+  // Each cluster's box over the rest of its sub-step.
+  std::vector<Box> cluster_boxes;
+  for (const SteppedCluster& cluster : stepping.clusters) {
+    Box box{Eigen::Vector3d::Constant(INFINITY), Eigen::Vector3d::Constant(-INFINITY)};
+    for (const std::size_t body : cluster.bodies) {
+      const Eigen::Vector3d here = positionAt<Motion>(world, body, time);
+      const Eigen::Vector3d there = positionAt<Motion>(world, body, end);
+      const Eigen::Vector3d low = here.cwiseMin(there).array() - world.radius[body];
+      const Eigen::Vector3d high = here.cwiseMax(there).array() + world.radius[body];
+      box.low = box.low.cwiseMin(low);
+      box.high = box.high.cwiseMax(high);
+    }
+    cluster_boxes.push_back(box);
+  }
+  std::vector<char> member(world.bodies.size(), 0);
+  bool any = false;
+  for (const std::size_t body : moved) {
+    if (!world.tracks[body].known || world.stepped(body) || world.inverse_mass[body] == 0.0) {
+      continue;
+    }
+    const double reach = reachBefore(world, body, time, span);
+    const Eigen::Vector3d centre = positionAt<Motion>(world, body, time);
+    const double half = world.radius[body] * (1 + 2 * world.settings.contact_tolerance) + reach;
+    const Box box{centre.array() - half, centre.array() + half};
+    for (std::size_t c = 0; c < stepping.clusters.size(); ++c) {
+      if (!cluster_boxes[c].overlaps(box)) continue;
+      for (const std::size_t other : stepping.clusters[c].bodies) {
+        const Geometry g =
+            geometry<Motion>(world, Pair(std::min(body, other), std::max(body, other)), time);
+        const double other_reach = velocityAt<Motion>(world, other, time).norm() * span;
+        if (g.valid && g.gap <= reach + other_reach + g.tolerance) {
+          member[body] = 1;
+          for (const std::size_t m : stepping.clusters[c].bodies) member[m] = 1;
+          any = true;
+          break;
+        }
+      }
+    }
+  }
+  std::vector<std::size_t> released;  // none: a re-solve within a sub-step releases no body
+  if (any) solveRegion(world, time, end, member, false, changed, released, report);
+}
+
+void reportSteppedContacts(const World& world, double time, std::vector<ContactRecord>& contacts) {
+  for (const SteppedCluster& cluster : world.stepping.clusters) {
+    const double duration = cluster.end - cluster.start;
+    if (!(duration > 0)) continue;
+    for (const SteppedClusterContact& contact : cluster.contacts) {
+      const auto [a, other] = contact.pair;
+      ContactRecord record;
+      record.time = time;
+      record.body_a = a;
+      record.other_is_obstacle = world.isObstacle(other);
+      record.other = record.other_is_obstacle ? other - world.bodyCount() : other;
+      record.contact_point = contact.point;
+      record.normal = contact.normal;
+      record.normal_force = contact.keeping_impulse / duration;
+      record.friction_force = contact.friction_impulse / duration * contact.friction_direction;
+      const auto since = world.contact_since.find(contact.pair);
+      record.since = since == world.contact_since.end() ? cluster.start : since->second;
+      const Eigen::Vector3d relative =
+          velocityAt<Motion>(world, other, time) - velocityAt<Motion>(world, a, time);
+      const Eigen::Vector3d turning =
+          angularVelocityAt<Motion>(world, other, time) - angularVelocityAt<Motion>(world, a, time);
+      const double moving = relative.norm() + world.radius[a] * turning.norm();
+      if (moving <= 1e-9) {
+        record.state = ContactState::kResting;
+      } else {
+        record.state = contact.sticking ? ContactState::kRolling : ContactState::kSliding;
+      }
+      contacts.push_back(record);
+    }
+  }
+}
+
+std::vector<Pair> touchingPairsOf(const World& world, double time,
+                                  const std::vector<std::size_t>& bodies, const PairIndex& index) {
+  std::vector<Pair> touching;
+  for (const std::size_t body : bodies) {
+    if (body >= index.of.size()) continue;
+    for (const std::size_t k : index.of[body]) {
+      const Pair& pair = index.pairs[k];
+      if (world.steppedPair(pair)) continue;
+      const Geometry g = geometry<Motion>(world, pair, time);
+      if (g.valid && std::abs(g.gap) <= g.tolerance) touching.push_back(pair);
+    }
+  }
+  std::sort(touching.begin(), touching.end());
+  touching.erase(std::unique(touching.begin(), touching.end()), touching.end());
+  return touching;
+}
+
+void clearStepped(World& world, double time) {
+  for (const SteppedCluster& cluster : world.stepping.clusters) {
+    for (const std::size_t body : cluster.bodies) {
+      Track& track = world.tracks[body];
+      if (track.known) {
+        track.position = positionAt<Motion>(world, body, time);
+        track.velocity = velocityAt<Motion>(world, body, time);
+        track.time = time;
+        track.acceleration = world.gravity;
+      }
+      track.stepped = -1;
+    }
+  }
+  world.stepping.clusters.clear();
+  world.stepping.keeping_force.clear();
+}
+
+std::size_t steppedBodies(const World& world) {
+  std::size_t count = 0;
+  for (const SteppedCluster& cluster : world.stepping.clusters) count += cluster.bodies.size();
+  return count;
+}
+
+}  // namespace collision_response::core::monitor
