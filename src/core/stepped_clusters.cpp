@@ -79,6 +79,19 @@ std::vector<Pair> nearPairs(const World& world, double time, double span,
   return pairs;
 }
 
+/// The point of a contact: on a plane, where the sphere touches it; between two spheres, half-way
+/// between their surface points along the line of centres, summed so that it is the same bits
+/// whichever sphere comes first in the pair (the solve's order of contacts comes from these
+/// points, and renaming bodies swaps pairs' sides).
+Eigen::Vector3d contactPoint(const World& world, const Pair& pair, const Geometry& g, double time) {
+  const Eigen::Vector3d on_first =
+      positionAt<Motion>(world, pair.first, time) + world.radius[pair.first] * g.normal;
+  if (world.isPlane(pair.second)) return on_first;
+  const Eigen::Vector3d on_second =
+      positionAt<Motion>(world, pair.second, time) - world.radius[pair.second] * g.normal;
+  return 0.5 * (on_first + on_second);
+}
+
 /// A component's solve: its members (sorted) and their sub-step.
 struct Component {
   std::vector<std::size_t> members;
@@ -137,8 +150,7 @@ void solveComponent(World& world, double time, double span, const std::vector<St
     contact.a = slot(pair.first);
     contact.b = slot(pair.second);
     contact.normal = g.normal;
-    contact.point =
-        positionAt<Motion>(world, pair.first, time) + world.radius[pair.first] * g.normal;
+    contact.point = contactPoint(world, pair, g, time);
     contact.gap = g.gap;
     contact.band = g.tolerance;
     contact.restitution = world.restitutionOf(pair);
@@ -368,8 +380,7 @@ void solveRegion(World& world, double time, double end, std::vector<char> member
       SteppedClusterContact contact;
       contact.pair = pair;
       contact.normal = g.normal;
-      contact.point =
-          positionAt<Motion>(world, pair.first, time) + world.radius[pair.first] * g.normal;
+      contact.point = contactPoint(world, pair, g, time);
       contact.keeping_impulse = received.keeping_impulse;
       contact.friction_impulse = received.friction_impulse;
       contact.friction_direction = received.friction_direction;
