@@ -39,8 +39,8 @@ Engine oursEngine(core::Detection detection) {
       }
       const core::StepReport report = monitor.step(t, states);
       run.truncated = run.truncated || report.truncated;
+      playback.applyImpacts(monitor, report.impacts, exact_contact);
       for (const core::ImpactRecord& impact : report.impacts) {
-        playback.applyImpact(monitor, impact, exact_contact);
         ReportedImpact reported;
         reported.time = impact.time;
         reported.body = scene_index[impact.body_a];

@@ -388,13 +388,62 @@ StepReport discreteStep(World& world, double time, const std::vector<BodyStateSa
   std::vector<Pair>& pairs = world.scratch.pairs;
   monitor::candidatePairs<Motion>(world, time, time, pairs);
   std::vector<Pair> touching;
+  std::vector<Pair> overlapped_before;  // touching still, overlapping at the sample before
   for (const Pair& pair : pairs) {
     const Geometry g = monitor::geometry<Motion>(world, pair, time);
     if (world.steppedPair(pair)) continue;  // its stepped cluster keeps it apart
-    if (g.valid && g.gap <= g.tolerance &&
-        (world.overlapping.count(pair) == 0 || world.lasting(pair))) {
+    if (!g.valid || g.gap > g.tolerance) continue;
+    if (world.overlapping.count(pair) == 0 || world.lasting(pair)) {
       touching.push_back(pair);
+    } else {
+      overlapped_before.push_back(pair);
     }
+  }
+  // A pair still overlapping from an earlier impact is no new impact, but it takes part in one
+  // on its bodies: a ball rising out of the floor it bounced off, struck from above, runs into
+  // the floor (alone it would be driven through it, the floor pair never found again). Reached
+  // from the pairs that strike now, through touching pairs, as continuous detection's clusters.
+  if (!overlapped_before.empty()) {
+    std::vector<char> struck(world.bodies.size(), 0);
+    std::vector<std::size_t> frontier;
+    const auto reach = [&](std::size_t participant) {
+      if (world.isObstacle(participant) || struck[participant]) return;
+      struck[participant] = 1;
+      frontier.push_back(participant);
+    };
+    for (const Pair& pair : touching) {
+      const Geometry g = monitor::geometry<Motion>(world, pair, time);
+      if (monitor::approaching<Motion>(world, pair, g.normal, time)) {
+        reach(pair.first);
+        reach(pair.second);
+      }
+    }
+    for (bool grown = !frontier.empty(); grown;) {
+      grown = false;
+      for (auto pair = overlapped_before.begin(); pair != overlapped_before.end();) {
+        const bool first = struck[pair->first] != 0;
+        const bool second = !world.isObstacle(pair->second) && struck[pair->second] != 0;
+        if (!first && !second) {
+          ++pair;
+          continue;
+        }
+        reach(pair->first);
+        reach(pair->second);
+        touching.push_back(*pair);
+        pair = overlapped_before.erase(pair);
+        grown = true;
+      }
+      // Touching pairs of the bodies reached carry the blow on (a rack, a stack).
+      for (const Pair& pair : touching) {
+        if (struck[pair.first] || (!world.isObstacle(pair.second) && struck[pair.second])) {
+          const std::size_t before = frontier.size();
+          reach(pair.first);
+          reach(pair.second);
+          grown = grown || frontier.size() != before;
+        }
+      }
+    }
+    std::sort(touching.begin(), touching.end());
   }
   std::vector<std::size_t> changed;
   monitor::resolveInstant<Motion>(world, time, touching, report, changed);

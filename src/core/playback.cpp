@@ -128,6 +128,35 @@ void Playback::applyImpact(const ImpactMonitor& monitor, const ImpactRecord& imp
   }
 }
 
+void Playback::applyImpacts(const ImpactMonitor& monitor, const std::vector<ImpactRecord>& impacts,
+                            bool exact_contact) {
+  if (exact_contact) {
+    for (const ImpactRecord& impact : impacts) applyImpact(monitor, impact, true);
+    return;
+  }
+  struct Placed {
+    std::size_t body;
+    double time;
+    Eigen::Vector3d centre, velocity, angular_velocity;
+  };
+  std::vector<Placed> placed;
+  for (const ImpactRecord& impact : impacts) {
+    const auto place = [&](std::size_t monitor_body, const Eigen::Vector3d& after,
+                           const Eigen::Vector3d& angular_after) {
+      const auto body = bodyIndex(monitor.body(monitor_body).id);
+      if (body)
+        placed.push_back({*body, impact.time, position(*body, impact.time), after, angular_after});
+    };
+    place(impact.body_a, impact.velocity_a_after, impact.angular_velocity_a_after);
+    if (!impact.other_is_obstacle) {
+      place(impact.other, impact.velocity_b_after, impact.angular_velocity_b_after);
+    }
+  }
+  for (const Placed& p : placed) {
+    applyImpact(p.body, p.time, p.centre, p.velocity, p.angular_velocity);
+  }
+}
+
 std::vector<Apex> Playback::apexesUntil(double time) {
   std::vector<Apex> apexes;
   const double g = gravity_.norm();

@@ -195,12 +195,14 @@ void ScenePlayer::onImpacts(const ImpactArray::ConstPtr& message) {
   if (!playback_) return;
   // In continuous detection the contact point is exact (the surfaces touch there), so each body
   // restarts one radius back along the normal from it; in discrete detection the bodies overlap
-  // at the sample, and each restarts where the player had it (Playback::applyImpact).
+  // at the sample, and each restarts where the player had it (Playback::applyImpacts).
   const bool exact_contact = scene_.detection == core::Detection::kContinuous;
+  std::vector<core::ImpactRecord> records;
   for (const Impact& impact : message->impacts) {
-    const auto record = toImpactRecord(impact, *indexing_, sinceStart(impact.header.stamp));
-    if (record) playback_->applyImpact(*indexing_, *record, exact_contact);
+    auto record = toImpactRecord(impact, *indexing_, sinceStart(impact.header.stamp));
+    if (record) records.push_back(std::move(*record));
   }
+  playback_->applyImpacts(*indexing_, records, exact_contact);
 }
 
 void ScenePlayer::publishApexes(const ros::Time& time) {

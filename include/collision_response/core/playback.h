@@ -52,6 +52,12 @@ class Playback {
   /// surfaces touch there) or where they were.
   void applyImpact(const ImpactMonitor& monitor, const ImpactRecord& impact, bool exact_contact);
 
+  /// applyImpact for every record of one step (discrete detection's all at one instant): where
+  /// the bodies are is read once for them all, before any is applied (an impact does not move a
+  /// body at its instant), instead of the played motion being worked out again after each one.
+  void applyImpacts(const ImpactMonitor& monitor, const std::vector<ImpactRecord>& impacts,
+                    bool exact_contact);
+
   /// The flights whose highest point is at or before `time` and not yet reported.
   std::vector<Apex> apexesUntil(double time);
 
