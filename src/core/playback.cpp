@@ -52,7 +52,14 @@ const ImpactMonitor& Playback::at(double time) const {
         final_part.push_back(pending_.front());
         pending_.erase(pending_.begin());
       }
-      committed_.advance(horizon_, final_part);
+      if (view_ && view_time_ == horizon_) {
+        // The view was worked out to that instant with the same impacts (any impact applied
+        // since would have dropped it): it is what advancing would give again.
+        committed_ = std::move(*view_);
+        view_.reset();
+      } else {
+        committed_.advance(horizon_, final_part);
+      }
       committed_time_ = horizon_;
     }
     horizon_ = time;
