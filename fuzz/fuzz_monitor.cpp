@@ -1,8 +1,8 @@
 // libFuzzer target: the monitor's update cycle (MonitorCycle: intake, time line, the monitor's
 // step, the finiteness check of every impact) on a scene and a stream of messages made from the
-// fuzzer's bytes: masses, radii, effects, detection and obstacles; ids (the scene's, unknown,
-// empty, repeated), stamps (any seconds and nanoseconds, the clock's zero), frames, and every
-// number of every state. Invariants:
+// fuzzer's bytes: masses, radii, effects, detection, obstacles, stepped clusters; ids (the
+// scene's, unknown, empty, repeated), stamps (any seconds and nanoseconds, the clock's zero),
+// frames, and every number of every state. Invariants:
 //  - every impact in an update has only finite numbers; every report (a named drop or notice)
 //    has a text, and a refused impact names its field;
 //  - the work of one message is bounded: at most kAllocationCap bytes are allocated while it
@@ -103,6 +103,12 @@ core::Scene makeScene(fuzz::FuzzInput& in) {
     for (int i = 0; i < 3; ++i) sphere.position[i] = in.number();
     sphere.radius = std::abs(in.number());
     scene.obstacles.push_back(sphere);
+  }
+  if (flags & 128) {
+    // Stepped clusters of one to three bodies (README, "Lasting contact"): the fuzzed numbers
+    // reach the sub-step's solve.
+    scene.stepped_cluster_min_bodies = 1 + in.byte() % 3;
+    scene.stepped_cluster_time_step = 1e-4 + in.byte() / 255.0 * 0.05;
   }
   return scene;
 }

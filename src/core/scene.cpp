@@ -195,8 +195,7 @@ Status validateScene(const Scene& scene, const std::string& prefix) {
 
 void normalizePlanes(Scene& scene) {
   for (ObstacleSpec& obstacle : scene.obstacles) {
-    if (obstacle.shape == ObstacleShape::kPlane)
-      obstacle.normal = obstacle.normal.stableNormalized();
+    if (obstacle.shape == ObstacleShape::kPlane) obstacle.normal = unitVector(obstacle.normal);
   }
 }
 

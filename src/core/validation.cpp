@@ -128,8 +128,7 @@ Expected<Eigen::Vector3d> lineOfImpact(const Eigen::Vector3d& normal,
                                        const Eigen::Vector3d& position_b,
                                        const std::string& field) {
   if (auto status = checkFinite(normal, field); !status) return status.error();
-  // stableNormalized() rescales before squaring, so 1e-300 and 1e300 normals both work.
-  if (normal != Eigen::Vector3d::Zero()) return Eigen::Vector3d(normal.stableNormalized());
+  if (normal != Eigen::Vector3d::Zero()) return unitVector(normal);
   const Eigen::Vector3d centre_to_centre = position_b - position_a;
   if (!centre_to_centre.allFinite()) {
     return Error{field,
@@ -140,7 +139,12 @@ Expected<Eigen::Vector3d> lineOfImpact(const Eigen::Vector3d& normal,
     return Error{field, "is zero and a.position equals b.position " + formatVector(position_a) +
                             ": no line of impact; give a nonzero normal"};
   }
-  return Eigen::Vector3d(centre_to_centre.stableNormalized());
+  return unitVector(centre_to_centre);
+}
+
+Eigen::Vector3d unitVector(const Eigen::Vector3d& v) {
+  const Eigen::Vector3d scaled = v / v.cwiseAbs().maxCoeff();
+  return scaled / scaled.norm();
 }
 
 }  // namespace collision_response::core

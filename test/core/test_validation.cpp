@@ -111,6 +111,14 @@ TEST(Validation, NormalIsScaledToUnitLength) {
     ASSERT_TRUE(n.ok()) << scale;
     EXPECT_EQ(*n, Eigen::Vector3d(0, 0, 1)) << scale;
   }
+  // Among the subnormals (a fuzzer's finding): 231 and 54,300 times the smallest double. The
+  // unit vector along (0, 231, 54300) has length 1 to an ulp or two.
+  const double tiny = std::numeric_limits<double>::denorm_min();
+  const auto subnormal = lineOfImpact(Eigen::Vector3d(0, 231 * tiny, 54300 * tiny),
+                                      Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+  ASSERT_TRUE(subnormal.ok());
+  EXPECT_NEAR(subnormal->norm(), 1.0, 4 * std::numeric_limits<double>::epsilon());
+  EXPECT_NEAR(subnormal->y() / subnormal->z(), 231.0 / 54300.0, 1e-15);
   const auto derived =
       lineOfImpact(Eigen::Vector3d::Zero(), Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(1, 1, -4));
   ASSERT_TRUE(derived.ok());

@@ -57,6 +57,13 @@ Status checkRepresentable(std::initializer_list<NamedResult> results);
 /// Mass, radius, position, velocity and angular velocity of one body; `prefix` names it ("a").
 Status checkBody(const Body& body, const std::string& prefix);
 
+/// `v` (nonzero, finite) scaled to unit length at any magnitude, 1e-320 as 1e300: divided by
+/// its largest component first (exactly 1 there, the others correctly rounded), then by the
+/// norm of that (between 1 and sqrt 3). Eigen's stableNormalized() divides by their product
+/// instead, which among the subnormals keeps a few bits only: (0, 1.1e-321, 2.7e-319) came out
+/// 1e-5 away from unit length, and an elastic impact along it gained energy (a fuzzer's finding).
+Eigen::Vector3d unitVector(const Eigen::Vector3d& v);
+
 /// The unit line of impact, pointing from a to b: `normal` scaled to unit length when it is
 /// nonzero; when it is zero, the direction from a's centre to b's. Errors: a non-finite normal,
 /// or a zero normal with coincident centres (no line of impact).
