@@ -250,7 +250,8 @@ GROUPS = {
                 "update'; 0: it never rose). The balls are frictionless: at 2 s no engine's pile "
                 "is at rest, balls still sliding on the floor and the upper ones wedging the "
                 "lower apart; what moves at the end is that rearrangement, not energy put in, "
-                "when the energy never rises from one state to the next.",
+                "where the energy rises from one state to the next by no more than settling "
+                "within the touching band allows (ours: below the table).",
         "columns": [("penetration_pairs", "deepest overlap, pairs (m)", fmt),
                     ("penetration_walls", "deepest penetration, walls (m)", fmt),
                     ("kinetic_end", "kinetic energy at the end (J)", fmt),
