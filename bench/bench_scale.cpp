@@ -1,15 +1,17 @@
 // Scale: pair responses per second, and one state update of a gas of 1k, 10k and 100k spheres
 // in a box (every body's state each update, as a source that applies the responses sends
 // them), with Bullet's btDbvtBroadphase and solver on the same gas in the same run; and one
-// update of a pile of 1,000 balls at rest on a floor (lasting contact under gravity), against
-// the same pile with gravity off and against Bullet on the same pile; and the friction of one
-// cluster of up to 1,000 touching, spinning balls (the joint tangential solve alone).
+// update of piles of up to 1,000 balls at rest in a box (lasting contact under gravity: one
+// layer 1 mm apart or touching, and a stack 10 high), against the same pile with gravity off
+// and against Bullet on the same pile; and the friction of one cluster of up to 1,000 touching,
+// spinning balls (the joint tangential solve alone).
 // scripts/performance.sh runs it and writes doc/performance.md.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <memory>
 #include <random>
@@ -106,18 +108,20 @@ void BM_GasUpdate(benchmark::State& state) {
   state.counters["bodies"] = static_cast<double>(states.size());
 }
 
-/// A pile at rest: `columns` x `rows` balls (radius 0.05 m, 0.1 kg, e = 0.5, frictionless) on a
-/// floor in a square lattice, `gap` apart (0: each touching its neighbours), walls around the
-/// lattice. With gravity it is at rest exactly (each ball on the floor, no force between
-/// neighbours): every ball has a lasting contact with the floor.
+/// A pile at rest: `columns` x `rows` x `layers` balls (radius 0.05 m, 0.1 kg, e = 0.5,
+/// frictionless) on a floor in a cubic lattice, `gap` apart in each layer (0: each touching its
+/// neighbours), each layer resting on the one below (its balls right above theirs, touching),
+/// walls around the lattice touching its outer balls. With gravity it is at rest exactly (each
+/// ball carries the ones above it, no force between neighbours in a layer): every ball has a
+/// lasting contact with the floor or the ball below.
 constexpr double kPileRadius = 0.05;
 
-core::Scene makePile(int columns, int rows, double gap, bool gravity) {
+core::Scene makePile(int columns, int rows, int layers, double gap, bool gravity) {
   core::Scene scene;
   scene.effects.gravity = gravity;
   (void)scene.materials.addMaterial("pile", core::Material{0.5, {}}, "m");
   const double r = kPileRadius, pitch = 2 * r + gap;
-  for (int i = 0; i < columns * rows; ++i) {
+  for (int i = 0; i < columns * rows * layers; ++i) {
     core::BodySpec body;
     char id[16];
     std::snprintf(id, sizeof id, "ball_%04d", i);
@@ -125,7 +129,9 @@ core::Scene makePile(int columns, int rows, double gap, bool gravity) {
     body.mass = 0.1;
     body.radius = r;
     body.material = "pile";
-    body.position = V(r + pitch * (i % columns), r + pitch * (i / columns), r);
+    const int layer = i / (columns * rows), cell = i % (columns * rows);
+    body.position =
+        V(r + pitch * (cell % columns), r + pitch * (cell / columns), r + 2 * r * layer);
     scene.bodies.push_back(body);
   }
   const double length = pitch * columns - gap, width = pitch * rows - gap;
@@ -146,10 +152,11 @@ core::Scene makePile(int columns, int rows, double gap, bool gravity) {
   return scene;
 }
 
-/// The pile of a benchmark's arguments: columns, rows, gap (um), gravity (1) or not (0).
+/// The pile of a benchmark's arguments: columns, rows, layers, gap (um), gravity (1) or not (0).
 core::Scene pileOf(const benchmark::State& state) {
   return makePile(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)),
-                  1e-6 * static_cast<double>(state.range(2)), state.range(3) != 0);
+                  static_cast<int>(state.range(2)), 1e-6 * static_cast<double>(state.range(3)),
+                  state.range(4) != 0);
 }
 
 /// One update of the pile at 100 Hz, the monitor's step alone: every body's state from a source
@@ -176,7 +183,7 @@ void BM_PileUpdate(benchmark::State& state) {
   sample(0.0);
   monitor.step(0.0, states);
   double time = 0.0, source_seconds = 0.0;
-  std::size_t impacts = 0, contacts = 0;
+  std::size_t impacts = 0, contacts = 0, fallbacks = 0, stepped = 0;
   for (auto _ : state) {
     state.PauseTiming();
     time += 0.01;
@@ -189,6 +196,8 @@ void BM_PileUpdate(benchmark::State& state) {
     state.PauseTiming();
     impacts += report.impacts.size();
     contacts += report.contacts.size();
+    fallbacks += report.fallbacks;
+    stepped = report.stepped_bodies;
     for (const core::ImpactRecord& impact : report.impacts)
       source.applyImpact(monitor, impact, true);
     state.ResumeTiming();
@@ -203,15 +212,24 @@ void BM_PileUpdate(benchmark::State& state) {
   state.counters["source_ms"] = 1e3 * source_seconds / updates;
   state.counters["drift_m"] = drift;  // the farthest any centre moved from the lattice
   state.counters["bodies"] = static_cast<double>(states.size());
+  // In stepped clusters after the last update (README, "Lasting contact"), and what the
+  // fallbacks did (a stepped sub-step held still, for one) per update.
+  state.counters["stepped_bodies"] = static_cast<double>(stepped);
+  state.counters["fallbacks/update"] = static_cast<double>(fallbacks) / updates;
 }
 
-/// The piles: 1,000 balls 1 mm apart (gravity on and off), and touching lattices of 25, 100 and
-/// 225 (the core's cost grows steeply with touching neighbours: 1,000 touching is out of reach).
+/// The piles: 1,000 balls in one layer 1 mm apart and touching, and 10 x 10 x 10 touching in a
+/// stack (gravity on and off: with gravity all three are stepped clusters, each ball within a
+/// sub-step's reach of its neighbours); one layer of 25, 100 and 225 touching.
 void pileArguments(benchmark::internal::Benchmark* bench, bool with_gravity_off) {
-  bench->ArgNames({"columns", "rows", "gap_um", "gravity"});
-  bench->Args({40, 25, 1000, 1});
-  if (with_gravity_off) bench->Args({40, 25, 1000, 0});
-  for (const int side : {5, 10, 15}) bench->Args({side, side, 0, 1});
+  bench->ArgNames({"columns", "rows", "layers", "gap_um", "gravity"});
+  const std::vector<std::vector<std::int64_t>> thousands = {
+      {40, 25, 1, 1000}, {40, 25, 1, 0}, {10, 10, 10, 0}};
+  for (const std::vector<std::int64_t>& pile : thousands) {
+    bench->Args({pile[0], pile[1], pile[2], pile[3], 1});
+    if (with_gravity_off) bench->Args({pile[0], pile[1], pile[2], pile[3], 0});
+  }
+  for (const int side : {5, 10, 15}) bench->Args({side, side, 1, 0, 1});
 }
 BENCHMARK(BM_PileUpdate)
     ->Apply([](benchmark::internal::Benchmark* bench) { pileArguments(bench, true); })

@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # What accuracy costs in time: every scene of bench/accuracy at every setting (our continuous
-# and discrete detection, effects on and off; Bullet with its defaults and with its recommended
-# bouncing settings; ODE; MuJoCo with its default contact and with restitution through solref;
-# DART; Box2D on the planar scenes; lasting contact under gravity: a ball into a corner, off a
-# fixed sphere, a stack of three, piles settling in a box), errors against references computed outside the code under
+# and discrete detection, effects on and off, and every body stepped where a scene asks for it;
+# Bullet with its defaults and with its recommended bouncing settings; ODE; MuJoCo with its
+# default contact and with restitution through solref; DART; Box2D on the planar scenes; lasting
+# contact under gravity: a ball into a corner, off a fixed sphere, a stack of three, piles of 27
+# to 1,000 balls settling in a box), errors against references computed outside the code under
 # test and CPU time (Google Benchmark). Writes doc/accuracy.md, doc/accuracy.png and the
 # accuracy section of doc/measurements.md (between its markers).
-#   bash scripts/accuracy.sh
+#   bash scripts/accuracy.sh    # about 15 minutes on 2 cores, most of it ours' 1,000-ball pile
 # The references are recomputed on every run (about ten seconds) from the scenes' inputs as the
 # benchmark builds them, so that a changed scene is never measured against a stale answer; they
 # are also checked in (bench/accuracy/reference/), so that any change of an answer shows in review.

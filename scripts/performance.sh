@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
-# Scale: the core per update for 1k, 10k and 100k bodies beside Bullet, and a pile of balls at
-# rest on a floor (lasting contact) with gravity on and off, beside Bullet (Google Benchmark); the
-# node over ROS with 10,000 bodies at 100 Hz (CPU share, latency, memory over a long run); the
-# collision service's round trip beside an empty service; the work of one hard message (an
-# array of 10,000 distinct stamps, a cluster of 1,000 touching balls: the monitor's CPU, and
-# the service's worst round trip meanwhile) and start-up from 1,000 to 30,000 bodies.
+# Scale: the core per update for 1k, 10k and 100k bodies beside Bullet, and piles of up to 1,000
+# balls at rest in a box (lasting contact: one layer, a stack 10 high) with gravity on and off,
+# beside Bullet (Google Benchmark); the node over ROS with 10,000 bodies at 100 Hz (CPU share,
+# latency, memory over a long run); the collision service's round trip beside an empty service;
+# the work of one hard message (an array of 10,000 distinct stamps, a cluster of 1,000 touching
+# balls: the monitor's CPU, and the service's worst round trip meanwhile) and start-up from
+# 1,000 to 30,000 bodies.
 # Writes doc/performance.md.
 #   bash scripts/performance.sh                    # the memory run lasts 10 minutes
 #   MEMORY_SECONDS=60 bash scripts/performance.sh  # a shorter one
@@ -12,7 +13,7 @@
 # The pile's section alone (about 2 minutes), into the existing doc/performance.md:
 #   .ws/devel/lib/collision_response/bench_scale --benchmark_filter=Pile \
 #     --benchmark_format=json --benchmark_out=.ws/pile.json
-#   python3 scripts/performance_report.py --pile-only .ws/pile.json doc/performance.md
+#   /usr/bin/python3 scripts/performance_report.py --pile-only .ws/pile.json doc/performance.md
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 PACKAGES+=(libbenchmark-dev libbullet-dev libstd-srvs-dev ros-std-srvs linux-perf)

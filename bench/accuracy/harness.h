@@ -56,6 +56,9 @@ struct Run {
   bool reports_impacts = false;         ///< true: `impacts` is the engine's own list
   bool truncated = false;               ///< the engine stopped a step early (ours: a guard)
   std::size_t states = 0;               ///< states recorded, kept or not
+  /// Ours: the bodies in stepped clusters after the last update (StepReport::stepped_bodies);
+  /// the peers: NaN.
+  double stepped_bodies = std::nan("");
 
   /// Appends the state at `time` (or replaces the last one when only the ends are kept).
   void record(const Play& play, double time, const std::vector<V>& p, const std::vector<V>& v);
@@ -94,6 +97,10 @@ struct BenchScene {
   std::vector<double> integration_tolerances = {};
   /// The engines that play the scene (empty: every one); e.g. a pile too large for some.
   std::vector<std::string> engines = {};
+  /// The rates at which "ours, stepped" (every body in a stepped cluster) plays the scene; empty:
+  /// not played. Its sub-step is each update's interval, split evenly when longer than
+  /// Scene::stepped_cluster_time_step (0.01 s): 1 / rate from 100 Hz up.
+  std::vector<double> stepped_rates = {};
 };
 
 /// Every scene, short ones first; names are unique. The one list: the benchmark, the exported
@@ -141,8 +148,10 @@ struct ProductRestitutions {
 ProductRestitutions productRestitutions(const core::Scene& scene);
 
 /// Our engine: the core's ImpactMonitor watching a core::Playback, as the node and the scene
-/// player do over ROS.
-Engine oursEngine(core::Detection detection);
+/// player do over ROS. `stepped_cluster_min_bodies` > 0: the scene's Scene::
+/// stepped_cluster_min_bodies set to it (1: every body under gravity is stepped). A stepped
+/// cluster reports no impacts, so such a run is measured from its states, as the peers' are.
+Engine oursEngine(core::Detection detection, int stepped_cluster_min_bodies = 0);
 
 #ifdef COLLISION_RESPONSE_WITH_BULLET
 /// Bullet 3: btDiscreteDynamicsWorld, spheres and static planes. `recommended`: the settings

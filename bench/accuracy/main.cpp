@@ -1,7 +1,8 @@
 // The accuracy-versus-cost benchmark: every scene at every setting (ours: continuous and
-// discrete detection, effects on and off; Bullet with its defaults and its recommended bouncing
-// settings; ODE; MuJoCo with its default soft contact and with restitution through solref; DART;
-// Box2D on the planar scenes), at the scene's state rates; errors against the references of
+// discrete detection, effects on and off, and every body stepped on the scenes that list
+// stepped rates; Bullet with its defaults and its recommended bouncing settings; ODE; MuJoCo
+// with its default soft contact and with restitution through solref; DART; Box2D on the planar
+// scenes), at the scene's state rates; errors against the references of
 // reference/references.txt written to a JSON file, CPU time measured by Google Benchmark.
 // scripts/accuracy.sh runs it and makes doc/accuracy.md and doc/accuracy.png.
 //   accuracy_benchmark --export-scenes <scenes.txt>
@@ -39,6 +40,9 @@ std::vector<EngineSetting> engineSettings() {
   std::vector<EngineSetting> settings = {
       {"ours", "continuous", oursEngine(core::Detection::kContinuous)},
       {"ours", "discrete", oursEngine(core::Detection::kDiscrete)},
+      // Every body under gravity in a stepped cluster (stepped_cluster_min_bodies = 1): what the
+      // stepped model costs in accuracy, at the rates of BenchScene::stepped_rates.
+      {"ours", "stepped", oursEngine(core::Detection::kContinuous, 1)},
   };
 #ifdef COLLISION_RESPONSE_WITH_BULLET
   settings.push_back({"bullet", "default", bulletEngine(false)});
@@ -103,8 +107,9 @@ struct Case {
   double tolerance = 0;  ///< Scene::contact_integration_tolerance; 0: the scene's own
 };
 
-/// Every engine setting (of the scene's engines) at every rate of the scene, then ours with the
-/// scene's extra effects, then ours at each integration tolerance of the scene.
+/// Every engine setting (of the scene's engines) at every rate of the scene (ours, stepped: at
+/// its stepped rates), then ours with the scene's extra effects, then ours at each integration
+/// tolerance of the scene.
 std::vector<Case> casesOf(const BenchScene& bench, const std::vector<EngineSetting>& settings) {
   std::vector<Case> cases;
   for (const EngineSetting& setting : settings) {
@@ -112,7 +117,10 @@ std::vector<Case> casesOf(const BenchScene& bench, const std::vector<EngineSetti
                        std::find(bench.engines.begin(), bench.engines.end(), setting.engine) !=
                            bench.engines.end();
     if (!plays) continue;
-    for (const double rate : bench.rates) cases.push_back({&setting, "none", rate});
+    const bool stepped = setting.engine == "ours" && setting.variant == "stepped";
+    for (const double rate : stepped ? bench.stepped_rates : bench.rates) {
+      cases.push_back({&setting, "none", rate});
+    }
   }
   for (const std::string& effects : bench.effect_variants) {
     cases.push_back({&settings.front(), effects, 100.0});  // ours, continuous

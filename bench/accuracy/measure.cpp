@@ -314,6 +314,19 @@ double energyGain(const core::Scene& scene, const Run& run) {
   return gain;
 }
 
+/// J: the largest rise of the energy (kinetic of the centres, plus potential) from one sampled
+/// instant to the next (0: it never rose). A settling pile that still moves at its end but never
+/// gains energy is rearranging, not being pumped.
+double energyStepRise(const core::Scene& scene, const Run& run) {
+  double rise = 0, before = energy(scene, run, 0);
+  for (std::size_t k = 1; k < run.samples(); ++k) {
+    const double now = energy(scene, run, k);
+    rise = std::max(rise, now - before);
+    before = now;
+  }
+  return rise;
+}
+
 double kineticEnergy(const core::Scene& scene, const Run& run, std::size_t sample) {
   double total = 0;
   for (std::size_t i = 0; i < run.bodies; ++i) {
@@ -442,7 +455,9 @@ Metrics ballPile(const core::Scene& scene, const Run& run) {
           {"penetration_walls", deepest.planes},
           {"kinetic_end", kineticEnergy(scene, run, run.samples() - 1)},
           {"final_speed", fastest},
-          {"energy_gain", energyGain(scene, run)}};
+          {"energy_gain", energyGain(scene, run)},
+          {"energy_step_rise", energyStepRise(scene, run)},
+          {"stepped_bodies", run.stepped_bodies}};
 }
 
 }  // namespace
