@@ -138,6 +138,9 @@ struct Stepping {
   std::vector<SteppedCluster> clusters;
   /// Per pair, the force that kept its gap over its last sub-step: the next one starts there.
   std::map<Pair, double> keeping_force;
+  /// Per pair that came into contact in the last sub-step, the speed it closed at (m/s): its
+  /// bounce, at the next sub-step, is e times that.
+  std::map<Pair, double> arrival_speed;
   /// Sub-steps whose solve could not keep the gaps at all (every body held still).
   std::size_t held = 0;
 

@@ -155,6 +155,10 @@ void solveComponent(World& world, double time, double span, const std::vector<St
     contact.band = g.tolerance;
     contact.restitution = world.restitutionOf(pair);
     if (world.friction_model) contact.friction = world.frictionOf(pair);
+    if (warm_start) {
+      const auto arrived = world.stepping.arrival_speed.find(pair);
+      if (arrived != world.stepping.arrival_speed.end()) contact.arrival_speed = arrived->second;
+    }
     contacts.push_back(contact);
     // At the grid, the last sub-step's forces; within a sub-step (whose gravity its members have
     // already), only what changed is solved for.
@@ -367,6 +371,11 @@ void solveRegion(World& world, double time, double end, std::vector<char> member
     for (std::size_t k = 0; k < component.pairs.size(); ++k) {
       const Pair& pair = component.pairs[k];
       const SteppedContactOutcome& received = outcome.contacts[k];
+      if (received.arrival_speed > 0) {
+        stepping.arrival_speed[pair] = received.arrival_speed;
+      } else {
+        stepping.arrival_speed.erase(pair);
+      }
       if (received.keeping_impulse > 0 || received.bounce_impulse > 0) {
         stepping.keeping_force[pair] = received.keeping_impulse / outcome.duration;
       } else {
@@ -548,6 +557,7 @@ void clearStepped(World& world, double time) {
   }
   world.stepping.clusters.clear();
   world.stepping.keeping_force.clear();
+  world.stepping.arrival_speed.clear();
 }
 
 std::size_t steppedBodies(const World& world) {

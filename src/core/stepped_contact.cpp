@@ -185,6 +185,16 @@ BoundedSolution solveBounded(const ContactSpace& space, const Eigen::VectorXd& q
   return result;
 }
 
+/// The movable bodies' kinetic energy at the velocities `v` (J).
+double kineticEnergy(const std::vector<SteppedBody>& bodies,
+                     const std::vector<Eigen::Vector3d>& v) {
+  double energy = 0.0;
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    if (bodies[i].inverse_mass > 0) energy += 0.5 * v[i].squaredNorm() / bodies[i].inverse_mass;
+  }
+  return energy;
+}
+
 /// The solve's order of the contacts: by their points (then normals), which no name and no
 /// listing order of the bodies changes; two contacts at one point and along one normal (only
 /// between overlapping bodies) keep the order they were given in.
@@ -270,58 +280,68 @@ SteppedOutcome solveSteppedSubstep(const std::vector<SteppedBody>& bodies,
 
   // 1. Bounce.
   std::vector<char> touching(contacts.size(), 0);
+  std::vector<double> bounce_speed(contacts.size(), 0.0);
   bool any_struck = false;
+  double owed = 0.0;  // what the sub-step before took from the arrivals (J)
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     const SteppedContact& c = contacts[k];
     SteppedContactOutcome& out = outcome.contacts[k];
     out.approach_speed = c.normal.dot(v[c.a] - v[c.b]);
     touching[k] = c.gap <= c.band;
+    const double speed = std::max(out.approach_speed, c.arrival_speed);
     // A bounce slower than sqrt(2 g band) would not leave the touching band under gravity g
     // (the exact model's rest rule, restSpeed in motion.h): it rests, and the gap keeping
     // stops it. What the solves leave behind (their residual) is far slower than that.
     const double gravity = std::max(bodies[c.a].kick.norm(), bodies[c.b].kick.norm()) / h;
     const double rounding =
         64 * kEps * (v[c.a].lpNorm<Eigen::Infinity>() + v[c.b].lpNorm<Eigen::Infinity>());
-    out.struck = touching[k] && out.approach_speed > rounding &&
-                 out.approach_speed > std::sqrt(2 * gravity * c.band) &&
-                 out.approach_speed >= settings.restitution_threshold;
+    out.struck = touching[k] && speed > rounding && speed > std::sqrt(2 * gravity * c.band) &&
+                 speed >= settings.restitution_threshold;
+    if (out.struck) {
+      bounce_speed[k] = c.restitution * speed;
+      const double closing = std::max(out.approach_speed, 0.0);
+      owed += 0.5 * (speed * speed - closing * closing) /
+              (bodies[c.a].inverse_mass + bodies[c.b].inverse_mass);
+    }
     any_struck = any_struck || out.struck;
   }
   if (any_struck) {
     const std::vector<std::size_t> order = contactOrder(contacts, touching);
     const ContactSpace space(bodies, contacts, order);
-    const Eigen::VectorXd q = space.normalVelocities(v);  // target d' >= 0
+    const double infinity = std::numeric_limits<double>::infinity();
+    const double before = kineticEnergy(bodies, v);
     const BoundedSolution compression =
-        solveBounded(space, q, Eigen::VectorXd::Zero(space.size()), tolerance,
-                     settings.max_iterations, std::numeric_limits<double>::infinity());
-    outcome.iterations += compression.iterations;
-    outcome.converged = outcome.converged && compression.converged;
-    const Eigen::VectorXd& stop = compression.impulses;
-    space.addVelocityChanges(stop, v);
-    Eigen::VectorXd restitution(space.size());
+        solveBounded(space, space.normalVelocities(v), Eigen::VectorXd::Zero(space.size()),
+                     tolerance, settings.max_iterations, infinity);  // d' >= 0
+    space.addVelocityChanges(compression.impulses, v);
+    Eigen::VectorXd q = space.normalVelocities(v);  // d' >= e u where struck, else >= 0
     for (Eigen::Index i = 0; i < space.size(); ++i) {
-      const std::size_t k = order[static_cast<std::size_t>(i)];
-      restitution[i] = outcome.contacts[k].struck ? contacts[k].restitution * stop[i] : 0.0;
+      q[i] -= bounce_speed[order[static_cast<std::size_t>(i)]];
     }
-    // The kinetic energy after both, against after none: -S/2 + s^2 R/2 + s X for the
-    // restitution scaled by s, with S = J.AJ, R = J_e.AJ_e and X = J_e.d (d after compression,
-    // ~0 where J > 0). For one restitution coefficient this is -(1 - e^2) S / 2 <= 0; where the
-    // contacts have different ones it may not be, and s is the largest in [0, 1] that adds none.
-    Eigen::VectorXd a_stop, a_restitution;
-    space.apply(stop, a_stop);
-    space.apply(restitution, a_restitution);
-    const double stopped = stop.dot(a_stop);
-    const double returned = restitution.dot(a_restitution);
-    const double cross = restitution.dot(space.normalVelocities(v));
+    const BoundedSolution restitution = solveBounded(space, q, Eigen::VectorXd::Zero(space.size()),
+                                                     tolerance, settings.max_iterations, infinity);
+    outcome.iterations += compression.iterations + restitution.iterations;
+    outcome.converged = outcome.converged && compression.converged && restitution.converged;
+    // The kinetic energy with the restitution scaled by s: K(s) = K_c + s X + s^2 R / 2 (X = J.d
+    // after compression, R = J.AJ). With one coefficient and no arrival it is below the energy
+    // before (Newton's law for one contact; jointly it need not be); s is the largest in [0, 1]
+    // with K(s) <= the energy before plus what the sub-step before took from the arrivals.
+    Eigen::VectorXd a_restitution;
+    space.apply(restitution.impulses, a_restitution);
+    const double compressed = kineticEnergy(bodies, v);
+    const double returned = restitution.impulses.dot(a_restitution);
+    const double cross = restitution.impulses.dot(space.normalVelocities(v));
+    const double allowed = before + owed - compressed;
     double scale = 1.0;
-    if (-0.5 * stopped + 0.5 * returned + cross > 0 && returned > 0) {
-      scale =
-          std::clamp((-cross + std::sqrt(cross * cross + returned * stopped)) / returned, 0.0, 1.0);
+    if (cross + 0.5 * returned > allowed && returned > 0) {
+      scale = std::clamp(
+          (-cross + std::sqrt(std::max(0.0, cross * cross + 2 * returned * allowed))) / returned,
+          0.0, 1.0);
     }
-    space.addVelocityChanges(scale * restitution, v);
+    space.addVelocityChanges(scale * restitution.impulses, v);
     for (Eigen::Index i = 0; i < space.size(); ++i) {
       outcome.contacts[order[static_cast<std::size_t>(i)]].bounce_impulse =
-          stop[i] + scale * restitution[i];
+          compression.impulses[i] + scale * restitution.impulses[i];
     }
   }
 
@@ -339,10 +359,20 @@ SteppedOutcome solveSteppedSubstep(const std::vector<SteppedBody>& bodies,
       start[static_cast<Eigen::Index>(i)] = warm[order[i]];
     }
   }
+  std::vector<double> closing_before(contacts.size());  // before the gaps are kept
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    closing_before[k] = contacts[k].normal.dot(v[contacts[k].a] - v[contacts[k].b]);
+  }
   BoundedSolution kept =
       keepGaps(bodies, contacts, order, start, h, tolerance, settings.max_iterations, v);
   outcome.iterations += kept.iterations;
   Eigen::VectorXd keeping = kept.impulses;
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const std::size_t k = order[i];
+    if (!touching[k] && keeping[static_cast<Eigen::Index>(i)] > 0 && closing_before[k] > 0) {
+      outcome.contacts[k].arrival_speed = closing_before[k];
+    }
+  }
 
   // 4. Friction, then the gaps again.
   if (settings.friction && !contacts.empty()) {

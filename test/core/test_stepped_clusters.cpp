@@ -126,6 +126,30 @@ TEST(SteppedSubstep, AFallStopsAtTheFloorNotInIt) {
   EXPECT_EQ(outcome.velocity[0].x(), 0.3);  // frictionless: the tangential part is untouched
 }
 
+// The same fall, one sub-step on: the ball touches the floor, closing at the -gap / h the gap
+// keeping left it, but it arrived at 1 m/s + g h (its speed over the sub-step before, reported
+// as arrival_speed). It leaves at e times the arrival speed, then gravity takes g h off.
+TEST(SteppedSubstep, AnArrivalBouncesAtETimesItsSpeed) {
+  const double m = 0.1, r = 0.05, h = 0.01, gap = 1e-3, band = 1e-9 * r, e = 0.5;
+  std::vector<SteppedBody> bodies = {movable(m, r, V(0, 0, -1.0), V(0, 0, -kG * h)), fixedPlane()};
+  std::vector<SteppedContact> contacts = {
+      contact(0, 1, V(0, 0, -1), V(0, 0, r + gap), r, gap, band, e)};
+  SteppedSettings settings;
+  settings.duration = h;
+  const SteppedOutcome landing = solveSteppedSubstep(bodies, contacts, settings);
+  const double arrival = 1.0 + kG * h;
+  EXPECT_NEAR(landing.contacts[0].arrival_speed, arrival, 1e-15);
+  bodies[0].velocity = landing.velocity[0];
+  contacts[0].gap = 0.0;
+  contacts[0].point = V(0, 0, 0);
+  contacts[0].arrival_speed = landing.contacts[0].arrival_speed;
+  const SteppedOutcome bounce = solveSteppedSubstep(bodies, contacts, settings);
+  ASSERT_TRUE(bounce.converged);
+  EXPECT_TRUE(bounce.contacts[0].struck);
+  EXPECT_NEAR(bounce.velocity[0].z(), e * arrival - kG * h, 1e-12);
+  EXPECT_EQ(bounce.contacts[0].arrival_speed, 0.0);  // touching at its start: no arrival
+}
+
 /// A random cluster: `count` balls in a loose heap on a floor, touching or near each other,
 /// with random velocities; every pair within `near` and every ball within `near` of the floor is
 /// a contact. Restitution from `restitutions`, per contact.
@@ -380,11 +404,11 @@ std::string plainName(int i) {
 }
 
 // 64 balls dropped into a box (e = 0.5): more than the 32 a stepped cluster needs, so the pile
-// they make is time-stepped. Over 2 s at 100 Hz no ball is ever more than a quarter of the
+// they make is time-stepped. Over 4 s at 100 Hz no ball is ever more than a quarter of the
 // touching band (1e-9 of the contact distance) into another or into a wall, the energy never
-// rises above the drop's, and the pile comes to rest: frictionless, it rearranges now and then
-// (a ball sliding off another: 3e-5 J at 1.9 s), and by 4 s its kinetic energy is below 1e-9 of
-// the drop's potential energy (1e-17 J, seen from 3.9 s on).
+// rises above the drop's, and the pile settles: its kinetic energy falls below 1e-6 of the drop's
+// potential energy. (Not to 0: frictionless, a ball sliding on the floor keeps its speed until
+// it meets a wall; seen: 1.2e-7 J, a ball at 1.5 mm/s, from 2.9 s to 3.9 s.)
 TEST(SteppedClusters, APileSettlesInABoxNeverInsideAnything) {
   const PileRun run = dropPile(4.0, plainName);
   EXPECT_GE(run.most_stepped, 32u);
@@ -392,7 +416,7 @@ TEST(SteppedClusters, APileSettlesInABoxNeverInsideAnything) {
   EXPECT_LE(run.deepest_into_ball, 0.25 * 1e-9 * 0.1);
   EXPECT_LE(run.deepest_into_wall, 0.25 * 1e-9 * 0.05 + 1e-16);
   EXPECT_LE(run.gain, 1e-12 * run.released);
-  EXPECT_LE(run.kinetic_end, 1e-9 * run.released);
+  EXPECT_LE(run.kinetic_end, 1e-6 * run.released);
 }
 
 // The same pile with every ball named otherwise (the monitor indexes bodies by sorted id, so the

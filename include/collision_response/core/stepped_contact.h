@@ -40,6 +40,10 @@ struct SteppedContact {
   double band = 0.0;  ///< m: within it the pair touches (it may strike); the overlap allowed
   double restitution = 0.0;
   double friction = 0.0;  ///< mu, read with a friction step only
+  /// m/s: the speed at which the pair closed in the sub-step before, when it came into contact
+  /// there (SteppedContactOutcome::arrival_speed); 0 when it did not. Its bounce is e times
+  /// this, not e times what that sub-step's gap keeping left of it.
+  double arrival_speed = 0.0;
 };
 
 struct SteppedSettings {
@@ -62,6 +66,9 @@ struct SteppedContactOutcome {
   Eigen::Vector3d friction_direction = Eigen::Vector3d::Zero();  ///< unit, against b's slip
   bool sticking = false;                                         ///< friction stopped the slip
   bool struck = false;  ///< touching and approaching at the threshold or faster
+  /// m/s: not touching at the start, closed by the gap keeping within the sub-step: the speed
+  /// it was closing at then (its bounce is the next sub-step's); 0 otherwise.
+  double arrival_speed = 0.0;
 };
 
 struct SteppedOutcome {
@@ -84,10 +91,12 @@ struct SteppedOutcome {
 /// 1997), in four stages:
 ///
 /// 1. Bounce: touching contacts (gap <= band) are compressed jointly (impulses J >= 0 after which
-///    none approaches, J = 0 where one separates anyway), and those that struck (approaching at
-///    the threshold or faster) get Poisson's restitution impulse e J on top. A restitution that
-///    would add kinetic energy (contacts coupled through a light body) is scaled down until it
-///    adds none.
+///    none approaches, J = 0 where one separates anyway); then those that struck (approaching, or
+///    having arrived in the sub-step before, at the threshold or faster, and faster than a
+///    bounce that would not leave the band) leave at e times that speed, the others do not
+///    approach (Newton's law, jointly: impulses J >= 0 again). A restitution that would add
+///    kinetic energy (contacts coupled through a light body), beyond what the sub-step before
+///    took from the arrivals, is scaled down until it adds none.
 /// 2. Gravity: every movable body's velocity gains its kick, g h.
 /// 3. Gap keeping: the velocities nearest (in kinetic energy) to those, among the ones with
 ///    which every contact's gap at the sub-step's end, gap + d' h, is >= 0 (d' the normal
