@@ -130,7 +130,7 @@ struct SteppedCluster {
 /// solveSteppedSubstep, the others stay with the exact model.
 struct Stepping {
   std::size_t min_bodies = 0;  ///< 0: never
-  double time_step = 0.01;     ///< s, the longest sub-step
+  double time_step = 0.01;     ///< s, a sub-step (one of up to 1.25 times it is not split)
   /// The step being taken: [begin, end] in `substeps` equal sub-steps; `next` the sub-step to
   /// start next (0 at the step's start). The instant `end` starts the next step's first one.
   double begin = 0.0, end = 0.0;
@@ -155,7 +155,9 @@ struct Stepping {
   void beginStep(double from, double to) {
     begin = from;
     end = to;
-    substeps = static_cast<long>(std::ceil((to - from) / time_step * (1 - 1e-12)));
+    // An update a little later than the rate time_step names (timer jitter) is not split: up
+    // to 1.25 time_step is one sub-step.
+    substeps = static_cast<long>(std::ceil((to - from) / (1.25 * time_step)));
     substeps = std::max(substeps, 1L);
     next = 0;
   }

@@ -209,11 +209,15 @@ void solveRegion(World& world, double time, double end, std::vector<char> member
   Stepping& stepping = world.stepping;
   const std::size_t n = world.bodies.size();
   const double span = end - time;
+  // Near is judged over a whole sub-step at least (stepped_cluster_time_step), whatever this one
+  // is: a sub-step shortened to the rest of an update, or an update a little early, would
+  // otherwise part a cluster for one sub-step and hand its bodies to the exact model.
+  const double horizon = std::max(span, stepping.time_step);
   std::vector<double> reach(n, 0.0);
   for (std::size_t i = 0; i < n; ++i) {
-    if (world.tracks[i].known) reach[i] = reachBefore(world, i, time, span);
+    if (world.tracks[i].known) reach[i] = reachBefore(world, i, time, horizon);
   }
-  std::vector<Pair> near = nearPairs(world, time, span, reach);
+  std::vector<Pair> near = nearPairs(world, time, horizon, reach);
   const auto movable = [&](std::size_t p) {
     return !world.isObstacle(p) && world.inverse_mass[p] > 0;
   };
@@ -309,7 +313,7 @@ void solveRegion(World& world, double time, double end, std::vector<char> member
                      component.outcome.velocity[i].norm() * component.outcome.duration);
       }
     }
-    if (!take_near(nearPairs(world, time, span, reach))) break;
+    if (!take_near(nearPairs(world, time, horizon, reach))) break;
   }
 
   // The clusters that were: those whose bodies are solved now are replaced (all, at the grid).
