@@ -110,22 +110,25 @@ bool Playback::applyImpact(std::size_t body, double time, const Eigen::Vector3d&
   return true;
 }
 
-void Playback::applyImpact(const ImpactMonitor& monitor, const ImpactRecord& impact,
+bool Playback::applyImpact(const ImpactMonitor& monitor, const ImpactRecord& impact,
                            bool exact_contact) {
   const auto apply = [&](std::size_t monitor_body, double side, const Eigen::Vector3d& after,
                          const Eigen::Vector3d& angular_after) {
     const auto body = bodyIndex(monitor.body(monitor_body).id);
-    if (!body) return;
+    if (!body) return true;  // not one of this scene's bodies: nothing to move
     const double radius = scene_.bodies[*body].radius;
     const Eigen::Vector3d centre =
         exact_contact ? Eigen::Vector3d(impact.contact_point + side * radius * impact.normal)
                       : position(*body, impact.time);
-    applyImpact(*body, impact.time, centre, after, angular_after);
+    return applyImpact(*body, impact.time, centre, after, angular_after);
   };
-  apply(impact.body_a, -1.0, impact.velocity_a_after, impact.angular_velocity_a_after);
+  bool applied =
+      apply(impact.body_a, -1.0, impact.velocity_a_after, impact.angular_velocity_a_after);
   if (!impact.other_is_obstacle) {
-    apply(impact.other, +1.0, impact.velocity_b_after, impact.angular_velocity_b_after);
+    applied = apply(impact.other, +1.0, impact.velocity_b_after, impact.angular_velocity_b_after) &&
+              applied;
   }
+  return applied;
 }
 
 std::vector<Apex> Playback::apexesUntil(double time) {

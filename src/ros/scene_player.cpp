@@ -199,7 +199,16 @@ void ScenePlayer::onImpacts(const ImpactArray::ConstPtr& message) {
   const bool exact_contact = scene_.detection == core::Detection::kContinuous;
   for (const Impact& impact : message->impacts) {
     const auto record = toImpactRecord(impact, *indexing_, sinceStart(impact.header.stamp));
-    if (record) playback_->applyImpact(*indexing_, *record, exact_contact);
+    if (!record || playback_->applyImpact(*indexing_, *record, exact_contact)) continue;
+    // Heard after its instant was played and made final: the bodies go on without it. Never
+    // silent: what is shown from here on may have them inside each other.
+    ROS_WARN_STREAM_THROTTLE(
+        5.0, "scene_player: the impact of '"
+                 << impact.body_a << "' and '" << impact.body_b << "' at "
+                 << sinceStart(impact.header.stamp)
+                 << " s came after that instant was played (the node answered more than a period "
+                    "of ~rate late): not applied, so those bodies go on without it and may be "
+                    "shown inside each other");
   }
 }
 

@@ -49,8 +49,9 @@ class Playback {
 
   /// Applies an impact record of `monitor` (whose bodies are indexed by id) to the bodies it
   /// names, placing them at the contact (`exact_contact`: continuous detection, where the
-  /// surfaces touch there) or where they were.
-  void applyImpact(const ImpactMonitor& monitor, const ImpactRecord& impact, bool exact_contact);
+  /// surfaces touch there) or where they were. False when a body refused it (its instant is older
+  /// than what is final: it came too late to be played), so that the caller can say so.
+  bool applyImpact(const ImpactMonitor& monitor, const ImpactRecord& impact, bool exact_contact);
 
   /// The flights whose highest point is at or before `time` and not yet reported.
   std::vector<Apex> apexesUntil(double time);
