@@ -117,42 +117,52 @@ bool Playback::applyImpact(std::size_t body, double time, const Eigen::Vector3d&
   return true;
 }
 
-void Playback::applyImpact(const ImpactMonitor& monitor, const ImpactRecord& impact,
+bool Playback::applyImpact(const ImpactMonitor& monitor, const ImpactRecord& impact,
                            bool exact_contact) {
   const auto apply = [&](std::size_t monitor_body, double side, const Eigen::Vector3d& after,
                          const Eigen::Vector3d& angular_after) {
     const auto body = bodyIndex(monitor.body(monitor_body).id);
-    if (!body) return;
+    if (!body) return true;  // not one of this scene's bodies: nothing to move
     const double radius = scene_.bodies[*body].radius;
     const Eigen::Vector3d centre =
         exact_contact ? Eigen::Vector3d(impact.contact_point + side * radius * impact.normal)
                       : position(*body, impact.time);
-    applyImpact(*body, impact.time, centre, after, angular_after);
+    return applyImpact(*body, impact.time, centre, after, angular_after);
   };
-  apply(impact.body_a, -1.0, impact.velocity_a_after, impact.angular_velocity_a_after);
+  bool applied =
+      apply(impact.body_a, -1.0, impact.velocity_a_after, impact.angular_velocity_a_after);
   if (!impact.other_is_obstacle) {
-    apply(impact.other, +1.0, impact.velocity_b_after, impact.angular_velocity_b_after);
+    applied = apply(impact.other, +1.0, impact.velocity_b_after, impact.angular_velocity_b_after) &&
+              applied;
   }
+  return applied;
 }
 
-void Playback::applyImpacts(const ImpactMonitor& monitor, const std::vector<ImpactRecord>& impacts,
-                            bool exact_contact) {
+std::vector<std::size_t> Playback::applyImpacts(const ImpactMonitor& monitor,
+                                                const std::vector<ImpactRecord>& impacts,
+                                                bool exact_contact) {
+  std::vector<std::size_t> refused;
   if (exact_contact) {
-    for (const ImpactRecord& impact : impacts) applyImpact(monitor, impact, true);
-    return;
+    for (std::size_t k = 0; k < impacts.size(); ++k) {
+      if (!applyImpact(monitor, impacts[k], true)) refused.push_back(k);
+    }
+    return refused;
   }
   struct Placed {
-    std::size_t body;
+    std::size_t record, body;
     double time;
     Eigen::Vector3d centre, velocity, angular_velocity;
   };
   std::vector<Placed> placed;
-  for (const ImpactRecord& impact : impacts) {
+  for (std::size_t k = 0; k < impacts.size(); ++k) {
+    const ImpactRecord& impact = impacts[k];
     const auto place = [&](std::size_t monitor_body, const Eigen::Vector3d& after,
                            const Eigen::Vector3d& angular_after) {
       const auto body = bodyIndex(monitor.body(monitor_body).id);
-      if (body)
-        placed.push_back({*body, impact.time, position(*body, impact.time), after, angular_after});
+      if (body) {
+        placed.push_back(
+            {k, *body, impact.time, position(*body, impact.time), after, angular_after});
+      }
     };
     place(impact.body_a, impact.velocity_a_after, impact.angular_velocity_a_after);
     if (!impact.other_is_obstacle) {
@@ -160,8 +170,10 @@ void Playback::applyImpacts(const ImpactMonitor& monitor, const std::vector<Impa
     }
   }
   for (const Placed& p : placed) {
-    applyImpact(p.body, p.time, p.centre, p.velocity, p.angular_velocity);
+    const bool applied = applyImpact(p.body, p.time, p.centre, p.velocity, p.angular_velocity);
+    if (!applied && (refused.empty() || refused.back() != p.record)) refused.push_back(p.record);
   }
+  return refused;
 }
 
 std::vector<Apex> Playback::apexesUntil(double time) {

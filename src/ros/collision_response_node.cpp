@@ -106,6 +106,13 @@ void CollisionResponseNode::logScene(const core::Scene& scene, const MonitorPara
                   << scene.restitution_threshold << " m/s, restitution_combine "
                   << core::toString(scene.materials.combineRule()) << ", "
                   << scene.materials.names().size() << " materials");
+  if (scene.effects.gravity) {
+    // Stepped clusters act with gravity only (README, "Scene file").
+    ROS_INFO_STREAM("collision_response: stepped_cluster_min_bodies "
+                    << scene.stepped_cluster_min_bodies
+                    << (scene.stepped_cluster_min_bodies == 0 ? " (never)" : "")
+                    << ", stepped_cluster_time_step " << scene.stepped_cluster_time_step << " s");
+  }
   ROS_INFO_STREAM("collision_response: " << scene.bodies.size() << " bodies, "
                                          << scene.obstacles.size() << " obstacles");
   ROS_INFO_STREAM("collision_response: transform_timeout "

@@ -193,9 +193,21 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
     update.reports.push_back(
         {Reason::kStepTruncated,
          "too many impacts at one instant or in one step; " + std::to_string(step.fallbacks) +
-             " fallback(s) resolved the rest inelastically or held the bodies, outside each "
-             "other"});
+             " fallback(s) (any held sub-step of a stepped cluster among them) resolved the "
+             "rest inelastically or held the bodies, outside each other"});
+  } else if (step.fallbacks > 0) {
+    // Only stepped clusters fall back without truncating the step (core::StepReport): a
+    // sub-step whose solve found no velocities keeping every gap held its movable bodies still.
+    update.reports.push_back(
+        {Reason::kSteppedHeld,
+         "a stepped cluster found no velocities that keep every gap open over " +
+             std::to_string(step.fallbacks) +
+             " sub-step(s) (a body squeezed between immovable bodies or obstacles closing on "
+             "it?): its bodies were held still there, and what closes on them may overlap them",
+         step.fallbacks});
   }
+  update.stepped_bodies = step.stepped_bodies;
+  stepped_bodies_ = step.stepped_bodies;
   update.contacts.header.stamp = newest;
   update.contacts.header.frame_id = scene_.fixed_frame;
   update.contacts.contacts.reserve(step.contacts.size());

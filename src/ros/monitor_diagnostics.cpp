@@ -53,6 +53,7 @@ void MonitorDiagnostics::report(diagnostic_updater::DiagnosticStatusWrapper& sta
   status.add("combine rule", core::toString(scene.materials.combineRule()));
   status.add("bodies in the scene", monitor.bodyCount());
   status.add("bodies tracked", monitor.trackedBodies());
+  status.add("bodies in stepped clusters", cycle.steppedBodies());
   status.add("input messages per second", static_cast<double>(period_.messages) / seconds);
   status.add("states per second", static_cast<double>(period_.states) / seconds);
   status.add("impacts per second", static_cast<double>(period_.impacts) / seconds);

@@ -252,6 +252,12 @@ const KeyTable<Scene>& sceneTable() {
                        [](Scene& s) -> double& { return s.restitution_threshold; }),
       numberKey<Scene>("contact_integration_tolerance",
                        [](Scene& s) -> double& { return s.contact_integration_tolerance; }),
+      // Stepped clusters (README, "Scene file"): the time step's range is validateScene's.
+      countKey<Scene>(
+          "stepped_cluster_min_bodies",
+          [](Scene& s) -> int& { return s.stepped_cluster_min_bodies; }, 0),
+      numberKey<Scene>("stepped_cluster_time_step",
+                       [](Scene& s) -> double& { return s.stepped_cluster_time_step; }),
       {"bodies", false,
        [](const XmlRpc::XmlRpcValue& value, const std::string& field, Scene& scene) {
          return readList(

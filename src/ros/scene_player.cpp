@@ -198,11 +198,24 @@ void ScenePlayer::onImpacts(const ImpactArray::ConstPtr& message) {
   // at the sample, and each restarts where the player had it (Playback::applyImpacts).
   const bool exact_contact = scene_.detection == core::Detection::kContinuous;
   std::vector<core::ImpactRecord> records;
+  std::vector<const Impact*> heard;
   for (const Impact& impact : message->impacts) {
     auto record = toImpactRecord(impact, *indexing_, sinceStart(impact.header.stamp));
-    if (record) records.push_back(std::move(*record));
+    if (!record) continue;
+    records.push_back(std::move(*record));
+    heard.push_back(&impact);
   }
-  playback_->applyImpacts(*indexing_, records, exact_contact);
+  for (const std::size_t k : playback_->applyImpacts(*indexing_, records, exact_contact)) {
+    // Heard after its instant was played and made final: the bodies go on without it. Never
+    // silent: what is shown from here on may have them inside each other.
+    ROS_WARN_STREAM_THROTTLE(
+        5.0, "scene_player: the impact of '"
+                 << heard[k]->body_a << "' and '" << heard[k]->body_b << "' at "
+                 << sinceStart(heard[k]->header.stamp)
+                 << " s came after that instant was played (the node answered more than a period "
+                    "of ~rate late): not applied, so those bodies go on without it and may be "
+                    "shown inside each other");
+  }
 }
 
 void ScenePlayer::publishApexes(const ros::Time& time) {

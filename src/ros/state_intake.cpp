@@ -88,6 +88,8 @@ const char* counterName(Reason reason) {
       return "clock offsets applied";
     case Reason::kStepTruncated:
       return "steps truncated";
+    case Reason::kSteppedHeld:
+      return "stepped sub-steps held";
     case Reason::kObstacleTransform:
       return "obstacle transform missing";
   }

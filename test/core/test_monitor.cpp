@@ -397,5 +397,57 @@ TEST(Playback, ImpactsAtTheSampleInstantsAreApplied) {
   EXPECT_EQ(playback.velocity(0, 3.0), V(0, 0, 0));
 }
 
+// An impact heard after its instant was made final (a node answering more than a period late)
+// cannot be played: the body goes on without it. The caller is told (false), so that the scene
+// player can say so instead of showing bodies inside each other without a word.
+TEST(Playback, AnImpactOlderThanWhatIsFinalIsRefusedAndSaysSo) {
+  using V = Eigen::Vector3d;
+  core::Scene scene;
+  core::BodySpec ball;
+  ball.id = "ball";
+  ball.radius = 0.05;
+  ball.material = "tennis_ball";
+  ball.velocity = V(1, 0, 0);
+  scene.bodies = {ball};
+  core::ObstacleSpec wall;
+  wall.id = "wall";
+  wall.normal = V(-1, 0, 0);
+  wall.offset = -10.0;
+  wall.material = "concrete";
+  scene.obstacles = {wall};
+  const core::ImpactMonitor monitor(scene, core::MonitorSettings{});
+  core::Playback playback(scene, 1e-9, 0.0);
+  EXPECT_EQ(playback.position(0, 0.1), V(0.1, 0, 0));
+  EXPECT_EQ(playback.position(0, 0.2), V(0.2, 0, 0));  // asking for 0.2 makes 0.1 final
+  core::ImpactRecord late;
+  late.time = 0.05;
+  late.body_a = 0;
+  late.other = 0;
+  late.other_is_obstacle = true;
+  late.normal = V(1, 0, 0);
+  late.contact_point = V(0.1, 0, 0);
+  late.velocity_a_after = V(-1, 0, 0);
+  EXPECT_FALSE(playback.applyImpact(monitor, late, true));
+  EXPECT_EQ(playback.velocity(0, 0.2), V(1, 0, 0)) << "a refused impact changes nothing";
+  core::ImpactRecord in_time = late;
+  in_time.time = 0.15;
+  in_time.contact_point = V(0.2, 0, 0);
+  EXPECT_TRUE(playback.applyImpact(monitor, in_time, true));
+  EXPECT_EQ(playback.velocity(0, 0.2), V(-1, 0, 0));
+  EXPECT_NEAR(playback.position(0, 0.2).x(), 0.15 - 0.05, 1e-15);  // from the centre at 0.15 s
+
+  // The batch (one step's records, as the scene player applies them) names the refused one in
+  // either detection, and applies the other.
+  for (const bool exact_contact : {true, false}) {
+    core::Playback batch(scene, 1e-9, 0.0);
+    EXPECT_EQ(batch.position(0, 0.1), V(0.1, 0, 0));
+    EXPECT_EQ(batch.position(0, 0.2), V(0.2, 0, 0));
+    const std::vector<std::size_t> refused =
+        batch.applyImpacts(monitor, {late, in_time}, exact_contact);
+    EXPECT_EQ(refused, std::vector<std::size_t>{0}) << "exact_contact " << exact_contact;
+    EXPECT_EQ(batch.velocity(0, 0.2), V(-1, 0, 0)) << "exact_contact " << exact_contact;
+  }
+}
+
 }  // namespace
 }  // namespace collision_response

@@ -1,5 +1,6 @@
 // Lasting contact over ROS: the real node and the scene player on config/scenes/stack.yaml
-// (lasting_contact_stack.test) and config/scenes/corner.yaml (lasting_contact_corner.test).
+// (lasting_contact_stack.test), config/scenes/corner.yaml (lasting_contact_corner.test) and
+// config/scenes/pile.yaml (stepped_pile.test).
 //
 // The geometry is read from the scene on the parameter server (the radii, masses and the plane
 // equations, the planes' normals normalised here), so the gaps below are computed independently
@@ -17,12 +18,19 @@
 //   (n2 = (-1, 0, 0), offset -0.5) rests touching both: n2.c = -0.5 + r gives x = 0.5 - r, and
 //   n1.c = r gives z = (r - 0.28 x) / 0.96. Forces on the ball balance its weight:
 //   z: 0.96 N1 = m g; x: 0.28 N1 - N2 = 0; so N1 = m g 25/24 (incline), N2 = m g 7/24 (wall).
+// - pile: 64 balls dropped into a closed box settle as a stepped cluster (README, "Scene file":
+//   stepped_cluster_min_bodies). Over a sub-step the floor's keeping impulses add up to the
+//   weight's M g h plus the change of the pile's vertical momentum (the walls' normals are
+//   horizontal, the balls' impulses on each other cancel in pairs): at rest, the floor's normal
+//   forces (impulse / h, all vertical) sum to M g, M = 64 m. Details above the test.
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <iterator>
 #include <map>
 #include <string>
 #include <vector>
@@ -110,7 +118,14 @@ class LastingContactRos : public ::testing::Test {
     last_stamp_ = array.header.stamp;
     stamps_.push_back(array.header.stamp);
     std::map<std::string, V> centres;
-    for (const auto& state : array.states) centres[state.id] = eigen(state.pose.position);
+    Vertical vertical;
+    for (const auto& state : array.states) {
+      centres[state.id] = eigen(state.pose.position);
+      const double mass = scene_.balls.count(state.id) ? scene_.balls.at(state.id).mass : 0.0;
+      vertical.momentum += mass * state.twist.linear.z;
+      vertical.fastest = std::max(vertical.fastest, std::abs(state.twist.linear.z));
+    }
+    vertical_[array.header.stamp] = vertical;
     for (const auto& [id, centre] : centres) {
       const Ball& ball = scene_.balls.at(id);
       for (const auto& [name, plane] : scene_.planes) {
@@ -221,6 +236,12 @@ class LastingContactRos : public ::testing::Test {
   ros::Time first_stamp_, last_stamp_;
   std::vector<ros::Time> stamps_;
   std::map<std::string, V> last_centres_;
+  /// Each state array's vertical momentum (kg m/s) and fastest vertical speed (m/s), by stamp.
+  struct Vertical {
+    double momentum = 0.0;
+    double fastest = 0.0;
+  };
+  std::map<ros::Time, Vertical> vertical_;
   double deepest_ = INFINITY;
   struct Overlap {
     ros::Time stamp;
@@ -327,6 +348,86 @@ TEST_F(LastingContactRos, CornerBallComesToRestTouchingBothPlanes) {
   }
   // Resting in the corner from about the first impact (0.39 s, the slide's closed form) on.
   expectContactsAtEveryInputFrom(1.0);
+}
+
+// The pile (stepped_pile.test, at 50 Hz; config/scenes/pile.yaml says why). Its states may not
+// go into anything by more than kGapTolerance (1e-9 m): the stepped solve keeps overlaps within a
+// quarter of the touching band (about 1e-11 m here). Should a ball leave the cluster and strike in
+// the exact model, the states that reveal that impact are allowed its approach (expectNoOverlap):
+// two balls fallen from the lattice's top (centre 0.474 m) onto the floor's layer (0.05 m) close
+// at most at 2 sqrt(2 g 0.424) = 5.77 m/s.
+//
+// The floor's forces, by Newton over the sub-step (T', T] that ends at a contacts array's stamp
+// T (the states at T' and T carry the velocities before and over it): the floor's impulses are
+// the only vertical ones from outside (the walls' normals are horizontal, the ceiling is not
+// touched at the end, the balls' impulses on each other cancel in pairs), so they add up to
+// M g (T - T') + P_z(T) - P_z(T'), P_z the states' vertical momentum. The forces published are
+// the keeping impulses / (T - T'); the rest is the floor's bounce impulses, which only balls
+// approaching the floor get: with every |v_z| < kVerticalRest at T' and T they total at most
+// (1 + e) M kVerticalRest (compression takes at most the pile's downward momentum, restitution
+// e = 0.5 of it again). So on such a sub-step
+//   |sum N_floor - (M g + (P_z(T) - P_z(T')) / (T - T'))| <= 1.5 M kVerticalRest / (T - T'),
+// 7.6e-4 of the weight at 50 Hz (a twentieth of one ball's weight), plus the solve's residual (a
+// quarter of the touching band per sub-step in velocity: about 1e-10 of the weight for all 64). The
+// pile, frictionless, may never be still (a ball sliding on the floor goes on); it is still
+// vertically often enough: the latest such sub-step from 1.5 s on is checked.
+constexpr double kPileApproach = 5.77 * (1 + 1e-3);  // m/s
+constexpr double kVerticalRest = 1e-4;               // m/s
+constexpr double kSolveResidual = 1e-9;              // relative to the weight, generous
+
+TEST_F(LastingContactRos, PileSettlesInsideTheBoxAndTheFloorCarriesItsWeight) {
+  ASSERT_TRUE(play(5.0)) << "the scene player published no states for 5 s";
+  ASSERT_EQ(scene_.balls.size(), 64u);
+  ASSERT_EQ(scene_.planes.size(), 6u);
+  double total_mass = 0.0;
+  for (const auto& [id, ball] : scene_.balls) total_mass += ball.mass;
+  const double weight = total_mass * kG;
+  std::printf("deepest gap of any state: %.3g m; impacts: %zu\n", deepest_,
+              impacts_received_.size());
+  const std::size_t revealing = expectNoOverlap(kPileApproach, kG);
+  std::printf("states past a contact before the player heard of its impact: %zu\n", revealing);
+  ASSERT_EQ(last_centres_.size(), 64u) << "every ball in the last state array";
+
+  // Collisions in a stepped cluster are contacts, not impacts: contacts reports the pile.
+  const auto with_contacts =
+      std::count_if(contact_arrays_.begin(), contact_arrays_.end(),
+                    [](const auto& array) { return !array.contacts.empty(); });
+  EXPECT_GT(with_contacts, 10) << "contacts never reported the pile";
+
+  // The latest sub-step from 1.5 s on with the pile vertically at rest.
+  std::size_t checked = 0;
+  for (auto array = contact_arrays_.rbegin(); array != contact_arrays_.rend(); ++array) {
+    const ros::Time& stamp = array->header.stamp;
+    if ((stamp - first_stamp_).toSec() < 1.5) break;
+    const auto at = vertical_.find(stamp);
+    if (at == vertical_.end() || at == vertical_.begin()) continue;
+    const auto before = std::prev(at);
+    if (at->second.fastest >= kVerticalRest || before->second.fastest >= kVerticalRest) continue;
+    double floor_force = 0.0;
+    std::size_t on_floor = 0;
+    for (const auto& contact : array->contacts) {
+      EXPECT_GE(contact.normal_force, 0.0) << contact.body_a << " and " << contact.body_b;
+      if (contact.body_b != "floor") continue;
+      ++on_floor;
+      // From the ball into the floor, straight down: the force is all vertical.
+      EXPECT_LT((eigen(contact.normal) - V(0, 0, -1)).norm(), 1e-12) << contact.body_a;
+      floor_force += contact.normal_force;
+    }
+    const double span = (stamp - before->first).toSec();
+    const double newton = weight + (at->second.momentum - before->second.momentum) / span;
+    const double bounce = 1.5 * total_mass * kVerticalRest / span;
+    std::printf(
+        "at %.2f s the floor carries %.12g N on %zu contacts; M g %.12g N, Newton %.12g N +- "
+        "%.3g N\n",
+        (stamp - first_stamp_).toSec(), floor_force, on_floor, weight, newton, bounce);
+    EXPECT_NEAR(floor_force, newton, bounce + kSolveResidual * weight);
+    EXPECT_NEAR(floor_force, weight,
+                bounce + 2 * total_mass * kVerticalRest / span + kSolveResidual * weight)
+        << "the weight itself, with the momentum's change bounded by kVerticalRest";
+    ++checked;
+    break;
+  }
+  EXPECT_EQ(checked, 1u) << "the pile never came to rest vertically from 1.5 s on";
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "collision_response/ros/monitor_cycle.h"
+#include "collision_response/ros/monitor_diagnostics.h"
 #include "collision_response/ros/throttled_warning.h"
 
 namespace collision_response {
@@ -477,6 +478,178 @@ TEST_F(FloorCycle, ContactsArePublishedFiniteAndNamed) {
   const std::string& text = firstReport(Reason::kContactNotFinite)->text;
   EXPECT_NE(text.find("'heavy' and 'floor'"), std::string::npos) << text;
   EXPECT_TRUE(isDrop(Reason::kContactNotFinite));
+}
+
+// Stepped clusters (README, "Scene file"): a layer of `count` balls (r = 0.05 m, 0.1 kg) at rest
+// on a floor, in a grid of rows of 8 whose neighbours touch (centres 2 r apart, at z = r), gravity
+// on. Each ball touches the floor and its neighbours: the whole layer is one connected set of
+// near bodies.
+constexpr double kLayerRadius = 0.05, kLayerMass = 0.1, kG = 9.81;
+
+core::Scene layerScene(int count) {
+  core::Scene scene;
+  scene.effects.gravity = true;
+  scene.gravity = Eigen::Vector3d(0, 0, -kG);
+  scene.materials.addMaterial("test_half", core::Material{0.5, std::nullopt}, "materials");
+  for (int i = 0; i < count; ++i) {
+    core::BodySpec body;
+    body.id = "ball_" + std::to_string(100 + i);
+    body.mass = kLayerMass;
+    body.radius = kLayerRadius;
+    body.material = "test_half";
+    body.position = Eigen::Vector3d(kLayerRadius * (1 + 2 * (i % 8)),
+                                    kLayerRadius * (1 + 2 * (i / 8)), kLayerRadius);
+    scene.bodies.push_back(body);
+  }
+  core::ObstacleSpec floor;
+  floor.id = "floor";
+  floor.normal = Eigen::Vector3d::UnitZ();
+  floor.material = "test_half";
+  scene.obstacles.push_back(floor);
+  return scene;
+}
+
+/// The states of `scene`'s bodies at rest where the scene places them, stamped `stamp`.
+std::vector<BodyState> atRest(const core::Scene& scene, const ros::Time& stamp) {
+  std::vector<BodyState> states;
+  for (const core::BodySpec& body : scene.bodies) {
+    states.push_back(state(body.id, stamp, body.position, Eigen::Vector3d::Zero()));
+  }
+  return states;
+}
+
+/// The value diagnostics shows under `key`, or "(none)".
+std::string diagnosticValue(const diagnostic_updater::DiagnosticStatusWrapper& status,
+                            const std::string& key) {
+  for (const diagnostic_msgs::KeyValue& value : status.values) {
+    if (value.key == key) return value.value;
+  }
+  return "(none)";
+}
+
+class LayerCycle : public Cycle {
+ protected:
+  LayerCycle() : Cycle(layerScene(32)) {}
+};
+
+// 32 touching balls: a stepped cluster of 32 (the default stepped_cluster_min_bodies) from the
+// first update on (the first input only starts the time line), shown in diagnostics. At rest,
+// every sub-step's gravity kick m g h is taken back by the floor's keeping impulse alone (the
+// neighbours' normals are horizontal): each ball's floor contact carries m g = 0.981 N.
+TEST_F(LayerCycle, ATouchingLayerOf32IsOneSteppedClusterShownInDiagnostics) {
+  const ros::Time start(1000, 0);
+  MonitorCycle::Update update = send(atRest(cycle_.scene(), start));
+  EXPECT_EQ(update.stepped_bodies, 0u) << "the first input starts the time line only";
+  for (int k = 1; k <= 5; ++k) {
+    update = send(atRest(cycle_.scene(), at(start, 0.01 * k)));
+    EXPECT_EQ(update.stepped_bodies, 32u) << "update " << k;
+  }
+  EXPECT_EQ(cycle_.steppedBodies(), 32u);
+  EXPECT_EQ(reportsOf(Reason::kSteppedHeld), 0u);
+  EXPECT_TRUE(impacts_.empty()) << "at rest: nothing strikes";
+  std::size_t on_floor = 0;
+  for (const Contact& contact : update.contacts.contacts) {
+    if (contact.body_b == "floor") {
+      ++on_floor;
+      EXPECT_NEAR(contact.normal_force, kLayerMass * kG, 1e-6 * kLayerMass * kG) << contact.body_a;
+    } else {
+      // Horizontal between neighbours: nothing pushes them together (rounding only).
+      EXPECT_NEAR(contact.normal_force, 0.0, 1e-9) << contact.body_a << " and " << contact.body_b;
+    }
+  }
+  EXPECT_EQ(on_floor, 32u) << "one floor contact a ball";
+
+  MonitorDiagnostics diagnostics;
+  for (const Report& report : reports_) diagnostics.count(report.reason, report.count);
+  diagnostic_updater::DiagnosticStatusWrapper status;
+  diagnostics.report(status, cycle_, 0);
+  EXPECT_EQ(diagnosticValue(status, "bodies in stepped clusters"), "32");
+  EXPECT_EQ(diagnosticValue(status, "stepped sub-steps held (total)"), "(none)")
+      << "a counter is shown once it has counted";
+}
+
+// One ball fewer than stepped_cluster_min_bodies: the exact model's, no cluster.
+class SmallLayerCycle : public Cycle {
+ protected:
+  SmallLayerCycle() : Cycle(layerScene(31)) {}
+};
+
+TEST_F(SmallLayerCycle, ALayerOf31IsNotStepped) {
+  const ros::Time start(1000, 0);
+  MonitorCycle::Update update;
+  for (int k = 0; k <= 5; ++k) update = send(atRest(cycle_.scene(), at(start, 0.01 * k)));
+  EXPECT_EQ(update.stepped_bodies, 0u);
+  EXPECT_EQ(cycle_.steppedBodies(), 0u);
+  EXPECT_EQ(update.contacts.contacts.size(), 31u) << "resting on the floor all the same";
+}
+
+// A held sub-step, from real inputs: a ball (1 kg, r = 0.1 m) in a gripper, between two
+// immovable balls (the jaws, r = 0.1 m) that touch it on either side along x, gravity on,
+// stepped_cluster_min_bodies 1 (the ball alone is a cluster). The tracker sees the ball at the
+// origin at rest (a real gripper holds it by friction), the jaws at rest for 0.02 s, then
+// closing at 0.1 m/s each. Inputs come at 100 Hz, so each update is one sub-step of 0.01 s
+// (stepped_cluster_time_step). No velocity of the ball keeps both gaps open over a sub-step in
+// which both jaws close on it from opposite sides: such a sub-step holds it still. Those are
+// the sub-steps of the updates at 0.03, 0.04 and 0.05 s (the jaws' tracks close from the states
+// of 0.02 s on): three held sub-steps, counted by name, and no step reported truncated.
+core::Scene squeezedScene() {
+  core::Scene scene = layerScene(0);
+  scene.obstacles.clear();
+  scene.stepped_cluster_min_bodies = 1;
+  for (const char* id : {"ball", "jaw_left", "jaw_right"}) {
+    core::BodySpec body;
+    body.id = id;
+    body.mass = std::string(id) == "ball" ? 1.0 : kInf;
+    body.radius = 0.1;
+    body.material = "test_half";
+    scene.bodies.push_back(body);
+  }
+  return scene;
+}
+
+class SqueezedCycle : public Cycle {
+ protected:
+  SqueezedCycle() : Cycle(squeezedScene()) {}
+
+  static constexpr double kCloseFrom = 0.02;  ///< s: the jaws close from then on
+  static constexpr double kClosing = 0.1;     ///< m/s, each jaw
+
+  /// The states at `t` s after `start`.
+  std::vector<BodyState> grip(const ros::Time& start, double t) {
+    const ros::Time stamp = at(start, t);
+    const double speed = t >= kCloseFrom ? kClosing : 0.0;
+    const double jaw = 0.2 - speed * (t - kCloseFrom);  // each jaw's centre from the ball's
+    return {state("ball", stamp, {0, 0, 0}, {0, 0, 0}),
+            state("jaw_left", stamp, {-jaw, 0, 0}, {speed, 0, 0}),
+            state("jaw_right", stamp, {jaw, 0, 0}, {-speed, 0, 0})};
+  }
+};
+
+TEST_F(SqueezedCycle, ASqueezedClusterIsHeldAndSaysSo) {
+  const ros::Time start(1000, 0);
+  std::vector<std::size_t> held;  // per update
+  MonitorCycle::Update update;
+  for (int k = 0; k <= 5; ++k) {
+    const std::size_t before = reportsOf(Reason::kSteppedHeld);
+    update = send(grip(start, 0.01 * k));
+    held.push_back(reportsOf(Reason::kSteppedHeld) - before);
+  }
+  EXPECT_EQ(held, (std::vector<std::size_t>{0, 0, 0, 1, 1, 1}));
+  EXPECT_EQ(update.stepped_bodies, 1u);
+  EXPECT_EQ(reportsOf(Reason::kStepTruncated), 0u);
+  ASSERT_NE(firstReport(Reason::kSteppedHeld), nullptr);
+  const std::string& text = firstReport(Reason::kSteppedHeld)->text;
+  EXPECT_NE(text.find("held still"), std::string::npos) << text;
+  EXPECT_NE(text.find("over 1 sub-step(s)"), std::string::npos) << text;
+  EXPECT_FALSE(isDrop(Reason::kSteppedHeld));
+  EXPECT_STREQ(counterName(Reason::kSteppedHeld), "stepped sub-steps held");
+
+  MonitorDiagnostics diagnostics;
+  for (const Report& report : reports_) diagnostics.count(report.reason, report.count);
+  diagnostic_updater::DiagnosticStatusWrapper status;
+  diagnostics.report(status, cycle_, 0);
+  EXPECT_EQ(diagnosticValue(status, "stepped sub-steps held (total)"), "3");
+  EXPECT_EQ(diagnosticValue(status, "bodies in stepped clusters"), "1");
 }
 
 TEST_F(Cycle, EveryReasonHasItsOwnCounter) {

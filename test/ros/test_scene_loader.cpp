@@ -12,6 +12,8 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "collision_response/ros/scene_loader.h"
 #include "collision_response/ros/scene_player.h"
@@ -205,10 +207,68 @@ TEST(SceneLoader, SceneErrorsNameTheKey) {
     EXPECT_EQ(sceneErrorField(scene), "~scene/contact_integration_tolerance") << tolerance;
   }
 
+  // Stepped clusters: a count of bodies is an integer >= 0 (YAML `32.0` and `true` are not);
+  // the sub-step is in [1e-4, 1] s (0 would never advance; 2 s would leave a pile unwatched).
+  const std::vector<XmlRpc::XmlRpcValue> counts = {
+      XmlRpc::XmlRpcValue(-1), XmlRpc::XmlRpcValue(32.0), XmlRpc::XmlRpcValue(2.5),
+      XmlRpc::XmlRpcValue(true), XmlRpc::XmlRpcValue("32")};
+  for (std::size_t i = 0; i < counts.size(); ++i) {
+    scene = fullScene();
+    scene["stepped_cluster_min_bodies"] = counts[i];
+    EXPECT_EQ(sceneErrorField(scene), "~scene/stepped_cluster_min_bodies") << "counts[" << i << "]";
+  }
+  for (const double time_step : {0.0, -0.01, 9e-5, 1.5, std::numeric_limits<double>::quiet_NaN(),
+                                 std::numeric_limits<double>::infinity()}) {
+    scene = fullScene();
+    scene["stepped_cluster_time_step"] = time_step;
+    EXPECT_EQ(sceneErrorField(scene), "~scene/stepped_cluster_time_step") << time_step;
+  }
+  scene = fullScene();
+  scene["stepped_cluster_time_step"] = "fast";
+  EXPECT_EQ(sceneErrorField(scene), "~scene/stepped_cluster_time_step");
+
   // A concrete ball on a concrete floor: that pair was never measured.
   scene = fullScene();
   scene["bodies"][0]["material"] = "concrete";
   EXPECT_EQ(sceneErrorField(scene), "~scene/bodies[0]/material");
+}
+
+// Stepped clusters' keys: the ends of their ranges load, and their absence leaves the
+// documented defaults (README, "Scene file": 32 bodies, 0.01 s).
+TEST(SceneLoader, SteppedClusterKeysLoadAtTheEndsOfTheirRanges) {
+  const auto defaults = loadScene(fullScene(), "~scene");
+  ASSERT_TRUE(defaults.ok()) << defaults.error().message();
+  EXPECT_EQ(defaults->stepped_cluster_min_bodies, 32);
+  EXPECT_EQ(defaults->stepped_cluster_time_step, 0.01);
+  // The low ends: 0 (never) and 1e-4 s.
+  auto scene = fullScene();
+  scene["stepped_cluster_min_bodies"] = 0;
+  scene["stepped_cluster_time_step"] = 1e-4;
+  auto loaded = loadScene(scene, "~scene");
+  ASSERT_TRUE(loaded.ok()) << loaded.error().message();
+  EXPECT_EQ(loaded->stepped_cluster_min_bodies, 0);
+  EXPECT_EQ(loaded->stepped_cluster_time_step, 1e-4);
+  // The high end, 1 s, written as the integer YAML makes of `1`; any count of bodies.
+  scene = fullScene();
+  scene["stepped_cluster_min_bodies"] = 100000;
+  scene["stepped_cluster_time_step"] = 1;
+  loaded = loadScene(scene, "~scene");
+  ASSERT_TRUE(loaded.ok()) << loaded.error().message();
+  EXPECT_EQ(loaded->stepped_cluster_min_bodies, 100000);
+  EXPECT_EQ(loaded->stepped_cluster_time_step, 1.0);
+  // The message says what is wrong, with the value.
+  scene = fullScene();
+  scene["stepped_cluster_min_bodies"] = -3;
+  loaded = loadScene(scene, "~scene");
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_EQ(loaded.error().message(),
+            "~scene/stepped_cluster_min_bodies: must be an integer >= 0, got -3");
+  scene = fullScene();
+  scene["stepped_cluster_time_step"] = 2.0;
+  loaded = loadScene(scene, "~scene");
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_EQ(loaded.error().message(),
+            "~scene/stepped_cluster_time_step: must be in [1e-4, 1] s, got 2");
 }
 
 // --- The README's keys against the loader's tables ----------------------------------------------
@@ -240,6 +300,8 @@ std::map<std::string, std::map<std::string, XmlRpc::XmlRpcValue>> examples() {
                      {"gravity", list3(0, 0, -9.8)},
                      {"restitution_threshold", 0.25},
                      {"contact_integration_tolerance", 1e-6},
+                     {"stepped_cluster_min_bodies", 40},
+                     {"stepped_cluster_time_step", 0.005},
                      {"restitution_combine", "max"}};
   values["materials.<name>"] = {{"restitution", 0.85}, {"friction", 0.9}};
   XmlRpc::XmlRpcValue pair;
@@ -348,6 +410,8 @@ TEST(SceneKeys, EveryDocumentedKeyLoadsWithItsValue) {
   EXPECT_EQ(loaded->gravity, Eigen::Vector3d(0, 0, -9.8));
   EXPECT_EQ(loaded->restitution_threshold, 0.25);
   EXPECT_EQ(loaded->contact_integration_tolerance, 1e-6);
+  EXPECT_EQ(loaded->stepped_cluster_min_bodies, 40);
+  EXPECT_EQ(loaded->stepped_cluster_time_step, 0.005);
   EXPECT_EQ(loaded->materials.combineRule(), core::CombineRule::kMax);
   EXPECT_EQ(*loaded->materials.restitution("rubber", "concrete"), 0.85);
   EXPECT_EQ(*loaded->materials.friction("rubber", "concrete"), 0.9);

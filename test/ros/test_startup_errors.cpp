@@ -157,6 +157,22 @@ TEST(StartupErrors, Item8_TheScenePlayersParametersAreTypedToo) {
   expectRefused(result, "/rate", "must be a number, got a string ('fast')");
 }
 
+// The stepped clusters' keys (README, "Scene file"), checked at start-up by the node and the
+// scene player alike, each refusal naming the key and the value.
+TEST(StartupErrors, SteppedClusterKeysOutOfRangeStopTheNodeAndThePlayerByName) {
+  for (const std::string& executable :
+       {kNode, std::string("rosrun collision_response scene_player")}) {
+    XmlRpc::XmlRpcValue value = scene({ball("ball")});
+    value["stepped_cluster_min_bodies"] = -1;
+    expectRefused(start(executable, value),
+                  "/scene/stepped_cluster_min_bodies: ", "must be an integer >= 0, got -1");
+    value = scene({ball("ball")});
+    value["stepped_cluster_time_step"] = 2.0;
+    expectRefused(start(executable, value),
+                  "/scene/stepped_cluster_time_step: ", "must be in [1e-4, 1] s, got 2");
+  }
+}
+
 // The other side: every scene the package ships (config/scenes/, and the tests' own) starts the
 // node and the scene player: no shipped key or value is refused.
 TEST(StartupErrors, EveryShippedSceneStartsTheNodeAndThePlayer) {

@@ -49,14 +49,17 @@ class Playback {
 
   /// Applies an impact record of `monitor` (whose bodies are indexed by id) to the bodies it
   /// names, placing them at the contact (`exact_contact`: continuous detection, where the
-  /// surfaces touch there) or where they were.
-  void applyImpact(const ImpactMonitor& monitor, const ImpactRecord& impact, bool exact_contact);
+  /// surfaces touch there) or where they were. False when a body refused it (its instant is older
+  /// than what is final: it came too late to be played), so that the caller can say so.
+  bool applyImpact(const ImpactMonitor& monitor, const ImpactRecord& impact, bool exact_contact);
 
   /// applyImpact for every record of one step (discrete detection's all at one instant): where
   /// the bodies are is read once for them all, before any is applied (an impact does not move a
   /// body at its instant), instead of the played motion being worked out again after each one.
-  void applyImpacts(const ImpactMonitor& monitor, const std::vector<ImpactRecord>& impacts,
-                    bool exact_contact);
+  /// Returns the indices of the records a body refused (came too late to be played).
+  std::vector<std::size_t> applyImpacts(const ImpactMonitor& monitor,
+                                        const std::vector<ImpactRecord>& impacts,
+                                        bool exact_contact);
 
   /// The flights whose highest point is at or before `time` and not yet reported.
   std::vector<Apex> apexesUntil(double time);

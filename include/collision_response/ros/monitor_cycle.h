@@ -50,6 +50,9 @@ class MonitorCycle {
     /// The lasting contacts at the step's time (gravity), every number finite, stamped with the
     /// input's newest stamp: to publish on `contacts` (README, "Topics").
     ContactArray contacts;
+    /// Bodies in stepped clusters at the step's end (README, "Scene file":
+    /// stepped_cluster_min_bodies).
+    std::size_t stepped_bodies = 0;
     /// What was dropped (states, impacts) and what else happened.
     std::vector<Report> reports;
   };
@@ -68,6 +71,8 @@ class MonitorCycle {
   const MonitorParams& params() const { return params_; }
   /// Steps taken so far: one per input that had a usable state.
   std::uint64_t steps() const { return steps_; }
+  /// Bodies in stepped clusters at the end of the last step (0 before the first).
+  std::size_t steppedBodies() const { return stepped_bodies_; }
 
  private:
   /// Places the tf-attached obstacles at `stamp` (line time `time`).
@@ -83,6 +88,7 @@ class MonitorCycle {
   std::vector<StampedSample> samples_;      ///< working memory, kept between inputs
   std::vector<core::BodyStateSample> timed_;
   std::uint64_t steps_ = 0;
+  std::size_t stepped_bodies_ = 0;
 };
 
 /// The impact message of a monitor's record, its stamp `stamp`; or the error naming the first

@@ -37,6 +37,7 @@ enum class Reason {
   kClockJumpedBack,    ///< a source's stamps went back: every track reset
   kClockOffset,        ///< a source's stamps lag the time line: shifted onto it
   kStepTruncated,      ///< a guard of the monitor cut a step short
+  kSteppedHeld,        ///< a stepped cluster held still over sub-steps it could not solve
   kObstacleTransform,  ///< a tf-attached obstacle keeps its last known motion
 };
 inline constexpr int kReasonCount = static_cast<int>(Reason::kObstacleTransform) + 1;
