@@ -59,6 +59,9 @@ build_workspace() {
 # about 5 minutes on 2 cores, a rebuild seconds). On failure, the log's last lines.
 build_package() {
   local log="$ws/build.log" status=0
+  # The pipeline's status is build_workspace's, also where the caller has no pipefail.
+  local -
+  set -o pipefail
   echo "== building collision_response in $ws (first build about 5 minutes; log: $log)"
   build_workspace "$@" 2>&1 | tee "$log" | awk '
     /^== / { print "  " substr($0, 4); fflush(); next }

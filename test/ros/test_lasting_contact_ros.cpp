@@ -350,7 +350,7 @@ TEST_F(LastingContactRos, CornerBallComesToRestTouchingBothPlanes) {
   expectContactsAtEveryInputFrom(1.0);
 }
 
-// The pile (stepped_pile.test, at 50 Hz; config/scenes/pile.yaml says why). Its states may not
+// The pile (stepped_pile.test, at 100 Hz as config/scenes/pile.yaml says). Its states may not
 // go into anything by more than kGapTolerance (1e-9 m): the stepped solve keeps overlaps within a
 // quarter of the touching band (about 1e-11 m here). Should a ball leave the cluster and strike in
 // the exact model, the states that reveal that impact are allowed its approach (expectNoOverlap):
@@ -367,7 +367,7 @@ TEST_F(LastingContactRos, CornerBallComesToRestTouchingBothPlanes) {
 // (1 + e) M kVerticalRest (compression takes at most the pile's downward momentum, restitution
 // e = 0.5 of it again). So on such a sub-step
 //   |sum N_floor - (M g + (P_z(T) - P_z(T')) / (T - T'))| <= 1.5 M kVerticalRest / (T - T'),
-// 7.6e-4 of the weight at 50 Hz (a twentieth of one ball's weight), plus the solve's residual (a
+// 1.5e-3 of the weight at 100 Hz (a tenth of one ball's weight), plus the solve's residual (a
 // quarter of the touching band per sub-step in velocity: about 1e-10 of the weight for all 64). The
 // pile, frictionless, may never be still (a ball sliding on the floor goes on); it is still
 // vertically often enough: the latest such sub-step from 1.5 s on is checked.
