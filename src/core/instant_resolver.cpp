@@ -285,7 +285,9 @@ std::vector<double> velocitiesOf(const World& world, double time,
 ///    unchanged to the bit, a mass ratio past the doubles) keeps a contact it strikes again no
 ///    slower than before struck without end (a light ball squeezed between it and a fixed post;
 ///    a ball sliding in a wedge of the floor and a post whose normals are 1e-11 rad from
-///    opposite): a contact struck so kUndecayedStrikes times in a row (none of them slower than
+///    opposite), and so does a contact the joint solve gives no impulse although it strikes
+///    (a heavy ball on a post beside a body 1e195 times lighter: its row is below the solve's
+///    rounding): a contact struck so kUndecayedStrikes times in a row (none of them slower than
 ///    the one before) ends them. A series decaying slower than kUndecayedRate a strike would need
 ///    millions of rounds, past the budget anyway.
 class RoundProgress {
@@ -333,8 +335,10 @@ class RoundProgress {
     for (std::size_t c = 0; c < cluster.size(); ++c) {
       if (contacts[c].restitution != 0.0) previous_plastic_ = false;
       const std::size_t k = cluster[c];
-      if (!undecayed_[k] || !(outcome.normal[c].impulse > 0)) continue;
-      bool driven = false;
+      if (!undecayed_[k]) continue;
+      // Struck again no slower and given no impulse: the solve leaves it as it is (a body 1e195
+      // times stiffer in the solve than its neighbours, past the doubles), as an unmoved body.
+      bool driven = !(outcome.normal[c].impulse > 0);
       for (const std::size_t m : {contacts[c].a, contacts[c].b}) {
         driven = driven || after[m].inverse_mass == 0 ||
                  (!before[m].velocity.isZero(0.0) && after[m].velocity == before[m].velocity);
@@ -365,7 +369,7 @@ class RoundProgress {
   std::vector<double> fastest_;        // per contact: its fastest approach so far (0: none)
   std::vector<double> last_approach_;  // per contact: at its previous strike
   std::vector<char> undecayed_;        // per contact: struck again no slower, this round
-  std::vector<int> driven_strikes_;    // per contact: such strikes by an unmoved body, in a row
+  std::vector<int> driven_strikes_;    // per contact: unmoved or unanswered such strikes in a row
   std::vector<std::vector<double>> recent_;
   std::vector<std::size_t> previous_;
   bool previous_plastic_ = false;

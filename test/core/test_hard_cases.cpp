@@ -737,5 +737,75 @@ TEST(FuzzFindings, RoundsInAWedgeOfNearlyOppositeNormalsEndEarly) {
   expectRoundsEndedEarly(monitor, monitor.step(now, {b1_later, b0_state}), now, wedge.b0_mass);
 }
 
+// Found by the monitor's fuzzer (a timeout: 160 s under the sanitizers, 13 s in release): a
+// 1.2e275 kg ball b0 whose radius (1.4e240 m) holds every other body, falling onto the post
+// beside a 1e80 kg ball b2. b0's contact with the immovable post is 1e195 times stiffer than b2's
+// in the joint solve, past the doubles: the solve gave it no impulse, so it struck again at the
+// same approach (0.197 m/s) every round, 10,000 rounds and 39,999 impacts before the fallback.
+// A contact struck again no slower that the solve gives no impulse is one it cannot move: like a
+// contact of an unmoved body, 64 such strikes in a row end the rounds.
+TEST(FuzzFindings, RoundsWithAContactTheSolveLeavesUnresolvedEndEarly) {
+  Scene scene;
+  scene.detection = Detection::kDiscrete;
+  scene.effects.gravity = true;
+  scene.effects.friction = true;
+  BodySpec b0;
+  b0.id = "b0";
+  b0.mass = 1.1850738525390624e+275;
+  b0.radius = 1.372589111328125e+240;
+  b0.material = "billiard_ball";
+  BodySpec b1;
+  b1.id = "b1";
+  b1.mass = 1.4509735107421876e+270;
+  b1.radius = 1.3749847412109374e-235;
+  b1.material = "rubber_band_ball";
+  BodySpec b2;
+  b2.id = "b2";
+  b2.mass = 1.00115966796875e+80;
+  b2.radius = 1.29803466796875e+80;
+  b2.material = "wooden_ball";
+  b2.inertia = Inertia::kHollow;
+  scene.bodies = {b0, b1, b2};
+  ObstacleSpec floor;
+  floor.id = "floor";
+  floor.material = "concrete";
+  floor.normal = V(1.29803466796875e+80, -1.0900715865557387e-175, 12431335449.21875);
+  floor.offset = 12431335449.21875;
+  ObstacleSpec post;
+  post.id = "post";
+  post.shape = ObstacleShape::kSphere;
+  post.material = "wooden_ball";
+  post.position = V(1.2436523437500001e-130, -5.875, -4.125);
+  post.radius = 4.125;
+  scene.obstacles = {floor, post};
+  ASSERT_TRUE(validateScene(scene, "scene").ok());
+  normalizePlanes(scene);
+  MonitorSettings settings;
+  settings.contact_tolerance = 0.296875;
+  ImpactMonitor monitor(scene, settings);
+  const double tiny = -1.5215606689453124e-240;
+  BodyStateSample first;
+  first.body = *monitor.bodyIndex("b2");
+  first.position = V(tiny, tiny, tiny);
+  first.velocity = V(tiny, tiny, tiny);
+  monitor.step(0.0, {first});
+  // The time line's nanoseconds, as the node takes them (stamps 0.593, 0.764 and 0.799 s).
+  const double now = 206000000 * 1e-9;
+  BodyStateSample b1_state;
+  b1_state.body = *monitor.bodyIndex("b1");
+  b1_state.time = now;
+  b1_state.position = V(-1.1348419189453125e-240, -1.5215606689453124e-240, -1.29803466796875e+80);
+  b1_state.velocity = V(1.5686187744140626e-125, 1.848175048828125e-180, 1.997039794921875e-235);
+  BodyStateSample b0_state;
+  b0_state.body = *monitor.bodyIndex("b0");
+  b0_state.time = 171000000 * 1e-9;
+  const StepReport report = monitor.step(now, {b1_state, b0_state});
+  EXPECT_LT(report.impacts.size(), 1000u);
+  EXPECT_EQ(report.fallbacks, 1u);
+  for (const char* id : {"b0", "b1", "b2"}) {
+    EXPECT_TRUE(monitor.predictedState(*monitor.bodyIndex(id), now)->second.allFinite()) << id;
+  }
+}
+
 }  // namespace
 }  // namespace collision_response::core
