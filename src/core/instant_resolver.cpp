@@ -197,6 +197,7 @@ void storeVelocities(World& world, double time, const PreparedCluster& prepared,
     track.velocity = prepared.bodies[m].velocity;
     track.angular_velocity = prepared.bodies[m].angular_velocity;
     track.last_impact_time = time;
+    track.impact_step = world.steps;
     track.constrained = nullptr;
     changed.push_back(participant);
   }
@@ -538,6 +539,7 @@ void resolveInelastically(World& world, double time, const std::vector<Pair>& pa
     track.velocity = solution.acceleration[i];
     if (world.spin_factor[p] != 0.0) track.angular_velocity = solution.angular_acceleration[i];
     track.last_impact_time = time;
+    track.impact_step = world.steps;
     track.constrained = nullptr;
     changed.push_back(p);
   }

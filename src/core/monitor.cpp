@@ -56,8 +56,9 @@ void computePairCoefficients(World& world, const MaterialTable& materials) {
 /// Takes the received states as the bodies' tracks, oldest first: a state not newer than its
 /// body's last one is stale (counted, dropped); a state older than the track, or the first after
 /// an impact the monitor applied to the body, does not replace the track (the monitor's
-/// post-impact motion is the newer knowledge).
-void applyStates(World& world, const std::vector<BodyStateSample>& states, StepReport& report) {
+/// post-impact motion is the newer knowledge). `in_step`: the states end the step being taken.
+void applyStates(World& world, const std::vector<BodyStateSample>& states, StepReport& report,
+                 bool in_step) {
   const auto earlier = [](const BodyStateSample& x, const BodyStateSample& y) {
     return x.time < y.time || (x.time == y.time && x.body < y.body);
   };
@@ -78,8 +79,12 @@ void applyStates(World& world, const std::vector<BodyStateSample>& states, StepR
     }
     const double previous_state_time = track.last_state_time;
     track.last_state_time = state.time;
+    // The source sampled this state before it heard of the impacts this step found: one since
+    // its previous state, or one at that very instant found only now (a body a stepped cluster
+    // let go of at the step's start, closing on the floor), is not in it.
     const bool impact_since_previous_state =
-        track.last_impact_time > previous_state_time && track.last_impact_time <= state.time;
+        (track.last_impact_time > previous_state_time && track.last_impact_time <= state.time) ||
+        (in_step && track.impact_step == world.steps);
     if (track.known && (state.time < track.time || impact_since_previous_state)) continue;
     track.known = true;
     track.time = state.time;
@@ -289,7 +294,7 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
     }
     if (!schedule.next(instant, touching)) break;
   }
-  applyStates(world, states, report);
+  applyStates(world, states, report, true);
   world.now = time;
   if constexpr (Motion::kAccelerates) {
     std::vector<std::size_t> formed;
@@ -383,7 +388,7 @@ StepReport discreteStep(World& world, double time, const std::vector<BodyStateSa
   StepReport report;
   world.sample_period = time - world.now;
   if constexpr (Motion::kAccelerates) advanceLastingContact<Motion>(world, time, report);
-  applyStates(world, states, report);
+  applyStates(world, states, report, true);
   world.now = time;
   std::vector<Pair>& pairs = world.scratch.pairs;
   monitor::candidatePairs<Motion>(world, time, time, pairs);
@@ -649,6 +654,7 @@ StepReport ImpactMonitor::advance(double time, const std::vector<BodyStateSample
   World& world = *world_;
   if (!world.started || time <= world.now) return StepReport{};
   forgetStaleBodies(world, time);
+  ++world.steps;
   return withMotionModel(world, [&](auto motion) {
     return continuousStep<decltype(motion)>(world, time, {}, imposed);
   });
@@ -658,7 +664,7 @@ StepReport ImpactMonitor::step(double time, const std::vector<BodyStateSample>& 
   World& world = *world_;
   if (!world.started || time <= world.now) {
     StepReport report;
-    applyStates(world, states, report);
+    applyStates(world, states, report, false);
     if (!world.started) {
       withMotionModel(world, [&](auto motion) {
         start<decltype(motion)>(world, time);
@@ -676,6 +682,7 @@ StepReport ImpactMonitor::step(double time, const std::vector<BodyStateSample>& 
     return report;
   }
   forgetStaleBodies(world, time);
+  ++world.steps;
   return withMotionModel(world, [&](auto motion) {
     using Motion = decltype(motion);
     return world.detection == Detection::kContinuous ? continuousStep<Motion>(world, time, states)

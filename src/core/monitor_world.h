@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <map>
 #include <memory>
@@ -58,6 +59,8 @@ struct Track {
   double kicked_until = kNever;
   double last_state_time = kNever;
   double last_impact_time = kNever;
+  /// World::steps of the step whose impact last changed its motion (0: none yet).
+  std::uint64_t impact_step = 0;
 };
 
 struct ObstacleTrack {
@@ -213,6 +216,8 @@ struct World {
   Scratch scratch;
   bool started = false;
   double now = 0.0;
+  /// Steps taken (ImpactMonitor::step from the start on): the current one while it runs.
+  std::uint64_t steps = 0;
   double step_end = 0.0;  // the end of the step being taken (curved motion is integrated to it)
   double sample_period = 0.0;  // discrete: the time from the step before to this one
 

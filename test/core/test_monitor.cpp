@@ -118,6 +118,36 @@ TEST(Monitor, ImpactAlreadyAppliedBySourceIsFound) {
   EXPECT_NEAR(report.impacts[0].contact_point.z(), 0.0, 4 * kEps);
 }
 
+TEST(Monitor, ImpactAtTheStepsStartIsNotUndoneByTheSourcesNextState) {
+  // The source puts the ball on the floor, falling at 1 m/s, at t = 0.1 (say a stepped cluster
+  // let it go there). Its impact is at that instant, but found by the step that starts there,
+  // after the source sampled its state at 0.2 from the ball's unbounced motion: that state
+  // (0.05 m into the floor, still falling) is not the ball's motion. Without it, the monitor's
+  // own: e = 0.5, leaving at 0.5 m/s, 0.05 + 0.5 x 0.1 = 0.1 m up at 0.2.
+  Scene scene = sceneWithRestitution(0.5);
+  scene.bodies = {ball("ball", 0.1, 0.05)};
+  ObstacleSpec floor;
+  floor.id = "floor";
+  floor.material = "test";
+  scene.obstacles = {floor};
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  monitor.step(0.0, {state(monitor, "ball", 0.0, V(0, 0, 1), V(0, 0, 0))});
+  EXPECT_TRUE(
+      monitor.step(0.1, {state(monitor, "ball", 0.1, V(0, 0, 0.05), V(0, 0, -1))}).impacts.empty());
+  const StepReport report =
+      monitor.step(0.2, {state(monitor, "ball", 0.2, V(0, 0, -0.05), V(0, 0, -1))});
+  ASSERT_EQ(report.impacts.size(), 1u);
+  EXPECT_EQ(report.impacts[0].time, 0.1);
+  EXPECT_EQ(report.impacts[0].velocity_a_after, V(0, 0, 0.5));
+  const auto predicted = monitor.predictedState(*monitor.bodyIndex("ball"), 0.2);
+  ASSERT_TRUE(predicted);
+  EXPECT_NEAR(predicted->first.z(), 0.1, 4 * kEps);
+  EXPECT_EQ(predicted->second, V(0, 0, 0.5));
+  // The source, told of the impact, sends its bounced state next: that one is taken.
+  monitor.step(0.3, {state(monitor, "ball", 0.3, V(0, 0, 0.15), V(0, 0, 0.5))});
+  EXPECT_NEAR(monitor.predictedState(*monitor.bodyIndex("ball"), 0.4)->first.z(), 0.2, 4 * kEps);
+}
+
 TEST(Monitor, DiscreteFindsTheImpactAtTheSampleAfter) {
   Scene scene = sceneWithRestitution(0.5);
   scene.detection = Detection::kDiscrete;
