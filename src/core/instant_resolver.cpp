@@ -337,8 +337,8 @@ class RoundProgress {
       if (contacts[c].restitution != 0.0) previous_plastic_ = false;
       const std::size_t k = cluster[c];
       if (!undecayed_[k]) continue;
-      // Struck again no slower and given no impulse: the solve leaves it as it is (a body 1e195
-      // times stiffer in the solve than its neighbours, past the doubles), as an unmoved body.
+      // Struck again no slower and given no impulse: the solve leaves it as it is (its row 1e195
+      // times below its neighbours', past the doubles), as an unmoved body.
       bool driven = !(outcome.normal[c].impulse > 0);
       for (const std::size_t m : {contacts[c].a, contacts[c].b}) {
         driven = driven || after[m].inverse_mass == 0 ||

@@ -626,43 +626,55 @@ TEST(FuzzFindings, FrictionOnAHugeSpinningBall) {
   EXPECT_NEAR(outcome->angular_velocity_b.y() * 1e145, 15.0 / 7.0, 1e-12);  // rolls: w r = v
 }
 
-/// The monitor fuzzer's scene of the rounds findings (discrete detection, gravity, friction): a
-/// ball "b0" and a 1.5e175 kg ball "b1" between a floor of normal (1, floor_y, floor_z) at
+/// A ball as the monitor fuzzer makes one (fuzz/fuzz_monitor.cpp, makeScene).
+BodySpec fuzzedBall(const std::string& id, double mass, double radius, const std::string& material,
+                    Inertia inertia = Inertia::kSolid) {
+  BodySpec body;
+  body.id = id;
+  body.mass = mass;
+  body.radius = radius;
+  body.material = material;
+  body.inertia = inertia;
+  return body;
+}
+
+/// The monitor fuzzer's scene of the rounds findings: discrete detection, gravity and friction,
+/// the balls given, a concrete plane "floor" and a wooden sphere "post"; checked and normalized
+/// as the loader does.
+Scene fuzzedFloorAndPost(std::vector<BodySpec> bodies, const V& floor_normal, double floor_offset,
+                         const V& post_position, double post_radius) {
+  Scene scene;
+  scene.detection = Detection::kDiscrete;
+  scene.effects.gravity = true;
+  scene.effects.friction = true;
+  scene.bodies = std::move(bodies);
+  ObstacleSpec floor;
+  floor.id = "floor";
+  floor.material = "concrete";
+  floor.normal = floor_normal;
+  floor.offset = floor_offset;
+  ObstacleSpec post;
+  post.id = "post";
+  post.shape = ObstacleShape::kSphere;
+  post.material = "wooden_ball";
+  post.position = post_position;
+  post.radius = post_radius;
+  scene.obstacles = {floor, post};
+  EXPECT_TRUE(validateScene(scene, "scene").ok());
+  normalizePlanes(scene);
+  return scene;
+}
+
+/// A ball "b0" and a 1.5e175 kg ball "b1" between a floor of normal (1, floor_y, floor_z) at
 /// x = -4.125 and a post at x = post_x, with the fuzzed masses and radii as they came.
 struct FloorAndPost {
   double b0_mass, b0_radius, b1_mass, floor_y, floor_z, post_x, post_radius;
 };
 Scene floorAndPostScene(const FloorAndPost& v) {
-  Scene scene;
-  scene.detection = Detection::kDiscrete;
-  scene.effects.gravity = true;
-  scene.effects.friction = true;
-  BodySpec b0;
-  b0.id = "b0";
-  b0.mass = v.b0_mass;
-  b0.radius = v.b0_radius;
-  b0.material = "billiard_ball";
-  BodySpec b1;
-  b1.id = "b1";
-  b1.mass = v.b1_mass;
-  b1.radius = 1.380645751953125e-235;
-  b1.material = "hand_ball";
-  scene.bodies = {b0, b1};
-  ObstacleSpec floor;
-  floor.id = "floor";
-  floor.material = "concrete";
-  floor.normal = V(1, v.floor_y, v.floor_z);
-  floor.offset = -4.125;
-  ObstacleSpec post;
-  post.id = "post";
-  post.shape = ObstacleShape::kSphere;
-  post.material = "wooden_ball";
-  post.position = V(v.post_x, -4.125, 1.2442169189453123e-240);
-  post.radius = v.post_radius;
-  scene.obstacles = {floor, post};
-  EXPECT_TRUE(validateScene(scene, "scene").ok());
-  normalizePlanes(scene);
-  return scene;
+  return fuzzedFloorAndPost({fuzzedBall("b0", v.b0_mass, v.b0_radius, "billiard_ball"),
+                             fuzzedBall("b1", v.b1_mass, 1.380645751953125e-235, "hand_ball")},
+                            V(1, v.floor_y, v.floor_z), -4.125,
+                            V(v.post_x, -4.125, 1.2442169189453123e-240), v.post_radius);
 }
 
 /// The step's rounds ended early: under 1,000 impacts (each input took 10,000 rounds before),
@@ -739,47 +751,19 @@ TEST(FuzzFindings, RoundsInAWedgeOfNearlyOppositeNormalsEndEarly) {
 
 // Found by the monitor's fuzzer (a timeout: 160 s under the sanitizers, 13 s in release): a
 // 1.2e275 kg ball b0 whose radius (1.4e240 m) holds every other body, falling onto the post
-// beside a 1e80 kg ball b2. b0's contact with the immovable post is 1e195 times stiffer than b2's
-// in the joint solve, past the doubles: the solve gave it no impulse, so it struck again at the
+// beside a 1e80 kg ball b2. b0's row in the joint solve is 1e195 times below b2's, past the
+// doubles: the solve gave its contact with the immovable post no impulse, so it struck again at the
 // same approach (0.197 m/s) every round, 10,000 rounds and 39,999 impacts before the fallback.
 // A contact struck again no slower that the solve gives no impulse is one it cannot move: like a
 // contact of an unmoved body, 64 such strikes in a row end the rounds.
 TEST(FuzzFindings, RoundsWithAContactTheSolveLeavesUnresolvedEndEarly) {
-  Scene scene;
-  scene.detection = Detection::kDiscrete;
-  scene.effects.gravity = true;
-  scene.effects.friction = true;
-  BodySpec b0;
-  b0.id = "b0";
-  b0.mass = 1.1850738525390624e+275;
-  b0.radius = 1.372589111328125e+240;
-  b0.material = "billiard_ball";
-  BodySpec b1;
-  b1.id = "b1";
-  b1.mass = 1.4509735107421876e+270;
-  b1.radius = 1.3749847412109374e-235;
-  b1.material = "rubber_band_ball";
-  BodySpec b2;
-  b2.id = "b2";
-  b2.mass = 1.00115966796875e+80;
-  b2.radius = 1.29803466796875e+80;
-  b2.material = "wooden_ball";
-  b2.inertia = Inertia::kHollow;
-  scene.bodies = {b0, b1, b2};
-  ObstacleSpec floor;
-  floor.id = "floor";
-  floor.material = "concrete";
-  floor.normal = V(1.29803466796875e+80, -1.0900715865557387e-175, 12431335449.21875);
-  floor.offset = 12431335449.21875;
-  ObstacleSpec post;
-  post.id = "post";
-  post.shape = ObstacleShape::kSphere;
-  post.material = "wooden_ball";
-  post.position = V(1.2436523437500001e-130, -5.875, -4.125);
-  post.radius = 4.125;
-  scene.obstacles = {floor, post};
-  ASSERT_TRUE(validateScene(scene, "scene").ok());
-  normalizePlanes(scene);
+  const Scene scene = fuzzedFloorAndPost(
+      {fuzzedBall("b0", 1.1850738525390624e+275, 1.372589111328125e+240, "billiard_ball"),
+       fuzzedBall("b1", 1.4509735107421876e+270, 1.3749847412109374e-235, "rubber_band_ball"),
+       fuzzedBall("b2", 1.00115966796875e+80, 1.29803466796875e+80, "wooden_ball",
+                  Inertia::kHollow)},
+      V(1.29803466796875e+80, -1.0900715865557387e-175, 12431335449.21875), 12431335449.21875,
+      V(1.2436523437500001e-130, -5.875, -4.125), 4.125);
   MonitorSettings settings;
   settings.contact_tolerance = 0.296875;
   ImpactMonitor monitor(scene, settings);

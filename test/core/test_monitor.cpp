@@ -97,15 +97,20 @@ TEST(Monitor, SourceThatIgnoresCollisionsGetsTheImpactOnce) {
   EXPECT_EQ(impacts, 1u);
 }
 
-TEST(Monitor, ImpactAlreadyAppliedBySourceIsFound) {
-  // The source bounced the ball itself: the state after the wall already moves away.
-  Scene scene = sceneWithRestitution(0.8);
+/// A ball "ball" (0.1 kg, r = 0.05 m) and the plane "floor" z = 0, of restitution e.
+Scene ballOnFloorScene(double restitution) {
+  Scene scene = sceneWithRestitution(restitution);
   scene.bodies = {ball("ball", 0.1, 0.05)};
   ObstacleSpec floor;
   floor.id = "floor";
   floor.material = "test";
   scene.obstacles = {floor};
-  ImpactMonitor monitor(scene, MonitorSettings{});
+  return scene;
+}
+
+TEST(Monitor, ImpactAlreadyAppliedBySourceIsFound) {
+  // The source bounced the ball itself: the state after the wall already moves away.
+  ImpactMonitor monitor(ballOnFloorScene(0.8), MonitorSettings{});
   // At t = 0: 0.25 m up (surface 0.2 m above the floor), falling at 1 m/s: contact at t = 0.2.
   monitor.step(0.0, {state(monitor, "ball", 0.0, V(0, 0, 0.25), V(0, 0, -1))});
   const StepReport report =
@@ -124,13 +129,7 @@ TEST(Monitor, ImpactAtTheStepsStartIsNotUndoneByTheSourcesNextState) {
   // after the source sampled its state at 0.2 from the ball's unbounced motion: that state
   // (0.05 m into the floor, still falling) is not the ball's motion. Without it, the monitor's
   // own: e = 0.5, leaving at 0.5 m/s, 0.05 + 0.5 x 0.1 = 0.1 m up at 0.2.
-  Scene scene = sceneWithRestitution(0.5);
-  scene.bodies = {ball("ball", 0.1, 0.05)};
-  ObstacleSpec floor;
-  floor.id = "floor";
-  floor.material = "test";
-  scene.obstacles = {floor};
-  ImpactMonitor monitor(scene, MonitorSettings{});
+  ImpactMonitor monitor(ballOnFloorScene(0.5), MonitorSettings{});
   monitor.step(0.0, {state(monitor, "ball", 0.0, V(0, 0, 1), V(0, 0, 0))});
   EXPECT_TRUE(
       monitor.step(0.1, {state(monitor, "ball", 0.1, V(0, 0, 0.05), V(0, 0, -1))}).impacts.empty());
