@@ -9,11 +9,16 @@
 namespace collision_response::core {
 namespace {
 
-MonitorSettings playbackSettings(double contact_tolerance) {
+/// Under continuous detection the played motion finds and resolves its own impacts, so that no
+/// body is shown inside another before the watcher's impact is heard, or where the replay of the
+/// watcher's impacts drifts from the watcher's own motion by its solves' residuals. Under discrete
+/// detection the watcher finds impacts as overlaps at its samples: the played bodies must reach
+/// them.
+MonitorSettings playbackSettings(double contact_tolerance, Detection detection) {
   MonitorSettings settings;
   settings.contact_tolerance = contact_tolerance;
   settings.body_timeout = std::numeric_limits<double>::infinity();
-  settings.detect_impacts = false;
+  settings.detect_impacts = detection == Detection::kContinuous;
   return settings;
 }
 
@@ -21,7 +26,7 @@ MonitorSettings playbackSettings(double contact_tolerance) {
 
 Playback::Playback(const Scene& scene, double contact_tolerance, double start)
     : scene_(scene),
-      committed_(scene, playbackSettings(contact_tolerance)),
+      committed_(scene, playbackSettings(contact_tolerance, scene.detection)),
       committed_time_(start),
       horizon_(start) {
   scene_.detection = Detection::kContinuous;

@@ -206,15 +206,16 @@ void ScenePlayer::onImpacts(const ImpactArray::ConstPtr& message) {
     heard.push_back(&impact);
   }
   for (const std::size_t k : playback_->applyImpacts(*indexing_, records, exact_contact)) {
-    // Heard after its instant was played and made final: the bodies go on without it. Never
-    // silent: what is shown from here on may have them inside each other.
+    // Heard after its instant was played and made final: the bodies go on without it (under
+    // continuous detection by the player's own resolution of it; under discrete, inside each
+    // other). Never silent.
     ROS_WARN_STREAM_THROTTLE(
         5.0, "scene_player: the impact of '"
                  << heard[k]->body_a << "' and '" << heard[k]->body_b << "' at "
                  << sinceStart(heard[k]->header.stamp)
                  << " s came after that instant was played (the node answered more than a period "
-                    "of ~rate late): not applied, so those bodies go on without it and may be "
-                    "shown inside each other");
+                    "of ~rate late): not applied, so those bodies go on without the node's answer "
+                    "(by the player's own, or under discrete detection inside each other)");
   }
 }
 

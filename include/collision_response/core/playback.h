@@ -23,8 +23,13 @@ struct Apex {
   int impacts_before = 0;  ///< impacts the body had before this flight
 };
 
-/// A scene played forward by the monitor's model with impact detection off (impacts come from
-/// whoever watches the played states, as from the node over ROS).
+/// A scene played forward by the monitor's model, the impacts of whoever watches the played
+/// states (the node over ROS) applied from their instants. Under the scene's continuous detection
+/// the played motion also finds and resolves impacts itself, by the same model, until the
+/// watcher's arrive and replace them: no body is shown inside another while an impact is on its
+/// way, nor where replaying the watcher's impacts drifts from its motion by the residual of its
+/// contact solves (a squeezed ball in a settling pile). Under discrete detection it does not:
+/// the watcher finds impacts as overlaps at its samples, which the played bodies must reach.
 ///
 /// Impacts arrive after the states that revealed them were played, so the motion is kept in two
 /// parts: what is final (committed, up to the latest instant asked for before the last one) and
