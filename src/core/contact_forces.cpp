@@ -983,9 +983,11 @@ void closeContactGaps(std::vector<Eigen::Vector3d>& positions, const std::vector
   }
 }
 
-ContactForceSolution solveContactForces(const std::vector<ForceBody>& bodies,
-                                        const std::vector<ForceContact>& contacts,
-                                        const ContactForceSettings& settings) {
+namespace {
+
+ContactForceSolution solveContactModes(const std::vector<ForceBody>& bodies,
+                                       const std::vector<ForceContact>& contacts,
+                                       const ContactForceSettings& settings) {
   const Group group(bodies, contacts);
   const std::size_t count = contacts.size();
   std::vector<Real> friction(count);
@@ -1145,6 +1147,26 @@ ContactForceSolution solveContactForces(const std::vector<ForceBody>& bodies,
   }
   package(group, trial, modes, scales, true, result);
   return result;
+}
+
+}  // namespace
+
+ContactForceSolution solveContactForces(const std::vector<ForceBody>& bodies,
+                                        const std::vector<ForceContact>& contacts,
+                                        const ContactForceSettings& settings) {
+  ContactForceSolution solution = solveContactModes(bodies, contacts, settings);
+  const bool with_friction = std::any_of(contacts.begin(), contacts.end(),
+                                         [](const ForceContact& c) { return c.friction > 0; });
+  if (solution.converged || !with_friction) return solution;
+  // The clamped forces of modes that did not settle may let a gap close (header): without
+  // friction, the normal forces alone.
+  std::vector<ForceContact> frictionless = contacts;
+  for (ForceContact& contact : frictionless) contact.friction = 0.0;
+  ContactForceSolution normal_only = solveContactModes(bodies, frictionless, settings);
+  if (!normal_only.converged) return solution;
+  normal_only.converged = false;
+  normal_only.friction_dropped = true;
+  return normal_only;
 }
 
 ContactForceSolution solveContactForcesWithModes(const std::vector<ForceBody>& bodies,

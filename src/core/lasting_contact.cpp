@@ -146,6 +146,11 @@ void solveGroup(World& world, double time, const std::vector<std::size_t>& bodie
   closeContactVelocities(force_bodies, contacts, std::vector<bool>(contacts.size(), false));
   const ContactForceSolution solution =
       solveContactForces(force_bodies, contacts, lastingContactSettings(world));
+  if (solution.friction_dropped) {
+    // Friction's modes did not settle: the group moves without it until it is formed again, its
+    // integrated motion and its slips included (solveContactForces).
+    for (ForceContact& contact : contacts) contact.friction = 0.0;
+  }
   std::vector<bool> sticking(contacts.size(), false);
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     sticking[k] = contacts[k].friction > 0 && solution.contacts[k].mode == ContactMode::kSticking;

@@ -69,6 +69,9 @@ struct ContactForceSolution {
   /// false: the modes did not settle within the iterations (the last ones are kept, clamped so
   /// that no contact pulls and no friction exceeds mu N).
   bool converged = true;
+  /// The modes with friction did not settle, and the forces are those of the same group without
+  /// friction (whose modes did): friction is lost here, rather than a contact left to close.
+  bool friction_dropped = false;
 };
 
 /// Slower slips than this count as none (static friction): m/s.
@@ -103,6 +106,12 @@ struct ContactForceSettings {
 /// slip within mu J). Pass each body's velocities as its `acceleration` and
 /// `angular_acceleration`, zero `velocity` and `angular_velocity`, curvature 0: the forces are
 /// then the impulses, the accelerations the velocities after.
+///
+/// Where the modes with friction do not settle within `max_iterations` (seen for a stack of four
+/// spinning balls with mu = 1 in a settling pile: the clamped forces left a contact's gap
+/// accelerating inwards at 10.7 m/s^2), the group is solved again without friction and, if those
+/// modes settle, that is the answer (`friction_dropped`): a body may slip where friction would
+/// have held it, but no contact closes.
 ContactForceSolution solveContactForces(const std::vector<ForceBody>& bodies,
                                         const std::vector<ForceContact>& contacts,
                                         const ContactForceSettings& settings = {});
