@@ -29,7 +29,6 @@ Playback::Playback(const Scene& scene, double contact_tolerance, double start)
       committed_(scene, playbackSettings(contact_tolerance, scene.detection)),
       committed_time_(start),
       horizon_(start) {
-  scene_.detection = Detection::kContinuous;
   if (scene_.effects.gravity) gravity_ = scene_.gravity;
   std::vector<BodyStateSample> states;
   for (std::size_t i = 0; i < scene_.bodies.size(); ++i) {

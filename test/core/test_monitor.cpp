@@ -488,20 +488,11 @@ TEST(Playback, AnImpactOlderThanWhatIsFinalIsRefusedAndSaysSo) {
 TEST(Playback, BodiesBounceBeforeTheImpactIsHeardUnderContinuousDetectionOnly) {
   using V = Eigen::Vector3d;
   constexpr double kH = 1.0, kR = 0.05, kG = 9.81;
-  core::Scene scene;
+  core::Scene scene = core::ballOnFloorScene(0.5);
+  ASSERT_EQ(scene.bodies[0].radius, kR);
   scene.effects.gravity = true;
   scene.gravity = V(0, 0, -kG);
-  ASSERT_TRUE(static_cast<bool>(scene.materials.addMaterial("half", core::Material{0.5, {}}, "m")));
-  core::BodySpec ball;
-  ball.id = "ball";
-  ball.radius = kR;
-  ball.material = "half";
-  ball.position = V(0, 0, kR + kH);
-  scene.bodies = {ball};
-  core::ObstacleSpec floor;
-  floor.id = "floor";
-  floor.material = "half";
-  scene.obstacles = {floor};
+  scene.bodies[0].position = V(0, 0, kR + kH);
   const double t1 = std::sqrt(2 * kH / kG);
   const double apex = 1.5 * t1;
 
