@@ -80,10 +80,11 @@ double slipStops(const ContactForce& force, double time) {
   return time + slip / -rate;
 }
 
-/// One connected set of candidates: solve, and give its bodies their motion.
+/// One connected set of candidates: solve, and give its bodies their motion (`frictionless`:
+/// without friction, the fallback below).
 void solveGroup(World& world, double time, const std::vector<std::size_t>& bodies,
                 const std::vector<std::pair<Pair, Geometry>>& candidates,
-                std::vector<std::size_t>& changed) {
+                std::vector<std::size_t>& changed, bool frictionless = false) {
   // The solver's bodies: the group's (0..n-1, sorted), then the fixed participants (obstacles,
   // immovable bodies) in sorted order.
   std::vector<std::size_t> participants = bodies;
@@ -126,7 +127,7 @@ void solveGroup(World& world, double time, const std::vector<std::size_t>& bodie
     contact.normal = g.normal;
     if (!world.isPlane(pair.second))
       contact.curvature = 1.0 / (g.gap + world.radius[pair.first] + world.radius[pair.second]);
-    if (world.friction_model) contact.friction = world.frictionOf(pair);
+    if (world.friction_model && !frictionless) contact.friction = world.frictionOf(pair);
     contacts.push_back(contact);
   }
   // Lasting contacts touch: their gaps closed (overlapping ones are held where they are), their
@@ -173,11 +174,7 @@ void solveGroup(World& world, double time, const std::vector<std::size_t>& bodie
   const double acceleration_tolerance = 1e-12 * world.gravity.norm();
   for (std::size_t k = 0; k < candidates.size(); ++k) {
     const ContactForce& force = solution.contacts[k];
-    const Pair& pair = candidates[k].first;
-    if (force.mode == ContactMode::kSeparating) {
-      world.contact_since.erase(pair);
-      continue;
-    }
+    if (force.mode == ContactMode::kSeparating) continue;
     pressed.push_back(k);
     const ForceContact& c = contacts[k];
     if (c.curvature > 0) {
@@ -198,25 +195,11 @@ void solveGroup(World& world, double time, const std::vector<std::size_t>& bodie
         curved = true;
       }
     }
-    GroupContact contact;
-    contact.pair = pair;
-    contact.normal = candidates[k].second.normal;
-    contact.point = positions[c.a] + world.radius[pair.first] * contact.normal;
-    contact.force = force;
-    const auto since = world.contact_since.emplace(pair, time).first;
-    contact.since = since->second;
-    contact_group.contacts.push_back(contact);
+    const Pair& pair = candidates[k].first;
     for (const std::size_t p : {pair.first, pair.second}) {
       if (world.inverseMassOf(p) > 0) pressed_body[slot(p)] = 1;
     }
-    world.partners[pair.first].push_back(pair.second);
-    if (!world.isObstacle(pair.second)) world.partners[pair.second].push_back(pair.first);
-    if (force.mode == ContactMode::kSliding && c.friction > 0) {
-      contact_group.next_event = std::min(contact_group.next_event, slipStops(force, time));
-    }
   }
-  contact_group.alive = !contact_group.contacts.empty();
-
   std::shared_ptr<const ConstrainedStep> step;
   std::vector<std::size_t> step_slot(participants.size(), 0);
   if (curved) {
@@ -253,11 +236,50 @@ void solveGroup(World& world, double time, const std::vector<std::size_t>& bodie
     step = std::make_shared<const ConstrainedStep>(
         step_bodies, step_positions, movable, step_contacts, time, std::max(world.step_end, time),
         world.integration_tolerance, speed_tolerance, guess > 0 ? guess : 1e-3);
+    if (step->modeChanged() && !frictionless &&
+        !(step->end() > time + eventResolution(step->end(), world.step_end - world.now)) &&
+        std::any_of(contacts.begin(), contacts.end(),
+                    [](const ForceContact& c) { return c.friction > 0; })) {
+      // The modes friction chose stop holding at once (slips at the slip tolerance, whose
+      // directions the solve and the integrator read apart): solved again at this instant it
+      // would be so for ever, and as its integrated motion ends here its bodies would be looked
+      // at by nothing until the step's end. It moves without friction until formed again, as
+      // where friction's modes do not settle (solveContactForces).
+      solveGroup(world, time, bodies, candidates, changed, true);
+      return;
+    }
+  }
+  for (const std::size_t k : pressed) {
+    const ContactForce& force = solution.contacts[k];
+    const Pair& pair = candidates[k].first;
+    const ForceContact& c = contacts[k];
+    GroupContact contact;
+    contact.pair = pair;
+    contact.normal = candidates[k].second.normal;
+    contact.point = positions[c.a] + world.radius[pair.first] * contact.normal;
+    contact.force = force;
+    const auto since = world.contact_since.emplace(pair, time).first;
+    contact.since = since->second;
+    contact_group.contacts.push_back(contact);
+    world.partners[pair.first].push_back(pair.second);
+    if (!world.isObstacle(pair.second)) world.partners[pair.second].push_back(pair.first);
+    if (force.mode == ContactMode::kSliding && c.friction > 0) {
+      contact_group.next_event = std::min(contact_group.next_event, slipStops(force, time));
+    }
+  }
+  for (std::size_t k = 0; k < candidates.size(); ++k) {
+    if (solution.contacts[k].mode == ContactMode::kSeparating) {
+      world.contact_since.erase(candidates[k].first);
+    }
+  }
+  contact_group.alive = !contact_group.contacts.empty();
+  if (step) {
     if (step->modeChanged()) {
       contact_group.next_event = std::min(contact_group.next_event, step->end());
     }
     contact_group.curved = true;
   }
+
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     const std::size_t body = bodies[i];
     Track& track = world.tracks[body];

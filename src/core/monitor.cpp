@@ -133,15 +133,12 @@ void holdEverything(World& world, double time) {
   monitor::clearGroups(world);
 }
 
-/// A group's event solves it again only past the instant it was solved by more than 1e-12 of
-/// the step's span (and the time line's rounding): solved again at that very instant it would
-/// be so for ever, and a group whose modes change back within a rounding (events a few ulps
-/// apart: seen for three balls rolling in contact on a floor with friction and spin, 20,000 in
-/// one 10 ms step) would spend the step's budget on nothing. Within it, its motion goes on as it
-/// is.
+/// A group's event solves it again only past the instant it was solved (eventResolution). Within
+/// it, its motion goes on as it is. (A curved group's integrated motion ends at its event: where
+/// friction's modes stop holding within the resolution, formGroups solves the group without
+/// friction, whose forces the solve and the integrator compute alike.)
 bool solvesAgain(const monitor::ContactGroup& group, double when, double span) {
-  const double resolution = 1e-12 * span + 4e-16 * std::abs(when);
-  return when > group.time + resolution;
+  return when > group.time + monitor::eventResolution(when, span);
 }
 
 /// Continuous detection: from the last states, the first contact of every candidate pair,
