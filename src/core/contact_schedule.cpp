@@ -66,6 +66,16 @@ void ContactSchedule<Motion>::schedule(std::size_t k, double from, const Geometr
   // in a straight line; under gravity it may (a ball that bounced falls back), so its next entry
   // is looked for, except on the plane it rests on.
   const bool touching_now = std::abs(g.gap) <= g.tolerance;
+  if (touching_now && approaching<Motion>(world_, pair, g.normal, from)) {
+    // Closing while it touches: an impact at this instant. The instant's resolver leaves none
+    // of its pairs approaching; this is one whose motion changed after it (a group formed
+    // again closes its contacts' normal velocities, which may turn a neighbouring touching pair
+    // that is none of its contacts, a ball leaving the floor, into the floor).
+    next_contact_[k] = from;
+    events_.emplace_back(from, k);
+    std::push_heap(events_.begin(), events_.end(), later);
+    return;
+  }
   if (!Motion::kAccelerates && touching_now) return;
   // Out of reach within the step even head-on (and accelerating all the way): no root needed.
   const double horizon = end_ - from;
@@ -81,7 +91,17 @@ void ContactSchedule<Motion>::schedule(std::size_t k, double from, const Geometr
 }
 
 template <class Motion>
-void ContactSchedule<Motion>::scheduleAll(double instant) {
+void ContactSchedule<Motion>::scheduleAll(double instant, const std::vector<std::size_t>& changed) {
+  if (world_.settings.broadphase) {
+    for (const std::size_t body : changed) {
+      for (const std::size_t k :
+           addReachablePairs<Motion>(world_, body, instant, end_, pairs_, pairs_of_)) {
+        next_contact_.push_back(INFINITY);
+        index(k);
+        start_geometry_.push_back(geometry<Motion>(world_, pairs_[k], instant));
+      }
+    }
+  }
   for (std::size_t k = 0; k < pairs_.size(); ++k) schedule(k, instant, start_geometry_[k]);
 }
 

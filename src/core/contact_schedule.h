@@ -24,8 +24,10 @@ class ContactSchedule {
   /// taken).
   void touchingAtStart(double instant, std::vector<std::size_t>& touching);
   /// Every pair's first contact after the start's impacts (positions do not jump at an impact,
-  /// so the start's geometry serves).
-  void scheduleAll(double instant);
+  /// so the start's geometry serves), with the pairs first that the new motion of the bodies of
+  /// `changed` may form (a stepped cluster let go of them, a group formed at the start: the
+  /// candidate pairs were found from their motion before).
+  void scheduleAll(double instant, const std::vector<std::size_t>& changed);
   /// After `body`'s motion changed at `instant`: the pairs its new motion may form, and all its
   /// pairs rescheduled (the others' next contact has not moved).
   void reschedule(std::size_t body, double instant);

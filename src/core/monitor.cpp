@@ -262,7 +262,7 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
     }
     event_bodies.clear();
     if (instants == 0) {
-      schedule.scheduleAll(instant);
+      schedule.scheduleAll(instant, changed);
     } else {
       for (const std::size_t body : changed) schedule.reschedule(body, instant);
     }
