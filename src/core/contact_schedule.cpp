@@ -91,15 +91,23 @@ void ContactSchedule<Motion>::schedule(std::size_t k, double from, const Geometr
 }
 
 template <class Motion>
+std::vector<std::size_t> ContactSchedule<Motion>::addPairsReached(std::size_t body,
+                                                                  double instant) {
+  if (!world_.settings.broadphase) return {};  // every pair is a candidate already
+  std::vector<std::size_t> added =
+      addReachablePairs<Motion>(world_, body, instant, end_, pairs_, pairs_of_);
+  for (const std::size_t k : added) {
+    next_contact_.push_back(INFINITY);
+    index(k);
+  }
+  return added;
+}
+
+template <class Motion>
 void ContactSchedule<Motion>::scheduleAll(double instant, const std::vector<std::size_t>& changed) {
-  if (world_.settings.broadphase) {
-    for (const std::size_t body : changed) {
-      for (const std::size_t k :
-           addReachablePairs<Motion>(world_, body, instant, end_, pairs_, pairs_of_)) {
-        next_contact_.push_back(INFINITY);
-        index(k);
-        start_geometry_.push_back(geometry<Motion>(world_, pairs_[k], instant));
-      }
+  for (const std::size_t body : changed) {
+    for (const std::size_t k : addPairsReached(body, instant)) {
+      start_geometry_.push_back(geometry<Motion>(world_, pairs_[k], instant));
     }
   }
   for (std::size_t k = 0; k < pairs_.size(); ++k) schedule(k, instant, start_geometry_[k]);
@@ -108,13 +116,7 @@ void ContactSchedule<Motion>::scheduleAll(double instant, const std::vector<std:
 template <class Motion>
 void ContactSchedule<Motion>::reschedule(std::size_t body, double instant) {
   // Its new motion may reach bodies its swept box did not: new candidate pairs.
-  if (world_.settings.broadphase) {
-    for (const std::size_t k :
-         addReachablePairs<Motion>(world_, body, instant, end_, pairs_, pairs_of_)) {
-      next_contact_.push_back(INFINITY);
-      index(k);
-    }
-  }
+  addPairsReached(body, instant);
   for (const std::size_t k : pairs_of_[body]) {
     schedule(k, instant, geometry<Motion>(world_, pairs_[k], instant));
   }

@@ -42,6 +42,9 @@ class ContactSchedule {
   /// The next first contact of pair k from `from`, given its geometry then.
   void schedule(std::size_t k, double from, const Geometry& g);
   void index(std::size_t k);
+  /// The candidate pairs `body`'s motion from `instant` may form that are not candidates yet
+  /// (addReachablePairs), added unscheduled; returns their indices.
+  std::vector<std::size_t> addPairsReached(std::size_t body, double instant);
   /// The pair touches at the instant of `g` (within its touching band, or a lasting contact).
   bool touches(const Pair& pair, const Geometry& g) const;
 
