@@ -40,8 +40,10 @@ Playback::Playback(const Scene& scene, double contact_tolerance, double start)
     state.time = start;
     state.position = body.position;
     state.velocity = body.velocity;
+    state.angular_velocity = body.angular_velocity;
     states.push_back(state);
-    flights_.push_back(Flight{start, body.position, body.velocity, false, 0});
+    flights_.push_back(
+        Flight{start, body.position, body.velocity, false, 0, body.angular_velocity});
   }
   committed_.step(start, states);
 }
@@ -107,7 +109,12 @@ bool Playback::applyImpact(std::size_t body, double time, const Eigen::Vector3d&
   state.velocity = velocity_after;
   state.angular_velocity = angular_velocity_after;
   view_.reset();
-  flights_[body] = Flight{time, centre, velocity_after, false, flights_[body].impacts_before + 1};
+  flights_[body] = Flight{time,
+                          centre,
+                          velocity_after,
+                          false,
+                          flights_[body].impacts_before + 1,
+                          angular_velocity_after};
   if (time == committed_time_) {
     // An impact at the instant the model was committed to (two bodies that touch exactly at a
     // sample, found by the next step): taken at that instant.
@@ -195,7 +202,8 @@ std::vector<Apex> Playback::apexesUntil(double time) {
     const double dt = apex_time - flight.start;
     apexes.push_back(Apex{i, apex_time,
                           positionAfter(flight.position, flight.velocity, gravity_, dt),
-                          velocityAfter(flight.velocity, gravity_, dt), flight.impacts_before});
+                          velocityAfter(flight.velocity, gravity_, dt), flight.impacts_before,
+                          flight.angular_velocity});
   }
   return apexes;
 }

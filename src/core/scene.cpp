@@ -110,6 +110,14 @@ Status validateScene(const Scene& scene, const std::string& prefix) {
     if (auto status = checkFinite(body.velocity, item(prefix, "bodies", i, "velocity")); !status) {
       return status;
     }
+    const std::string angular = item(prefix, "bodies", i, "angular_velocity");
+    if (auto status = checkFinite(body.angular_velocity, angular); !status) return status;
+    if (!scene.effects.spin && body.angular_velocity != Eigen::Vector3d::Zero()) {
+      return Error{angular,
+                   "is nonzero but the scene's effects do not include spin: without it the model "
+                   "has no spin, so the value would be ignored (add spin to effects, or remove "
+                   "the key)"};
+    }
   }
   for (std::size_t i = 0; i < scene.obstacles.size(); ++i) {
     const ObstacleSpec& obstacle = scene.obstacles[i];

@@ -96,6 +96,8 @@ const KeyTable<BodySpec>& bodyKeys() {
       textKey<BodySpec>("topic", [](BodySpec& b) -> std::string& { return b.topic; }),
       vectorKey<BodySpec>("position", [](BodySpec& b) -> Eigen::Vector3d& { return b.position; }),
       vectorKey<BodySpec>("velocity", [](BodySpec& b) -> Eigen::Vector3d& { return b.velocity; }),
+      vectorKey<BodySpec>("angular_velocity",
+                          [](BodySpec& b) -> Eigen::Vector3d& { return b.angular_velocity; }),
       {"inertia", false,
        [](const XmlRpc::XmlRpcValue& value, const std::string& field, BodySpec& body) {
          const auto name = readString(value, field);

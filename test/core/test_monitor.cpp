@@ -426,6 +426,48 @@ TEST(Playback, ImpactsAtTheSampleInstantsAreApplied) {
   EXPECT_EQ(playback.velocity(0, 3.0), V(0, 0, 0));
 }
 
+// Issue 27, item 2: a body's initial spin comes from the scene (BodySpec::angular_velocity) and
+// the played states carry it. A solid ball (I = 2/5 m r^2) set down at rest on a rough floor
+// spinning at omega0 about y slips backwards at omega0 r; friction mu m g pushes it forwards:
+// v = mu g t, omega_y = omega0 - 5/2 mu g t / r, until it rolls at t = omega0 r / (7/2 mu g),
+// from when v = 2/7 omega0 r = omega_y r.
+TEST(Playback, ABallSetDownSpinningIsPulledAlongUntilItRolls) {
+  using V = Eigen::Vector3d;
+  constexpr double kG = 9.81, kMu = 0.2, kRadius = 0.05, kOmega0 = 40.0;
+  core::Scene scene;
+  scene.effects.gravity = scene.effects.friction = scene.effects.spin = true;
+  scene.gravity = V(0, 0, -kG);
+  ASSERT_TRUE(
+      static_cast<bool>(scene.materials.addMaterial("cloth", core::Material{0.5, kMu}, "m")));
+  core::BodySpec ball;
+  ball.id = "ball";
+  ball.mass = 0.17;
+  ball.radius = kRadius;
+  ball.material = "cloth";
+  ball.position = V(0, 0, kRadius);
+  ball.angular_velocity = V(0, kOmega0, 0);
+  scene.bodies = {ball};
+  core::ObstacleSpec floor;
+  floor.id = "floor";
+  floor.normal = V(0, 0, 1);
+  floor.material = "cloth";
+  scene.obstacles = {floor};
+  core::Playback playback(scene, 1e-9, 0.0);
+  const double rolling_from = kOmega0 * kRadius / (3.5 * kMu * kG);
+  for (int k = 0; k <= 100; ++k) {
+    const double t = 0.005 * k;
+    const double v = t < rolling_from ? kMu * kG * t : 2.0 / 7.0 * kOmega0 * kRadius;
+    const double omega = t < rolling_from ? kOmega0 - 2.5 * kMu * kG * t / kRadius : v / kRadius;
+    const V velocity = playback.velocity(0, t);
+    const V spin = playback.angularVelocity(0, t);
+    EXPECT_NEAR(velocity.x(), v, 1e-12) << "at " << t << " s";
+    EXPECT_NEAR(velocity.z(), 0.0, 1e-12) << "at " << t << " s";
+    EXPECT_NEAR(spin.y(), omega, 1e-12 / kRadius) << "at " << t << " s";
+    EXPECT_NEAR(spin.x(), 0.0, 1e-12) << "at " << t << " s";
+    EXPECT_NEAR(spin.z(), 0.0, 1e-12) << "at " << t << " s";
+  }
+}
+
 // An impact heard after its instant was made final (a node answering more than a period late)
 // cannot be played: the body goes on without it. The caller is told (false), so that the scene
 // player can say so instead of showing bodies inside each other without a word.

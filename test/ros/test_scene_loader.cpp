@@ -150,6 +150,45 @@ TEST(SceneLoader, WholeScene) {
   EXPECT_EQ(scene->obstacles[1].frame, "paddle_link");
 }
 
+// Issue 27, item 2: a body's initial spin (a draw shot, topspin) is a key of its own, in rad/s in
+// the fixed frame, finite, and only with the spin effect (without it nothing would spin).
+TEST(SceneLoader, BodyAngularVelocity) {
+  auto tree = fullScene();
+  tree["effects"][0] = "spin";
+  tree["bodies"][0]["angular_velocity"][0] = 0.0;
+  tree["bodies"][0]["angular_velocity"][1] = -30.5;
+  tree["bodies"][0]["angular_velocity"][2] = 2;
+  const auto scene = loadScene(tree, "~scene");
+  ASSERT_TRUE(scene.ok()) << scene.error().message();
+  EXPECT_EQ(scene->bodies[0].angular_velocity, Eigen::Vector3d(0, -30.5, 2));
+  EXPECT_EQ(scene->bodies[1].angular_velocity, Eigen::Vector3d::Zero());  // the default
+
+  auto bad = tree;
+  bad["bodies"][0]["angular_velocity"][1] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(sceneErrorField(bad).rfind("~scene/bodies[0]/angular_velocity", 0), 0u);
+  bad = tree;
+  bad["bodies"][0]["angular_velocity"][1] = "fast";
+  EXPECT_EQ(sceneErrorField(bad), "~scene/bodies[0]/angular_velocity[1]");
+  bad = tree;
+  XmlRpc::XmlRpcValue two;
+  two[0] = 1.0;
+  two[1] = 2.0;
+  bad["bodies"][0]["angular_velocity"] = two;
+  EXPECT_EQ(sceneErrorField(bad), "~scene/bodies[0]/angular_velocity");
+
+  // Without the spin effect a nonzero spin would be ignored: named, not dropped silently.
+  bad = tree;
+  bad["effects"][0] = "gravity";
+  const auto ignored = loadScene(bad, "~scene");
+  ASSERT_FALSE(ignored.ok());
+  EXPECT_EQ(ignored.error().field, "~scene/bodies[0]/angular_velocity");
+  EXPECT_NE(ignored.error().reason.find("spin"), std::string::npos) << ignored.error().reason;
+  // A zero spin says nothing the model would ignore.
+  bad["bodies"][0]["angular_velocity"][1] = 0.0;
+  bad["bodies"][0]["angular_velocity"][2] = 0.0;
+  EXPECT_TRUE(loadScene(bad, "~scene").ok());
+}
+
 TEST(SceneLoader, SceneErrorsNameTheKey) {
   auto scene = fullScene();
   scene["detection"] = "psychic";
@@ -294,6 +333,7 @@ std::map<std::string, std::map<std::string, XmlRpc::XmlRpcValue>> examples() {
   std::map<std::string, std::map<std::string, XmlRpc::XmlRpcValue>> values;
   XmlRpc::XmlRpcValue effects;
   effects[0] = "gravity";
+  effects[1] = "spin";  // bodies[].angular_velocity needs it
   values["scene"] = {{"fixed_frame", "world"},
                      {"detection", "discrete"},
                      {"effects", effects},
@@ -315,6 +355,7 @@ std::map<std::string, std::map<std::string, XmlRpc::XmlRpcValue>> examples() {
                         {"topic", "/ball/state"},
                         {"position", list3(1, 2, 3)},
                         {"velocity", list3(4, 5, 6)},
+                        {"angular_velocity", list3(7, 8, 9)},
                         {"inertia", "hollow"}};
   values["obstacles[] plane"] = {
       {"id", "floor"},         {"type", "plane"},          {"material", "concrete"},
@@ -426,6 +467,7 @@ TEST(SceneKeys, EveryDocumentedKeyLoadsWithItsValue) {
   EXPECT_EQ(ball.topic, "/ball/state");
   EXPECT_EQ(ball.position, Eigen::Vector3d(1, 2, 3));
   EXPECT_EQ(ball.velocity, Eigen::Vector3d(4, 5, 6));
+  EXPECT_EQ(ball.angular_velocity, Eigen::Vector3d(7, 8, 9));
   EXPECT_EQ(ball.inertia, core::Inertia::kHollow);  // once refused as an unknown key
   ASSERT_EQ(loaded->obstacles.size(), 2u);
   EXPECT_EQ(loaded->obstacles[0].frame, "floor_link");

@@ -21,6 +21,7 @@ struct Apex {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
   int impacts_before = 0;  ///< impacts the body had before this flight
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  ///< rad/s, constant in flight
 };
 
 /// A scene played forward by the monitor's model, the impacts of whoever watches the played
@@ -81,6 +82,7 @@ class Playback {
     Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
     bool apex_reported = false;
     int impacts_before = 0;
+    Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
   };
   /// The model at `time`: the final part advanced with the impacts applied up to then.
   const ImpactMonitor& at(double time) const;

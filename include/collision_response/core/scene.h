@@ -40,6 +40,9 @@ struct BodySpec {
   Inertia inertia = Inertia::kSolid;  ///< with the spin effect: I = 2/5 m r^2 or 2/3 m r^2
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< m, initial, in the fixed frame
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< m/s, initial, in the fixed frame
+  /// rad/s, initial, in the fixed frame; nonzero only with the spin effect (without it the
+  /// model has no spin to give it)
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
 };
 
 enum class ObstacleShape { kPlane, kSphere };
