@@ -186,6 +186,7 @@ void ScenePlayer::publishStates(const ros::Time& time) {
     state.pose.position = toPointMsg(playback_->position(i, t));
     state.pose.orientation.w = 1.0;
     state.twist.linear = toVector3Msg(playback_->velocity(i, t));
+    state.twist.angular = toVector3Msg(playback_->angularVelocity(i, t));
     array.states.push_back(state);
   }
   state_publisher_.publish(array);
@@ -229,6 +230,7 @@ void ScenePlayer::publishApexes(const ros::Time& time) {
     state.pose.position = toPointMsg(apex.position);
     state.pose.orientation.w = 1.0;
     state.twist.linear = toVector3Msg(apex.velocity);
+    state.twist.angular = toVector3Msg(apex.angular_velocity);
     apex_publisher_.publish(state);
     if (!params_.report_restitution || apex.impacts_before != 1) continue;
     // The seed's method: dropped from rest, e from the heights of the lowest point above the
