@@ -63,12 +63,18 @@ def describe(impact):
 def main():
     rospy.init_node("python_client", anonymous=True)
     node = rospy.get_param("~node", NODE)
-    # 2 kg at 3 m/s meets 1 kg at -1 m/s, e = 0.5: v_a' = 1 m/s, v_b' = 3 m/s.
-    response = compute_collision(head_on(2.0, 3.0, 1.0, -1.0, 0.5), node)
+    try:
+        # 2 kg at 3 m/s meets 1 kg at -1 m/s, e = 0.5: v_a' = 1 m/s, v_b' = 3 m/s.
+        response = compute_collision(head_on(2.0, 3.0, 1.0, -1.0, 0.5), node)
+        # A ball dropped from 1 m bounces to 0.25 m: e = 0.5.
+        answer = estimate_restitution(1.0, 0.25, node)
+    except rospy.ROSException as error:  # wait_for_service's time-out: no node serves it
+        print(f"python_client: {error}: is the node running? Start it with "
+              f"'rosrun collision_response collision_response_node' (or a launch file), "
+              f"or give its name with _node:=/its_name")
+        return 1
     print(f"compute_collision: success {response.success}, {response.message}: "
           f"v_a' {response.velocity_a.x:g} m/s, v_b' {response.velocity_b.x:g} m/s")
-    # A ball dropped from 1 m bounces to 0.25 m: e = 0.5.
-    answer = estimate_restitution(1.0, 0.25, node)
     print(f"estimate_restitution: success {answer.success}, e {answer.restitution:g}, "
           f"nearest {answer.nearest_material}")
     seconds = rospy.get_param("~listen", 0.0)

@@ -10,13 +10,12 @@ mkdir -p "$ws"
 
 # Debian 12 packages: the package's own dependencies, read from package.xml
 # (scripts/install_dependencies.sh, the command the README gives for one's own workspace), and
-# the tools the scripts and the README's commands use: ROS's command-line tools, catkin_lint,
-# and clang with its sanitizer and fuzzer runtimes.
+# the tools the scripts use beyond them (ROS's command-line tools are dependencies of the
+# package): catkin_lint, and clang with its sanitizer and fuzzer runtimes.
 source "$repo/scripts/install_dependencies.sh"
 mapfile -t PACKAGES < <(package_debian_packages "$repo/package.xml")
 package_debian_packages "$repo/package.xml" >/dev/null || exit 1
 PACKAGES+=(
-  rosbash python3-rostopic python3-rosnode python3-rosparam python3-rosservice
   catkin-lint clang libclang-rt-14-dev
 )
 

@@ -39,7 +39,7 @@ class ImpactPrinter {
     for (const auto& impact : message->impacts) {
       const double time = start_.isZero() ? 0.0 : (impact.header.stamp - start_).toSec();
       std::printf(
-          "impact %9.6f s  %-10s -> %-10s e %.3f  J %.4g N s  lost %.4g J  a %s -> %s  b %s -> "
+          "impact %9.6f s  a %-10s b %-10s e %.3f  J %.4g N s  lost %.4g J  a %s -> %s  b %s -> "
           "%s\n",
           time, impact.body_a.c_str(), impact.body_b.c_str(), impact.restitution, impact.impulse,
           impact.energy_lost, vectorText(impact.velocity_a_before.linear).c_str(),
