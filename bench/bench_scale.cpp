@@ -20,10 +20,10 @@
 #include <vector>
 
 #include "box_walls.h"
-#include "collision_response/core/cluster_solver.h"
 #include "collision_response/core/impact.h"
 #include "collision_response/core/monitor.h"
 #include "collision_response/core/playback.h"
+#include "impact/cluster_solver.h"
 #ifdef COLLISION_RESPONSE_WITH_BULLET
 #include <btBulletDynamicsCommon.h>
 #endif

@@ -63,7 +63,7 @@ def main():
         "## An effect that is off, against a build without the effects",
         "",
         "The same workloads with every effect off, counted in instructions (deterministic), in the",
-        "core as built and in the core built with `src/core/effect_selection_none.cpp` instead of",
+        "core as built and in the core built with `src/core/impact/effect_selection_none.cpp` instead of",
         "`effect_selection.cpp` (a build in which no scene or request can turn an effect on):",
         "",
         "| workload | this build, effects off | build without effects | ratio |",

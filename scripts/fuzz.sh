@@ -20,12 +20,12 @@ mkdir -p "$out" "$results" "$repo/fuzz/regressions"
 # The monitor's target needs the generated message headers of a built workspace.
 [ -f "$ws/devel/include/collision_response/BodyState.h" ] || build_workspace >"$ws/fuzz-build.log" 2>&1
 flags=(-std=c++17 -O1 -g -Wall -Wextra -fsanitize=fuzzer-no-link,address,undefined
-  -fno-sanitize-recover=undefined -I "$repo/include" -isystem /usr/include/eigen3
+  -fno-sanitize-recover=undefined -I "$repo/include" -I "$repo/src/core" -isystem /usr/include/eigen3
   -isystem "$ws/devel/include" -isystem /usr/include/xmlrpcpp)
 echo "== building the core with clang -fsanitize=fuzzer-no-link,address,undefined"
 mkdir -p "$out/core"
 objects=()
-for source in "$repo"/src/core/*.cpp; do
+for source in "$repo"/src/core/*/*.cpp; do
   # The product's core: effect_selection_none.cpp is the benchmark's reference build instead.
   [ "$(basename "$source")" = effect_selection_none.cpp ] && continue
   object="$out/core/$(basename "$source" .cpp).o"

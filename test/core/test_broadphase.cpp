@@ -6,7 +6,7 @@
 #include <utility>
 #include <vector>
 
-#include "collision_response/core/broadphase.h"
+#include "geometry/broadphase.h"
 
 namespace collision_response::core {
 namespace {

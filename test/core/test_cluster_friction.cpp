@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "collision_response/core/cluster_solver.h"
 #include "collision_response/core/monitor.h"
+#include "impact/cluster_solver.h"
 
 namespace collision_response::core {
 namespace {

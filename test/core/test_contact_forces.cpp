@@ -6,7 +6,7 @@
 #include <cmath>
 #include <vector>
 
-#include "collision_response/core/contact_forces.h"
+#include "contact/contact_forces.h"
 
 namespace collision_response::core {
 namespace {

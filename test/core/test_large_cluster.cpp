@@ -16,9 +16,9 @@
 #include <random>
 #include <vector>
 
-#include "collision_response/core/cluster_solver.h"
-#include "collision_response/core/contact_forces.h"
 #include "collision_response/core/simultaneous.h"
+#include "contact/contact_forces.h"
+#include "impact/cluster_solver.h"
 
 namespace collision_response::core {
 namespace {

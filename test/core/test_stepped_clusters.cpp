@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "collision_response/core/monitor.h"
-#include "collision_response/core/stepped_contact.h"
+#include "contact/stepped_contact.h"
 
 namespace collision_response::core {
 namespace {

@@ -1,10 +1,10 @@
-#include "contact_schedule.h"
+#include "monitor/contact_schedule.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "candidate_pairs.h"
-#include "motion_model.h"
+#include "monitor/candidate_pairs.h"
+#include "monitor/motion_model.h"
 
 namespace collision_response::core::monitor {
 namespace {

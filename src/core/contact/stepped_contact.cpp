@@ -1,4 +1,4 @@
-#include "collision_response/core/stepped_contact.h"
+#include "contact/stepped_contact.h"
 
 #include <Eigen/Dense>
 #include <algorithm>

@@ -4,7 +4,7 @@
 #include <algorithm>
 
 #include "collision_response/core/impact.h"
-#include "order_free.h"
+#include "impact/order_free.h"
 
 namespace collision_response::core {
 namespace {

@@ -1,4 +1,4 @@
-#include "collision_response/core/contact_forces.h"
+#include "contact/contact_forces.h"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -7,7 +7,7 @@
 #include <set>
 #include <utility>
 
-#include "order_free.h"
+#include "impact/order_free.h"
 
 namespace collision_response::core {
 namespace {

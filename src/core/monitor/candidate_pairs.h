@@ -5,8 +5,8 @@
 #include <cstddef>
 #include <vector>
 
-#include "collision_response/core/broadphase.h"
-#include "monitor_world.h"
+#include "geometry/broadphase.h"
+#include "monitor/monitor_world.h"
 
 namespace collision_response::core::monitor {
 

@@ -1,13 +1,13 @@
-#include "lasting_contact.h"
+#include "contact/lasting_contact.h"
 
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 
-#include "candidate_pairs.h"
-#include "motion_model.h"
-#include "stepped_clusters.h"
+#include "contact/stepped_clusters.h"
+#include "monitor/candidate_pairs.h"
+#include "monitor/motion_model.h"
 
 namespace collision_response::core {
 

@@ -1,6 +1,6 @@
-#include "candidate_pairs.h"
+#include "monitor/candidate_pairs.h"
 
-#include "motion_model.h"
+#include "monitor/motion_model.h"
 
 namespace collision_response::core::monitor {
 

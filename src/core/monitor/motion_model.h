@@ -9,10 +9,10 @@
 #include <cmath>
 #include <optional>
 
-#include "collision_response/core/broadphase.h"
-#include "collision_response/core/motion.h"
 #include "collision_response/core/time_of_impact.h"
-#include "monitor_world.h"
+#include "geometry/broadphase.h"
+#include "geometry/motion.h"
+#include "monitor/monitor_world.h"
 
 namespace collision_response::core::monitor {
 

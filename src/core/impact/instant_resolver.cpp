@@ -1,14 +1,14 @@
-#include "instant_resolver.h"
+#include "impact/instant_resolver.h"
 
 #include <algorithm>
 #include <map>
 #include <numeric>
 #include <utility>
 
-#include "collision_response/core/cluster_solver.h"
-#include "collision_response/core/contact_forces.h"
 #include "collision_response/core/impact.h"
-#include "motion_model.h"
+#include "contact/contact_forces.h"
+#include "impact/cluster_solver.h"
+#include "monitor/motion_model.h"
 
 namespace collision_response::core::monitor {
 namespace {

@@ -8,15 +8,15 @@
 #include <cmath>
 #include <tuple>
 
-#include "candidate_pairs.h"
 #include "collision_response/core/body.h"
-#include "collision_response/core/cluster_solver.h"
-#include "contact_schedule.h"
-#include "instant_resolver.h"
-#include "lasting_contact.h"
-#include "monitor_world.h"
-#include "motion_model.h"
-#include "stepped_clusters.h"
+#include "contact/lasting_contact.h"
+#include "contact/stepped_clusters.h"
+#include "impact/cluster_solver.h"
+#include "impact/instant_resolver.h"
+#include "monitor/candidate_pairs.h"
+#include "monitor/contact_schedule.h"
+#include "monitor/monitor_world.h"
+#include "monitor/motion_model.h"
 
 namespace collision_response::core {
 

@@ -1,4 +1,4 @@
-#include "collision_response/core/motion.h"
+#include "geometry/motion.h"
 
 namespace collision_response::core {
 

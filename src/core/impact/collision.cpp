@@ -2,10 +2,10 @@
 
 #include <cmath>
 
-#include "collision_response/core/cluster_solver.h"
 #include "collision_response/core/friction.h"
 #include "collision_response/core/scene.h"
 #include "collision_response/core/validation.h"
+#include "impact/cluster_solver.h"
 
 namespace collision_response::core {
 namespace {

@@ -1,14 +1,14 @@
-#include "stepped_clusters.h"
+#include "contact/stepped_clusters.h"
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <set>
 
-#include "collision_response/core/broadphase.h"
-#include "collision_response/core/stepped_contact.h"
-#include "motion_model.h"
-#include "order_free.h"
+#include "contact/stepped_contact.h"
+#include "geometry/broadphase.h"
+#include "impact/order_free.h"
+#include "monitor/motion_model.h"
 
 namespace collision_response::core::monitor {
 namespace {

@@ -6,7 +6,7 @@
 #include <utility>
 #include <vector>
 
-#include "monitor_world.h"
+#include "monitor/monitor_world.h"
 
 namespace collision_response::core::monitor {
 

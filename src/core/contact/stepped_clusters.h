@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "collision_response/core/monitor.h"
-#include "lasting_contact.h"
-#include "monitor_world.h"
+#include "contact/lasting_contact.h"
+#include "monitor/monitor_world.h"
 
 namespace collision_response::core::monitor {
 

@@ -9,7 +9,7 @@
 #include <memory>
 #include <vector>
 
-#include "collision_response/core/contact_forces.h"
+#include "contact/contact_forces.h"
 
 namespace collision_response::core::monitor {
 

@@ -1,4 +1,4 @@
-#include "constrained_motion.h"
+#include "contact/constrained_motion.h"
 
 #include <Eigen/Geometry>
 #include <algorithm>

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "collision_response/core/motion.h"
+#include "geometry/motion.h"
 
 namespace collision_response::core {
 namespace {

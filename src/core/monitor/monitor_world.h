@@ -17,14 +17,14 @@
 #include <utility>
 #include <vector>
 
-#include "collision_response/core/broadphase.h"
-#include "collision_response/core/cluster_solver.h"
-#include "collision_response/core/contact_forces.h"
 #include "collision_response/core/friction.h"
 #include "collision_response/core/monitor.h"
-#include "collision_response/core/motion.h"
 #include "collision_response/core/scene.h"
-#include "constrained_motion.h"
+#include "contact/constrained_motion.h"
+#include "contact/contact_forces.h"
+#include "geometry/broadphase.h"
+#include "geometry/motion.h"
+#include "impact/cluster_solver.h"
 
 namespace collision_response::core::monitor {
 

@@ -1,4 +1,4 @@
-#include "collision_response/core/broadphase.h"
+#include "geometry/broadphase.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,7 +1,7 @@
-#include "collision_response/core/cluster_solver.h"
+#include "impact/cluster_solver.h"
 
-#include "collision_response/core/contact_forces.h"
 #include "collision_response/core/impact.h"
+#include "contact/contact_forces.h"
 
 namespace collision_response::core {
 
