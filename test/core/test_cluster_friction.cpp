@@ -13,6 +13,7 @@
 
 #include "collision_response/core/monitor.h"
 #include "impact/cluster_solver.h"
+#include "scene_builders.h"
 
 namespace collision_response::core {
 namespace {
@@ -28,12 +29,7 @@ Scene frictionScene() {
 }
 
 BodySpec ball(const std::string& id, double mass, double radius) {
-  BodySpec body;
-  body.id = id;
-  body.mass = mass;
-  body.radius = radius;
-  body.material = "cloth";
-  return body;
+  return scene_builders::ball(id, mass, radius, "cloth");
 }
 
 struct Outcome {

@@ -11,11 +11,15 @@
 
 #include "collision_response/core/body.h"
 #include "collision_response/core/monitor.h"
+#include "scene_builders.h"
 
 namespace collision_response::core {
 namespace {
 
 using V = Eigen::Vector3d;
+using scene_builders::ball;
+using scene_builders::plane;
+using scene_builders::sphere;
 constexpr double kG = 9.81;
 
 /// A scene with gravity (0, 0, -g) and the given effects.
@@ -30,25 +34,6 @@ Scene gravityScene(bool friction = false, bool spin = false) {
 
 void addMaterial(Scene& scene, const std::string& name, double restitution, double friction) {
   ASSERT_TRUE(scene.materials.addMaterial(name, Material{restitution, friction}, "m").ok());
-}
-
-BodySpec ball(const std::string& id, double mass, double radius, const std::string& material) {
-  BodySpec body;
-  body.id = id;
-  body.mass = mass;
-  body.radius = radius;
-  body.material = material;
-  return body;
-}
-
-ObstacleSpec plane(const std::string& id, const V& normal, double offset,
-                   const std::string& material) {
-  ObstacleSpec obstacle;
-  obstacle.id = id;
-  obstacle.normal = normal;
-  obstacle.offset = offset;
-  obstacle.material = material;
-  return obstacle;
 }
 
 MonitorSettings longLived() {
@@ -629,17 +614,6 @@ TEST(LastingContact, BallStruckWhileRestingInACorner) {
   EXPECT_TRUE(wall_hit);
   EXPECT_LT(deepest, 1e-9 * r + 1e-15);
   EXPECT_LT((monitor.predictedState(0, 4.0)->first - corner).norm(), 1e-8 * r);
-}
-
-ObstacleSpec sphere(const std::string& id, const V& centre, double radius,
-                    const std::string& material) {
-  ObstacleSpec obstacle;
-  obstacle.id = id;
-  obstacle.shape = ObstacleShape::kSphere;
-  obstacle.position = centre;
-  obstacle.radius = radius;
-  obstacle.material = material;
-  return obstacle;
 }
 
 // A ball on top of a fixed sphere, nudged at v0 across it (no friction). On the sphere, with d the

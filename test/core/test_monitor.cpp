@@ -11,6 +11,7 @@
 
 #include "collision_response/core/monitor.h"
 #include "collision_response/core/playback.h"
+#include "scene_builders.h"
 
 namespace collision_response::core {
 namespace {
@@ -26,12 +27,7 @@ Scene sceneWithRestitution(double restitution) {
 }
 
 BodySpec ball(const std::string& id, double mass, double radius) {
-  BodySpec body;
-  body.id = id;
-  body.mass = mass;
-  body.radius = radius;
-  body.material = "test";
-  return body;
+  return scene_builders::ball(id, mass, radius, "test");
 }
 
 BodyStateSample state(const ImpactMonitor& monitor, const std::string& id, double time,

@@ -15,6 +15,7 @@
 
 #include "collision_response/core/monitor.h"
 #include "contact/stepped_contact.h"
+#include "scene_builders.h"
 
 namespace collision_response::core {
 namespace {
@@ -301,12 +302,7 @@ TEST(SteppedSubstep, AWedgedRowIsHeldNotPushedApart) {
 // --- the monitor ------------------------------------------------------------------------------
 
 BodySpec ball(const std::string& id, double mass, double radius) {
-  BodySpec body;
-  body.id = id;
-  body.mass = mass;
-  body.radius = radius;
-  body.material = "pile";
-  return body;
+  return scene_builders::ball(id, mass, radius, "pile");
 }
 
 /// A closed box [0, size]^3 of six planes, e = 0.5 for every pair, gravity (0, 0, -g).
