@@ -212,7 +212,7 @@ void BM_PileUpdate(benchmark::State& state) {
   state.counters["source_ms"] = 1e3 * source_seconds / updates;
   state.counters["drift_m"] = drift;  // the farthest any centre moved from the lattice
   state.counters["bodies"] = static_cast<double>(states.size());
-  // In stepped clusters after the last update (README, "Lasting contact"), and what the
+  // In stepped clusters after the last update (doc/model.md, "Lasting contact"), and what the
   // fallbacks did (a stepped sub-step held still, for one) per update.
   state.counters["stepped_bodies"] = static_cast<double>(stepped);
   state.counters["fallbacks/update"] = static_cast<double>(fallbacks) / updates;

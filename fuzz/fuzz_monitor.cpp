@@ -105,8 +105,8 @@ core::Scene makeScene(fuzz::FuzzInput& in) {
     scene.obstacles.push_back(sphere);
   }
   if (flags & 128) {
-    // Stepped clusters of one to three bodies (README, "Lasting contact"): the fuzzed numbers
-    // reach the sub-step's solve.
+    // Stepped clusters of one to three bodies (doc/model.md, "Lasting contact"): the fuzzed
+    // numbers reach the sub-step's solve.
     scene.stepped_cluster_min_bodies = 1 + in.byte() % 3;
     scene.stepped_cluster_time_step = 1e-4 + in.byte() / 255.0 * 0.05;
   }

@@ -88,7 +88,7 @@ SCENES = [
     {"scene": "cradle", "duration": 0.1,
      "short": "Newton's cradle (5 balls, e = 1)",
      "title": "Newton's cradle: five touching balls, e = 1",
-     "reference": "event-driven, the README's simultaneous-contact model: the first four at "
+     "reference": "event-driven, doc/model.md's simultaneous-contact model: the first four at "
                   "rest, the last at 1 m/s",
      "note": "Worst ball's velocity after 0.1 s against the reference; energy and momentum "
              "against the start.",
@@ -100,10 +100,10 @@ SCENES = [
     {"scene": "billiards_break", "duration": 1.0,
      "short": "billiards break (16 balls, 1 s)",
      "title": "Billiards break: the cue ball at 6 m/s into a rack of fifteen",
-     "reference": "event-driven, 50 digits, the README's simultaneous-contact model for the "
+     "reference": "event-driven, 50 digits, doc/model.md's simultaneous-contact model for the "
                   "touching rack (44 impacts)",
      "note": "RMS over the sixteen balls after 1 s against the event-driven reference. The rack "
-             "touches: engines whose model of simultaneous contacts differs from the README's "
+             "touches: engines whose model of simultaneous contacts differs from doc/model.md's "
              "(rounds of joint Newton restitution) differ from it by that model as well.",
      "columns": [("velocity", "velocity RMS after 1 s (m/s)", fmt),
                  ("position", "position RMS after 1 s (m)", fmt),
@@ -494,7 +494,7 @@ def pile_findings(results, specs):
                       f"accounts for 1e-9 J at most. The 27-ball pile, never stepped (the exact "
                       f"model alone), rises by up to "
                       f"{fmt(max(exact_rises))} J: the player resolves the impacts it has not "
-                      f"heard yet itself (README, 'The scene player and the scenes'), and the monitor's, heard "
+                      f"heard yet itself (doc/model.md, 'The scene player and the scenes'), and the monitor's, heard "
                       f"an update later, replace them; in a ball's last micro-bounces the two "
                       f"histories part at the rounding of the contact, each losing energy, one "
                       f"losing a little more. Above that, the stepped bounce: a contact "
@@ -506,7 +506,7 @@ def pile_findings(results, specs):
     deep = [(spec, r, "penetration") for spec, r in runs("continuous") + runs("stepped")
             if (metric(r, "penetration") or 0) > 1e-9]
     if deep:
-        lines += ["", "Ours deeper than 1e-9 m: " + where(deep) + ". Open work: README, "
+        lines += ["", "Ours deeper than 1e-9 m: " + where(deep) + ". Open work: doc/model.md, "
                   "'Where it does not hold yet'."]
     through = [(spec, r, "penetration_walls") for spec, r in runs("discrete")
                if (metric(r, "penetration_walls") or 0) > 0.1]

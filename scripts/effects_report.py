@@ -56,7 +56,7 @@ def main():
         "effects change the motion, so each scene makes its own impacts: gravity makes the balls",
         "fall and bounce on the floor until they rest, friction takes energy out. Later the box",
         "costs more with every effect on: the balls gather and roll in contact, and each curved",
-        "contact between two balls is integrated (README, \"Lasting contact\"). Measured by hand",
+        "contact between two balls is integrated (doc/model.md, \"Lasting contact\"). Measured by hand",
         "on the same workload for 8 s: 11 s of CPU in all; an update took 0.1-2 ms up to 4 s,",
         "10-40 ms from 4.5 to 7.5 s, and the worst 0.75 s (at 7.06 s, 132 impacts).",
         "",

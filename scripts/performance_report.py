@@ -98,7 +98,7 @@ def pile_section(scale):
         "balls up to twice that apart are near each other: every pile here whose balls are "
         "within 2 mm of their neighbours is one connected set, and from "
         "`Scene::stepped_cluster_min_bodies` (32) bodies a stepped cluster, advanced by "
-        "gap-keeping sub-steps (README, \"Lasting contact\"), the layer 1 mm apart included. "
+        "gap-keeping sub-steps (doc/model.md, \"Lasting contact\"), the layer 1 mm apart included. "
         "Stepped whole in this run: " + ("; ".join(whole) if whole else "none") + ". "
         "Gravity off, nothing is stepped (stepping needs the steady force): the balls at rest, "
         "each touching or not, cost the exact model "

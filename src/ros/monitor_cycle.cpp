@@ -188,8 +188,8 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
                               step.stale_states});
   }
   if (step.truncated) {
-    // What remained was resolved by a fallback that puts no body into another (README,
-    // "Lasting contact"): as one inelastic cluster, or the step's bodies held.
+    // What remained was resolved by a fallback that puts no body into another
+    // (doc/model.md, "Lasting contact"): as one inelastic cluster, or the step's bodies held.
     update.reports.push_back(
         {Reason::kStepTruncated,
          "too many impacts at one instant or in one step; " + std::to_string(step.fallbacks) +

@@ -152,8 +152,8 @@ TEST(ContactForces, CornerOfAnInclineAndAWall) {
 // two equations for N_i, N_w and t. A one-parameter family whose members all give the same
 // accelerations, 0. Determined: no contact pulls, the contacts' forces on the ball sum to
 // its weight, and the ball stays (acceleration, angular acceleration 0). The solver takes the
-// least static friction (README, "Lasting contact"): the frictionless N = m g / cos t and
-// m g tan t with no friction lie in the family, so that is the answer. (The family's
+// least static friction (doc/model.md, "Lasting contact"): the frictionless N = m g / cos t
+// and m g tan t with no friction lie in the family, so that is the answer. (The family's
 // minimum-norm member, friction 0.288 N at each contact, has the wall pull: N_w = -0.17 N.)
 TEST(ContactForces, RoughCornerWithSpinHoldsWithoutPulling) {
   const double theta = 10.0 * M_PI / 180.0, m = 0.1, mu = 1.0;

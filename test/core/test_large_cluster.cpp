@@ -1,6 +1,6 @@
-// A cluster too large for one dense solve (README, "Work per message"): a lattice of touching
-// balls closing on its centre, 1,000 balls and 2,700 contacts, once a minute's dense solve.
-// Solved block by block, by conjugate gradients above 128 contacts. What must hold is Newton's
+// A cluster too large for one dense solve (doc/model.md, "Work per message"): a lattice of touching
+// balls closing on its centre, 1,000 balls and 2,700 contacts, once a minute's dense solve. Solved
+// block by block, by conjugate gradients above 128 contacts. What must hold is Newton's
 // restitution on every contact (d' = -e d where an impulse acts, J >= 0, no contact left
 // approaching), momentum to the rounding, no energy gained, and the same answer to the bit
 // for any naming of the bodies (conditions that hold for the exact answer, whatever computes

@@ -338,9 +338,9 @@ TEST(LastingContact, StaysAtRestInARoughCornerWithSpin) {
   EXPECT_LT((forceOnBody(last.contacts) - V(0, 0, CornerScene::kM * kG)).norm(), 1e-9);
 }
 
-// Discrete detection finds an impact by overlap at a sample, so a body meets a plane up to
-// speed x period inside it (README, "Detection"); lasting contact must then hold it there, not
-// let it go through. The corner under discrete detection at 100 Hz, frictionless and with
+// Discrete detection finds an impact by overlap at a sample, so a body meets a plane up to speed x
+// period inside it (doc/model.md, "Detection"); lasting contact must then hold it there, not let it
+// go through. The corner under discrete detection at 100 Hz, frictionless and with
 // friction and spin: the fastest arrival is what the fall to the wall gives without rolling,
 // v = sqrt(2 g s sin t) = 0.825 m/s, and a body is found at most one period after it arrives,
 // so the ball is never more than (v + g / rate) / rate inside a plane;

@@ -10,7 +10,7 @@ hard_cases.txt: one impact per line, the seed's combined formulas along the line
 v_a' = v_b + e (v_b - v_a) when a mass is inf; impulse = m_a |v_a - v_a'| (or m_b |...|); the energy
 lost as the exact difference of kinetic energies (in the immovable body's rest frame).
 
-cradle_cases.txt: the README's simultaneous-contact model run exactly: a row of touching equal
+cradle_cases.txt: doc/model.md's simultaneous-contact model run exactly: a row of touching equal
 balls, the first moving at 1 m/s; in rounds, every touching pair that approaches is resolved
 (pairs in one round never share a ball in a row struck at one end, so pairwise is exact here),
 until none approaches.

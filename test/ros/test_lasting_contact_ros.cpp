@@ -147,8 +147,8 @@ class LastingContactRos : public ::testing::Test {
   }
 
   /// No state overlapped anything by more than kGapTolerance: under continuous detection the
-  /// scene player resolves impacts itself until it hears the node's (README, "The scene player
-  /// and the scenes"), so not even the state that reveals an impact to the node is past the
+  /// scene player resolves impacts itself until it hears the node's (doc/model.md, "The scene
+  /// player and the scenes"), so not even the state that reveals an impact to the node is past the
   /// contact.
   void expectNoOverlap() const {
     for (const Overlap& overlap : overlaps_) {

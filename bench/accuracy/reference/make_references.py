@@ -5,7 +5,7 @@ Reads the scenes' inputs (scenes.txt, written by `accuracy_benchmark --export-sc
 double exactly, as a C99 hex float) and writes references.txt, which the benchmark reads to
 measure every engine (ours and the peers) against the same answers.
 
-How (nothing here calls or copies the C++ code; the physics is the seed's and the README's):
+How (nothing here calls or copies the C++ code; the physics is the seed's and doc/model.md's):
 
 - every number is taken exactly from its double (mpmath.mpf(float)) and carried in mpmath with
   50 significant digits, so the answers are exact to far below a double's rounding;
@@ -18,7 +18,7 @@ How (nothing here calls or copies the C++ code; the physics is the seed's and th
   |p_b - p_a| = r_a + r_b (relative motion is a straight line: every body feels the same
   gravity) or of a sphere-plane gap (a quadratic in time); at an impact the seed's combined
   formulas act along the line of impact (immovable bodies: inverse mass 0);
-- contacts that touch at one instant (a rack, a cradle) follow the README's documented model,
+- contacts that touch at one instant (a rack, a cradle) follow doc/model.md's documented model,
   "Simultaneous contacts": in rounds, every touching pair that approaches gets the impulses
   J >= 0 of the joint solve of Newton's restitution (d' = -e d on every contact that receives
   one; a contact whose impulse would pull is dropped, the most negative first, and the rest
@@ -288,8 +288,8 @@ def accelerated_time_to_impact(s, v, a, reach):
 
 
 def resolve_instant(scene):
-    """Every touching, approaching contact, in rounds (README "Simultaneous contacts"). Returns
-    the contacts that received an impulse, and the bodies whose velocity changed."""
+    """Every touching, approaching contact, in rounds (doc/model.md, "Simultaneous contacts").
+    Returns the contacts that received an impulse, and the bodies whose velocity changed."""
     impacts, touched = 0, set()
     for _ in range(100000):
         contacts = []

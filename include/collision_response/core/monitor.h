@@ -108,7 +108,7 @@ struct StepReport {
   /// resolved as one inelastic cluster, the step's bodies held where they were, or a stepped
   /// cluster held still over a sub-step its solve could not keep the gaps of.
   std::size_t fallbacks = 0;
-  /// Bodies in stepped clusters at the step's end (README, "Lasting contact").
+  /// Bodies in stepped clusters at the step's end (doc/model.md, "Lasting contact").
   std::size_t stepped_bodies = 0;
 };
 

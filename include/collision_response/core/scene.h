@@ -70,8 +70,8 @@ struct Scene {
   /// Curved lasting contact (a ball rolling on a sphere) is integrated: the error allowed per
   /// integrator step, absolute (m, m/s, rad/s) and relative.
   double contact_integration_tolerance = 1e-9;
-  /// Stepped clusters (gravity; README, "Lasting contact"): a connected set of at least this
-  /// many bodies near each other (within what they can move in a sub-step) is advanced by time
+  /// Stepped clusters (gravity; doc/model.md, "Lasting contact"): a connected set of at least
+  /// this many bodies near each other (within what they can move in a sub-step) is advanced by time
   /// steps instead of event by event; 0: never (every contact exact, at whatever cost).
   int stepped_cluster_min_bodies = 32;
   /// s: the longest sub-step; each update's interval is split into equal sub-steps no longer.

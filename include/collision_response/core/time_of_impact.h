@@ -1,4 +1,4 @@
-// The instant two bodies moving in straight lines first touch: the stable roots of the README,
+// The instant two bodies moving in straight lines first touch: the stable roots of doc/model.md,
 // "Detection" (derived in doc/development.md, "The physics, and how it is made exact").
 #pragma once
 

@@ -28,7 +28,8 @@ struct MovingFrame {
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< m/s, in parent
 };
 
-/// The scene player's private parameters, with their defaults (README.md, "The scene player").
+/// The scene player's private parameters, with their defaults (README.md, "Parameters"; what
+/// the player does: doc/model.md, "The scene player and the scenes").
 struct ScenePlayerParams {
   double rate = 100.0;              ///< Hz: states published this often
   double duration = 0.0;            ///< s played, then the player stops; 0: until stopped

@@ -340,7 +340,7 @@ Trial solveModes(const Group& group, const std::vector<Mode>& modes,
     // of three planes that a pair of them already holds). Where sticking contacts are redundant
     // (a ball held by friction in the corner of an incline and a wall), static friction is
     // indeterminate: every solution gives the same accelerations, but the one of minimum norm
-    // may pull at a contact (README, "Lasting contact"). The least static friction is taken
+    // may pull at a contact (doc/model.md, "Lasting contact"). The least static friction is taken
     // first: where normal forces alone can hold the group (the frictionless corner's
     // m g / cos t and m g tan t), friction takes nothing and no contact pulls.
     std::vector<char> static_friction(static_cast<std::size_t>(size));
@@ -681,7 +681,7 @@ Vector frictionByBarrier(const Matrix& coupling, const Vector& slip,
 using CouplingRows = std::vector<std::vector<std::pair<Eigen::Index, Real>>>;
 
 /// Relative to the largest slip, the projected-gradient residual at which the iterative friction
-/// solve stops (README, "Work per message, and threads").
+/// solve stops (doc/model.md, "Work per message, and threads").
 constexpr Real kFrictionResidual = 1e-12L;
 /// The iterative friction solve's iterations at most.
 constexpr int kFrictionIterations = 10000;

@@ -133,7 +133,7 @@ ContactForceSolution solveContactForcesWithModes(const std::vector<ForceBody>& b
 /// (contacts connected through shared movable bodies; exact), in long double: a block of up to
 /// 128 contacts by dense algebra, a larger one iteratively to a projected-gradient residual of
 /// 1e-12 of its largest slip (`converged` false where a block stops short of it: the bounds and
-/// the energy still hold). Nothing depends on the order of the contacts (README, "Work per
+/// the energy still hold). Nothing depends on the order of the contacts (doc/model.md, "Work per
 /// message, and threads"). Returns the impulses (tangential, on b) and modes per contact, and per
 /// body the change of velocity (in `acceleration`) and of angular velocity (in
 /// `angular_acceleration`).

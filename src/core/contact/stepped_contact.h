@@ -2,8 +2,8 @@
 // instead of event by event. An exact event-driven model meets an inelastic collapse there (the
 // impacts of a settling pile come ever closer: tens of thousands in one 10 ms update); a time
 // step bounds the work and keeps every body outside every other. The monitor uses it for the
-// clusters of near bodies the scene's `stepped_cluster_min_bodies` names (README, "Lasting
-// contact"); everything else stays exact.
+// clusters of near bodies the scene's `stepped_cluster_min_bodies` names (doc/model.md,
+// "Lasting contact"); everything else stays exact.
 #pragma once
 
 #include <Eigen/Core>

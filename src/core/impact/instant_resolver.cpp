@@ -14,7 +14,7 @@ namespace collision_response::core::monitor {
 namespace {
 
 /// Relative to a contact's fastest approach in the rounds of one instant, the approach below which
-/// it strikes again plastically (README, "Simultaneous contacts").
+/// it strikes again plastically (doc/model.md, "Simultaneous contacts").
 constexpr double kRepeatStrikeResolution = 1e-12;
 
 /// A touching contact at the instant: positions do not change during an instant, so its
@@ -110,8 +110,8 @@ std::vector<std::vector<std::size_t>> formClusters(const World& world,
 /// detection finds impacts by overlap at the samples) has the overlap as its band, widened so
 /// that the bounce must stay out of it for a sample period (World::riseBand): one that would not
 /// would fall back in deeper, a pair that overlapped at the sample before (so no new impact),
-/// and no contact would hold the body; so it rests there, held where it is (README,
-/// "Detection").
+/// and no contact would hold the body; so it rests there, held where it is
+/// (doc/model.md, "Detection").
 template <class Motion>
 double contactRestitution(World& world, double time, const InstantContact& contact,
                           double approach_speed) {
@@ -269,7 +269,7 @@ std::vector<double> velocitiesOf(const World& world, double time,
   return velocities;
 }
 
-/// Whether the rounds of one instant still converge (README, "Simultaneous contacts"). Rounds
+/// Whether the rounds of one instant still converge (doc/model.md, "Simultaneous contacts"). Rounds
 /// that converge are left alone; these end them, and what remains is resolved as at the rounds'
 /// budget's end (the inelastic fallback):
 ///  - a contact that strikes again slower than kRepeatStrikeResolution of its fastest approach

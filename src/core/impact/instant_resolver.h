@@ -11,7 +11,7 @@
 namespace collision_response::core::monitor {
 
 /// Resolves, in rounds, the pairs of `touching` that approach at `time` (the model of "Simultaneous
-/// contacts" in the README): each round finds the striking contacts, groups them into clusters
+/// contacts" in doc/model.md): each round finds the striking contacts, groups them into clusters
 /// (contacts that share a movable body), prepares each cluster (bodies, contacts, and the
 /// restitution each contact uses: contactRestitution), solves it (solveCluster: the joint normal
 /// solve, then friction), stores the new velocities in the tracks and records the impacts. The

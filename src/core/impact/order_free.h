@@ -1,7 +1,7 @@
 // What the joint solves of a cluster share so that their answers depend on no order of the bodies
 // or contacts: sums whose value does not depend on the order of their terms, the blocks of
 // contacts connected through shared movable bodies, and the size above which a block is solved
-// iteratively (README, "Work per message, and threads").
+// iteratively (doc/model.md, "Work per message, and threads").
 #pragma once
 
 #include <algorithm>

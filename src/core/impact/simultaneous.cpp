@@ -25,7 +25,7 @@ std::vector<ContactOutcome> resolveOne(std::vector<ClusterBody>& bodies,
   return {ContactOutcome{response.normal_impulse, response.approach_speed, response.energy_lost}};
 }
 
-// Blocks of more than kDenseBlockContacts contacts are solved by conjugate gradients (README,
+// Blocks of more than kDenseBlockContacts contacts are solved by conjugate gradients (doc/model.md,
 // "Work per message"): a dense solve costs the cube of the contacts (a lattice of 1,000 touching
 // balls closing on its centre, 2,700 contacts, took a minute).
 

@@ -125,8 +125,8 @@ struct SteppedCluster {
   bool stale = false;  ///< a member's state was replaced within the sub-step: solve again
 };
 
-/// The stepped clusters (README, "Lasting contact"): with gravity, at the start of every step
-/// and every `time_step` at most within it (the step's interval split into equal sub-steps, so
+/// The stepped clusters (doc/model.md, "Lasting contact"): with gravity, at the start of every
+/// step and every `time_step` at most within it (the step's interval split into equal sub-steps, so
 /// that a source stepping at the same instants, the scene player, moves its clusters by the
 /// same sub-steps), the bodies near each other (within what they can move in a sub-step) form
 /// connected sets; a set of at least `min_bodies` is advanced by a sub-step of

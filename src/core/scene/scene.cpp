@@ -67,8 +67,8 @@ Status validateScene(const Scene& scene, const std::string& prefix) {
       !status) {
     return status;
   }
-  // The integrator of curved lasting contact (README, "Lasting contact") can meet an error per
-  // step down to about 1e-14 in doubles; above 1e-3 its contacts would open by millimetres.
+  // The integrator of curved lasting contact (doc/model.md, "Lasting contact") can meet an error
+  // per step down to about 1e-14 in doubles; above 1e-3 its contacts would open by millimetres.
   if (!(scene.contact_integration_tolerance >= 1e-14 &&
         scene.contact_integration_tolerance <= 1e-3)) {
     return Error{
