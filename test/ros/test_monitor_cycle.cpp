@@ -275,6 +275,107 @@ TEST_F(Cycle, ASourceWhoseOwnClockGoesBackRestartsTheLine) {
   expectTwoBallImpactOnce(again);
 }
 
+// Issue 27, item 3: a second source sent one state stamped now + 299 s (inside
+// ~future_stamp_tolerance); the tracker's states were then shifted onto the line by 299 s and
+// its impact was stamped 299 s late. The tracker keeps the node's clock here (the node's clock
+// is each message's stamp): it keeps offset 0, its instants and its impact's stamp; the odd
+// source gets an offset of its own, said once, naming it and header.stamp.
+class ThirdBodyCycle : public Cycle {
+ protected:
+  ThirdBodyCycle() : Cycle(twoBallScene(1.0, 1)) {}
+
+  /// The two-ball case from /tracker, the node's clock at each stamp; `odd` before state k.
+  void playWithOddStamp(const ros::Time& start, int odd_at) {
+    for (int k = 0; k <= 10; ++k) {
+      const double t = 0.1 * k;
+      const ros::Time stamp = start + ros::Duration(0, 100000000 * k);
+      clock_ = stamp;
+      if (k == odd_at) {
+        send({state("extra_100000", stamp + ros::Duration(299.0), {0, 5, 0}, {0, 0, 0})}, "/other");
+      }
+      times_.push_back(send({state("a", stamp, {t, 0, 0}, {1, 0, 0}),
+                             state("b", stamp, {1.06 - t, 0, 0}, {-1, 0, 0})},
+                            "/tracker")
+                           .time);
+    }
+  }
+
+  void expectTheTrackerUnmoved(const ros::Time& start) {
+    EXPECT_EQ(cycle_.timeLine().offset("/body_states from /tracker"), 0.0);
+    ASSERT_EQ(times_.size(), 11u);
+    for (int k = 1; k <= 10; ++k) {
+      EXPECT_NEAR(times_[k] - times_[0], 0.1 * k, 1e-9) << "the tracker's instants: its stamps";
+    }
+    EXPECT_EQ(reportsOf(Reason::kClockJumpedBack), 0u);
+    ASSERT_EQ(reportsOf(Reason::kClockOffset), 1u) << "said once";
+    const std::string& text = firstReport(Reason::kClockOffset)->text;
+    EXPECT_NE(text.find("/body_states from /other"), std::string::npos) << text;
+    EXPECT_NE(text.find("299 s ahead of"), std::string::npos) << text;
+    EXPECT_NE(text.find("header.stamp 1299."), std::string::npos) << text;
+    expectTwoBallImpactOnce(start);
+  }
+
+  std::vector<double> times_;
+};
+
+TEST_F(ThirdBodyCycle, Issue27_Item3_OneStamp299sAheadFromASecondSourceMovesNoOtherSource) {
+  const ros::Time start(1000, 0);
+  playWithOddStamp(start, 3);
+  expectTheTrackerUnmoved(start);
+  EXPECT_EQ(cycle_.timeLine().offset("/body_states from /other"), -299.0);
+}
+
+TEST_F(ThirdBodyCycle, Issue27_Item3_OneStamp299sAheadAsTheFirstStampEverMovesNoOtherSource) {
+  const ros::Time start(1000, 0);
+  playWithOddStamp(start, 0);
+  expectTheTrackerUnmoved(start);
+}
+
+// Issue 27, item 3: one publisher interleaving two clocks reset every track on every message,
+// and the pair's impact was never found. Here /mixed sends a's states on the node's clock (at
+// the true instants 0.1 k s) and, 0.05 s after each, b's on a clock 299 s behind it. Expected:
+// no reset; b's clock is placed on the line on its own from its first state (said once), by
+// the node's clock at its arrival (exact here: the clock is each message's true instant); the
+// impact once, with the closed form, stamped in a's clock, the one that keeps the node's:
+// start + 0.43 s.
+TEST_F(Cycle, Issue27_Item3_OnePublisherInterleavingTwoClocksForThePairsTwoBodies) {
+  const ros::Time start(1000, 0);
+  for (int k = 0; k <= 10; ++k) {
+    const double t = 0.1 * k;
+    clock_ = start + ros::Duration(t);
+    send({state("a", clock_, {t, 0, 0}, {1, 0, 0})}, "/mixed");
+    clock_ = start + ros::Duration(t + 0.05);
+    send({state("b", clock_ - ros::Duration(299.0), {1.06 - (t + 0.05), 0, 0}, {-1, 0, 0})},
+         "/mixed");
+  }
+  EXPECT_EQ(reportsOf(Reason::kClockJumpedBack), 0u);
+  ASSERT_EQ(reportsOf(Reason::kClockOffset), 1u) << "said once";
+  EXPECT_NE(firstReport(Reason::kClockOffset)->text.find("/body_states from /mixed"),
+            std::string::npos);
+  expectTwoBallImpactOnce(start);
+}
+
+// The same, the two clocks alternating message by message with both bodies in each: {a, b} at
+// 0.1 k s on the node's clock, then at 0.1 k + 0.05 s on the clock 299 s behind. Expected: no
+// reset; the impact once, stamped in the clock of the states it was predicted from (those at
+// 0.4 s, on the node's clock; the ones at 0.45 s reveal it): start + 0.43 s.
+TEST_F(Cycle, Issue27_Item3_OnePublisherInterleavingTwoClocksForTheSameBodies) {
+  const ros::Time start(1000, 0);
+  for (int k = 0; k <= 10; ++k) {
+    for (const double late : {0.0, 0.05}) {
+      const double t = 0.1 * k + late;
+      clock_ = start + ros::Duration(t);
+      const ros::Time stamp = late > 0.0 ? clock_ - ros::Duration(299.0) : clock_;
+      send({state("a", stamp, {t, 0, 0}, {1, 0, 0}),
+            state("b", stamp, {1.06 - t, 0, 0}, {-1, 0, 0})},
+           "/mixed");
+    }
+  }
+  EXPECT_EQ(reportsOf(Reason::kClockJumpedBack), 0u);
+  EXPECT_EQ(reportsOf(Reason::kClockOffset), 1u) << "said once";
+  expectTwoBallImpactOnce(start);
+}
+
 // Issue 13, item 7: the same id twice in one array was dropped as "not newer" without naming
 // the id or the duplicate.
 TEST_F(Cycle, Item7_TheSameIdTwiceInOneArrayIsNamed) {
