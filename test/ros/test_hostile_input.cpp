@@ -283,7 +283,12 @@ TEST_F(HostileInput, Item5_TwoSourcesWhoseClocksDifferBy5s) {
   }
   expectTwoBallImpact("clock_a", start, before, 0.1 + 1e-9);
   EXPECT_EQ(harness_.countWarnings({"jumped back"}, logs), 0u);
-  EXPECT_EQ(harness_.countWarnings({"/clock_b/state", "behind the time line"}, logs), 1u)
+  // The line keeps this node's clock, and this file's windows of stamps run ahead of it: the
+  // lagging source may read behind or ahead of the line (the unit test has the clocks of a
+  // real pair of machines and reads "5 s behind"). Said once either way.
+  EXPECT_EQ(harness_.countWarnings({"/clock_b/state", "s behind the time line"}, logs) +
+                harness_.countWarnings({"/clock_b/state", "s ahead of the time line"}, logs),
+            1u)
       << "said once";
 }
 
