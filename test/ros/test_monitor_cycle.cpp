@@ -376,6 +376,134 @@ TEST_F(Cycle, Issue27_Item3_OnePublisherInterleavingTwoClocksForTheSameBodies) {
   expectTwoBallImpactOnce(start);
 }
 
+// The time line itself (issue 27, item 3), the node's clock at each stamp's true instant.
+ros::Time stampAt(const ros::Time& start, double seconds) { return start + ros::Duration(seconds); }
+
+TEST(TimeLine, Issue27_Item3_A299sStampFromASecondSourceLeavesTheGoodSourceAtOffsetZero) {
+  TimeLine line(1.0);
+  const ros::Time start(1000, 0);
+  double now = 0.0;
+  for (int k = 0; k <= 5; ++k) {
+    const ros::Time stamp = stampAt(start, 0.1 * k);
+    if (k == 3) {
+      const TimeLine::Placed odd = line.place("/odd", stamp + ros::Duration(299.0), stamp, now);
+      EXPECT_EQ(odd.event, TimeLine::Event::kOffsetChanged);
+      EXPECT_NEAR(odd.time, 0.3, 1e-9) << "at the line's present";
+      EXPECT_NEAR(line.offset("/odd"), -299.0, 1e-9);
+    }
+    const TimeLine::Placed good = line.place("/good", stamp, stamp, now);
+    EXPECT_EQ(good.event, k == 0 ? TimeLine::Event::kStarted : TimeLine::Event::kNone);
+    EXPECT_NEAR(good.time, 0.1 * k, 1e-9) << "its own stamps";
+    EXPECT_EQ(good.clock_offset, 0);
+    now = good.time;
+  }
+  EXPECT_EQ(line.offset("/good"), 0.0);
+  ros::Time stamp;
+  ASSERT_TRUE(line.stampOf(0.43, 0, stamp));
+  EXPECT_EQ(stamp, ros::Time(1000, 430000000));
+}
+
+// Interleaving: /mixed keeps clock A for four messages, then alternates A and B = A - 299 s.
+// B's first stamp is held (its clock went back), dropped when A's next one continues A, and
+// B's second makes B the source's second clock; from then on each is placed on its own clock
+// at its true instant, and nothing is ever reset.
+TEST(TimeLine, Issue27_Item3_ASourceInterleavingTwoClocksDoesNotResetOnEveryMessage) {
+  TimeLine line(1.0);
+  const ros::Time start(1000, 0);
+  double now = 0.0;
+  std::vector<TimeLine::Event> events;
+  for (int k = 0; k <= 8; ++k) {
+    const ros::Time a = stampAt(start, 0.1 * k);
+    const TimeLine::Placed on_a = line.place("/mixed", a, a, now);
+    EXPECT_NEAR(on_a.time, 0.1 * k, 1e-9);
+    EXPECT_EQ(on_a.clock_offset, 0);
+    EXPECT_EQ(on_a.dropped_held, k == 4);
+    now = on_a.time;
+    events.push_back(on_a.event);
+    if (k < 3) continue;
+    const ros::Time clock = stampAt(start, 0.1 * k + 0.05);
+    const TimeLine::Placed on_b = line.place("/mixed", clock - ros::Duration(299.0), clock, now);
+    events.push_back(on_b.event);
+    if (on_b.event == TimeLine::Event::kHeld) continue;
+    EXPECT_NEAR(on_b.time, 0.1 * k + 0.05, 1e-9) << "at its true instant";
+    EXPECT_EQ(on_b.clock_offset, 299000000000);
+    now = on_b.time;
+  }
+  using E = TimeLine::Event;
+  // A0 A1 A2 A3 B3 (held) A4 (drops it) B4 (second clock), then A5 B5 ... A8 B8 on their clocks.
+  std::vector<E> expected{E::kStarted, E::kNone, E::kNone,       E::kNone,
+                          E::kHeld,    E::kNone, E::kSecondClock};
+  expected.resize(expected.size() + 8, E::kNone);
+  EXPECT_EQ(events, expected);
+  const auto sources = line.sources();
+  ASSERT_EQ(sources.count("/mixed"), 1u);
+  EXPECT_EQ(sources.at("/mixed").offsets.size(), 2u);
+  EXPECT_EQ(sources.at("/mixed").dropped, 1u);
+}
+
+// rosbag play --loop: the source's stamps go back 100 s and continue from there. The first is
+// held, the second confirms: the line restarts at the first, every track to be reset.
+TEST(TimeLine, Issue27_Item3_ABagLoopStillResets) {
+  TimeLine line(1.0);
+  const ros::Time start(1000, 0);
+  double now = 0.0;
+  for (int k = 0; k <= 10; ++k) {
+    const ros::Time stamp = stampAt(start, 0.1 * k);
+    now = line.place("/bag", stamp, stamp, now).time;
+  }
+  const ros::Time again(900, 0);
+  const TimeLine::Placed held = line.place("/bag", again, stampAt(start, 1.1), now);
+  EXPECT_EQ(held.event, TimeLine::Event::kHeld);
+  const TimeLine::Placed loop = line.place("/bag", stampAt(again, 0.1), stampAt(start, 1.2), now);
+  EXPECT_EQ(loop.event, TimeLine::Event::kJumpedBack);
+  EXPECT_TRUE(loop.release_held);
+  EXPECT_EQ(loop.held_stamp, again);
+  EXPECT_NEAR(loop.time, 0.1, 1e-9) << "the line restarts at the held stamp";
+  ros::Time stamp;
+  ASSERT_TRUE(line.stampOf(0.43, loop.clock_offset, stamp));
+  EXPECT_EQ(stamp, ros::Time(900, 430000000)) << "in the bag's clock";
+}
+
+// A single stamp back from a good source is dropped, not a reset.
+TEST(TimeLine, Issue27_Item3_OneStampBackFromItsClockIsDroppedNotAReset) {
+  TimeLine line(1.0);
+  const ros::Time start(1000, 0);
+  double now = 0.0;
+  for (int k = 0; k <= 10; ++k) {
+    const ros::Time stamp = stampAt(start, 0.1 * k);
+    if (k == 5) {
+      EXPECT_EQ(line.place("/good", stamp - ros::Duration(299.0), stamp, now).event,
+                TimeLine::Event::kHeld);
+    }
+    const TimeLine::Placed placed = line.place("/good", stamp, stamp, now);
+    EXPECT_EQ(placed.event, k == 0 ? TimeLine::Event::kStarted : TimeLine::Event::kNone);
+    EXPECT_EQ(placed.dropped_held, k == 5);
+    EXPECT_NEAR(placed.time, 0.1 * k, 1e-9);
+    now = placed.time;
+  }
+  EXPECT_EQ(line.sources().at("/good").dropped, 1u);
+}
+
+// A second machine whose clock is 5 s behind the node's (and the first source's): its offset
+// is 5 s, once, and its states land at their true instants.
+TEST(TimeLine, Issue27_Item3_AMachine5sBehindIsStillAligned) {
+  TimeLine line(1.0);
+  const ros::Time start(1000, 0);
+  double now = 0.0;
+  for (int k = 0; k <= 10; ++k) {
+    const ros::Time stamp = stampAt(start, 0.1 * k);
+    const TimeLine::Placed on_a = line.place("/tracker_a", stamp, stamp, now);
+    EXPECT_NEAR(on_a.time, 0.1 * k, 1e-9);
+    const TimeLine::Placed on_b =
+        line.place("/tracker_b", stamp - ros::Duration(5.0), stamp, on_a.time);
+    EXPECT_EQ(on_b.event, k == 0 ? TimeLine::Event::kOffsetChanged : TimeLine::Event::kNone);
+    EXPECT_NEAR(on_b.time, 0.1 * k, 1e-9);
+    now = on_b.time;
+  }
+  EXPECT_EQ(line.offset("/tracker_a"), 0.0);
+  EXPECT_EQ(line.offset("/tracker_b"), 5.0);
+}
+
 // Issue 13, item 7: the same id twice in one array was dropped as "not newer" without naming
 // the id or the duplicate.
 TEST_F(Cycle, Item7_TheSameIdTwiceInOneArrayIsNamed) {
