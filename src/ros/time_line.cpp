@@ -38,7 +38,8 @@ TimeLine::Placed TimeLine::start(const std::string& source, std::int64_t first, 
   last_clock_ = clock;
   first_source_ = source;
   Source& known = sources_[source];
-  known.clocks.push_back(Clock{offset, std::max(first, at), ++heard_, 1});
+  known.clocks.push_back(
+      Clock{offset, std::max(first, at), ++heard_, 1, at + offset - epoch_, clock});
   known.heard = heard_;
   Placed placed;
   placed.time = static_cast<double>(at - first) * 1e-9;
@@ -49,7 +50,23 @@ TimeLine::Placed TimeLine::start(const std::string& source, std::int64_t first, 
 
 std::int64_t TimeLine::newOffset(std::int64_t at, std::int64_t clock, std::int64_t present) const {
   if (clock == 0 || std::abs(clock - at) <= jump_ns_) return 0;
-  return present - (at - epoch_);
+  // A clock another source keeps (heard within ~clock_jump_back of the node's clock) on which
+  // this stamp lands where that source is now: the two share it (two topics of one machine or
+  // of one bag), and instants across them stay exact. The closest such.
+  const Clock* shared = nullptr;
+  std::int64_t closest = jump_ns_;
+  for (const auto& entry : sources_) {
+    for (const Clock& other : entry.second.clocks) {
+      if (other.last_clock == 0 || clock - other.last_clock > jump_ns_) continue;
+      const std::int64_t expected = other.last_line + (clock - other.last_clock);
+      const std::int64_t distance = std::abs(at + other.offset - epoch_ - expected);
+      if (distance <= closest) {
+        closest = distance;
+        shared = &other;
+      }
+    }
+  }
+  return shared != nullptr ? shared->offset : present - (at - epoch_);
 }
 
 bool TimeLine::continues(const Clock& clock, std::int64_t at, std::int64_t node_clock,
@@ -96,6 +113,8 @@ TimeLine::Placed TimeLine::on(Clock& clock, std::int64_t at, std::int64_t node_c
     placed.event = Event::kOffsetChanged;
   }
   if (node_clock != 0) last_clock_ = node_clock;
+  clock.last_line = line;
+  clock.last_clock = node_clock;
   placed.time = static_cast<double>(line) * 1e-9;
   placed.clock_offset = clock.offset;
   return placed;
@@ -154,7 +173,7 @@ TimeLine::Placed TimeLine::place(const std::string& source, const ros::Time& sta
       return placed;
     }
     // The held clock went on, interleaved with the other one: a second clock of the source.
-    Placed placed = on(addClock(Clock{newOffset(at, node_clock, present), at, 0, 0}), at,
+    Placed placed = on(addClock(Clock{newOffset(at, node_clock, present), at, 0, 0, 0, 0}), at,
                        node_clock, now_ns, present);
     placed.event = Event::kSecondClock;
     return placed;
@@ -176,8 +195,8 @@ TimeLine::Placed TimeLine::place(const std::string& source, const ros::Time& sta
   }
 
   // A new source, or a stamp on none of its clocks: a clock of its own.
-  Placed placed = on(addClock(Clock{newOffset(at, node_clock, present), at, 0, 0}), at, node_clock,
-                     now_ns, present);
+  Placed placed = on(addClock(Clock{newOffset(at, node_clock, present), at, 0, 0, 0, 0}), at,
+                     node_clock, now_ns, present);
   if (!is_new) {
     placed.event = Event::kNewClock;
   } else if (placed.clock_offset != 0) {

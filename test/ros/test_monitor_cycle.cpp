@@ -498,10 +498,16 @@ TEST(TimeLine, Issue27_Item3_AMachine5sBehindIsStillAligned) {
         line.place("/tracker_b", stamp - ros::Duration(5.0), stamp, on_a.time);
     EXPECT_EQ(on_b.event, k == 0 ? TimeLine::Event::kOffsetChanged : TimeLine::Event::kNone);
     EXPECT_NEAR(on_b.time, 0.1 * k, 1e-9);
-    now = on_b.time;
+    // A second topic of the same machine, 1 ms later by the node's clock: the same offset.
+    const TimeLine::Placed on_imu = line.place("/tracker_b_imu", stamp - ros::Duration(5.0),
+                                               stamp + ros::Duration(0.001), on_b.time);
+    EXPECT_EQ(on_imu.clock_offset, on_b.clock_offset) << "sources sharing a clock share it";
+    EXPECT_NEAR(on_imu.time, 0.1 * k, 1e-9);
+    now = on_imu.time;
   }
   EXPECT_EQ(line.offset("/tracker_a"), 0.0);
   EXPECT_EQ(line.offset("/tracker_b"), 5.0);
+  EXPECT_EQ(line.offset("/tracker_b_imu"), 5.0);
 }
 
 // Issue 13, item 7: the same id twice in one array was dropped as "not newer" without naming

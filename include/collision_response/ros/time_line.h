@@ -9,14 +9,18 @@
 //    offset zero: nothing another source sends moves it (a source sending one state stamped
 //    now + 299 s does not shift the good ones: it is the odd one that gets an offset);
 //  - a new source whose stamps differ from the node's clock by more (a second machine whose
-//    clock is 5 s behind, a bag played without use_sim_time) is placed at the line's present:
-//    its offset is said once, in a warning that names it. Instants across it and the others are
+//    clock is 5 s behind, a bag played without use_sim_time) takes the offset of a clock
+//    another source keeps if its stamp lands where that source is now (two topics of one
+//    machine or one bag: exact across them), else one that places it at the line's present;
+//    said once, in a warning that names it. Instants across sources of different clocks are
 //    then only as good as that alignment (about one message period). Without the node's clock,
 //    a new source keeps offset zero unless it lags the line by more than ~clock_jump_back;
-//  - a stamp that leaps more than ~clock_jump_back ahead of its source's clock's present is
-//    placed at the line's present on a clock of its own (one odd stamp, or a publisher
-//    interleaving two clocks): the source's other clock and every other source are not moved;
-//  - a stamp that goes back by more than ~clock_jump_back on its source's clock is held: if
+//  - a stamp that, on its source's clock, lands more than ~clock_jump_back ahead of the line's
+//    present (judged only with the node's clock) is placed at the line's present on a clock of
+//    its own (one odd stamp, a publisher interleaving two clocks, or a source whose stamps
+//    leapt ahead): the source's other clock and every other source are not moved;
+//  - a stamp that goes back by more than ~clock_jump_back on its source's clock (one heard
+//    more than once, or any without the node's clock; else it is a clock of its own) is held: if
 //    the source's next message continues from it (rosbag play --loop, a simulator restarted),
 //    every track is reset and the line restarts at the held stamp (the held states enter the
 //    new line); if the next one continues the clock before, the held states are dropped,
@@ -108,6 +112,8 @@ class TimeLine {
     std::int64_t last_stamp = 0;  ///< ns, its newest stamp
     std::uint64_t heard = 0;      ///< when it was last heard (a counter)
     std::uint64_t messages = 0;
+    std::int64_t last_line = 0;   ///< ns, where its last stamp was placed
+    std::int64_t last_clock = 0;  ///< ns, the node's clock then (0: unknown)
   };
   struct Held {
     bool active = false;
