@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "collision_response/core/validation.h"
 #include "collision_response/ros/conversions.h"
@@ -147,34 +148,99 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
   // The input's newest stamp places it on the time line; its other states keep their distance
   // from it (integer nanoseconds).
   const std::string source = input.topic + " from " + input.publisher;
-  const TimeLine::Placed placed = time_line_.place(source, newest, monitor_.now());
+  const TimeLine::Placed placed = time_line_.place(source, newest, clock, monitor_.now());
+  const auto offsetText = [](std::int64_t offset) {
+    return core::formatNumber(std::abs(static_cast<double>(offset)) * 1e-9) + " s " +
+           (offset > 0 ? "behind" : "ahead of");
+  };
+  if (placed.dropped_held) {
+    const auto held = held_.find(source);
+    const std::size_t states = held == held_.end() ? 1 : held->second.size();
+    update.reports.push_back(
+        {Reason::kStampOffClock,
+         "dropped " + std::to_string(states) + " state(s) of " + source + " stamped header.stamp " +
+             formatStamp(placed.held_stamp) +
+             ", more than ~clock_jump_back before its clock, and its next message continued "
+             "that clock (one stamp off its clock, or a publisher interleaving two clocks): "
+             "nothing was reset",
+         states});
+    if (held != held_.end()) held_.erase(held);
+  }
+  if (placed.event == TimeLine::Event::kHeld) {
+    // Until the source's next input says whether its clock went back: nothing is stepped.
+    if (held_.size() >= TimeLine::kMaxSources && held_.count(source) == 0) {
+      held_.erase(held_.begin());
+    }
+    held_[source] = samples_;
+    return update;
+  }
   if (placed.event == TimeLine::Event::kJumpedBack) {
     update.reports.push_back(
         {Reason::kClockJumpedBack,
-         "time jumped back: " + source + " sent header.stamp " + formatStamp(newest) +
+         "time jumped back: " + source + " sent header.stamp " + formatStamp(placed.held_stamp) +
              ", more than ~clock_jump_back (" + core::formatNumber(params_.clock_jump_back) +
-             " s) before its last (a bag played with --loop? a simulator restarted?): every "
-             "track is reset and the time line starts again there"});
+             " s) before its last, and its next message continued from there (a bag played "
+             "with --loop? a simulator restarted?): every track is reset and the time line "
+             "starts again there"});
     monitor_.reset();
     placed_obstacles_.clear();
-  } else if (placed.event == TimeLine::Event::kOffsetChanged) {
+    body_clock_.assign(monitor_.bodyCount(), 0);
+    body_time_.assign(monitor_.bodyCount(), -std::numeric_limits<double>::infinity());
+    // The held input's states enter the new line before this one's (a body in both: this
+    // one's).
+    const auto held = held_.find(source);
+    if (held != held_.end()) {
+      for (const StampedSample& item : held->second) {
+        const bool newer = std::any_of(samples_.begin(), samples_.end(), [&](const auto& x) {
+          return x.sample.body == item.sample.body;
+        });
+        if (!newer && item.stamp <= newest) samples_.push_back(item);
+      }
+    }
+    held_.clear();  // the line forgot every other source's held stamp too
+  } else if (placed.event == TimeLine::Event::kOffsetChanged ||
+             (placed.event == TimeLine::Event::kStarted && placed.clock_offset != 0)) {
     update.reports.push_back(
         {Reason::kClockOffset,
-         source + "'s stamps are " + core::formatNumber(time_line_.offset(source)) +
-             " s behind the time line, which " + time_line_.firstSource() +
-             " started: its clock differs. Its states are shifted onto the line by that much "
-             "(instants across the two are as good as that alignment; synchronise the clocks "
-             "for exact ones)"});
+         source + "'s stamps are " + offsetText(placed.clock_offset) +
+             " the time line (this node's clock; the line was started by " +
+             time_line_.firstSource() + "; header.stamp " + formatStamp(newest) +
+             "): its clock differs. Its states are shifted onto the line by that much (instants "
+             "across sources are as good as that alignment; synchronise the clocks for exact "
+             "ones); impacts among its bodies keep its clock"});
+  } else if (placed.event == TimeLine::Event::kNewClock ||
+             placed.event == TimeLine::Event::kSecondClock) {
+    const bool second = placed.event == TimeLine::Event::kSecondClock;
+    Report report{
+        Reason::kClockOffset,
+        source + " sent header.stamp " + formatStamp(newest) + ", off its clock by more than " +
+            "~clock_jump_back (" + core::formatNumber(params_.clock_jump_back) + " s): " +
+            (second ? "it interleaves two clocks; this one is placed on the line on its own, "
+                    : "one odd stamp, a publisher interleaving two clocks, or its clock leapt "
+                      "ahead? Placed on a clock of its own, ") +
+            offsetText(placed.clock_offset) +
+            " the time line; its other clock and every other source keep theirs"};
+    report.variant = second ? 1 : 2;
+    update.reports.push_back(std::move(report));
+  }
+  if (body_clock_.size() != monitor_.bodyCount()) {
+    body_clock_.assign(monitor_.bodyCount(), 0);
+    body_time_.assign(monitor_.bodyCount(), -std::numeric_limits<double>::infinity());
   }
   update.stamp = newest;
   update.time = placed.time;
   timed_.clear();
   timed_.reserve(samples_.size());
+  clock_before_ = body_clock_;
   const std::int64_t newest_ns = nanoseconds(newest);
   for (const StampedSample& item : samples_) {
     core::BodyStateSample sample = item.sample;
     sample.time = placed.time - static_cast<double>(newest_ns - nanoseconds(item.stamp)) * 1e-9;
     timed_.push_back(sample);
+    if (sample.body < body_time_.size() && sample.time > body_time_[sample.body]) {
+      body_time_[sample.body] = sample.time;
+      body_clock_[sample.body] = placed.clock_offset;
+    }
   }
 
   updateObstacles(newest, placed.time, tf, update);
@@ -213,7 +279,9 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
   update.contacts.contacts.reserve(step.contacts.size());
   for (const core::ContactRecord& record : step.contacts) {
     ros::Time since;
-    const bool stamped = time_line_.stampOf(record.since, since);
+    const bool stamped = time_line_.stampOf(
+        record.since, clockOf(record.since, record.body_a, record.other, record.other_is_obstacle),
+        since);
     auto contact = toContactMessage(record, monitor_, since);
     if (contact && stamped) {
       update.contacts.contacts.push_back(std::move(contact.value()));
@@ -232,7 +300,9 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
   update.impacts.impacts.reserve(step.impacts.size());
   for (const core::ImpactRecord& record : step.impacts) {
     ros::Time stamp;
-    const bool stamped = time_line_.stampOf(record.time, stamp);
+    const bool stamped = time_line_.stampOf(
+        record.time, clockOf(record.time, record.body_a, record.other, record.other_is_obstacle),
+        stamp);
     auto impact = toImpactMessage(record, monitor_, stamp, scene_.fixed_frame);
     if (impact && stamped) {
       update.impacts.impacts.push_back(std::move(impact.value()));
@@ -247,6 +317,21 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
              "; the states were finite, the answer is not"});
   }
   return update;
+}
+
+std::int64_t MonitorCycle::clockOf(double time, std::size_t body_a, std::size_t other,
+                                   bool other_is_obstacle) const {
+  // A body's clock at `time`: its newest state's if that state had entered by then, else the
+  // one before (the track the instant was predicted from).
+  const auto clockOfBody = [&](std::size_t body) {
+    if (body >= body_clock_.size()) return std::int64_t{0};
+    return time >= body_time_[body] || body >= clock_before_.size() ? body_clock_[body]
+                                                                    : clock_before_[body];
+  };
+  const std::int64_t a = clockOfBody(body_a);
+  if (other_is_obstacle) return a;
+  const std::int64_t b = clockOfBody(other);
+  return a != b && b == 0 ? b : a;
 }
 
 void MonitorCycle::updateObstacles(const ros::Time& stamp, double time, const tf2::BufferCore& tf,

@@ -67,8 +67,15 @@ void MonitorDiagnostics::report(diagnostic_updater::DiagnosticStatusWrapper& sta
   status.add("messages waiting for transforms", waiting);
   status.add("transforms missing (states dropped, total)", total(Reason::kTransformMissing));
   status.add("obstacle transforms missing (total)", total(Reason::kObstacleTransform));
-  for (const auto& [source, offset] : cycle.timeLine().offsets()) {
-    if (offset != 0.0) status.add("clock offset of " + source + " (s)", offset);
+  // By source (at most TimeLine::kMaxSources): the clocks that are not the node's, and the
+  // stamps dropped off its clock.
+  for (const auto& [source, clocks] : cycle.timeLine().sources()) {
+    if (!clocks.offsets.empty() && clocks.offsets[0] != 0.0)
+      status.add("clock offset of " + source + " (s)", clocks.offsets[0]);
+    if (clocks.offsets.size() > 1)
+      status.add("clock offset of " + source + ", its other clock (s)", clocks.offsets[1]);
+    if (clocks.dropped > 0)
+      status.add("stamps off the clock of " + source + ", dropped (total)", clocks.dropped);
   }
   for (int i = 0; i < kReasonCount; ++i) {
     if (totals_[i] > 0)

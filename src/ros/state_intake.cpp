@@ -72,6 +72,8 @@ const char* counterName(Reason reason) {
       return "dropped: transform missing";
     case Reason::kStale:
       return "dropped: stamp not newer than the body's last";
+    case Reason::kStampOffClock:
+      return "dropped: stamp off its source's clock";
     case Reason::kTooManyStates:
       return "dropped: too many states in one message";
     case Reason::kQueueFull:

@@ -1,5 +1,6 @@
 #include "collision_response/ros/time_line.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -14,29 +15,77 @@ std::int64_t toNanoseconds(double seconds) {
   return static_cast<std::int64_t>(std::llround(seconds * 1e9));
 }
 
+ros::Time fromNanoseconds(std::int64_t at) {
+  ros::Time stamp;
+  stamp.sec = static_cast<std::uint32_t>(at / 1000000000);
+  stamp.nsec = static_cast<std::uint32_t>(at % 1000000000);
+  return stamp;
+}
+
 }  // namespace
 
 TimeLine::TimeLine(double clock_jump_back) : jump_ns_(toNanoseconds(clock_jump_back)) {}
 
-TimeLine::Placed TimeLine::place(const std::string& source, const ros::Time& stamp, double now) {
-  const std::int64_t at = nanoseconds(stamp);  // stamps are at most 2^32 s: no overflow
+TimeLine::Placed TimeLine::start(const std::string& source, std::int64_t first, std::int64_t at,
+                                 std::int64_t clock, Event event) {
+  reset();
+  started_ = true;
+  // Line zero is `first` in the node's clock: a stamp far from the node's clock (one
+  // arriving first, say) starts the line at the node's present, not at the stamp.
+  const std::int64_t offset =
+      clock != 0 && std::abs(clock - at) > jump_ns_ ? clock - at : std::int64_t{0};
+  epoch_ = first + offset;
+  last_clock_ = clock;
+  first_source_ = source;
+  Source& known = sources_[source];
+  known.clocks.push_back(
+      Clock{offset, std::max(first, at), ++heard_, 1, at + offset - epoch_, clock});
+  known.heard = heard_;
   Placed placed;
-  const auto restart = [&](Event event) {
-    reset();
-    started_ = true;
-    epoch_ = at;
-    first_source_ = source;
-    sources_[source] = Source{0, at, ++heard_};
-    placed.time = 0.0;
-    placed.event = event;
-    return placed;
-  };
-  if (!started_) return restart(Event::kStarted);
-  auto found = sources_.find(source);
-  if (found != sources_.end() && at < found->second.last_stamp - jump_ns_) {
-    return restart(Event::kJumpedBack);
+  placed.time = static_cast<double>(at - first) * 1e-9;
+  placed.event = event;
+  placed.clock_offset = offset;
+  return placed;
+}
+
+std::int64_t TimeLine::newOffset(std::int64_t at, std::int64_t clock, std::int64_t present) const {
+  if (clock == 0 || std::abs(clock - at) <= jump_ns_) return 0;
+  // A clock another source keeps (heard within ~clock_jump_back of the node's clock) on which
+  // this stamp lands where that source is now: the two share it (two topics of one machine or
+  // of one bag), and instants across them stay exact. The closest such.
+  const Clock* shared = nullptr;
+  std::int64_t closest = jump_ns_;
+  for (const auto& entry : sources_) {
+    for (const Clock& other : entry.second.clocks) {
+      if (other.last_clock == 0 || clock - other.last_clock > jump_ns_) continue;
+      const std::int64_t expected = other.last_line + (clock - other.last_clock);
+      const std::int64_t distance = std::abs(at + other.offset - epoch_ - expected);
+      if (distance <= closest) {
+        closest = distance;
+        shared = &other;
+      }
+    }
   }
-  if (found == sources_.end()) {
+  return shared != nullptr ? shared->offset : present - (at - epoch_);
+}
+
+bool TimeLine::continues(const Clock& clock, std::int64_t at, std::int64_t node_clock,
+                         std::int64_t present) const {
+  if (at < clock.last_stamp - jump_ns_) return false;  // went back
+  // Leapt ahead of the line's present (judged only with the node's clock: `present` moves
+  // with it; without it, a source's stamps going forward are its own business).
+  return node_clock == 0 || at + clock.offset - epoch_ <= present + jump_ns_;
+}
+
+bool TimeLine::continues(const Held& held, std::int64_t at, std::int64_t node_clock) const {
+  if (at < held.last - jump_ns_) return false;
+  return node_clock == 0 || held.clock == 0 || at - held.last <= node_clock - held.clock + jump_ns_;
+}
+
+TimeLine::Source& TimeLine::sourceOf(const std::string& source, bool& is_new) {
+  auto found = sources_.find(source);
+  is_new = found == sources_.end();
+  if (is_new) {
     if (sources_.size() >= kMaxSources) {
       auto oldest = sources_.begin();
       for (auto it = sources_.begin(); it != sources_.end(); ++it) {
@@ -44,48 +93,161 @@ TimeLine::Placed TimeLine::place(const std::string& source, const ros::Time& sta
       }
       sources_.erase(oldest);
     }
-    found = sources_.emplace(source, Source{0, at, 0}).first;
+    found = sources_.emplace(source, Source{}).first;
   }
-  Source& known = found->second;
-  known.heard = ++heard_;
-  if (at > known.last_stamp) known.last_stamp = at;
-  std::int64_t line = at - epoch_ + known.offset;
-  const std::int64_t now_ns = toNanoseconds(now);
-  if (line < now_ns - jump_ns_) {
+  return found->second;
+}
+
+TimeLine::Placed TimeLine::on(Clock& clock, std::int64_t at, std::int64_t node_clock,
+                              std::int64_t now, std::int64_t present) {
+  Placed placed;
+  clock.heard = heard_;
+  ++clock.messages;
+  if (at > clock.last_stamp) clock.last_stamp = at;
+  std::int64_t line = at + clock.offset - epoch_;
+  if (line < now - jump_ns_) {
     // Behind the line although its own clock did not go back: another clock. Shifted onto
     // the line's present.
-    known.offset += now_ns - line;
-    line = now_ns;
+    clock.offset += present - line;
+    line = present;
     placed.event = Event::kOffsetChanged;
   }
+  if (node_clock != 0) last_clock_ = node_clock;
+  clock.last_line = line;
+  clock.last_clock = node_clock;
   placed.time = static_cast<double>(line) * 1e-9;
+  placed.clock_offset = clock.offset;
   return placed;
 }
 
-bool TimeLine::stampOf(double time, ros::Time& stamp) const {
+TimeLine::Placed TimeLine::place(const std::string& source, const ros::Time& stamp,
+                                 const ros::Time& clock, double now) {
+  const std::int64_t at = nanoseconds(stamp);  // stamps are at most 2^32 s: no overflow
+  const std::int64_t node_clock = clock.isZero() ? 0 : nanoseconds(clock);
+  if (!started_) return start(source, at, at, node_clock, Event::kStarted);
+  const std::int64_t now_ns = toNanoseconds(now);
+  const std::int64_t present = now_ns + (node_clock != 0 && last_clock_ != 0
+                                             ? std::max<std::int64_t>(0, node_clock - last_clock_)
+                                             : std::int64_t{0});
+  bool is_new = false;
+  Source& known = sourceOf(source, is_new);
+  known.heard = ++heard_;
+  const auto addClock = [&known](const Clock& added) -> Clock& {
+    if (known.clocks.size() >= kMaxClocks) {
+      known.clocks.erase(
+          std::min_element(known.clocks.begin(), known.clocks.end(),
+                           [](const Clock& x, const Clock& y) { return x.heard < y.heard; }));
+    }
+    known.clocks.push_back(added);
+    return known.clocks.back();
+  };
+
+  // A clock of the source that this stamp continues, the one heard last first.
+  Clock* continued = nullptr;
+  for (Clock& candidate : known.clocks) {
+    if (continues(candidate, at, node_clock, present) &&
+        (continued == nullptr || candidate.heard > continued->heard)) {
+      continued = &candidate;
+    }
+  }
+  if (continued != nullptr) {
+    Placed placed = on(*continued, at, node_clock, now_ns, present);
+    if (known.held.active && !known.held.interrupted) {
+      // The stamp held before this one was off the source's clock: its states are dropped.
+      known.held.interrupted = true;
+      ++known.dropped;
+      placed.dropped_held = true;
+      placed.held_stamp = fromNanoseconds(known.held.first);
+    }
+    return placed;
+  }
+
+  if (known.held.active && continues(known.held, at, node_clock)) {
+    const Held held = known.held;
+    known.held = Held{};
+    if (!held.interrupted) {
+      // Its next message continued from the held stamp: its clock really went back.
+      Placed placed = start(source, held.first, at, node_clock, Event::kJumpedBack);
+      placed.release_held = true;
+      placed.held_stamp = fromNanoseconds(held.first);
+      return placed;
+    }
+    // The held clock went on, interleaved with the other one: a second clock of the source.
+    Placed placed = on(addClock(Clock{newOffset(at, node_clock, present), at, 0, 0, 0, 0}), at,
+                       node_clock, now_ns, present);
+    placed.event = Event::kSecondClock;
+    return placed;
+  }
+
+  const Clock* last = nullptr;
+  for (const Clock& candidate : known.clocks) {
+    if (last == nullptr || candidate.heard > last->heard) last = &candidate;
+  }
+  // Back from a clock it kept for more than one message (or without the node's clock to tell
+  // which stamp is odd): held until its next message says which.
+  if (last != nullptr && at < last->last_stamp - jump_ns_ &&
+      (last->messages >= 2 || node_clock == 0)) {
+    known.held = Held{true, false, at, at, node_clock};
+    Placed placed;
+    placed.event = Event::kHeld;
+    placed.held_stamp = stamp;
+    return placed;
+  }
+
+  // A new source, or a stamp on none of its clocks: a clock of its own.
+  Placed placed = on(addClock(Clock{newOffset(at, node_clock, present), at, 0, 0, 0, 0}), at,
+                     node_clock, now_ns, present);
+  if (!is_new) {
+    placed.event = Event::kNewClock;
+  } else if (placed.clock_offset != 0) {
+    placed.event = Event::kOffsetChanged;
+  }
+  return placed;
+}
+
+bool TimeLine::stampOf(double time, std::int64_t clock_offset, ros::Time& stamp) const {
   if (!std::isfinite(time) || std::abs(time) > 1e10) return false;
-  const std::int64_t at = epoch_ + toNanoseconds(time);
+  // Offsets are at most 2^32 s either way: no overflow.
+  const std::int64_t at = epoch_ + toNanoseconds(time) - clock_offset;
   if (at < 0 || at >= (std::int64_t{1} << 32) * 1000000000) return false;
-  stamp.sec = static_cast<std::uint32_t>(at / 1000000000);
-  stamp.nsec = static_cast<std::uint32_t>(at % 1000000000);
+  stamp = fromNanoseconds(at);
   return true;
 }
 
 double TimeLine::offset(const std::string& source) const {
   const auto found = sources_.find(source);
-  return found == sources_.end() ? 0.0 : static_cast<double>(found->second.offset) * 1e-9;
+  if (found == sources_.end() || found->second.clocks.empty()) return 0.0;
+  const Clock* last = &found->second.clocks.front();
+  for (const Clock& clock : found->second.clocks) {
+    if (clock.heard > last->heard) last = &clock;
+  }
+  return static_cast<double>(last->offset) * 1e-9;
 }
 
 std::map<std::string, double> TimeLine::offsets() const {
   std::map<std::string, double> result;
-  for (const auto& [name, source] : sources_)
-    result[name] = static_cast<double>(source.offset) * 1e-9;
+  for (const auto& entry : sources_) result[entry.first] = offset(entry.first);
+  return result;
+}
+
+std::map<std::string, TimeLine::SourceClocks> TimeLine::sources() const {
+  std::map<std::string, SourceClocks> result;
+  for (const auto& [name, source] : sources_) {
+    std::vector<Clock> clocks = source.clocks;
+    std::sort(clocks.begin(), clocks.end(),
+              [](const Clock& x, const Clock& y) { return x.heard > y.heard; });
+    SourceClocks& entry = result[name];
+    for (const Clock& clock : clocks)
+      entry.offsets.push_back(static_cast<double>(clock.offset) * 1e-9);
+    entry.dropped = source.dropped;
+  }
   return result;
 }
 
 void TimeLine::reset() {
   started_ = false;
   epoch_ = 0;
+  last_clock_ = 0;
   first_source_.clear();
   sources_.clear();
 }

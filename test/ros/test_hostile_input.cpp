@@ -283,7 +283,12 @@ TEST_F(HostileInput, Item5_TwoSourcesWhoseClocksDifferBy5s) {
   }
   expectTwoBallImpact("clock_a", start, before, 0.1 + 1e-9);
   EXPECT_EQ(harness_.countWarnings({"jumped back"}, logs), 0u);
-  EXPECT_EQ(harness_.countWarnings({"/clock_b/state", "behind the time line"}, logs), 1u)
+  // The line keeps this node's clock, and this file's windows of stamps run ahead of it: the
+  // lagging source may read behind or ahead of the line (the unit test has the clocks of a
+  // real pair of machines and reads "5 s behind"). Said once either way.
+  EXPECT_EQ(harness_.countWarnings({"/clock_b/state", "s behind the time line"}, logs) +
+                harness_.countWarnings({"/clock_b/state", "s ahead of the time line"}, logs),
+            1u)
       << "said once";
 }
 
@@ -378,6 +383,60 @@ TEST_F(HostileInput, Item10_DropHeightsAtTheEndsOfTheDoubles) {
   ASSERT_TRUE(srv.response.success) << srv.response.message;
   EXPECT_EQ(srv.response.restitution, 0.0);
   EXPECT_FALSE(std::signbit(srv.response.restitution));
+}
+
+// Issue 27, item 3: a second source sent one state stamped now + 299 s (inside
+// ~future_stamp_tolerance): the tracker's states were then shifted onto the line by about
+// 299 s, and every impact afterwards was stamped as much late. Here the second source is this
+// node's publisher on /clock_b/state (another topic: another source) and its state is of a body
+// out of the pair's way. Expected: that source gets a clock of its own, said naming it and
+// header.stamp; the tracker's impact is found once, with the closed form, stamped in the
+// tracker's clock: start + 0.43 s (within 1 ms); nothing is reset.
+TEST_F(HostileInput, Issue27_Item3_OneStateFromASecondPublisher299sAheadShiftsNoImpact) {
+  ros::Publisher own = harness_.node().advertise<BodyState>("/clock_b/state", 100);
+  ASSERT_TRUE(MonitorHarness::waitFor([&own] { return own.getNumSubscribers() > 0; }, 10.0));
+  ros::WallDuration(0.5).sleep();
+  const std::size_t logs = harness_.logCount();
+  const std::size_t before = harness_.impactCount();
+  own.publish(makeState(ros::Time::now() + ros::Duration(299.0),
+                        StateSpec{"", Eigen::Vector3d(0, 60, 0), Eigen::Vector3d::Zero()}));
+  EXPECT_TRUE(MonitorHarness::waitFor(
+      [&] {
+        return harness_.countWarnings({"/clock_b/state", "header.stamp", "ahead of the time line"},
+                                      logs) > 0;
+      },
+      5.0))
+      << "the odd source is named";
+  const ros::Time start = window();
+  playTwoBalls(start);
+  expectTwoBallImpact("a", start, before, 1e-3);
+  EXPECT_EQ(harness_.countWarnings({"jumped back"}, logs), 0u);
+}
+
+// Issue 27, item 3: one publisher interleaving two clocks reset every track on every message,
+// and the pair's impact was never found. Here this node's /body_states publisher sends a's
+// states on its clock and, 0.05 s after each, b's on a clock 299 s behind it. Expected: no
+// reset; b's clock is placed on the line on its own (said, naming the source and
+// header.stamp); the impact once, with the closed form, stamped in a's clock: start + 0.43 s,
+// within 0.05 s (half the period between the two clocks' messages: b's clock is aligned by
+// the node's clock at its messages' arrival).
+TEST_F(HostileInput, Issue27_Item3_OnePublisherInterleavingTwoClocks) {
+  const std::size_t logs = harness_.logCount();
+  const std::size_t before = harness_.impactCount();
+  const ros::Time start = window();
+  for (int k = 0; k <= 10; ++k) {
+    const double t = 0.1 * k;
+    harness_.publish(start + ros::Duration(t),
+                     {StateSpec{"a", Eigen::Vector3d(t, 0, 0), Eigen::Vector3d(1, 0, 0)}});
+    ros::WallDuration(0.05).sleep();
+    harness_.publish(
+        start + ros::Duration(t + 0.05 - 299.0),
+        {StateSpec{"b", Eigen::Vector3d(1.06 - (t + 0.05), 0, 0), Eigen::Vector3d(-1, 0, 0)}});
+    ros::WallDuration(0.05).sleep();
+  }
+  expectTwoBallImpact("a", start, before, 0.05);
+  EXPECT_EQ(harness_.countWarnings({"jumped back"}, logs), 0u);
+  EXPECT_GE(harness_.countWarnings({"/body_states from", "header.stamp", "clock"}, logs), 1u);
 }
 
 }  // namespace

@@ -275,6 +275,241 @@ TEST_F(Cycle, ASourceWhoseOwnClockGoesBackRestartsTheLine) {
   expectTwoBallImpactOnce(again);
 }
 
+// Issue 27, item 3: a second source sent one state stamped now + 299 s (inside
+// ~future_stamp_tolerance); the tracker's states were then shifted onto the line by 299 s and
+// its impact was stamped 299 s late. The tracker keeps the node's clock here (the node's clock
+// is each message's stamp): it keeps offset 0, its instants and its impact's stamp; the odd
+// source gets an offset of its own, said once, naming it and header.stamp.
+class ThirdBodyCycle : public Cycle {
+ protected:
+  ThirdBodyCycle() : Cycle(twoBallScene(1.0, 1)) {}
+
+  /// The two-ball case from /tracker, the node's clock at each stamp; `odd` before state k.
+  void playWithOddStamp(const ros::Time& start, int odd_at) {
+    for (int k = 0; k <= 10; ++k) {
+      const double t = 0.1 * k;
+      const ros::Time stamp = start + ros::Duration(0, 100000000 * k);
+      clock_ = stamp;
+      if (k == odd_at) {
+        send({state("extra_100000", stamp + ros::Duration(299.0), {0, 5, 0}, {0, 0, 0})}, "/other");
+      }
+      times_.push_back(send({state("a", stamp, {t, 0, 0}, {1, 0, 0}),
+                             state("b", stamp, {1.06 - t, 0, 0}, {-1, 0, 0})},
+                            "/tracker")
+                           .time);
+    }
+  }
+
+  void expectTheTrackerUnmoved(const ros::Time& start) {
+    EXPECT_EQ(cycle_.timeLine().offset("/body_states from /tracker"), 0.0);
+    ASSERT_EQ(times_.size(), 11u);
+    for (int k = 1; k <= 10; ++k) {
+      EXPECT_NEAR(times_[k] - times_[0], 0.1 * k, 1e-9) << "the tracker's instants: its stamps";
+    }
+    EXPECT_EQ(reportsOf(Reason::kClockJumpedBack), 0u);
+    ASSERT_EQ(reportsOf(Reason::kClockOffset), 1u) << "said once";
+    const std::string& text = firstReport(Reason::kClockOffset)->text;
+    EXPECT_NE(text.find("/body_states from /other"), std::string::npos) << text;
+    EXPECT_NE(text.find("299 s ahead of"), std::string::npos) << text;
+    EXPECT_NE(text.find("header.stamp 1299."), std::string::npos) << text;
+    expectTwoBallImpactOnce(start);
+  }
+
+  std::vector<double> times_;
+};
+
+TEST_F(ThirdBodyCycle, Issue27_Item3_OneStamp299sAheadFromASecondSourceMovesNoOtherSource) {
+  const ros::Time start(1000, 0);
+  playWithOddStamp(start, 3);
+  expectTheTrackerUnmoved(start);
+  EXPECT_EQ(cycle_.timeLine().offset("/body_states from /other"), -299.0);
+}
+
+TEST_F(ThirdBodyCycle, Issue27_Item3_OneStamp299sAheadAsTheFirstStampEverMovesNoOtherSource) {
+  const ros::Time start(1000, 0);
+  playWithOddStamp(start, 0);
+  expectTheTrackerUnmoved(start);
+}
+
+// Issue 27, item 3: one publisher interleaving two clocks reset every track on every message,
+// and the pair's impact was never found. Here /mixed sends a's states on the node's clock (at
+// the true instants 0.1 k s) and, 0.05 s after each, b's on a clock 299 s behind it. Expected:
+// no reset; b's clock is placed on the line on its own from its first state (said once), by
+// the node's clock at its arrival (exact here: the clock is each message's true instant); the
+// impact once, with the closed form, stamped in a's clock, the one that keeps the node's:
+// start + 0.43 s.
+TEST_F(Cycle, Issue27_Item3_OnePublisherInterleavingTwoClocksForThePairsTwoBodies) {
+  const ros::Time start(1000, 0);
+  for (int k = 0; k <= 10; ++k) {
+    const double t = 0.1 * k;
+    clock_ = start + ros::Duration(t);
+    send({state("a", clock_, {t, 0, 0}, {1, 0, 0})}, "/mixed");
+    clock_ = start + ros::Duration(t + 0.05);
+    send({state("b", clock_ - ros::Duration(299.0), {1.06 - (t + 0.05), 0, 0}, {-1, 0, 0})},
+         "/mixed");
+  }
+  EXPECT_EQ(reportsOf(Reason::kClockJumpedBack), 0u);
+  ASSERT_EQ(reportsOf(Reason::kClockOffset), 1u) << "said once";
+  EXPECT_NE(firstReport(Reason::kClockOffset)->text.find("/body_states from /mixed"),
+            std::string::npos);
+  expectTwoBallImpactOnce(start);
+}
+
+// The same, the two clocks alternating message by message with both bodies in each: {a, b} at
+// 0.1 k s on the node's clock, then at 0.1 k + 0.05 s on the clock 299 s behind. Expected: no
+// reset; the impact once, stamped in the clock of the states it was predicted from (those at
+// 0.4 s, on the node's clock; the ones at 0.45 s reveal it): start + 0.43 s.
+TEST_F(Cycle, Issue27_Item3_OnePublisherInterleavingTwoClocksForTheSameBodies) {
+  const ros::Time start(1000, 0);
+  for (int k = 0; k <= 10; ++k) {
+    for (const double late : {0.0, 0.05}) {
+      const double t = 0.1 * k + late;
+      clock_ = start + ros::Duration(t);
+      const ros::Time stamp = late > 0.0 ? clock_ - ros::Duration(299.0) : clock_;
+      send({state("a", stamp, {t, 0, 0}, {1, 0, 0}),
+            state("b", stamp, {1.06 - t, 0, 0}, {-1, 0, 0})},
+           "/mixed");
+    }
+  }
+  EXPECT_EQ(reportsOf(Reason::kClockJumpedBack), 0u);
+  EXPECT_EQ(reportsOf(Reason::kClockOffset), 1u) << "said once";
+  expectTwoBallImpactOnce(start);
+}
+
+// The time line itself (issue 27, item 3), the node's clock at each stamp's true instant.
+ros::Time stampAt(const ros::Time& start, double seconds) { return start + ros::Duration(seconds); }
+
+TEST(TimeLine, Issue27_Item3_A299sStampFromASecondSourceLeavesTheGoodSourceAtOffsetZero) {
+  TimeLine line(1.0);
+  const ros::Time start(1000, 0);
+  double now = 0.0;
+  for (int k = 0; k <= 5; ++k) {
+    const ros::Time stamp = stampAt(start, 0.1 * k);
+    if (k == 3) {
+      const TimeLine::Placed odd = line.place("/odd", stamp + ros::Duration(299.0), stamp, now);
+      EXPECT_EQ(odd.event, TimeLine::Event::kOffsetChanged);
+      EXPECT_NEAR(odd.time, 0.3, 1e-9) << "at the line's present";
+      EXPECT_NEAR(line.offset("/odd"), -299.0, 1e-9);
+    }
+    const TimeLine::Placed good = line.place("/good", stamp, stamp, now);
+    EXPECT_EQ(good.event, k == 0 ? TimeLine::Event::kStarted : TimeLine::Event::kNone);
+    EXPECT_NEAR(good.time, 0.1 * k, 1e-9) << "its own stamps";
+    EXPECT_EQ(good.clock_offset, 0);
+    now = good.time;
+  }
+  EXPECT_EQ(line.offset("/good"), 0.0);
+  ros::Time stamp;
+  ASSERT_TRUE(line.stampOf(0.43, 0, stamp));
+  EXPECT_EQ(stamp, ros::Time(1000, 430000000));
+}
+
+// Interleaving: /mixed keeps clock A for four messages, then alternates A and B = A - 299 s.
+// B's first stamp is held (its clock went back), dropped when A's next one continues A, and
+// B's second makes B the source's second clock; from then on each is placed on its own clock
+// at its true instant, and nothing is ever reset.
+TEST(TimeLine, Issue27_Item3_ASourceInterleavingTwoClocksDoesNotResetOnEveryMessage) {
+  TimeLine line(1.0);
+  const ros::Time start(1000, 0);
+  double now = 0.0;
+  std::vector<TimeLine::Event> events;
+  for (int k = 0; k <= 8; ++k) {
+    const ros::Time a = stampAt(start, 0.1 * k);
+    const TimeLine::Placed on_a = line.place("/mixed", a, a, now);
+    EXPECT_NEAR(on_a.time, 0.1 * k, 1e-9);
+    EXPECT_EQ(on_a.clock_offset, 0);
+    EXPECT_EQ(on_a.dropped_held, k == 4);
+    now = on_a.time;
+    events.push_back(on_a.event);
+    if (k < 3) continue;
+    const ros::Time clock = stampAt(start, 0.1 * k + 0.05);
+    const TimeLine::Placed on_b = line.place("/mixed", clock - ros::Duration(299.0), clock, now);
+    events.push_back(on_b.event);
+    if (on_b.event == TimeLine::Event::kHeld) continue;
+    EXPECT_NEAR(on_b.time, 0.1 * k + 0.05, 1e-9) << "at its true instant";
+    EXPECT_EQ(on_b.clock_offset, 299000000000);
+    now = on_b.time;
+  }
+  using E = TimeLine::Event;
+  // A0 A1 A2 A3 B3 (held) A4 (drops it) B4 (second clock), then A5 B5 ... A8 B8 on their clocks.
+  std::vector<E> expected{E::kStarted, E::kNone, E::kNone,       E::kNone,
+                          E::kHeld,    E::kNone, E::kSecondClock};
+  expected.resize(expected.size() + 8, E::kNone);
+  EXPECT_EQ(events, expected);
+  const auto sources = line.sources();
+  ASSERT_EQ(sources.count("/mixed"), 1u);
+  EXPECT_EQ(sources.at("/mixed").offsets.size(), 2u);
+  EXPECT_EQ(sources.at("/mixed").dropped, 1u);
+}
+
+// rosbag play --loop: the source's stamps go back 100 s and continue from there. The first is
+// held, the second confirms: the line restarts at the first, every track to be reset.
+TEST(TimeLine, Issue27_Item3_ABagLoopStillResets) {
+  TimeLine line(1.0);
+  const ros::Time start(1000, 0);
+  double now = 0.0;
+  for (int k = 0; k <= 10; ++k) {
+    const ros::Time stamp = stampAt(start, 0.1 * k);
+    now = line.place("/bag", stamp, stamp, now).time;
+  }
+  const ros::Time again(900, 0);
+  const TimeLine::Placed held = line.place("/bag", again, stampAt(start, 1.1), now);
+  EXPECT_EQ(held.event, TimeLine::Event::kHeld);
+  const TimeLine::Placed loop = line.place("/bag", stampAt(again, 0.1), stampAt(start, 1.2), now);
+  EXPECT_EQ(loop.event, TimeLine::Event::kJumpedBack);
+  EXPECT_TRUE(loop.release_held);
+  EXPECT_EQ(loop.held_stamp, again);
+  EXPECT_NEAR(loop.time, 0.1, 1e-9) << "the line restarts at the held stamp";
+  ros::Time stamp;
+  ASSERT_TRUE(line.stampOf(0.43, loop.clock_offset, stamp));
+  EXPECT_EQ(stamp, ros::Time(900, 430000000)) << "in the bag's clock";
+}
+
+// A single stamp back from a good source is dropped, not a reset.
+TEST(TimeLine, Issue27_Item3_OneStampBackFromItsClockIsDroppedNotAReset) {
+  TimeLine line(1.0);
+  const ros::Time start(1000, 0);
+  double now = 0.0;
+  for (int k = 0; k <= 10; ++k) {
+    const ros::Time stamp = stampAt(start, 0.1 * k);
+    if (k == 5) {
+      EXPECT_EQ(line.place("/good", stamp - ros::Duration(299.0), stamp, now).event,
+                TimeLine::Event::kHeld);
+    }
+    const TimeLine::Placed placed = line.place("/good", stamp, stamp, now);
+    EXPECT_EQ(placed.event, k == 0 ? TimeLine::Event::kStarted : TimeLine::Event::kNone);
+    EXPECT_EQ(placed.dropped_held, k == 5);
+    EXPECT_NEAR(placed.time, 0.1 * k, 1e-9);
+    now = placed.time;
+  }
+  EXPECT_EQ(line.sources().at("/good").dropped, 1u);
+}
+
+// A second machine whose clock is 5 s behind the node's (and the first source's): its offset
+// is 5 s, once, and its states land at their true instants.
+TEST(TimeLine, Issue27_Item3_AMachine5sBehindIsStillAligned) {
+  TimeLine line(1.0);
+  const ros::Time start(1000, 0);
+  double now = 0.0;
+  for (int k = 0; k <= 10; ++k) {
+    const ros::Time stamp = stampAt(start, 0.1 * k);
+    const TimeLine::Placed on_a = line.place("/tracker_a", stamp, stamp, now);
+    EXPECT_NEAR(on_a.time, 0.1 * k, 1e-9);
+    const TimeLine::Placed on_b =
+        line.place("/tracker_b", stamp - ros::Duration(5.0), stamp, on_a.time);
+    EXPECT_EQ(on_b.event, k == 0 ? TimeLine::Event::kOffsetChanged : TimeLine::Event::kNone);
+    EXPECT_NEAR(on_b.time, 0.1 * k, 1e-9);
+    // A second topic of the same machine, 1 ms later by the node's clock: the same offset.
+    const TimeLine::Placed on_imu = line.place("/tracker_b_imu", stamp - ros::Duration(5.0),
+                                               stamp + ros::Duration(0.001), on_b.time);
+    EXPECT_EQ(on_imu.clock_offset, on_b.clock_offset) << "sources sharing a clock share it";
+    EXPECT_NEAR(on_imu.time, 0.1 * k, 1e-9);
+    now = on_imu.time;
+  }
+  EXPECT_EQ(line.offset("/tracker_a"), 0.0);
+  EXPECT_EQ(line.offset("/tracker_b"), 5.0);
+  EXPECT_EQ(line.offset("/tracker_b_imu"), 5.0);
+}
+
 // Issue 13, item 7: the same id twice in one array was dropped as "not newer" without naming
 // the id or the duplicate.
 TEST_F(Cycle, Item7_TheSameIdTwiceInOneArrayIsNamed) {

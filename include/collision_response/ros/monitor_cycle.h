@@ -13,6 +13,7 @@
 #include <tf2/buffer_core.h>
 
 #include <cstdint>
+#include <map>
 #include <set>
 #include <string>
 #include <vector>
@@ -75,6 +76,11 @@ class MonitorCycle {
   std::size_t steppedBodies() const { return stepped_bodies_; }
 
  private:
+  /// The offset (ns, TimeLine::stampOf) of the clock to stamp an instant `time` of the two
+  /// sides in: the clock of the states it was predicted from when they share one; else the
+  /// node's clock if one side keeps it, else body_a's.
+  std::int64_t clockOf(double time, std::size_t body_a, std::size_t other,
+                       bool other_is_obstacle) const;
   /// Places the tf-attached obstacles at `stamp` (line time `time`).
   void updateObstacles(const ros::Time& stamp, double time, const tf2::BufferCore& tf,
                        Update& update);
@@ -87,6 +93,13 @@ class MonitorCycle {
   std::set<std::size_t> placed_obstacles_;  ///< tf-attached obstacles placed at least once
   std::vector<StampedSample> samples_;      ///< working memory, kept between inputs
   std::vector<core::BodyStateSample> timed_;
+  /// By source: the states of an input whose stamp went back on its clock, until its next
+  /// input tells a clock jump from a stamp off the clock (TimeLine::Event::kHeld).
+  std::map<std::string, std::vector<StampedSample>> held_;
+  /// By body: the clock offset (ns) of its newest state, and that state's line time.
+  std::vector<std::int64_t> body_clock_;
+  std::vector<double> body_time_;
+  std::vector<std::int64_t> clock_before_;  ///< body_clock_ before the input's states
   std::uint64_t steps_ = 0;
   std::size_t stepped_bodies_ = 0;
 };

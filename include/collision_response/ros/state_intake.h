@@ -29,13 +29,14 @@ enum class Reason {
   kNonFinite,          ///< a NaN or infinite number
   kTransformMissing,   ///< no transform from the state's frame, after waiting
   kStale,              ///< not newer than the body's last state
+  kStampOffClock,      ///< a stamp back from its source's clock, the next one continuing it
   kTooManyStates,      ///< a message with more than ~max_states states
   kQueueFull,          ///< the oldest waiting input, dropped for a new one
   kInternalError,      ///< an exception while processing a message
   kImpactNotFinite,    ///< an impact whose numbers the doubles cannot hold: not published
   kContactNotFinite,   ///< a lasting contact whose numbers the doubles cannot hold: not published
   kClockJumpedBack,    ///< a source's stamps went back: every track reset
-  kClockOffset,        ///< a source's stamps lag the time line: shifted onto it
+  kClockOffset,        ///< a source's (or a stamp's) clock differs: placed with an offset
   kStepTruncated,      ///< a guard of the monitor cut a step short
   kSteppedHeld,        ///< a stepped cluster held still over sub-steps it could not solve
   kObstacleTransform,  ///< a tf-attached obstacle keeps its last known motion
