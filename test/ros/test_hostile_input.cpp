@@ -380,6 +380,53 @@ TEST_F(HostileInput, Item10_DropHeightsAtTheEndsOfTheDoubles) {
   EXPECT_FALSE(std::signbit(srv.response.restitution));
 }
 
+/// The messages on /diagnostics of `node` (its status named "<node>: impact monitor") while
+/// `during` runs and `seconds` after.
+std::vector<diagnostic_msgs::DiagnosticStatus> diagnosticsOf(const std::string& node,
+                                                             const std::function<void()>& during,
+                                                             double seconds) {
+  std::vector<diagnostic_msgs::DiagnosticStatus> received;
+  ros::NodeHandle handle;
+  const std::string name = node.substr(1) + ": impact monitor";
+  ros::Subscriber subscriber = handle.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 100, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& array) {
+        for (const auto& status : array->status) {
+          if (status.name == name) received.push_back(status);
+        }
+      });
+  MonitorHarness::waitFor([&] { return subscriber.getNumPublishers() > 0; }, 10.0);
+  if (during) during();
+  MonitorHarness::waitFor([] { return false; }, seconds);
+  return received;
+}
+
+// Issue 27, item 4: `rosparam set ~diagnostic_period 1e10` while the node ran aborted it
+// (diagnostic_updater re-read the value and ros::Duration(1e10) threw from its timer: SIGABRT
+// within 3 s, the services gone). The re-read is checked as at start-up: the value is refused
+// with a warning naming the key, the period in use (0.2 s, from the launch file) is kept, and
+// the node keeps answering, publishing diagnostics and finding impacts.
+TEST_F(HostileInput, Issue27_Item4_ADiagnosticPeriodNoRosDurationHoldsSetWhileRunningIsRefused) {
+  const std::string key = "/collision_response/diagnostic_period";
+  const auto diagnostics = diagnosticsOf(
+      "/collision_response", [&] { ros::param::set(key, 1e10); }, 4.0);
+  EXPECT_TRUE(harness_.waitForWarning(
+      {key + ": 1e+10 s is longer than a ros::Duration can hold (2147483647 s)", "kept 0.2 s"}));
+  // Still published every 0.2 s: over the 4 s after the set, about 20 (at least 10).
+  EXPECT_GE(diagnostics.size(), 10u);
+  EstimateRestitution srv;
+  srv.request.drop_height = 1.0;
+  srv.request.bounce_height = 0.25;  // e = sqrt(0.25 / 1) = 0.5
+  ASSERT_TRUE(ros::service::call("/collision_response/estimate_restitution", srv))
+      << "the node's services are gone";
+  ASSERT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_EQ(srv.response.restitution, 0.5);
+  // A good value is taken again, and the node is still right.
+  ros::param::set(key, 0.2);
+  const ros::Time start = window();
+  playTwoBalls(start);
+  expectTwoBallImpact("a", start);
+}
+
 }  // namespace
 }  // namespace collision_response::testing
 
