@@ -178,6 +178,20 @@ TEST(StartupErrors, Issue27_Item4_ADurationNoRosDurationHoldsStopsTheNodeByName)
   expectRefused(player, "/rate: ", "1e-10 Hz is too slow");
 }
 
+// Issue 27, item 5: a body placed past where the monitor resolves contacts (x = 1.7e308) is
+// refused at start-up by the node and the scene player, naming the coordinate.
+TEST(StartupErrors, Issue27_Item5_ABodyPlacedAtXOf1point7e308StopsTheNodeAndThePlayerByName) {
+  for (const std::string& executable :
+       {kNode, std::string("rosrun collision_response scene_player")}) {
+    XmlRpc::XmlRpcValue body = ball("ball");
+    body["position"][0] = 1.7e308;
+    body["position"][1] = 0.0;
+    body["position"][2] = 0.05;
+    expectRefused(start(executable, scene({body})), "/scene/bodies[0]/position.x: ",
+                  "1.7e+308 m is beyond where the monitor can resolve a contact");
+  }
+}
+
 // The stepped clusters' keys (README, "Scene file"), checked at start-up by the node and the
 // scene player alike, each refusal naming the key and the value.
 TEST(StartupErrors, SteppedClusterKeysOutOfRangeStopTheNodeAndThePlayerByName) {
