@@ -59,12 +59,20 @@ bool CollisionResponseNode::start() {
     monitor_ = std::make_unique<ImpactMonitorRos>(node_, *scene, *params);
 
     // Diagnostics, named after this node (or nodelet): ~diagnostic_period s apart (default 1).
-    diagnostics_ = std::make_unique<diagnostic_updater::Updater>(node_, private_node_,
-                                                                 private_node_.getNamespace());
+    // The Updater would re-read ~diagnostic_period itself, unchecked, at every publication, and
+    // a value a ros::Duration cannot hold (rosparam set ~diagnostic_period 1e10) thrown from its
+    // timer aborted the node. So it is given a namespace of its own, where it finds no period
+    // (its own default then never matters), and the node keeps the period: it re-reads
+    // ~diagnostic_period with the check of start-up and calls force_update when the period is
+    // over (updateDiagnostics).
+    diagnostic_period_ = params->diagnostic_period;
+    next_diagnostics_ = ros::Time::now().toSec() + diagnostic_period_;
+    diagnostics_ = std::make_unique<diagnostic_updater::Updater>(
+        node_, ros::NodeHandle(private_node_, "diagnostic_updater"), private_node_.getNamespace());
     diagnostics_->setHardwareID("none");
     diagnostics_->add("impact monitor", monitor_.get(), &ImpactMonitorRos::diagnose);
     diagnostics_timer_ = node_.createWallTimer(
-        ros::WallDuration(0.1), [this](const ros::WallTimerEvent&) { diagnostics_->update(); });
+        ros::WallDuration(0.1), [this](const ros::WallTimerEvent&) { updateDiagnostics(); });
 
     // Live tuning, starting from the scene's values.
     config_.detection = core::toString(scene->detection);
@@ -96,6 +104,39 @@ bool CollisionResponseNode::start() {
 std::shared_ptr<const core::MaterialTable> CollisionResponseNode::materials() const {
   std::lock_guard<std::mutex> lock(materials_mutex_);
   return materials_;
+}
+
+void CollisionResponseNode::updateDiagnostics() {
+  rereadDiagnosticPeriod();
+  // In doubles: now + a period of up to 2^31 s may lie past a ros::Time's end (2^32 s).
+  const double now = ros::Time::now().toSec();
+  if (now < next_diagnostics_) return;
+  next_diagnostics_ = now + diagnostic_period_;
+  diagnostics_->force_update();
+}
+
+void CollisionResponseNode::rereadDiagnosticPeriod() {
+  const std::string field = joinKey(private_node_.getNamespace(), "diagnostic_period");
+  XmlRpc::XmlRpcValue value;
+  if (!private_node_.getParamCached("diagnostic_period", value)) return;  // unset: kept
+  MonitorParams read;
+  read.diagnostic_period = diagnostic_period_;
+  if (auto status = readKey(value, MonitorParams::keys(), "diagnostic_period", field, read);
+      !status) {
+    if (status.error().message() != period_refused_) {
+      period_refused_ = status.error().message();
+      ROS_WARN_STREAM("collision_response: refused a new value: "
+                      << period_refused_ << "; kept " << core::formatNumber(diagnostic_period_)
+                      << " s");
+    }
+    return;
+  }
+  period_refused_.clear();
+  if (read.diagnostic_period != diagnostic_period_) {
+    // As the Updater did: the next publication moves by the change of the period.
+    next_diagnostics_ += read.diagnostic_period - diagnostic_period_;
+    diagnostic_period_ = read.diagnostic_period;
+  }
 }
 
 void CollisionResponseNode::logScene(const core::Scene& scene, const MonitorParams& params) const {

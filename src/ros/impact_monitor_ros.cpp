@@ -152,6 +152,7 @@ void ImpactMonitorRos::tell(const std::string& topic, const std::vector<Report>&
   std::map<std::pair<Reason, int>, Group> groups;
   for (const Report& report : reports) {
     diagnostics_.count(report.reason, report.count);
+    if (report.reason == Reason::kBeyondResolution) diagnostics_.noteBeyondResolution(report.text);
     Group& group = groups[{report.reason, report.variant}];
     group.events += report.count;
     if (report.warn && group.first == nullptr) group.first = &report;

@@ -81,6 +81,9 @@ void MonitorDiagnostics::report(diagnostic_updater::DiagnosticStatusWrapper& sta
     if (totals_[i] > 0)
       status.add(std::string(counterName(static_cast<Reason>(i))) + " (total)", totals_[i]);
   }
+  if (!last_beyond_resolution_.empty()) {
+    status.add("last state beyond resolution", last_beyond_resolution_);
+  }
   status.add("impacts published (total)", impacts_published_);
   period_ = Period{};
   period_.totals = totals_;

@@ -33,29 +33,29 @@ const KeyTable<MonitorParams>& MonitorParams::keys() {
       typeOnly("player", XmlRpc::XmlRpcValue::TypeStruct, "a mapping (the scene player's)"),
       numberKey<P>(
           "transform_timeout", [](P& p) -> double& { return p.transform_timeout; },
-          checkNonNegative),
+          checkDurationOrZero),
       numberKey<P>(
           "frame_velocity_interval", [](P& p) -> double& { return p.frame_velocity_interval; },
-          checkPositive),
+          checkDuration),
       numberKey<P>(
-          "body_timeout", [](P& p) -> double& { return p.body_timeout; }, checkPositive),
+          "body_timeout", [](P& p) -> double& { return p.body_timeout; }, checkDuration),
       numberKey<P>(
           "contact_tolerance", [](P& p) -> double& { return p.contact_tolerance; },
           core::checkContactTolerance),
       numberKey<P>(
-          "clock_jump_back", [](P& p) -> double& { return p.clock_jump_back; }, checkPositive),
+          "clock_jump_back", [](P& p) -> double& { return p.clock_jump_back; }, checkDuration),
       numberKey<P>(
           "future_stamp_tolerance", [](P& p) -> double& { return p.future_stamp_tolerance; },
-          checkPositive),
+          checkDuration),
       countKey<P>(
           "queue_size", [](P& p) -> int& { return p.queue_size; }, 1),
       countKey<P>(
           "max_states", [](P& p) -> int& { return p.max_states; }, 1),
       numberKey<P>(
-          "marker_rate", [](P& p) -> double& { return p.markers.rate; }, checkPositive),
+          "marker_rate", [](P& p) -> double& { return p.markers.rate; }, checkRate),
       numberKey<P>(
           "impact_marker_lifetime", [](P& p) -> double& { return p.markers.impact_lifetime; },
-          checkPositive),
+          checkDuration),
       numberKey<P>(
           "impulse_marker_scale", [](P& p) -> double& { return p.markers.impulse_scale; },
           checkPositive),
@@ -68,7 +68,7 @@ const KeyTable<MonitorParams>& MonitorParams::keys() {
           "contact_marker_diameter", [](P& p) -> double& { return p.markers.contact_diameter; },
           checkPositive),
       numberKey<P>(
-          "diagnostic_period", [](P& p) -> double& { return p.diagnostic_period; }, checkPositive),
+          "diagnostic_period", [](P& p) -> double& { return p.diagnostic_period; }, checkDuration),
       typeOnly("detection", XmlRpc::XmlRpcValue::TypeString, "a string"),
       typeOnly("restitution_threshold", XmlRpc::XmlRpcValue::TypeDouble, "a number"),
       typeOnly("restitution_combine", XmlRpc::XmlRpcValue::TypeString, "a string"),

@@ -136,4 +136,60 @@ core::Status checkNonNegative(double value, const std::string& field) {
   return core::Ok{};
 }
 
+namespace {
+
+/// A duration's bounds, for `seconds` finite and > 0.
+core::Status checkDurationRange(double seconds, const std::string& field) {
+  if (seconds > kMaxDurationSeconds) {
+    return core::Error{field, core::formatNumber(seconds) +
+                                  " s is longer than a ros::Duration can hold (" +
+                                  core::formatNumber(kMaxDurationSeconds) + " s)"};
+  }
+  if (seconds < kMinDurationSeconds) {
+    return core::Error{field, core::formatNumber(seconds) +
+                                  " s is shorter than a ros::Duration can hold (" +
+                                  core::formatNumber(kMinDurationSeconds) + " s, one nanosecond)"};
+  }
+  return core::Ok{};
+}
+
+}  // namespace
+
+core::Status checkDuration(double seconds, const std::string& field) {
+  if (!std::isfinite(seconds) || !(seconds > 0.0)) {
+    return core::Error{
+        field, "must be a finite number of seconds > 0, got " + core::formatNumber(seconds)};
+  }
+  return checkDurationRange(seconds, field);
+}
+
+core::Status checkDurationOrZero(double seconds, const std::string& field) {
+  if (!std::isfinite(seconds) || seconds < 0.0) {
+    return core::Error{
+        field, "must be a finite number of seconds >= 0, got " + core::formatNumber(seconds)};
+  }
+  return seconds == 0.0 ? core::Status(core::Ok{}) : checkDurationRange(seconds, field);
+}
+
+core::Status checkRate(double hertz, const std::string& field) {
+  if (!std::isfinite(hertz) || !(hertz > 0.0)) {
+    return core::Error{field,
+                       "must be a finite number of Hz > 0, got " + core::formatNumber(hertz)};
+  }
+  const double period = 1.0 / hertz;
+  if (period > kMaxDurationSeconds) {
+    return core::Error{field, core::formatNumber(hertz) + " Hz is too slow: its period, " +
+                                  core::formatNumber(period) +
+                                  " s, is longer than a ros::Duration can hold (" +
+                                  core::formatNumber(kMaxDurationSeconds) + " s)"};
+  }
+  if (period < kMinDurationSeconds) {
+    return core::Error{field, core::formatNumber(hertz) + " Hz is too fast: its period, " +
+                                  core::formatNumber(period) +
+                                  " s, is shorter than a ros::Duration can hold (" +
+                                  core::formatNumber(kMinDurationSeconds) + " s, one nanosecond)"};
+  }
+  return core::Ok{};
+}
+
 }  // namespace collision_response

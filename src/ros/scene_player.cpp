@@ -84,11 +84,11 @@ const KeyTable<ScenePlayerParams>& ScenePlayerParams::keys() {
          return core::Status(core::Ok{});
        }},
       numberKey<P>(
-          "rate", [](P& p) -> double& { return p.rate; }, checkPositive),
+          "rate", [](P& p) -> double& { return p.rate; }, checkRate),
       numberKey<P>(
-          "duration", [](P& p) -> double& { return p.duration; }, checkNonNegative),
+          "duration", [](P& p) -> double& { return p.duration; }, checkDurationOrZero),
       numberKey<P>(
-          "start_delay", [](P& p) -> double& { return p.start_delay; }, checkNonNegative),
+          "start_delay", [](P& p) -> double& { return p.start_delay; }, checkDurationOrZero),
       numberKey<P>(
           "contact_tolerance", [](P& p) -> double& { return p.contact_tolerance; },
           core::checkContactTolerance),

@@ -68,6 +68,8 @@ const char* counterName(Reason reason) {
       return "dropped: stamp ahead of the clock";
     case Reason::kNonFinite:
       return "dropped: non-finite value";
+    case Reason::kBeyondResolution:
+      return "dropped: position beyond resolution";
     case Reason::kTransformMissing:
       return "dropped: transform missing";
     case Reason::kStale:
@@ -197,6 +199,16 @@ StateIntake::Outcome StateIntake::convert(const std::vector<BodyState>& states,
       reports.push_back(std::move(report));
       continue;
     }
+    // Far enough out, the monitor's sums of two positions overflow and the contacts are lost
+    // without a word (a stack at x = 1.7e308 fell through its floor): refused by name.
+    if (auto status = core::checkResolvablePosition(toEigen(state.pose.position), "pose.position");
+        !status) {
+      Report report{Reason::kBeyondResolution,
+                    "dropped " + which(place, id) + ": " + status.error().message()};
+      report.variant = static_cast<int>(status.error().field.back() - 'x');
+      reports.push_back(std::move(report));
+      continue;
+    }
     const std::string frame = frameOf(state, settings_.fixed_frame);
     if (!motion || frame != motion_frame || state.header.stamp != motion_stamp) {
       motion = lookupFrameMotion(tf, settings_.fixed_frame, frame, state.header.stamp,
@@ -226,6 +238,18 @@ StateIntake::Outcome StateIntake::convert(const std::vector<BodyState>& states,
     item.sample.velocity = frame_motion.velocity(position, toEigen(state.twist.linear));
     item.sample.angular_velocity =
         frame_motion.pose.linear() * toEigen(state.twist.angular) + frame_motion.angular_velocity;
+    // A frame far out can carry a resolvable position past the bound (or past the doubles).
+    if (auto status = core::checkResolvablePosition(item.sample.position, "pose.position");
+        !status) {
+      const std::string& fixed_frame = settings_.fixed_frame;
+      Report report{Reason::kBeyondResolution, "dropped " + which(place, id) + ": " +
+                                                   status.error().field + " (in " +
+                                                   quoted(fixed_frame) + ", from " + quoted(frame) +
+                                                   "): " + status.error().reason};
+      report.variant = 3 + static_cast<int>(status.error().field.back() - 'x');
+      reports.push_back(std::move(report));
+      continue;
+    }
     // A body once per input: of two states of one body, the newer stamp is kept (the first of
     // equal ones), and the other is dropped naming both places.
     if (seen_in_input_[index] == input_serial_) {

@@ -11,6 +11,7 @@
 
 #include "collision_response/core/body.h"
 #include "collision_response/core/monitor.h"
+#include "collision_response/core/validation.h"
 #include "scene_builders.h"
 
 namespace collision_response::core {
@@ -175,6 +176,64 @@ TEST(LastingContact, CentredStackOfThreeHolds) {
     EXPECT_NEAR((monitor.predictedState(i, 2.0)->first - V(0, 0, (2 * i + 1) * r)).norm(), 0.0,
                 1e-15);
   }
+  ASSERT_EQ(last.contacts.size(), 3u);
+  // In the order of pairs: a-b, a-floor, b-c.
+  EXPECT_NEAR(last.contacts[0].normal_force, 0.3 * kG, 1e-13);
+  EXPECT_NEAR(last.contacts[1].normal_force, 0.6 * kG, 1e-13);
+  EXPECT_NEAR(last.contacts[2].normal_force, 0.1 * kG, 1e-13);
+}
+
+// Issue 27, item 5: the same stack at x = 1.7e308 (past 2^1023, where the touching bands and
+// the swept boxes' padding overflow) fell through its floor with no contact; the intake now
+// refuses such states (kMaxResolvedCoordinate). Just below that bound, at the largest double
+// below 2^1022, the arithmetic holds: no impact, the balls stay where they were placed, and the
+// contacts are finite and carry the whole weight, (0.3 + 0.2 + 0.1) g, into the floor. (Which
+// pairs touch is coarse there: the bands are 2^-48 (|a| + |b|) wide, far wider than the balls.)
+TEST(LastingContact, CentredStackOfThreeStaysUpAtTheLargestResolvedX) {
+  const double r = 0.05;
+  const double x = std::nextafter(kMaxResolvedCoordinate, 0.0);
+  Scene scene = gravityScene();
+  addMaterial(scene, "wood", 0.6, 0.0);
+  scene.bodies = {ball("a", 0.3, r, "wood"), ball("b", 0.2, r, "wood"), ball("c", 0.1, r, "wood")};
+  scene.obstacles = {plane("floor", V(0, 0, 1), 0.0, "wood")};
+  ImpactMonitor monitor(scene, longLived());
+  const std::vector<BodyStateSample> start = {state(monitor, "a", V(x, 0, r)),
+                                              state(monitor, "b", V(x, 0, 3 * r)),
+                                              state(monitor, "c", V(x, 0, 5 * r))};
+  StepReport last;
+  const auto impacts =
+      run(monitor, start, 100, 2.0, [&](double, const StepReport& report) { last = report; });
+  EXPECT_TRUE(impacts.empty());
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(monitor.predictedState(i, 2.0)->first, V(x, 0, (2 * i + 1) * r));
+  }
+  ASSERT_FALSE(last.contacts.empty());
+  double into_floor = 0.0;
+  for (const ContactRecord& contact : last.contacts) {
+    EXPECT_TRUE(std::isfinite(contact.normal_force));
+    EXPECT_TRUE(contact.contact_point.allFinite());
+    if (contact.other_is_obstacle) into_floor += contact.normal_force;
+  }
+  EXPECT_NEAR(into_floor, 0.6 * kG, 1e-13);
+}
+
+// The stack holds with the same contacts and forces as at the origin at x = 1e12: its bands,
+// 2^-48 (1e12 + 1e12) = 0.0071 m for a pair, are narrower than every gap between surfaces that
+// do not touch (2 r = 0.1 m and more: the middle ball and the floor, the bottom and the top
+// ball). The limit of that is |x| = 2^47 r (7.04e12 m), where a pair's band is r.
+TEST(LastingContact, CentredStackOfThreeHoldsAtATeraMetre) {
+  const double r = 0.05;
+  const double x = 1e12;
+  Scene scene = gravityScene();
+  addMaterial(scene, "wood", 0.6, 0.0);
+  scene.bodies = {ball("a", 0.3, r, "wood"), ball("b", 0.2, r, "wood"), ball("c", 0.1, r, "wood")};
+  scene.obstacles = {plane("floor", V(0, 0, 1), 0.0, "wood")};
+  ImpactMonitor monitor(scene, longLived());
+  const std::vector<BodyStateSample> start = {state(monitor, "a", V(x, 0, r)),
+                                              state(monitor, "b", V(x, 0, 3 * r)),
+                                              state(monitor, "c", V(x, 0, 5 * r))};
+  StepReport last;
+  run(monitor, start, 100, 2.0, [&](double, const StepReport& report) { last = report; });
   ASSERT_EQ(last.contacts.size(), 3u);
   // In the order of pairs: a-b, a-floor, b-c.
   EXPECT_NEAR(last.contacts[0].normal_force, 0.3 * kG, 1e-13);

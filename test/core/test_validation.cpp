@@ -249,5 +249,31 @@ TEST(Validation, OneRefusalForAnswersBeyondTheDoubles) {
   EXPECT_EQ(status.error().reason, kBeyondDoubles);
 }
 
+// Issue 27, item 5: a stack placed at x = 1.7e308 gave one empty `contacts` array and no word.
+// The monitor's geometry sums two positions' magnitudes (a pair's touching band, a swept box's
+// padding), which overflows past 2^1023 = 8.98846567431158e+307; the bound is half that, 2^1022
+// (4.49423283715579e+307, shortest decimal that reads back as it), below which a coordinate is
+// resolved. The largest double below it, 4.4942328371557893e+307, is accepted.
+TEST(Validation, APositionPastTheMonitorsResolutionIsRefusedNamingTheCoordinate) {
+  EXPECT_TRUE(checkResolvablePosition(Eigen::Vector3d(0, 0, 0), "p").ok());
+  const double below = std::nextafter(0x1p1022, 0.0);
+  EXPECT_TRUE(checkResolvablePosition(Eigen::Vector3d(below, -below, below), "p").ok());
+  const auto stack = checkResolvablePosition(Eigen::Vector3d(1.7e308, 0, 0.05), "pose.position");
+  ASSERT_FALSE(stack.ok());
+  EXPECT_EQ(stack.error().message(),
+            "pose.position.x: 1.7e+308 m is beyond where the monitor can resolve a contact (|x| "
+            "must be below 2^1022 = 4.49423283715579e+307 m: past 2^1023 the sum of two bodies' "
+            "coordinates overflows)");
+  const auto edge = checkResolvablePosition(Eigen::Vector3d(0, -0x1p1022, 0), "p");
+  ASSERT_FALSE(edge.ok());
+  EXPECT_EQ(edge.error().message(),
+            "p.y: -4.49423283715579e+307 m is beyond where the monitor can resolve a contact (|y| "
+            "must be below 2^1022 = 4.49423283715579e+307 m: past 2^1023 the sum of two bodies' "
+            "coordinates overflows)");
+  const auto nan = checkResolvablePosition(Eigen::Vector3d(0, 0, kNan), "p");
+  ASSERT_FALSE(nan.ok());
+  EXPECT_EQ(nan.error().message(), "p.z: must be a finite number, got nan");
+}
+
 }  // namespace
 }  // namespace collision_response::core

@@ -14,6 +14,7 @@
 #include <sstream>
 #include <string>
 
+#include "collision_response/ContactArray.h"
 #include "collision_response/EstimateRestitution.h"
 #include "monitor_harness.h"
 
@@ -437,6 +438,129 @@ TEST_F(HostileInput, Issue27_Item3_OnePublisherInterleavingTwoClocks) {
   expectTwoBallImpact("a", start, before, 0.05);
   EXPECT_EQ(harness_.countWarnings({"jumped back"}, logs), 0u);
   EXPECT_GE(harness_.countWarnings({"/body_states from", "header.stamp", "clock"}, logs), 1u);
+}
+
+/// The messages on /diagnostics of `node` (its status named "<node>: impact monitor") while
+/// `during` runs and `seconds` after.
+std::vector<diagnostic_msgs::DiagnosticStatus> diagnosticsOf(const std::string& node,
+                                                             const std::function<void()>& during,
+                                                             double seconds) {
+  std::vector<diagnostic_msgs::DiagnosticStatus> received;
+  ros::NodeHandle handle;
+  const std::string name = node.substr(1) + ": impact monitor";
+  ros::Subscriber subscriber = handle.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 100, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& array) {
+        for (const auto& status : array->status) {
+          if (status.name == name) received.push_back(status);
+        }
+      });
+  MonitorHarness::waitFor([&] { return subscriber.getNumPublishers() > 0; }, 10.0);
+  if (during) during();
+  MonitorHarness::waitFor([] { return false; }, seconds);
+  return received;
+}
+
+// Issue 27, item 4: `rosparam set ~diagnostic_period 1e10` while the node ran aborted it
+// (diagnostic_updater re-read the value and ros::Duration(1e10) threw from its timer: SIGABRT
+// within 3 s, the services gone). The re-read is checked as at start-up: the value is refused
+// with a warning naming the key, the period in use (0.2 s, from the launch file) is kept, and
+// the node keeps answering, publishing diagnostics and finding impacts.
+TEST_F(HostileInput, Issue27_Item4_ADiagnosticPeriodNoRosDurationHoldsSetWhileRunningIsRefused) {
+  const std::string key = "/collision_response/diagnostic_period";
+  const auto diagnostics = diagnosticsOf(
+      "/collision_response", [&] { ros::param::set(key, 1e10); }, 4.0);
+  EXPECT_TRUE(harness_.waitForWarning(
+      {key + ": 1e+10 s is longer than a ros::Duration can hold (2147483647 s)", "kept 0.2 s"}));
+  // Still published every 0.2 s: over the 4 s after the set, about 20 (at least 10).
+  EXPECT_GE(diagnostics.size(), 10u);
+  EstimateRestitution srv;
+  srv.request.drop_height = 1.0;
+  srv.request.bounce_height = 0.25;  // e = sqrt(0.25 / 1) = 0.5
+  ASSERT_TRUE(ros::service::call("/collision_response/estimate_restitution", srv))
+      << "the node's services are gone";
+  ASSERT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_EQ(srv.response.restitution, 0.5);
+  // A good value is taken again, and the node is still right.
+  ros::param::set(key, 0.2);
+  const ros::Time start = window();
+  playTwoBalls(start);
+  expectTwoBallImpact("a", start);
+}
+
+// Issue 27, item 5: the lasting-contact stack (config/scenes/stack.yaml: three 0.2 kg balls of
+// radius 0.05 m on the floor) placed at x = 1.7e308 gave one empty `contacts` array and no word:
+// past 2^1023 the monitor's sums of two bodies' coordinates overflow, and the stack fell through
+// its floor. Each state is now dropped at intake with a warning naming the body and the field,
+// shown in /diagnostics, and nothing is published as a contact; the same stack at x = 0 still
+// rests, each contact carrying the weight above it (2 m g, 3 m g, m g in the order of pairs).
+TEST_F(HostileInput, Issue27_Item5_AStackPlacedAtXOf1point7e308IsRefusedByName) {
+  ASSERT_TRUE(harness_.connect(20.0, "/far/stack"));
+  ros::NodeHandle handle;
+  ros::Publisher states = handle.advertise<BodyStateArray>("/far/body_states", 10);
+  std::vector<ContactArray> contacts;
+  ros::Subscriber subscriber = handle.subscribe<ContactArray>(
+      "/far/contacts", 100,
+      [&contacts](const ContactArray::ConstPtr& array) { contacts.push_back(*array); });
+  ASSERT_TRUE(MonitorHarness::waitFor(
+      [&] { return states.getNumSubscribers() > 0 && subscriber.getNumPublishers() > 0; }, 20.0));
+  const auto stack = [&](const ros::Time& stamp, double x) {
+    BodyStateArray array;
+    array.header.stamp = stamp;
+    const char* ids[] = {"bottom", "middle", "top"};
+    for (int i = 0; i < 3; ++i) {
+      array.states.push_back(makeState(
+          stamp,
+          StateSpec{ids[i], Eigen::Vector3d(x, 0, 0.05 + 0.1 * i), Eigen::Vector3d::Zero()}));
+    }
+    states.publish(array);
+  };
+  const std::string why =
+      "pose.position.x: 1.7e+308 m is beyond where the monitor can resolve a contact (|x| must be "
+      "below 2^1022 = 4.49423283715579e+307 m";
+  const ros::Time far = window();
+  const auto diagnostics = diagnosticsOf(
+      "/far/stack",
+      [&] {
+        for (int k = 0; k <= 10; ++k) {
+          stack(far + ros::Duration(0, 100000000 * k), 1.7e308);
+          MonitorHarness::waitFor([] { return false; }, 0.05);
+        }
+      },
+      1.0);
+  EXPECT_TRUE(harness_.waitForWarning({"dropped states[0] ('bottom'): " + why}, 5.0, "/far/stack"));
+  EXPECT_TRUE(contacts.empty()) << "a contact was published for states the node refused";
+  bool counted = false, named = false;
+  for (const auto& status : diagnostics) {
+    for (const auto& value : status.values) {
+      counted = counted || (value.key == "dropped: position beyond resolution (total)" &&
+                            std::stoi(value.value) >= 3);
+      named = named || (value.key == "last state beyond resolution" &&
+                        value.value.find("('top'): " + why) != std::string::npos);
+    }
+  }
+  EXPECT_TRUE(counted) << "no count of the dropped states in /diagnostics";
+  EXPECT_TRUE(named) << "/diagnostics does not name the body and the field";
+  // The node lives, and the stack at x = 0 rests.
+  const ros::Time near = window();
+  for (int k = 0; k <= 10; ++k) {
+    stack(near + ros::Duration(0, 100000000 * k), 0.0);
+    MonitorHarness::waitFor([] { return false; }, 0.05);
+  }
+  ASSERT_TRUE(MonitorHarness::waitFor(
+      [&] { return !contacts.empty() && contacts.back().contacts.size() == 3; }, 5.0));
+  const double weight = 0.2 * 9.81;
+  const auto& last = contacts.back().contacts;
+  EXPECT_NEAR(last[0].normal_force, 2 * weight, 1e-9);
+  EXPECT_NEAR(last[1].normal_force, 3 * weight, 1e-9);
+  EXPECT_NEAR(last[2].normal_force, weight, 1e-9);
+  for (const ContactArray& array : contacts) {
+    for (const Contact& contact : array.contacts) {
+      for (const double value : {contact.normal_force, contact.contact_point.x,
+                                 contact.contact_point.z, contact.normal.z}) {
+        EXPECT_TRUE(std::isfinite(value)) << "a non-finite number on /far/contacts";
+      }
+    }
+  }
 }
 
 }  // namespace

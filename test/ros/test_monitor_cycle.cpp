@@ -887,6 +887,30 @@ TEST_F(SqueezedCycle, ASqueezedClusterIsHeldAndSaysSo) {
   EXPECT_EQ(diagnosticValue(status, "bodies in stepped clusters"), "1");
 }
 
+// Issue 27, item 5: a light ball on the floor placed at x = 1.7e308 gave an empty `contacts`
+// and no word (past 2^1023 the monitor's sums of two coordinates overflow: no contact, the ball
+// fell through the floor). Its state
+// is dropped at intake, every time, naming the body and the field, and no contact of it is
+// published.
+TEST_F(FloorCycle, Issue27_Item5_AStatePastTheMonitorsResolutionIsDroppedByName) {
+  const ros::Time start(1000, 0);
+  MonitorCycle::Update update;
+  for (int k = 0; k <= 5; ++k) {
+    update = send({state("light", at(start, 0.1 * k), {1.7e308, 0, 0.1}, {0, 0, 0}),
+                   state("heavy", at(start, 0.1 * k), {10, 0, 0.1}, {0, 0, 0})});
+  }
+  EXPECT_EQ(reportsOf(Reason::kBeyondResolution), 6u);
+  const Report* report = firstReport(Reason::kBeyondResolution);
+  ASSERT_NE(report, nullptr);
+  EXPECT_EQ(report->text,
+            "dropped states[0] ('light'): pose.position.x: 1.7e+308 m is beyond where the monitor "
+            "can resolve a contact (|x| must be below 2^1022 = 4.49423283715579e+307 m: past "
+            "2^1023 the sum of two bodies' coordinates overflows)");
+  EXPECT_STREQ(counterName(Reason::kBeyondResolution), "dropped: position beyond resolution");
+  EXPECT_TRUE(isDrop(Reason::kBeyondResolution));
+  for (const Contact& contact : update.contacts.contacts) EXPECT_NE(contact.body_a, "light");
+}
+
 TEST_F(Cycle, EveryReasonHasItsOwnCounter) {
   std::set<std::string> names;
   for (int i = 0; i < kReasonCount; ++i) names.insert(counterName(static_cast<Reason>(i)));

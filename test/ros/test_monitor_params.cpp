@@ -230,6 +230,99 @@ std::string topicError(const std::vector<std::string>& topics, const std::string
 // the node (ros::InvalidNameException, ConflictingSubscriptionException; as a nodelet "Failed to
 // load"); two bodies on one topic were accepted and a right state was then warned as the other
 // body's. Each is now an error naming the body's key.
+// Issue 27, item 4: a duration past what a ros::Duration holds (its seconds an int32, at most
+// 2^31 - 1 = 2147483647 s) passed the start-up check, then killed or blinded the node:
+// `~diagnostic_period: 1e10` ended it with "Duration is out of dual 32-bit range", naming no
+// key; `~frame_velocity_interval: 1e10` and `~impact_marker_lifetime: 1e10` made every message
+// an internal error. Every duration is now checked at start-up, the key named: 2147483647 s
+// (exactly representable) is the longest accepted, and one nanosecond the shortest nonzero.
+const std::vector<std::string> kDurationKeys = {
+    "transform_timeout",      "frame_velocity_interval", "body_timeout",     "clock_jump_back",
+    "future_stamp_tolerance", "impact_marker_lifetime",  "diagnostic_period"};
+
+std::string durationError(const std::string& key, double seconds) {
+  XmlRpc::XmlRpcValue tree;
+  tree[key] = seconds;
+  return loadError(tree);
+}
+
+TEST(MonitorParams, EveryDurationIsBoundedByWhatARosDurationHolds) {
+  for (const std::string& key : kDurationKeys) {
+    EXPECT_EQ(durationError(key, 2147483647.0), "") << key;
+    EXPECT_EQ(durationError(key, 1e-9), "") << key;
+    EXPECT_EQ(durationError(key, 1e10),
+              kNs + "/" + key + ": 1e+10 s is longer than a ros::Duration can hold (2147483647 s)");
+    EXPECT_EQ(
+        durationError(key, 2147483648.0),
+        kNs + "/" + key + ": 2147483648 s is longer than a ros::Duration can hold (2147483647 s)");
+    EXPECT_EQ(durationError(key, 1e-10),
+              kNs + "/" + key +
+                  ": 1e-10 s is shorter than a ros::Duration can hold (1e-09 s, one nanosecond)");
+  }
+  EXPECT_EQ(durationError("transform_timeout", 0.0), "");  // 0: never wait, as before
+  EXPECT_EQ(durationError("diagnostic_period", 0.0),
+            kNs + "/diagnostic_period: must be a finite number of seconds > 0, got 0");
+}
+
+// A rate's period 1/rate is the duration: 2^-30 Hz (period 2^30 s) and 1e9 Hz (1/1e9 rounds to
+// the double nearest 1e-9, as the literal 1e-9 does) are the accepted edges; 2^-31 Hz (period
+// 2^31 = 2147483648 s) and 2^30 Hz (period 2^-30 s, 9.3e-10 s) are past them.
+TEST(MonitorParams, AMarkerRateWhosePeriodNoRosDurationHoldsIsAnError) {
+  EXPECT_EQ(durationError("marker_rate", 9.313225746154785e-10), "");
+  EXPECT_EQ(durationError("marker_rate", 1e9), "");
+  EXPECT_EQ(durationError("marker_rate", 4.656612873077393e-10),
+            kNs +
+                "/marker_rate: 4.656612873077393e-10 Hz is too slow: its period, 2147483648 s, "
+                "is longer than a ros::Duration can hold (2147483647 s)");
+  EXPECT_EQ(durationError("marker_rate", 1073741824.0),
+            kNs +
+                "/marker_rate: 1073741824 Hz is too fast: its period, 9.313225746154785e-10 s, "
+                "is shorter than a ros::Duration can hold (1e-09 s, one nanosecond)");
+}
+
+std::string playerError(const std::string& key, double value) {
+  XmlRpc::XmlRpcValue tree;
+  tree["scene"] = minimalScene();
+  tree[key] = value;
+  const auto params = ScenePlayerParams::load(tree, "/scene_player");
+  return params ? "" : params.error().message();
+}
+
+TEST(ScenePlayerParams, ItsRateDurationAndStartDelayAreBoundedAsDurations) {
+  EXPECT_EQ(playerError("rate", 9.313225746154785e-10), "");
+  EXPECT_EQ(playerError("rate", 1e9), "");
+  EXPECT_EQ(playerError("rate", 4.656612873077393e-10),
+            "/scene_player/rate: 4.656612873077393e-10 Hz is too slow: its period, 2147483648 s, "
+            "is longer than a ros::Duration can hold (2147483647 s)");
+  EXPECT_EQ(playerError("rate", 1e-10).rfind("/scene_player/rate: 1e-10 Hz is too slow", 0), 0u);
+  for (const std::string key : {"duration", "start_delay"}) {
+    EXPECT_EQ(playerError(key, 0.0), "") << key;
+    EXPECT_EQ(playerError(key, 2147483647.0), "") << key;
+    EXPECT_EQ(playerError(key, 1e10), "/scene_player/" + key +
+                                          ": 1e+10 s is longer than a ros::Duration can hold "
+                                          "(2147483647 s)");
+  }
+}
+
+// The re-read of one key while the node runs (~diagnostic_period) is the start-up's reader:
+// a refused value names the key and leaves the value in use as it was.
+TEST(MonitorParams, AReReadKeyIsCheckedAsAtStartUp) {
+  MonitorParams params;
+  params.diagnostic_period = 0.2;
+  const auto status = readKey(XmlRpc::XmlRpcValue(1e10), MonitorParams::keys(), "diagnostic_period",
+                              kNs + "/diagnostic_period", params);
+  ASSERT_FALSE(status.ok());
+  EXPECT_EQ(status.error().message(),
+            kNs +
+                "/diagnostic_period: 1e+10 s is longer than a ros::Duration can hold "
+                "(2147483647 s)");
+  EXPECT_EQ(params.diagnostic_period, 0.2);
+  ASSERT_TRUE(readKey(XmlRpc::XmlRpcValue(3), MonitorParams::keys(), "diagnostic_period",
+                      kNs + "/diagnostic_period", params)
+                  .ok());
+  EXPECT_EQ(params.diagnostic_period, 3.0);
+}
+
 TEST(BodyTopics, InvalidConflictingAndSharedTopicsAreErrors) {
   EXPECT_EQ(topicError({"/a/state", "b/state", ""}), "");
   for (const std::string bad : {"bad topic", "1abc", "a//b?", "~private"}) {

@@ -510,6 +510,24 @@ TEST(SceneLoader, PlaneNormalsOfAnyLengthAreUnitAfterLoading) {
 
 // Issue 13, item 7: `fixed_frame: /world` was accepted, then every state naming a frame was
 // dropped (tf2 frame ids have no leading slash).
+// Issue 27, item 5: a stack placed at x = 1.7e308 was loaded, played, and fell through its
+// floor with no contact and no word (past 2^1023 the monitor's sums of two positions overflow).
+// A body's position must be below 2^1022 on every axis (core::kMaxResolvedCoordinate).
+TEST(SceneLoader, ABodyPlacedPastTheMonitorsResolutionIsRefusedNamingTheCoordinate) {
+  auto scene = fullScene();
+  scene["bodies"][0]["position"][0] = 1.7e308;
+  scene["bodies"][0]["position"][1] = 0.0;
+  scene["bodies"][0]["position"][2] = 0.05;
+  const auto loaded = loadScene(scene, "~scene");
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_EQ(loaded.error().message(),
+            "~scene/bodies[0]/position.x: 1.7e+308 m is beyond where the monitor can resolve a "
+            "contact (|x| must be below 2^1022 = 4.49423283715579e+307 m: past 2^1023 the sum of "
+            "two bodies' coordinates overflows)");
+  scene["bodies"][0]["position"][0] = std::nextafter(0x1p1022, 0.0);
+  EXPECT_EQ(sceneErrorField(scene), "");
+}
+
 TEST(SceneLoader, FramesWithALeadingSlashAreRefused) {
   auto scene = fullScene();
   scene["fixed_frame"] = "/world";

@@ -157,6 +157,41 @@ TEST(StartupErrors, Item8_TheScenePlayersParametersAreTypedToo) {
   expectRefused(result, "/rate", "must be a number, got a string ('fast')");
 }
 
+// Issue 27, item 4: `~diagnostic_period: 1e10` ended the node with "Duration is out of dual
+// 32-bit range", naming no key; `~frame_velocity_interval: 1e10` and
+// `~impact_marker_lifetime: 1e10` started it, and then every message was an internal error. A
+// duration a ros::Duration cannot hold (its seconds an int32: at most 2147483647 s) now stops
+// the node at start-up with the key named; so does the scene player's rate whose period is one.
+TEST(StartupErrors, Issue27_Item4_ADurationNoRosDurationHoldsStopsTheNodeByName) {
+  for (const std::string key :
+       {"diagnostic_period", "frame_velocity_interval", "impact_marker_lifetime"}) {
+    const Outcome result = start(kNode, scene({ball("ball")}), [&key](const std::string& name) {
+      ros::param::set(name + "/" + key, 1e10);
+    });
+    expectRefused(result, "/" + key + ": ",
+                  "1e+10 s is longer than a ros::Duration can hold (2147483647 s)");
+    EXPECT_EQ(result.output.find("out of dual 32-bit range"), std::string::npos) << result.output;
+  }
+  const Outcome player =
+      start("rosrun collision_response scene_player", scene({ball("ball")}),
+            [](const std::string& name) { ros::param::set(name + "/rate", 1e-10); });
+  expectRefused(player, "/rate: ", "1e-10 Hz is too slow");
+}
+
+// Issue 27, item 5: a body placed past where the monitor resolves contacts (x = 1.7e308) is
+// refused at start-up by the node and the scene player, naming the coordinate.
+TEST(StartupErrors, Issue27_Item5_ABodyPlacedAtXOf1point7e308StopsTheNodeAndThePlayerByName) {
+  for (const std::string& executable :
+       {kNode, std::string("rosrun collision_response scene_player")}) {
+    XmlRpc::XmlRpcValue body = ball("ball");
+    body["position"][0] = 1.7e308;
+    body["position"][1] = 0.0;
+    body["position"][2] = 0.05;
+    expectRefused(start(executable, scene({body})), "/scene/bodies[0]/position.x: ",
+                  "1.7e+308 m is beyond where the monitor can resolve a contact");
+  }
+}
+
 // The stepped clusters' keys (README, "Scene file"), checked at start-up by the node and the
 // scene player alike, each refusal naming the key and the value.
 TEST(StartupErrors, SteppedClusterKeysOutOfRangeStopTheNodeAndThePlayerByName) {

@@ -54,6 +54,21 @@ inline constexpr const char* kBeyondDoubles =
 /// every output, the service's answers and the monitor's impacts alike.
 Status checkRepresentable(std::initializer_list<NamedResult> results);
 
+/// The monitor resolves contacts only at positions whose every coordinate is below this, m:
+/// 2^1022 (about 4.49e307). Its geometry adds the magnitudes of two positions: each pair's
+/// touching band is 16 eps (|a| + |b| + r_a + r_b) (motion_model.h) and each swept box is padded
+/// by 64 eps (|low| + |high|). Past 2^1023 (DBL_MAX / 2) those sums overflow to infinity and the
+/// pair is lost without a word: a stack at x = 9e307 (or 1.7e308) fell through its floor, with
+/// no contact, where at 8.9e307 it stayed. Half that, 2^1022, leaves the other half of the range
+/// to the motion within a step (a box's corners, a body's reach), so the sums stay finite.
+/// Far below it the contacts are coarse, not lost: the band, 2^-48 (|a| + |b|) (16 eps = 2^-48),
+/// is as wide as a body of radius r from |x| = 2^47 r on (7.04e12 m for 5 cm), and bodies that
+/// far apart touch (README, "Bad input on the topics").
+inline constexpr double kMaxResolvedCoordinate = 0x1p1022;
+/// Each coordinate of a position the monitor tracks: finite and |x| < kMaxResolvedCoordinate. The
+/// error names the coordinate (`field`.x) and the bound.
+Status checkResolvablePosition(const Eigen::Vector3d& position, const std::string& field);
+
 /// Mass, radius, position, velocity and angular velocity of one body; `prefix` names it ("a").
 Status checkBody(const Body& body, const std::string& prefix);
 

@@ -48,6 +48,11 @@ class CollisionResponseNode {
   /// to the one in use (in `config`, which the server then reports) with an error naming it.
   void onReconfigure(MonitorConfig& config, std::uint32_t level);
   std::shared_ptr<const core::MaterialTable> materials() const;
+  /// Publishes /diagnostics once ~diagnostic_period has passed, re-reading that parameter first.
+  void updateDiagnostics();
+  /// ~diagnostic_period as set now, checked as at start-up: a refused value (one a
+  /// ros::Duration cannot hold, say) keeps the period in use, with one warning naming the key.
+  void rereadDiagnosticPeriod();
 
   ros::NodeHandle node_;
   ros::NodeHandle private_node_;
@@ -57,6 +62,9 @@ class CollisionResponseNode {
   std::unique_ptr<ImpactMonitorRos> monitor_;
   std::unique_ptr<diagnostic_updater::Updater> diagnostics_;
   ros::WallTimer diagnostics_timer_;
+  double diagnostic_period_ = 1.0;  ///< s, ~diagnostic_period as last accepted
+  double next_diagnostics_ = 0.0;   ///< ros::Time::now() in s at which to publish next
+  std::string period_refused_;      ///< the last refusal warned of ("" while the value is good)
   boost::recursive_mutex reconfigure_mutex_;  ///< the server's, so updateConfig is safe
   std::unique_ptr<dynamic_reconfigure::Server<MonitorConfig>> reconfigure_;
   MonitorConfig config_;  ///< the values in use

@@ -25,6 +25,9 @@ class MonitorDiagnostics {
   void count(Reason reason, std::size_t events = 1) {
     totals_[static_cast<std::size_t>(reason)] += events;
   }
+  /// The warning of the last state dropped as beyond resolution: it names the body and the
+  /// field, and /diagnostics shows it (one entry, whatever the publisher sends).
+  void noteBeyondResolution(const std::string& text) { last_beyond_resolution_ = text; }
   /// A processed input: the step's processing time and the arrival-to-publication latency (s).
   void stepped(double step_seconds, double latency_seconds, std::size_t impacts_published);
 
@@ -47,6 +50,7 @@ class MonitorDiagnostics {
   Period period_;
   std::array<std::uint64_t, kReasonCount> totals_{};
   std::uint64_t impacts_published_ = 0;
+  std::string last_beyond_resolution_;
 };
 
 }  // namespace collision_response

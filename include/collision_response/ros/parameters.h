@@ -161,8 +161,35 @@ Key<Target> vectorKey(const std::string& name, std::function<Eigen::Vector3d&(Ta
           }};
 }
 
+/// Reads the one key `name` of `keys` from `value` into `target`, as readKeys reads it (the same
+/// reader, the same checks): how a parameter re-read while the node runs is checked exactly as at
+/// start-up. `field` is the key's full name.
+template <class Target>
+core::Status readKey(const XmlRpc::XmlRpcValue& value, const KeyTable<Target>& keys,
+                     const std::string& name, const std::string& field, Target& target) {
+  for (const Key<Target>& key : keys) {
+    if (key.name == name) return key.read(value, field, target);
+  }
+  return unknownKey(field, keyNames(keys));
+}
+
 /// Number checks used by the parameter tables.
 core::Status checkPositive(double value, const std::string& field);     ///< finite, > 0
 core::Status checkNonNegative(double value, const std::string& field);  ///< finite, >= 0
+
+/// The longest time a ros::Duration holds, s: its seconds are an int32 (ros::Duration(1e10)
+/// throws "Duration is out of dual 32-bit range"). Durations up to it also fit a ros::Time's
+/// range from 0 and, in nanoseconds, an int64.
+inline constexpr double kMaxDurationSeconds = 2147483647.0;
+/// The shortest nonzero time a ros::Duration holds, s: one nanosecond (shorter rounds to 0).
+inline constexpr double kMinDurationSeconds = 1e-9;
+
+/// Every parameter that is a time span (a ros::Duration, a timer's period, a limit compared with
+/// one): finite, > 0, at least kMinDurationSeconds and at most kMaxDurationSeconds.
+core::Status checkDuration(double seconds, const std::string& field);
+/// As checkDuration, or 0.
+core::Status checkDurationOrZero(double seconds, const std::string& field);
+/// A rate, Hz: finite, > 0, and its period 1/rate a duration (checkDuration).
+core::Status checkRate(double hertz, const std::string& field);
 
 }  // namespace collision_response

@@ -27,6 +27,7 @@ enum class Reason {
   kZeroStamp,          ///< header.stamp zero
   kStampAhead,         ///< header.stamp too far ahead of the node's clock
   kNonFinite,          ///< a NaN or infinite number
+  kBeyondResolution,   ///< a position past core::kMaxResolvedCoordinate: no contact resolved there
   kTransformMissing,   ///< no transform from the state's frame, after waiting
   kStale,              ///< not newer than the body's last state
   kStampOffClock,      ///< a stamp back from its source's clock, the next one continuing it
@@ -56,7 +57,7 @@ struct Report {
   std::size_t count = 1;  ///< how many events it stands for (states dropped, say)
   bool warn = true;       ///< false: counted only (an obstacle's first instants, say)
   /// Tells apart warnings of one reason that are throttled apart, from a fixed small set (the
-  /// field of a non-finite number: 13 of them).
+  /// field of a non-finite number: 13 of them; the coordinate of a position beyond resolution).
   int variant = 0;
 };
 

@@ -115,6 +115,21 @@ Status checkRepresentable(std::initializer_list<NamedResult> results) {
   return Ok{};
 }
 
+Status checkResolvablePosition(const Eigen::Vector3d& position, const std::string& field) {
+  if (auto status = checkFinite(position, field); !status) return status;
+  static const std::array<const char*, 3> kAxes = {"x", "y", "z"};
+  for (int axis = 0; axis < 3; ++axis) {
+    if (std::abs(position[axis]) < kMaxResolvedCoordinate) continue;
+    const std::string axis_name = kAxes[axis];
+    return Error{field + "." + axis_name,
+                 formatNumber(position[axis]) +
+                     " m is beyond where the monitor can resolve a contact (|" + axis_name +
+                     "| must be below 2^1022 = " + formatNumber(kMaxResolvedCoordinate) +
+                     " m: past 2^1023 the sum of two bodies' coordinates overflows)"};
+  }
+  return Ok{};
+}
+
 Status checkBody(const Body& body, const std::string& prefix) {
   if (auto status = checkMass(body.mass, prefix + ".mass"); !status) return status;
   if (auto status = checkRadius(body.radius, prefix + ".radius"); !status) return status;
