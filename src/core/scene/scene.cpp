@@ -55,9 +55,8 @@ Status checkMaterial(const MaterialTable& materials, const std::string& name,
   return materials.checkMaterial(name, field);
 }
 
-}  // namespace
-
-Status validateScene(const Scene& scene, const std::string& prefix) {
+/// The scene-wide settings: frame, gravity, threshold, integrator tolerance, stepped clusters.
+Status checkSettings(const Scene& scene, const std::string& prefix) {
   if (auto status = checkFrameId(scene.fixed_frame, prefix + "/fixed_frame"); !status) {
     return status;
   }
@@ -86,7 +85,12 @@ Status validateScene(const Scene& scene, const std::string& prefix) {
     return Error{prefix + "/stepped_cluster_time_step",
                  "must be in [1e-4, 1] s, got " + formatNumber(scene.stepped_cluster_time_step)};
   }
-  std::set<std::string> ids;
+  return Ok{};
+}
+
+/// Each body: a unique id, mass, radius, material, and a finite initial state (its spin only with
+/// the spin effect). `ids` collects the ids, shared with the obstacles.
+Status checkBodies(const Scene& scene, const std::string& prefix, std::set<std::string>& ids) {
   for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
     const BodySpec& body = scene.bodies[i];
     if (auto status = checkName(body.id, item(prefix, "bodies", i, "id")); !status) return status;
@@ -121,6 +125,12 @@ Status validateScene(const Scene& scene, const std::string& prefix) {
                    "the key)"};
     }
   }
+  return Ok{};
+}
+
+/// Each obstacle: an id unique among bodies and obstacles, a material, a frame, and its shape's
+/// numbers (a plane's nonzero normal and offset, a sphere's centre and radius).
+Status checkObstacles(const Scene& scene, const std::string& prefix, std::set<std::string>& ids) {
   for (std::size_t i = 0; i < scene.obstacles.size(); ++i) {
     const ObstacleSpec& obstacle = scene.obstacles[i];
     if (auto status = checkName(obstacle.id, item(prefix, "obstacles", i, "id")); !status) {
@@ -164,6 +174,12 @@ Status validateScene(const Scene& scene, const std::string& prefix) {
       }
     }
   }
+  return Ok{};
+}
+
+/// Every pair of participants that can meet has a coefficient of restitution; the first pair
+/// that has none is named, in the order a check of every pair would meet it.
+Status checkEveryPairHasRestitution(const Scene& scene, const std::string& prefix) {
   // Every pair that can meet needs a coefficient of restitution. The coefficient depends on the
   // two materials only, so each pair of distinct materials is checked once, at the first body
   // (in the scene's order) that makes it: linear in the bodies, where a check of every pair of
@@ -201,6 +217,16 @@ Status validateScene(const Scene& scene, const std::string& prefix) {
   }
   if (first_failure) return first_failure->second;
   return Ok{};
+}
+
+}  // namespace
+
+Status validateScene(const Scene& scene, const std::string& prefix) {
+  if (auto status = checkSettings(scene, prefix); !status) return status;
+  std::set<std::string> ids;  // shared by bodies and obstacles
+  if (auto status = checkBodies(scene, prefix, ids); !status) return status;
+  if (auto status = checkObstacles(scene, prefix, ids); !status) return status;
+  return checkEveryPairHasRestitution(scene, prefix);
 }
 
 void normalizePlanes(Scene& scene) {
