@@ -203,6 +203,44 @@ void storeVelocities(World& world, double time, const PreparedCluster& prepared,
   }
 }
 
+/// A body's velocities at an impact, linear and angular.
+struct BodyVelocities {
+  Eigen::Vector3d linear;
+  Eigen::Vector3d angular;
+};
+
+/// The record of an impact of `pair` (its geometry `g`) at `time`: who struck whom, along which
+/// normal, where (a's surface plus half the gap), and the bodies' velocities before and after.
+/// The restitution, the impulses and the energy lost are the caller's to fill in.
+template <class Motion>
+ImpactRecord impactRecord(const World& world, double time, const Pair& pair, const Geometry& g,
+                          const BodyVelocities& a_before, const BodyVelocities& b_before,
+                          const BodyVelocities& a_after, const BodyVelocities& b_after) {
+  ImpactRecord record;
+  record.time = time;
+  record.body_a = pair.first;
+  record.other_is_obstacle = world.isObstacle(pair.second);
+  record.other = record.other_is_obstacle ? pair.second - world.bodyCount() : pair.second;
+  record.normal = g.normal;
+  record.contact_point = positionAt<Motion>(world, pair.first, time) +
+                         (world.radius[pair.first] + 0.5 * g.gap) * g.normal;
+  record.velocity_a_before = a_before.linear;
+  record.velocity_b_before = b_before.linear;
+  record.velocity_a_after = a_after.linear;
+  record.velocity_b_after = b_after.linear;
+  record.angular_velocity_a_before = a_before.angular;
+  record.angular_velocity_b_before = b_before.angular;
+  record.angular_velocity_a_after = a_after.angular;
+  record.angular_velocity_b_after = b_after.angular;
+  record.oblique = hasObliqueComponent(record.velocity_a_before, g.normal) ||
+                   hasObliqueComponent(record.velocity_b_before, g.normal);
+  return record;
+}
+
+BodyVelocities velocitiesOf(const ClusterBody& body) {
+  return {body.velocity, body.angular_velocity};
+}
+
 template <class Motion>
 void recordImpacts(const World& world, double time, const std::vector<InstantContact>& contacts,
                    const std::vector<std::size_t>& cluster, const PreparedCluster& prepared,
@@ -214,28 +252,13 @@ void recordImpacts(const World& world, double time, const std::vector<InstantCon
     const auto& [pair, g] = contacts[cluster[c]];
     const ClusterContact& contact = prepared.contacts[c];
     const std::vector<ClusterBody>& after = prepared.bodies;
-    ImpactRecord record;
-    record.time = time;
-    record.body_a = pair.first;
-    record.other_is_obstacle = world.isObstacle(pair.second);
-    record.other = record.other_is_obstacle ? pair.second - world.bodyCount() : pair.second;
-    record.normal = g.normal;
-    record.contact_point = positionAt<Motion>(world, pair.first, time) +
-                           (world.radius[pair.first] + 0.5 * g.gap) * g.normal;
+    ImpactRecord record = impactRecord<Motion>(
+        world, time, pair, g, velocitiesOf(before[contact.a]), velocitiesOf(before[contact.b]),
+        velocitiesOf(after[contact.a]), velocitiesOf(after[contact.b]));
     record.restitution = contact.restitution;
     record.impulse = outcome.normal[c].impulse;
     record.friction_impulse = outcome.friction[c].impulse;
     record.energy_lost = outcome.normal[c].energy_lost + outcome.friction[c].energy_lost;
-    record.velocity_a_before = before[contact.a].velocity;
-    record.velocity_b_before = before[contact.b].velocity;
-    record.velocity_a_after = after[contact.a].velocity;
-    record.velocity_b_after = after[contact.b].velocity;
-    record.angular_velocity_a_before = before[contact.a].angular_velocity;
-    record.angular_velocity_b_before = before[contact.b].angular_velocity;
-    record.angular_velocity_a_after = after[contact.a].angular_velocity;
-    record.angular_velocity_b_after = after[contact.b].angular_velocity;
-    record.oblique = hasObliqueComponent(record.velocity_a_before, g.normal) ||
-                     hasObliqueComponent(record.velocity_b_before, g.normal);
     report.impacts.push_back(record);
   }
 }
@@ -488,29 +511,22 @@ void resolveInelastically(World& world, double time, const std::vector<Pair>& pa
     const ForceContact& contact = contacts[k];
     ++k;
     if (impulse.mode == ContactMode::kSeparating) continue;
-    ImpactRecord record;
-    record.time = time;
-    record.body_a = pair.first;
-    record.other_is_obstacle = world.isObstacle(pair.second);
-    record.other = record.other_is_obstacle ? pair.second - world.bodyCount() : pair.second;
-    record.normal = g.normal;
-    record.contact_point = positionAt<Motion>(world, pair.first, time) +
-                           (world.radius[pair.first] + 0.5 * g.gap) * g.normal;
+    const BodyVelocities a_before{bodies[contact.a].acceleration,
+                                  bodies[contact.a].angular_acceleration};
+    const BodyVelocities b_before{bodies[contact.b].acceleration,
+                                  bodies[contact.b].angular_acceleration};
+    const BodyVelocities a_after{world.isObstacle(pair.first) || bodies[contact.a].inverse_mass == 0
+                                     ? a_before.linear
+                                     : solution.acceleration[contact.a],
+                                 solution.angular_acceleration[contact.a]};
+    const BodyVelocities b_after{
+        bodies[contact.b].inverse_mass == 0 ? b_before.linear : solution.acceleration[contact.b],
+        solution.angular_acceleration[contact.b]};
+    ImpactRecord record =
+        impactRecord<Motion>(world, time, pair, g, a_before, b_before, a_after, b_after);
     record.restitution = 0.0;
     record.impulse = impulse.normal;
     record.friction_impulse = impulse.tangential.norm();
-    record.velocity_a_before = bodies[contact.a].acceleration;
-    record.velocity_b_before = bodies[contact.b].acceleration;
-    record.angular_velocity_a_before = bodies[contact.a].angular_acceleration;
-    record.angular_velocity_b_before = bodies[contact.b].angular_acceleration;
-    record.velocity_a_after = world.isObstacle(pair.first) || bodies[contact.a].inverse_mass == 0
-                                  ? record.velocity_a_before
-                                  : solution.acceleration[contact.a];
-    record.velocity_b_after = bodies[contact.b].inverse_mass == 0
-                                  ? record.velocity_b_before
-                                  : solution.acceleration[contact.b];
-    record.angular_velocity_a_after = solution.angular_acceleration[contact.a];
-    record.angular_velocity_b_after = solution.angular_acceleration[contact.b];
     // The work of the impulse F on b (-F on a) over the change of the contact points' relative
     // velocity w: -F.(w_before + w_after) / 2.
     const auto contact_velocity = [&](const Eigen::Vector3d& va, const Eigen::Vector3d& wa,
@@ -526,8 +542,6 @@ void resolveInelastically(World& world, double time, const std::vector<Pair>& pa
                                    record.velocity_b_before, record.angular_velocity_b_before) +
                   contact_velocity(record.velocity_a_after, record.angular_velocity_a_after,
                                    record.velocity_b_after, record.angular_velocity_b_after));
-    record.oblique = hasObliqueComponent(record.velocity_a_before, g.normal) ||
-                     hasObliqueComponent(record.velocity_b_before, g.normal);
     report.impacts.push_back(record);
   }
   for (std::size_t i = 0; i < participants.size(); ++i) {
