@@ -53,6 +53,33 @@ void computePairCoefficients(World& world, const MaterialTable& materials) {
   }
 }
 
+/// The body's track starts again from `state`: known, at the state's time, position and
+/// velocities, and no longer in a constrained motion.
+Track& restartTrack(World& world, const BodyStateSample& state) {
+  Track& track = world.tracks[state.body];
+  track.known = true;
+  track.time = state.time;
+  track.position = state.position;
+  track.velocity = state.velocity;
+  track.angular_velocity = state.angular_velocity;
+  track.constrained = nullptr;
+  return track;
+}
+
+/// A body given a state moves freely from it until the groups of lasting contact are formed
+/// again: a movable body under gravity; a body of a stepped cluster goes on in its sub-step's
+/// straight line from the state, and its cluster is solved again from there (marked stale).
+/// Returns whether the body is a stepped cluster's.
+bool releaseFromState(World& world, std::size_t body) {
+  Track& track = world.tracks[body];
+  const bool stepped = track.stepped >= 0;
+  track.acceleration =
+      world.inverse_mass[body] > 0 && !stepped ? world.gravity : Eigen::Vector3d::Zero();
+  track.angular_acceleration.setZero();
+  if (stepped) world.stepping.clusters[static_cast<std::size_t>(track.stepped)].stale = true;
+  return stepped;
+}
+
 /// Takes the received states as the bodies' tracks, oldest first: a state not newer than its
 /// body's last one is stale (counted, dropped); a state older than the track, or the first after
 /// an impact the monitor applied to the body, does not replace the track (the monitor's
@@ -86,21 +113,9 @@ void applyStates(World& world, const std::vector<BodyStateSample>& states, StepR
         (track.last_impact_time > previous_state_time && track.last_impact_time <= state.time) ||
         (in_step && track.impact_step == world.steps);
     if (track.known && (state.time < track.time || impact_since_previous_state)) continue;
-    track.known = true;
-    track.time = state.time;
-    track.position = state.position;
-    track.velocity = state.velocity;
-    track.angular_velocity = state.angular_velocity;
-    track.constrained = nullptr;
+    restartTrack(world, state);
     if (world.effects.gravity) {
-      // Free until the groups of lasting contact are formed again from the new states; a body
-      // of a stepped cluster goes on in its sub-step's straight line from the state, and its
-      // cluster is solved again from there.
-      const bool stepped = track.stepped >= 0;
-      track.acceleration =
-          world.inverse_mass[state.body] > 0 && !stepped ? world.gravity : Eigen::Vector3d::Zero();
-      track.angular_acceleration.setZero();
-      if (stepped) world.stepping.clusters[static_cast<std::size_t>(track.stepped)].stale = true;
+      releaseFromState(world, state.body);
       world.groups_current = false;
     }
   }
@@ -201,20 +216,9 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
     // States imposed at this instant (the impacts a playback was told of).
     for (; next_imposed < imposed.size() && imposed[next_imposed].time <= instant; ++next_imposed) {
       const BodyStateSample& state = imposed[next_imposed];
-      Track& track = world.tracks[state.body];
-      track.known = true;
-      track.time = state.time;
-      track.position = state.position;
-      track.velocity = state.velocity;
-      track.angular_velocity = state.angular_velocity;
-      // A body of a stepped cluster goes on in a straight line, its cluster solved again.
-      const bool stepped = track.stepped >= 0;
-      track.acceleration =
-          world.inverse_mass[state.body] > 0 && !stepped ? world.gravity : Eigen::Vector3d::Zero();
-      if (stepped) world.stepping.clusters[static_cast<std::size_t>(track.stepped)].stale = true;
+      Track& track = restartTrack(world, state);
+      const bool stepped = releaseFromState(world, state.body);
       stepped_due = stepped_due || stepped;
-      track.angular_acceleration.setZero();
-      track.constrained = nullptr;
       track.last_impact_time = state.time;
       // It is a state too: one given later at its own instant is newer than it.
       track.last_state_time = std::max(track.last_state_time, state.time);
