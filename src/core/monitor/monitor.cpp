@@ -442,6 +442,86 @@ void advanceLastingContact(World& world, double time, StepReport& report) {
   }
 }
 
+/// The candidate pairs touching at the sample (but for a stepped cluster's, which it keeps
+/// apart): new contacts and lasting ones in `touching`, those that overlapped at the sample before
+/// already (no new impact) in `overlapped_before`.
+template <class Motion>
+void touchingAtSample(const World& world, double time, const std::vector<Pair>& pairs,
+                      std::vector<Pair>& touching, std::vector<Pair>& overlapped_before) {
+  for (const Pair& pair : pairs) {
+    const Geometry g = monitor::geometry<Motion>(world, pair, time);
+    if (world.steppedPair(pair)) continue;  // its stepped cluster keeps it apart
+    if (!g.valid || g.gap > g.tolerance) continue;
+    if (world.overlapping.count(pair) == 0 || world.lasting(pair)) {
+      touching.push_back(pair);
+    } else {
+      overlapped_before.push_back(pair);
+    }
+  }
+}
+
+/// A pair still overlapping from an earlier impact is no new impact, but it takes part in one on
+/// its bodies: a ball rising out of the floor it bounced off, struck from above, runs into the
+/// floor (alone it would be driven through it, the floor pair never found again). The pairs of
+/// `overlapped_before` reached from the pairs that strike now, through touching pairs, as
+/// continuous detection's clusters, move to `touching` (sorted then).
+template <class Motion>
+void joinOverlappedBefore(const World& world, double time, std::vector<Pair>& overlapped_before,
+                          std::vector<Pair>& touching) {
+  std::vector<char> struck(world.bodies.size(), 0);
+  std::vector<std::size_t> frontier;
+  const auto reach = [&](std::size_t participant) {
+    if (world.isObstacle(participant) || struck[participant]) return;
+    struck[participant] = 1;
+    frontier.push_back(participant);
+  };
+  for (const Pair& pair : touching) {
+    const Geometry g = monitor::geometry<Motion>(world, pair, time);
+    if (monitor::approaching<Motion>(world, pair, g.normal, time)) {
+      reach(pair.first);
+      reach(pair.second);
+    }
+  }
+  for (bool grown = !frontier.empty(); grown;) {
+    grown = false;
+    for (auto pair = overlapped_before.begin(); pair != overlapped_before.end();) {
+      const bool first = struck[pair->first] != 0;
+      const bool second = !world.isObstacle(pair->second) && struck[pair->second] != 0;
+      if (!first && !second) {
+        ++pair;
+        continue;
+      }
+      reach(pair->first);
+      reach(pair->second);
+      touching.push_back(*pair);
+      pair = overlapped_before.erase(pair);
+      grown = true;
+    }
+    // Touching pairs of the bodies reached carry the blow on (a rack, a stack).
+    for (const Pair& pair : touching) {
+      if (struck[pair.first] || (!world.isObstacle(pair.second) && struck[pair.second])) {
+        const std::size_t before = frontier.size();
+        reach(pair.first);
+        reach(pair.second);
+        grown = grown || frontier.size() != before;
+      }
+    }
+  }
+  std::sort(touching.begin(), touching.end());
+}
+
+/// The pairs overlapping at the sample (but for a stepped cluster's), remembered for the next:
+/// an impact is found when contact begins.
+template <class Motion>
+void rememberOverlapping(World& world, double time, const std::vector<Pair>& pairs) {
+  world.overlapping.clear();
+  for (const Pair& pair : pairs) {
+    if (world.steppedPair(pair)) continue;
+    const Geometry g = monitor::geometry<Motion>(world, pair, time);
+    if (g.valid && g.gap < -g.tolerance) world.overlapping.insert(pair);
+  }
+}
+
 /// Discrete detection: the groups' events up to `time` (advanceLastingContact), the states at
 /// `time` taken, then the pairs that overlap then (and did not at the previous step, unless they
 /// are lasting contacts) and approach are resolved. A lasting contact held overlapping (where its
@@ -458,61 +538,9 @@ StepReport discreteStep(World& world, double time, const std::vector<BodyStateSa
   monitor::candidatePairs<Motion>(world, time, time, pairs);
   std::vector<Pair> touching;
   std::vector<Pair> overlapped_before;  // touching still, overlapping at the sample before
-  for (const Pair& pair : pairs) {
-    const Geometry g = monitor::geometry<Motion>(world, pair, time);
-    if (world.steppedPair(pair)) continue;  // its stepped cluster keeps it apart
-    if (!g.valid || g.gap > g.tolerance) continue;
-    if (world.overlapping.count(pair) == 0 || world.lasting(pair)) {
-      touching.push_back(pair);
-    } else {
-      overlapped_before.push_back(pair);
-    }
-  }
-  // A pair still overlapping from an earlier impact is no new impact, but it takes part in one
-  // on its bodies: a ball rising out of the floor it bounced off, struck from above, runs into
-  // the floor (alone it would be driven through it, the floor pair never found again). Reached
-  // from the pairs that strike now, through touching pairs, as continuous detection's clusters.
+  touchingAtSample<Motion>(world, time, pairs, touching, overlapped_before);
   if (!overlapped_before.empty()) {
-    std::vector<char> struck(world.bodies.size(), 0);
-    std::vector<std::size_t> frontier;
-    const auto reach = [&](std::size_t participant) {
-      if (world.isObstacle(participant) || struck[participant]) return;
-      struck[participant] = 1;
-      frontier.push_back(participant);
-    };
-    for (const Pair& pair : touching) {
-      const Geometry g = monitor::geometry<Motion>(world, pair, time);
-      if (monitor::approaching<Motion>(world, pair, g.normal, time)) {
-        reach(pair.first);
-        reach(pair.second);
-      }
-    }
-    for (bool grown = !frontier.empty(); grown;) {
-      grown = false;
-      for (auto pair = overlapped_before.begin(); pair != overlapped_before.end();) {
-        const bool first = struck[pair->first] != 0;
-        const bool second = !world.isObstacle(pair->second) && struck[pair->second] != 0;
-        if (!first && !second) {
-          ++pair;
-          continue;
-        }
-        reach(pair->first);
-        reach(pair->second);
-        touching.push_back(*pair);
-        pair = overlapped_before.erase(pair);
-        grown = true;
-      }
-      // Touching pairs of the bodies reached carry the blow on (a rack, a stack).
-      for (const Pair& pair : touching) {
-        if (struck[pair.first] || (!world.isObstacle(pair.second) && struck[pair.second])) {
-          const std::size_t before = frontier.size();
-          reach(pair.first);
-          reach(pair.second);
-          grown = grown || frontier.size() != before;
-        }
-      }
-    }
-    std::sort(touching.begin(), touching.end());
+    joinOverlappedBefore<Motion>(world, time, overlapped_before, touching);
   }
   std::vector<std::size_t> changed;
   monitor::resolveInstant<Motion>(world, time, touching, report, changed);
@@ -520,18 +548,8 @@ StepReport discreteStep(World& world, double time, const std::vector<BodyStateSa
     const std::vector<std::size_t> moved = changed;
     monitor::joinStepped(world, time, moved, changed, report);
   }
-  world.overlapping.clear();
-  for (const Pair& pair : pairs) {
-    if (world.steppedPair(pair)) continue;
-    const Geometry g = monitor::geometry<Motion>(world, pair, time);
-    if (g.valid && g.gap < -g.tolerance) world.overlapping.insert(pair);
-  }
-  if constexpr (Motion::kAccelerates) {
-    std::vector<std::size_t> formed;
-    monitor::formAllGroups(world, time, formed);
-    monitor::reportContacts(world, time, report.contacts);
-    report.stepped_bodies = monitor::steppedBodies(world);
-  }
+  rememberOverlapping<Motion>(world, time, pairs);
+  if constexpr (Motion::kAccelerates) reportLastingContact(world, time, report);
   return report;
 }
 
