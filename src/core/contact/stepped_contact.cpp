@@ -96,6 +96,101 @@ struct BoundedSolution {
   int iterations = 0;
 };
 
+/// One run of MPRGP over a contact space: the impulses x, the gradient g = Ax + q at x with its
+/// free, chopped and reduced free parts, and the search direction p.
+class Mprgp {
+ public:
+  Mprgp(const ContactSpace& space, const Eigen::VectorXd& q, Eigen::VectorXd& x)
+      : space_(space),
+        q_(q),
+        x_(x),
+        step_(1.9 / space.normBound()),
+        free_(space.size()),
+        chopped_(space.size()),
+        reduced_(space.size()) {}
+
+  /// The gradient computed afresh at x (the recurrences drift by rounding), and split.
+  void refresh() {
+    space_.apply(x_, g_);
+    g_ += q_;
+    split();
+  }
+
+  /// The search direction starts again along the free gradient.
+  void restartDirection() { p_ = free_; }
+
+  /// The largest component of the projected gradient: of its free part, and of the negative part
+  /// of its bound one.
+  double residual() const {
+    return std::max(free_.lpNorm<Eigen::Infinity>(), chopped_.lpNorm<Eigen::Infinity>());
+  }
+
+  /// Whether x is proportional: the chopped gradient is not kProportioning times the reduced free
+  /// one (then the free components are minimised on, else the bound ones released).
+  bool proportional() const {
+    return chopped_.squaredNorm() <= kProportioning * kProportioning * reduced_.dot(free_);
+  }
+
+  /// A conjugate gradient step along p, or, where it would leave x >= 0, an expansion: to the
+  /// bound along p, then a projected gradient step. False on a direction of no curvature and no
+  /// bound.
+  bool conjugateGradientStep() {
+    space_.apply(p_, ap_);
+    const double curvature = p_.dot(ap_);
+    double feasible = std::numeric_limits<double>::infinity();  // longest step keeping x >= 0
+    for (Eigen::Index i = 0; i < space_.size(); ++i) {
+      if (p_[i] > 0) feasible = std::min(feasible, x_[i] / p_[i]);
+    }
+    const double conjugate = curvature > 0 ? g_.dot(p_) / curvature : feasible;
+    if (!std::isfinite(conjugate)) return false;
+    if (conjugate <= feasible) {
+      x_ = (x_ - conjugate * p_).cwiseMax(0.0);
+      g_ -= conjugate * ap_;
+      split();
+      p_ = free_ - (curvature > 0 ? free_.dot(ap_) / curvature : 0.0) * p_;
+    } else {
+      x_ = (x_ - feasible * p_).cwiseMax(0.0);
+      g_ -= feasible * ap_;
+      split();
+      x_ = (x_ - step_ * free_).cwiseMax(0.0);
+      refresh();
+      p_ = free_;
+    }
+    return true;
+  }
+
+  /// Proportioning: the bound components whose gradient points inside released. False where the
+  /// chopped gradient meets no curvature.
+  bool proportioningStep() {
+    space_.apply(chopped_, ap_);
+    const double curvature = chopped_.dot(ap_);
+    if (!(curvature > 0)) return false;
+    const double length = g_.dot(chopped_) / curvature;
+    x_ = (x_ - length * chopped_).cwiseMax(0.0);
+    g_ -= length * ap_;
+    split();
+    p_ = free_;
+    return true;
+  }
+
+ private:
+  /// The free, chopped and reduced free gradients at x.
+  void split() {
+    for (Eigen::Index i = 0; i < space_.size(); ++i) {
+      const bool is_free = x_[i] > 0;
+      free_[i] = is_free ? g_[i] : 0.0;
+      chopped_[i] = is_free ? 0.0 : std::min(g_[i], 0.0);
+      reduced_[i] = is_free ? std::min(x_[i] / step_, g_[i]) : 0.0;
+    }
+  }
+
+  const ContactSpace& space_;
+  const Eigen::VectorXd& q_;
+  Eigen::VectorXd& x_;
+  const double step_;  // the gradient projection's fixed step
+  Eigen::VectorXd g_, ap_, free_, chopped_, reduced_, p_;
+};
+
 /// min 1/2 x'Ax + q'x over x >= 0 (the complementarity problem x >= 0, Ax + q >= 0,
 /// x'(Ax + q) = 0), by MPRGP (header), from `start`, until every component of the projected
 /// gradient is within `tolerance` (its free components, and the negative part of the bound ones).
@@ -104,81 +199,31 @@ struct BoundedSolution {
 BoundedSolution solveBounded(const ContactSpace& space, const Eigen::VectorXd& q,
                              const Eigen::VectorXd& start, double tolerance, int max_iterations,
                              double runaway) {
-  const Eigen::Index n = space.size();
   BoundedSolution result;
   Eigen::VectorXd& x = result.impulses;
   x = start.cwiseMax(0.0);
-  if (n == 0) {
+  if (space.size() == 0) {
     result.converged = true;
     return result;
   }
-  const double step = 1.9 / space.normBound();  // the gradient projection's fixed step
-  Eigen::VectorXd g, ap, free(n), chopped(n), reduced(n);
-  const auto gradient = [&] {
-    space.apply(x, g);
-    g += q;
-  };
-  const auto split = [&] {  // the free, chopped and reduced free gradients at x
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const bool is_free = x[i] > 0;
-      free[i] = is_free ? g[i] : 0.0;
-      chopped[i] = is_free ? 0.0 : std::min(g[i], 0.0);
-      reduced[i] = is_free ? std::min(x[i] / step, g[i]) : 0.0;
-    }
-  };
-  gradient();
-  split();
-  Eigen::VectorXd p = free;
+  Mprgp mprgp(space, q, x);
+  mprgp.refresh();
+  mprgp.restartDirection();
   for (; result.iterations < max_iterations; ++result.iterations) {
-    if (std::max(free.lpNorm<Eigen::Infinity>(), chopped.lpNorm<Eigen::Infinity>()) <= tolerance) {
+    if (mprgp.residual() <= tolerance) {
       // Confirmed on a fresh gradient: the recurrences drift by rounding.
-      gradient();
-      split();
-      if (std::max(free.lpNorm<Eigen::Infinity>(), chopped.lpNorm<Eigen::Infinity>()) <=
-          tolerance) {
+      mprgp.refresh();
+      if (mprgp.residual() <= tolerance) {
         result.converged = true;
         return result;
       }
-      p = free;
+      mprgp.restartDirection();
     }
-    if (chopped.squaredNorm() <= kProportioning * kProportioning * reduced.dot(free)) {
-      space.apply(p, ap);
-      const double curvature = p.dot(ap);
-      double feasible = std::numeric_limits<double>::infinity();  // longest step keeping x >= 0
-      for (Eigen::Index i = 0; i < n; ++i) {
-        if (p[i] > 0) feasible = std::min(feasible, x[i] / p[i]);
-      }
-      const double conjugate = curvature > 0 ? g.dot(p) / curvature : feasible;
-      if (!std::isfinite(conjugate)) break;  // a direction of no curvature and no bound
-      if (conjugate <= feasible) {
-        x = (x - conjugate * p).cwiseMax(0.0);
-        g -= conjugate * ap;
-        split();
-        p = free - (curvature > 0 ? free.dot(ap) / curvature : 0.0) * p;
-      } else {
-        // Expansion: to the bound along p, then a projected gradient step.
-        x = (x - feasible * p).cwiseMax(0.0);
-        g -= feasible * ap;
-        split();
-        x = (x - step * free).cwiseMax(0.0);
-        gradient();
-        split();
-        p = free;
-      }
-    } else {
-      // Proportioning: release the bound components whose gradient points inside.
-      space.apply(chopped, ap);
-      const double curvature = chopped.dot(ap);
-      if (!(curvature > 0)) break;
-      const double length = g.dot(chopped) / curvature;
-      x = (x - length * chopped).cwiseMax(0.0);
-      g -= length * ap;
-      split();
-      p = free;
-    }
+    const bool went_on =
+        mprgp.proportional() ? mprgp.conjugateGradientStep() : mprgp.proportioningStep();
+    if (!went_on) break;
     if (result.iterations % 64 == 63) {
-      gradient();
-      split();
+      mprgp.refresh();
       if (x.maxCoeff() > runaway) break;
     }
   }
