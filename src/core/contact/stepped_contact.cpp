@@ -96,6 +96,101 @@ struct BoundedSolution {
   int iterations = 0;
 };
 
+/// One run of MPRGP over a contact space: the impulses x, the gradient g = Ax + q at x with its
+/// free, chopped and reduced free parts, and the search direction p.
+class Mprgp {
+ public:
+  Mprgp(const ContactSpace& space, const Eigen::VectorXd& q, Eigen::VectorXd& x)
+      : space_(space),
+        q_(q),
+        x_(x),
+        step_(1.9 / space.normBound()),
+        free_(space.size()),
+        chopped_(space.size()),
+        reduced_(space.size()) {}
+
+  /// The gradient computed afresh at x (the recurrences drift by rounding), and split.
+  void refresh() {
+    space_.apply(x_, g_);
+    g_ += q_;
+    split();
+  }
+
+  /// The search direction starts again along the free gradient.
+  void restartDirection() { p_ = free_; }
+
+  /// The largest component of the projected gradient: of its free part, and of the negative part
+  /// of its bound one.
+  double residual() const {
+    return std::max(free_.lpNorm<Eigen::Infinity>(), chopped_.lpNorm<Eigen::Infinity>());
+  }
+
+  /// Whether x is proportional: the chopped gradient is not kProportioning times the reduced free
+  /// one (then the free components are minimised on, else the bound ones released).
+  bool proportional() const {
+    return chopped_.squaredNorm() <= kProportioning * kProportioning * reduced_.dot(free_);
+  }
+
+  /// A conjugate gradient step along p, or, where it would leave x >= 0, an expansion: to the
+  /// bound along p, then a projected gradient step. False on a direction of no curvature and no
+  /// bound.
+  bool conjugateGradientStep() {
+    space_.apply(p_, ap_);
+    const double curvature = p_.dot(ap_);
+    double feasible = std::numeric_limits<double>::infinity();  // longest step keeping x >= 0
+    for (Eigen::Index i = 0; i < space_.size(); ++i) {
+      if (p_[i] > 0) feasible = std::min(feasible, x_[i] / p_[i]);
+    }
+    const double conjugate = curvature > 0 ? g_.dot(p_) / curvature : feasible;
+    if (!std::isfinite(conjugate)) return false;
+    if (conjugate <= feasible) {
+      x_ = (x_ - conjugate * p_).cwiseMax(0.0);
+      g_ -= conjugate * ap_;
+      split();
+      p_ = free_ - (curvature > 0 ? free_.dot(ap_) / curvature : 0.0) * p_;
+    } else {
+      x_ = (x_ - feasible * p_).cwiseMax(0.0);
+      g_ -= feasible * ap_;
+      split();
+      x_ = (x_ - step_ * free_).cwiseMax(0.0);
+      refresh();
+      p_ = free_;
+    }
+    return true;
+  }
+
+  /// Proportioning: the bound components whose gradient points inside released. False where the
+  /// chopped gradient meets no curvature.
+  bool proportioningStep() {
+    space_.apply(chopped_, ap_);
+    const double curvature = chopped_.dot(ap_);
+    if (!(curvature > 0)) return false;
+    const double length = g_.dot(chopped_) / curvature;
+    x_ = (x_ - length * chopped_).cwiseMax(0.0);
+    g_ -= length * ap_;
+    split();
+    p_ = free_;
+    return true;
+  }
+
+ private:
+  /// The free, chopped and reduced free gradients at x.
+  void split() {
+    for (Eigen::Index i = 0; i < space_.size(); ++i) {
+      const bool is_free = x_[i] > 0;
+      free_[i] = is_free ? g_[i] : 0.0;
+      chopped_[i] = is_free ? 0.0 : std::min(g_[i], 0.0);
+      reduced_[i] = is_free ? std::min(x_[i] / step_, g_[i]) : 0.0;
+    }
+  }
+
+  const ContactSpace& space_;
+  const Eigen::VectorXd& q_;
+  Eigen::VectorXd& x_;
+  const double step_;  // the gradient projection's fixed step
+  Eigen::VectorXd g_, ap_, free_, chopped_, reduced_, p_;
+};
+
 /// min 1/2 x'Ax + q'x over x >= 0 (the complementarity problem x >= 0, Ax + q >= 0,
 /// x'(Ax + q) = 0), by MPRGP (header), from `start`, until every component of the projected
 /// gradient is within `tolerance` (its free components, and the negative part of the bound ones).
@@ -104,81 +199,31 @@ struct BoundedSolution {
 BoundedSolution solveBounded(const ContactSpace& space, const Eigen::VectorXd& q,
                              const Eigen::VectorXd& start, double tolerance, int max_iterations,
                              double runaway) {
-  const Eigen::Index n = space.size();
   BoundedSolution result;
   Eigen::VectorXd& x = result.impulses;
   x = start.cwiseMax(0.0);
-  if (n == 0) {
+  if (space.size() == 0) {
     result.converged = true;
     return result;
   }
-  const double step = 1.9 / space.normBound();  // the gradient projection's fixed step
-  Eigen::VectorXd g, ap, free(n), chopped(n), reduced(n);
-  const auto gradient = [&] {
-    space.apply(x, g);
-    g += q;
-  };
-  const auto split = [&] {  // the free, chopped and reduced free gradients at x
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const bool is_free = x[i] > 0;
-      free[i] = is_free ? g[i] : 0.0;
-      chopped[i] = is_free ? 0.0 : std::min(g[i], 0.0);
-      reduced[i] = is_free ? std::min(x[i] / step, g[i]) : 0.0;
-    }
-  };
-  gradient();
-  split();
-  Eigen::VectorXd p = free;
+  Mprgp mprgp(space, q, x);
+  mprgp.refresh();
+  mprgp.restartDirection();
   for (; result.iterations < max_iterations; ++result.iterations) {
-    if (std::max(free.lpNorm<Eigen::Infinity>(), chopped.lpNorm<Eigen::Infinity>()) <= tolerance) {
+    if (mprgp.residual() <= tolerance) {
       // Confirmed on a fresh gradient: the recurrences drift by rounding.
-      gradient();
-      split();
-      if (std::max(free.lpNorm<Eigen::Infinity>(), chopped.lpNorm<Eigen::Infinity>()) <=
-          tolerance) {
+      mprgp.refresh();
+      if (mprgp.residual() <= tolerance) {
         result.converged = true;
         return result;
       }
-      p = free;
+      mprgp.restartDirection();
     }
-    if (chopped.squaredNorm() <= kProportioning * kProportioning * reduced.dot(free)) {
-      space.apply(p, ap);
-      const double curvature = p.dot(ap);
-      double feasible = std::numeric_limits<double>::infinity();  // longest step keeping x >= 0
-      for (Eigen::Index i = 0; i < n; ++i) {
-        if (p[i] > 0) feasible = std::min(feasible, x[i] / p[i]);
-      }
-      const double conjugate = curvature > 0 ? g.dot(p) / curvature : feasible;
-      if (!std::isfinite(conjugate)) break;  // a direction of no curvature and no bound
-      if (conjugate <= feasible) {
-        x = (x - conjugate * p).cwiseMax(0.0);
-        g -= conjugate * ap;
-        split();
-        p = free - (curvature > 0 ? free.dot(ap) / curvature : 0.0) * p;
-      } else {
-        // Expansion: to the bound along p, then a projected gradient step.
-        x = (x - feasible * p).cwiseMax(0.0);
-        g -= feasible * ap;
-        split();
-        x = (x - step * free).cwiseMax(0.0);
-        gradient();
-        split();
-        p = free;
-      }
-    } else {
-      // Proportioning: release the bound components whose gradient points inside.
-      space.apply(chopped, ap);
-      const double curvature = chopped.dot(ap);
-      if (!(curvature > 0)) break;
-      const double length = g.dot(chopped) / curvature;
-      x = (x - length * chopped).cwiseMax(0.0);
-      g -= length * ap;
-      split();
-      p = free;
-    }
+    const bool went_on =
+        mprgp.proportional() ? mprgp.conjugateGradientStep() : mprgp.proportioningStep();
+    if (!went_on) break;
     if (result.iterations % 64 == 63) {
-      gradient();
-      split();
+      mprgp.refresh();
       if (x.maxCoeff() > runaway) break;
     }
   }
@@ -258,36 +303,52 @@ BoundedSolution keepGaps(const std::vector<SteppedBody>& bodies,
   return solution;
 }
 
-}  // namespace
-
-SteppedOutcome solveSteppedSubstep(const std::vector<SteppedBody>& bodies,
-                                   const std::vector<SteppedContact>& contacts,
-                                   const SteppedSettings& settings,
-                                   const std::vector<double>& warm) {
-  const double h = settings.duration;
+/// The outcome the stages fill in: the sub-step's duration, a record per contact, and each
+/// participant's velocities at the start (which the stages change).
+SteppedOutcome startingOutcome(const std::vector<SteppedBody>& bodies, std::size_t contacts,
+                               double duration) {
   SteppedOutcome outcome;
-  outcome.duration = h;
-  outcome.contacts.resize(contacts.size());
-  std::vector<Eigen::Vector3d>& v = outcome.velocity;
-  std::vector<Eigen::Vector3d>& w = outcome.angular_velocity;
+  outcome.duration = duration;
+  outcome.contacts.resize(contacts);
   for (const SteppedBody& body : bodies) {
-    v.push_back(body.velocity);
-    w.push_back(body.angular_velocity);
+    outcome.velocity.push_back(body.velocity);
+    outcome.angular_velocity.push_back(body.angular_velocity);
   }
-  // The residual allowed of every solve (m/s): over the sub-step, a quarter of the tightest band.
-  double tolerance = std::numeric_limits<double>::infinity();
-  for (const SteppedContact& c : contacts) tolerance = std::min(tolerance, 0.25 * c.band / h);
+  return outcome;
+}
 
-  // 1. Bounce.
-  std::vector<char> touching(contacts.size(), 0);
-  std::vector<double> bounce_speed(contacts.size(), 0.0);
-  bool any_struck = false;
-  double owed = 0.0;  // what the sub-step before took from the arrivals (J)
+/// The residual allowed of every solve (m/s): over the sub-step, a quarter of the tightest band.
+double solveTolerance(const std::vector<SteppedContact>& contacts, double duration) {
+  double tolerance = std::numeric_limits<double>::infinity();
+  for (const SteppedContact& c : contacts)
+    tolerance = std::min(tolerance, 0.25 * c.band / duration);
+  return tolerance;
+}
+
+/// Which contacts touch at the start and which of them strike, with the speed each striking one
+/// leaves at and what the sub-step before took from the arrivals (J).
+struct Strikes {
+  std::vector<char> touching;
+  std::vector<double> bounce_speed;
+  bool any = false;
+  double owed = 0.0;
+};
+
+/// The strikes of stage 1 (header), each contact's approach speed and whether it struck recorded
+/// in `outcome`.
+Strikes findStrikes(const std::vector<SteppedBody>& bodies,
+                    const std::vector<SteppedContact>& contacts, const SteppedSettings& settings,
+                    SteppedOutcome& outcome) {
+  const double h = settings.duration;
+  const std::vector<Eigen::Vector3d>& v = outcome.velocity;
+  Strikes strikes;
+  strikes.touching.assign(contacts.size(), 0);
+  strikes.bounce_speed.assign(contacts.size(), 0.0);
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     const SteppedContact& c = contacts[k];
     SteppedContactOutcome& out = outcome.contacts[k];
     out.approach_speed = c.normal.dot(v[c.a] - v[c.b]);
-    touching[k] = c.gap <= c.band;
+    strikes.touching[k] = c.gap <= c.band;
     const double speed = std::max(out.approach_speed, c.arrival_speed);
     // A bounce slower than sqrt(2 g band) would not leave the touching band under gravity g
     // (the exact model's rest rule, restSpeed in motion.h): it rests, and the gap keeping
@@ -295,64 +356,90 @@ SteppedOutcome solveSteppedSubstep(const std::vector<SteppedBody>& bodies,
     const double gravity = std::max(bodies[c.a].kick.norm(), bodies[c.b].kick.norm()) / h;
     const double rounding =
         64 * kEps * (v[c.a].lpNorm<Eigen::Infinity>() + v[c.b].lpNorm<Eigen::Infinity>());
-    out.struck = touching[k] && speed > rounding && speed > std::sqrt(2 * gravity * c.band) &&
-                 speed >= settings.restitution_threshold;
+    out.struck = strikes.touching[k] && speed > rounding &&
+                 speed > std::sqrt(2 * gravity * c.band) && speed >= settings.restitution_threshold;
     if (out.struck) {
-      bounce_speed[k] = c.restitution * speed;
+      strikes.bounce_speed[k] = c.restitution * speed;
       const double closing = std::max(out.approach_speed, 0.0);
-      owed += 0.5 * (speed * speed - closing * closing) /
-              (bodies[c.a].inverse_mass + bodies[c.b].inverse_mass);
+      strikes.owed += 0.5 * (speed * speed - closing * closing) /
+                      (bodies[c.a].inverse_mass + bodies[c.b].inverse_mass);
     }
-    any_struck = any_struck || out.struck;
+    strikes.any = strikes.any || out.struck;
   }
-  if (any_struck) {
-    const std::vector<std::size_t> order = contactOrder(contacts, touching);
-    const ContactSpace space(bodies, contacts, order);
-    const double infinity = std::numeric_limits<double>::infinity();
-    const double before = kineticEnergy(bodies, v);
-    const BoundedSolution compression =
-        solveBounded(space, space.normalVelocities(v), Eigen::VectorXd::Zero(space.size()),
-                     tolerance, settings.max_iterations, infinity);  // d' >= 0
-    space.addVelocityChanges(compression.impulses, v);
-    Eigen::VectorXd q = space.normalVelocities(v);  // d' >= e u where struck, else >= 0
-    for (Eigen::Index i = 0; i < space.size(); ++i) {
-      q[i] -= bounce_speed[order[static_cast<std::size_t>(i)]];
-    }
-    const BoundedSolution restitution = solveBounded(space, q, Eigen::VectorXd::Zero(space.size()),
-                                                     tolerance, settings.max_iterations, infinity);
-    outcome.iterations += compression.iterations + restitution.iterations;
-    outcome.converged = outcome.converged && compression.converged && restitution.converged;
-    // The kinetic energy with the restitution scaled by s: K(s) = K_c + s X + s^2 R / 2 (X = J.d
-    // after compression, R = J.AJ). With one coefficient and no arrival it is below the energy
-    // before (Newton's law for one contact; jointly it need not be); s is the largest in [0, 1]
-    // with K(s) <= the energy before plus what the sub-step before took from the arrivals.
-    Eigen::VectorXd a_restitution;
-    space.apply(restitution.impulses, a_restitution);
-    const double compressed = kineticEnergy(bodies, v);
-    const double returned = restitution.impulses.dot(a_restitution);
-    const double cross = restitution.impulses.dot(space.normalVelocities(v));
-    const double allowed = before + owed - compressed;
-    double scale = 1.0;
-    if (cross + 0.5 * returned > allowed && returned > 0) {
-      scale = std::clamp(
-          (-cross + std::sqrt(std::max(0.0, cross * cross + 2 * returned * allowed))) / returned,
-          0.0, 1.0);
-    }
-    space.addVelocityChanges(scale * restitution.impulses, v);
-    for (Eigen::Index i = 0; i < space.size(); ++i) {
-      outcome.contacts[order[static_cast<std::size_t>(i)]].bounce_impulse =
-          compression.impulses[i] + scale * restitution.impulses[i];
-    }
-  }
+  return strikes;
+}
 
-  // 2. Gravity.
+/// The kinetic energy with the restitution impulses J scaled by s: K(s) = K_c + s X + s^2 R / 2
+/// (X = J.d after compression, R = J.AJ). With one coefficient and no arrival it is below the
+/// energy before (Newton's law for one contact; jointly it need not be); s is the largest in
+/// [0, 1] with K(s) <= the energy `before` plus what the sub-step before took from the arrivals
+/// (`owed`). `v`: the velocities after compression.
+double restitutionScale(const std::vector<SteppedBody>& bodies, const ContactSpace& space,
+                        const Eigen::VectorXd& restitution, const std::vector<Eigen::Vector3d>& v,
+                        double before, double owed) {
+  Eigen::VectorXd a_restitution;
+  space.apply(restitution, a_restitution);
+  const double compressed = kineticEnergy(bodies, v);
+  const double returned = restitution.dot(a_restitution);
+  const double cross = restitution.dot(space.normalVelocities(v));
+  const double allowed = before + owed - compressed;
+  double scale = 1.0;
+  if (cross + 0.5 * returned > allowed && returned > 0) {
+    scale = std::clamp(
+        (-cross + std::sqrt(std::max(0.0, cross * cross + 2 * returned * allowed))) / returned, 0.0,
+        1.0);
+  }
+  return scale;
+}
+
+/// Stage 1, the bounce (header): the touching contacts compressed jointly (d' >= 0), then the
+/// struck ones leave at their bounce speed and the others do not approach (d' >= e u where
+/// struck, else >= 0), the restitution scaled down where it would add kinetic energy.
+void bounce(const std::vector<SteppedBody>& bodies, const std::vector<SteppedContact>& contacts,
+            const SteppedSettings& settings, double tolerance, const Strikes& strikes,
+            SteppedOutcome& outcome) {
+  std::vector<Eigen::Vector3d>& v = outcome.velocity;
+  const std::vector<std::size_t> order = contactOrder(contacts, strikes.touching);
+  const ContactSpace space(bodies, contacts, order);
+  const double infinity = std::numeric_limits<double>::infinity();
+  const double before = kineticEnergy(bodies, v);
+  const BoundedSolution compression =
+      solveBounded(space, space.normalVelocities(v), Eigen::VectorXd::Zero(space.size()), tolerance,
+                   settings.max_iterations, infinity);
+  space.addVelocityChanges(compression.impulses, v);
+  Eigen::VectorXd q = space.normalVelocities(v);
+  for (Eigen::Index i = 0; i < space.size(); ++i) {
+    q[i] -= strikes.bounce_speed[order[static_cast<std::size_t>(i)]];
+  }
+  const BoundedSolution restitution = solveBounded(space, q, Eigen::VectorXd::Zero(space.size()),
+                                                   tolerance, settings.max_iterations, infinity);
+  outcome.iterations += compression.iterations + restitution.iterations;
+  outcome.converged = outcome.converged && compression.converged && restitution.converged;
+  const double scale =
+      restitutionScale(bodies, space, restitution.impulses, v, before, strikes.owed);
+  space.addVelocityChanges(scale * restitution.impulses, v);
+  for (Eigen::Index i = 0; i < space.size(); ++i) {
+    outcome.contacts[order[static_cast<std::size_t>(i)]].bounce_impulse =
+        compression.impulses[i] + scale * restitution.impulses[i];
+  }
+}
+
+/// Stage 2, gravity (header): every movable body's velocity gains its kick.
+void addGravity(const std::vector<SteppedBody>& bodies, std::vector<Eigen::Vector3d>& v) {
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     if (bodies[i].inverse_mass > 0) v[i] += bodies[i].kick;
   }
+}
 
-  // 3. Gap keeping.
-  const std::vector<std::size_t> order =
-      contactOrder(contacts, std::vector<char>(contacts.size(), 1));
+/// Stage 3, gap keeping (header), from the `warm` impulses (per contact; empty for none). A
+/// contact not `touching` at the start that the keeping stops arrives in the sub-step: the speed
+/// it was closing at is recorded (its bounce is the next sub-step's).
+BoundedSolution keepGapsFrom(const std::vector<SteppedBody>& bodies,
+                             const std::vector<SteppedContact>& contacts,
+                             const std::vector<std::size_t>& order, const std::vector<double>& warm,
+                             const SteppedSettings& settings, double tolerance,
+                             const std::vector<char>& touching, SteppedOutcome& outcome) {
+  std::vector<Eigen::Vector3d>& v = outcome.velocity;
   Eigen::VectorXd start = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(order.size()));
   if (warm.size() == contacts.size()) {
     for (std::size_t i = 0; i < order.size(); ++i) {
@@ -363,74 +450,99 @@ SteppedOutcome solveSteppedSubstep(const std::vector<SteppedBody>& bodies,
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     closing_before[k] = contacts[k].normal.dot(v[contacts[k].a] - v[contacts[k].b]);
   }
-  BoundedSolution kept =
-      keepGaps(bodies, contacts, order, start, h, tolerance, settings.max_iterations, v);
+  BoundedSolution kept = keepGaps(bodies, contacts, order, start, settings.duration, tolerance,
+                                  settings.max_iterations, v);
   outcome.iterations += kept.iterations;
-  Eigen::VectorXd keeping = kept.impulses;
   for (std::size_t i = 0; i < order.size(); ++i) {
     const std::size_t k = order[i];
-    if (!touching[k] && keeping[static_cast<Eigen::Index>(i)] > 0 && closing_before[k] > 0) {
+    if (!touching[k] && kept.impulses[static_cast<Eigen::Index>(i)] > 0 && closing_before[k] > 0) {
       outcome.contacts[k].arrival_speed = closing_before[k];
     }
   }
+  return kept;
+}
 
-  // 4. Friction, then the gaps again.
-  if (settings.friction && !contacts.empty()) {
-    std::vector<ClusterBody> cluster_bodies(bodies.size());
-    for (std::size_t i = 0; i < bodies.size(); ++i) {
-      cluster_bodies[i].inverse_mass = bodies[i].inverse_mass;
-      cluster_bodies[i].velocity = v[i];
-      cluster_bodies[i].angular_velocity = w[i];
-      cluster_bodies[i].spin_factor = bodies[i].spin_factor;
-      cluster_bodies[i].radius = bodies[i].radius;
-    }
-    std::vector<ClusterContact> pressed;
-    std::vector<FrictionContact> frictions;
-    std::vector<std::size_t> pressed_index;
-    for (std::size_t i = 0; i < order.size(); ++i) {
-      const std::size_t k = order[i];
-      const double normal =
-          outcome.contacts[k].bounce_impulse + keeping[static_cast<Eigen::Index>(i)];
-      if (!(normal > 0) || !(contacts[k].friction > 0)) continue;
-      const SteppedContact& c = contacts[k];
-      pressed.push_back(ClusterContact{c.a, c.b, c.normal, 0.0});
-      frictions.push_back(FrictionContact{c.friction, normal});
-      pressed_index.push_back(k);
-      // The slip before friction (b's surface against a's at the contact point): friction acts
-      // on b against it.
-      Eigen::Vector3d slip = v[c.b] - v[c.a];
-      if (bodies[c.b].spin_factor != 0.0) slip += w[c.b].cross(-bodies[c.b].radius * c.normal);
-      if (bodies[c.a].spin_factor != 0.0) slip -= w[c.a].cross(bodies[c.a].radius * c.normal);
-      slip -= slip.dot(c.normal) * c.normal;
-      if (slip.norm() > 0) outcome.contacts[k].friction_direction = -slip.normalized();
-    }
-    if (!pressed.empty()) {
-      std::vector<FrictionOutcome> friction_outcomes;
-      settings.friction(cluster_bodies, pressed, frictions, friction_outcomes);
-      for (std::size_t i = 0; i < bodies.size(); ++i) {
-        v[i] = cluster_bodies[i].velocity;
-        w[i] = cluster_bodies[i].angular_velocity;
-      }
-      for (std::size_t j = 0; j < pressed_index.size() && j < friction_outcomes.size(); ++j) {
-        outcome.contacts[pressed_index[j]].friction_impulse = friction_outcomes[j].impulse;
-        outcome.contacts[pressed_index[j]].sticking = friction_outcomes[j].sticking;
-      }
-      const BoundedSolution again = keepGaps(
-          bodies, contacts, order, Eigen::VectorXd::Zero(static_cast<Eigen::Index>(order.size())),
-          h, tolerance, settings.max_iterations, v);
-      outcome.iterations += again.iterations;
-      keeping += again.impulses;
-      kept.converged = again.converged;
-    }
-  }
-  outcome.converged = outcome.converged && kept.converged;
+/// The contacts that carry a normal impulse (`keeping`: the gap keeping's, in the solve's
+/// order) and have friction, as the friction step takes them.
+struct PressedContacts {
+  std::vector<ClusterContact> contacts;
+  std::vector<FrictionContact> frictions;
+  std::vector<std::size_t> index;  ///< each one's contact
+};
+
+/// The pressed contacts, each one's friction direction (against b's slip before friction)
+/// recorded in `outcome`.
+PressedContacts pressedContacts(const std::vector<SteppedBody>& bodies,
+                                const std::vector<SteppedContact>& contacts,
+                                const std::vector<std::size_t>& order,
+                                const Eigen::VectorXd& keeping, SteppedOutcome& outcome) {
+  const std::vector<Eigen::Vector3d>& v = outcome.velocity;
+  const std::vector<Eigen::Vector3d>& w = outcome.angular_velocity;
+  PressedContacts pressed;
   for (std::size_t i = 0; i < order.size(); ++i) {
-    outcome.contacts[order[i]].keeping_impulse = keeping[static_cast<Eigen::Index>(i)];
+    const std::size_t k = order[i];
+    const double normal =
+        outcome.contacts[k].bounce_impulse + keeping[static_cast<Eigen::Index>(i)];
+    if (!(normal > 0) || !(contacts[k].friction > 0)) continue;
+    const SteppedContact& c = contacts[k];
+    pressed.contacts.push_back(ClusterContact{c.a, c.b, c.normal, 0.0});
+    pressed.frictions.push_back(FrictionContact{c.friction, normal});
+    pressed.index.push_back(k);
+    // The slip before friction (b's surface against a's at the contact point): friction acts
+    // on b against it.
+    Eigen::Vector3d slip = v[c.b] - v[c.a];
+    if (bodies[c.b].spin_factor != 0.0) slip += w[c.b].cross(-bodies[c.b].radius * c.normal);
+    if (bodies[c.a].spin_factor != 0.0) slip -= w[c.a].cross(bodies[c.a].radius * c.normal);
+    slip -= slip.dot(c.normal) * c.normal;
+    if (slip.norm() > 0) outcome.contacts[k].friction_direction = -slip.normalized();
   }
-  if (outcome.converged) return outcome;
+  return pressed;
+}
 
-  // A solve fell short: the sub-step ends before any contact closes past its band (for an
-  // overlap: before it deepens past it), at the first instant one would.
+/// Stage 4, friction (header): Coulomb's impulses on the pressed contacts, then the gaps kept
+/// again, whose impulses (and convergence) `kept` takes on.
+void frictionThenGaps(const std::vector<SteppedBody>& bodies,
+                      const std::vector<SteppedContact>& contacts,
+                      const std::vector<std::size_t>& order, const SteppedSettings& settings,
+                      double tolerance, BoundedSolution& kept, SteppedOutcome& outcome) {
+  std::vector<Eigen::Vector3d>& v = outcome.velocity;
+  std::vector<Eigen::Vector3d>& w = outcome.angular_velocity;
+  std::vector<ClusterBody> cluster_bodies(bodies.size());
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    cluster_bodies[i].inverse_mass = bodies[i].inverse_mass;
+    cluster_bodies[i].velocity = v[i];
+    cluster_bodies[i].angular_velocity = w[i];
+    cluster_bodies[i].spin_factor = bodies[i].spin_factor;
+    cluster_bodies[i].radius = bodies[i].radius;
+  }
+  const PressedContacts pressed = pressedContacts(bodies, contacts, order, kept.impulses, outcome);
+  if (pressed.contacts.empty()) return;
+  std::vector<FrictionOutcome> friction_outcomes;
+  settings.friction(cluster_bodies, pressed.contacts, pressed.frictions, friction_outcomes);
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    v[i] = cluster_bodies[i].velocity;
+    w[i] = cluster_bodies[i].angular_velocity;
+  }
+  for (std::size_t j = 0; j < pressed.index.size() && j < friction_outcomes.size(); ++j) {
+    outcome.contacts[pressed.index[j]].friction_impulse = friction_outcomes[j].impulse;
+    outcome.contacts[pressed.index[j]].sticking = friction_outcomes[j].sticking;
+  }
+  const BoundedSolution again = keepGaps(
+      bodies, contacts, order, Eigen::VectorXd::Zero(static_cast<Eigen::Index>(order.size())),
+      settings.duration, tolerance, settings.max_iterations, v);
+  outcome.iterations += again.iterations;
+  kept.impulses += again.impulses;
+  kept.converged = again.converged;
+}
+
+/// A solve fell short: the sub-step ends before any contact closes past its band (for an
+/// overlap: before it deepens past it), at the first instant one would; where that leaves too
+/// short a sub-step, every movable body is held still over it instead.
+void endEarlyOrHold(const std::vector<SteppedBody>& bodies,
+                    const std::vector<SteppedContact>& contacts, double h,
+                    SteppedOutcome& outcome) {
+  std::vector<Eigen::Vector3d>& v = outcome.velocity;
+  std::vector<Eigen::Vector3d>& w = outcome.angular_velocity;
   double duration = h;
   for (const SteppedContact& c : contacts) {
     const double closing = c.normal.dot(v[c.a] - v[c.b]);  // -d'
@@ -441,7 +553,7 @@ SteppedOutcome solveSteppedSubstep(const std::vector<SteppedBody>& bodies,
   }
   if (duration >= kShortestSubstep * h) {
     outcome.duration = duration;
-    return outcome;
+    return;
   }
   outcome.held = true;
   for (std::size_t i = 0; i < bodies.size(); ++i) {
@@ -454,6 +566,31 @@ SteppedOutcome solveSteppedSubstep(const std::vector<SteppedBody>& bodies,
     out.keeping_impulse = 0.0;
     out.friction_impulse = 0.0;
   }
+}
+
+}  // namespace
+
+SteppedOutcome solveSteppedSubstep(const std::vector<SteppedBody>& bodies,
+                                   const std::vector<SteppedContact>& contacts,
+                                   const SteppedSettings& settings,
+                                   const std::vector<double>& warm) {
+  SteppedOutcome outcome = startingOutcome(bodies, contacts.size(), settings.duration);
+  const double tolerance = solveTolerance(contacts, settings.duration);
+  const Strikes strikes = findStrikes(bodies, contacts, settings, outcome);
+  if (strikes.any) bounce(bodies, contacts, settings, tolerance, strikes, outcome);
+  addGravity(bodies, outcome.velocity);
+  const std::vector<std::size_t> order =
+      contactOrder(contacts, std::vector<char>(contacts.size(), 1));
+  BoundedSolution kept =
+      keepGapsFrom(bodies, contacts, order, warm, settings, tolerance, strikes.touching, outcome);
+  if (settings.friction && !contacts.empty()) {
+    frictionThenGaps(bodies, contacts, order, settings, tolerance, kept, outcome);
+  }
+  outcome.converged = outcome.converged && kept.converged;
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    outcome.contacts[order[i]].keeping_impulse = kept.impulses[static_cast<Eigen::Index>(i)];
+  }
+  if (!outcome.converged) endEarlyOrHold(bodies, contacts, settings.duration, outcome);
   return outcome;
 }
 

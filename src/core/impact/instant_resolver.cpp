@@ -203,6 +203,44 @@ void storeVelocities(World& world, double time, const PreparedCluster& prepared,
   }
 }
 
+/// A body's velocities at an impact, linear and angular.
+struct BodyVelocities {
+  Eigen::Vector3d linear;
+  Eigen::Vector3d angular;
+};
+
+/// The record of an impact of `pair` (its geometry `g`) at `time`: who struck whom, along which
+/// normal, where (a's surface plus half the gap), and the bodies' velocities before and after.
+/// The restitution, the impulses and the energy lost are the caller's to fill in.
+template <class Motion>
+ImpactRecord impactRecord(const World& world, double time, const Pair& pair, const Geometry& g,
+                          const BodyVelocities& a_before, const BodyVelocities& b_before,
+                          const BodyVelocities& a_after, const BodyVelocities& b_after) {
+  ImpactRecord record;
+  record.time = time;
+  record.body_a = pair.first;
+  record.other_is_obstacle = world.isObstacle(pair.second);
+  record.other = record.other_is_obstacle ? pair.second - world.bodyCount() : pair.second;
+  record.normal = g.normal;
+  record.contact_point = positionAt<Motion>(world, pair.first, time) +
+                         (world.radius[pair.first] + 0.5 * g.gap) * g.normal;
+  record.velocity_a_before = a_before.linear;
+  record.velocity_b_before = b_before.linear;
+  record.velocity_a_after = a_after.linear;
+  record.velocity_b_after = b_after.linear;
+  record.angular_velocity_a_before = a_before.angular;
+  record.angular_velocity_b_before = b_before.angular;
+  record.angular_velocity_a_after = a_after.angular;
+  record.angular_velocity_b_after = b_after.angular;
+  record.oblique = hasObliqueComponent(record.velocity_a_before, g.normal) ||
+                   hasObliqueComponent(record.velocity_b_before, g.normal);
+  return record;
+}
+
+BodyVelocities velocitiesOf(const ClusterBody& body) {
+  return {body.velocity, body.angular_velocity};
+}
+
 template <class Motion>
 void recordImpacts(const World& world, double time, const std::vector<InstantContact>& contacts,
                    const std::vector<std::size_t>& cluster, const PreparedCluster& prepared,
@@ -214,28 +252,13 @@ void recordImpacts(const World& world, double time, const std::vector<InstantCon
     const auto& [pair, g] = contacts[cluster[c]];
     const ClusterContact& contact = prepared.contacts[c];
     const std::vector<ClusterBody>& after = prepared.bodies;
-    ImpactRecord record;
-    record.time = time;
-    record.body_a = pair.first;
-    record.other_is_obstacle = world.isObstacle(pair.second);
-    record.other = record.other_is_obstacle ? pair.second - world.bodyCount() : pair.second;
-    record.normal = g.normal;
-    record.contact_point = positionAt<Motion>(world, pair.first, time) +
-                           (world.radius[pair.first] + 0.5 * g.gap) * g.normal;
+    ImpactRecord record = impactRecord<Motion>(
+        world, time, pair, g, velocitiesOf(before[contact.a]), velocitiesOf(before[contact.b]),
+        velocitiesOf(after[contact.a]), velocitiesOf(after[contact.b]));
     record.restitution = contact.restitution;
     record.impulse = outcome.normal[c].impulse;
     record.friction_impulse = outcome.friction[c].impulse;
     record.energy_lost = outcome.normal[c].energy_lost + outcome.friction[c].energy_lost;
-    record.velocity_a_before = before[contact.a].velocity;
-    record.velocity_b_before = before[contact.b].velocity;
-    record.velocity_a_after = after[contact.a].velocity;
-    record.velocity_b_after = after[contact.b].velocity;
-    record.angular_velocity_a_before = before[contact.a].angular_velocity;
-    record.angular_velocity_b_before = before[contact.b].angular_velocity;
-    record.angular_velocity_a_after = after[contact.a].angular_velocity;
-    record.angular_velocity_b_after = after[contact.b].angular_velocity;
-    record.oblique = hasObliqueComponent(record.velocity_a_before, g.normal) ||
-                     hasObliqueComponent(record.velocity_b_before, g.normal);
     report.impacts.push_back(record);
   }
 }
@@ -378,6 +401,198 @@ class RoundProgress {
   int stale_rounds_ = 0;
 };
 
+/// A body of an inelastic impact: what its impulses act on, and its velocities just before.
+struct ImpactBody {
+  double inverse_mass = 0.0;  ///< 1/kg; 0: immovable
+  double spin_factor = 0.0;   ///< 1/k of I = k m r^2; 0: it does not turn
+  double radius = 0.0;        ///< m; 0 for a plane
+  BodyVelocities before;
+};
+
+/// A pair of an inelastic impact (indices into its bodies), along its line of impact.
+struct ImpactContact {
+  std::size_t a = 0;
+  std::size_t b = 0;
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();  ///< unit, from a towards b
+  double friction = 0.0;                              ///< Coulomb mu; 0 frictionless
+};
+
+/// The impulse on b at a contact (on a the opposite).
+struct ContactImpulse {
+  bool separating = true;                                ///< none: the pair separates anyway
+  double normal = 0.0;                                   ///< N s, >= 0, along the normal
+  Eigen::Vector3d tangential = Eigen::Vector3d::Zero();  ///< N s, friction
+};
+
+struct InelasticImpact {
+  std::vector<ContactImpulse> impulses;  ///< per contact
+  std::vector<BodyVelocities> after;     ///< per body
+};
+
+/// The inelastic impact of touching bodies: impulses J >= 0 after which no contact approaches,
+/// J = 0 where one separates anyway, friction stopping the slip within mu J. It is the
+/// complementarity problem of the contact forces of lasting contact one level down
+/// (solveContactForces, its use with impulses): the bodies' velocities stand in its
+/// accelerations, its forces are the impulses and its accelerations the velocities after.
+InelasticImpact solveInelasticImpact(const std::vector<ImpactBody>& bodies,
+                                     const std::vector<ImpactContact>& contacts) {
+  std::vector<ForceBody> velocity_level;
+  for (const ImpactBody& body : bodies) {
+    ForceBody force_body;
+    force_body.inverse_mass = body.inverse_mass;
+    force_body.spin_factor = body.spin_factor;
+    force_body.radius = body.radius;
+    force_body.acceleration = body.before.linear;
+    force_body.angular_acceleration = body.before.angular;
+    velocity_level.push_back(force_body);
+  }
+  std::vector<ForceContact> force_contacts;
+  for (const ImpactContact& contact : contacts) {
+    ForceContact force_contact;
+    force_contact.a = contact.a;
+    force_contact.b = contact.b;
+    force_contact.normal = contact.normal;
+    force_contact.friction = contact.friction;
+    force_contacts.push_back(force_contact);
+  }
+  const ContactForceSolution solution = solveContactForces(velocity_level, force_contacts);
+  InelasticImpact impact;
+  for (const ContactForce& force : solution.contacts) {
+    impact.impulses.push_back(
+        ContactImpulse{force.mode == ContactMode::kSeparating, force.normal, force.tangential});
+  }
+  for (std::size_t i = 0; i < solution.acceleration.size(); ++i) {
+    impact.after.push_back(
+        BodyVelocities{solution.acceleration[i], solution.angular_acceleration[i]});
+  }
+  return impact;
+}
+
+/// The participants of `pairs`, sorted, each once.
+std::vector<std::size_t> participantsOf(const std::vector<Pair>& pairs) {
+  std::vector<std::size_t> participants;
+  for (const Pair& pair : pairs) {
+    participants.push_back(pair.first);
+    participants.push_back(pair.second);
+  }
+  std::sort(participants.begin(), participants.end());
+  participants.erase(std::unique(participants.begin(), participants.end()), participants.end());
+  return participants;
+}
+
+/// The participants as bodies of the impact, with their velocities at `time`.
+template <class Motion>
+std::vector<ImpactBody> impactBodies(const World& world, double time,
+                                     const std::vector<std::size_t>& participants) {
+  std::vector<ImpactBody> bodies;
+  for (const std::size_t p : participants) {
+    ImpactBody body;
+    body.inverse_mass = world.inverseMassOf(p);
+    body.radius = world.radius[p];
+    body.before = {velocityAt<Motion>(world, p, time), angularVelocityAt<Motion>(world, p, time)};
+    if (!world.isObstacle(p)) body.spin_factor = world.spin_factor[p];
+    bodies.push_back(body);
+  }
+  return bodies;
+}
+
+/// The pairs of an inelastic impact that have a line of impact at `time`, with their geometry
+/// and as contacts between the participants (sorted).
+struct InelasticPairs {
+  std::vector<Pair> pairs;
+  std::vector<Geometry> geometries;
+  std::vector<ImpactContact> contacts;
+};
+
+template <class Motion>
+InelasticPairs inelasticPairs(const World& world, double time, const std::vector<Pair>& pairs,
+                              const std::vector<std::size_t>& participants) {
+  const auto slot = [&](std::size_t participant) {
+    return static_cast<std::size_t>(
+        std::lower_bound(participants.begin(), participants.end(), participant) -
+        participants.begin());
+  };
+  InelasticPairs inelastic;
+  for (const Pair& pair : pairs) {
+    const Geometry g = geometry<Motion>(world, pair, time);
+    if (!g.valid) continue;
+    ImpactContact contact;
+    contact.a = slot(pair.first);
+    contact.b = slot(pair.second);
+    contact.normal = g.normal;
+    if (world.friction_model) contact.friction = world.frictionOf(pair);
+    inelastic.pairs.push_back(pair);
+    inelastic.geometries.push_back(g);
+    inelastic.contacts.push_back(contact);
+  }
+  return inelastic;
+}
+
+/// The velocity of b's contact point relative to a's (radii r_a, r_b along the normal n).
+Eigen::Vector3d contactVelocity(double radius_a, double radius_b, const Eigen::Vector3d& normal,
+                                const BodyVelocities& a, const BodyVelocities& b) {
+  return Eigen::Vector3d(b.linear - a.linear -
+                         (radius_a * a.angular + radius_b * b.angular).cross(normal));
+}
+
+/// The impacts of the pairs that took an impulse, with restitution 0.
+template <class Motion>
+void recordInelasticImpacts(const World& world, double time, const InelasticPairs& inelastic,
+                            const std::vector<ImpactBody>& bodies, const InelasticImpact& impact,
+                            StepReport& report) {
+  for (std::size_t k = 0; k < inelastic.pairs.size(); ++k) {
+    const ContactImpulse& impulse = impact.impulses[k];
+    if (impulse.separating) continue;
+    const Pair& pair = inelastic.pairs[k];
+    const Geometry& g = inelastic.geometries[k];
+    const ImpactContact& contact = inelastic.contacts[k];
+    const BodyVelocities& a_before = bodies[contact.a].before;
+    const BodyVelocities& b_before = bodies[contact.b].before;
+    const BodyVelocities a_after{world.isObstacle(pair.first) || bodies[contact.a].inverse_mass == 0
+                                     ? a_before.linear
+                                     : impact.after[contact.a].linear,
+                                 impact.after[contact.a].angular};
+    const BodyVelocities b_after{
+        bodies[contact.b].inverse_mass == 0 ? b_before.linear : impact.after[contact.b].linear,
+        impact.after[contact.b].angular};
+    ImpactRecord record =
+        impactRecord<Motion>(world, time, pair, g, a_before, b_before, a_after, b_after);
+    record.restitution = 0.0;
+    record.impulse = impulse.normal;
+    record.friction_impulse = impulse.tangential.norm();
+    // The work of the impulse F on b (-F on a) over the change of the contact points' relative
+    // velocity w: -F.(w_before + w_after) / 2.
+    const double radius_a = world.radius[pair.first];
+    const double radius_b = world.radius[pair.second];
+    const Eigen::Vector3d force = impulse.normal * g.normal + impulse.tangential;
+    record.energy_lost =
+        -0.5 * force.dot(contactVelocity(radius_a, radius_b, g.normal, a_before, b_before) +
+                         contactVelocity(radius_a, radius_b, g.normal, a_after, b_after));
+    report.impacts.push_back(record);
+  }
+}
+
+/// The movable participants continue from `time` with their velocities after the impact (the
+/// angular one where they turn).
+template <class Motion>
+void storeInelasticVelocities(World& world, double time,
+                              const std::vector<std::size_t>& participants,
+                              const InelasticImpact& impact, std::vector<std::size_t>& changed) {
+  for (std::size_t i = 0; i < participants.size(); ++i) {
+    const std::size_t p = participants[i];
+    if (world.isObstacle(p) || world.inverseMassOf(p) == 0.0) continue;
+    Track& track = world.tracks[p];
+    track.position = positionAt<Motion>(world, p, time);
+    track.time = time;
+    track.velocity = impact.after[i].linear;
+    if (world.spin_factor[p] != 0.0) track.angular_velocity = impact.after[i].angular;
+    track.last_impact_time = time;
+    track.impact_step = world.steps;
+    track.constrained = nullptr;
+    changed.push_back(p);
+  }
+}
+
 }  // namespace
 
 template <class Motion>
@@ -443,106 +658,12 @@ void resolveInstant(World& world, double time, const std::vector<Pair>& touching
 template <class Motion>
 void resolveInelastically(World& world, double time, const std::vector<Pair>& pairs,
                           StepReport& report, std::vector<std::size_t>& changed) {
-  // The participants in sorted order; the solver sees velocities as its "accelerations".
-  std::vector<std::size_t> participants;
-  for (const Pair& pair : pairs) {
-    participants.push_back(pair.first);
-    participants.push_back(pair.second);
-  }
-  std::sort(participants.begin(), participants.end());
-  participants.erase(std::unique(participants.begin(), participants.end()), participants.end());
-  const auto slot = [&](std::size_t participant) {
-    return static_cast<std::size_t>(
-        std::lower_bound(participants.begin(), participants.end(), participant) -
-        participants.begin());
-  };
-  std::vector<ForceBody> bodies;
-  for (const std::size_t p : participants) {
-    ForceBody body;
-    body.inverse_mass = world.inverseMassOf(p);
-    body.radius = world.radius[p];
-    body.acceleration = velocityAt<Motion>(world, p, time);
-    body.angular_acceleration = angularVelocityAt<Motion>(world, p, time);
-    if (!world.isObstacle(p)) body.spin_factor = world.spin_factor[p];
-    bodies.push_back(body);
-  }
-  std::vector<ForceContact> contacts;
-  std::vector<Geometry> geometries;
-  for (const Pair& pair : pairs) {
-    const Geometry g = geometry<Motion>(world, pair, time);
-    if (!g.valid) continue;
-    ForceContact contact;
-    contact.a = slot(pair.first);
-    contact.b = slot(pair.second);
-    contact.normal = g.normal;
-    if (world.friction_model) contact.friction = world.frictionOf(pair);
-    contacts.push_back(contact);
-    geometries.push_back(g);
-  }
-  const ContactForceSolution solution = solveContactForces(bodies, contacts);
-  std::size_t k = 0;
-  for (const Pair& pair : pairs) {
-    const Geometry g = geometry<Motion>(world, pair, time);
-    if (!g.valid) continue;
-    const ContactForce& impulse = solution.contacts[k];
-    const ForceContact& contact = contacts[k];
-    ++k;
-    if (impulse.mode == ContactMode::kSeparating) continue;
-    ImpactRecord record;
-    record.time = time;
-    record.body_a = pair.first;
-    record.other_is_obstacle = world.isObstacle(pair.second);
-    record.other = record.other_is_obstacle ? pair.second - world.bodyCount() : pair.second;
-    record.normal = g.normal;
-    record.contact_point = positionAt<Motion>(world, pair.first, time) +
-                           (world.radius[pair.first] + 0.5 * g.gap) * g.normal;
-    record.restitution = 0.0;
-    record.impulse = impulse.normal;
-    record.friction_impulse = impulse.tangential.norm();
-    record.velocity_a_before = bodies[contact.a].acceleration;
-    record.velocity_b_before = bodies[contact.b].acceleration;
-    record.angular_velocity_a_before = bodies[contact.a].angular_acceleration;
-    record.angular_velocity_b_before = bodies[contact.b].angular_acceleration;
-    record.velocity_a_after = world.isObstacle(pair.first) || bodies[contact.a].inverse_mass == 0
-                                  ? record.velocity_a_before
-                                  : solution.acceleration[contact.a];
-    record.velocity_b_after = bodies[contact.b].inverse_mass == 0
-                                  ? record.velocity_b_before
-                                  : solution.acceleration[contact.b];
-    record.angular_velocity_a_after = solution.angular_acceleration[contact.a];
-    record.angular_velocity_b_after = solution.angular_acceleration[contact.b];
-    // The work of the impulse F on b (-F on a) over the change of the contact points' relative
-    // velocity w: -F.(w_before + w_after) / 2.
-    const auto contact_velocity = [&](const Eigen::Vector3d& va, const Eigen::Vector3d& wa,
-                                      const Eigen::Vector3d& vb, const Eigen::Vector3d& wb) {
-      return Eigen::Vector3d(
-          vb - va -
-          (world.radius[pair.first] * wa + world.radius[pair.second] * wb).cross(g.normal));
-    };
-    const Eigen::Vector3d force = impulse.normal * g.normal + impulse.tangential;
-    record.energy_lost =
-        -0.5 *
-        force.dot(contact_velocity(record.velocity_a_before, record.angular_velocity_a_before,
-                                   record.velocity_b_before, record.angular_velocity_b_before) +
-                  contact_velocity(record.velocity_a_after, record.angular_velocity_a_after,
-                                   record.velocity_b_after, record.angular_velocity_b_after));
-    record.oblique = hasObliqueComponent(record.velocity_a_before, g.normal) ||
-                     hasObliqueComponent(record.velocity_b_before, g.normal);
-    report.impacts.push_back(record);
-  }
-  for (std::size_t i = 0; i < participants.size(); ++i) {
-    const std::size_t p = participants[i];
-    if (world.isObstacle(p) || world.inverseMassOf(p) == 0.0) continue;
-    Track& track = world.tracks[p];
-    track.position = positionAt<Motion>(world, p, time);
-    track.time = time;
-    track.velocity = solution.acceleration[i];
-    if (world.spin_factor[p] != 0.0) track.angular_velocity = solution.angular_acceleration[i];
-    track.last_impact_time = time;
-    track.impact_step = world.steps;
-    track.constrained = nullptr;
-    changed.push_back(p);
-  }
+  const std::vector<std::size_t> participants = participantsOf(pairs);
+  const std::vector<ImpactBody> bodies = impactBodies<Motion>(world, time, participants);
+  const InelasticPairs inelastic = inelasticPairs<Motion>(world, time, pairs, participants);
+  const InelasticImpact impact = solveInelasticImpact(bodies, inelastic.contacts);
+  recordInelasticImpacts<Motion>(world, time, inelastic, bodies, impact, report);
+  storeInelasticVelocities<Motion>(world, time, participants, impact, changed);
 }
 
 template void resolveInstant<StraightLine>(World&, double, const std::vector<Pair>&, StepReport&,

@@ -53,6 +53,33 @@ void computePairCoefficients(World& world, const MaterialTable& materials) {
   }
 }
 
+/// The body's track starts again from `state`: known, at the state's time, position and
+/// velocities, and no longer in a constrained motion.
+Track& restartTrack(World& world, const BodyStateSample& state) {
+  Track& track = world.tracks[state.body];
+  track.known = true;
+  track.time = state.time;
+  track.position = state.position;
+  track.velocity = state.velocity;
+  track.angular_velocity = state.angular_velocity;
+  track.constrained = nullptr;
+  return track;
+}
+
+/// A body given a state moves freely from it until the groups of lasting contact are formed
+/// again: a movable body under gravity; a body of a stepped cluster goes on in its sub-step's
+/// straight line from the state, and its cluster is solved again from there (marked stale).
+/// Returns whether the body is a stepped cluster's.
+bool releaseFromState(World& world, std::size_t body) {
+  Track& track = world.tracks[body];
+  const bool stepped = track.stepped >= 0;
+  track.acceleration =
+      world.inverse_mass[body] > 0 && !stepped ? world.gravity : Eigen::Vector3d::Zero();
+  track.angular_acceleration.setZero();
+  if (stepped) world.stepping.clusters[static_cast<std::size_t>(track.stepped)].stale = true;
+  return stepped;
+}
+
 /// Takes the received states as the bodies' tracks, oldest first: a state not newer than its
 /// body's last one is stale (counted, dropped); a state older than the track, or the first after
 /// an impact the monitor applied to the body, does not replace the track (the monitor's
@@ -86,21 +113,9 @@ void applyStates(World& world, const std::vector<BodyStateSample>& states, StepR
         (track.last_impact_time > previous_state_time && track.last_impact_time <= state.time) ||
         (in_step && track.impact_step == world.steps);
     if (track.known && (state.time < track.time || impact_since_previous_state)) continue;
-    track.known = true;
-    track.time = state.time;
-    track.position = state.position;
-    track.velocity = state.velocity;
-    track.angular_velocity = state.angular_velocity;
-    track.constrained = nullptr;
+    restartTrack(world, state);
     if (world.effects.gravity) {
-      // Free until the groups of lasting contact are formed again from the new states; a body
-      // of a stepped cluster goes on in its sub-step's straight line from the state, and its
-      // cluster is solved again from there.
-      const bool stepped = track.stepped >= 0;
-      track.acceleration =
-          world.inverse_mass[state.body] > 0 && !stepped ? world.gravity : Eigen::Vector3d::Zero();
-      track.angular_acceleration.setZero();
-      if (stepped) world.stepping.clusters[static_cast<std::size_t>(track.stepped)].stale = true;
+      releaseFromState(world, state.body);
       world.groups_current = false;
     }
   }
@@ -141,6 +156,185 @@ bool solvesAgain(const monitor::ContactGroup& group, double when, double span) {
   return when > group.time + monitor::eventResolution(when, span);
 }
 
+/// Where a continuous step has got to: the instant, the schedule's contacts touching at it, the
+/// bodies whose motion changed there, a group event's bodies (their groups form again), whether
+/// the stepped clusters have an event at the instant, the next state imposed, and the budget of
+/// instants (a second one after the first fallback).
+struct StepProgress {
+  double instant = 0.0;
+  std::vector<std::size_t> touching;
+  std::vector<Pair> touching_pairs;  // the touching contacts' pairs outside stepped clusters
+  std::vector<std::size_t> changed;
+  std::vector<std::size_t> event_bodies;
+  bool stepped_due = false;
+  std::size_t next_imposed = 0;
+  int budget = 0;
+  bool fell_back = false;
+};
+
+/// The pairs struck in the step so far, sorted, each once.
+std::vector<Pair> struckPairs(const World& world, const StepReport& report) {
+  std::vector<Pair> struck;
+  for (const ImpactRecord& impact : report.impacts) {
+    struck.emplace_back(impact.body_a,
+                        impact.other_is_obstacle ? impact.other + world.bodyCount() : impact.other);
+  }
+  std::sort(struck.begin(), struck.end());
+  struck.erase(std::unique(struck.begin(), struck.end()), struck.end());
+  return struck;
+}
+
+/// The step's instants ran out: the first time, every pair struck in the step is resolved at once
+/// as one inelastic cluster and the step goes on with a second budget; the second time, every
+/// body is held where it is (false: the step ends here).
+template <class Motion>
+bool fallBack(World& world, StepProgress& at, StepReport& report) {
+  report.truncated = true;
+  ++report.fallbacks;
+  if (at.fell_back) {
+    holdEverything<Motion>(world, at.instant);
+    return false;
+  }
+  at.fell_back = true;
+  at.budget += world.settings.max_instants_per_step;
+  monitor::resolveInelastically<Motion>(world, at.instant, struckPairs(world, report), report,
+                                        at.changed);
+  return true;
+}
+
+/// The touching contacts at the instant resolved, but for a pair with a body of a stepped
+/// cluster: the cluster's to keep apart.
+template <class Motion>
+void resolveTouching(World& world, const ContactSchedule<Motion>& schedule, StepProgress& at,
+                     StepReport& report) {
+  at.touching_pairs.clear();
+  for (const std::size_t k : at.touching) {
+    if (!world.steppedPair(schedule.pair(k))) at.touching_pairs.push_back(schedule.pair(k));
+  }
+  if (!at.touching_pairs.empty() && world.settings.detect_impacts) {
+    monitor::resolveInstant<Motion>(world, at.instant, at.touching_pairs, report, at.changed);
+  }
+}
+
+/// The states imposed at the instant (the impacts a playback was told of) taken as the tracks.
+void imposeStates(World& world, const std::vector<BodyStateSample>& imposed, StepProgress& at) {
+  for (; at.next_imposed < imposed.size() && imposed[at.next_imposed].time <= at.instant;
+       ++at.next_imposed) {
+    const BodyStateSample& state = imposed[at.next_imposed];
+    Track& track = restartTrack(world, state);
+    const bool stepped = releaseFromState(world, state.body);
+    at.stepped_due = at.stepped_due || stepped;
+    track.last_impact_time = state.time;
+    // It is a state too: one given later at its own instant is newer than it.
+    track.last_state_time = std::max(track.last_state_time, state.time);
+    at.changed.push_back(state.body);
+  }
+}
+
+/// The stepped clusters advanced at `when`. A body a cluster let go of may be closing on what it
+/// touches (its last sub-step brought it there): that is an impact of the exact model, at `when`.
+template <class Motion>
+void stepClusters(World& world, double when, const monitor::PairIndex& index,
+                  std::vector<std::size_t>& changed, StepReport& report) {
+  std::vector<std::size_t> released;
+  monitor::advanceStepped(world, when, changed, released, report);
+  if (!released.empty() && world.settings.detect_impacts) {
+    monitor::resolveInstant<Motion>(
+        world, when, monitor::touchingPairsOf(world, when, released, index), report, changed);
+  }
+}
+
+/// The bodies whose groups of lasting contact form again at the instant: those whose motion
+/// changed and a group event's. At the step's start (`first`): every known body's, the groups
+/// cleared, unless the groups hold already for these tracks; then also the curved groups' bodies
+/// (integrated to the last step's end: on to this one's).
+std::vector<std::size_t> regroupedBodies(World& world, bool first, const StepProgress& at) {
+  std::vector<std::size_t> seeds = at.changed;
+  seeds.insert(seeds.end(), at.event_bodies.begin(), at.event_bodies.end());
+  if (first && !world.groups_current) {
+    monitor::clearGroups(world);
+    seeds.clear();
+    for (std::size_t body = 0; body < world.bodies.size(); ++body) {
+      if (world.tracks[body].known) seeds.push_back(body);
+    }
+  } else if (first) {
+    for (const monitor::ContactGroup& group : world.groups) {
+      if (group.alive && group.curved) {
+        seeds.insert(seeds.end(), group.bodies.begin(), group.bodies.end());
+      }
+    }
+  }
+  return seeds;
+}
+
+/// Gravity, at the instant: the stepped clusters (the grid's sub-steps, a sub-step that ended
+/// early, or a cluster whose members' states were replaced; at the start, what the last step left
+/// due), the groups of lasting contact of the bodies whose motion changed, and the stepped
+/// clusters those bodies may now reach within their sub-step. `changed` ends sorted, each once.
+template <class Motion>
+void settleLastingContact(World& world, const monitor::PairIndex& index, bool first,
+                          StepProgress& at, StepReport& report) {
+  if (at.stepped_due || first) stepClusters<Motion>(world, at.instant, index, at.changed, report);
+  at.stepped_due = false;
+  const std::vector<std::size_t> seeds = regroupedBodies(world, first, at);
+  if (!seeds.empty()) monitor::formGroups(world, at.instant, seeds, index, at.changed);
+  const std::vector<std::size_t> moved = at.changed;
+  monitor::joinStepped(world, at.instant, moved, at.changed, report);
+  std::sort(at.changed.begin(), at.changed.end());
+  at.changed.erase(std::unique(at.changed.begin(), at.changed.end()), at.changed.end());
+}
+
+/// The first contacts of the pairs of the bodies whose motion changed scheduled again (at the
+/// start: of every pair).
+template <class Motion>
+void scheduleChanged(ContactSchedule<Motion>& schedule, bool first, const StepProgress& at) {
+  if (first) {
+    schedule.scheduleAll(at.instant, at.changed);
+  } else {
+    for (const std::size_t body : at.changed) schedule.reschedule(body, at.instant);
+  }
+}
+
+/// On to the next event within the step: the earliest of a first contact, a state imposed and
+/// (gravity) a group's motion changing or a stepped cluster's sub-step (at one instant: the group
+/// first, then the state, then the contact). False when there is none up to `time`.
+template <class Motion>
+bool nextEvent(World& world, ContactSchedule<Motion>& schedule,
+               const std::vector<BodyStateSample>& imposed, double time, StepProgress& at) {
+  const double next_contact = schedule.earliest();
+  const double next_state =
+      at.next_imposed < imposed.size() ? imposed[at.next_imposed].time : INFINITY;
+  double next_group_event = INFINITY, next_stepped = INFINITY;
+  std::size_t group = 0;
+  if constexpr (Motion::kAccelerates) {
+    std::tie(next_group_event, group) = monitor::nextGroupEvent(world);
+    next_stepped = monitor::nextSteppedEvent(world, time);
+  }
+  const double next = std::min({next_contact, next_state, next_group_event, next_stepped});
+  if (!(next <= time)) return false;
+  if (next_group_event == next || next_state == next || next_stepped == next) {
+    at.instant = next;
+    at.touching.clear();
+    if (next_group_event == next) {
+      monitor::ContactGroup& changing = world.groups[group];
+      changing.next_event = INFINITY;
+      if (solvesAgain(changing, next, time - world.now)) at.event_bodies = changing.bodies;
+    }
+    at.stepped_due = next_stepped == next;
+    return true;
+  }
+  return schedule.next(at.instant, at.touching);
+}
+
+/// Gravity, at the step's end: the groups of lasting contact formed for the tracks at `time`,
+/// their contacts reported, and the bodies of the stepped clusters.
+void reportLastingContact(World& world, double time, StepReport& report) {
+  std::vector<std::size_t> formed;
+  monitor::formAllGroups(world, time, formed);
+  monitor::reportContacts(world, time, report.contacts);
+  report.stepped_bodies = monitor::steppedBodies(world);
+}
+
 /// Continuous detection: from the last states, the first contact of every candidate pair,
 /// earliest first, and (gravity) the events of the groups of lasting contact; at each instant of
 /// contact the touching contacts are resolved, the groups of the bodies whose motion changed
@@ -154,151 +348,33 @@ template <class Motion>
 StepReport continuousStep(World& world, double time, const std::vector<BodyStateSample>& states,
                           const std::vector<BodyStateSample>& imposed = {}) {
   StepReport report;
-  std::size_t next_imposed = 0;
   world.step_end = time;
   world.stepping.beginStep(world.now, time);
   monitor::candidatePairs<Motion>(world, world.now, time, world.scratch.pairs);
   ContactSchedule<Motion> schedule(world, time);
   const monitor::PairIndex index{world.scratch.pairs, world.scratch.pairs_of};
-  double instant = world.now;
-  std::vector<std::size_t> touching;
-  schedule.touchingAtStart(instant, touching);
-  std::vector<Pair> touching_pairs;
-  std::vector<std::size_t> changed;
-  std::vector<std::size_t> event_bodies;  // a group event's bodies: their groups form again
-  bool stepped_due = false;               // the stepped clusters have an event at the instant
-  int budget = world.settings.max_instants_per_step;
-  bool fell_back = false;
+  StepProgress at;
+  at.instant = world.now;
+  at.budget = world.settings.max_instants_per_step;
+  schedule.touchingAtStart(at.instant, at.touching);
   for (int instants = 0;; ++instants) {
-    changed.clear();
-    if (instants >= budget) {
-      report.truncated = true;
-      ++report.fallbacks;
-      if (fell_back) {
-        holdEverything<Motion>(world, instant);
-        break;
-      }
-      fell_back = true;
-      budget += world.settings.max_instants_per_step;
-      std::vector<Pair> struck;
-      for (const ImpactRecord& impact : report.impacts) {
-        struck.emplace_back(impact.body_a, impact.other_is_obstacle
-                                               ? impact.other + world.bodyCount()
-                                               : impact.other);
-      }
-      std::sort(struck.begin(), struck.end());
-      struck.erase(std::unique(struck.begin(), struck.end()), struck.end());
-      monitor::resolveInelastically<Motion>(world, instant, struck, report, changed);
-    }
-    touching_pairs.clear();
-    for (const std::size_t k : touching) {
-      // A pair with a body of a stepped cluster is the cluster's to keep apart.
-      if (!world.steppedPair(schedule.pair(k))) touching_pairs.push_back(schedule.pair(k));
-    }
-    if (!touching_pairs.empty() && world.settings.detect_impacts) {
-      monitor::resolveInstant<Motion>(world, instant, touching_pairs, report, changed);
-    }
-    // States imposed at this instant (the impacts a playback was told of).
-    for (; next_imposed < imposed.size() && imposed[next_imposed].time <= instant; ++next_imposed) {
-      const BodyStateSample& state = imposed[next_imposed];
-      Track& track = world.tracks[state.body];
-      track.known = true;
-      track.time = state.time;
-      track.position = state.position;
-      track.velocity = state.velocity;
-      track.angular_velocity = state.angular_velocity;
-      // A body of a stepped cluster goes on in a straight line, its cluster solved again.
-      const bool stepped = track.stepped >= 0;
-      track.acceleration =
-          world.inverse_mass[state.body] > 0 && !stepped ? world.gravity : Eigen::Vector3d::Zero();
-      if (stepped) world.stepping.clusters[static_cast<std::size_t>(track.stepped)].stale = true;
-      stepped_due = stepped_due || stepped;
-      track.angular_acceleration.setZero();
-      track.constrained = nullptr;
-      track.last_impact_time = state.time;
-      // It is a state too: one given later at its own instant is newer than it.
-      track.last_state_time = std::max(track.last_state_time, state.time);
-      changed.push_back(state.body);
-    }
+    const bool first = instants == 0;
+    at.changed.clear();
+    if (instants >= at.budget && !fallBack<Motion>(world, at, report)) break;
+    resolveTouching<Motion>(world, schedule, at, report);
+    imposeStates(world, imposed, at);
     if constexpr (Motion::kAccelerates) {
-      // Stepped clusters: the grid's sub-steps, a sub-step that ended early, or a cluster whose
-      // members' states were replaced (at the start: what the last step left due).
-      if (stepped_due || instants == 0) {
-        std::vector<std::size_t> released;
-        monitor::advanceStepped(world, instant, changed, released, report);
-        // A body a cluster let go of may be closing on what it touches (its last sub-step
-        // brought it there): that is an impact of the exact model, at this instant.
-        if (!released.empty() && world.settings.detect_impacts) {
-          monitor::resolveInstant<Motion>(world, instant,
-                                          monitor::touchingPairsOf(world, instant, released, index),
-                                          report, changed);
-        }
-      }
-      stepped_due = false;
-      // Lasting contact: the groups of the bodies whose motion changed (at the start, of every
-      // body, unless the groups hold already for these tracks).
-      std::vector<std::size_t> seeds = changed;
-      seeds.insert(seeds.end(), event_bodies.begin(), event_bodies.end());
-      if (instants == 0 && !world.groups_current) {
-        monitor::clearGroups(world);
-        seeds.clear();
-        for (std::size_t body = 0; body < world.bodies.size(); ++body) {
-          if (world.tracks[body].known) seeds.push_back(body);
-        }
-      } else if (instants == 0) {
-        // Curved groups were integrated to the last step's end: on to this one's.
-        for (const monitor::ContactGroup& group : world.groups) {
-          if (group.alive && group.curved) {
-            seeds.insert(seeds.end(), group.bodies.begin(), group.bodies.end());
-          }
-        }
-      }
-      if (!seeds.empty()) monitor::formGroups(world, instant, seeds, index, changed);
-      // Bodies whose exact motion changed may now reach a stepped cluster within its sub-step.
-      const std::vector<std::size_t> moved = changed;
-      monitor::joinStepped(world, instant, moved, changed, report);
-      std::sort(changed.begin(), changed.end());
-      changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
+      settleLastingContact<Motion>(world, index, first, at, report);
     }
-    event_bodies.clear();
-    if (instants == 0) {
-      schedule.scheduleAll(instant, changed);
-    } else {
-      for (const std::size_t body : changed) schedule.reschedule(body, instant);
-    }
-    // The next event: the earliest of a first contact, a state imposed and (gravity) a group's
-    // motion changing (at one instant: the group first, then the state, then the contact).
-    const double next_contact = schedule.earliest();
-    const double next_state = next_imposed < imposed.size() ? imposed[next_imposed].time : INFINITY;
-    double next_group_event = INFINITY, next_stepped = INFINITY;
-    std::size_t group = 0;
-    if constexpr (Motion::kAccelerates) {
-      std::tie(next_group_event, group) = monitor::nextGroupEvent(world);
-      next_stepped = monitor::nextSteppedEvent(world, time);
-    }
-    const double next = std::min({next_contact, next_state, next_group_event, next_stepped});
-    if (!(next <= time)) break;
-    if (next_group_event == next || next_state == next || next_stepped == next) {
-      instant = next;
-      touching.clear();
-      if (next_group_event == next) {
-        monitor::ContactGroup& changing = world.groups[group];
-        changing.next_event = INFINITY;
-        if (solvesAgain(changing, next, time - world.now)) event_bodies = changing.bodies;
-      }
-      stepped_due = next_stepped == next;
-      continue;
-    }
-    if (!schedule.next(instant, touching)) break;
+    at.event_bodies.clear();
+    scheduleChanged<Motion>(schedule, first, at);
+    if (!nextEvent<Motion>(world, schedule, imposed, time, at)) break;
   }
   applyStates(world, states, report, true);
   world.now = time;
   if constexpr (Motion::kAccelerates) {
-    std::vector<std::size_t> formed;
     world.step_end = time;
-    monitor::formAllGroups(world, time, formed);
-    monitor::reportContacts(world, time, report.contacts);
-    report.stepped_bodies = monitor::steppedBodies(world);
+    reportLastingContact(world, time, report);
   }
   return report;
 }
@@ -342,17 +418,8 @@ void advanceLastingContact(World& world, double time, StepReport& report) {
     const std::vector<std::size_t> moved = changed;
     monitor::joinStepped(world, when, moved, changed, report);
   };
-  // A body a cluster let go of may be closing on what it touches: an impact, at that instant.
-  const auto step_clusters = [&](double when) {
-    std::vector<std::size_t> released;
-    monitor::advanceStepped(world, when, changed, released, report);
-    if (!released.empty() && world.settings.detect_impacts) {
-      monitor::resolveInstant<Motion>(
-          world, when, monitor::touchingPairsOf(world, when, released, index), report, changed);
-    }
-  };
   changed.clear();
-  step_clusters(world.now);
+  stepClusters<Motion>(world, world.now, index, changed, report);
   settle(world.now);
   for (int events = 0; events < world.settings.max_instants_per_step; ++events) {
     auto [when, group] =
@@ -361,7 +428,7 @@ void advanceLastingContact(World& world, double time, StepReport& report) {
     if (!(std::min(when, stepped) <= time)) break;
     changed.clear();
     if (stepped <= when) {
-      step_clusters(stepped);
+      stepClusters<Motion>(world, stepped, index, changed, report);
       settle(stepped);
       continue;
     }
@@ -372,6 +439,86 @@ void advanceLastingContact(World& world, double time, StepReport& report) {
     monitor::formGroups(world, when, seeds, index, changed);
     const std::vector<std::size_t> moved = changed;
     monitor::joinStepped(world, when, moved, changed, report);
+  }
+}
+
+/// The candidate pairs touching at the sample (but for a stepped cluster's, which it keeps
+/// apart): new contacts and lasting ones in `touching`, those that overlapped at the sample before
+/// already (no new impact) in `overlapped_before`.
+template <class Motion>
+void touchingAtSample(const World& world, double time, const std::vector<Pair>& pairs,
+                      std::vector<Pair>& touching, std::vector<Pair>& overlapped_before) {
+  for (const Pair& pair : pairs) {
+    const Geometry g = monitor::geometry<Motion>(world, pair, time);
+    if (world.steppedPair(pair)) continue;  // its stepped cluster keeps it apart
+    if (!g.valid || g.gap > g.tolerance) continue;
+    if (world.overlapping.count(pair) == 0 || world.lasting(pair)) {
+      touching.push_back(pair);
+    } else {
+      overlapped_before.push_back(pair);
+    }
+  }
+}
+
+/// A pair still overlapping from an earlier impact is no new impact, but it takes part in one on
+/// its bodies: a ball rising out of the floor it bounced off, struck from above, runs into the
+/// floor (alone it would be driven through it, the floor pair never found again). The pairs of
+/// `overlapped_before` reached from the pairs that strike now, through touching pairs, as
+/// continuous detection's clusters, move to `touching` (sorted then).
+template <class Motion>
+void joinOverlappedBefore(const World& world, double time, std::vector<Pair>& overlapped_before,
+                          std::vector<Pair>& touching) {
+  std::vector<char> struck(world.bodies.size(), 0);
+  std::vector<std::size_t> frontier;
+  const auto reach = [&](std::size_t participant) {
+    if (world.isObstacle(participant) || struck[participant]) return;
+    struck[participant] = 1;
+    frontier.push_back(participant);
+  };
+  for (const Pair& pair : touching) {
+    const Geometry g = monitor::geometry<Motion>(world, pair, time);
+    if (monitor::approaching<Motion>(world, pair, g.normal, time)) {
+      reach(pair.first);
+      reach(pair.second);
+    }
+  }
+  for (bool grown = !frontier.empty(); grown;) {
+    grown = false;
+    for (auto pair = overlapped_before.begin(); pair != overlapped_before.end();) {
+      const bool first = struck[pair->first] != 0;
+      const bool second = !world.isObstacle(pair->second) && struck[pair->second] != 0;
+      if (!first && !second) {
+        ++pair;
+        continue;
+      }
+      reach(pair->first);
+      reach(pair->second);
+      touching.push_back(*pair);
+      pair = overlapped_before.erase(pair);
+      grown = true;
+    }
+    // Touching pairs of the bodies reached carry the blow on (a rack, a stack).
+    for (const Pair& pair : touching) {
+      if (struck[pair.first] || (!world.isObstacle(pair.second) && struck[pair.second])) {
+        const std::size_t before = frontier.size();
+        reach(pair.first);
+        reach(pair.second);
+        grown = grown || frontier.size() != before;
+      }
+    }
+  }
+  std::sort(touching.begin(), touching.end());
+}
+
+/// The pairs overlapping at the sample (but for a stepped cluster's), remembered for the next:
+/// an impact is found when contact begins.
+template <class Motion>
+void rememberOverlapping(World& world, double time, const std::vector<Pair>& pairs) {
+  world.overlapping.clear();
+  for (const Pair& pair : pairs) {
+    if (world.steppedPair(pair)) continue;
+    const Geometry g = monitor::geometry<Motion>(world, pair, time);
+    if (g.valid && g.gap < -g.tolerance) world.overlapping.insert(pair);
   }
 }
 
@@ -391,61 +538,9 @@ StepReport discreteStep(World& world, double time, const std::vector<BodyStateSa
   monitor::candidatePairs<Motion>(world, time, time, pairs);
   std::vector<Pair> touching;
   std::vector<Pair> overlapped_before;  // touching still, overlapping at the sample before
-  for (const Pair& pair : pairs) {
-    const Geometry g = monitor::geometry<Motion>(world, pair, time);
-    if (world.steppedPair(pair)) continue;  // its stepped cluster keeps it apart
-    if (!g.valid || g.gap > g.tolerance) continue;
-    if (world.overlapping.count(pair) == 0 || world.lasting(pair)) {
-      touching.push_back(pair);
-    } else {
-      overlapped_before.push_back(pair);
-    }
-  }
-  // A pair still overlapping from an earlier impact is no new impact, but it takes part in one
-  // on its bodies: a ball rising out of the floor it bounced off, struck from above, runs into
-  // the floor (alone it would be driven through it, the floor pair never found again). Reached
-  // from the pairs that strike now, through touching pairs, as continuous detection's clusters.
+  touchingAtSample<Motion>(world, time, pairs, touching, overlapped_before);
   if (!overlapped_before.empty()) {
-    std::vector<char> struck(world.bodies.size(), 0);
-    std::vector<std::size_t> frontier;
-    const auto reach = [&](std::size_t participant) {
-      if (world.isObstacle(participant) || struck[participant]) return;
-      struck[participant] = 1;
-      frontier.push_back(participant);
-    };
-    for (const Pair& pair : touching) {
-      const Geometry g = monitor::geometry<Motion>(world, pair, time);
-      if (monitor::approaching<Motion>(world, pair, g.normal, time)) {
-        reach(pair.first);
-        reach(pair.second);
-      }
-    }
-    for (bool grown = !frontier.empty(); grown;) {
-      grown = false;
-      for (auto pair = overlapped_before.begin(); pair != overlapped_before.end();) {
-        const bool first = struck[pair->first] != 0;
-        const bool second = !world.isObstacle(pair->second) && struck[pair->second] != 0;
-        if (!first && !second) {
-          ++pair;
-          continue;
-        }
-        reach(pair->first);
-        reach(pair->second);
-        touching.push_back(*pair);
-        pair = overlapped_before.erase(pair);
-        grown = true;
-      }
-      // Touching pairs of the bodies reached carry the blow on (a rack, a stack).
-      for (const Pair& pair : touching) {
-        if (struck[pair.first] || (!world.isObstacle(pair.second) && struck[pair.second])) {
-          const std::size_t before = frontier.size();
-          reach(pair.first);
-          reach(pair.second);
-          grown = grown || frontier.size() != before;
-        }
-      }
-    }
-    std::sort(touching.begin(), touching.end());
+    joinOverlappedBefore<Motion>(world, time, overlapped_before, touching);
   }
   std::vector<std::size_t> changed;
   monitor::resolveInstant<Motion>(world, time, touching, report, changed);
@@ -453,18 +548,8 @@ StepReport discreteStep(World& world, double time, const std::vector<BodyStateSa
     const std::vector<std::size_t> moved = changed;
     monitor::joinStepped(world, time, moved, changed, report);
   }
-  world.overlapping.clear();
-  for (const Pair& pair : pairs) {
-    if (world.steppedPair(pair)) continue;
-    const Geometry g = monitor::geometry<Motion>(world, pair, time);
-    if (g.valid && g.gap < -g.tolerance) world.overlapping.insert(pair);
-  }
-  if constexpr (Motion::kAccelerates) {
-    std::vector<std::size_t> formed;
-    monitor::formAllGroups(world, time, formed);
-    monitor::reportContacts(world, time, report.contacts);
-    report.stepped_bodies = monitor::steppedBodies(world);
-  }
+  rememberOverlapping<Motion>(world, time, pairs);
+  if constexpr (Motion::kAccelerates) reportLastingContact(world, time, report);
   return report;
 }
 
