@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "contact/solve_participants.h"
 #include "contact/stepped_clusters.h"
 #include "monitor/candidate_pairs.h"
 #include "monitor/motion_model.h"
@@ -87,25 +88,11 @@ void solveGroup(World& world, double time, const std::vector<std::size_t>& bodie
                 std::vector<std::size_t>& changed, bool frictionless = false) {
   // The solver's bodies: the group's (0..n-1, sorted), then the fixed participants (obstacles,
   // immovable bodies) in sorted order.
-  std::vector<std::size_t> participants = bodies;
-  std::vector<std::size_t> fixed;
-  for (const auto& [pair, g] : candidates) {
-    for (const std::size_t p : {pair.first, pair.second}) {
-      if (world.inverseMassOf(p) == 0.0) fixed.push_back(p);
-    }
-  }
-  std::sort(fixed.begin(), fixed.end());
-  fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
-  participants.insert(participants.end(), fixed.begin(), fixed.end());
-  const auto slot = [&](std::size_t participant) {
-    const auto movable = std::lower_bound(bodies.begin(), bodies.end(), participant);
-    if (movable != bodies.end() && *movable == participant) {
-      return static_cast<std::size_t>(movable - bodies.begin());
-    }
-    return bodies.size() +
-           static_cast<std::size_t>(std::lower_bound(fixed.begin(), fixed.end(), participant) -
-                                    fixed.begin());
-  };
+  std::vector<Pair> pairs;
+  for (const auto& [pair, g] : candidates) pairs.push_back(pair);
+  const SolveParticipants solve_participants = solveParticipants(world, bodies, pairs);
+  const std::vector<std::size_t>& participants = solve_participants.all;
+  const auto slot = [&](std::size_t participant) { return solve_participants.slot(participant); };
   std::vector<ForceBody> force_bodies;
   for (const std::size_t p : participants) {
     ForceBody body;

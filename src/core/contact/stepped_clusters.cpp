@@ -5,6 +5,7 @@
 #include <numeric>
 #include <set>
 
+#include "contact/solve_participants.h"
 #include "contact/stepped_contact.h"
 #include "geometry/broadphase.h"
 #include "impact/order_free.h"
@@ -97,32 +98,15 @@ struct Component {
   std::vector<std::size_t> members;
   std::vector<Pair> pairs;  ///< its contacts, canonical order
   SteppedOutcome outcome;
-  std::vector<std::size_t> participants;  ///< members, then the fixed participants
 };
 
 /// The solve of one component from `starts` over `span`.
 void solveComponent(World& world, double time, double span, const std::vector<Start>& starts,
                     bool warm_start, Component& component) {
-  std::vector<std::size_t>& participants = component.participants;
-  participants = component.members;
-  std::vector<std::size_t> fixed;
-  for (const Pair& pair : component.pairs) {
-    for (const std::size_t p : {pair.first, pair.second}) {
-      if (world.inverseMassOf(p) == 0.0) fixed.push_back(p);
-    }
-  }
-  std::sort(fixed.begin(), fixed.end());
-  fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
-  participants.insert(participants.end(), fixed.begin(), fixed.end());
-  const auto slot = [&](std::size_t p) {
-    const auto movable = std::lower_bound(component.members.begin(), component.members.end(), p);
-    if (movable != component.members.end() && *movable == p) {
-      return static_cast<std::size_t>(movable - component.members.begin());
-    }
-    return component.members.size() +
-           static_cast<std::size_t>(std::lower_bound(fixed.begin(), fixed.end(), p) -
-                                    fixed.begin());
-  };
+  const SolveParticipants solve_participants =
+      solveParticipants(world, component.members, component.pairs);
+  const std::vector<std::size_t>& participants = solve_participants.all;
+  const auto slot = [&](std::size_t p) { return solve_participants.slot(p); };
   std::vector<SteppedBody> bodies;
   for (const std::size_t p : participants) {
     SteppedBody body;
