@@ -293,6 +293,13 @@ void solveGroup(World& world, double time, const std::vector<std::size_t>& bodie
   }
 }
 
+/// A group's contact slides in its force's mode; otherwise it rolls where its surfaces move.
+ContactState groupContactState(const World& world, double time, const GroupContact& contact) {
+  if (contact.force.mode == ContactMode::kSliding) return ContactState::kSliding;
+  return surfaceSpeed(world, contact.pair, time) > 1e-9 ? ContactState::kRolling
+                                                        : ContactState::kResting;
+}
+
 }  // namespace
 
 void clearGroups(World& world) {
@@ -430,32 +437,41 @@ std::pair<double, std::size_t> nextGroupEvent(const World& world) {
   return next;
 }
 
+double surfaceSpeed(const World& world, const Pair& pair, double time) {
+  const auto [a, other] = pair;
+  const Eigen::Vector3d relative =
+      velocityAt<Motion>(world, other, time) - velocityAt<Motion>(world, a, time);
+  const Eigen::Vector3d turning =
+      angularVelocityAt<Motion>(world, other, time) - angularVelocityAt<Motion>(world, a, time);
+  return relative.norm() + world.radius[a] * turning.norm();
+}
+
+ContactRecord contactRecord(const World& world, double time, const Pair& pair,
+                            const Eigen::Vector3d& point, const Eigen::Vector3d& normal,
+                            double normal_force, const Eigen::Vector3d& friction_force,
+                            ContactState state, double since) {
+  const auto [a, other] = pair;
+  ContactRecord record;
+  record.time = time;
+  record.body_a = a;
+  record.other_is_obstacle = world.isObstacle(other);
+  record.other = record.other_is_obstacle ? other - world.bodyCount() : other;
+  record.contact_point = point;
+  record.normal = normal;
+  record.normal_force = normal_force;
+  record.friction_force = friction_force;
+  record.state = state;
+  record.since = since;
+  return record;
+}
+
 void reportContacts(const World& world, double time, std::vector<ContactRecord>& contacts) {
   for (const ContactGroup& group : world.groups) {
     if (!group.alive) continue;
     for (const GroupContact& contact : group.contacts) {
-      const auto [a, other] = contact.pair;
-      ContactRecord record;
-      record.time = time;
-      record.body_a = a;
-      record.other_is_obstacle = world.isObstacle(other);
-      record.other = record.other_is_obstacle ? other - world.bodyCount() : other;
-      record.contact_point = contact.point;
-      record.normal = contact.normal;
-      record.normal_force = contact.force.normal;
-      record.friction_force = contact.force.tangential;
-      record.since = contact.since;
-      const Eigen::Vector3d relative =
-          velocityAt<Motion>(world, other, time) - velocityAt<Motion>(world, a, time);
-      const Eigen::Vector3d turning =
-          angularVelocityAt<Motion>(world, other, time) - angularVelocityAt<Motion>(world, a, time);
-      const double moving = relative.norm() + world.radius[a] * turning.norm();
-      if (contact.force.mode == ContactMode::kSliding) {
-        record.state = ContactState::kSliding;
-      } else {
-        record.state = moving > 1e-9 ? ContactState::kRolling : ContactState::kResting;
-      }
-      contacts.push_back(record);
+      contacts.push_back(contactRecord(world, time, contact.pair, contact.point, contact.normal,
+                                       contact.force.normal, contact.force.tangential,
+                                       groupContactState(world, time, contact), contact.since));
     }
   }
   reportSteppedContacts(world, time, contacts);

@@ -390,6 +390,13 @@ void solveRegion(World& world, double time, double end, std::vector<char> member
   indexClusters(world);
 }
 
+/// A cluster's contact rests where its surfaces do not move; otherwise it rolls where it sticks.
+ContactState clusterContactState(const World& world, double time,
+                                 const SteppedClusterContact& contact) {
+  if (surfaceSpeed(world, contact.pair, time) <= 1e-9) return ContactState::kResting;
+  return contact.sticking ? ContactState::kRolling : ContactState::kSliding;
+}
+
 }  // namespace
 
 double nextSteppedEvent(const World& world, double time) {
@@ -486,29 +493,13 @@ void reportSteppedContacts(const World& world, double time, std::vector<ContactR
     const double duration = cluster.end - cluster.start;
     if (!(duration > 0)) continue;
     for (const SteppedClusterContact& contact : cluster.contacts) {
-      const auto [a, other] = contact.pair;
-      ContactRecord record;
-      record.time = time;
-      record.body_a = a;
-      record.other_is_obstacle = world.isObstacle(other);
-      record.other = record.other_is_obstacle ? other - world.bodyCount() : other;
-      record.contact_point = contact.point;
-      record.normal = contact.normal;
-      record.normal_force = contact.keeping_impulse / duration;
-      record.friction_force = contact.friction_impulse / duration * contact.friction_direction;
       const auto since = world.contact_since.find(contact.pair);
-      record.since = since == world.contact_since.end() ? cluster.start : since->second;
-      const Eigen::Vector3d relative =
-          velocityAt<Motion>(world, other, time) - velocityAt<Motion>(world, a, time);
-      const Eigen::Vector3d turning =
-          angularVelocityAt<Motion>(world, other, time) - angularVelocityAt<Motion>(world, a, time);
-      const double moving = relative.norm() + world.radius[a] * turning.norm();
-      if (moving <= 1e-9) {
-        record.state = ContactState::kResting;
-      } else {
-        record.state = contact.sticking ? ContactState::kRolling : ContactState::kSliding;
-      }
-      contacts.push_back(record);
+      contacts.push_back(
+          contactRecord(world, time, contact.pair, contact.point, contact.normal,
+                        contact.keeping_impulse / duration,
+                        contact.friction_impulse / duration * contact.friction_direction,
+                        clusterContactState(world, time, contact),
+                        since == world.contact_since.end() ? cluster.start : since->second));
     }
   }
 }
