@@ -423,53 +423,49 @@ void solveGroup(World& world, double time, const std::vector<std::size_t>& bodie
   storeGroupTracks(world, time, bodies, group, motion, changed);
 }
 
-/// A group's contact slides in its force's mode; otherwise it rolls where its surfaces move.
-ContactState groupContactState(const World& world, double time, const GroupContact& contact) {
-  if (contact.force.mode == ContactMode::kSliding) return ContactState::kSliding;
-  return surfaceSpeed(world, contact.pair, time) > 1e-9 ? ContactState::kRolling
-                                                        : ContactState::kResting;
-}
+/// The bodies a search of lasting contact reaches, in the order reached: each one visited joins
+/// with the group it was in (dissolved).
+class GroupSearch {
+ public:
+  explicit GroupSearch(World& world) : world_(world), visited_(world.bodies.size(), 0) {}
 
-}  // namespace
-
-void clearGroups(World& world) {
-  world.groups.clear();
-  for (Track& track : world.tracks) track.group = -1;
-  world.partners.assign(world.bodies.size(), {});
-  world.groups_current = false;
-}
-
-void formGroups(World& world, double time, const std::vector<std::size_t>& seeds,
-                const PairIndex& index, std::vector<std::size_t>& changed) {
-  if (world.partners.size() != world.bodies.size()) world.partners.assign(world.bodies.size(), {});
-  std::vector<char> visited(world.bodies.size(), 0);
-  std::vector<std::size_t> members;  // the bodies reached, in the order reached
-  std::vector<std::size_t> dissolved;
-  const auto visit = [&](std::size_t body) {
-    // A body of a stepped cluster moves with its cluster (stepped_clusters.h).
-    if (visited[body] || !world.tracks[body].known || world.inverse_mass[body] == 0.0 ||
-        world.stepped(body)) {
+  /// A tracked movable body joins, unless it moves with a stepped cluster (stepped_clusters.h).
+  void visit(std::size_t body) {
+    if (visited_[body] || !world_.tracks[body].known || world_.inverse_mass[body] == 0.0 ||
+        world_.stepped(body)) {
       return;
     }
-    visited[body] = 1;
+    visited_[body] = 1;
     members.push_back(body);
-    const int group = world.tracks[body].group;
+    const int group = world_.tracks[body].group;
     if (group >= 0) {
-      dissolved.clear();
-      dissolve(world, static_cast<std::size_t>(group), dissolved);
-      for (const std::size_t member : dissolved) {
-        if (!visited[member]) {
-          visited[member] = 1;
+      dissolved_.clear();
+      dissolve(world_, static_cast<std::size_t>(group), dissolved_);
+      for (const std::size_t member : dissolved_) {
+        if (!visited_[member]) {
+          visited_[member] = 1;
           members.push_back(member);
         }
       }
     }
-  };
-  for (const std::size_t seed : seeds) visit(seed);
-  std::vector<std::pair<Pair, Geometry>> candidates;
+  }
+
+  std::vector<std::size_t> members;
+
+ private:
+  World& world_;
+  std::vector<char> visited_;
+  std::vector<std::size_t> dissolved_;
+};
+
+/// The lasting candidates of the search's members at `time`, the other bodies of each joining
+/// the search; the pairs that are none no longer last.
+Candidates lastingCandidates(World& world, double time, const PairIndex& index,
+                             GroupSearch& search) {
+  Candidates candidates;
   std::vector<char> seen(index.pairs.size(), 0);
-  for (std::size_t i = 0; i < members.size(); ++i) {
-    const std::size_t body = members[i];
+  for (std::size_t i = 0; i < search.members.size(); ++i) {
+    const std::size_t body = search.members[i];
     for (const std::size_t k : index.of[body]) {
       if (seen[k]) continue;
       seen[k] = 1;
@@ -482,10 +478,23 @@ void formGroups(World& world, double time, const std::vector<std::size_t>& seeds
       }
       candidates.emplace_back(pair, g);
       const std::size_t other = pair.first == body ? pair.second : pair.first;
-      if (!world.isObstacle(other)) visit(other);
+      if (!world.isObstacle(other)) search.visit(other);
     }
   }
-  // Connected sets of movable bodies (union-find over the members, in sorted order).
+  return candidates;
+}
+
+/// A connected set of movable bodies: its bodies (sorted) and its candidates (in the order of
+/// their pairs).
+struct ConnectedSet {
+  std::vector<std::size_t> bodies;
+  Candidates candidates;
+};
+
+/// The connected sets of `members` through the candidates between two movable bodies (union-find
+/// over the members, in sorted order), by their smallest member; some are empty.
+std::vector<ConnectedSet> connectedSets(const World& world, std::vector<std::size_t> members,
+                                        Candidates candidates) {
   std::sort(members.begin(), members.end());
   std::vector<std::size_t> parent(members.size());
   std::iota(parent.begin(), parent.end(), 0);
@@ -505,38 +514,67 @@ void formGroups(World& world, double time, const std::vector<std::size_t>& seeds
   }
   std::sort(candidates.begin(), candidates.end(),
             [](const auto& x, const auto& y) { return x.first < y.first; });
-  // Each set: its bodies (sorted) and its candidates (in the order of their pairs).
-  std::vector<std::vector<std::size_t>> set_bodies(members.size());
-  std::vector<std::vector<std::pair<Pair, Geometry>>> set_candidates(members.size());
-  for (std::size_t i = 0; i < members.size(); ++i) set_bodies[find(i)].push_back(members[i]);
+  std::vector<ConnectedSet> sets(members.size());
+  for (std::size_t i = 0; i < members.size(); ++i) sets[find(i)].bodies.push_back(members[i]);
   for (const auto& candidate : candidates) {
     const std::size_t body = world.inverseMassOf(candidate.first.first) > 0
                                  ? candidate.first.first
                                  : candidate.first.second;
-    set_candidates[find(slot(body))].push_back(candidate);
+    sets[find(slot(body))].candidates.push_back(candidate);
   }
-  for (std::size_t root = 0; root < members.size(); ++root) {
-    if (set_bodies[root].empty()) continue;
-    if (set_candidates[root].empty()) {
-      // Free: gravity alone, from here.
-      for (const std::size_t body : set_bodies[root]) {
-        Track& track = world.tracks[body];
-        if (track.acceleration == world.gravity && track.angular_acceleration.isZero() &&
-            !track.constrained) {
-          continue;
-        }
-        track.position = positionAt<Motion>(world, body, time);
-        track.velocity = velocityAt<Motion>(world, body, time);
-        track.angular_velocity = angularVelocityAt<Motion>(world, body, time);
-        track.time = time;
-        track.acceleration = world.gravity;
-        track.angular_acceleration.setZero();
-        track.constrained = nullptr;
-        changed.push_back(body);
-      }
+  return sets;
+}
+
+/// Bodies without lasting contact move under gravity alone, from `time` (unless they already do).
+void fallFreely(World& world, double time, const std::vector<std::size_t>& bodies,
+                std::vector<std::size_t>& changed) {
+  for (const std::size_t body : bodies) {
+    Track& track = world.tracks[body];
+    if (track.acceleration == world.gravity && track.angular_acceleration.isZero() &&
+        !track.constrained) {
       continue;
     }
-    solveGroup(world, time, set_bodies[root], set_candidates[root], changed);
+    track.position = positionAt<Motion>(world, body, time);
+    track.velocity = velocityAt<Motion>(world, body, time);
+    track.angular_velocity = angularVelocityAt<Motion>(world, body, time);
+    track.time = time;
+    track.acceleration = world.gravity;
+    track.angular_acceleration.setZero();
+    track.constrained = nullptr;
+    changed.push_back(body);
+  }
+}
+
+/// A group's contact slides in its force's mode; otherwise it rolls where its surfaces move.
+ContactState groupContactState(const World& world, double time, const GroupContact& contact) {
+  if (contact.force.mode == ContactMode::kSliding) return ContactState::kSliding;
+  return surfaceSpeed(world, contact.pair, time) > 1e-9 ? ContactState::kRolling
+                                                        : ContactState::kResting;
+}
+
+}  // namespace
+
+void clearGroups(World& world) {
+  world.groups.clear();
+  for (Track& track : world.tracks) track.group = -1;
+  world.partners.assign(world.bodies.size(), {});
+  world.groups_current = false;
+}
+
+void formGroups(World& world, double time, const std::vector<std::size_t>& seeds,
+                const PairIndex& index, std::vector<std::size_t>& changed) {
+  if (world.partners.size() != world.bodies.size()) world.partners.assign(world.bodies.size(), {});
+  GroupSearch search(world);
+  for (const std::size_t seed : seeds) search.visit(seed);
+  Candidates candidates = lastingCandidates(world, time, index, search);
+  for (const ConnectedSet& set :
+       connectedSets(world, std::move(search.members), std::move(candidates))) {
+    if (set.bodies.empty()) continue;
+    if (set.candidates.empty()) {
+      fallFreely(world, time, set.bodies, changed);
+    } else {
+      solveGroup(world, time, set.bodies, set.candidates, changed);
+    }
   }
 }
 
