@@ -120,7 +120,7 @@ std::vector<ForceBody> forceBodiesOf(const World& world, double time,
   return force_bodies;
 }
 
-/// The solver's contacts, one a candidate (`frictionless`: without friction).
+/// The solver's contacts, one per candidate (`frictionless`: without friction).
 std::vector<ForceContact> forceContactsOf(const World& world, const Candidates& candidates,
                                           const SolveParticipants& participants,
                                           bool frictionless) {

@@ -408,7 +408,7 @@ void storeClusterTracks(World& world, const Region& region, const Component& com
 }
 
 /// What the component's contacts leave the next sub-step (arrivals, keeping forces), and those
-/// that kept a gap as the cluster's contacts; the others no longer last.
+/// that carried a keeping impulse as the cluster's contacts; the others no longer last.
 void storeClusterContacts(World& world, double time, const Component& component,
                           SteppedCluster& cluster) {
   Stepping& stepping = world.stepping;
@@ -460,10 +460,11 @@ void storeCluster(World& world, const Region& region, const Component& component
   world.stepping.clusters.push_back(std::move(cluster));
 }
 
-/// Solves the bodies of `region` (and every body their sub-steps bring near them) from `time`
-/// to `end`, in connected components of near pairs, and makes them the clusters `replaced` was.
-/// `grid`: every tracked body is looked at and only components of at least min_bodies are
-/// stepped (region: empty, found here); otherwise every component of the region is.
+/// Solves the bodies of `member` (and every body their sub-steps bring near them) from `time`
+/// to `end`, in connected components of near pairs, and makes them the clusters in place of
+/// those they were in. `grid`: every tracked body is looked at and only components of at least
+/// min_bodies are stepped (`member`: empty, found here); otherwise every component of the region
+/// is.
 void solveRegion(World& world, double time, double end, std::vector<char> member, bool grid,
                  std::vector<std::size_t>& changed, std::vector<std::size_t>& released,
                  StepReport& report) {
