@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "contact/solve_participants.h"
 #include "contact/stepped_clusters.h"
 #include "monitor/candidate_pairs.h"
 #include "monitor/motion_model.h"
@@ -80,34 +81,31 @@ double slipStops(const ContactForce& force, double time) {
   return time + slip / -rate;
 }
 
-/// One connected set of candidates: solve, and give its bodies their motion (`frictionless`:
-/// without friction, the fallback below).
-void solveGroup(World& world, double time, const std::vector<std::size_t>& bodies,
-                const std::vector<std::pair<Pair, Geometry>>& candidates,
-                std::vector<std::size_t>& changed, bool frictionless = false) {
-  // The solver's bodies: the group's (0..n-1, sorted), then the fixed participants (obstacles,
-  // immovable bodies) in sorted order.
-  std::vector<std::size_t> participants = bodies;
-  std::vector<std::size_t> fixed;
-  for (const auto& [pair, g] : candidates) {
-    for (const std::size_t p : {pair.first, pair.second}) {
-      if (world.inverseMassOf(p) == 0.0) fixed.push_back(p);
-    }
-  }
-  std::sort(fixed.begin(), fixed.end());
-  fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
-  participants.insert(participants.end(), fixed.begin(), fixed.end());
-  const auto slot = [&](std::size_t participant) {
-    const auto movable = std::lower_bound(bodies.begin(), bodies.end(), participant);
-    if (movable != bodies.end() && *movable == participant) {
-      return static_cast<std::size_t>(movable - bodies.begin());
-    }
-    return bodies.size() +
-           static_cast<std::size_t>(std::lower_bound(fixed.begin(), fixed.end(), participant) -
-                                    fixed.begin());
-  };
+/// The candidates of one connected set: each pair with its geometry at the set's instant.
+using Candidates = std::vector<std::pair<Pair, Geometry>>;
+
+std::vector<Pair> pairsOf(const Candidates& candidates) {
+  std::vector<Pair> pairs;
+  for (const auto& [pair, g] : candidates) pairs.push_back(pair);
+  return pairs;
+}
+
+/// A group's solve at its instant: its participants (the group's bodies, then the fixed ones) as
+/// the force solver's bodies, where they are, its candidates as the solver's contacts, and the
+/// forces.
+struct GroupSolve {
+  SolveParticipants participants;
+  std::vector<ForceBody> bodies;
+  std::vector<Eigen::Vector3d> positions;
+  std::vector<ForceContact> contacts;
+  ContactForceSolution solution;
+};
+
+/// The solver's bodies: each participant as it moves at `time`, a movable one under gravity.
+std::vector<ForceBody> forceBodiesOf(const World& world, double time,
+                                     const SolveParticipants& participants) {
   std::vector<ForceBody> force_bodies;
-  for (const std::size_t p : participants) {
+  for (const std::size_t p : participants.all) {
     ForceBody body;
     body.inverse_mass = world.inverseMassOf(p);
     body.radius = world.radius[p];
@@ -119,144 +117,236 @@ void solveGroup(World& world, double time, const std::vector<std::size_t>& bodie
     }
     force_bodies.push_back(body);
   }
+  return force_bodies;
+}
+
+/// The solver's contacts, one per candidate (`frictionless`: without friction).
+std::vector<ForceContact> forceContactsOf(const World& world, const Candidates& candidates,
+                                          const SolveParticipants& participants,
+                                          bool frictionless) {
   std::vector<ForceContact> contacts;
   for (const auto& [pair, g] : candidates) {
     ForceContact contact;
-    contact.a = slot(pair.first);
-    contact.b = slot(pair.second);
+    contact.a = participants.slot(pair.first);
+    contact.b = participants.slot(pair.second);
     contact.normal = g.normal;
     if (!world.isPlane(pair.second))
       contact.curvature = 1.0 / (g.gap + world.radius[pair.first] + world.radius[pair.second]);
     if (world.friction_model && !frictionless) contact.friction = world.frictionOf(pair);
     contacts.push_back(contact);
   }
-  // Lasting contacts touch: their gaps closed (overlapping ones are held where they are), their
-  // normal relative velocities closed; then the forces; then sticking ones do not slip.
+  return contacts;
+}
+
+std::vector<Eigen::Vector3d> positionsOf(const World& world, double time,
+                                         const SolveParticipants& participants) {
   std::vector<Eigen::Vector3d> positions;
-  for (const std::size_t p : participants) positions.push_back(positionAt<Motion>(world, p, time));
+  for (const std::size_t p : participants.all)
+    positions.push_back(positionAt<Motion>(world, p, time));
+  return positions;
+}
+
+/// The gap each candidate is closed by: within the band, or (continuous detection) a lasting
+/// contact whose integrated motion drifted past it, its gap. An overlap the states gave, or one
+/// discrete detection found an impact in, is held where it is (0).
+std::vector<double> gapsToClose(const World& world, const Candidates& candidates) {
   std::vector<double> gaps;
   for (const auto& [pair, g] : candidates) {
-    // Within the band, or (continuous detection) a lasting contact whose integrated motion
-    // drifted past it: closed. An overlap the states gave, or one discrete detection found an
-    // impact in, is held where it is.
     const bool drifted = world.detection == Detection::kContinuous && g.gap < 0 &&
                          world.contact_since.count(pair) > 0;
     gaps.push_back(std::abs(g.gap) <= g.tolerance || drifted ? g.gap : 0.0);
   }
-  closeContactGaps(positions, force_bodies, contacts, gaps);
-  closeContactVelocities(force_bodies, contacts, std::vector<bool>(contacts.size(), false));
-  const ContactForceSolution solution =
-      solveContactForces(force_bodies, contacts, lastingContactSettings(world));
-  if (solution.friction_dropped) {
+  return gaps;
+}
+
+/// The group's bodies and contacts at `time`, in the force solver's terms.
+GroupSolve setUpGroup(const World& world, double time, const std::vector<std::size_t>& bodies,
+                      const Candidates& candidates, bool frictionless) {
+  GroupSolve solve;
+  solve.participants = solveParticipants(world, bodies, pairsOf(candidates));
+  solve.bodies = forceBodiesOf(world, time, solve.participants);
+  solve.contacts = forceContactsOf(world, candidates, solve.participants, frictionless);
+  solve.positions = positionsOf(world, time, solve.participants);
+  return solve;
+}
+
+/// Lasting contacts touch: their gaps closed, their normal relative velocities closed; then the
+/// forces; then sticking ones do not slip.
+void solveGroupForces(const World& world, const std::vector<double>& gaps, GroupSolve& solve) {
+  std::vector<ForceContact>& contacts = solve.contacts;
+  closeContactGaps(solve.positions, solve.bodies, contacts, gaps);
+  closeContactVelocities(solve.bodies, contacts, std::vector<bool>(contacts.size(), false));
+  solve.solution = solveContactForces(solve.bodies, contacts, lastingContactSettings(world));
+  if (solve.solution.friction_dropped) {
     // Friction's modes did not settle: the group moves without it until it is formed again, its
     // integrated motion and its slips included (solveContactForces).
     for (ForceContact& contact : contacts) contact.friction = 0.0;
   }
   std::vector<bool> sticking(contacts.size(), false);
   for (std::size_t k = 0; k < contacts.size(); ++k) {
-    sticking[k] = contacts[k].friction > 0 && solution.contacts[k].mode == ContactMode::kSticking;
+    sticking[k] =
+        contacts[k].friction > 0 && solve.solution.contacts[k].mode == ContactMode::kSticking;
   }
   if (std::find(sticking.begin(), sticking.end(), true) != sticking.end()) {
-    closeContactVelocities(force_bodies, contacts, sticking);
+    closeContactVelocities(solve.bodies, contacts, sticking);
   }
+}
 
-  const std::size_t group = newGroup(world);
-  ContactGroup& contact_group = world.groups[group];
-  contact_group.time = time;
-  contact_group.next_event = INFINITY;
-  std::vector<char> pressed_body(bodies.size(), 0);
-  std::vector<std::size_t> pressed;  // indices into candidates
-  // Curved: a pressed contact of two spheres whose line of centres turns (they move or
-  // accelerate relative to each other), or a sliding contact whose slip turns. Then the motion
-  // is integrated; otherwise the forces are constant and it is a parabola.
-  bool curved = false;
+/// Whether the pressed contact `k` curves the group's motion: two spheres whose line of centres
+/// turns (they move or accelerate relative to each other), or a sliding contact whose slip turns.
+bool curvesMotion(const World& world, const GroupSolve& solve, std::size_t k) {
   const double speed_tolerance = lastingContactSettings(world).slip_tolerance;
   const double acceleration_tolerance = 1e-12 * world.gravity.norm();
+  const ContactForce& force = solve.solution.contacts[k];
+  const ForceContact& c = solve.contacts[k];
+  if (c.curvature > 0) {
+    const Eigen::Vector3d relative_velocity =
+        solve.bodies[c.b].velocity - solve.bodies[c.a].velocity;
+    const Eigen::Vector3d relative_acceleration =
+        solve.solution.acceleration[c.b] - solve.solution.acceleration[c.a];
+    if (relative_velocity.norm() > speed_tolerance ||
+        relative_acceleration.norm() > acceleration_tolerance) {
+      return true;
+    }
+  }
+  if (force.mode == ContactMode::kSliding && c.friction > 0 && force.slip.norm() > 0) {
+    const Eigen::Vector3d along = force.slip.normalized();
+    const Eigen::Vector3d rate = force.slip_acceleration;
+    if ((rate - rate.dot(along) * along).norm() > 1e-12 * (rate.norm() + acceleration_tolerance)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+/// The contacts that press (the others separate) and what they press.
+struct Pressed {
+  std::vector<std::size_t> contacts;  ///< indices into the candidates
+  std::vector<char> bodies;           ///< per body of the group: pressed by one of them
+  /// Then the motion is integrated; otherwise the forces are constant and it is a parabola.
+  bool curved = false;
+};
+
+Pressed pressedContacts(const World& world, const std::vector<std::size_t>& bodies,
+                        const Candidates& candidates, const GroupSolve& solve) {
+  Pressed pressed;
+  pressed.bodies.assign(bodies.size(), 0);
   for (std::size_t k = 0; k < candidates.size(); ++k) {
-    const ContactForce& force = solution.contacts[k];
-    if (force.mode == ContactMode::kSeparating) continue;
-    pressed.push_back(k);
-    const ForceContact& c = contacts[k];
-    if (c.curvature > 0) {
-      const Eigen::Vector3d relative_velocity =
-          force_bodies[c.b].velocity - force_bodies[c.a].velocity;
-      const Eigen::Vector3d relative_acceleration =
-          solution.acceleration[c.b] - solution.acceleration[c.a];
-      if (relative_velocity.norm() > speed_tolerance ||
-          relative_acceleration.norm() > acceleration_tolerance) {
-        curved = true;
-      }
-    }
-    if (force.mode == ContactMode::kSliding && c.friction > 0 && force.slip.norm() > 0) {
-      const Eigen::Vector3d along = force.slip.normalized();
-      const Eigen::Vector3d rate = force.slip_acceleration;
-      if ((rate - rate.dot(along) * along).norm() >
-          1e-12 * (rate.norm() + acceleration_tolerance)) {
-        curved = true;
-      }
-    }
+    if (solve.solution.contacts[k].mode == ContactMode::kSeparating) continue;
+    pressed.contacts.push_back(k);
+    if (curvesMotion(world, solve, k)) pressed.curved = true;
     const Pair& pair = candidates[k].first;
     for (const std::size_t p : {pair.first, pair.second}) {
-      if (world.inverseMassOf(p) > 0) pressed_body[slot(p)] = 1;
+      if (world.inverseMassOf(p) > 0) pressed.bodies[solve.participants.slot(p)] = 1;
     }
   }
+  return pressed;
+}
+
+/// A curved group's integrated motion, and each participant's slot in it.
+struct IntegratedMotion {
   std::shared_ptr<const ConstrainedStep> step;
-  std::vector<std::size_t> step_slot(participants.size(), 0);
-  if (curved) {
-    // The integrated step: the pressed bodies, then the fixed participants of pressed contacts.
-    std::vector<std::size_t> order;
-    for (std::size_t i = 0; i < bodies.size(); ++i) {
-      if (pressed_body[i]) order.push_back(i);
-    }
-    const std::size_t movable = order.size();
-    for (std::size_t i = bodies.size(); i < participants.size(); ++i) order.push_back(i);
-    std::vector<ForceBody> step_bodies;
-    std::vector<Eigen::Vector3d> step_positions;
-    double guess = 0;
-    for (std::size_t j = 0; j < order.size(); ++j) {
-      step_slot[order[j]] = j;
-      step_bodies.push_back(force_bodies[order[j]]);
-      step_positions.push_back(positions[order[j]]);
-      if (j < movable)
-        guess = std::max(guess, world.tracks[participants[order[j]]].integration_step);
-    }
-    std::vector<ConstrainedContact> step_contacts;
-    for (const std::size_t k : pressed) {
-      const Pair& pair = candidates[k].first;
-      ConstrainedContact c;
-      c.a = step_slot[contacts[k].a];
-      c.b = step_slot[contacts[k].b];
-      c.plane = world.isPlane(pair.second);
-      if (c.plane) c.plane_normal = -candidates[k].second.normal;
-      c.friction = contacts[k].friction;
-      c.mode = solution.contacts[k].mode;
-      c.slide_direction = solution.contacts[k].slide_direction;
-      step_contacts.push_back(c);
-    }
-    step = std::make_shared<const ConstrainedStep>(
-        step_bodies, step_positions, movable, step_contacts, time, std::max(world.step_end, time),
-        world.integration_tolerance, speed_tolerance, guess > 0 ? guess : 1e-3);
-    if (step->modeChanged() && !frictionless &&
-        !(step->end() > time + eventResolution(step->end(), world.step_end - world.now)) &&
-        std::any_of(contacts.begin(), contacts.end(),
-                    [](const ForceContact& c) { return c.friction > 0; })) {
-      // The modes friction chose stop holding at once (slips at the slip tolerance, whose
-      // directions the solve and the integrator read apart): solved again at this instant it
-      // would be so for ever, and as its integrated motion ends here its bodies would be looked
-      // at by nothing until the step's end. It moves without friction until formed again, as
-      // where friction's modes do not settle (solveContactForces).
-      solveGroup(world, time, bodies, candidates, changed, true);
-      return;
-    }
+  std::vector<std::size_t> slot;  ///< per slot of the solve
+};
+
+/// The integrated step: the pressed bodies, then the fixed participants of pressed contacts.
+IntegratedMotion integrateGroup(const World& world, double time, const Candidates& candidates,
+                                const GroupSolve& solve, const Pressed& pressed) {
+  const std::size_t count = solve.participants.movable.size();
+  IntegratedMotion motion;
+  motion.slot.assign(solve.participants.all.size(), 0);
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < count; ++i) {
+    if (pressed.bodies[i]) order.push_back(i);
   }
-  for (const std::size_t k : pressed) {
-    const ContactForce& force = solution.contacts[k];
+  const std::size_t movable = order.size();
+  for (std::size_t i = count; i < solve.participants.all.size(); ++i) order.push_back(i);
+  std::vector<ForceBody> step_bodies;
+  std::vector<Eigen::Vector3d> step_positions;
+  double guess = 0;
+  for (std::size_t j = 0; j < order.size(); ++j) {
+    motion.slot[order[j]] = j;
+    step_bodies.push_back(solve.bodies[order[j]]);
+    step_positions.push_back(solve.positions[order[j]]);
+    if (j < movable)
+      guess = std::max(guess, world.tracks[solve.participants.all[order[j]]].integration_step);
+  }
+  std::vector<ConstrainedContact> step_contacts;
+  for (const std::size_t k : pressed.contacts) {
     const Pair& pair = candidates[k].first;
-    const ForceContact& c = contacts[k];
+    ConstrainedContact c;
+    c.a = motion.slot[solve.contacts[k].a];
+    c.b = motion.slot[solve.contacts[k].b];
+    c.plane = world.isPlane(pair.second);
+    if (c.plane) c.plane_normal = -candidates[k].second.normal;
+    c.friction = solve.contacts[k].friction;
+    c.mode = solve.solution.contacts[k].mode;
+    c.slide_direction = solve.solution.contacts[k].slide_direction;
+    step_contacts.push_back(c);
+  }
+  motion.step = std::make_shared<const ConstrainedStep>(
+      step_bodies, step_positions, movable, step_contacts, time, std::max(world.step_end, time),
+      world.integration_tolerance, lastingContactSettings(world).slip_tolerance,
+      guess > 0 ? guess : 1e-3);
+  return motion;
+}
+
+/// A group's motion from its instant: its solve, its pressed contacts, and (curved) its
+/// integrated motion.
+struct GroupMotion {
+  GroupSolve solve;
+  Pressed pressed;
+  IntegratedMotion integrated;
+};
+
+/// Sets up, solves and (curved) integrates the group (`frictionless`: without friction).
+GroupMotion groupMotion(const World& world, double time, const std::vector<std::size_t>& bodies,
+                        const Candidates& candidates, bool frictionless) {
+  GroupMotion motion;
+  motion.solve = setUpGroup(world, time, bodies, candidates, frictionless);
+  solveGroupForces(world, gapsToClose(world, candidates), motion.solve);
+  motion.pressed = pressedContacts(world, bodies, candidates, motion.solve);
+  if (motion.pressed.curved) {
+    motion.integrated = integrateGroup(world, time, candidates, motion.solve, motion.pressed);
+  }
+  return motion;
+}
+
+/// Whether the modes friction chose stop holding at once: the integrated motion ends at the
+/// group's instant, to the time line's resolution (slips at the slip tolerance, whose directions
+/// the solve and the integrator read apart).
+bool frictionModesStopAtOnce(const World& world, double time, const GroupMotion& motion) {
+  const ConstrainedStep* step = motion.integrated.step.get();
+  return step && step->modeChanged() &&
+         !(step->end() > time + eventResolution(step->end(), world.step_end - world.now)) &&
+         std::any_of(motion.solve.contacts.begin(), motion.solve.contacts.end(),
+                     [](const ForceContact& c) { return c.friction > 0; });
+}
+
+/// The point of a lasting contact: on the surface of the pair's first sphere, at `position_a`
+/// (radius `radius_a`), along the normal.
+Eigen::Vector3d contactPointOnSurfaceOfA(const Eigen::Vector3d& position_a, double radius_a,
+                                         const Eigen::Vector3d& normal) {
+  return position_a + radius_a * normal;
+}
+
+/// The pressed contacts last (from `time`, or from when they began to), with the forces of the
+/// solve; the separating ones end. The group's next event: a slip that stops, or the end of its
+/// integrated motion where its modes change.
+void storeGroupContacts(World& world, double time, const Candidates& candidates,
+                        const GroupMotion& motion, ContactGroup& contact_group) {
+  const GroupSolve& solve = motion.solve;
+  contact_group.time = time;
+  contact_group.next_event = INFINITY;
+  for (const std::size_t k : motion.pressed.contacts) {
+    const ContactForce& force = solve.solution.contacts[k];
+    const Pair& pair = candidates[k].first;
+    const ForceContact& c = solve.contacts[k];
     GroupContact contact;
     contact.pair = pair;
     contact.normal = candidates[k].second.normal;
-    contact.point = positions[c.a] + world.radius[pair.first] * contact.normal;
+    contact.point =
+        contactPointOnSurfaceOfA(solve.positions[c.a], world.radius[pair.first], contact.normal);
     contact.force = force;
     const auto since = world.contact_since.emplace(pair, time).first;
     contact.since = since->second;
@@ -268,35 +358,45 @@ void solveGroup(World& world, double time, const std::vector<std::size_t>& bodie
     }
   }
   for (std::size_t k = 0; k < candidates.size(); ++k) {
-    if (solution.contacts[k].mode == ContactMode::kSeparating) {
+    if (solve.solution.contacts[k].mode == ContactMode::kSeparating) {
       world.contact_since.erase(candidates[k].first);
     }
   }
   contact_group.alive = !contact_group.contacts.empty();
-  if (step) {
+  if (const ConstrainedStep* step = motion.integrated.step.get()) {
     if (step->modeChanged()) {
       contact_group.next_event = std::min(contact_group.next_event, step->end());
     }
     contact_group.curved = true;
   }
+}
 
+/// Every body of the group continues from `time` with the solve's motion: a pressed one in
+/// `group` (and curved, integrated), any other free of it.
+void storeGroupTracks(World& world, double time, const std::vector<std::size_t>& bodies,
+                      std::size_t group, const GroupMotion& motion,
+                      std::vector<std::size_t>& changed) {
+  const GroupSolve& solve = motion.solve;
+  const std::shared_ptr<const ConstrainedStep>& step = motion.integrated.step;
+  ContactGroup& contact_group = world.groups[group];
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     const std::size_t body = bodies[i];
     Track& track = world.tracks[body];
-    track.position = positions[i];
-    track.angular_velocity = force_bodies[i].angular_velocity;
+    track.position = solve.positions[i];
+    track.angular_velocity = solve.bodies[i].angular_velocity;
     track.time = time;
-    track.velocity = force_bodies[i].velocity;
-    track.acceleration = solution.acceleration[i];
-    track.angular_acceleration =
-        world.spin_factor[body] != 0.0 ? solution.angular_acceleration[i] : Eigen::Vector3d::Zero();
+    track.velocity = solve.bodies[i].velocity;
+    track.acceleration = solve.solution.acceleration[i];
+    track.angular_acceleration = world.spin_factor[body] != 0.0
+                                     ? solve.solution.angular_acceleration[i]
+                                     : Eigen::Vector3d::Zero();
     track.constrained = nullptr;
-    if (pressed_body[i]) {
+    if (motion.pressed.bodies[i]) {
       track.group = static_cast<int>(group);
       contact_group.bodies.push_back(body);
       if (step) {
         track.constrained = step;
-        track.slot = step_slot[i];
+        track.slot = motion.integrated.slot[i];
         track.integration_step = step->nextStep();
       }
     } else {
@@ -306,46 +406,66 @@ void solveGroup(World& world, double time, const std::vector<std::size_t>& bodie
   }
 }
 
-}  // namespace
-
-void clearGroups(World& world) {
-  world.groups.clear();
-  for (Track& track : world.tracks) track.group = -1;
-  world.partners.assign(world.bodies.size(), {});
-  world.groups_current = false;
+/// One connected set of candidates: solve, and give its bodies their motion. Set up, solved and
+/// (curved) integrated by groupMotion; where friction's modes stop holding at once, the same
+/// without friction; then its contacts and its bodies' tracks stored.
+void solveGroup(World& world, double time, const std::vector<std::size_t>& bodies,
+                const Candidates& candidates, std::vector<std::size_t>& changed) {
+  GroupMotion motion = groupMotion(world, time, bodies, candidates, /*frictionless=*/false);
+  if (frictionModesStopAtOnce(world, time, motion)) {
+    // Solved again at this instant it would be so for ever, and as its integrated motion ends
+    // here its bodies would be looked at by nothing until the step's end. It moves without
+    // friction until formed again, as where friction's modes do not settle (solveContactForces).
+    motion = groupMotion(world, time, bodies, candidates, /*frictionless=*/true);
+  }
+  const std::size_t group = newGroup(world);
+  storeGroupContacts(world, time, candidates, motion, world.groups[group]);
+  storeGroupTracks(world, time, bodies, group, motion, changed);
 }
 
-void formGroups(World& world, double time, const std::vector<std::size_t>& seeds,
-                const PairIndex& index, std::vector<std::size_t>& changed) {
-  if (world.partners.size() != world.bodies.size()) world.partners.assign(world.bodies.size(), {});
-  std::vector<char> visited(world.bodies.size(), 0);
-  std::vector<std::size_t> members;  // the bodies reached, in the order reached
-  std::vector<std::size_t> dissolved;
-  const auto visit = [&](std::size_t body) {
-    // A body of a stepped cluster moves with its cluster (stepped_clusters.h).
-    if (visited[body] || !world.tracks[body].known || world.inverse_mass[body] == 0.0 ||
-        world.stepped(body)) {
+/// The bodies a search of lasting contact reaches, in the order reached: each one visited joins
+/// with the group it was in (dissolved).
+class GroupSearch {
+ public:
+  explicit GroupSearch(World& world) : world_(world), visited_(world.bodies.size(), 0) {}
+
+  /// A tracked movable body joins, unless it moves with a stepped cluster (stepped_clusters.h).
+  void visit(std::size_t body) {
+    if (visited_[body] || !world_.tracks[body].known || world_.inverse_mass[body] == 0.0 ||
+        world_.stepped(body)) {
       return;
     }
-    visited[body] = 1;
+    visited_[body] = 1;
     members.push_back(body);
-    const int group = world.tracks[body].group;
+    const int group = world_.tracks[body].group;
     if (group >= 0) {
-      dissolved.clear();
-      dissolve(world, static_cast<std::size_t>(group), dissolved);
-      for (const std::size_t member : dissolved) {
-        if (!visited[member]) {
-          visited[member] = 1;
+      dissolved_.clear();
+      dissolve(world_, static_cast<std::size_t>(group), dissolved_);
+      for (const std::size_t member : dissolved_) {
+        if (!visited_[member]) {
+          visited_[member] = 1;
           members.push_back(member);
         }
       }
     }
-  };
-  for (const std::size_t seed : seeds) visit(seed);
-  std::vector<std::pair<Pair, Geometry>> candidates;
+  }
+
+  std::vector<std::size_t> members;
+
+ private:
+  World& world_;
+  std::vector<char> visited_;
+  std::vector<std::size_t> dissolved_;
+};
+
+/// The lasting candidates of the search's members at `time`, the other bodies of each joining
+/// the search; the pairs that are none no longer last.
+Candidates lastingCandidates(World& world, double time, const PairIndex& index,
+                             GroupSearch& search) {
+  Candidates candidates;
   std::vector<char> seen(index.pairs.size(), 0);
-  for (std::size_t i = 0; i < members.size(); ++i) {
-    const std::size_t body = members[i];
+  for (std::size_t i = 0; i < search.members.size(); ++i) {
+    const std::size_t body = search.members[i];
     for (const std::size_t k : index.of[body]) {
       if (seen[k]) continue;
       seen[k] = 1;
@@ -358,10 +478,23 @@ void formGroups(World& world, double time, const std::vector<std::size_t>& seeds
       }
       candidates.emplace_back(pair, g);
       const std::size_t other = pair.first == body ? pair.second : pair.first;
-      if (!world.isObstacle(other)) visit(other);
+      if (!world.isObstacle(other)) search.visit(other);
     }
   }
-  // Connected sets of movable bodies (union-find over the members, in sorted order).
+  return candidates;
+}
+
+/// A connected set of movable bodies: its bodies (sorted) and its candidates (in the order of
+/// their pairs).
+struct ConnectedSet {
+  std::vector<std::size_t> bodies;
+  Candidates candidates;
+};
+
+/// The connected sets of `members` through the candidates between two movable bodies (union-find
+/// over the members, in sorted order), by their smallest member; some are empty.
+std::vector<ConnectedSet> connectedSets(const World& world, std::vector<std::size_t> members,
+                                        Candidates candidates) {
   std::sort(members.begin(), members.end());
   std::vector<std::size_t> parent(members.size());
   std::iota(parent.begin(), parent.end(), 0);
@@ -381,38 +514,67 @@ void formGroups(World& world, double time, const std::vector<std::size_t>& seeds
   }
   std::sort(candidates.begin(), candidates.end(),
             [](const auto& x, const auto& y) { return x.first < y.first; });
-  // Each set: its bodies (sorted) and its candidates (in the order of their pairs).
-  std::vector<std::vector<std::size_t>> set_bodies(members.size());
-  std::vector<std::vector<std::pair<Pair, Geometry>>> set_candidates(members.size());
-  for (std::size_t i = 0; i < members.size(); ++i) set_bodies[find(i)].push_back(members[i]);
+  std::vector<ConnectedSet> sets(members.size());
+  for (std::size_t i = 0; i < members.size(); ++i) sets[find(i)].bodies.push_back(members[i]);
   for (const auto& candidate : candidates) {
     const std::size_t body = world.inverseMassOf(candidate.first.first) > 0
                                  ? candidate.first.first
                                  : candidate.first.second;
-    set_candidates[find(slot(body))].push_back(candidate);
+    sets[find(slot(body))].candidates.push_back(candidate);
   }
-  for (std::size_t root = 0; root < members.size(); ++root) {
-    if (set_bodies[root].empty()) continue;
-    if (set_candidates[root].empty()) {
-      // Free: gravity alone, from here.
-      for (const std::size_t body : set_bodies[root]) {
-        Track& track = world.tracks[body];
-        if (track.acceleration == world.gravity && track.angular_acceleration.isZero() &&
-            !track.constrained) {
-          continue;
-        }
-        track.position = positionAt<Motion>(world, body, time);
-        track.velocity = velocityAt<Motion>(world, body, time);
-        track.angular_velocity = angularVelocityAt<Motion>(world, body, time);
-        track.time = time;
-        track.acceleration = world.gravity;
-        track.angular_acceleration.setZero();
-        track.constrained = nullptr;
-        changed.push_back(body);
-      }
+  return sets;
+}
+
+/// Bodies without lasting contact move under gravity alone, from `time` (unless they already do).
+void fallFreely(World& world, double time, const std::vector<std::size_t>& bodies,
+                std::vector<std::size_t>& changed) {
+  for (const std::size_t body : bodies) {
+    Track& track = world.tracks[body];
+    if (track.acceleration == world.gravity && track.angular_acceleration.isZero() &&
+        !track.constrained) {
       continue;
     }
-    solveGroup(world, time, set_bodies[root], set_candidates[root], changed);
+    track.position = positionAt<Motion>(world, body, time);
+    track.velocity = velocityAt<Motion>(world, body, time);
+    track.angular_velocity = angularVelocityAt<Motion>(world, body, time);
+    track.time = time;
+    track.acceleration = world.gravity;
+    track.angular_acceleration.setZero();
+    track.constrained = nullptr;
+    changed.push_back(body);
+  }
+}
+
+/// A group's contact slides in its force's mode; otherwise it rolls where its surfaces move.
+ContactState groupContactState(const World& world, double time, const GroupContact& contact) {
+  if (contact.force.mode == ContactMode::kSliding) return ContactState::kSliding;
+  return surfaceSpeed(world, contact.pair, time) > 1e-9 ? ContactState::kRolling
+                                                        : ContactState::kResting;
+}
+
+}  // namespace
+
+void clearGroups(World& world) {
+  world.groups.clear();
+  for (Track& track : world.tracks) track.group = -1;
+  world.partners.assign(world.bodies.size(), {});
+  world.groups_current = false;
+}
+
+void formGroups(World& world, double time, const std::vector<std::size_t>& seeds,
+                const PairIndex& index, std::vector<std::size_t>& changed) {
+  if (world.partners.size() != world.bodies.size()) world.partners.assign(world.bodies.size(), {});
+  GroupSearch search(world);
+  for (const std::size_t seed : seeds) search.visit(seed);
+  Candidates candidates = lastingCandidates(world, time, index, search);
+  for (const ConnectedSet& set :
+       connectedSets(world, std::move(search.members), std::move(candidates))) {
+    if (set.bodies.empty()) continue;
+    if (set.candidates.empty()) {
+      fallFreely(world, time, set.bodies, changed);
+    } else {
+      solveGroup(world, time, set.bodies, set.candidates, changed);
+    }
   }
 }
 
@@ -443,32 +605,41 @@ std::pair<double, std::size_t> nextGroupEvent(const World& world) {
   return next;
 }
 
+double surfaceSpeed(const World& world, const Pair& pair, double time) {
+  const auto [a, other] = pair;
+  const Eigen::Vector3d relative =
+      velocityAt<Motion>(world, other, time) - velocityAt<Motion>(world, a, time);
+  const Eigen::Vector3d turning =
+      angularVelocityAt<Motion>(world, other, time) - angularVelocityAt<Motion>(world, a, time);
+  return relative.norm() + world.radius[a] * turning.norm();
+}
+
+ContactRecord contactRecord(const World& world, double time, const Pair& pair,
+                            const Eigen::Vector3d& point, const Eigen::Vector3d& normal,
+                            double normal_force, const Eigen::Vector3d& friction_force,
+                            ContactState state, double since) {
+  const auto [a, other] = pair;
+  ContactRecord record;
+  record.time = time;
+  record.body_a = a;
+  record.other_is_obstacle = world.isObstacle(other);
+  record.other = record.other_is_obstacle ? other - world.bodyCount() : other;
+  record.contact_point = point;
+  record.normal = normal;
+  record.normal_force = normal_force;
+  record.friction_force = friction_force;
+  record.state = state;
+  record.since = since;
+  return record;
+}
+
 void reportContacts(const World& world, double time, std::vector<ContactRecord>& contacts) {
   for (const ContactGroup& group : world.groups) {
     if (!group.alive) continue;
     for (const GroupContact& contact : group.contacts) {
-      const auto [a, other] = contact.pair;
-      ContactRecord record;
-      record.time = time;
-      record.body_a = a;
-      record.other_is_obstacle = world.isObstacle(other);
-      record.other = record.other_is_obstacle ? other - world.bodyCount() : other;
-      record.contact_point = contact.point;
-      record.normal = contact.normal;
-      record.normal_force = contact.force.normal;
-      record.friction_force = contact.force.tangential;
-      record.since = contact.since;
-      const Eigen::Vector3d relative =
-          velocityAt<Motion>(world, other, time) - velocityAt<Motion>(world, a, time);
-      const Eigen::Vector3d turning =
-          angularVelocityAt<Motion>(world, other, time) - angularVelocityAt<Motion>(world, a, time);
-      const double moving = relative.norm() + world.radius[a] * turning.norm();
-      if (contact.force.mode == ContactMode::kSliding) {
-        record.state = ContactState::kSliding;
-      } else {
-        record.state = moving > 1e-9 ? ContactState::kRolling : ContactState::kResting;
-      }
-      contacts.push_back(record);
+      contacts.push_back(contactRecord(world, time, contact.pair, contact.point, contact.normal,
+                                       contact.force.normal, contact.force.tangential,
+                                       groupContactState(world, time, contact), contact.since));
     }
   }
   reportSteppedContacts(world, time, contacts);

@@ -43,6 +43,17 @@ inline double eventResolution(double when, double span) {
 /// The earliest event of any group and that group; {infinity, 0} when there is none.
 std::pair<double, std::size_t> nextGroupEvent(const World& world);
 
+/// m/s: how fast the surfaces of `pair` move relative to each other at `time`: the norm of their
+/// relative velocity plus the first's radius times the norm of their relative turning.
+double surfaceSpeed(const World& world, const Pair& pair, double time);
+
+/// The record of the lasting contact of `pair` at `time` (its other side numbered as a body or
+/// as an obstacle), at `point` along `normal`, with the forces on the other side.
+ContactRecord contactRecord(const World& world, double time, const Pair& pair,
+                            const Eigen::Vector3d& point, const Eigen::Vector3d& normal,
+                            double normal_force, const Eigen::Vector3d& friction_force,
+                            ContactState state, double since);
+
 /// The lasting contacts as the groups hold them at `time`.
 void reportContacts(const World& world, double time, std::vector<ContactRecord>& contacts);
 

@@ -5,6 +5,7 @@
 #include <numeric>
 #include <set>
 
+#include "contact/solve_participants.h"
 #include "contact/stepped_contact.h"
 #include "geometry/broadphase.h"
 #include "impact/order_free.h"
@@ -83,7 +84,8 @@ std::vector<Pair> nearPairs(const World& world, double time, double span,
 /// between their surface points along the line of centres, summed so that it is the same bits
 /// whichever sphere comes first in the pair (the solve's order of contacts comes from these
 /// points, and renaming bodies swaps pairs' sides).
-Eigen::Vector3d contactPoint(const World& world, const Pair& pair, const Geometry& g, double time) {
+Eigen::Vector3d contactPointMidway(const World& world, const Pair& pair, const Geometry& g,
+                                   double time) {
   const Eigen::Vector3d on_first =
       positionAt<Motion>(world, pair.first, time) + world.radius[pair.first] * g.normal;
   if (world.isPlane(pair.second)) return on_first;
@@ -97,34 +99,14 @@ struct Component {
   std::vector<std::size_t> members;
   std::vector<Pair> pairs;  ///< its contacts, canonical order
   SteppedOutcome outcome;
-  std::vector<std::size_t> participants;  ///< members, then the fixed participants
 };
 
-/// The solve of one component from `starts` over `span`.
-void solveComponent(World& world, double time, double span, const std::vector<Start>& starts,
-                    bool warm_start, Component& component) {
-  std::vector<std::size_t>& participants = component.participants;
-  participants = component.members;
-  std::vector<std::size_t> fixed;
-  for (const Pair& pair : component.pairs) {
-    for (const std::size_t p : {pair.first, pair.second}) {
-      if (world.inverseMassOf(p) == 0.0) fixed.push_back(p);
-    }
-  }
-  std::sort(fixed.begin(), fixed.end());
-  fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
-  participants.insert(participants.end(), fixed.begin(), fixed.end());
-  const auto slot = [&](std::size_t p) {
-    const auto movable = std::lower_bound(component.members.begin(), component.members.end(), p);
-    if (movable != component.members.end() && *movable == p) {
-      return static_cast<std::size_t>(movable - component.members.begin());
-    }
-    return component.members.size() +
-           static_cast<std::size_t>(std::lower_bound(fixed.begin(), fixed.end(), p) -
-                                    fixed.begin());
-  };
+/// The sub-step's bodies: each movable participant from its start, each fixed one as it moves.
+std::vector<SteppedBody> steppedBodiesOf(const World& world, double time,
+                                         const SolveParticipants& participants,
+                                         const std::vector<Start>& starts) {
   std::vector<SteppedBody> bodies;
-  for (const std::size_t p : participants) {
+  for (const std::size_t p : participants.all) {
     SteppedBody body;
     body.inverse_mass = world.inverseMassOf(p);
     body.radius = world.radius[p];
@@ -140,17 +122,30 @@ void solveComponent(World& world, double time, double span, const std::vector<St
     }
     bodies.push_back(body);
   }
+  return bodies;
+}
+
+/// The sub-step's contacts, and each one's warm start: a force times the span.
+struct SteppedContacts {
   std::vector<SteppedContact> contacts;
   std::vector<double> warm;
-  std::vector<Pair> kept;
-  for (const Pair& pair : component.pairs) {
+  std::vector<Pair> pairs;  ///< those of `contacts`
+};
+
+/// The component's pairs that have a line to keep apart along, as the sub-step's contacts
+/// (`warm_start`: with the arrivals and forces the last sub-step left).
+SteppedContacts steppedContactsOf(const World& world, double time, double span, bool warm_start,
+                                  const SolveParticipants& participants,
+                                  const std::vector<Pair>& pairs) {
+  SteppedContacts stepped;
+  for (const Pair& pair : pairs) {
     const Geometry g = geometry<Motion>(world, pair, time);
     if (!g.valid) continue;  // coincident centres and no approach: no line to keep apart along
     SteppedContact contact;
-    contact.a = slot(pair.first);
-    contact.b = slot(pair.second);
+    contact.a = participants.slot(pair.first);
+    contact.b = participants.slot(pair.second);
     contact.normal = g.normal;
-    contact.point = contactPoint(world, pair, g, time);
+    contact.point = contactPointMidway(world, pair, g, time);
     contact.gap = g.gap;
     contact.band = g.tolerance;
     contact.restitution = world.restitutionOf(pair);
@@ -159,20 +154,31 @@ void solveComponent(World& world, double time, double span, const std::vector<St
       const auto arrived = world.stepping.arrival_speed.find(pair);
       if (arrived != world.stepping.arrival_speed.end()) contact.arrival_speed = arrived->second;
     }
-    contacts.push_back(contact);
+    stepped.contacts.push_back(contact);
     // At the grid, the last sub-step's forces; within a sub-step (whose gravity its members have
     // already), only what changed is solved for.
     const auto force = world.stepping.keeping_force.find(pair);
     const bool known = warm_start && force != world.stepping.keeping_force.end();
-    warm.push_back(known ? force->second * span : 0.0);
-    kept.push_back(pair);
+    stepped.warm.push_back(known ? force->second * span : 0.0);
+    stepped.pairs.push_back(pair);
   }
-  component.pairs = kept;
+  return stepped;
+}
+
+/// The solve of one component from `starts` over `span`.
+void solveComponent(const World& world, double time, double span, const std::vector<Start>& starts,
+                    bool warm_start, Component& component) {
+  const SolveParticipants participants =
+      solveParticipants(world, component.members, component.pairs);
+  const std::vector<SteppedBody> bodies = steppedBodiesOf(world, time, participants, starts);
+  SteppedContacts stepped =
+      steppedContactsOf(world, time, span, warm_start, participants, component.pairs);
+  component.pairs = std::move(stepped.pairs);
   SteppedSettings settings;
   settings.duration = span;
   settings.restitution_threshold = world.restitution_threshold;
   if (world.friction_model) settings.friction = world.friction_model.cluster;
-  component.outcome = solveSteppedSubstep(bodies, contacts, settings, warm);
+  component.outcome = solveSteppedSubstep(bodies, stepped.contacts, settings, stepped.warm);
 }
 
 /// Takes a lasting group apart: its bodies leave it (to be formed again by the caller).
@@ -199,127 +205,159 @@ void indexClusters(World& world) {
   }
 }
 
-/// Solves the bodies of `region` (and every body their sub-steps bring near them) from `time`
-/// to `end`, in connected components of near pairs, and makes them the clusters `replaced` was.
-/// `grid`: every tracked body is looked at and only components of at least min_bodies are
-/// stepped (region: empty, found here); otherwise every component of the region is.
-void solveRegion(World& world, double time, double end, std::vector<char> member, bool grid,
-                 std::vector<std::size_t>& changed, std::vector<std::size_t>& released,
-                 StepReport& report) {
-  Stepping& stepping = world.stepping;
-  const std::size_t n = world.bodies.size();
-  const double span = end - time;
-  // Near is judged over a whole sub-step at least (stepped_cluster_time_step), whatever this one
-  // is: a sub-step shortened to the rest of an update, or an update a little early, would
-  // otherwise part a cluster for one sub-step and hand its bodies to the exact model.
-  const double horizon = std::max(span, stepping.time_step);
-  std::vector<double> reach(n, 0.0);
-  for (std::size_t i = 0; i < n; ++i) {
+/// Whether `p` is a body the solves move.
+bool movable(const World& world, std::size_t p) {
+  return !world.isObstacle(p) && world.inverse_mass[p] > 0;
+}
+
+/// How far each tracked body may move over `horizon` from `time` (reachBefore); 0 for the others.
+std::vector<double> reachesOver(const World& world, double time, double horizon) {
+  std::vector<double> reach(world.bodies.size(), 0.0);
+  for (std::size_t i = 0; i < world.bodies.size(); ++i) {
     if (world.tracks[i].known) reach[i] = reachBefore(world, i, time, horizon);
   }
-  std::vector<Pair> near = nearPairs(world, time, horizon, reach);
-  const auto movable = [&](std::size_t p) {
-    return !world.isObstacle(p) && world.inverse_mass[p] > 0;
-  };
-  if (grid) {
-    ConnectedSets sets(n);
-    for (const Pair& pair : near) {
-      if (movable(pair.first) && movable(pair.second)) sets.link(pair.first, pair.second);
-    }
-    member.assign(n, 0);
-    for (const std::vector<std::size_t>& set : sets.sets()) {
-      if (set.size() < stepping.min_bodies || !movable(set.front())) continue;
-      for (const std::size_t body : set) member[body] = world.tracks[body].known ? 1 : 0;
-    }
-  }
-  // A body that is in a cluster not being solved again joins with its whole cluster.
-  const auto add_cluster_of = [&](std::size_t body) {
-    const int cluster = world.tracks[body].stepped;
-    if (cluster < 0 || grid) return;
-    for (const std::size_t other : stepping.clusters[static_cast<std::size_t>(cluster)].bodies) {
-      member[other] = 1;
-    }
-  };
-  for (std::size_t i = 0; i < n; ++i) {
-    if (member[i]) add_cluster_of(i);
-  }
+  return reach;
+}
 
-  std::vector<Start> starts(n);
-  std::vector<char> started(n, 0);
-  const auto start_members = [&] {
-    for (std::size_t body = 0; body < n; ++body) {
-      if (!member[body] || started[body]) continue;
-      started[body] = 1;
-      Start& start = starts[body];
-      start.position = positionAt<Motion>(world, body, time);
-      start.velocity = velocityAt<Motion>(world, body, time);
-      start.angular_velocity = angularVelocityAt<Motion>(world, body, time);
-      // Gravity once per sub-step: a body of a cluster solved again within its sub-step has it.
-      const bool given = world.stepped(body) && world.tracks[body].kicked_until >= end;
-      start.kick = given ? Eigen::Vector3d::Zero() : Eigen::Vector3d(world.gravity * span);
+/// At the grid: the tracked bodies of the connected sets of near pairs with at least min_bodies.
+std::vector<char> gridMembers(const World& world, const std::vector<Pair>& near) {
+  const std::size_t n = world.bodies.size();
+  ConnectedSets sets(n);
+  for (const Pair& pair : near) {
+    if (movable(world, pair.first) && movable(world, pair.second)) {
+      sets.link(pair.first, pair.second);
     }
-  };
+  }
+  std::vector<char> member(n, 0);
+  for (const std::vector<std::size_t>& set : sets.sets()) {
+    if (set.size() < world.stepping.min_bodies || !movable(world, set.front())) continue;
+    for (const std::size_t body : set) member[body] = world.tracks[body].known ? 1 : 0;
+  }
+  return member;
+}
+
+/// What a region's solve takes from `time` to `end`, growing as near pairs bring outsiders in:
+/// its members, where each starts, and the pairs that are contacts of the solve.
+struct Region {
+  double time = 0.0;
+  double end = 0.0;
+  bool grid = false;
+  std::vector<char> member;
+  std::vector<Start> starts;
+  std::vector<char> started;
   std::set<Pair> contact_pairs;
-  // The near pairs with a member: their outsiders join (an immovable body stays a fixed
-  // participant), and the pairs are contacts of the solve. True when anything was added.
-  const auto take_near = [&](const std::vector<Pair>& pairs) {
-    bool grown = false;
-    for (const Pair& pair : pairs) {
-      const bool in_first = member[pair.first] != 0;
-      const bool in_second = !world.isObstacle(pair.second) && member[pair.second] != 0;
-      if (!in_first && !in_second) continue;
-      for (const std::size_t p : {pair.first, pair.second}) {
-        if (movable(p) && !member[p]) {
-          member[p] = 1;
-          add_cluster_of(p);
-          grown = true;
-        }
-      }
-      grown = contact_pairs.insert(pair).second || grown;
-    }
-    start_members();
-    return grown;
-  };
-  take_near(near);
+};
 
-  std::vector<Component> components;
-  for (int closure = 0;; ++closure) {
-    ConnectedSets sets(n);
-    for (const Pair& pair : contact_pairs) {
-      if (movable(pair.first) && movable(pair.second)) sets.link(pair.first, pair.second);
-    }
-    components.clear();
-    std::vector<long> component_of(n, -1);
-    for (const std::vector<std::size_t>& set : sets.sets()) {
-      if (!member[set.front()]) continue;
-      component_of[set.front()] = static_cast<long>(components.size());
-      components.emplace_back();
-      components.back().members = set;
-      for (const std::size_t body : set) component_of[body] = component_of[set.front()];
-    }
-    for (const Pair& pair : contact_pairs) {
-      const std::size_t body = movable(pair.first) ? pair.first : pair.second;
-      components[static_cast<std::size_t>(component_of[body])].pairs.push_back(pair);
-    }
-    for (Component& component : components) {
-      solveComponent(world, time, span, starts, grid, component);
-    }
-    if (closure + 1 >= kMaxClosures) break;
-    // The solved velocities may carry a member farther than its reach before: near pairs again.
-    for (const Component& component : components) {
-      for (std::size_t i = 0; i < component.members.size(); ++i) {
-        reach[component.members[i]] =
-            std::max(reach[component.members[i]],
-                     component.outcome.velocity[i].norm() * component.outcome.duration);
-      }
-    }
-    if (!take_near(nearPairs(world, time, horizon, reach))) break;
+/// A body that is in a cluster not being solved again joins with its whole cluster.
+void addClusterOf(const World& world, std::size_t body, Region& region) {
+  const int cluster = world.tracks[body].stepped;
+  if (cluster < 0 || region.grid) return;
+  for (const std::size_t other :
+       world.stepping.clusters[static_cast<std::size_t>(cluster)].bodies) {
+    region.member[other] = 1;
   }
+}
 
-  // The clusters that were: those whose bodies are solved now are replaced (all, at the grid).
+/// Where each member not started yet starts.
+void startMembers(const World& world, Region& region) {
+  const double span = region.end - region.time;
+  for (std::size_t body = 0; body < world.bodies.size(); ++body) {
+    if (!region.member[body] || region.started[body]) continue;
+    region.started[body] = 1;
+    Start& start = region.starts[body];
+    start.position = positionAt<Motion>(world, body, region.time);
+    start.velocity = velocityAt<Motion>(world, body, region.time);
+    start.angular_velocity = angularVelocityAt<Motion>(world, body, region.time);
+    // Gravity once per sub-step: a body of a cluster solved again within its sub-step has it.
+    const bool given = world.stepped(body) && world.tracks[body].kicked_until >= region.end;
+    start.kick = given ? Eigen::Vector3d::Zero() : Eigen::Vector3d(world.gravity * span);
+  }
+}
+
+/// The near pairs with a member: their outsiders join (an immovable body stays a fixed
+/// participant), and the pairs are contacts of the solve. True when anything was added.
+bool takeNear(const World& world, const std::vector<Pair>& pairs, Region& region) {
+  bool grown = false;
+  for (const Pair& pair : pairs) {
+    const bool in_first = region.member[pair.first] != 0;
+    const bool in_second = !world.isObstacle(pair.second) && region.member[pair.second] != 0;
+    if (!in_first && !in_second) continue;
+    for (const std::size_t p : {pair.first, pair.second}) {
+      if (movable(world, p) && !region.member[p]) {
+        region.member[p] = 1;
+        addClusterOf(world, p, region);
+        grown = true;
+      }
+    }
+    grown = region.contact_pairs.insert(pair).second || grown;
+  }
+  startMembers(world, region);
+  return grown;
+}
+
+/// The region of `member` (with the clusters of its bodies) and of the near pairs it touches.
+Region setUpRegion(const World& world, double time, double end, bool grid, std::vector<char> member,
+                   const std::vector<Pair>& near) {
+  const std::size_t n = world.bodies.size();
+  Region region;
+  region.time = time;
+  region.end = end;
+  region.grid = grid;
+  region.member = std::move(member);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (region.member[i]) addClusterOf(world, i, region);
+  }
+  region.starts.assign(n, Start{});
+  region.started.assign(n, 0);
+  takeNear(world, near, region);
+  return region;
+}
+
+/// The connected components of the region's contact pairs among its members, each with its
+/// pairs.
+std::vector<Component> componentsOf(const World& world, const Region& region) {
+  const std::size_t n = world.bodies.size();
+  ConnectedSets sets(n);
+  for (const Pair& pair : region.contact_pairs) {
+    if (movable(world, pair.first) && movable(world, pair.second)) {
+      sets.link(pair.first, pair.second);
+    }
+  }
+  std::vector<Component> components;
+  std::vector<long> component_of(n, -1);
+  for (const std::vector<std::size_t>& set : sets.sets()) {
+    if (!region.member[set.front()]) continue;
+    component_of[set.front()] = static_cast<long>(components.size());
+    components.emplace_back();
+    components.back().members = set;
+    for (const std::size_t body : set) component_of[body] = component_of[set.front()];
+  }
+  for (const Pair& pair : region.contact_pairs) {
+    const std::size_t body = movable(world, pair.first) ? pair.first : pair.second;
+    components[static_cast<std::size_t>(component_of[body])].pairs.push_back(pair);
+  }
+  return components;
+}
+
+/// The solved velocities may carry a member farther than its reach before.
+void widenReaches(const std::vector<Component>& components, std::vector<double>& reach) {
+  for (const Component& component : components) {
+    for (std::size_t i = 0; i < component.members.size(); ++i) {
+      reach[component.members[i]] =
+          std::max(reach[component.members[i]],
+                   component.outcome.velocity[i].norm() * component.outcome.duration);
+    }
+  }
+}
+
+/// The clusters that were: those whose bodies are solved now are replaced (all, at the grid);
+/// their bodies outside the region go back to the exact model, and their contacts outside it end.
+void replaceClusters(World& world, const Region& region, std::vector<std::size_t>& changed,
+                     std::vector<std::size_t>& released) {
+  const std::vector<char>& member = region.member;
   std::vector<SteppedCluster> kept;
-  for (SteppedCluster& cluster : stepping.clusters) {
-    bool replaced = grid;
+  for (SteppedCluster& cluster : world.stepping.clusters) {
+    bool replaced = region.grid;
     for (const std::size_t body : cluster.bodies) replaced = replaced || member[body];
     if (!replaced) {
       kept.push_back(std::move(cluster));
@@ -329,9 +367,9 @@ void solveRegion(World& world, double time, double end, std::vector<char> member
       if (member[body]) continue;
       // Out of every cluster: back to the exact model, from where it is, under gravity.
       Track& track = world.tracks[body];
-      track.position = positionAt<Motion>(world, body, time);
-      track.velocity = velocityAt<Motion>(world, body, time);
-      track.time = time;
+      track.position = positionAt<Motion>(world, body, region.time);
+      track.velocity = velocityAt<Motion>(world, body, region.time);
+      track.time = region.time;
       track.acceleration = world.gravity;
       track.angular_acceleration.setZero();
       track.stepped = -1;
@@ -345,65 +383,123 @@ void solveRegion(World& world, double time, double end, std::vector<char> member
       }
     }
   }
-  stepping.clusters = std::move(kept);
+  world.stepping.clusters = std::move(kept);
+}
 
+/// The component's members move with its sub-step from the region's instant, out of any lasting
+/// group.
+void storeClusterTracks(World& world, const Region& region, const Component& component,
+                        std::vector<std::size_t>& changed) {
+  for (std::size_t i = 0; i < component.members.size(); ++i) {
+    const std::size_t body = component.members[i];
+    leaveLastingGroup(world, body, changed);
+    Track& track = world.tracks[body];
+    track.position = region.starts[body].position;
+    track.velocity = component.outcome.velocity[i];
+    track.angular_velocity = component.outcome.angular_velocity[i];
+    track.acceleration.setZero();
+    track.angular_acceleration.setZero();
+    track.time = region.time;
+    track.constrained = nullptr;
+    track.kicked_until = region.end;
+    track.stepped = 0;  // numbered by indexClusters
+    changed.push_back(body);
+  }
+}
+
+/// What the component's contacts leave the next sub-step (arrivals, keeping forces), and those
+/// that carried a keeping impulse as the cluster's contacts; the others no longer last.
+void storeClusterContacts(World& world, double time, const Component& component,
+                          SteppedCluster& cluster) {
+  Stepping& stepping = world.stepping;
+  const SteppedOutcome& outcome = component.outcome;
+  for (std::size_t k = 0; k < component.pairs.size(); ++k) {
+    const Pair& pair = component.pairs[k];
+    const SteppedContactOutcome& received = outcome.contacts[k];
+    if (received.arrival_speed > 0) {
+      stepping.arrival_speed[pair] = received.arrival_speed;
+    } else {
+      stepping.arrival_speed.erase(pair);
+    }
+    if (received.keeping_impulse > 0 || received.bounce_impulse > 0) {
+      stepping.keeping_force[pair] = received.keeping_impulse / outcome.duration;
+    } else {
+      stepping.keeping_force.erase(pair);
+    }
+    if (!(received.keeping_impulse > 0)) {
+      world.contact_since.erase(pair);
+      continue;
+    }
+    const Geometry g = geometry<Motion>(world, pair, time);
+    SteppedClusterContact contact;
+    contact.pair = pair;
+    contact.normal = g.normal;
+    contact.point = contactPointMidway(world, pair, g, time);
+    contact.keeping_impulse = received.keeping_impulse;
+    contact.friction_impulse = received.friction_impulse;
+    contact.friction_direction = received.friction_direction;
+    contact.sticking = received.sticking;
+    world.contact_since.emplace(pair, time);
+    cluster.contacts.push_back(contact);
+  }
+}
+
+/// A solved component becomes a cluster over its sub-step (one held counted as a fallback).
+void storeCluster(World& world, const Region& region, const Component& component,
+                  std::vector<std::size_t>& changed, StepReport& report) {
+  SteppedCluster cluster;
+  cluster.bodies = component.members;
+  cluster.start = region.time;
+  cluster.end = region.time + component.outcome.duration;
+  if (component.outcome.held) {
+    ++world.stepping.held;
+    ++report.fallbacks;
+  }
+  storeClusterTracks(world, region, component, changed);
+  storeClusterContacts(world, region.time, component, cluster);
+  world.stepping.clusters.push_back(std::move(cluster));
+}
+
+/// Solves the bodies of `member` (and every body their sub-steps bring near them) from `time`
+/// to `end`, in connected components of near pairs, and makes them the clusters in place of
+/// those they were in. `grid`: every tracked body is looked at and only components of at least
+/// min_bodies are stepped (`member`: empty, found here); otherwise every component of the region
+/// is.
+void solveRegion(World& world, double time, double end, std::vector<char> member, bool grid,
+                 std::vector<std::size_t>& changed, std::vector<std::size_t>& released,
+                 StepReport& report) {
+  const double span = end - time;
+  // Near is judged over a whole sub-step at least (stepped_cluster_time_step), whatever this one
+  // is: a sub-step shortened to the rest of an update, or an update a little early, would
+  // otherwise part a cluster for one sub-step and hand its bodies to the exact model.
+  const double horizon = std::max(span, world.stepping.time_step);
+  std::vector<double> reach = reachesOver(world, time, horizon);
+  const std::vector<Pair> near = nearPairs(world, time, horizon, reach);
+  Region region = setUpRegion(world, time, end, grid,
+                              grid ? gridMembers(world, near) : std::move(member), near);
+  // The closure: the components solved, then near pairs again with the solved velocities.
+  std::vector<Component> components;
+  for (int closure = 0;; ++closure) {
+    components = componentsOf(world, region);
+    for (Component& component : components) {
+      solveComponent(world, time, span, region.starts, grid, component);
+    }
+    if (closure + 1 >= kMaxClosures) break;
+    widenReaches(components, reach);
+    if (!takeNear(world, nearPairs(world, time, horizon, reach), region)) break;
+  }
+  replaceClusters(world, region, changed, released);
   for (const Component& component : components) {
-    const SteppedOutcome& outcome = component.outcome;
-    SteppedCluster cluster;
-    cluster.bodies = component.members;
-    cluster.start = time;
-    cluster.end = time + outcome.duration;
-    if (outcome.held) {
-      ++stepping.held;
-      ++report.fallbacks;
-    }
-    for (std::size_t i = 0; i < component.members.size(); ++i) {
-      const std::size_t body = component.members[i];
-      leaveLastingGroup(world, body, changed);
-      Track& track = world.tracks[body];
-      track.position = starts[body].position;
-      track.velocity = outcome.velocity[i];
-      track.angular_velocity = outcome.angular_velocity[i];
-      track.acceleration.setZero();
-      track.angular_acceleration.setZero();
-      track.time = time;
-      track.constrained = nullptr;
-      track.kicked_until = end;
-      track.stepped = 0;  // numbered by indexClusters
-      changed.push_back(body);
-    }
-    for (std::size_t k = 0; k < component.pairs.size(); ++k) {
-      const Pair& pair = component.pairs[k];
-      const SteppedContactOutcome& received = outcome.contacts[k];
-      if (received.arrival_speed > 0) {
-        stepping.arrival_speed[pair] = received.arrival_speed;
-      } else {
-        stepping.arrival_speed.erase(pair);
-      }
-      if (received.keeping_impulse > 0 || received.bounce_impulse > 0) {
-        stepping.keeping_force[pair] = received.keeping_impulse / outcome.duration;
-      } else {
-        stepping.keeping_force.erase(pair);
-      }
-      if (!(received.keeping_impulse > 0)) {
-        world.contact_since.erase(pair);
-        continue;
-      }
-      const Geometry g = geometry<Motion>(world, pair, time);
-      SteppedClusterContact contact;
-      contact.pair = pair;
-      contact.normal = g.normal;
-      contact.point = contactPoint(world, pair, g, time);
-      contact.keeping_impulse = received.keeping_impulse;
-      contact.friction_impulse = received.friction_impulse;
-      contact.friction_direction = received.friction_direction;
-      contact.sticking = received.sticking;
-      world.contact_since.emplace(pair, time);
-      cluster.contacts.push_back(contact);
-    }
-    stepping.clusters.push_back(std::move(cluster));
+    storeCluster(world, region, component, changed, report);
   }
   indexClusters(world);
+}
+
+/// A cluster's contact rests where its surfaces do not move; otherwise it rolls where it sticks.
+ContactState clusterContactState(const World& world, double time,
+                                 const SteppedClusterContact& contact) {
+  if (surfaceSpeed(world, contact.pair, time) <= 1e-9) return ContactState::kResting;
+  return contact.sticking ? ContactState::kRolling : ContactState::kSliding;
 }
 
 }  // namespace
@@ -502,29 +598,13 @@ void reportSteppedContacts(const World& world, double time, std::vector<ContactR
     const double duration = cluster.end - cluster.start;
     if (!(duration > 0)) continue;
     for (const SteppedClusterContact& contact : cluster.contacts) {
-      const auto [a, other] = contact.pair;
-      ContactRecord record;
-      record.time = time;
-      record.body_a = a;
-      record.other_is_obstacle = world.isObstacle(other);
-      record.other = record.other_is_obstacle ? other - world.bodyCount() : other;
-      record.contact_point = contact.point;
-      record.normal = contact.normal;
-      record.normal_force = contact.keeping_impulse / duration;
-      record.friction_force = contact.friction_impulse / duration * contact.friction_direction;
       const auto since = world.contact_since.find(contact.pair);
-      record.since = since == world.contact_since.end() ? cluster.start : since->second;
-      const Eigen::Vector3d relative =
-          velocityAt<Motion>(world, other, time) - velocityAt<Motion>(world, a, time);
-      const Eigen::Vector3d turning =
-          angularVelocityAt<Motion>(world, other, time) - angularVelocityAt<Motion>(world, a, time);
-      const double moving = relative.norm() + world.radius[a] * turning.norm();
-      if (moving <= 1e-9) {
-        record.state = ContactState::kResting;
-      } else {
-        record.state = contact.sticking ? ContactState::kRolling : ContactState::kSliding;
-      }
-      contacts.push_back(record);
+      contacts.push_back(
+          contactRecord(world, time, contact.pair, contact.point, contact.normal,
+                        contact.keeping_impulse / duration,
+                        contact.friction_impulse / duration * contact.friction_direction,
+                        clusterContactState(world, time, contact),
+                        since == world.contact_since.end() ? cluster.start : since->second));
     }
   }
 }
