@@ -281,89 +281,140 @@ Vector solveMinimumNorm(Eigen::Index size, const std::vector<Entry>& entries, co
   return solution;
 }
 
-Trial solveModes(const Group& group, const std::vector<Mode>& modes,
-                 const std::vector<Real>& friction) {
-  const std::size_t count = group.contactCount();
+/// One linear condition on the group's response at contact `contact`, to be 0: its gap's
+/// acceleration (`normal`) or its slip's acceleration along the tangent `direction`. With
+/// impulses for forces the same conditions hold the velocities (closeContactVelocities), with
+/// displacements the gaps (closeContactGaps).
+struct Condition {
+  std::size_t contact = 0;
+  V3 direction = V3::Zero();
+  bool normal = true;
+};
+
+/// The condition's value where the contact's gap accelerates by `gap` and its slip by `slip`.
+Real conditionValue(const Condition& condition, Real gap, const V3& slip) {
+  return condition.normal ? gap : condition.direction.dot(slip);
+}
+
+/// The conditions' matrix by its nonzero entries: (i, j) is condition i's value under unknown j
+/// alone, at unit size. Column by column from each unknown's response (Group::respondToOne), so
+/// in O(the nonzeros): a condition changes only where its contact shares a movable body with
+/// the unknown's.
+std::vector<Entry> assembleConditions(const Group& group, const std::vector<Unknown>& unknowns,
+                                      const std::vector<Condition>& conditions) {
+  std::vector<std::vector<Eigen::Index>> conditions_of(group.contactCount());
+  for (std::size_t i = 0; i < conditions.size(); ++i) {
+    conditions_of[conditions[i].contact].push_back(static_cast<Eigen::Index>(i));
+  }
+  std::vector<Entry> entries;
+  for (std::size_t u = 0; u < unknowns.size(); ++u) {
+    const auto j = static_cast<Eigen::Index>(u);
+    group.respondToOne(unknowns[u].contact, unknowns[u].pattern,
+                       [&](std::size_t k, Real gap, const V3& slip) {
+                         for (const Eigen::Index i : conditions_of[k]) {
+                           const Condition& condition = conditions[static_cast<std::size_t>(i)];
+                           entries.push_back(Entry{i, j, conditionValue(condition, gap, slip)});
+                         }
+                       });
+  }
+  return entries;
+}
+
+/// Each contact's force (on b) for the unknowns' sizes `solution`: the sum of its unknowns'
+/// patterns times their sizes.
+std::vector<V3> forcesOf(std::size_t count, const std::vector<Unknown>& unknowns,
+                         const Vector& solution) {
+  std::vector<V3> forces(count, V3::Zero());
+  for (Eigen::Index j = 0; j < solution.size(); ++j) {
+    const Unknown& unknown = unknowns[static_cast<std::size_t>(j)];
+    forces[unknown.contact] += solution[j] * unknown.pattern;
+  }
+  return forces;
+}
+
+/// The linear system of an assignment of modes, unknown i with condition i: a pressed contact's
+/// normal force N (a sliding one's friction -mu N along its slide direction in the same
+/// unknown) with its gap's acceleration; a sticking one's friction along each tangent with its
+/// slip's acceleration along that tangent.
+struct ModeSystem {
   std::vector<Unknown> unknowns;
-  // Rows: one condition per unknown (gap acceleration 0 for a pressed contact's normal force,
-  // slip acceleration 0 along each tangent of a sticking one).
-  struct Row {
-    std::size_t contact;
-    int kind;  // 0 gap, 1 first tangent, 2 second tangent
-  };
-  std::vector<Row> rows;
-  for (std::size_t k = 0; k < count; ++k) {
+  std::vector<Condition> conditions;
+};
+
+ModeSystem modeSystem(const Group& group, const std::vector<Mode>& modes,
+                      const std::vector<Real>& friction) {
+  ModeSystem system;
+  for (std::size_t k = 0; k < group.contactCount(); ++k) {
     if (!modes[k].pressed) continue;
     V3 pattern = group.normal(k);
     if (modes[k].tangential == Tangential::kSlide) {
       pattern -= friction[k] * modes[k].slide_direction;
     }
-    unknowns.push_back(Unknown{k, pattern});
-    rows.push_back(Row{k, 0});
+    system.unknowns.push_back(Unknown{k, pattern});
+    system.conditions.push_back(Condition{k, group.normal(k), true});
     if (modes[k].tangential == Tangential::kStick) {
-      unknowns.push_back(Unknown{k, group.first(k)});
-      rows.push_back(Row{k, 1});
-      unknowns.push_back(Unknown{k, group.second(k)});
-      rows.push_back(Row{k, 2});
+      for (const V3& tangent : {group.first(k), group.second(k)}) {
+        system.unknowns.push_back(Unknown{k, tangent});
+        system.conditions.push_back(Condition{k, tangent, false});
+      }
     }
   }
-  const auto condition = [&](const Response& response, const Row& row) -> Real {
-    if (row.kind == 0) return response.gap_acceleration[row.contact];
-    const V3& tangent = row.kind == 1 ? group.first(row.contact) : group.second(row.contact);
-    return tangent.dot(response.slip_acceleration[row.contact]);
-  };
-  const std::vector<V3> no_forces(count, V3::Zero());
-  const Response free = group.respond(no_forces, true);
-  const auto size = static_cast<Eigen::Index>(unknowns.size());
-  Vector solution = Vector::Zero(size);
-  if (size > 0) {
-    std::vector<std::vector<Eigen::Index>> rows_of(count);
-    for (Eigen::Index i = 0; i < size; ++i)
-      rows_of[rows[static_cast<std::size_t>(i)].contact].push_back(i);
-    std::vector<Entry> entries;
-    for (Eigen::Index j = 0; j < size; ++j) {
-      const Unknown& unknown = unknowns[static_cast<std::size_t>(j)];
-      group.respondToOne(
-          unknown.contact, unknown.pattern, [&](std::size_t k, Real gap, const V3& slip) {
-            for (const Eigen::Index i : rows_of[k]) {
-              const Row& row = rows[static_cast<std::size_t>(i)];
-              const Real value = row.kind == 0
-                                     ? gap
-                                     : (row.kind == 1 ? group.first(k) : group.second(k)).dot(slip);
-              entries.push_back(Entry{i, j, value});
-            }
-          });
-    }
-    Vector target(size);
-    for (Eigen::Index i = 0; i < size; ++i) target[i] = -condition(free, rows[i]);
-    // Minimum-norm least squares: also right where contacts are redundant (a ball in a corner
-    // of three planes that a pair of them already holds). Where sticking contacts are redundant
-    // (a ball held by friction in the corner of an incline and a wall), static friction is
-    // indeterminate: every solution gives the same accelerations, but the one of minimum norm
-    // may pull at a contact (README, "Lasting contact"). The least static friction is taken
-    // first: where normal forces alone can hold the group (the frictionless corner's
-    // m g / cos t and m g tan t), friction takes nothing and no contact pulls.
-    std::vector<char> static_friction(static_cast<std::size_t>(size));
-    for (Eigen::Index i = 0; i < size; ++i) {
-      static_friction[static_cast<std::size_t>(i)] = rows[static_cast<std::size_t>(i)].kind != 0;
-    }
-    solution = solveMinimumNorm(size, entries, target, static_friction);
+  return system;
+}
+
+/// The unknowns' sizes that bring every condition of `system` to 0 from its value `free` takes
+/// without contact forces (gravity and the velocity terms).
+Vector solveModeSystem(const Group& group, const ModeSystem& system, const Response& free) {
+  const auto size = static_cast<Eigen::Index>(system.unknowns.size());
+  const std::vector<Entry> entries = assembleConditions(group, system.unknowns, system.conditions);
+  Vector target(size);
+  for (Eigen::Index i = 0; i < size; ++i) {
+    const Condition& condition = system.conditions[static_cast<std::size_t>(i)];
+    target[i] = -conditionValue(condition, free.gap_acceleration[condition.contact],
+                                free.slip_acceleration[condition.contact]);
   }
+  // Minimum-norm least squares: also right where contacts are redundant (a ball in a corner
+  // of three planes that a pair of them already holds). Where sticking contacts are redundant
+  // (a ball held by friction in the corner of an incline and a wall), static friction is
+  // indeterminate: every solution gives the same accelerations, but the one of minimum norm
+  // may pull at a contact (README, "Lasting contact"). The least static friction is taken
+  // first: where normal forces alone can hold the group (the frictionless corner's
+  // m g / cos t and m g tan t), friction takes nothing and no contact pulls.
+  std::vector<char> static_friction(static_cast<std::size_t>(size));
+  for (std::size_t i = 0; i < static_friction.size(); ++i) {
+    static_friction[i] = !system.conditions[i].normal;
+  }
+  return solveMinimumNorm(size, entries, target, static_friction);
+}
+
+/// The trial of the unknowns' sizes `solution`: each contact's force, its normal and tangential
+/// parts, and the group's response.
+Trial storeTrial(const Group& group, const ModeSystem& system, const Vector& solution) {
+  const std::size_t count = group.contactCount();
   Trial trial;
-  trial.forces.assign(count, V3::Zero());
+  trial.forces = forcesOf(count, system.unknowns, solution);
   trial.normal_force.assign(count, 0);
-  trial.tangential_force.assign(count, V3::Zero());
-  for (Eigen::Index j = 0; j < size; ++j) {
-    const Unknown& unknown = unknowns[j];
-    trial.forces[unknown.contact] += solution[j] * unknown.pattern;
-    if (rows[j].kind == 0) trial.normal_force[unknown.contact] = solution[j];
+  for (Eigen::Index j = 0; j < solution.size(); ++j) {
+    const Condition& condition = system.conditions[static_cast<std::size_t>(j)];
+    if (condition.normal) trial.normal_force[condition.contact] = solution[j];
   }
+  trial.tangential_force.assign(count, V3::Zero());
   for (std::size_t k = 0; k < count; ++k) {
     trial.tangential_force[k] =
         trial.forces[k] - trial.forces[k].dot(group.normal(k)) * group.normal(k);
   }
   trial.response = group.respond(trial.forces, true);
   return trial;
+}
+
+/// The forces for an assignment of modes: its linear conditions solved jointly.
+Trial solveModes(const Group& group, const std::vector<Mode>& modes,
+                 const std::vector<Real>& friction) {
+  const ModeSystem system = modeSystem(group, modes, friction);
+  const Response free = group.respond(std::vector<V3>(group.contactCount(), V3::Zero()), true);
+  Vector solution = Vector::Zero(static_cast<Eigen::Index>(system.unknowns.size()));
+  if (solution.size() > 0) solution = solveModeSystem(group, system, free);
+  return storeTrial(group, system, solution);
 }
 
 /// The tolerances' scales: the accelerations and speeds the group has.
@@ -452,11 +503,6 @@ void closeContactVelocities(std::vector<ForceBody>& bodies,
   // each tangent of a sticking contact.
   const Group group(bodies, contacts);
   const std::size_t count = contacts.size();
-  struct Condition {
-    std::size_t contact;
-    V3 direction;
-    bool normal;
-  };
   std::vector<Condition> conditions;
   std::vector<Real> targets;
   for (std::size_t k = 0; k < count; ++k) {
@@ -481,29 +527,15 @@ void closeContactVelocities(std::vector<ForceBody>& bodies,
   }
   for (const Real target : targets) widest = std::max(widest, std::abs(target));
   if (widest <= std::numeric_limits<double>::epsilon() * speed) return;
-  const std::vector<V3> no_impulses(count, V3::Zero());
-  std::vector<std::vector<Eigen::Index>> conditions_of(count);
-  for (Eigen::Index i = 0; i < size; ++i) {
-    conditions_of[conditions[static_cast<std::size_t>(i)].contact].push_back(i);
+  std::vector<Unknown> unknowns;  // an impulse along each condition's direction
+  for (const Condition& condition : conditions) {
+    unknowns.push_back(Unknown{condition.contact, condition.direction});
   }
-  std::vector<Entry> entries;
-  for (Eigen::Index j = 0; j < size; ++j) {
-    const Condition& source = conditions[static_cast<std::size_t>(j)];
-    group.respondToOne(
-        source.contact, source.direction, [&](std::size_t k, Real gap, const V3& slip) {
-          for (const Eigen::Index i : conditions_of[k]) {
-            const Condition& condition = conditions[static_cast<std::size_t>(i)];
-            entries.push_back(Entry{i, j, condition.normal ? gap : condition.direction.dot(slip)});
-          }
-        });
-  }
+  const std::vector<Entry> entries = assembleConditions(group, unknowns, conditions);
   Vector target(size);
-  for (Eigen::Index i = 0; i < size; ++i) target[i] = targets[i];
+  for (Eigen::Index i = 0; i < size; ++i) target[i] = targets[static_cast<std::size_t>(i)];
   const Vector solution = solveMinimumNorm(size, entries, target);
-  std::vector<V3> impulses = no_impulses;
-  for (Eigen::Index j = 0; j < size; ++j) {
-    impulses[conditions[j].contact] += solution[j] * conditions[j].direction;
-  }
+  const std::vector<V3> impulses = forcesOf(count, unknowns, solution);
   const Response change = group.respond(impulses, false);
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     if (bodies[i].inverse_mass == 0.0) continue;
@@ -963,19 +995,17 @@ void closeContactGaps(std::vector<Eigen::Vector3d>& positions, const std::vector
   for (const double gap : gaps) widest = std::max(widest, std::abs(gap));
   if (widest <= std::numeric_limits<double>::epsilon() * reach) return;
   const Group group(bodies, contacts);
-  const std::vector<V3> none(contacts.size(), V3::Zero());
-  std::vector<Entry> entries;
-  for (Eigen::Index j = 0; j < size; ++j) {
-    group.respondToOne(static_cast<std::size_t>(j), group.normal(static_cast<std::size_t>(j)),
-                       [&](std::size_t k, Real gap, const V3&) {
-                         entries.push_back(Entry{static_cast<Eigen::Index>(k), j, gap});
-                       });
+  std::vector<Unknown> unknowns;      // a displacement along each normal
+  std::vector<Condition> conditions;  // each gap
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    unknowns.push_back(Unknown{k, group.normal(k)});
+    conditions.push_back(Condition{k, group.normal(k), true});
   }
+  const std::vector<Entry> entries = assembleConditions(group, unknowns, conditions);
   Vector target(size);
-  for (Eigen::Index i = 0; i < size; ++i) target[i] = -Real(gaps[i]);
+  for (Eigen::Index i = 0; i < size; ++i) target[i] = -Real(gaps[static_cast<std::size_t>(i)]);
   const Vector solution = solveMinimumNorm(size, entries, target);
-  std::vector<V3> pushes = none;
-  for (Eigen::Index j = 0; j < size; ++j) pushes[j] = solution[j] * group.normal(j);
+  const std::vector<V3> pushes = forcesOf(contacts.size(), unknowns, solution);
   const Response change = group.respond(pushes, false);
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     if (bodies[i].inverse_mass == 0.0) continue;
