@@ -1015,166 +1015,209 @@ void closeContactGaps(std::vector<Eigen::Vector3d>& positions, const std::vector
 
 namespace {
 
+/// A pressed contact with friction takes it up by its slip: sliding, friction against the slip,
+/// where it slips faster than the slip tolerance; sticking where it does not.
+void takeUpFriction(const Group& group, std::size_t k, Real slip_tolerance, Mode& mode) {
+  const V3& slip = group.slip(k);
+  if (slip.norm() > slip_tolerance) {
+    mode.tangential = Tangential::kSlide;
+    mode.slide_direction = slip.normalized();
+  } else {
+    mode.tangential = Tangential::kStick;
+  }
+}
+
+/// The first guess: pressed where the gap would close with no contact force at all (the floor
+/// under a ball), free where it would not (two balls side by side that fall together); the
+/// iteration corrects it. A good guess keeps the first solve small.
+std::vector<Mode> guessModes(const Group& group, const std::vector<Real>& friction,
+                             const Scales& scales) {
+  const std::size_t count = group.contactCount();
+  std::vector<Mode> modes(count);
+  const Response unpressed = group.respond(std::vector<V3>(count, V3::Zero()), true);
+  for (std::size_t k = 0; k < count; ++k) {
+    modes[k].pressed =
+        unpressed.gap_acceleration[k] < -kTolerance * std::max(scales.acceleration, Real(1e-300));
+  }
+  for (std::size_t k = 0; k < count; ++k) {
+    if (modes[k].pressed && friction[k] > 0) {
+      takeUpFriction(group, k, scales.slip_tolerance, modes[k]);
+    }
+  }
+  return modes;
+}
+
+/// The largest normal force of a trial: the scale of its forces.
+Real largestNormalForce(const Trial& trial) {
+  Real force_scale = 0;
+  for (const Real normal : trial.normal_force) {
+    force_scale = std::max(force_scale, std::abs(normal));
+  }
+  return force_scale;
+}
+
+/// A contact whose mode fails under a trial's forces: by how much (in units of its scale, > 0),
+/// to change the worst first when changing all at once cycles, and the mode it changes to.
+struct Change {
+  std::size_t contact;
+  Real size;
+  Mode mode;
+};
+
+/// Whether a pressed contact k's mode holds under the trial's forces (size 0) or how it fails: a
+/// normal force that would pull, static friction beyond mu N, or a contact starting to slide
+/// whose slip would not grow along the direction taken.
+Change pressedFailure(const Group& group, std::size_t k, const Mode& mode, const Trial& trial,
+                      Real friction, Real force_scale, const Scales& scales) {
+  const Real tolerance = kTolerance;
+  const Real acceleration_scale = scales.acceleration;
+  Change change{k, 0, mode};
+  const Real normal = trial.normal_force[k];
+  if (normal < -tolerance * force_scale) {  // it would pull: let it go
+    change.mode.pressed = false;
+    change.size = -normal / std::max(force_scale, Real(1e-300));
+  } else if (mode.tangential == Tangential::kStick) {
+    const Real needed = trial.tangential_force[k].norm();
+    const Real bound = friction * std::max(normal, Real(0));
+    if (needed > bound * (1 + tolerance) + tolerance * force_scale * friction) {
+      // Static friction cannot hold it: it starts to slide, the friction against the direction
+      // the sticking force pointed away from.
+      change.mode.tangential = Tangential::kSlide;
+      change.mode.slide_direction = -trial.tangential_force[k] / needed;
+      change.size = (needed - bound) / std::max(force_scale, Real(1e-300));
+    }
+  } else if (mode.tangential == Tangential::kSlide &&
+             group.slip(k).norm() <= scales.slip_tolerance) {
+    // Starting to slide: the slip must grow along the direction taken.
+    const V3& rate = trial.response.slip_acceleration[k];
+    const Real along = rate.dot(mode.slide_direction);
+    if (along < -tolerance * acceleration_scale) {
+      change.mode.tangential = Tangential::kStick;
+      change.size = -along / std::max(acceleration_scale, Real(1e-300));
+    } else if (rate.norm() > tolerance * acceleration_scale &&
+               (rate.normalized() - mode.slide_direction).norm() > 1e-12L) {
+      change.mode.slide_direction = rate.normalized();  // follow the slip it starts
+      change.size = (rate.normalized() - mode.slide_direction).norm();
+    }
+  }
+  return change;
+}
+
+/// The contacts whose modes fail under the trial's forces: pressed ones (pressedFailure), and
+/// free ones whose gap would close.
+std::vector<Change> failingModes(const Group& group, const std::vector<Mode>& modes,
+                                 const Trial& trial, const std::vector<Real>& friction,
+                                 const Scales& scales) {
+  const Real force_scale = largestNormalForce(trial);
+  const Real acceleration_scale = std::max(scales.acceleration, Real(1e-300));
+  std::vector<Change> changes;
+  for (std::size_t k = 0; k < group.contactCount(); ++k) {
+    Change change{k, 0, modes[k]};
+    if (modes[k].pressed) {
+      change = pressedFailure(group, k, modes[k], trial, friction[k], force_scale, scales);
+    } else {
+      const Real gap = trial.response.gap_acceleration[k];
+      if (gap < -kTolerance * acceleration_scale) {  // it would close
+        change.mode.pressed = true;
+        change.size = -gap / acceleration_scale;
+      }
+    }
+    if (change.size > 0) changes.push_back(change);
+  }
+  return changes;
+}
+
+/// The modes as one key, to see an assignment come back.
+std::vector<int> modeSignature(const std::vector<Mode>& modes) {
+  std::vector<int> signature;
+  for (const Mode& mode : modes) {
+    signature.push_back(mode.pressed * 4 + static_cast<int>(mode.tangential));
+  }
+  return signature;
+}
+
+/// The failing contacts take their new modes: all at once, or, `one_at_a_time` (all at once
+/// cycled), the largest failure; among equal ones (mirror images) all of them. A contact let go
+/// drops its friction; one pressed again takes friction up by its slip.
+void changeModes(const Group& group, const std::vector<Real>& friction, Real slip_tolerance,
+                 const std::vector<Change>& changes, bool one_at_a_time, std::vector<Mode>& modes) {
+  if (one_at_a_time) {
+    Real largest = 0;
+    for (const Change& change : changes) largest = std::max(largest, change.size);
+    for (const Change& change : changes) {
+      if (change.size >= largest * (1 - 1e-9L)) modes[change.contact] = change.mode;
+    }
+  } else {
+    for (const Change& change : changes) modes[change.contact] = change.mode;
+  }
+  for (Mode& mode : modes) {
+    if (!mode.pressed) mode.tangential = Tangential::kNone;
+  }
+  for (std::size_t k = 0; k < modes.size(); ++k) {
+    if (modes[k].pressed && modes[k].tangential == Tangential::kNone && friction[k] > 0) {
+      takeUpFriction(group, k, slip_tolerance, modes[k]);
+    }
+  }
+}
+
+/// The last forces of modes that did not settle, clamped: no contact pulls, no friction beyond
+/// mu N; and the group's response to them.
+void clampForces(const Group& group, const std::vector<Real>& friction, Trial& trial) {
+  for (std::size_t k = 0; k < group.contactCount(); ++k) {
+    const Real normal = std::max(trial.normal_force[k], Real(0));
+    V3 tangential = trial.tangential_force[k];
+    const Real bound = friction[k] * normal;
+    if (tangential.norm() > bound) {
+      tangential =
+          tangential.norm() > 0 ? V3(tangential * (bound / tangential.norm())) : V3(V3::Zero());
+    }
+    trial.normal_force[k] = normal;
+    trial.tangential_force[k] = tangential;
+    trial.forces[k] = normal * group.normal(k) + tangential;
+  }
+  trial.response = group.respond(trial.forces, true);
+}
+
+/// A pressed contact left with no force only touches (a neighbour on the floor): it carries
+/// nothing and lasts no more than any touching pair.
+void releaseUnloaded(const Trial& trial, std::vector<Mode>& modes) {
+  const Real force_scale = largestNormalForce(trial);
+  for (std::size_t k = 0; k < modes.size(); ++k) {
+    if (modes[k].pressed && trial.normal_force[k] <= kTolerance * force_scale) {
+      modes[k].pressed = false;
+    }
+  }
+}
+
+/// Baraff's and Coulomb's conditions (header) by their modes: from a first guess, the forces of
+/// the modes (solveModes), and where a mode fails the contact changes it, all failing contacts
+/// at once (the worst first where that cycles), until none fails or the iterations run out.
 ContactForceSolution solveContactModes(const std::vector<ForceBody>& bodies,
                                        const std::vector<ForceContact>& contacts,
                                        const ContactForceSettings& settings) {
   const Group group(bodies, contacts);
-  const std::size_t count = contacts.size();
-  std::vector<Real> friction(count);
-  for (std::size_t k = 0; k < count; ++k) friction[k] = contacts[k].friction;
-
+  std::vector<Real> friction(contacts.size());
+  for (std::size_t k = 0; k < contacts.size(); ++k) friction[k] = contacts[k].friction;
   const Scales scales = scalesOf(bodies, settings);
-  const Real acceleration_scale = scales.acceleration;
-  const Real tolerance = kTolerance;
-  const Real slip_tolerance = scales.slip_tolerance;
-
-  std::vector<Mode> modes(count);
-  // The first guess: pressed where the gap would close with no contact force at all (the
-  // floor under a ball), free where it would not (two balls side by side that fall together);
-  // the iteration below corrects it. A good guess keeps the first solve small.
-  const Response unpressed = group.respond(std::vector<V3>(count, V3::Zero()), true);
-  for (std::size_t k = 0; k < count; ++k) {
-    modes[k].pressed =
-        unpressed.gap_acceleration[k] < -tolerance * std::max(acceleration_scale, Real(1e-300));
-  }
-  for (std::size_t k = 0; k < count; ++k) {
-    if (!modes[k].pressed) continue;
-    if (friction[k] > 0) {
-      const V3& slip = group.slip(k);
-      if (slip.norm() > slip_tolerance) {
-        modes[k].tangential = Tangential::kSlide;
-        modes[k].slide_direction = slip.normalized();
-      } else {
-        modes[k].tangential = Tangential::kStick;
-      }
-    }
-  }
-
-  ContactForceSolution result;
+  std::vector<Mode> modes = guessModes(group, friction, scales);
   Trial trial;
   std::set<std::vector<int>> seen;
   bool one_at_a_time = false;
   bool settled = false;
   for (int iteration = 0; iteration < settings.max_iterations; ++iteration) {
     trial = solveModes(group, modes, friction);
-    Real force_scale = 0;
-    for (std::size_t k = 0; k < count; ++k) {
-      force_scale = std::max(force_scale, std::abs(trial.normal_force[k]));
-    }
-    // Each failing condition with its size (in units of its scale), to change the worst first
-    // when changing all at once cycles.
-    struct Change {
-      std::size_t contact;
-      Real size;
-      Mode mode;
-    };
-    std::vector<Change> changes;
-    for (std::size_t k = 0; k < count; ++k) {
-      const Mode& mode = modes[k];
-      Mode next = mode;
-      Real size = 0;
-      if (mode.pressed) {
-        const Real normal = trial.normal_force[k];
-        if (normal < -tolerance * force_scale) {  // it would pull: let it go
-          next.pressed = false;
-          size = -normal / std::max(force_scale, Real(1e-300));
-        } else if (mode.tangential == Tangential::kStick) {
-          const Real needed = trial.tangential_force[k].norm();
-          const Real bound = friction[k] * std::max(normal, Real(0));
-          if (needed > bound * (1 + tolerance) + tolerance * force_scale * friction[k]) {
-            // Static friction cannot hold it: it starts to slide, the friction against the
-            // direction the sticking force pointed away from.
-            next.tangential = Tangential::kSlide;
-            next.slide_direction = -trial.tangential_force[k] / needed;
-            size = (needed - bound) / std::max(force_scale, Real(1e-300));
-          }
-        } else if (mode.tangential == Tangential::kSlide &&
-                   group.slip(k).norm() <= slip_tolerance) {
-          // Starting to slide: the slip must grow along the direction taken.
-          const V3& rate = trial.response.slip_acceleration[k];
-          const Real along = rate.dot(mode.slide_direction);
-          if (along < -tolerance * acceleration_scale) {
-            next.tangential = Tangential::kStick;
-            size = -along / std::max(acceleration_scale, Real(1e-300));
-          } else if (rate.norm() > tolerance * acceleration_scale &&
-                     (rate.normalized() - mode.slide_direction).norm() > 1e-12L) {
-            next.slide_direction = rate.normalized();  // follow the slip it starts
-            size = (rate.normalized() - mode.slide_direction).norm();
-          }
-        }
-      } else {
-        const Real gap = trial.response.gap_acceleration[k];
-        if (gap < -tolerance * std::max(acceleration_scale, Real(1e-300))) {  // it would close
-          next.pressed = true;
-          size = -gap / std::max(acceleration_scale, Real(1e-300));
-        }
-      }
-      if (size > 0) changes.push_back(Change{k, size, next});
-    }
+    const std::vector<Change> changes = failingModes(group, modes, trial, friction, scales);
     if (changes.empty()) {
       settled = true;
       break;
     }
-    std::vector<int> signature;
-    for (const Mode& mode : modes) {
-      signature.push_back(mode.pressed * 4 + static_cast<int>(mode.tangential));
-    }
-    if (!seen.insert(signature).second) one_at_a_time = true;  // all at once cycled
-    if (one_at_a_time) {
-      // The largest failure; among equal ones (mirror images) all of them.
-      Real largest = 0;
-      for (const Change& change : changes) largest = std::max(largest, change.size);
-      for (const Change& change : changes) {
-        if (change.size >= largest * (1 - 1e-9L)) modes[change.contact] = change.mode;
-      }
-    } else {
-      for (const Change& change : changes) modes[change.contact] = change.mode;
-    }
-    for (Mode& mode : modes) {
-      if (!mode.pressed) mode.tangential = Tangential::kNone;
-    }
-    for (std::size_t k = 0; k < count; ++k) {
-      if (modes[k].pressed && modes[k].tangential == Tangential::kNone && friction[k] > 0) {
-        // A contact pressed again takes up friction by its slip.
-        const V3& slip = group.slip(k);
-        if (slip.norm() > slip_tolerance) {
-          modes[k].tangential = Tangential::kSlide;
-          modes[k].slide_direction = slip.normalized();
-        } else {
-          modes[k].tangential = Tangential::kStick;
-        }
-      }
-    }
+    if (!seen.insert(modeSignature(modes)).second) one_at_a_time = true;  // all at once cycled
+    changeModes(group, friction, scales.slip_tolerance, changes, one_at_a_time, modes);
   }
-
+  ContactForceSolution result;
   result.converged = settled;
-  if (!settled) {
-    // Keep the last forces, clamped: no contact pulls, no friction beyond mu N.
-    for (std::size_t k = 0; k < count; ++k) {
-      const Real normal = std::max(trial.normal_force[k], Real(0));
-      V3 tangential = trial.tangential_force[k];
-      const Real bound = friction[k] * normal;
-      if (tangential.norm() > bound) {
-        tangential =
-            tangential.norm() > 0 ? V3(tangential * (bound / tangential.norm())) : V3(V3::Zero());
-      }
-      trial.normal_force[k] = normal;
-      trial.tangential_force[k] = tangential;
-      trial.forces[k] = normal * group.normal(k) + tangential;
-    }
-    trial.response = group.respond(trial.forces, true);
-  }
-  // A pressed contact left with no force only touches (a neighbour on the floor): it carries
-  // nothing and lasts no more than any touching pair.
-  Real force_scale = 0;
-  for (std::size_t k = 0; k < count; ++k) {
-    force_scale = std::max(force_scale, std::abs(trial.normal_force[k]));
-  }
-  for (std::size_t k = 0; k < count; ++k) {
-    if (modes[k].pressed && trial.normal_force[k] <= tolerance * force_scale) {
-      modes[k].pressed = false;
-    }
-  }
+  if (!settled) clampForces(group, friction, trial);
+  releaseUnloaded(trial, modes);
   package(group, trial, modes, scales, true, result);
   return result;
 }
