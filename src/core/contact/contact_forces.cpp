@@ -547,164 +547,220 @@ void closeContactVelocities(std::vector<ForceBody>& bodies,
 
 namespace {
 
+/// A block's friction problem, dense: the minimum of E(x) = x'A x / 2 + s'x over the discs
+/// |x_k| <= b_k (`coupling` A, `slip` s, `bound` b; x_k = x[2 k], x[2 k + 1] in contact k's
+/// tangent basis).
+struct DiscProblem {
+  const Matrix& coupling;
+  const Vector& slip;
+  const std::vector<Real>& bound;
+
+  Eigen::Index size() const { return slip.size(); }
+  Eigen::Index discs() const { return slip.size() / 2; }
+  Real b(Eigen::Index k) const { return bound[static_cast<std::size_t>(k)]; }
+  Real energy(const Vector& x) const { return 0.5L * x.dot(coupling * x) + slip.dot(x); }
+  /// b_k^2 - |x_k|^2: > 0 inside disc k.
+  Real room(const Vector& x, Eigen::Index k) const {
+    return b(k) * b(k) - x.segment<2>(2 * k).squaredNorm();
+  }
+};
+
+/// The scale of the energies: what stopping every slip alone would remove.
+Real energyScale(const DiscProblem& problem) {
+  Real scale = 0;
+  for (Eigen::Index i = 0; i < problem.size(); ++i) {
+    scale = std::max(scale, std::abs(problem.slip[i]) * problem.b(i / 2));
+  }
+  return scale;
+}
+
+/// The contacts at their disc's edge take the bound exactly, against the slip A x + s they
+/// leave.
+void pressEdgesToBound(const DiscProblem& problem, const std::vector<char>& edge, Vector& x) {
+  const Vector residual = problem.coupling * x + problem.slip;  // the slips left
+  for (Eigen::Index k = 0; k < problem.discs(); ++k) {
+    if (!edge[static_cast<std::size_t>(k)]) continue;
+    const Eigen::Matrix<Real, 2, 1> left = residual.segment<2>(2 * k);
+    const Real b = problem.b(k);
+    if (left.norm() > 0) {
+      x.segment<2>(2 * k) = -b * left.normalized();
+    } else if (x.segment<2>(2 * k).norm() > b) {
+      x.segment<2>(2 * k) *= b / x.segment<2>(2 * k).norm();
+    }
+  }
+}
+
+/// The contacts inside their discs stop their slip exactly, the edge ones' impulses given: the
+/// rows of A x + s = 0 of the inner unknowns, solved for them (least squares, minimum norm).
+void stopInnerSlips(const DiscProblem& problem, const std::vector<char>& edge, Vector& x) {
+  std::vector<Eigen::Index> inner;
+  for (Eigen::Index i = 0; i < problem.size(); ++i) {
+    if (!edge[static_cast<std::size_t>(i / 2)]) inner.push_back(i);
+  }
+  if (inner.empty()) return;
+  const auto n = static_cast<Eigen::Index>(inner.size());
+  Matrix system(n, n);
+  Vector target(n);
+  for (Eigen::Index r = 0; r < n; ++r) {
+    target[r] = -problem.slip[inner[r]];
+    for (Eigen::Index j = 0; j < problem.size(); ++j) {
+      if (edge[static_cast<std::size_t>(j / 2)]) {
+        target[r] -= problem.coupling(inner[r], j) * x[j];
+      }
+    }
+    for (Eigen::Index c = 0; c < n; ++c) system(r, c) = problem.coupling(inner[r], inner[c]);
+  }
+  const Vector solved = system.completeOrthogonalDecomposition().solve(target);
+  for (Eigen::Index r = 0; r < n; ++r) x[inner[r]] = solved[r];
+}
+
+/// Whether Coulomb's conditions hold at x: an edge contact's impulse against the slip left
+/// (not reversing it), an inner one within its bound with its slip stopped; and whether an edge
+/// impulse has yet to settle along the slip left (to within rounding).
+struct CoulombVerdict {
+  bool holds = true;
+  bool moved = false;
+};
+
+CoulombVerdict coulombVerdict(const DiscProblem& problem, const std::vector<char>& edge,
+                              const Vector& x) {
+  const Vector left = problem.coupling * x + problem.slip;
+  CoulombVerdict verdict;
+  for (Eigen::Index k = 0; k < problem.discs() && verdict.holds; ++k) {
+    const Real b = problem.b(k);
+    const Eigen::Matrix<Real, 2, 1> xk = x.segment<2>(2 * k), lk = left.segment<2>(2 * k);
+    if (edge[static_cast<std::size_t>(k)]) {
+      if (lk.norm() == 0) continue;
+      verdict.holds = xk.dot(lk) <= 0;
+      if ((xk / b + lk.normalized()).norm() > 1e-15L) verdict.moved = true;
+    } else {
+      verdict.holds = xk.norm() <= b && lk.norm() <= 1e-15L * (problem.slip.norm() + 1);
+    }
+  }
+  return verdict;
+}
+
+/// Where a condition fails, the contact changes sides (all at once): an inner one beyond its
+/// bound goes to the edge, an edge one whose impulse would reverse the slip goes inside.
+void switchSides(const DiscProblem& problem, const Vector& x, std::vector<char>& edge) {
+  const Vector left = problem.coupling * x + problem.slip;
+  for (Eigen::Index k = 0; k < problem.discs(); ++k) {
+    const Real b = problem.b(k);
+    const Eigen::Matrix<Real, 2, 1> xk = x.segment<2>(2 * k), lk = left.segment<2>(2 * k);
+    char& on_edge = edge[static_cast<std::size_t>(k)];
+    if (!on_edge && xk.norm() > b) {
+      on_edge = 1;
+    } else if (on_edge && xk.dot(lk) > 0) {
+      on_edge = 0;
+    }
+  }
+}
+
+/// Coulomb's conditions for a given set of contacts at their disc's edge: those take the bound
+/// exactly, against the slip they leave; the others stop their slip exactly (a linear solve);
+/// repeated while the edge directions move. True (and `x` set) when they then hold; else `x` is
+/// the last attempt and `edge` switched where a condition failed.
+bool polishCoulomb(const DiscProblem& problem, Vector& x, std::vector<char>& edge) {
+  Vector polished = x;
+  for (int round = 0; round < 8; ++round) {
+    pressEdgesToBound(problem, edge, polished);
+    stopInnerSlips(problem, edge, polished);
+    const CoulombVerdict verdict = coulombVerdict(problem, edge, polished);
+    if (verdict.holds && !verdict.moved) {
+      x = polished;
+      return true;
+    }
+    if (!verdict.holds) break;
+  }
+  switchSides(problem, polished, edge);
+  x = polished;
+  return false;
+}
+
+/// The barrier objective t E(y) - sum_k log(b_k^2 - |y_k|^2).
+Real barrierObjective(const DiscProblem& problem, Real t, const Vector& y) {
+  Real value = t * problem.energy(y);
+  for (Eigen::Index k = 0; k < problem.discs(); ++k) value -= std::log(problem.room(y, k));
+  return value;
+}
+
+/// One damped Newton step on the barrier objective at x for weight t: false where it no longer
+/// decreases (the decrement below 1e-20, or no step length that stays inside every disc and
+/// decreases it by a quarter of the decrement times the length: Armijo backtracking).
+bool newtonStep(const DiscProblem& problem, Real t, Vector& x) {
+  Vector gradient = t * (problem.coupling * x + problem.slip);
+  Matrix hessian = t * problem.coupling;
+  for (Eigen::Index k = 0; k < problem.discs(); ++k) {
+    // -log g, g = b^2 - |x_k|^2: gradient 2 x_k / g, Hessian 2 I / g + 4 x_k x_k' / g^2.
+    const Real g = problem.room(x, k);
+    const Eigen::Matrix<Real, 2, 1> xk = x.segment<2>(2 * k);
+    gradient.segment<2>(2 * k) += (2 / g) * xk;
+    hessian.block<2, 2>(2 * k, 2 * k) +=
+        (2 / g) * Eigen::Matrix<Real, 2, 2>::Identity() + (4 / (g * g)) * xk * xk.transpose();
+  }
+  const Vector step = -hessian.ldlt().solve(gradient);
+  const Real decrement = -gradient.dot(step);
+  if (!(decrement > 1e-20L)) return false;
+  const Real here = barrierObjective(problem, t, x);
+  Real length = 1;
+  for (int halving = 0; halving < 60; ++halving, length *= 0.5L) {
+    const Vector y = x + length * step;
+    bool inside = true;
+    for (Eigen::Index k = 0; k < problem.discs() && inside; ++k) inside = problem.room(y, k) > 0;
+    if (inside && barrierObjective(problem, t, y) <= here - 0.25L * length * decrement) {
+      x = y;
+      return true;
+    }
+  }
+  return false;
+}
+
+/// The primal barrier method (Boyd and Vandenberghe, "Convex Optimization", 2004, section
+/// 11.3): from x = 0, Newton's method on t E(x) - sum log(b^2 - |x_k|^2) for t growing tenfold,
+/// until the duality gap discs / t is below 1e-14 of the energies (nearer the discs' edges
+/// b^2 - |x|^2 loses its digits). Where A is singular the barrier tends to the centre of the
+/// optimal set, so the answer depends on no order.
+Vector barrierMinimum(const DiscProblem& problem) {
+  const Real scale = energyScale(problem);
+  Vector x = Vector::Zero(problem.size());
+  Real t = 1 / std::max(scale, Real(1e-300));
+  const Real gap_wanted = 1e-14L * std::max(scale, Real(1e-300));
+  for (int outer = 0; outer < 40; ++outer) {
+    for (int newton = 0; newton < 50; ++newton) {
+      if (!newtonStep(problem, t, x)) break;
+    }
+    if (Real(problem.discs()) / t < gap_wanted) break;
+    t *= 10;
+  }
+  return x;
+}
+
 /// The friction impulses x (each contact's, in its tangent basis: x[2 k], x[2 k + 1]) of a block
 /// small enough for dense algebra: the minimum of E(x) = x'A x / 2 + s'x over the discs
 /// |x_k| <= b_k (`coupling` A, `slip` s, `bound` b). First Coulomb's conditions solved exactly
-/// from the sticking answer; where they do not settle, a primal barrier method (Newton's method
-/// on t E(x) - sum log(b^2 - |x_k|^2) for t growing, in long double), then the same exact
-/// conditions from its answer. Where A is singular (redundant contacts) the barrier tends to the
-/// centre of the optimal set, so the answer depends on no order.
+/// from the sticking answer (fast, and usually right at once); where they do not settle, a
+/// primal barrier method (barrierMinimum, in long double), then the same exact conditions from
+/// its answer.
 Vector frictionByBarrier(const Matrix& coupling, const Vector& slip,
                          const std::vector<Real>& bound) {
-  const Eigen::Index size = slip.size();
-  const Eigen::Index disc = size / 2;
-  const auto energy = [&](const Vector& x) { return 0.5L * x.dot(coupling * x) + slip.dot(x); };
-  const auto room = [&](const Vector& x, Eigen::Index k) {
-    return bound[static_cast<std::size_t>(k)] * bound[static_cast<std::size_t>(k)] -
-           x.segment<2>(2 * k).squaredNorm();
-  };
-  // The scale of the energies: what stopping every slip alone would remove.
-  Real scale = 0;
-  for (Eigen::Index i = 0; i < size; ++i) {
-    scale = std::max(scale, std::abs(slip[i]) * bound[static_cast<std::size_t>(i / 2)]);
-  }
-  // Coulomb's conditions for a given set of contacts at their disc's edge: those take the
-  // bound exactly, against the slip they leave; the others stop their slip exactly (a linear
-  // solve); repeated while the edge directions move. True (and `x` set) when they then hold.
-  const auto polish = [&](Vector& x, std::vector<char>& edge) {
-    Vector polished = x;
-    for (int round = 0; round < 8; ++round) {
-      const Vector residual = coupling * polished + slip;  // the slips left
-      for (Eigen::Index k = 0; k < disc; ++k) {
-        if (!edge[static_cast<std::size_t>(k)]) continue;
-        const Eigen::Matrix<Real, 2, 1> left = residual.segment<2>(2 * k);
-        const Real b = bound[static_cast<std::size_t>(k)];
-        if (left.norm() > 0) {
-          polished.segment<2>(2 * k) = -b * left.normalized();
-        } else if (polished.segment<2>(2 * k).norm() > b) {
-          polished.segment<2>(2 * k) *= b / polished.segment<2>(2 * k).norm();
-        }
-      }
-      std::vector<Eigen::Index> inner;
-      for (Eigen::Index i = 0; i < size; ++i) {
-        if (!edge[static_cast<std::size_t>(i / 2)]) inner.push_back(i);
-      }
-      if (!inner.empty()) {
-        const auto n = static_cast<Eigen::Index>(inner.size());
-        Matrix system(n, n);
-        Vector target(n);
-        for (Eigen::Index r = 0; r < n; ++r) {
-          target[r] = -slip[inner[r]];
-          for (Eigen::Index j = 0; j < size; ++j) {
-            if (edge[static_cast<std::size_t>(j / 2)]) {
-              target[r] -= coupling(inner[r], j) * polished[j];
-            }
-          }
-          for (Eigen::Index c = 0; c < n; ++c) system(r, c) = coupling(inner[r], inner[c]);
-        }
-        const Vector solved = system.completeOrthogonalDecomposition().solve(target);
-        for (Eigen::Index r = 0; r < n; ++r) polished[inner[r]] = solved[r];
-      }
-      const Vector left = coupling * polished + slip;
-      bool holds = true;
-      bool moved = false;
-      for (Eigen::Index k = 0; k < disc && holds; ++k) {
-        const Real b = bound[static_cast<std::size_t>(k)];
-        const Eigen::Matrix<Real, 2, 1> xk = polished.segment<2>(2 * k),
-                                        lk = left.segment<2>(2 * k);
-        if (edge[static_cast<std::size_t>(k)]) {
-          // Against the slip left (not reversing it), along it to within rounding.
-          if (lk.norm() == 0) continue;
-          holds = xk.dot(lk) <= 0;
-          if ((xk / b + lk.normalized()).norm() > 1e-15L) moved = true;
-        } else {
-          holds = xk.norm() <= b && lk.norm() <= 1e-15L * (slip.norm() + 1);
-        }
-      }
-      if (holds && !moved) {
-        x = polished;
-        return true;
-      }
-      if (!holds) break;
-    }
-    // Where a condition fails, the contact changes sides (all at once).
-    const Vector left = coupling * polished + slip;
-    bool changed = false;
-    for (Eigen::Index k = 0; k < disc; ++k) {
-      const Real b = bound[static_cast<std::size_t>(k)];
-      const Eigen::Matrix<Real, 2, 1> xk = polished.segment<2>(2 * k), lk = left.segment<2>(2 * k);
-      char& on_edge = edge[static_cast<std::size_t>(k)];
-      if (!on_edge && xk.norm() > b) {
-        on_edge = 1;
-        changed = true;
-      } else if (on_edge && xk.dot(lk) > 0) {
-        on_edge = 0;
-        changed = true;
-      }
-    }
-    x = polished;
-    static_cast<void>(changed);
-    return false;
-  };
-  // First the exact conditions from the sticking answer (fast, and usually right at once);
-  // where they do not settle, the barrier method, then the same polish from its answer.
-  Vector x = coupling.completeOrthogonalDecomposition().solve(-slip);
+  const DiscProblem problem{coupling, slip, bound};
+  const Eigen::Index disc = problem.discs();
+  Vector x = coupling.completeOrthogonalDecomposition().solve(-slip);  // sticking everywhere
   std::vector<char> edge(static_cast<std::size_t>(disc), 0);
   for (Eigen::Index k = 0; k < disc; ++k) {
-    edge[static_cast<std::size_t>(k)] =
-        x.segment<2>(2 * k).norm() > bound[static_cast<std::size_t>(k)];
+    edge[static_cast<std::size_t>(k)] = x.segment<2>(2 * k).norm() > problem.b(k);
   }
   bool settled = false;
-  for (int attempt = 0; attempt < 8 && !settled; ++attempt) settled = polish(x, edge);
-  if (!settled) {
-    x = Vector::Zero(size);
-    Real t = 1 / std::max(scale, Real(1e-300));
-    // To 1e-14 of the energies: nearer the discs' edges b^2 - |x|^2 loses its digits.
-    const Real gap_wanted = 1e-14L * std::max(scale, Real(1e-300));
-    for (int outer = 0; outer < 40; ++outer) {
-      for (int newton = 0; newton < 50; ++newton) {
-        Vector gradient = t * (coupling * x + slip);
-        Matrix hessian = t * coupling;
-        for (Eigen::Index k = 0; k < disc; ++k) {
-          const Real g = room(x, k);
-          const Eigen::Matrix<Real, 2, 1> xk = x.segment<2>(2 * k);
-          gradient.segment<2>(2 * k) += (2 / g) * xk;
-          hessian.block<2, 2>(2 * k, 2 * k) +=
-              (2 / g) * Eigen::Matrix<Real, 2, 2>::Identity() + (4 / (g * g)) * xk * xk.transpose();
-        }
-        const Vector step = -hessian.ldlt().solve(gradient);
-        const Real decrement = -gradient.dot(step);
-        if (!(decrement > 1e-20L)) break;
-        // Backtracking: inside every disc, and the barrier objective decreasing enough.
-        const auto objective = [&](const Vector& y) {
-          Real value = t * energy(y);
-          for (Eigen::Index k = 0; k < disc; ++k) value -= std::log(room(y, k));
-          return value;
-        };
-        const Real here = objective(x);
-        bool moved = false;
-        Real length = 1;
-        for (int halving = 0; halving < 60 && !moved; ++halving, length *= 0.5L) {
-          const Vector y = x + length * step;
-          bool inside = true;
-          for (Eigen::Index k = 0; k < disc && inside; ++k) inside = room(y, k) > 0;
-          if (inside && objective(y) <= here - 0.25L * length * decrement) {
-            x = y;
-            moved = true;
-          }
-        }
-        if (!moved) break;
-      }
-      if (Real(disc) / t < gap_wanted) break;
-      t *= 10;
-    }
-    for (Eigen::Index k = 0; k < disc; ++k) {
-      edge[static_cast<std::size_t>(k)] =
-          x.segment<2>(2 * k).norm() >= bound[static_cast<std::size_t>(k)] * (1 - 1e-8L);
-    }
-    Vector polished = x;
-    if (polish(polished, edge)) x = polished;
+  for (int attempt = 0; attempt < 8 && !settled; ++attempt) {
+    settled = polishCoulomb(problem, x, edge);
   }
+  if (settled) return x;
+  x = barrierMinimum(problem);
+  for (Eigen::Index k = 0; k < disc; ++k) {
+    edge[static_cast<std::size_t>(k)] = x.segment<2>(2 * k).norm() >= problem.b(k) * (1 - 1e-8L);
+  }
+  Vector polished = x;
+  if (polishCoulomb(problem, polished, edge)) x = polished;
   return x;
 }
 
