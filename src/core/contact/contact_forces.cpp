@@ -793,95 +793,141 @@ constexpr int kFrictionIterations = 10000;
 /// (x = 0 at worst), returning false. Every sum (rows of A x, the energy, dot products, the
 /// bound) is order-free and sign-symmetric (orderFreeSum), so renaming the bodies or mirroring
 /// the cluster changes no bit.
-bool frictionByProjectedGradient(const CouplingRows& rows, const Vector& slip,
-                                 const std::vector<Real>& bound, Vector& solution) {
-  const Eigen::Index size = slip.size();
-  const Eigen::Index discs = size / 2;
-  std::vector<Real> terms;
-  const auto apply = [&](const Vector& v) {
-    Vector out(size);
-    for (Eigen::Index i = 0; i < size; ++i) {
-      terms.clear();
-      for (const auto& [j, value] : rows[static_cast<std::size_t>(i)]) {
-        terms.push_back(value * v[j]);
+/// A block's friction problem by A's nonzeros (CouplingRows), every sum order-free.
+class SparseDiscProblem {
+ public:
+  SparseDiscProblem(const CouplingRows& rows, const Vector& slip, const std::vector<Real>& bound)
+      : rows_(rows), slip_(slip), bound_(bound) {}
+
+  Eigen::Index size() const { return slip_.size(); }
+  Eigen::Index discs() const { return slip_.size() / 2; }
+
+  /// A v, row by row.
+  Vector apply(const Vector& v) {
+    Vector out(size());
+    for (Eigen::Index i = 0; i < size(); ++i) {
+      terms_.clear();
+      for (const auto& [j, value] : rows_[static_cast<std::size_t>(i)]) {
+        terms_.push_back(value * v[j]);
       }
-      out[i] = orderFreeSum(terms);
+      out[i] = orderFreeSum(terms_);
     }
     return out;
-  };
-  const auto energy = [&](const Vector& v, const Vector& coupled) {  // E(v), A v given
-    terms.clear();
-    for (Eigen::Index i = 0; i < size; ++i) terms.push_back(v[i] * (0.5L * coupled[i] + slip[i]));
-    return orderFreeSum(terms);
-  };
-  const auto dot = [&](const Vector& u, const Vector& v) {
-    terms.clear();
-    for (Eigen::Index i = 0; i < size; ++i) terms.push_back(u[i] * v[i]);
-    return orderFreeSum(terms);
-  };
-  const auto project = [&](Vector& v) {
-    for (Eigen::Index k = 0; k < discs; ++k) {
-      const Real length = v.segment<2>(2 * k).norm(), b = bound[static_cast<std::size_t>(k)];
-      if (length > b) v.segment<2>(2 * k) *= b / length;
-    }
-  };
-  Real lipschitz = 0, largest_slip = 0;
-  for (Eigen::Index i = 0; i < size; ++i) {
-    terms.clear();
-    for (const auto& entry : rows[static_cast<std::size_t>(i)]) {
-      terms.push_back(std::abs(entry.second));
-    }
-    lipschitz = std::max(lipschitz, orderFreeSum(terms));
   }
-  for (Eigen::Index k = 0; k < discs; ++k) {
-    largest_slip = std::max(largest_slip, slip.segment<2>(2 * k).norm());
+  /// E(v), A v given.
+  Real energy(const Vector& v, const Vector& coupled) {
+    terms_.clear();
+    for (Eigen::Index i = 0; i < size(); ++i) {
+      terms_.push_back(v[i] * (0.5L * coupled[i] + slip_[i]));
+    }
+    return orderFreeSum(terms_);
   }
-  solution = Vector::Zero(size);
-  if (!(lipschitz > 0)) return false;  // no contact moves a body: no impulse does anything
-  const Real tolerance = kFrictionResidual * largest_slip;
-  // The residual at v, A v given.
-  const auto residual = [&](const Vector& v, const Vector& coupled) {
-    Vector step = v - (coupled + slip) / lipschitz;
-    project(step);
+  Real dot(const Vector& u, const Vector& v) {
+    terms_.clear();
+    for (Eigen::Index i = 0; i < size(); ++i) terms_.push_back(u[i] * v[i]);
+    return orderFreeSum(terms_);
+  }
+  /// L = max_i sum_j |A_ij|: at least A's largest eigenvalue (Gershgorin).
+  Real lipschitz() {
+    Real bound = 0;
+    for (Eigen::Index i = 0; i < size(); ++i) {
+      terms_.clear();
+      for (const auto& entry : rows_[static_cast<std::size_t>(i)]) {
+        terms_.push_back(std::abs(entry.second));
+      }
+      bound = std::max(bound, orderFreeSum(terms_));
+    }
+    return bound;
+  }
+  Real largestSlip() const {
+    Real largest = 0;
+    for (Eigen::Index k = 0; k < discs(); ++k) {
+      largest = std::max(largest, slip_.segment<2>(2 * k).norm());
+    }
+    return largest;
+  }
+  /// P(v - (A v + s) / L), A v given: a gradient step of length 1/L projected onto the discs.
+  Vector projectedStep(const Vector& v, const Vector& coupled, Real lipschitz) const {
+    Vector step = v - (coupled + slip_) / lipschitz;
+    for (Eigen::Index k = 0; k < discs(); ++k) {
+      const Real length = step.segment<2>(2 * k).norm(), b = bound_[static_cast<std::size_t>(k)];
+      if (length > b) step.segment<2>(2 * k) *= b / length;
+    }
+    return step;
+  }
+  /// The projected-gradient residual L |v - P(v - (A v + s) / L)|, its largest per contact.
+  Real residual(const Vector& v, const Vector& coupled, Real lipschitz) const {
+    const Vector step = projectedStep(v, coupled, lipschitz);
     Real worst = 0;
-    for (Eigen::Index k = 0; k < discs; ++k) {
+    for (Eigen::Index k = 0; k < discs(); ++k) {
       worst = std::max(worst, lipschitz * (v.segment<2>(2 * k) - step.segment<2>(2 * k)).norm());
     }
     return worst;
-  };
-  Vector x = Vector::Zero(size), coupled_x = Vector::Zero(size);  // the last iterate, A x
-  Vector y = x, coupled_y = coupled_x;  // where the next step starts (x plus momentum), A y
-  Vector lowest = x;                    // the iterate of the lowest energy so far
-  Real lowest_energy = 0, energy_x = 0, momentum = 1;
+  }
+
+ private:
+  const CouplingRows& rows_;
+  const Vector& slip_;
+  const std::vector<Real>& bound_;
+  std::vector<Real> terms_;  // the sums' terms (orderFreeSum orders them in place)
+};
+
+/// The accelerated iteration's state: the last iterate x, where the next step starts (x plus
+/// momentum) y, each with its A times it, and the momentum's weight.
+struct AcceleratedIterate {
+  Vector x, coupled_x, y, coupled_y;
+  Real momentum = 1;
+};
+
+/// The iteration moves on to z (A z given): its momentum restarted where it points against the
+/// step taken (O'Donoghue and Candes), else carried by Beck and Teboulle's weights
+/// m' = (1 + sqrt(1 + 4 m^2)) / 2, y = z + (m - 1) / m' (z - x).
+void advance(SparseDiscProblem& problem, Vector z, const Vector& coupled_z,
+             AcceleratedIterate& it) {
+  if (problem.dot(it.y - z, z - it.x) > 0) {
+    it.y = z;
+    it.coupled_y = coupled_z;
+    it.momentum = 1;
+  } else {
+    const Real next = (1 + std::sqrt(1 + 4 * it.momentum * it.momentum)) / 2;
+    const Real carried = (it.momentum - 1) / next;
+    it.y = z + carried * (z - it.x);
+    it.coupled_y = coupled_z + carried * (coupled_z - it.coupled_x);  // A y, by linearity
+    it.momentum = next;
+  }
+  it.x = std::move(z);
+  it.coupled_x = coupled_z;
+}
+
+bool frictionByProjectedGradient(const CouplingRows& rows, const Vector& slip,
+                                 const std::vector<Real>& bound, Vector& solution) {
+  SparseDiscProblem problem(rows, slip, bound);
+  const Eigen::Index size = problem.size();
+  const Real lipschitz = problem.lipschitz();
+  const Real largest_slip = problem.largestSlip();
+  solution = Vector::Zero(size);
+  if (!(lipschitz > 0)) return false;  // no contact moves a body: no impulse does anything
+  const Real tolerance = kFrictionResidual * largest_slip;
+  AcceleratedIterate it{Vector::Zero(size), Vector::Zero(size), Vector::Zero(size),
+                        Vector::Zero(size)};
+  Vector lowest = it.x;  // the iterate of the lowest energy so far
+  Real lowest_energy = 0, energy_x = 0;
   bool settled = false;
-  int iteration = 0;
-  for (; iteration < kFrictionIterations && !settled; ++iteration) {
-    Vector z = y - (coupled_y + slip) / lipschitz;
-    project(z);
-    const Vector coupled_z = apply(z);
-    energy_x = energy(z, coupled_z);
+  for (int iteration = 0; iteration < kFrictionIterations && !settled; ++iteration) {
+    Vector z = problem.projectedStep(it.y, it.coupled_y, lipschitz);
+    const Vector coupled_z = problem.apply(z);
+    energy_x = problem.energy(z, coupled_z);
     if (energy_x <= lowest_energy) {
       lowest = z;
       lowest_energy = energy_x;
     }
-    settled = residual(z, coupled_z) <= tolerance || z == x;  // or a fixed point of the rounding
-    if (dot(y - z, z - x) > 0) {  // the momentum points against the step: restart it
-      y = z;
-      coupled_y = coupled_z;
-      momentum = 1;
-    } else {
-      const Real next = (1 + std::sqrt(1 + 4 * momentum * momentum)) / 2;
-      const Real carried = (momentum - 1) / next;
-      y = z + carried * (z - x);
-      coupled_y = coupled_z + carried * (coupled_z - coupled_x);  // A y, by linearity
-      momentum = next;
-    }
-    x = std::move(z);
-    coupled_x = coupled_z;
+    // Or a fixed point of the rounding.
+    settled = problem.residual(z, coupled_z, lipschitz) <= tolerance || z == it.x;
+    advance(problem, std::move(z), coupled_z, it);
   }
   if (energy_x <= 0) {
-    solution = x;
-    return residual(x, coupled_x) <= tolerance;
+    solution = it.x;
+    return problem.residual(it.x, it.coupled_x, lipschitz) <= tolerance;
   }
   solution = lowest;
   return false;
