@@ -933,6 +933,196 @@ bool frictionByProjectedGradient(const CouplingRows& rows, const Vector& slip,
   return false;
 }
 
+/// The contacts of an impact that can take friction: a bound mu J > 0 and a slip.
+struct FrictionContacts {
+  std::vector<std::size_t> active;  // their indices
+  std::vector<Real> bound;          // per active contact: mu J
+  std::vector<long> slot;           // per contact: its place in `active`, -1 if not there
+};
+
+FrictionContacts frictionContacts(const Group& group, const std::vector<ForceContact>& contacts,
+                                  const std::vector<double>& normal_impulses) {
+  FrictionContacts friction;
+  friction.slot.assign(contacts.size(), -1);
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    const Real b = Real(contacts[k].friction) * Real(normal_impulses[k]);
+    if (b > 0 && group.slip(k).norm() > 0) {
+      friction.slot[k] = static_cast<long>(friction.active.size());
+      friction.active.push_back(k);
+      friction.bound.push_back(b);
+    }
+  }
+  return friction;
+}
+
+/// Contact k's tangent t (0: first, 1: second).
+const V3& tangentOf(const Group& group, std::size_t k, Eigen::Index t) {
+  return t == 0 ? group.first(k) : group.second(k);
+}
+
+/// The tangential coupling of the active contacts: per active contact l, what a unit impulse
+/// along each of its tangents does to the slips of the active contacts m it shares a movable
+/// body with, C(m, l) (row: m's tangents; column: l's), sorted by m; and the blocks of contacts
+/// so connected. Built column by column from each unknown's response (Group::respondToOne), in
+/// O(its nonzeros).
+class TangentialCoupling {
+ public:
+  using Block = Eigen::Matrix<Real, 2, 2>;
+  using Column = std::vector<std::pair<std::size_t, Block>>;
+
+  TangentialCoupling(const Group& group, const FrictionContacts& friction)
+      : columns_(friction.active.size()), connected_(friction.active.size()) {
+    for (std::size_t l = 0; l < friction.active.size(); ++l) {
+      for (Eigen::Index t = 0; t < 2; ++t) {
+        std::size_t visited = 0;  // respondToOne visits in the same order for either force
+        group.respondToOne(friction.active[l], tangentOf(group, friction.active[l], t),
+                           [&](std::size_t k, Real, const V3& slip_change) {
+                             if (friction.slot[k] < 0) return;
+                             const auto m = static_cast<std::size_t>(friction.slot[k]);
+                             if (t == 0) {
+                               columns_[l].emplace_back(m, Block::Zero());
+                               connected_.link(l, m);
+                             }
+                             Block& entry = columns_[l][visited++].second;
+                             entry(0, t) = group.first(k).dot(slip_change);
+                             entry(1, t) = group.second(k).dot(slip_change);
+                           });
+      }
+      std::sort(columns_[l].begin(), columns_[l].end(),
+                [](const auto& p, const auto& q) { return p.first < q.first; });
+    }
+  }
+
+  /// The blocks: sets of active contacts connected through shared movable bodies.
+  std::vector<std::vector<std::size_t>> blocks() { return connected_.sets(); }
+  /// The active contacts m whose slips contact l's impulses change (m, C(m, l)), by m.
+  const Column& column(std::size_t l) const { return columns_[l]; }
+
+  /// The symmetric coupling A(m, l) = (C(m, l) + C(l, m)') / 2 (C is symmetric up to rounding),
+  /// row r of m's tangents, column c of l's.
+  Real operator()(std::size_t m, std::size_t l, Eigen::Index r, Eigen::Index c) const {
+    const Column& column = columns_[l];
+    const Column& row = columns_[m];
+    const auto at = [](const Column& list, std::size_t key) {
+      return std::lower_bound(list.begin(), list.end(), key,
+                              [](const auto& p, std::size_t value) { return p.first < value; });
+    };
+    const auto forward = at(column, m);
+    const auto backward = at(row, l);
+    const Real there = forward != column.end() && forward->first == m ? forward->second(r, c) : 0;
+    const Real back = backward != row.end() && backward->first == l ? backward->second(c, r) : 0;
+    return 0.5L * (there + back);
+  }
+
+ private:
+  std::vector<Column> columns_;
+  ConnectedSets connected_;
+};
+
+/// Visits every coupling entry of a block, visit(row, column, A_ij), in the block's numbering
+/// (contact p of the block: unknowns 2 p and 2 p + 1; `place`: each active contact's p).
+template <class Visit>
+void forEachCouplingEntry(const TangentialCoupling& coupling, const std::vector<std::size_t>& block,
+                          const std::vector<Eigen::Index>& place, Visit visit) {
+  for (std::size_t q = 0; q < block.size(); ++q) {
+    const std::size_t l = block[q];
+    const auto column = static_cast<Eigen::Index>(2 * q);
+    for (const auto& entry : coupling.column(l)) {
+      for (Eigen::Index r = 0; r < 2; ++r) {
+        for (Eigen::Index c = 0; c < 2; ++c) {
+          visit(2 * place[entry.first] + r, column + c, coupling(entry.first, l, r, c));
+        }
+      }
+    }
+  }
+}
+
+/// A block's friction problem in its numbering (contact p of the block: unknowns 2 p, 2 p + 1):
+/// the slips s in the contacts' tangent bases and the bounds b.
+struct BlockProblem {
+  Vector slip;
+  std::vector<Real> bound;
+};
+
+/// The block's problem; `place` takes each of its contacts' p.
+BlockProblem setUpBlock(const Group& group, const FrictionContacts& friction,
+                        const std::vector<std::size_t>& block, std::vector<Eigen::Index>& place) {
+  const auto n = static_cast<Eigen::Index>(block.size());
+  BlockProblem problem{Vector(2 * n), std::vector<Real>(block.size())};
+  for (Eigen::Index p = 0; p < n; ++p) {
+    const std::size_t l = block[static_cast<std::size_t>(p)];
+    place[l] = p;
+    problem.bound[static_cast<std::size_t>(p)] = friction.bound[l];
+    for (Eigen::Index t = 0; t < 2; ++t) {
+      problem.slip[2 * p + t] =
+          tangentOf(group, friction.active[l], t).dot(group.slip(friction.active[l]));
+    }
+  }
+  return problem;
+}
+
+/// The block's impulses x (in its numbering) onto each contact's tangents: its impulse on b.
+void addBlockImpulses(const Group& group, const FrictionContacts& friction,
+                      const std::vector<std::size_t>& block, const Vector& x,
+                      std::vector<V3>& impulses) {
+  for (Eigen::Index j = 0; j < x.size(); ++j) {
+    const std::size_t k = friction.active[block[static_cast<std::size_t>(j / 2)]];
+    impulses[k] += x[j] * tangentOf(group, k, j % 2);
+  }
+}
+
+/// A block's friction impulses x (in its numbering), by dense algebra up to kDenseBlockContacts
+/// contacts (frictionByBarrier), above by the accelerated projected gradient
+/// (frictionByProjectedGradient; false where it stops short of its residual).
+bool frictionOfBlock(const TangentialCoupling& coupling, const std::vector<std::size_t>& block,
+                     const std::vector<Eigen::Index>& place, const Vector& slip,
+                     const std::vector<Real>& bound, Vector& x) {
+  if (block.size() <= kDenseBlockContacts) {
+    Matrix dense = Matrix::Zero(slip.size(), slip.size());
+    forEachCouplingEntry(coupling, block, place,
+                         [&](Eigen::Index i, Eigen::Index j, Real value) { dense(i, j) = value; });
+    x = frictionByBarrier(dense, slip, bound);
+    return true;
+  }
+  CouplingRows rows(static_cast<std::size_t>(slip.size()));
+  forEachCouplingEntry(coupling, block, place, [&](Eigen::Index i, Eigen::Index j, Real value) {
+    if (value != 0) rows[static_cast<std::size_t>(i)].emplace_back(j, value);
+  });
+  return frictionByProjectedGradient(rows, slip, bound, x);
+}
+
+/// The answer in doubles: each contact's impulse (in `tangential`), slip, slip change and mode
+/// (sticking where the impulse stays within its bound), each body's change of velocity (in
+/// `acceleration`) and of angular velocity (in `angular_acceleration`).
+ContactForceSolution storeFrictionImpulses(const Group& group, const FrictionContacts& friction,
+                                           const std::vector<V3>& impulses, std::size_t body_count,
+                                           bool converged) {
+  const Response change = group.respond(impulses, false);
+  ContactForceSolution result;
+  result.converged = converged;
+  result.contacts.resize(impulses.size());
+  for (std::size_t k = 0; k < impulses.size(); ++k) {
+    ContactForce& out = result.contacts[k];
+    out.tangential = impulses[k].cast<double>();
+    out.slip = group.slip(k).cast<double>();
+    out.slip_acceleration = change.slip_acceleration[k].cast<double>();
+    if (friction.slot[k] < 0) {
+      out.mode = ContactMode::kSeparating;
+    } else {
+      const Real b = friction.bound[static_cast<std::size_t>(friction.slot[k])];
+      out.mode =
+          impulses[k].norm() < b * (1 - 1e-9L) ? ContactMode::kSticking : ContactMode::kSliding;
+    }
+  }
+  result.acceleration.resize(body_count);
+  result.angular_acceleration.resize(body_count);
+  for (std::size_t i = 0; i < body_count; ++i) {
+    result.acceleration[i] = change.acceleration[i].cast<double>();
+    result.angular_acceleration[i] = change.angular_acceleration[i].cast<double>();
+  }
+  return result;
+}
+
 }  // namespace
 
 ContactForceSolution solveFrictionImpulses(const std::vector<ForceBody>& bodies,
@@ -950,136 +1140,19 @@ ContactForceSolution solveFrictionImpulses(const std::vector<ForceBody>& bodies,
   // A is built column by column from each unknown's response (Group::respondToOne), in
   // O(its nonzeros).
   const Group group(bodies, contacts);
-  const std::size_t count = contacts.size();
-  std::vector<std::size_t> active;  // contacts that can take friction
-  std::vector<Real> bound;
-  std::vector<long> slot(count, -1);  // each contact's place in `active`, -1 if not there
-  for (std::size_t k = 0; k < count; ++k) {
-    const Real b = Real(contacts[k].friction) * Real(normal_impulses[k]);
-    if (b > 0 && group.slip(k).norm() > 0) {
-      slot[k] = static_cast<long>(active.size());
-      active.push_back(k);
-      bound.push_back(b);
-    }
-  }
-  const auto tangent = [&](std::size_t k, Eigen::Index t) -> const V3& {
-    return t == 0 ? group.first(k) : group.second(k);
-  };
-  // Per active contact l: what a unit impulse along each of its tangents does to the slips of
-  // the active contacts m it shares a movable body with, C(m, l) (row: m's tangents; column:
-  // l's), sorted by m.
-  using Block = Eigen::Matrix<Real, 2, 2>;
-  std::vector<std::vector<std::pair<std::size_t, Block>>> columns(active.size());
-  ConnectedSets connected(active.size());
-  for (std::size_t l = 0; l < active.size(); ++l) {
-    for (Eigen::Index t = 0; t < 2; ++t) {
-      std::size_t visited = 0;  // respondToOne visits in the same order for either force
-      group.respondToOne(active[l], tangent(active[l], t),
-                         [&](std::size_t k, Real, const V3& slip_change) {
-                           if (slot[k] < 0) return;
-                           const auto m = static_cast<std::size_t>(slot[k]);
-                           if (t == 0) {
-                             columns[l].emplace_back(m, Block::Zero());
-                             connected.link(l, m);
-                           }
-                           Block& entry = columns[l][visited++].second;
-                           entry(0, t) = group.first(k).dot(slip_change);
-                           entry(1, t) = group.second(k).dot(slip_change);
-                         });
-    }
-    std::sort(columns[l].begin(), columns[l].end(),
-              [](const auto& p, const auto& q) { return p.first < q.first; });
-  }
-  // The symmetric coupling A(m, l) = (C(m, l) + C(l, m)') / 2: symmetric up to rounding.
-  const auto coupling = [&](std::size_t m, std::size_t l, Eigen::Index r, Eigen::Index c) {
-    const auto& column = columns[l];
-    const auto& row = columns[m];
-    const auto at = [](const std::vector<std::pair<std::size_t, Block>>& list, std::size_t key) {
-      return std::lower_bound(list.begin(), list.end(), key,
-                              [](const auto& p, std::size_t value) { return p.first < value; });
-    };
-    const auto forward = at(column, m);
-    const auto backward = at(row, l);
-    const Real there = forward != column.end() && forward->first == m ? forward->second(r, c) : 0;
-    const Real back = backward != row.end() && backward->first == l ? backward->second(c, r) : 0;
-    return 0.5L * (there + back);
-  };
-  std::vector<V3> impulses(count, V3::Zero());
+  const FrictionContacts friction = frictionContacts(group, contacts, normal_impulses);
+  TangentialCoupling coupling(group, friction);
+  std::vector<V3> impulses(contacts.size(), V3::Zero());
   bool converged = true;
-  std::vector<Eigen::Index> place(active.size(), -1);  // each contact's place in its block
-  for (const std::vector<std::size_t>& block : connected.sets()) {
-    const auto n = static_cast<Eigen::Index>(block.size());
-    std::vector<Real> block_bound(block.size());
-    Vector slip(2 * n);
-    for (Eigen::Index p = 0; p < n; ++p) {
-      const std::size_t l = block[static_cast<std::size_t>(p)];
-      place[l] = p;
-      block_bound[static_cast<std::size_t>(p)] = bound[l];
-      for (Eigen::Index t = 0; t < 2; ++t) {
-        slip[2 * p + t] = tangent(active[l], t).dot(group.slip(active[l]));
-      }
-    }
+  std::vector<Eigen::Index> place(friction.active.size(), -1);  // each one's place in its block
+  for (const std::vector<std::size_t>& block : coupling.blocks()) {
+    const BlockProblem problem = setUpBlock(group, friction, block, place);
     Vector x;
-    if (block.size() <= kDenseBlockContacts) {
-      Matrix dense = Matrix::Zero(2 * n, 2 * n);
-      for (Eigen::Index q = 0; q < n; ++q) {
-        const std::size_t l = block[static_cast<std::size_t>(q)];
-        for (const auto& entry : columns[l]) {
-          for (Eigen::Index r = 0; r < 2; ++r) {
-            for (Eigen::Index c = 0; c < 2; ++c) {
-              dense(2 * place[entry.first] + r, 2 * q + c) = coupling(entry.first, l, r, c);
-            }
-          }
-        }
-      }
-      x = frictionByBarrier(dense, slip, block_bound);
-    } else {
-      CouplingRows rows(static_cast<std::size_t>(2 * n));
-      for (Eigen::Index q = 0; q < n; ++q) {
-        const std::size_t l = block[static_cast<std::size_t>(q)];
-        for (const auto& entry : columns[l]) {
-          for (Eigen::Index r = 0; r < 2; ++r) {
-            for (Eigen::Index c = 0; c < 2; ++c) {
-              const Real value = coupling(entry.first, l, r, c);
-              if (value != 0) {
-                rows[static_cast<std::size_t>(2 * place[entry.first] + r)].emplace_back(2 * q + c,
-                                                                                        value);
-              }
-            }
-          }
-        }
-      }
-      converged = frictionByProjectedGradient(rows, slip, block_bound, x) && converged;
-    }
-    for (Eigen::Index j = 0; j < 2 * n; ++j) {
-      const std::size_t k = active[block[static_cast<std::size_t>(j / 2)]];
-      impulses[k] += x[j] * tangent(k, j % 2);
-    }
+    converged =
+        frictionOfBlock(coupling, block, place, problem.slip, problem.bound, x) && converged;
+    addBlockImpulses(group, friction, block, x, impulses);
   }
-  const Response change = group.respond(impulses, false);
-  ContactForceSolution result;
-  result.converged = converged;
-  result.contacts.resize(count);
-  for (std::size_t k = 0; k < count; ++k) {
-    ContactForce& out = result.contacts[k];
-    out.tangential = impulses[k].cast<double>();
-    out.slip = group.slip(k).cast<double>();
-    out.slip_acceleration = change.slip_acceleration[k].cast<double>();
-    if (slot[k] < 0) {
-      out.mode = ContactMode::kSeparating;
-    } else {
-      const Real b = bound[static_cast<std::size_t>(slot[k])];
-      out.mode =
-          impulses[k].norm() < b * (1 - 1e-9L) ? ContactMode::kSticking : ContactMode::kSliding;
-    }
-  }
-  result.acceleration.resize(bodies.size());
-  result.angular_acceleration.resize(bodies.size());
-  for (std::size_t i = 0; i < bodies.size(); ++i) {
-    result.acceleration[i] = change.acceleration[i].cast<double>();
-    result.angular_acceleration[i] = change.angular_acceleration[i].cast<double>();
-  }
-  return result;
+  return storeFrictionImpulses(group, friction, impulses, bodies.size(), converged);
 }
 
 void closeContactGaps(std::vector<Eigen::Vector3d>& positions, const std::vector<ForceBody>& bodies,
