@@ -281,89 +281,140 @@ Vector solveMinimumNorm(Eigen::Index size, const std::vector<Entry>& entries, co
   return solution;
 }
 
-Trial solveModes(const Group& group, const std::vector<Mode>& modes,
-                 const std::vector<Real>& friction) {
-  const std::size_t count = group.contactCount();
+/// One linear condition on the group's response at contact `contact`, to be 0: its gap's
+/// acceleration (`normal`) or its slip's acceleration along the tangent `direction`. With
+/// impulses for forces the same conditions hold the velocities (closeContactVelocities), with
+/// displacements the gaps (closeContactGaps).
+struct Condition {
+  std::size_t contact = 0;
+  V3 direction = V3::Zero();
+  bool normal = true;
+};
+
+/// The condition's value where the contact's gap accelerates by `gap` and its slip by `slip`.
+Real conditionValue(const Condition& condition, Real gap, const V3& slip) {
+  return condition.normal ? gap : condition.direction.dot(slip);
+}
+
+/// The conditions' matrix by its nonzero entries: (i, j) is condition i's value under unknown j
+/// alone, at unit size. Column by column from each unknown's response (Group::respondToOne), so
+/// in O(the nonzeros): a condition changes only where its contact shares a movable body with
+/// the unknown's.
+std::vector<Entry> assembleConditions(const Group& group, const std::vector<Unknown>& unknowns,
+                                      const std::vector<Condition>& conditions) {
+  std::vector<std::vector<Eigen::Index>> conditions_of(group.contactCount());
+  for (std::size_t i = 0; i < conditions.size(); ++i) {
+    conditions_of[conditions[i].contact].push_back(static_cast<Eigen::Index>(i));
+  }
+  std::vector<Entry> entries;
+  for (std::size_t u = 0; u < unknowns.size(); ++u) {
+    const auto j = static_cast<Eigen::Index>(u);
+    group.respondToOne(unknowns[u].contact, unknowns[u].pattern,
+                       [&](std::size_t k, Real gap, const V3& slip) {
+                         for (const Eigen::Index i : conditions_of[k]) {
+                           const Condition& condition = conditions[static_cast<std::size_t>(i)];
+                           entries.push_back(Entry{i, j, conditionValue(condition, gap, slip)});
+                         }
+                       });
+  }
+  return entries;
+}
+
+/// Each contact's force (on b) for the unknowns' sizes `solution`: the sum of its unknowns'
+/// patterns times their sizes.
+std::vector<V3> forcesOf(std::size_t count, const std::vector<Unknown>& unknowns,
+                         const Vector& solution) {
+  std::vector<V3> forces(count, V3::Zero());
+  for (Eigen::Index j = 0; j < solution.size(); ++j) {
+    const Unknown& unknown = unknowns[static_cast<std::size_t>(j)];
+    forces[unknown.contact] += solution[j] * unknown.pattern;
+  }
+  return forces;
+}
+
+/// The linear system of an assignment of modes, unknown i with condition i: a pressed contact's
+/// normal force N (a sliding one's friction -mu N along its slide direction in the same
+/// unknown) with its gap's acceleration; a sticking one's friction along each tangent with its
+/// slip's acceleration along that tangent.
+struct ModeSystem {
   std::vector<Unknown> unknowns;
-  // Rows: one condition per unknown (gap acceleration 0 for a pressed contact's normal force,
-  // slip acceleration 0 along each tangent of a sticking one).
-  struct Row {
-    std::size_t contact;
-    int kind;  // 0 gap, 1 first tangent, 2 second tangent
-  };
-  std::vector<Row> rows;
-  for (std::size_t k = 0; k < count; ++k) {
+  std::vector<Condition> conditions;
+};
+
+ModeSystem modeSystem(const Group& group, const std::vector<Mode>& modes,
+                      const std::vector<Real>& friction) {
+  ModeSystem system;
+  for (std::size_t k = 0; k < group.contactCount(); ++k) {
     if (!modes[k].pressed) continue;
     V3 pattern = group.normal(k);
     if (modes[k].tangential == Tangential::kSlide) {
       pattern -= friction[k] * modes[k].slide_direction;
     }
-    unknowns.push_back(Unknown{k, pattern});
-    rows.push_back(Row{k, 0});
+    system.unknowns.push_back(Unknown{k, pattern});
+    system.conditions.push_back(Condition{k, group.normal(k), true});
     if (modes[k].tangential == Tangential::kStick) {
-      unknowns.push_back(Unknown{k, group.first(k)});
-      rows.push_back(Row{k, 1});
-      unknowns.push_back(Unknown{k, group.second(k)});
-      rows.push_back(Row{k, 2});
+      for (const V3& tangent : {group.first(k), group.second(k)}) {
+        system.unknowns.push_back(Unknown{k, tangent});
+        system.conditions.push_back(Condition{k, tangent, false});
+      }
     }
   }
-  const auto condition = [&](const Response& response, const Row& row) -> Real {
-    if (row.kind == 0) return response.gap_acceleration[row.contact];
-    const V3& tangent = row.kind == 1 ? group.first(row.contact) : group.second(row.contact);
-    return tangent.dot(response.slip_acceleration[row.contact]);
-  };
-  const std::vector<V3> no_forces(count, V3::Zero());
-  const Response free = group.respond(no_forces, true);
-  const auto size = static_cast<Eigen::Index>(unknowns.size());
-  Vector solution = Vector::Zero(size);
-  if (size > 0) {
-    std::vector<std::vector<Eigen::Index>> rows_of(count);
-    for (Eigen::Index i = 0; i < size; ++i)
-      rows_of[rows[static_cast<std::size_t>(i)].contact].push_back(i);
-    std::vector<Entry> entries;
-    for (Eigen::Index j = 0; j < size; ++j) {
-      const Unknown& unknown = unknowns[static_cast<std::size_t>(j)];
-      group.respondToOne(
-          unknown.contact, unknown.pattern, [&](std::size_t k, Real gap, const V3& slip) {
-            for (const Eigen::Index i : rows_of[k]) {
-              const Row& row = rows[static_cast<std::size_t>(i)];
-              const Real value = row.kind == 0
-                                     ? gap
-                                     : (row.kind == 1 ? group.first(k) : group.second(k)).dot(slip);
-              entries.push_back(Entry{i, j, value});
-            }
-          });
-    }
-    Vector target(size);
-    for (Eigen::Index i = 0; i < size; ++i) target[i] = -condition(free, rows[i]);
-    // Minimum-norm least squares: also right where contacts are redundant (a ball in a corner
-    // of three planes that a pair of them already holds). Where sticking contacts are redundant
-    // (a ball held by friction in the corner of an incline and a wall), static friction is
-    // indeterminate: every solution gives the same accelerations, but the one of minimum norm
-    // may pull at a contact (doc/model.md, "Lasting contact"). The least static friction is taken
-    // first: where normal forces alone can hold the group (the frictionless corner's
-    // m g / cos t and m g tan t), friction takes nothing and no contact pulls.
-    std::vector<char> static_friction(static_cast<std::size_t>(size));
-    for (Eigen::Index i = 0; i < size; ++i) {
-      static_friction[static_cast<std::size_t>(i)] = rows[static_cast<std::size_t>(i)].kind != 0;
-    }
-    solution = solveMinimumNorm(size, entries, target, static_friction);
+  return system;
+}
+
+/// The unknowns' sizes that bring every condition of `system` to 0 from its value `free` takes
+/// without contact forces (gravity and the velocity terms).
+Vector solveModeSystem(const Group& group, const ModeSystem& system, const Response& free) {
+  const auto size = static_cast<Eigen::Index>(system.unknowns.size());
+  const std::vector<Entry> entries = assembleConditions(group, system.unknowns, system.conditions);
+  Vector target(size);
+  for (Eigen::Index i = 0; i < size; ++i) {
+    const Condition& condition = system.conditions[static_cast<std::size_t>(i)];
+    target[i] = -conditionValue(condition, free.gap_acceleration[condition.contact],
+                                free.slip_acceleration[condition.contact]);
   }
+  // Minimum-norm least squares: also right where contacts are redundant (a ball in a corner
+  // of three planes that a pair of them already holds). Where sticking contacts are redundant
+  // (a ball held by friction in the corner of an incline and a wall), static friction is
+  // indeterminate: every solution gives the same accelerations, but the one of minimum norm
+  // may pull at a contact (doc/model.md, "Lasting contact"). The least static friction is taken
+  // first: where normal forces alone can hold the group (the frictionless corner's
+  // m g / cos t and m g tan t), friction takes nothing and no contact pulls.
+  std::vector<char> static_friction(static_cast<std::size_t>(size));
+  for (std::size_t i = 0; i < static_friction.size(); ++i) {
+    static_friction[i] = !system.conditions[i].normal;
+  }
+  return solveMinimumNorm(size, entries, target, static_friction);
+}
+
+/// The trial of the unknowns' sizes `solution`: each contact's force, its normal and tangential
+/// parts, and the group's response.
+Trial storeTrial(const Group& group, const ModeSystem& system, const Vector& solution) {
+  const std::size_t count = group.contactCount();
   Trial trial;
-  trial.forces.assign(count, V3::Zero());
+  trial.forces = forcesOf(count, system.unknowns, solution);
   trial.normal_force.assign(count, 0);
-  trial.tangential_force.assign(count, V3::Zero());
-  for (Eigen::Index j = 0; j < size; ++j) {
-    const Unknown& unknown = unknowns[j];
-    trial.forces[unknown.contact] += solution[j] * unknown.pattern;
-    if (rows[j].kind == 0) trial.normal_force[unknown.contact] = solution[j];
+  for (Eigen::Index j = 0; j < solution.size(); ++j) {
+    const Condition& condition = system.conditions[static_cast<std::size_t>(j)];
+    if (condition.normal) trial.normal_force[condition.contact] = solution[j];
   }
+  trial.tangential_force.assign(count, V3::Zero());
   for (std::size_t k = 0; k < count; ++k) {
     trial.tangential_force[k] =
         trial.forces[k] - trial.forces[k].dot(group.normal(k)) * group.normal(k);
   }
   trial.response = group.respond(trial.forces, true);
   return trial;
+}
+
+/// The forces for an assignment of modes: its linear conditions solved jointly.
+Trial solveModes(const Group& group, const std::vector<Mode>& modes,
+                 const std::vector<Real>& friction) {
+  const ModeSystem system = modeSystem(group, modes, friction);
+  const Response free = group.respond(std::vector<V3>(group.contactCount(), V3::Zero()), true);
+  Vector solution = Vector::Zero(static_cast<Eigen::Index>(system.unknowns.size()));
+  if (solution.size() > 0) solution = solveModeSystem(group, system, free);
+  return storeTrial(group, system, solution);
 }
 
 /// The tolerances' scales: the accelerations and speeds the group has.
@@ -452,11 +503,6 @@ void closeContactVelocities(std::vector<ForceBody>& bodies,
   // each tangent of a sticking contact.
   const Group group(bodies, contacts);
   const std::size_t count = contacts.size();
-  struct Condition {
-    std::size_t contact;
-    V3 direction;
-    bool normal;
-  };
   std::vector<Condition> conditions;
   std::vector<Real> targets;
   for (std::size_t k = 0; k < count; ++k) {
@@ -481,29 +527,15 @@ void closeContactVelocities(std::vector<ForceBody>& bodies,
   }
   for (const Real target : targets) widest = std::max(widest, std::abs(target));
   if (widest <= std::numeric_limits<double>::epsilon() * speed) return;
-  const std::vector<V3> no_impulses(count, V3::Zero());
-  std::vector<std::vector<Eigen::Index>> conditions_of(count);
-  for (Eigen::Index i = 0; i < size; ++i) {
-    conditions_of[conditions[static_cast<std::size_t>(i)].contact].push_back(i);
+  std::vector<Unknown> unknowns;  // an impulse along each condition's direction
+  for (const Condition& condition : conditions) {
+    unknowns.push_back(Unknown{condition.contact, condition.direction});
   }
-  std::vector<Entry> entries;
-  for (Eigen::Index j = 0; j < size; ++j) {
-    const Condition& source = conditions[static_cast<std::size_t>(j)];
-    group.respondToOne(
-        source.contact, source.direction, [&](std::size_t k, Real gap, const V3& slip) {
-          for (const Eigen::Index i : conditions_of[k]) {
-            const Condition& condition = conditions[static_cast<std::size_t>(i)];
-            entries.push_back(Entry{i, j, condition.normal ? gap : condition.direction.dot(slip)});
-          }
-        });
-  }
+  const std::vector<Entry> entries = assembleConditions(group, unknowns, conditions);
   Vector target(size);
-  for (Eigen::Index i = 0; i < size; ++i) target[i] = targets[i];
+  for (Eigen::Index i = 0; i < size; ++i) target[i] = targets[static_cast<std::size_t>(i)];
   const Vector solution = solveMinimumNorm(size, entries, target);
-  std::vector<V3> impulses = no_impulses;
-  for (Eigen::Index j = 0; j < size; ++j) {
-    impulses[conditions[j].contact] += solution[j] * conditions[j].direction;
-  }
+  const std::vector<V3> impulses = forcesOf(count, unknowns, solution);
   const Response change = group.respond(impulses, false);
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     if (bodies[i].inverse_mass == 0.0) continue;
@@ -515,164 +547,220 @@ void closeContactVelocities(std::vector<ForceBody>& bodies,
 
 namespace {
 
+/// A block's friction problem, dense: the minimum of E(x) = x'A x / 2 + s'x over the discs
+/// |x_k| <= b_k (`coupling` A, `slip` s, `bound` b; x_k = x[2 k], x[2 k + 1] in contact k's
+/// tangent basis).
+struct DiscProblem {
+  const Matrix& coupling;
+  const Vector& slip;
+  const std::vector<Real>& bound;
+
+  Eigen::Index size() const { return slip.size(); }
+  Eigen::Index discs() const { return slip.size() / 2; }
+  Real b(Eigen::Index k) const { return bound[static_cast<std::size_t>(k)]; }
+  Real energy(const Vector& x) const { return 0.5L * x.dot(coupling * x) + slip.dot(x); }
+  /// b_k^2 - |x_k|^2: > 0 inside disc k.
+  Real room(const Vector& x, Eigen::Index k) const {
+    return b(k) * b(k) - x.segment<2>(2 * k).squaredNorm();
+  }
+};
+
+/// The scale of the energies: what stopping every slip alone would remove.
+Real energyScale(const DiscProblem& problem) {
+  Real scale = 0;
+  for (Eigen::Index i = 0; i < problem.size(); ++i) {
+    scale = std::max(scale, std::abs(problem.slip[i]) * problem.b(i / 2));
+  }
+  return scale;
+}
+
+/// The contacts at their disc's edge take the bound exactly, against the slip A x + s they
+/// leave.
+void pressEdgesToBound(const DiscProblem& problem, const std::vector<char>& edge, Vector& x) {
+  const Vector residual = problem.coupling * x + problem.slip;  // the slips left
+  for (Eigen::Index k = 0; k < problem.discs(); ++k) {
+    if (!edge[static_cast<std::size_t>(k)]) continue;
+    const Eigen::Matrix<Real, 2, 1> left = residual.segment<2>(2 * k);
+    const Real b = problem.b(k);
+    if (left.norm() > 0) {
+      x.segment<2>(2 * k) = -b * left.normalized();
+    } else if (x.segment<2>(2 * k).norm() > b) {
+      x.segment<2>(2 * k) *= b / x.segment<2>(2 * k).norm();
+    }
+  }
+}
+
+/// The contacts inside their discs stop their slip exactly, the edge ones' impulses given: the
+/// rows of A x + s = 0 of the inner unknowns, solved for them (least squares, minimum norm).
+void stopInnerSlips(const DiscProblem& problem, const std::vector<char>& edge, Vector& x) {
+  std::vector<Eigen::Index> inner;
+  for (Eigen::Index i = 0; i < problem.size(); ++i) {
+    if (!edge[static_cast<std::size_t>(i / 2)]) inner.push_back(i);
+  }
+  if (inner.empty()) return;
+  const auto n = static_cast<Eigen::Index>(inner.size());
+  Matrix system(n, n);
+  Vector target(n);
+  for (Eigen::Index r = 0; r < n; ++r) {
+    target[r] = -problem.slip[inner[r]];
+    for (Eigen::Index j = 0; j < problem.size(); ++j) {
+      if (edge[static_cast<std::size_t>(j / 2)]) {
+        target[r] -= problem.coupling(inner[r], j) * x[j];
+      }
+    }
+    for (Eigen::Index c = 0; c < n; ++c) system(r, c) = problem.coupling(inner[r], inner[c]);
+  }
+  const Vector solved = system.completeOrthogonalDecomposition().solve(target);
+  for (Eigen::Index r = 0; r < n; ++r) x[inner[r]] = solved[r];
+}
+
+/// Whether Coulomb's conditions hold at x: an edge contact's impulse against the slip left
+/// (not reversing it), an inner one within its bound with its slip stopped; and whether an edge
+/// impulse has yet to settle along the slip left (to within rounding).
+struct CoulombVerdict {
+  bool holds = true;
+  bool moved = false;
+};
+
+CoulombVerdict coulombVerdict(const DiscProblem& problem, const std::vector<char>& edge,
+                              const Vector& x) {
+  const Vector left = problem.coupling * x + problem.slip;
+  CoulombVerdict verdict;
+  for (Eigen::Index k = 0; k < problem.discs() && verdict.holds; ++k) {
+    const Real b = problem.b(k);
+    const Eigen::Matrix<Real, 2, 1> xk = x.segment<2>(2 * k), lk = left.segment<2>(2 * k);
+    if (edge[static_cast<std::size_t>(k)]) {
+      if (lk.norm() == 0) continue;
+      verdict.holds = xk.dot(lk) <= 0;
+      if ((xk / b + lk.normalized()).norm() > 1e-15L) verdict.moved = true;
+    } else {
+      verdict.holds = xk.norm() <= b && lk.norm() <= 1e-15L * (problem.slip.norm() + 1);
+    }
+  }
+  return verdict;
+}
+
+/// Where a condition fails, the contact changes sides (all at once): an inner one beyond its
+/// bound goes to the edge, an edge one whose impulse would reverse the slip goes inside.
+void switchSides(const DiscProblem& problem, const Vector& x, std::vector<char>& edge) {
+  const Vector left = problem.coupling * x + problem.slip;
+  for (Eigen::Index k = 0; k < problem.discs(); ++k) {
+    const Real b = problem.b(k);
+    const Eigen::Matrix<Real, 2, 1> xk = x.segment<2>(2 * k), lk = left.segment<2>(2 * k);
+    char& on_edge = edge[static_cast<std::size_t>(k)];
+    if (!on_edge && xk.norm() > b) {
+      on_edge = 1;
+    } else if (on_edge && xk.dot(lk) > 0) {
+      on_edge = 0;
+    }
+  }
+}
+
+/// Coulomb's conditions for a given set of contacts at their disc's edge: those take the bound
+/// exactly, against the slip they leave; the others stop their slip exactly (a linear solve);
+/// repeated while the edge directions move. True (and `x` set) when they then hold; else `x` is
+/// the last attempt and `edge` switched where a condition failed.
+bool polishCoulomb(const DiscProblem& problem, Vector& x, std::vector<char>& edge) {
+  Vector polished = x;
+  for (int round = 0; round < 8; ++round) {
+    pressEdgesToBound(problem, edge, polished);
+    stopInnerSlips(problem, edge, polished);
+    const CoulombVerdict verdict = coulombVerdict(problem, edge, polished);
+    if (verdict.holds && !verdict.moved) {
+      x = polished;
+      return true;
+    }
+    if (!verdict.holds) break;
+  }
+  switchSides(problem, polished, edge);
+  x = polished;
+  return false;
+}
+
+/// The barrier objective t E(y) - sum_k log(b_k^2 - |y_k|^2).
+Real barrierObjective(const DiscProblem& problem, Real t, const Vector& y) {
+  Real value = t * problem.energy(y);
+  for (Eigen::Index k = 0; k < problem.discs(); ++k) value -= std::log(problem.room(y, k));
+  return value;
+}
+
+/// One damped Newton step on the barrier objective at x for weight t: false where it no longer
+/// decreases (the decrement below 1e-20, or no step length that stays inside every disc and
+/// decreases it by a quarter of the decrement times the length: Armijo backtracking).
+bool newtonStep(const DiscProblem& problem, Real t, Vector& x) {
+  Vector gradient = t * (problem.coupling * x + problem.slip);
+  Matrix hessian = t * problem.coupling;
+  for (Eigen::Index k = 0; k < problem.discs(); ++k) {
+    // -log g, g = b^2 - |x_k|^2: gradient 2 x_k / g, Hessian 2 I / g + 4 x_k x_k' / g^2.
+    const Real g = problem.room(x, k);
+    const Eigen::Matrix<Real, 2, 1> xk = x.segment<2>(2 * k);
+    gradient.segment<2>(2 * k) += (2 / g) * xk;
+    hessian.block<2, 2>(2 * k, 2 * k) +=
+        (2 / g) * Eigen::Matrix<Real, 2, 2>::Identity() + (4 / (g * g)) * xk * xk.transpose();
+  }
+  const Vector step = -hessian.ldlt().solve(gradient);
+  const Real decrement = -gradient.dot(step);
+  if (!(decrement > 1e-20L)) return false;
+  const Real here = barrierObjective(problem, t, x);
+  Real length = 1;
+  for (int halving = 0; halving < 60; ++halving, length *= 0.5L) {
+    const Vector y = x + length * step;
+    bool inside = true;
+    for (Eigen::Index k = 0; k < problem.discs() && inside; ++k) inside = problem.room(y, k) > 0;
+    if (inside && barrierObjective(problem, t, y) <= here - 0.25L * length * decrement) {
+      x = y;
+      return true;
+    }
+  }
+  return false;
+}
+
+/// The primal barrier method (Boyd and Vandenberghe, "Convex Optimization", 2004, section
+/// 11.3): from x = 0, Newton's method on t E(x) - sum log(b^2 - |x_k|^2) for t growing tenfold,
+/// until the duality gap discs / t is below 1e-14 of the energies (nearer the discs' edges
+/// b^2 - |x|^2 loses its digits). Where A is singular the barrier tends to the centre of the
+/// optimal set, so the answer depends on no order.
+Vector barrierMinimum(const DiscProblem& problem) {
+  const Real scale = energyScale(problem);
+  Vector x = Vector::Zero(problem.size());
+  Real t = 1 / std::max(scale, Real(1e-300));
+  const Real gap_wanted = 1e-14L * std::max(scale, Real(1e-300));
+  for (int outer = 0; outer < 40; ++outer) {
+    for (int newton = 0; newton < 50; ++newton) {
+      if (!newtonStep(problem, t, x)) break;
+    }
+    if (Real(problem.discs()) / t < gap_wanted) break;
+    t *= 10;
+  }
+  return x;
+}
+
 /// The friction impulses x (each contact's, in its tangent basis: x[2 k], x[2 k + 1]) of a block
 /// small enough for dense algebra: the minimum of E(x) = x'A x / 2 + s'x over the discs
 /// |x_k| <= b_k (`coupling` A, `slip` s, `bound` b). First Coulomb's conditions solved exactly
-/// from the sticking answer; where they do not settle, a primal barrier method (Newton's method
-/// on t E(x) - sum log(b^2 - |x_k|^2) for t growing, in long double), then the same exact
-/// conditions from its answer. Where A is singular (redundant contacts) the barrier tends to the
-/// centre of the optimal set, so the answer depends on no order.
+/// from the sticking answer (fast, and usually right at once); where they do not settle, a
+/// primal barrier method (barrierMinimum, in long double), then the same exact conditions from
+/// its answer.
 Vector frictionByBarrier(const Matrix& coupling, const Vector& slip,
                          const std::vector<Real>& bound) {
-  const Eigen::Index size = slip.size();
-  const Eigen::Index disc = size / 2;
-  const auto energy = [&](const Vector& x) { return 0.5L * x.dot(coupling * x) + slip.dot(x); };
-  const auto room = [&](const Vector& x, Eigen::Index k) {
-    return bound[static_cast<std::size_t>(k)] * bound[static_cast<std::size_t>(k)] -
-           x.segment<2>(2 * k).squaredNorm();
-  };
-  // The scale of the energies: what stopping every slip alone would remove.
-  Real scale = 0;
-  for (Eigen::Index i = 0; i < size; ++i) {
-    scale = std::max(scale, std::abs(slip[i]) * bound[static_cast<std::size_t>(i / 2)]);
-  }
-  // Coulomb's conditions for a given set of contacts at their disc's edge: those take the
-  // bound exactly, against the slip they leave; the others stop their slip exactly (a linear
-  // solve); repeated while the edge directions move. True (and `x` set) when they then hold.
-  const auto polish = [&](Vector& x, std::vector<char>& edge) {
-    Vector polished = x;
-    for (int round = 0; round < 8; ++round) {
-      const Vector residual = coupling * polished + slip;  // the slips left
-      for (Eigen::Index k = 0; k < disc; ++k) {
-        if (!edge[static_cast<std::size_t>(k)]) continue;
-        const Eigen::Matrix<Real, 2, 1> left = residual.segment<2>(2 * k);
-        const Real b = bound[static_cast<std::size_t>(k)];
-        if (left.norm() > 0) {
-          polished.segment<2>(2 * k) = -b * left.normalized();
-        } else if (polished.segment<2>(2 * k).norm() > b) {
-          polished.segment<2>(2 * k) *= b / polished.segment<2>(2 * k).norm();
-        }
-      }
-      std::vector<Eigen::Index> inner;
-      for (Eigen::Index i = 0; i < size; ++i) {
-        if (!edge[static_cast<std::size_t>(i / 2)]) inner.push_back(i);
-      }
-      if (!inner.empty()) {
-        const auto n = static_cast<Eigen::Index>(inner.size());
-        Matrix system(n, n);
-        Vector target(n);
-        for (Eigen::Index r = 0; r < n; ++r) {
-          target[r] = -slip[inner[r]];
-          for (Eigen::Index j = 0; j < size; ++j) {
-            if (edge[static_cast<std::size_t>(j / 2)]) {
-              target[r] -= coupling(inner[r], j) * polished[j];
-            }
-          }
-          for (Eigen::Index c = 0; c < n; ++c) system(r, c) = coupling(inner[r], inner[c]);
-        }
-        const Vector solved = system.completeOrthogonalDecomposition().solve(target);
-        for (Eigen::Index r = 0; r < n; ++r) polished[inner[r]] = solved[r];
-      }
-      const Vector left = coupling * polished + slip;
-      bool holds = true;
-      bool moved = false;
-      for (Eigen::Index k = 0; k < disc && holds; ++k) {
-        const Real b = bound[static_cast<std::size_t>(k)];
-        const Eigen::Matrix<Real, 2, 1> xk = polished.segment<2>(2 * k),
-                                        lk = left.segment<2>(2 * k);
-        if (edge[static_cast<std::size_t>(k)]) {
-          // Against the slip left (not reversing it), along it to within rounding.
-          if (lk.norm() == 0) continue;
-          holds = xk.dot(lk) <= 0;
-          if ((xk / b + lk.normalized()).norm() > 1e-15L) moved = true;
-        } else {
-          holds = xk.norm() <= b && lk.norm() <= 1e-15L * (slip.norm() + 1);
-        }
-      }
-      if (holds && !moved) {
-        x = polished;
-        return true;
-      }
-      if (!holds) break;
-    }
-    // Where a condition fails, the contact changes sides (all at once).
-    const Vector left = coupling * polished + slip;
-    bool changed = false;
-    for (Eigen::Index k = 0; k < disc; ++k) {
-      const Real b = bound[static_cast<std::size_t>(k)];
-      const Eigen::Matrix<Real, 2, 1> xk = polished.segment<2>(2 * k), lk = left.segment<2>(2 * k);
-      char& on_edge = edge[static_cast<std::size_t>(k)];
-      if (!on_edge && xk.norm() > b) {
-        on_edge = 1;
-        changed = true;
-      } else if (on_edge && xk.dot(lk) > 0) {
-        on_edge = 0;
-        changed = true;
-      }
-    }
-    x = polished;
-    static_cast<void>(changed);
-    return false;
-  };
-  // First the exact conditions from the sticking answer (fast, and usually right at once);
-  // where they do not settle, the barrier method, then the same polish from its answer.
-  Vector x = coupling.completeOrthogonalDecomposition().solve(-slip);
+  const DiscProblem problem{coupling, slip, bound};
+  const Eigen::Index disc = problem.discs();
+  Vector x = coupling.completeOrthogonalDecomposition().solve(-slip);  // sticking everywhere
   std::vector<char> edge(static_cast<std::size_t>(disc), 0);
   for (Eigen::Index k = 0; k < disc; ++k) {
-    edge[static_cast<std::size_t>(k)] =
-        x.segment<2>(2 * k).norm() > bound[static_cast<std::size_t>(k)];
+    edge[static_cast<std::size_t>(k)] = x.segment<2>(2 * k).norm() > problem.b(k);
   }
   bool settled = false;
-  for (int attempt = 0; attempt < 8 && !settled; ++attempt) settled = polish(x, edge);
-  if (!settled) {
-    x = Vector::Zero(size);
-    Real t = 1 / std::max(scale, Real(1e-300));
-    // To 1e-14 of the energies: nearer the discs' edges b^2 - |x|^2 loses its digits.
-    const Real gap_wanted = 1e-14L * std::max(scale, Real(1e-300));
-    for (int outer = 0; outer < 40; ++outer) {
-      for (int newton = 0; newton < 50; ++newton) {
-        Vector gradient = t * (coupling * x + slip);
-        Matrix hessian = t * coupling;
-        for (Eigen::Index k = 0; k < disc; ++k) {
-          const Real g = room(x, k);
-          const Eigen::Matrix<Real, 2, 1> xk = x.segment<2>(2 * k);
-          gradient.segment<2>(2 * k) += (2 / g) * xk;
-          hessian.block<2, 2>(2 * k, 2 * k) +=
-              (2 / g) * Eigen::Matrix<Real, 2, 2>::Identity() + (4 / (g * g)) * xk * xk.transpose();
-        }
-        const Vector step = -hessian.ldlt().solve(gradient);
-        const Real decrement = -gradient.dot(step);
-        if (!(decrement > 1e-20L)) break;
-        // Backtracking: inside every disc, and the barrier objective decreasing enough.
-        const auto objective = [&](const Vector& y) {
-          Real value = t * energy(y);
-          for (Eigen::Index k = 0; k < disc; ++k) value -= std::log(room(y, k));
-          return value;
-        };
-        const Real here = objective(x);
-        bool moved = false;
-        Real length = 1;
-        for (int halving = 0; halving < 60 && !moved; ++halving, length *= 0.5L) {
-          const Vector y = x + length * step;
-          bool inside = true;
-          for (Eigen::Index k = 0; k < disc && inside; ++k) inside = room(y, k) > 0;
-          if (inside && objective(y) <= here - 0.25L * length * decrement) {
-            x = y;
-            moved = true;
-          }
-        }
-        if (!moved) break;
-      }
-      if (Real(disc) / t < gap_wanted) break;
-      t *= 10;
-    }
-    for (Eigen::Index k = 0; k < disc; ++k) {
-      edge[static_cast<std::size_t>(k)] =
-          x.segment<2>(2 * k).norm() >= bound[static_cast<std::size_t>(k)] * (1 - 1e-8L);
-    }
-    Vector polished = x;
-    if (polish(polished, edge)) x = polished;
+  for (int attempt = 0; attempt < 8 && !settled; ++attempt) {
+    settled = polishCoulomb(problem, x, edge);
   }
+  if (settled) return x;
+  x = barrierMinimum(problem);
+  for (Eigen::Index k = 0; k < disc; ++k) {
+    edge[static_cast<std::size_t>(k)] = x.segment<2>(2 * k).norm() >= problem.b(k) * (1 - 1e-8L);
+  }
+  Vector polished = x;
+  if (polishCoulomb(problem, polished, edge)) x = polished;
   return x;
 }
 
@@ -705,98 +793,334 @@ constexpr int kFrictionIterations = 10000;
 /// (x = 0 at worst), returning false. Every sum (rows of A x, the energy, dot products, the
 /// bound) is order-free and sign-symmetric (orderFreeSum), so renaming the bodies or mirroring
 /// the cluster changes no bit.
-bool frictionByProjectedGradient(const CouplingRows& rows, const Vector& slip,
-                                 const std::vector<Real>& bound, Vector& solution) {
-  const Eigen::Index size = slip.size();
-  const Eigen::Index discs = size / 2;
-  std::vector<Real> terms;
-  const auto apply = [&](const Vector& v) {
-    Vector out(size);
-    for (Eigen::Index i = 0; i < size; ++i) {
-      terms.clear();
-      for (const auto& [j, value] : rows[static_cast<std::size_t>(i)]) {
-        terms.push_back(value * v[j]);
+/// A block's friction problem by A's nonzeros (CouplingRows), every sum order-free.
+class SparseDiscProblem {
+ public:
+  SparseDiscProblem(const CouplingRows& rows, const Vector& slip, const std::vector<Real>& bound)
+      : rows_(rows), slip_(slip), bound_(bound) {}
+
+  Eigen::Index size() const { return slip_.size(); }
+  Eigen::Index discs() const { return slip_.size() / 2; }
+
+  /// A v, row by row.
+  Vector apply(const Vector& v) {
+    Vector out(size());
+    for (Eigen::Index i = 0; i < size(); ++i) {
+      terms_.clear();
+      for (const auto& [j, value] : rows_[static_cast<std::size_t>(i)]) {
+        terms_.push_back(value * v[j]);
       }
-      out[i] = orderFreeSum(terms);
+      out[i] = orderFreeSum(terms_);
     }
     return out;
-  };
-  const auto energy = [&](const Vector& v, const Vector& coupled) {  // E(v), A v given
-    terms.clear();
-    for (Eigen::Index i = 0; i < size; ++i) terms.push_back(v[i] * (0.5L * coupled[i] + slip[i]));
-    return orderFreeSum(terms);
-  };
-  const auto dot = [&](const Vector& u, const Vector& v) {
-    terms.clear();
-    for (Eigen::Index i = 0; i < size; ++i) terms.push_back(u[i] * v[i]);
-    return orderFreeSum(terms);
-  };
-  const auto project = [&](Vector& v) {
-    for (Eigen::Index k = 0; k < discs; ++k) {
-      const Real length = v.segment<2>(2 * k).norm(), b = bound[static_cast<std::size_t>(k)];
-      if (length > b) v.segment<2>(2 * k) *= b / length;
-    }
-  };
-  Real lipschitz = 0, largest_slip = 0;
-  for (Eigen::Index i = 0; i < size; ++i) {
-    terms.clear();
-    for (const auto& entry : rows[static_cast<std::size_t>(i)]) {
-      terms.push_back(std::abs(entry.second));
-    }
-    lipschitz = std::max(lipschitz, orderFreeSum(terms));
   }
-  for (Eigen::Index k = 0; k < discs; ++k) {
-    largest_slip = std::max(largest_slip, slip.segment<2>(2 * k).norm());
+  /// E(v), A v given.
+  Real energy(const Vector& v, const Vector& coupled) {
+    terms_.clear();
+    for (Eigen::Index i = 0; i < size(); ++i) {
+      terms_.push_back(v[i] * (0.5L * coupled[i] + slip_[i]));
+    }
+    return orderFreeSum(terms_);
   }
-  solution = Vector::Zero(size);
-  if (!(lipschitz > 0)) return false;  // no contact moves a body: no impulse does anything
-  const Real tolerance = kFrictionResidual * largest_slip;
-  // The residual at v, A v given.
-  const auto residual = [&](const Vector& v, const Vector& coupled) {
-    Vector step = v - (coupled + slip) / lipschitz;
-    project(step);
+  Real dot(const Vector& u, const Vector& v) {
+    terms_.clear();
+    for (Eigen::Index i = 0; i < size(); ++i) terms_.push_back(u[i] * v[i]);
+    return orderFreeSum(terms_);
+  }
+  /// L = max_i sum_j |A_ij|: at least A's largest eigenvalue (Gershgorin).
+  Real lipschitz() {
+    Real bound = 0;
+    for (Eigen::Index i = 0; i < size(); ++i) {
+      terms_.clear();
+      for (const auto& entry : rows_[static_cast<std::size_t>(i)]) {
+        terms_.push_back(std::abs(entry.second));
+      }
+      bound = std::max(bound, orderFreeSum(terms_));
+    }
+    return bound;
+  }
+  Real largestSlip() const {
+    Real largest = 0;
+    for (Eigen::Index k = 0; k < discs(); ++k) {
+      largest = std::max(largest, slip_.segment<2>(2 * k).norm());
+    }
+    return largest;
+  }
+  /// P(v - (A v + s) / L), A v given: a gradient step of length 1/L projected onto the discs.
+  Vector projectedStep(const Vector& v, const Vector& coupled, Real lipschitz) const {
+    Vector step = v - (coupled + slip_) / lipschitz;
+    for (Eigen::Index k = 0; k < discs(); ++k) {
+      const Real length = step.segment<2>(2 * k).norm(), b = bound_[static_cast<std::size_t>(k)];
+      if (length > b) step.segment<2>(2 * k) *= b / length;
+    }
+    return step;
+  }
+  /// The projected-gradient residual L |v - P(v - (A v + s) / L)|, its largest per contact.
+  Real residual(const Vector& v, const Vector& coupled, Real lipschitz) const {
+    const Vector step = projectedStep(v, coupled, lipschitz);
     Real worst = 0;
-    for (Eigen::Index k = 0; k < discs; ++k) {
+    for (Eigen::Index k = 0; k < discs(); ++k) {
       worst = std::max(worst, lipschitz * (v.segment<2>(2 * k) - step.segment<2>(2 * k)).norm());
     }
     return worst;
-  };
-  Vector x = Vector::Zero(size), coupled_x = Vector::Zero(size);  // the last iterate, A x
-  Vector y = x, coupled_y = coupled_x;  // where the next step starts (x plus momentum), A y
-  Vector lowest = x;                    // the iterate of the lowest energy so far
-  Real lowest_energy = 0, energy_x = 0, momentum = 1;
+  }
+
+ private:
+  const CouplingRows& rows_;
+  const Vector& slip_;
+  const std::vector<Real>& bound_;
+  std::vector<Real> terms_;  // the sums' terms (orderFreeSum orders them in place)
+};
+
+/// The accelerated iteration's state: the last iterate x, where the next step starts (x plus
+/// momentum) y, each with its A times it, and the momentum's weight.
+struct AcceleratedIterate {
+  Vector x, coupled_x, y, coupled_y;
+  Real momentum = 1;
+};
+
+/// The iteration moves on to z (A z given): its momentum restarted where it points against the
+/// step taken (O'Donoghue and Candes), else carried by Beck and Teboulle's weights
+/// m' = (1 + sqrt(1 + 4 m^2)) / 2, y = z + (m - 1) / m' (z - x).
+void advance(SparseDiscProblem& problem, Vector z, const Vector& coupled_z,
+             AcceleratedIterate& it) {
+  if (problem.dot(it.y - z, z - it.x) > 0) {
+    it.y = z;
+    it.coupled_y = coupled_z;
+    it.momentum = 1;
+  } else {
+    const Real next = (1 + std::sqrt(1 + 4 * it.momentum * it.momentum)) / 2;
+    const Real carried = (it.momentum - 1) / next;
+    it.y = z + carried * (z - it.x);
+    it.coupled_y = coupled_z + carried * (coupled_z - it.coupled_x);  // A y, by linearity
+    it.momentum = next;
+  }
+  it.x = std::move(z);
+  it.coupled_x = coupled_z;
+}
+
+bool frictionByProjectedGradient(const CouplingRows& rows, const Vector& slip,
+                                 const std::vector<Real>& bound, Vector& solution) {
+  SparseDiscProblem problem(rows, slip, bound);
+  const Eigen::Index size = problem.size();
+  const Real lipschitz = problem.lipschitz();
+  const Real largest_slip = problem.largestSlip();
+  solution = Vector::Zero(size);
+  if (!(lipschitz > 0)) return false;  // no contact moves a body: no impulse does anything
+  const Real tolerance = kFrictionResidual * largest_slip;
+  AcceleratedIterate it{Vector::Zero(size), Vector::Zero(size), Vector::Zero(size),
+                        Vector::Zero(size)};
+  Vector lowest = it.x;  // the iterate of the lowest energy so far
+  Real lowest_energy = 0, energy_x = 0;
   bool settled = false;
-  int iteration = 0;
-  for (; iteration < kFrictionIterations && !settled; ++iteration) {
-    Vector z = y - (coupled_y + slip) / lipschitz;
-    project(z);
-    const Vector coupled_z = apply(z);
-    energy_x = energy(z, coupled_z);
+  for (int iteration = 0; iteration < kFrictionIterations && !settled; ++iteration) {
+    Vector z = problem.projectedStep(it.y, it.coupled_y, lipschitz);
+    const Vector coupled_z = problem.apply(z);
+    energy_x = problem.energy(z, coupled_z);
     if (energy_x <= lowest_energy) {
       lowest = z;
       lowest_energy = energy_x;
     }
-    settled = residual(z, coupled_z) <= tolerance || z == x;  // or a fixed point of the rounding
-    if (dot(y - z, z - x) > 0) {  // the momentum points against the step: restart it
-      y = z;
-      coupled_y = coupled_z;
-      momentum = 1;
-    } else {
-      const Real next = (1 + std::sqrt(1 + 4 * momentum * momentum)) / 2;
-      const Real carried = (momentum - 1) / next;
-      y = z + carried * (z - x);
-      coupled_y = coupled_z + carried * (coupled_z - coupled_x);  // A y, by linearity
-      momentum = next;
-    }
-    x = std::move(z);
-    coupled_x = coupled_z;
+    // Or a fixed point of the rounding.
+    settled = problem.residual(z, coupled_z, lipschitz) <= tolerance || z == it.x;
+    advance(problem, std::move(z), coupled_z, it);
   }
   if (energy_x <= 0) {
-    solution = x;
-    return residual(x, coupled_x) <= tolerance;
+    solution = it.x;
+    return problem.residual(it.x, it.coupled_x, lipschitz) <= tolerance;
   }
   solution = lowest;
   return false;
+}
+
+/// The contacts of an impact that can take friction: a bound mu J > 0 and a slip.
+struct FrictionContacts {
+  std::vector<std::size_t> active;  // their indices
+  std::vector<Real> bound;          // per active contact: mu J
+  std::vector<long> slot;           // per contact: its place in `active`, -1 if not there
+};
+
+FrictionContacts frictionContacts(const Group& group, const std::vector<ForceContact>& contacts,
+                                  const std::vector<double>& normal_impulses) {
+  FrictionContacts friction;
+  friction.slot.assign(contacts.size(), -1);
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    const Real b = Real(contacts[k].friction) * Real(normal_impulses[k]);
+    if (b > 0 && group.slip(k).norm() > 0) {
+      friction.slot[k] = static_cast<long>(friction.active.size());
+      friction.active.push_back(k);
+      friction.bound.push_back(b);
+    }
+  }
+  return friction;
+}
+
+/// Contact k's tangent t (0: first, 1: second).
+const V3& tangentOf(const Group& group, std::size_t k, Eigen::Index t) {
+  return t == 0 ? group.first(k) : group.second(k);
+}
+
+/// The tangential coupling of the active contacts: per active contact l, what a unit impulse
+/// along each of its tangents does to the slips of the active contacts m it shares a movable
+/// body with, C(m, l) (row: m's tangents; column: l's), sorted by m; and the blocks of contacts
+/// so connected. Built column by column from each unknown's response (Group::respondToOne), in
+/// O(its nonzeros).
+class TangentialCoupling {
+ public:
+  using Block = Eigen::Matrix<Real, 2, 2>;
+  using Column = std::vector<std::pair<std::size_t, Block>>;
+
+  TangentialCoupling(const Group& group, const FrictionContacts& friction)
+      : columns_(friction.active.size()), connected_(friction.active.size()) {
+    for (std::size_t l = 0; l < friction.active.size(); ++l) {
+      for (Eigen::Index t = 0; t < 2; ++t) {
+        std::size_t visited = 0;  // respondToOne visits in the same order for either force
+        group.respondToOne(friction.active[l], tangentOf(group, friction.active[l], t),
+                           [&](std::size_t k, Real, const V3& slip_change) {
+                             if (friction.slot[k] < 0) return;
+                             const auto m = static_cast<std::size_t>(friction.slot[k]);
+                             if (t == 0) {
+                               columns_[l].emplace_back(m, Block::Zero());
+                               connected_.link(l, m);
+                             }
+                             Block& entry = columns_[l][visited++].second;
+                             entry(0, t) = group.first(k).dot(slip_change);
+                             entry(1, t) = group.second(k).dot(slip_change);
+                           });
+      }
+      std::sort(columns_[l].begin(), columns_[l].end(),
+                [](const auto& p, const auto& q) { return p.first < q.first; });
+    }
+  }
+
+  /// The blocks: sets of active contacts connected through shared movable bodies.
+  std::vector<std::vector<std::size_t>> blocks() { return connected_.sets(); }
+  /// The active contacts m whose slips contact l's impulses change (m, C(m, l)), by m.
+  const Column& column(std::size_t l) const { return columns_[l]; }
+
+  /// The symmetric coupling A(m, l) = (C(m, l) + C(l, m)') / 2 (C is symmetric up to rounding),
+  /// row r of m's tangents, column c of l's.
+  Real operator()(std::size_t m, std::size_t l, Eigen::Index r, Eigen::Index c) const {
+    const Column& column = columns_[l];
+    const Column& row = columns_[m];
+    const auto at = [](const Column& list, std::size_t key) {
+      return std::lower_bound(list.begin(), list.end(), key,
+                              [](const auto& p, std::size_t value) { return p.first < value; });
+    };
+    const auto forward = at(column, m);
+    const auto backward = at(row, l);
+    const Real there = forward != column.end() && forward->first == m ? forward->second(r, c) : 0;
+    const Real back = backward != row.end() && backward->first == l ? backward->second(c, r) : 0;
+    return 0.5L * (there + back);
+  }
+
+ private:
+  std::vector<Column> columns_;
+  ConnectedSets connected_;
+};
+
+/// Visits every coupling entry of a block, visit(row, column, A_ij), in the block's numbering
+/// (contact p of the block: unknowns 2 p and 2 p + 1; `place`: each active contact's p).
+template <class Visit>
+void forEachCouplingEntry(const TangentialCoupling& coupling, const std::vector<std::size_t>& block,
+                          const std::vector<Eigen::Index>& place, Visit visit) {
+  for (std::size_t q = 0; q < block.size(); ++q) {
+    const std::size_t l = block[q];
+    const auto column = static_cast<Eigen::Index>(2 * q);
+    for (const auto& entry : coupling.column(l)) {
+      for (Eigen::Index r = 0; r < 2; ++r) {
+        for (Eigen::Index c = 0; c < 2; ++c) {
+          visit(2 * place[entry.first] + r, column + c, coupling(entry.first, l, r, c));
+        }
+      }
+    }
+  }
+}
+
+/// A block's friction problem in its numbering (contact p of the block: unknowns 2 p, 2 p + 1):
+/// the slips s in the contacts' tangent bases and the bounds b.
+struct BlockProblem {
+  Vector slip;
+  std::vector<Real> bound;
+};
+
+/// The block's problem; `place` takes each of its contacts' p.
+BlockProblem setUpBlock(const Group& group, const FrictionContacts& friction,
+                        const std::vector<std::size_t>& block, std::vector<Eigen::Index>& place) {
+  const auto n = static_cast<Eigen::Index>(block.size());
+  BlockProblem problem{Vector(2 * n), std::vector<Real>(block.size())};
+  for (Eigen::Index p = 0; p < n; ++p) {
+    const std::size_t l = block[static_cast<std::size_t>(p)];
+    place[l] = p;
+    problem.bound[static_cast<std::size_t>(p)] = friction.bound[l];
+    for (Eigen::Index t = 0; t < 2; ++t) {
+      problem.slip[2 * p + t] =
+          tangentOf(group, friction.active[l], t).dot(group.slip(friction.active[l]));
+    }
+  }
+  return problem;
+}
+
+/// The block's impulses x (in its numbering) onto each contact's tangents: its impulse on b.
+void addBlockImpulses(const Group& group, const FrictionContacts& friction,
+                      const std::vector<std::size_t>& block, const Vector& x,
+                      std::vector<V3>& impulses) {
+  for (Eigen::Index j = 0; j < x.size(); ++j) {
+    const std::size_t k = friction.active[block[static_cast<std::size_t>(j / 2)]];
+    impulses[k] += x[j] * tangentOf(group, k, j % 2);
+  }
+}
+
+/// A block's friction impulses x (in its numbering), by dense algebra up to kDenseBlockContacts
+/// contacts (frictionByBarrier), above by the accelerated projected gradient
+/// (frictionByProjectedGradient; false where it stops short of its residual).
+bool frictionOfBlock(const TangentialCoupling& coupling, const std::vector<std::size_t>& block,
+                     const std::vector<Eigen::Index>& place, const Vector& slip,
+                     const std::vector<Real>& bound, Vector& x) {
+  if (block.size() <= kDenseBlockContacts) {
+    Matrix dense = Matrix::Zero(slip.size(), slip.size());
+    forEachCouplingEntry(coupling, block, place,
+                         [&](Eigen::Index i, Eigen::Index j, Real value) { dense(i, j) = value; });
+    x = frictionByBarrier(dense, slip, bound);
+    return true;
+  }
+  CouplingRows rows(static_cast<std::size_t>(slip.size()));
+  forEachCouplingEntry(coupling, block, place, [&](Eigen::Index i, Eigen::Index j, Real value) {
+    if (value != 0) rows[static_cast<std::size_t>(i)].emplace_back(j, value);
+  });
+  return frictionByProjectedGradient(rows, slip, bound, x);
+}
+
+/// The answer in doubles: each contact's impulse (in `tangential`), slip, slip change and mode
+/// (sticking where the impulse stays within its bound), each body's change of velocity (in
+/// `acceleration`) and of angular velocity (in `angular_acceleration`).
+ContactForceSolution storeFrictionImpulses(const Group& group, const FrictionContacts& friction,
+                                           const std::vector<V3>& impulses, std::size_t body_count,
+                                           bool converged) {
+  const Response change = group.respond(impulses, false);
+  ContactForceSolution result;
+  result.converged = converged;
+  result.contacts.resize(impulses.size());
+  for (std::size_t k = 0; k < impulses.size(); ++k) {
+    ContactForce& out = result.contacts[k];
+    out.tangential = impulses[k].cast<double>();
+    out.slip = group.slip(k).cast<double>();
+    out.slip_acceleration = change.slip_acceleration[k].cast<double>();
+    if (friction.slot[k] < 0) {
+      out.mode = ContactMode::kSeparating;
+    } else {
+      const Real b = friction.bound[static_cast<std::size_t>(friction.slot[k])];
+      out.mode =
+          impulses[k].norm() < b * (1 - 1e-9L) ? ContactMode::kSticking : ContactMode::kSliding;
+    }
+  }
+  result.acceleration.resize(body_count);
+  result.angular_acceleration.resize(body_count);
+  for (std::size_t i = 0; i < body_count; ++i) {
+    result.acceleration[i] = change.acceleration[i].cast<double>();
+    result.angular_acceleration[i] = change.angular_acceleration[i].cast<double>();
+  }
+  return result;
 }
 
 }  // namespace
@@ -816,136 +1140,19 @@ ContactForceSolution solveFrictionImpulses(const std::vector<ForceBody>& bodies,
   // A is built column by column from each unknown's response (Group::respondToOne), in
   // O(its nonzeros).
   const Group group(bodies, contacts);
-  const std::size_t count = contacts.size();
-  std::vector<std::size_t> active;  // contacts that can take friction
-  std::vector<Real> bound;
-  std::vector<long> slot(count, -1);  // each contact's place in `active`, -1 if not there
-  for (std::size_t k = 0; k < count; ++k) {
-    const Real b = Real(contacts[k].friction) * Real(normal_impulses[k]);
-    if (b > 0 && group.slip(k).norm() > 0) {
-      slot[k] = static_cast<long>(active.size());
-      active.push_back(k);
-      bound.push_back(b);
-    }
-  }
-  const auto tangent = [&](std::size_t k, Eigen::Index t) -> const V3& {
-    return t == 0 ? group.first(k) : group.second(k);
-  };
-  // Per active contact l: what a unit impulse along each of its tangents does to the slips of
-  // the active contacts m it shares a movable body with, C(m, l) (row: m's tangents; column:
-  // l's), sorted by m.
-  using Block = Eigen::Matrix<Real, 2, 2>;
-  std::vector<std::vector<std::pair<std::size_t, Block>>> columns(active.size());
-  ConnectedSets connected(active.size());
-  for (std::size_t l = 0; l < active.size(); ++l) {
-    for (Eigen::Index t = 0; t < 2; ++t) {
-      std::size_t visited = 0;  // respondToOne visits in the same order for either force
-      group.respondToOne(active[l], tangent(active[l], t),
-                         [&](std::size_t k, Real, const V3& slip_change) {
-                           if (slot[k] < 0) return;
-                           const auto m = static_cast<std::size_t>(slot[k]);
-                           if (t == 0) {
-                             columns[l].emplace_back(m, Block::Zero());
-                             connected.link(l, m);
-                           }
-                           Block& entry = columns[l][visited++].second;
-                           entry(0, t) = group.first(k).dot(slip_change);
-                           entry(1, t) = group.second(k).dot(slip_change);
-                         });
-    }
-    std::sort(columns[l].begin(), columns[l].end(),
-              [](const auto& p, const auto& q) { return p.first < q.first; });
-  }
-  // The symmetric coupling A(m, l) = (C(m, l) + C(l, m)') / 2: symmetric up to rounding.
-  const auto coupling = [&](std::size_t m, std::size_t l, Eigen::Index r, Eigen::Index c) {
-    const auto& column = columns[l];
-    const auto& row = columns[m];
-    const auto at = [](const std::vector<std::pair<std::size_t, Block>>& list, std::size_t key) {
-      return std::lower_bound(list.begin(), list.end(), key,
-                              [](const auto& p, std::size_t value) { return p.first < value; });
-    };
-    const auto forward = at(column, m);
-    const auto backward = at(row, l);
-    const Real there = forward != column.end() && forward->first == m ? forward->second(r, c) : 0;
-    const Real back = backward != row.end() && backward->first == l ? backward->second(c, r) : 0;
-    return 0.5L * (there + back);
-  };
-  std::vector<V3> impulses(count, V3::Zero());
+  const FrictionContacts friction = frictionContacts(group, contacts, normal_impulses);
+  TangentialCoupling coupling(group, friction);
+  std::vector<V3> impulses(contacts.size(), V3::Zero());
   bool converged = true;
-  std::vector<Eigen::Index> place(active.size(), -1);  // each contact's place in its block
-  for (const std::vector<std::size_t>& block : connected.sets()) {
-    const auto n = static_cast<Eigen::Index>(block.size());
-    std::vector<Real> block_bound(block.size());
-    Vector slip(2 * n);
-    for (Eigen::Index p = 0; p < n; ++p) {
-      const std::size_t l = block[static_cast<std::size_t>(p)];
-      place[l] = p;
-      block_bound[static_cast<std::size_t>(p)] = bound[l];
-      for (Eigen::Index t = 0; t < 2; ++t) {
-        slip[2 * p + t] = tangent(active[l], t).dot(group.slip(active[l]));
-      }
-    }
+  std::vector<Eigen::Index> place(friction.active.size(), -1);  // each one's place in its block
+  for (const std::vector<std::size_t>& block : coupling.blocks()) {
+    const BlockProblem problem = setUpBlock(group, friction, block, place);
     Vector x;
-    if (block.size() <= kDenseBlockContacts) {
-      Matrix dense = Matrix::Zero(2 * n, 2 * n);
-      for (Eigen::Index q = 0; q < n; ++q) {
-        const std::size_t l = block[static_cast<std::size_t>(q)];
-        for (const auto& entry : columns[l]) {
-          for (Eigen::Index r = 0; r < 2; ++r) {
-            for (Eigen::Index c = 0; c < 2; ++c) {
-              dense(2 * place[entry.first] + r, 2 * q + c) = coupling(entry.first, l, r, c);
-            }
-          }
-        }
-      }
-      x = frictionByBarrier(dense, slip, block_bound);
-    } else {
-      CouplingRows rows(static_cast<std::size_t>(2 * n));
-      for (Eigen::Index q = 0; q < n; ++q) {
-        const std::size_t l = block[static_cast<std::size_t>(q)];
-        for (const auto& entry : columns[l]) {
-          for (Eigen::Index r = 0; r < 2; ++r) {
-            for (Eigen::Index c = 0; c < 2; ++c) {
-              const Real value = coupling(entry.first, l, r, c);
-              if (value != 0) {
-                rows[static_cast<std::size_t>(2 * place[entry.first] + r)].emplace_back(2 * q + c,
-                                                                                        value);
-              }
-            }
-          }
-        }
-      }
-      converged = frictionByProjectedGradient(rows, slip, block_bound, x) && converged;
-    }
-    for (Eigen::Index j = 0; j < 2 * n; ++j) {
-      const std::size_t k = active[block[static_cast<std::size_t>(j / 2)]];
-      impulses[k] += x[j] * tangent(k, j % 2);
-    }
+    converged =
+        frictionOfBlock(coupling, block, place, problem.slip, problem.bound, x) && converged;
+    addBlockImpulses(group, friction, block, x, impulses);
   }
-  const Response change = group.respond(impulses, false);
-  ContactForceSolution result;
-  result.converged = converged;
-  result.contacts.resize(count);
-  for (std::size_t k = 0; k < count; ++k) {
-    ContactForce& out = result.contacts[k];
-    out.tangential = impulses[k].cast<double>();
-    out.slip = group.slip(k).cast<double>();
-    out.slip_acceleration = change.slip_acceleration[k].cast<double>();
-    if (slot[k] < 0) {
-      out.mode = ContactMode::kSeparating;
-    } else {
-      const Real b = bound[static_cast<std::size_t>(slot[k])];
-      out.mode =
-          impulses[k].norm() < b * (1 - 1e-9L) ? ContactMode::kSticking : ContactMode::kSliding;
-    }
-  }
-  result.acceleration.resize(bodies.size());
-  result.angular_acceleration.resize(bodies.size());
-  for (std::size_t i = 0; i < bodies.size(); ++i) {
-    result.acceleration[i] = change.acceleration[i].cast<double>();
-    result.angular_acceleration[i] = change.angular_acceleration[i].cast<double>();
-  }
-  return result;
+  return storeFrictionImpulses(group, friction, impulses, bodies.size(), converged);
 }
 
 void closeContactGaps(std::vector<Eigen::Vector3d>& positions, const std::vector<ForceBody>& bodies,
@@ -963,19 +1170,17 @@ void closeContactGaps(std::vector<Eigen::Vector3d>& positions, const std::vector
   for (const double gap : gaps) widest = std::max(widest, std::abs(gap));
   if (widest <= std::numeric_limits<double>::epsilon() * reach) return;
   const Group group(bodies, contacts);
-  const std::vector<V3> none(contacts.size(), V3::Zero());
-  std::vector<Entry> entries;
-  for (Eigen::Index j = 0; j < size; ++j) {
-    group.respondToOne(static_cast<std::size_t>(j), group.normal(static_cast<std::size_t>(j)),
-                       [&](std::size_t k, Real gap, const V3&) {
-                         entries.push_back(Entry{static_cast<Eigen::Index>(k), j, gap});
-                       });
+  std::vector<Unknown> unknowns;      // a displacement along each normal
+  std::vector<Condition> conditions;  // each gap
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    unknowns.push_back(Unknown{k, group.normal(k)});
+    conditions.push_back(Condition{k, group.normal(k), true});
   }
+  const std::vector<Entry> entries = assembleConditions(group, unknowns, conditions);
   Vector target(size);
-  for (Eigen::Index i = 0; i < size; ++i) target[i] = -Real(gaps[i]);
+  for (Eigen::Index i = 0; i < size; ++i) target[i] = -Real(gaps[static_cast<std::size_t>(i)]);
   const Vector solution = solveMinimumNorm(size, entries, target);
-  std::vector<V3> pushes = none;
-  for (Eigen::Index j = 0; j < size; ++j) pushes[j] = solution[j] * group.normal(j);
+  const std::vector<V3> pushes = forcesOf(contacts.size(), unknowns, solution);
   const Response change = group.respond(pushes, false);
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     if (bodies[i].inverse_mass == 0.0) continue;
@@ -985,166 +1190,209 @@ void closeContactGaps(std::vector<Eigen::Vector3d>& positions, const std::vector
 
 namespace {
 
+/// A pressed contact with friction takes it up by its slip: sliding, friction against the slip,
+/// where it slips faster than the slip tolerance; sticking where it does not.
+void takeUpFriction(const Group& group, std::size_t k, Real slip_tolerance, Mode& mode) {
+  const V3& slip = group.slip(k);
+  if (slip.norm() > slip_tolerance) {
+    mode.tangential = Tangential::kSlide;
+    mode.slide_direction = slip.normalized();
+  } else {
+    mode.tangential = Tangential::kStick;
+  }
+}
+
+/// The first guess: pressed where the gap would close with no contact force at all (the floor
+/// under a ball), free where it would not (two balls side by side that fall together); the
+/// iteration corrects it. A good guess keeps the first solve small.
+std::vector<Mode> guessModes(const Group& group, const std::vector<Real>& friction,
+                             const Scales& scales) {
+  const std::size_t count = group.contactCount();
+  std::vector<Mode> modes(count);
+  const Response unpressed = group.respond(std::vector<V3>(count, V3::Zero()), true);
+  for (std::size_t k = 0; k < count; ++k) {
+    modes[k].pressed =
+        unpressed.gap_acceleration[k] < -kTolerance * std::max(scales.acceleration, Real(1e-300));
+  }
+  for (std::size_t k = 0; k < count; ++k) {
+    if (modes[k].pressed && friction[k] > 0) {
+      takeUpFriction(group, k, scales.slip_tolerance, modes[k]);
+    }
+  }
+  return modes;
+}
+
+/// The largest normal force of a trial: the scale of its forces.
+Real largestNormalForce(const Trial& trial) {
+  Real force_scale = 0;
+  for (const Real normal : trial.normal_force) {
+    force_scale = std::max(force_scale, std::abs(normal));
+  }
+  return force_scale;
+}
+
+/// A contact whose mode fails under a trial's forces: by how much (in units of its scale, > 0),
+/// to change the worst first when changing all at once cycles, and the mode it changes to.
+struct Change {
+  std::size_t contact;
+  Real size;
+  Mode mode;
+};
+
+/// Whether a pressed contact k's mode holds under the trial's forces (size 0) or how it fails: a
+/// normal force that would pull, static friction beyond mu N, or a contact starting to slide
+/// whose slip would not grow along the direction taken.
+Change pressedFailure(const Group& group, std::size_t k, const Mode& mode, const Trial& trial,
+                      Real friction, Real force_scale, const Scales& scales) {
+  const Real tolerance = kTolerance;
+  const Real acceleration_scale = scales.acceleration;
+  Change change{k, 0, mode};
+  const Real normal = trial.normal_force[k];
+  if (normal < -tolerance * force_scale) {  // it would pull: let it go
+    change.mode.pressed = false;
+    change.size = -normal / std::max(force_scale, Real(1e-300));
+  } else if (mode.tangential == Tangential::kStick) {
+    const Real needed = trial.tangential_force[k].norm();
+    const Real bound = friction * std::max(normal, Real(0));
+    if (needed > bound * (1 + tolerance) + tolerance * force_scale * friction) {
+      // Static friction cannot hold it: it starts to slide, the friction against the direction
+      // the sticking force pointed away from.
+      change.mode.tangential = Tangential::kSlide;
+      change.mode.slide_direction = -trial.tangential_force[k] / needed;
+      change.size = (needed - bound) / std::max(force_scale, Real(1e-300));
+    }
+  } else if (mode.tangential == Tangential::kSlide &&
+             group.slip(k).norm() <= scales.slip_tolerance) {
+    // Starting to slide: the slip must grow along the direction taken.
+    const V3& rate = trial.response.slip_acceleration[k];
+    const Real along = rate.dot(mode.slide_direction);
+    if (along < -tolerance * acceleration_scale) {
+      change.mode.tangential = Tangential::kStick;
+      change.size = -along / std::max(acceleration_scale, Real(1e-300));
+    } else if (rate.norm() > tolerance * acceleration_scale &&
+               (rate.normalized() - mode.slide_direction).norm() > 1e-12L) {
+      change.mode.slide_direction = rate.normalized();  // follow the slip it starts
+      change.size = (rate.normalized() - mode.slide_direction).norm();
+    }
+  }
+  return change;
+}
+
+/// The contacts whose modes fail under the trial's forces: pressed ones (pressedFailure), and
+/// free ones whose gap would close.
+std::vector<Change> failingModes(const Group& group, const std::vector<Mode>& modes,
+                                 const Trial& trial, const std::vector<Real>& friction,
+                                 const Scales& scales) {
+  const Real force_scale = largestNormalForce(trial);
+  const Real acceleration_scale = std::max(scales.acceleration, Real(1e-300));
+  std::vector<Change> changes;
+  for (std::size_t k = 0; k < group.contactCount(); ++k) {
+    Change change{k, 0, modes[k]};
+    if (modes[k].pressed) {
+      change = pressedFailure(group, k, modes[k], trial, friction[k], force_scale, scales);
+    } else {
+      const Real gap = trial.response.gap_acceleration[k];
+      if (gap < -kTolerance * acceleration_scale) {  // it would close
+        change.mode.pressed = true;
+        change.size = -gap / acceleration_scale;
+      }
+    }
+    if (change.size > 0) changes.push_back(change);
+  }
+  return changes;
+}
+
+/// The modes as one key, to see an assignment come back.
+std::vector<int> modeSignature(const std::vector<Mode>& modes) {
+  std::vector<int> signature;
+  for (const Mode& mode : modes) {
+    signature.push_back(mode.pressed * 4 + static_cast<int>(mode.tangential));
+  }
+  return signature;
+}
+
+/// The failing contacts take their new modes: all at once, or, `one_at_a_time` (all at once
+/// cycled), the largest failure; among equal ones (mirror images) all of them. A contact let go
+/// drops its friction; one pressed again takes friction up by its slip.
+void changeModes(const Group& group, const std::vector<Real>& friction, Real slip_tolerance,
+                 const std::vector<Change>& changes, bool one_at_a_time, std::vector<Mode>& modes) {
+  if (one_at_a_time) {
+    Real largest = 0;
+    for (const Change& change : changes) largest = std::max(largest, change.size);
+    for (const Change& change : changes) {
+      if (change.size >= largest * (1 - 1e-9L)) modes[change.contact] = change.mode;
+    }
+  } else {
+    for (const Change& change : changes) modes[change.contact] = change.mode;
+  }
+  for (Mode& mode : modes) {
+    if (!mode.pressed) mode.tangential = Tangential::kNone;
+  }
+  for (std::size_t k = 0; k < modes.size(); ++k) {
+    if (modes[k].pressed && modes[k].tangential == Tangential::kNone && friction[k] > 0) {
+      takeUpFriction(group, k, slip_tolerance, modes[k]);
+    }
+  }
+}
+
+/// The last forces of modes that did not settle, clamped: no contact pulls, no friction beyond
+/// mu N; and the group's response to them.
+void clampForces(const Group& group, const std::vector<Real>& friction, Trial& trial) {
+  for (std::size_t k = 0; k < group.contactCount(); ++k) {
+    const Real normal = std::max(trial.normal_force[k], Real(0));
+    V3 tangential = trial.tangential_force[k];
+    const Real bound = friction[k] * normal;
+    if (tangential.norm() > bound) {
+      tangential =
+          tangential.norm() > 0 ? V3(tangential * (bound / tangential.norm())) : V3(V3::Zero());
+    }
+    trial.normal_force[k] = normal;
+    trial.tangential_force[k] = tangential;
+    trial.forces[k] = normal * group.normal(k) + tangential;
+  }
+  trial.response = group.respond(trial.forces, true);
+}
+
+/// A pressed contact left with no force only touches (a neighbour on the floor): it carries
+/// nothing and lasts no more than any touching pair.
+void releaseUnloaded(const Trial& trial, std::vector<Mode>& modes) {
+  const Real force_scale = largestNormalForce(trial);
+  for (std::size_t k = 0; k < modes.size(); ++k) {
+    if (modes[k].pressed && trial.normal_force[k] <= kTolerance * force_scale) {
+      modes[k].pressed = false;
+    }
+  }
+}
+
+/// Baraff's and Coulomb's conditions (header) by their modes: from a first guess, the forces of
+/// the modes (solveModes), and where a mode fails the contact changes it, all failing contacts
+/// at once (the worst first where that cycles), until none fails or the iterations run out.
 ContactForceSolution solveContactModes(const std::vector<ForceBody>& bodies,
                                        const std::vector<ForceContact>& contacts,
                                        const ContactForceSettings& settings) {
   const Group group(bodies, contacts);
-  const std::size_t count = contacts.size();
-  std::vector<Real> friction(count);
-  for (std::size_t k = 0; k < count; ++k) friction[k] = contacts[k].friction;
-
+  std::vector<Real> friction(contacts.size());
+  for (std::size_t k = 0; k < contacts.size(); ++k) friction[k] = contacts[k].friction;
   const Scales scales = scalesOf(bodies, settings);
-  const Real acceleration_scale = scales.acceleration;
-  const Real tolerance = kTolerance;
-  const Real slip_tolerance = scales.slip_tolerance;
-
-  std::vector<Mode> modes(count);
-  // The first guess: pressed where the gap would close with no contact force at all (the
-  // floor under a ball), free where it would not (two balls side by side that fall together);
-  // the iteration below corrects it. A good guess keeps the first solve small.
-  const Response unpressed = group.respond(std::vector<V3>(count, V3::Zero()), true);
-  for (std::size_t k = 0; k < count; ++k) {
-    modes[k].pressed =
-        unpressed.gap_acceleration[k] < -tolerance * std::max(acceleration_scale, Real(1e-300));
-  }
-  for (std::size_t k = 0; k < count; ++k) {
-    if (!modes[k].pressed) continue;
-    if (friction[k] > 0) {
-      const V3& slip = group.slip(k);
-      if (slip.norm() > slip_tolerance) {
-        modes[k].tangential = Tangential::kSlide;
-        modes[k].slide_direction = slip.normalized();
-      } else {
-        modes[k].tangential = Tangential::kStick;
-      }
-    }
-  }
-
-  ContactForceSolution result;
+  std::vector<Mode> modes = guessModes(group, friction, scales);
   Trial trial;
   std::set<std::vector<int>> seen;
   bool one_at_a_time = false;
   bool settled = false;
   for (int iteration = 0; iteration < settings.max_iterations; ++iteration) {
     trial = solveModes(group, modes, friction);
-    Real force_scale = 0;
-    for (std::size_t k = 0; k < count; ++k) {
-      force_scale = std::max(force_scale, std::abs(trial.normal_force[k]));
-    }
-    // Each failing condition with its size (in units of its scale), to change the worst first
-    // when changing all at once cycles.
-    struct Change {
-      std::size_t contact;
-      Real size;
-      Mode mode;
-    };
-    std::vector<Change> changes;
-    for (std::size_t k = 0; k < count; ++k) {
-      const Mode& mode = modes[k];
-      Mode next = mode;
-      Real size = 0;
-      if (mode.pressed) {
-        const Real normal = trial.normal_force[k];
-        if (normal < -tolerance * force_scale) {  // it would pull: let it go
-          next.pressed = false;
-          size = -normal / std::max(force_scale, Real(1e-300));
-        } else if (mode.tangential == Tangential::kStick) {
-          const Real needed = trial.tangential_force[k].norm();
-          const Real bound = friction[k] * std::max(normal, Real(0));
-          if (needed > bound * (1 + tolerance) + tolerance * force_scale * friction[k]) {
-            // Static friction cannot hold it: it starts to slide, the friction against the
-            // direction the sticking force pointed away from.
-            next.tangential = Tangential::kSlide;
-            next.slide_direction = -trial.tangential_force[k] / needed;
-            size = (needed - bound) / std::max(force_scale, Real(1e-300));
-          }
-        } else if (mode.tangential == Tangential::kSlide &&
-                   group.slip(k).norm() <= slip_tolerance) {
-          // Starting to slide: the slip must grow along the direction taken.
-          const V3& rate = trial.response.slip_acceleration[k];
-          const Real along = rate.dot(mode.slide_direction);
-          if (along < -tolerance * acceleration_scale) {
-            next.tangential = Tangential::kStick;
-            size = -along / std::max(acceleration_scale, Real(1e-300));
-          } else if (rate.norm() > tolerance * acceleration_scale &&
-                     (rate.normalized() - mode.slide_direction).norm() > 1e-12L) {
-            next.slide_direction = rate.normalized();  // follow the slip it starts
-            size = (rate.normalized() - mode.slide_direction).norm();
-          }
-        }
-      } else {
-        const Real gap = trial.response.gap_acceleration[k];
-        if (gap < -tolerance * std::max(acceleration_scale, Real(1e-300))) {  // it would close
-          next.pressed = true;
-          size = -gap / std::max(acceleration_scale, Real(1e-300));
-        }
-      }
-      if (size > 0) changes.push_back(Change{k, size, next});
-    }
+    const std::vector<Change> changes = failingModes(group, modes, trial, friction, scales);
     if (changes.empty()) {
       settled = true;
       break;
     }
-    std::vector<int> signature;
-    for (const Mode& mode : modes) {
-      signature.push_back(mode.pressed * 4 + static_cast<int>(mode.tangential));
-    }
-    if (!seen.insert(signature).second) one_at_a_time = true;  // all at once cycled
-    if (one_at_a_time) {
-      // The largest failure; among equal ones (mirror images) all of them.
-      Real largest = 0;
-      for (const Change& change : changes) largest = std::max(largest, change.size);
-      for (const Change& change : changes) {
-        if (change.size >= largest * (1 - 1e-9L)) modes[change.contact] = change.mode;
-      }
-    } else {
-      for (const Change& change : changes) modes[change.contact] = change.mode;
-    }
-    for (Mode& mode : modes) {
-      if (!mode.pressed) mode.tangential = Tangential::kNone;
-    }
-    for (std::size_t k = 0; k < count; ++k) {
-      if (modes[k].pressed && modes[k].tangential == Tangential::kNone && friction[k] > 0) {
-        // A contact pressed again takes up friction by its slip.
-        const V3& slip = group.slip(k);
-        if (slip.norm() > slip_tolerance) {
-          modes[k].tangential = Tangential::kSlide;
-          modes[k].slide_direction = slip.normalized();
-        } else {
-          modes[k].tangential = Tangential::kStick;
-        }
-      }
-    }
+    if (!seen.insert(modeSignature(modes)).second) one_at_a_time = true;  // all at once cycled
+    changeModes(group, friction, scales.slip_tolerance, changes, one_at_a_time, modes);
   }
-
+  ContactForceSolution result;
   result.converged = settled;
-  if (!settled) {
-    // Keep the last forces, clamped: no contact pulls, no friction beyond mu N.
-    for (std::size_t k = 0; k < count; ++k) {
-      const Real normal = std::max(trial.normal_force[k], Real(0));
-      V3 tangential = trial.tangential_force[k];
-      const Real bound = friction[k] * normal;
-      if (tangential.norm() > bound) {
-        tangential =
-            tangential.norm() > 0 ? V3(tangential * (bound / tangential.norm())) : V3(V3::Zero());
-      }
-      trial.normal_force[k] = normal;
-      trial.tangential_force[k] = tangential;
-      trial.forces[k] = normal * group.normal(k) + tangential;
-    }
-    trial.response = group.respond(trial.forces, true);
-  }
-  // A pressed contact left with no force only touches (a neighbour on the floor): it carries
-  // nothing and lasts no more than any touching pair.
-  Real force_scale = 0;
-  for (std::size_t k = 0; k < count; ++k) {
-    force_scale = std::max(force_scale, std::abs(trial.normal_force[k]));
-  }
-  for (std::size_t k = 0; k < count; ++k) {
-    if (modes[k].pressed && trial.normal_force[k] <= tolerance * force_scale) {
-      modes[k].pressed = false;
-    }
-  }
+  if (!settled) clampForces(group, friction, trial);
+  releaseUnloaded(trial, modes);
   package(group, trial, modes, scales, true, result);
   return result;
 }
