@@ -132,74 +132,116 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
       std::max_element(samples_.begin(), samples_.end(), [](const auto& x, const auto& y) {
         return x.stamp < y.stamp;
       })->stamp;
-  // The tf-attached obstacles must be known up to the newest stamp as well.
-  if (may_wait) {
-    for (const core::ObstacleSpec& obstacle : scene_.obstacles) {
-      if (!obstacle.frame.empty() &&
-          !lookupFrameMotion(tf, scene_.fixed_frame, obstacle.frame, newest,
-                             ros::Duration(params_.frame_velocity_interval))) {
-        update.waiting = true;
-        update.reports.clear();
-        return update;
-      }
-    }
+  if (may_wait && obstacleFrameMissing(newest, tf)) {
+    update.waiting = true;
+    update.reports.clear();
+    return update;
   }
-
   // The input's newest stamp places it on the time line; its other states keep their distance
   // from it (integer nanoseconds).
   const std::string source = input.topic + " from " + input.publisher;
   const TimeLine::Placed placed = time_line_.place(source, newest, clock, monitor_.now());
-  const auto offsetText = [](std::int64_t offset) {
-    return core::formatNumber(std::abs(static_cast<double>(offset)) * 1e-9) + " s " +
-           (offset > 0 ? "behind" : "ahead of");
-  };
-  if (placed.dropped_held) {
-    const auto held = held_.find(source);
-    const std::size_t states = held == held_.end() ? 1 : held->second.size();
-    update.reports.push_back(
-        {Reason::kStampOffClock,
-         "dropped " + std::to_string(states) + " state(s) of " + source + " stamped header.stamp " +
-             formatStamp(placed.held_stamp) +
-             ", more than ~clock_jump_back before its clock, and its next message continued "
-             "that clock (one stamp off its clock, or a publisher interleaving two clocks): "
-             "nothing was reset",
-         states});
-    if (held != held_.end()) held_.erase(held);
-  }
+  if (placed.dropped_held) dropHeldStates(source, placed, update);
   if (placed.event == TimeLine::Event::kHeld) {
-    // Until the source's next input says whether its clock went back: nothing is stepped.
-    if (held_.size() >= TimeLine::kMaxSources && held_.count(source) == 0) {
-      held_.erase(held_.begin());
-    }
-    held_[source] = samples_;
+    holdStates(source);
     return update;
   }
   if (placed.event == TimeLine::Event::kJumpedBack) {
-    update.reports.push_back(
-        {Reason::kClockJumpedBack,
-         "time jumped back: " + source + " sent header.stamp " + formatStamp(placed.held_stamp) +
-             ", more than ~clock_jump_back (" + core::formatNumber(params_.clock_jump_back) +
-             " s) before its last, and its next message continued from there (a bag played "
-             "with --loop? a simulator restarted?): every track is reset and the time line "
-             "starts again there"});
-    monitor_.reset();
-    placed_obstacles_.clear();
-    body_clock_.assign(monitor_.bodyCount(), 0);
-    body_time_.assign(monitor_.bodyCount(), -std::numeric_limits<double>::infinity());
-    // The held input's states enter the new line before this one's (a body in both: this
-    // one's).
-    const auto held = held_.find(source);
-    if (held != held_.end()) {
-      for (const StampedSample& item : held->second) {
-        const bool newer = std::any_of(samples_.begin(), samples_.end(), [&](const auto& x) {
-          return x.sample.body == item.sample.body;
-        });
-        if (!newer && item.stamp <= newest) samples_.push_back(item);
-      }
+    restartTimeLine(source, placed, newest, update);
+  } else {
+    reportClockOffset(source, placed, newest, update);
+  }
+  update.stamp = newest;
+  update.time = placed.time;
+  timeSamples(placed, newest);
+  updateObstacles(newest, placed.time, tf, update);
+  const core::StepReport step = monitor_.step(placed.time, timed_);
+  update.stepped = true;
+  ++steps_;
+  reportStep(step, update);
+  update.stepped_bodies = step.stepped_bodies;
+  stepped_bodies_ = step.stepped_bodies;
+  publishContacts(step, newest, update);
+  publishImpacts(step, newest, update);
+  return update;
+}
+
+bool MonitorCycle::obstacleFrameMissing(const ros::Time& newest, const tf2::BufferCore& tf) const {
+  // The tf-attached obstacles must be known up to the newest stamp as well.
+  for (const core::ObstacleSpec& obstacle : scene_.obstacles) {
+    if (!obstacle.frame.empty() &&
+        !lookupFrameMotion(tf, scene_.fixed_frame, obstacle.frame, newest,
+                           ros::Duration(params_.frame_velocity_interval))) {
+      return true;
     }
-    held_.clear();  // the line forgot every other source's held stamp too
-  } else if (placed.event == TimeLine::Event::kOffsetChanged ||
-             (placed.event == TimeLine::Event::kStarted && placed.clock_offset != 0)) {
+  }
+  return false;
+}
+
+namespace {
+
+/// "N s behind" or "N s ahead of" for a clock offset (ns) from the time line.
+std::string offsetText(std::int64_t offset) {
+  return core::formatNumber(std::abs(static_cast<double>(offset)) * 1e-9) + " s " +
+         (offset > 0 ? "behind" : "ahead of");
+}
+
+}  // namespace
+
+void MonitorCycle::dropHeldStates(const std::string& source, const TimeLine::Placed& placed,
+                                  Update& update) {
+  const auto held = held_.find(source);
+  const std::size_t states = held == held_.end() ? 1 : held->second.size();
+  update.reports.push_back(
+      {Reason::kStampOffClock,
+       "dropped " + std::to_string(states) + " state(s) of " + source + " stamped header.stamp " +
+           formatStamp(placed.held_stamp) +
+           ", more than ~clock_jump_back before its clock, and its next message continued "
+           "that clock (one stamp off its clock, or a publisher interleaving two clocks): "
+           "nothing was reset",
+       states});
+  if (held != held_.end()) held_.erase(held);
+}
+
+void MonitorCycle::holdStates(const std::string& source) {
+  // Until the source's next input says whether its clock went back: nothing is stepped.
+  if (held_.size() >= TimeLine::kMaxSources && held_.count(source) == 0) {
+    held_.erase(held_.begin());
+  }
+  held_[source] = samples_;
+}
+
+void MonitorCycle::restartTimeLine(const std::string& source, const TimeLine::Placed& placed,
+                                   const ros::Time& newest, Update& update) {
+  update.reports.push_back(
+      {Reason::kClockJumpedBack,
+       "time jumped back: " + source + " sent header.stamp " + formatStamp(placed.held_stamp) +
+           ", more than ~clock_jump_back (" + core::formatNumber(params_.clock_jump_back) +
+           " s) before its last, and its next message continued from there (a bag played "
+           "with --loop? a simulator restarted?): every track is reset and the time line "
+           "starts again there"});
+  monitor_.reset();
+  placed_obstacles_.clear();
+  body_clock_.assign(monitor_.bodyCount(), 0);
+  body_time_.assign(monitor_.bodyCount(), -std::numeric_limits<double>::infinity());
+  // The held input's states enter the new line before this one's (a body in both: this
+  // one's).
+  const auto held = held_.find(source);
+  if (held != held_.end()) {
+    for (const StampedSample& item : held->second) {
+      const bool newer = std::any_of(samples_.begin(), samples_.end(), [&](const auto& x) {
+        return x.sample.body == item.sample.body;
+      });
+      if (!newer && item.stamp <= newest) samples_.push_back(item);
+    }
+  }
+  held_.clear();  // the line forgot every other source's held stamp too
+}
+
+void MonitorCycle::reportClockOffset(const std::string& source, const TimeLine::Placed& placed,
+                                     const ros::Time& newest, Update& update) {
+  if (placed.event == TimeLine::Event::kOffsetChanged ||
+      (placed.event == TimeLine::Event::kStarted && placed.clock_offset != 0)) {
     update.reports.push_back(
         {Reason::kClockOffset,
          source + "'s stamps are " + offsetText(placed.clock_offset) +
@@ -223,12 +265,13 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
     report.variant = second ? 1 : 2;
     update.reports.push_back(std::move(report));
   }
+}
+
+void MonitorCycle::timeSamples(const TimeLine::Placed& placed, const ros::Time& newest) {
   if (body_clock_.size() != monitor_.bodyCount()) {
     body_clock_.assign(monitor_.bodyCount(), 0);
     body_time_.assign(monitor_.bodyCount(), -std::numeric_limits<double>::infinity());
   }
-  update.stamp = newest;
-  update.time = placed.time;
   timed_.clear();
   timed_.reserve(samples_.size());
   clock_before_ = body_clock_;
@@ -242,11 +285,9 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
       body_clock_[sample.body] = placed.clock_offset;
     }
   }
+}
 
-  updateObstacles(newest, placed.time, tf, update);
-  const core::StepReport step = monitor_.step(placed.time, timed_);
-  update.stepped = true;
-  ++steps_;
+void MonitorCycle::reportStep(const core::StepReport& step, Update& update) const {
   if (step.stale_states > 0) {
     update.reports.push_back({Reason::kStale,
                               "dropped " + std::to_string(step.stale_states) +
@@ -272,8 +313,10 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
              "it?): its bodies were held still there, and what closes on them may overlap them",
          step.fallbacks});
   }
-  update.stepped_bodies = step.stepped_bodies;
-  stepped_bodies_ = step.stepped_bodies;
+}
+
+void MonitorCycle::publishContacts(const core::StepReport& step, const ros::Time& newest,
+                                   Update& update) const {
   update.contacts.header.stamp = newest;
   update.contacts.header.frame_id = scene_.fixed_frame;
   update.contacts.contacts.reserve(step.contacts.size());
@@ -295,6 +338,10 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
              sides(monitor_, record.body_a, record.other, record.other_is_obstacle) + ": " + why +
              "; the states were finite, the answer is not"});
   }
+}
+
+void MonitorCycle::publishImpacts(const core::StepReport& step, const ros::Time& newest,
+                                  Update& update) const {
   update.impacts.header.stamp = newest;
   update.impacts.header.frame_id = scene_.fixed_frame;
   update.impacts.impacts.reserve(step.impacts.size());
@@ -316,7 +363,6 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
              sides(monitor_, record.body_a, record.other, record.other_is_obstacle) + ": " + why +
              "; the states were finite, the answer is not"});
   }
-  return update;
 }
 
 std::int64_t MonitorCycle::clockOf(double time, std::size_t body_a, std::size_t other,

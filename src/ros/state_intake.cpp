@@ -135,6 +135,109 @@ bool StateIntake::lookUp(const BodyState& state, std::size_t place, std::size_t&
   return false;
 }
 
+/// Where a state stood in its input, as warnings name it: "states[3] ('ball')", "a state".
+std::string StateIntake::Place::text(const std::string& id) const {
+  std::string text = array ? "states[" + std::to_string(index) + "]" : std::string("a state");
+  return id.empty() ? text : text + " (" + quoted(id) + ")";
+}
+
+std::optional<std::size_t> StateIntake::bodyOf(const BodyState& state, const Place& place,
+                                               const std::string& own_body,
+                                               std::vector<Report>& reports) {
+  if (!place.array) {
+    const std::string& id = state.id.empty() ? own_body : state.id;
+    if (id != own_body) {
+      reports.push_back({Reason::kIdMismatch, "dropped a state: id: " + quoted(id) +
+                                                  " does not match this topic's body " +
+                                                  quoted(own_body)});
+      return std::nullopt;
+    }
+    const auto found = index_of_.find(id);
+    if (found == index_of_.end()) return std::nullopt;  // it subscribes to its bodies' topics
+    return found->second;
+  }
+  std::size_t index = 0;
+  std::vector<Report> why;
+  if (!lookUp(state, place.index, index, why)) {
+    reports.push_back({why.front().reason, "dropped " + place.text("") + ": " + why.front().text});
+    return std::nullopt;
+  }
+  return index;
+}
+
+std::optional<Report> StateIntake::problemOf(const BodyState& state, const ros::Time& clock) const {
+  if (state.header.stamp.isZero()) {
+    return Report{Reason::kZeroStamp, "header.stamp: is zero; a state needs the instant it holds"};
+  }
+  if (!clock.isZero() &&
+      state.header.stamp.toSec() - clock.toSec() > settings_.future_stamp_tolerance) {
+    return Report{Reason::kStampAhead,
+                  "header.stamp: " + formatStamp(state.header.stamp) + " is " +
+                      core::formatNumber(state.header.stamp.toSec() - clock.toSec()) +
+                      " s ahead of this node's clock (" + formatStamp(clock) +
+                      "), more than ~future_stamp_tolerance (" +
+                      core::formatNumber(settings_.future_stamp_tolerance) +
+                      " s): not a measurement yet (a source on another clock? use_sim_time?)"};
+  }
+  int field_index = 0;
+  if (const std::string bad = firstNonFinite(state, field_index); !bad.empty()) {
+    Report report{Reason::kNonFinite, bad};
+    report.variant = field_index;
+    return report;
+  }
+  // Far enough out, the monitor's sums of two positions overflow and the contacts are lost
+  // without a word (a stack at x = 1.7e308 fell through its floor): refused by name.
+  if (auto status = core::checkResolvablePosition(toEigen(state.pose.position), "pose.position");
+      !status) {
+    Report report{Reason::kBeyondResolution, status.error().message()};
+    report.variant = static_cast<int>(status.error().field.back() - 'x');
+    return report;
+  }
+  return std::nullopt;
+}
+
+StampedSample StateIntake::inFixedFrame(const BodyState& state, std::size_t index,
+                                        const FrameMotion& frame_motion) {
+  StampedSample item;
+  item.stamp = state.header.stamp;
+  item.sample.body = index;
+  const Eigen::Vector3d position = toEigen(state.pose.position);
+  item.sample.position = frame_motion.point(position);
+  item.sample.velocity = frame_motion.velocity(position, toEigen(state.twist.linear));
+  item.sample.angular_velocity =
+      frame_motion.pose.linear() * toEigen(state.twist.angular) + frame_motion.angular_velocity;
+  return item;
+}
+
+void StateIntake::keepOncePerInput(const StampedSample& item, const Place& place,
+                                   const std::string& id, std::vector<StampedSample>& samples,
+                                   std::vector<Report>& reports) {
+  const std::size_t index = item.sample.body;
+  // A body once per input: of two states of one body, the newer stamp is kept (the first of
+  // equal ones), and the other is dropped naming both places.
+  if (seen_in_input_[index] == input_serial_) {
+    const std::size_t kept_place = seen_at_place_[index];
+    StampedSample& kept = samples[seen_at_sample_[index]];
+    const bool newer = item.stamp > kept.stamp;
+    const std::size_t dropped_place = newer ? kept_place : place.index;
+    reports.push_back(
+        {Reason::kDuplicateId, "dropped " + Place{place.array, dropped_place}.text(id) +
+                                   ": id: " + quoted(id) + " is also states[" +
+                                   std::to_string(newer ? place.index : kept_place) +
+                                   "] of this message (a body once per message; the newer stamp is "
+                                   "kept)"});
+    if (newer) {
+      kept = item;
+      seen_at_place_[index] = place.index;
+    }
+    return;
+  }
+  seen_in_input_[index] = input_serial_;
+  seen_at_place_[index] = place.index;
+  seen_at_sample_[index] = samples.size();
+  samples.push_back(item);
+}
+
 StateIntake::Outcome StateIntake::convert(const std::vector<BodyState>& states,
                                           const std::string& own_body, const ros::Time& clock,
                                           bool may_wait, const tf2::BufferCore& tf,
@@ -143,70 +246,19 @@ StateIntake::Outcome StateIntake::convert(const std::vector<BodyState>& states,
   const std::size_t samples_before = samples.size();
   const std::size_t reports_before = reports.size();
   ++input_serial_;
-  const bool array = own_body.empty();
-  const auto which = [&](std::size_t place, const std::string& id) {
-    std::string text = array ? "states[" + std::to_string(place) + "]" : std::string("a state");
-    return id.empty() ? text : text + " (" + quoted(id) + ")";
-  };
   // The states of an input usually share a frame and a stamp: one lookup serves them all.
   std::optional<core::Expected<FrameMotion>> motion;
   std::string motion_frame;
   ros::Time motion_stamp;
-  for (std::size_t place = 0; place < states.size(); ++place) {
-    const BodyState& state = states[place];
-    const std::string& id = !array && state.id.empty() ? own_body : state.id;
-    if (!array && id != own_body) {
-      reports.push_back({Reason::kIdMismatch, "dropped a state: id: " + quoted(id) +
-                                                  " does not match this topic's body " +
-                                                  quoted(own_body)});
-      continue;
-    }
-    std::size_t index = 0;
-    if (array) {
-      std::vector<Report> why;
-      if (!lookUp(state, place, index, why)) {
-        reports.push_back(
-            {why.front().reason, "dropped " + which(place, "") + ": " + why.front().text});
-        continue;
-      }
-    } else {
-      const auto found = index_of_.find(id);
-      if (found == index_of_.end()) continue;  // the node subscribes only to its bodies' topics
-      index = found->second;
-    }
-    if (state.header.stamp.isZero()) {
-      reports.push_back({Reason::kZeroStamp, "dropped " + which(place, id) +
-                                                 ": header.stamp: is zero; a state needs the "
-                                                 "instant it holds"});
-      continue;
-    }
-    if (!clock.isZero() &&
-        state.header.stamp.toSec() - clock.toSec() > settings_.future_stamp_tolerance) {
-      reports.push_back(
-          {Reason::kStampAhead,
-           "dropped " + which(place, id) + ": header.stamp: " + formatStamp(state.header.stamp) +
-               " is " + core::formatNumber(state.header.stamp.toSec() - clock.toSec()) +
-               " s ahead of this node's clock (" + formatStamp(clock) +
-               "), more than ~future_stamp_tolerance (" +
-               core::formatNumber(settings_.future_stamp_tolerance) +
-               " s): not a measurement yet (a source on another clock? use_sim_time?)"});
-      continue;
-    }
-    int field_index = 0;
-    if (const std::string bad = firstNonFinite(state, field_index); !bad.empty()) {
-      Report report{Reason::kNonFinite, "dropped " + which(place, id) + ": " + bad};
-      report.variant = field_index;
-      reports.push_back(std::move(report));
-      continue;
-    }
-    // Far enough out, the monitor's sums of two positions overflow and the contacts are lost
-    // without a word (a stack at x = 1.7e308 fell through its floor): refused by name.
-    if (auto status = core::checkResolvablePosition(toEigen(state.pose.position), "pose.position");
-        !status) {
-      Report report{Reason::kBeyondResolution,
-                    "dropped " + which(place, id) + ": " + status.error().message()};
-      report.variant = static_cast<int>(status.error().field.back() - 'x');
-      reports.push_back(std::move(report));
+  for (std::size_t k = 0; k < states.size(); ++k) {
+    const BodyState& state = states[k];
+    const Place place{own_body.empty(), k};
+    const std::string& id = !place.array && state.id.empty() ? own_body : state.id;
+    const auto index = bodyOf(state, place, own_body, reports);
+    if (!index) continue;
+    if (auto problem = problemOf(state, clock)) {
+      problem->text = "dropped " + place.text(id) + ": " + problem->text;
+      reports.push_back(std::move(*problem));
       continue;
     }
     const std::string frame = frameOf(state, settings_.fixed_frame);
@@ -224,54 +276,24 @@ StateIntake::Outcome StateIntake::convert(const std::vector<BodyState>& states,
         return Outcome::kWait;
       }
       reports.push_back(
-          {Reason::kTransformMissing, "dropped " + which(place, id) + " after waiting " +
+          {Reason::kTransformMissing, "dropped " + place.text(id) + " after waiting " +
                                           core::formatNumber(settings_.transform_timeout) +
                                           " s: header.frame_id: " + motion->error().message()});
       continue;
     }
-    StampedSample item;
-    item.stamp = state.header.stamp;
-    item.sample.body = index;
-    const FrameMotion& frame_motion = **motion;
-    const Eigen::Vector3d position = toEigen(state.pose.position);
-    item.sample.position = frame_motion.point(position);
-    item.sample.velocity = frame_motion.velocity(position, toEigen(state.twist.linear));
-    item.sample.angular_velocity =
-        frame_motion.pose.linear() * toEigen(state.twist.angular) + frame_motion.angular_velocity;
+    const StampedSample item = inFixedFrame(state, *index, **motion);
     // A frame far out can carry a resolvable position past the bound (or past the doubles).
     if (auto status = core::checkResolvablePosition(item.sample.position, "pose.position");
         !status) {
-      const std::string& fixed_frame = settings_.fixed_frame;
-      Report report{Reason::kBeyondResolution, "dropped " + which(place, id) + ": " +
-                                                   status.error().field + " (in " +
-                                                   quoted(fixed_frame) + ", from " + quoted(frame) +
-                                                   "): " + status.error().reason};
+      Report report{Reason::kBeyondResolution,
+                    "dropped " + place.text(id) + ": " + status.error().field + " (in " +
+                        quoted(std::as_const(settings_.fixed_frame)) + ", from " + quoted(frame) +
+                        "): " + status.error().reason};
       report.variant = 3 + static_cast<int>(status.error().field.back() - 'x');
       reports.push_back(std::move(report));
       continue;
     }
-    // A body once per input: of two states of one body, the newer stamp is kept (the first of
-    // equal ones), and the other is dropped naming both places.
-    if (seen_in_input_[index] == input_serial_) {
-      const std::size_t kept_place = seen_at_place_[index];
-      StampedSample& kept = samples[seen_at_sample_[index]];
-      const bool newer = item.stamp > kept.stamp;
-      const std::size_t dropped_place = newer ? kept_place : place;
-      reports.push_back({Reason::kDuplicateId,
-                         "dropped " + which(dropped_place, id) + ": id: " + quoted(id) +
-                             " is also states[" + std::to_string(newer ? place : kept_place) +
-                             "] of this message (a body once per message; the newer stamp is "
-                             "kept)"});
-      if (newer) {
-        kept = item;
-        seen_at_place_[index] = place;
-      }
-      continue;
-    }
-    seen_in_input_[index] = input_serial_;
-    seen_at_place_[index] = place;
-    seen_at_sample_[index] = samples.size();
-    samples.push_back(item);
+    keepOncePerInput(item, place, id, samples, reports);
   }
   return Outcome::kDone;
 }

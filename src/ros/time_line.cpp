@@ -120,6 +120,48 @@ TimeLine::Placed TimeLine::on(Clock& clock, std::int64_t at, std::int64_t node_c
   return placed;
 }
 
+TimeLine::Clock& TimeLine::addClock(Source& known, const Clock& added) {
+  if (known.clocks.size() >= kMaxClocks) {
+    known.clocks.erase(
+        std::min_element(known.clocks.begin(), known.clocks.end(),
+                         [](const Clock& x, const Clock& y) { return x.heard < y.heard; }));
+  }
+  known.clocks.push_back(added);
+  return known.clocks.back();
+}
+
+TimeLine::Clock* TimeLine::continuedClock(Source& known, std::int64_t at, std::int64_t node_clock,
+                                          std::int64_t present) const {
+  // The one heard last first.
+  Clock* continued = nullptr;
+  for (Clock& candidate : known.clocks) {
+    if (continues(candidate, at, node_clock, present) &&
+        (continued == nullptr || candidate.heard > continued->heard)) {
+      continued = &candidate;
+    }
+  }
+  return continued;
+}
+
+TimeLine::Placed TimeLine::continueHeld(const std::string& source, Source& known, std::int64_t at,
+                                        std::int64_t node_clock, std::int64_t now_ns,
+                                        std::int64_t present) {
+  const Held held = known.held;
+  known.held = Held{};
+  if (!held.interrupted) {
+    // Its next message continued from the held stamp: its clock really went back.
+    Placed placed = start(source, held.first, at, node_clock, Event::kJumpedBack);
+    placed.release_held = true;
+    placed.held_stamp = fromNanoseconds(held.first);
+    return placed;
+  }
+  // The held clock went on, interleaved with the other one: a second clock of the source.
+  Placed placed = on(addClock(known, Clock{newOffset(at, node_clock, present), at, 0, 0, 0, 0}), at,
+                     node_clock, now_ns, present);
+  placed.event = Event::kSecondClock;
+  return placed;
+}
+
 TimeLine::Placed TimeLine::place(const std::string& source, const ros::Time& stamp,
                                  const ros::Time& clock, double now) {
   const std::int64_t at = nanoseconds(stamp);  // stamps are at most 2^32 s: no overflow
@@ -132,25 +174,7 @@ TimeLine::Placed TimeLine::place(const std::string& source, const ros::Time& sta
   bool is_new = false;
   Source& known = sourceOf(source, is_new);
   known.heard = ++heard_;
-  const auto addClock = [&known](const Clock& added) -> Clock& {
-    if (known.clocks.size() >= kMaxClocks) {
-      known.clocks.erase(
-          std::min_element(known.clocks.begin(), known.clocks.end(),
-                           [](const Clock& x, const Clock& y) { return x.heard < y.heard; }));
-    }
-    known.clocks.push_back(added);
-    return known.clocks.back();
-  };
-
-  // A clock of the source that this stamp continues, the one heard last first.
-  Clock* continued = nullptr;
-  for (Clock& candidate : known.clocks) {
-    if (continues(candidate, at, node_clock, present) &&
-        (continued == nullptr || candidate.heard > continued->heard)) {
-      continued = &candidate;
-    }
-  }
-  if (continued != nullptr) {
+  if (Clock* continued = continuedClock(known, at, node_clock, present)) {
     Placed placed = on(*continued, at, node_clock, now_ns, present);
     if (known.held.active && !known.held.interrupted) {
       // The stamp held before this one was off the source's clock: its states are dropped.
@@ -163,20 +187,7 @@ TimeLine::Placed TimeLine::place(const std::string& source, const ros::Time& sta
   }
 
   if (known.held.active && continues(known.held, at, node_clock)) {
-    const Held held = known.held;
-    known.held = Held{};
-    if (!held.interrupted) {
-      // Its next message continued from the held stamp: its clock really went back.
-      Placed placed = start(source, held.first, at, node_clock, Event::kJumpedBack);
-      placed.release_held = true;
-      placed.held_stamp = fromNanoseconds(held.first);
-      return placed;
-    }
-    // The held clock went on, interleaved with the other one: a second clock of the source.
-    Placed placed = on(addClock(Clock{newOffset(at, node_clock, present), at, 0, 0, 0, 0}), at,
-                       node_clock, now_ns, present);
-    placed.event = Event::kSecondClock;
-    return placed;
+    return continueHeld(source, known, at, node_clock, now_ns, present);
   }
 
   const Clock* last = nullptr;
@@ -195,7 +206,7 @@ TimeLine::Placed TimeLine::place(const std::string& source, const ros::Time& sta
   }
 
   // A new source, or a stamp on none of its clocks: a clock of its own.
-  Placed placed = on(addClock(Clock{newOffset(at, node_clock, present), at, 0, 0, 0, 0}), at,
+  Placed placed = on(addClock(known, Clock{newOffset(at, node_clock, present), at, 0, 0, 0, 0}), at,
                      node_clock, now_ns, present);
   if (!is_new) {
     placed.event = Event::kNewClock;

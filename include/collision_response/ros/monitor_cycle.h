@@ -81,6 +81,28 @@ class MonitorCycle {
   /// node's clock if one side keeps it, else body_a's.
   std::int64_t clockOf(double time, std::size_t body_a, std::size_t other,
                        bool other_is_obstacle) const;
+  // The stages of process(), in its order.
+  /// A tf-attached obstacle's frame not yet known at `newest`: the input waits.
+  bool obstacleFrameMissing(const ros::Time& newest, const tf2::BufferCore& tf) const;
+  /// The held states of `source` (one stamp off its clock) are dropped, said.
+  void dropHeldStates(const std::string& source, const TimeLine::Placed& placed, Update& update);
+  /// The input's states wait for the source's next input (TimeLine::Event::kHeld).
+  void holdStates(const std::string& source);
+  /// The source's clock went back and its next input confirmed it: every track is reset and the
+  /// held states enter the new line.
+  void restartTimeLine(const std::string& source, const TimeLine::Placed& placed,
+                       const ros::Time& newest, Update& update);
+  /// A source (or a stamp) whose clock differs from the line's is said once.
+  void reportClockOffset(const std::string& source, const TimeLine::Placed& placed,
+                         const ros::Time& newest, Update& update);
+  /// The input's samples on the line (timed_), each body's clock remembered.
+  void timeSamples(const TimeLine::Placed& placed, const ros::Time& newest);
+  /// What the step dropped or fell back on, as reports.
+  void reportStep(const core::StepReport& step, Update& update) const;
+  /// The step's contacts and impacts as messages, stamped in their states' clocks; one that
+  /// the doubles or a ros::Time cannot hold is reported, not published.
+  void publishContacts(const core::StepReport& step, const ros::Time& newest, Update& update) const;
+  void publishImpacts(const core::StepReport& step, const ros::Time& newest, Update& update) const;
   /// Places the tf-attached obstacles at `stamp` (line time `time`).
   void updateObstacles(const ros::Time& stamp, double time, const tf2::BufferCore& tf,
                        Update& update);

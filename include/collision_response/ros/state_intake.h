@@ -7,12 +7,14 @@
 #include <tf2/buffer_core.h>
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
 
 #include "collision_response/BodyState.h"
 #include "collision_response/core/monitor.h"
+#include "collision_response/ros/frame_motion.h"
 
 namespace collision_response {
 
@@ -97,6 +99,26 @@ class StateIntake {
   const IntakeSettings& settings() const { return settings_; }
 
  private:
+  /// Where a state stands in its input: in a BodyStateArray (states[index]) or on a body's
+  /// own topic.
+  struct Place {
+    bool array = true;
+    std::size_t index = 0;
+    std::string text(const std::string& id) const;
+  };
+  // The stages of convert(), in its order.
+  /// The body a state is of, or nothing (reported, but for another body's topic).
+  std::optional<std::size_t> bodyOf(const BodyState& state, const Place& place,
+                                    const std::string& own_body, std::vector<Report>& reports);
+  /// Why a state's values cannot be used (its stamp, a non-finite number, a position past the
+  /// monitor's resolution), or nothing.
+  std::optional<Report> problemOf(const BodyState& state, const ros::Time& clock) const;
+  /// The state in the fixed frame (the frame's own motion added).
+  static StampedSample inFixedFrame(const BodyState& state, std::size_t index,
+                                    const FrameMotion& frame_motion);
+  /// Adds `item` unless its body already has a state in this input (the newer stamp is kept).
+  void keepOncePerInput(const StampedSample& item, const Place& place, const std::string& id,
+                        std::vector<StampedSample>& samples, std::vector<Report>& reports);
   /// The body's index, or a report of why there is none.
   bool lookUp(const BodyState& state, std::size_t place, std::size_t& index,
               std::vector<Report>& reports);

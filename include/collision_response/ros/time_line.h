@@ -140,6 +140,15 @@ class TimeLine {
                  std::int64_t present) const;
   bool continues(const Held& held, std::int64_t at, std::int64_t node_clock) const;
   Source& sourceOf(const std::string& source, bool& is_new);
+  /// Adds a clock to the source, forgetting its least recently heard one past kMaxClocks.
+  static Clock& addClock(Source& known, const Clock& added);
+  /// The source's clock that the stamp `at` continues (the one heard last first), if any.
+  Clock* continuedClock(Source& known, std::int64_t at, std::int64_t node_clock,
+                        std::int64_t present) const;
+  /// The source's next stamp after a held one continues the held stamp: a real jump back (every
+  /// track reset), or, after an interruption, the source's second clock.
+  Placed continueHeld(const std::string& source, Source& known, std::int64_t at,
+                      std::int64_t node_clock, std::int64_t now_ns, std::int64_t present);
 
   std::int64_t jump_ns_;
   bool started_ = false;
