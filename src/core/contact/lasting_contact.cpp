@@ -130,8 +130,7 @@ std::vector<ForceContact> forceContactsOf(const World& world, const Candidates& 
     contact.a = participants.slot(pair.first);
     contact.b = participants.slot(pair.second);
     contact.normal = g.normal;
-    if (!world.isPlane(pair.second))
-      contact.curvature = 1.0 / (g.gap + world.radius[pair.first] + world.radius[pair.second]);
+    contact.curvature = g.curvature;
     if (world.friction_model && !frictionless) contact.friction = world.frictionOf(pair);
     contacts.push_back(contact);
   }
@@ -273,11 +272,10 @@ IntegratedMotion integrateGroup(const World& world, double time, const Candidate
   }
   std::vector<ConstrainedContact> step_contacts;
   for (const std::size_t k : pressed.contacts) {
-    const Pair& pair = candidates[k].first;
     ConstrainedContact c;
     c.a = motion.slot[solve.contacts[k].a];
     c.b = motion.slot[solve.contacts[k].b];
-    c.plane = world.isPlane(pair.second);
+    c.plane = candidates[k].second.flat();
     if (c.plane) c.plane_normal = -candidates[k].second.normal;
     c.friction = solve.contacts[k].friction;
     c.mode = solve.solution.contacts[k].mode;

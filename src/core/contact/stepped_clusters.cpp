@@ -88,7 +88,7 @@ Eigen::Vector3d contactPointMidway(const World& world, const Pair& pair, const G
                                    double time) {
   const Eigen::Vector3d on_first =
       positionAt<Motion>(world, pair.first, time) + world.radius[pair.first] * g.normal;
-  if (world.isPlane(pair.second)) return on_first;
+  if (g.flat()) return on_first;
   const Eigen::Vector3d on_second =
       positionAt<Motion>(world, pair.second, time) - world.radius[pair.second] * g.normal;
   return 0.5 * (on_first + on_second);

@@ -124,7 +124,7 @@ double contactRestitution(World& world, double time, const InstantContact& conta
     // leave of it, less the turning of the line of centres (|v_perp|^2 / d).
     double pressing =
         -normal.dot(accelerationOf<Motion>(world, other) - accelerationOf<Motion>(world, a));
-    if (!world.isPlane(other)) {
+    if (!contact.geometry.flat()) {
       const Eigen::Vector3d relative =
           velocityAt<Motion>(world, other, time) - velocityAt<Motion>(world, a, time);
       const Eigen::Vector3d across = relative - relative.dot(normal) * normal;
