@@ -1,6 +1,7 @@
 #include "geometry/narrow_phase.h"
 
 #include "collision_response/core/time_of_impact.h"
+#include "collision_response/core/validation.h"
 
 namespace collision_response::core {
 
@@ -44,6 +45,48 @@ Shape shapeOf(const ObstacleSpec& spec) {
       return Sphere{spec.position, spec.radius};
   }
   return Plane{};
+}
+
+void setShape(ObstacleSpec& spec, const Shape& shape) {
+  std::visit(Dispatch{[&](const Plane& plane) {
+                        spec.shape = ObstacleShape::kPlane;
+                        spec.normal = plane.normal;
+                        spec.offset = plane.offset;
+                      },
+                      [&](const Sphere& sphere) {
+                        spec.shape = ObstacleShape::kSphere;
+                        spec.position = sphere.centre;
+                        spec.radius = sphere.radius;
+                      }},
+             shape);
+}
+
+Status checkShape(const Shape& shape, const std::function<std::string(const char*)>& field) {
+  return std::visit(
+      Dispatch{[&](const Plane& plane) -> Status {
+                 if (auto status = checkFinite(plane.normal, field("normal")); !status) {
+                   return status;
+                 }
+                 if (plane.normal == Eigen::Vector3d::Zero()) {
+                   return Error{field("normal"), "must not be zero"};
+                 }
+                 return checkFinite(plane.offset, field("offset"));
+               },
+               [&](const Sphere& sphere) -> Status {
+                 if (auto status = checkFinite(sphere.centre, field("position")); !status) {
+                   return status;
+                 }
+                 return checkRadius(sphere.radius, field("radius"));
+               }},
+      shape);
+}
+
+Shape normalized(const Shape& shape) {
+  return std::visit(Dispatch{[](const Plane& plane) -> Shape {
+                               return Plane{unitVector(plane.normal), plane.offset};
+                             },
+                             [](const Sphere& sphere) -> Shape { return sphere; }},
+                    shape);
 }
 
 PlacedShape placeFixed(const ObstacleSpec& spec) {

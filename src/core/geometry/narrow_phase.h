@@ -13,10 +13,13 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <optional>
+#include <string>
 #include <type_traits>
 #include <variant>
 
+#include "collision_response/core/expected.h"
 #include "collision_response/core/scene.h"
 #include "collision_response/core/shape.h"
 #include "geometry/broadphase.h"
@@ -47,6 +50,14 @@ struct ContactGeometry {
 
 /// An obstacle's shape as its scene entry gives it, in its frame.
 Shape shapeOf(const ObstacleSpec& spec);
+/// Sets an obstacle's scene entry to `shape` (its kind and its numbers).
+void setShape(ObstacleSpec& spec, const Shape& shape);
+/// A shape's numbers are usable: finite, a plane's normal nonzero, a sphere's radius positive;
+/// errors name the scene key `field(key)` ("normal", "offset", "position", "radius").
+Status checkShape(const Shape& shape, const std::function<std::string(const char*)>& field);
+/// The shape with a plane's normal scaled to unit length without under- or overflow
+/// (validation.h, unitVector); other shapes as they are. For a shape checkShape accepted.
+Shape normalized(const Shape& shape);
 /// An obstacle in the fixed frame, at rest: placed where its scene entry says.
 PlacedShape placeFixed(const ObstacleSpec& spec);
 /// An obstacle given in a moving frame, placed where `frame` (the frame's motion) puts it.
