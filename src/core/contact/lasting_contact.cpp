@@ -321,13 +321,6 @@ bool frictionModesStopAtOnce(const World& world, double time, const GroupMotion&
                      [](const ForceContact& c) { return c.friction > 0; });
 }
 
-/// The point of a lasting contact: on the surface of the pair's first sphere, at `position_a`
-/// (radius `radius_a`), along the normal.
-Eigen::Vector3d contactPointOnSurfaceOfA(const Eigen::Vector3d& position_a, double radius_a,
-                                         const Eigen::Vector3d& normal) {
-  return position_a + radius_a * normal;
-}
-
 /// The pressed contacts last (from `time`, or from when they began to), with the forces of the
 /// solve; the separating ones end. The group's next event: a slip that stops, or the end of its
 /// integrated motion where its modes change.

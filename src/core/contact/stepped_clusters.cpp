@@ -80,18 +80,14 @@ std::vector<Pair> nearPairs(const World& world, double time, double span,
   return pairs;
 }
 
-/// The point of a contact: on a plane, where the sphere touches it; between two spheres, half-way
-/// between their surface points along the line of centres, summed so that it is the same bits
-/// whichever sphere comes first in the pair (the solve's order of contacts comes from these
-/// points, and renaming bodies swaps pairs' sides).
+/// The point of a contact (the narrow phase's contactPointMidway: the same bits whichever sphere
+/// comes first in the pair, as the solve's order of contacts comes from these points and renaming
+/// bodies swaps pairs' sides).
 Eigen::Vector3d contactPointMidway(const World& world, const Pair& pair, const Geometry& g,
                                    double time) {
-  const Eigen::Vector3d on_first =
-      positionAt<Motion>(world, pair.first, time) + world.radius[pair.first] * g.normal;
-  if (g.flat()) return on_first;
-  const Eigen::Vector3d on_second =
-      positionAt<Motion>(world, pair.second, time) - world.radius[pair.second] * g.normal;
-  return 0.5 * (on_first + on_second);
+  return core::contactPointMidway(positionAt<Motion>(world, pair.first, time),
+                                  world.radius[pair.first], world.radius[pair.second], g,
+                                  [&] { return positionAt<Motion>(world, pair.second, time); });
 }
 
 /// A component's solve: its members (sorted) and their sub-step.

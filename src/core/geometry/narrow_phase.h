@@ -120,6 +120,36 @@ ContactGeometry contactGeometry(const Eigen::Vector3d& centre, double radius,
   return result;
 }
 
+// The contact point, as each stage records it today: three formulas, equal for touching
+// surfaces, apart by up to half the gap otherwise. Kept by name so that each record's point is
+// the bits it was.
+
+/// An impact's: from a's centre along the normal by its radius and half the gap (the middle of
+/// the gap).
+inline Eigen::Vector3d contactPointAcrossHalfGap(const Eigen::Vector3d& centre_a, double radius_a,
+                                                 const ContactGeometry& g) {
+  return centre_a + (radius_a + 0.5 * g.gap) * g.normal;
+}
+
+/// A lasting contact's: on the surface of the ball a, along the normal.
+inline Eigen::Vector3d contactPointOnSurfaceOfA(const Eigen::Vector3d& centre_a, double radius_a,
+                                                const Eigen::Vector3d& normal) {
+  return centre_a + radius_a * normal;
+}
+
+/// A stepped cluster's: on a flat shape, where the ball's surface is; between two spheres,
+/// half-way between their surface points along the line of centres, summed so that it is the
+/// same bits whichever sphere comes first in the pair. `centre_b()` gives the other sphere's
+/// centre (asked only for a curved pair).
+template <class CentreB>
+Eigen::Vector3d contactPointMidway(const Eigen::Vector3d& centre_a, double radius_a,
+                                   double radius_b, const ContactGeometry& g, CentreB&& centre_b) {
+  const Eigen::Vector3d on_first = centre_a + radius_a * g.normal;
+  if (g.flat()) return on_first;
+  const Eigen::Vector3d on_second = centre_b() - radius_b * g.normal;
+  return 0.5 * (on_first + on_second);
+}
+
 /// How a ball moves from an instant on: along a straight line, or (accelerates) a parabola.
 struct BallMotion {
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
