@@ -31,9 +31,10 @@ TEST(NarrowPhase, BallAbovePlane) {
   EXPECT_EQ(g.normal, V(0, 0, -1));
   EXPECT_EQ(g.gap, 3 - 0.5 - 0.25);
   EXPECT_TRUE(g.flat());
-  EXPECT_EQ(g.point, V(1, 2, 2.75));
+  // The middle of the gap: between the ball's surface (z = 2.75) and the plane's (z = 0.5).
+  EXPECT_EQ(g.point, V(1, 2, 1.625));
   // v + w x r, r from the pose's origin (0, 0, 0.5) to the point.
-  EXPECT_EQ(g.surface_velocity, V(1, 0, 0) + V(0, 0, 2).cross(V(1, 2, 2.25)));
+  EXPECT_EQ(g.surface_velocity, V(1, 0, 0) + V(0, 0, 2).cross(V(1, 2, 1.125)));
 }
 
 TEST(NarrowPhase, BallBesideSphere) {
@@ -44,8 +45,25 @@ TEST(NarrowPhase, BallBesideSphere) {
   EXPECT_EQ(g.gap, 1.5);
   EXPECT_EQ(g.curvature, 1.0 / 3.0);
   EXPECT_FALSE(g.flat());
-  EXPECT_EQ(g.point, V(0.5, 0, 0));
+  EXPECT_EQ(g.point, V(1.25, 0, 0));  // between the surfaces at x = 0.5 and x = 2
   EXPECT_EQ(g.surface_velocity, V::Zero());
+}
+
+// Impacts, lasting contacts and stepped clusters record this one point; between two spheres it
+// is the same bits whichever is the ball (renaming bodies swaps pairs' sides), and for touching
+// surfaces it is where they touch.
+TEST(NarrowPhase, OneContactPointWhicheverSphereIsTheBall) {
+  const V a(0.1, -0.3, 0.7), b(0.4, 0.2, 1.3);
+  const double ra = 0.3, rb = 0.5;
+  const ContactGeometry ab = contactGeometry(a, ra, atRest(Sphere{b, rb}, b), 1e-9, kNoApproach);
+  const ContactGeometry ba = contactGeometry(b, rb, atRest(Sphere{a, ra}, a), 1e-9, kNoApproach);
+  EXPECT_EQ(ab.point, ba.point);
+  EXPECT_NEAR((ab.point - (a + (ra + 0.5 * ab.gap) * ab.normal)).norm(), 0, 1e-15);
+  const V touching(0, 0, 0.3);
+  const ContactGeometry on_floor =
+      contactGeometry(touching, 0.3, atRest(Plane{V::UnitZ(), 0.0}, V::Zero()), 1e-9, kNoApproach);
+  EXPECT_EQ(on_floor.gap, 0.0);
+  EXPECT_EQ(on_floor.point, V::Zero());
 }
 
 TEST(NarrowPhase, CoincidentCentresTakeTheApproachOrNone) {

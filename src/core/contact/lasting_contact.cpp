@@ -336,8 +336,7 @@ void storeGroupContacts(World& world, double time, const Candidates& candidates,
     GroupContact contact;
     contact.pair = pair;
     contact.normal = candidates[k].second.normal;
-    contact.point =
-        contactPointOnSurfaceOfA(solve.positions[c.a], world.radius[pair.first], contact.normal);
+    contact.point = candidates[k].second.point;
     contact.force = force;
     const auto since = world.contact_since.emplace(pair, time).first;
     contact.since = since->second;

@@ -36,7 +36,11 @@ struct ContactGeometry {
   /// 1/m: how the line of contact turns as the ball moves across it, 1 / (the distance between
   /// the centres) for a ball on a sphere, 0 on a flat shape.
   double curvature = 0.0;
-  Eigen::Vector3d point = Eigen::Vector3d::Zero();  ///< on the ball's surface along the normal
+  /// The contact point: the middle of the gap along the normal, half-way between the ball's
+  /// surface point and the shape's, summed so that it is the same bits whichever of two spheres
+  /// is the ball (the stepped solve's order of contacts comes from these points, and renaming
+  /// bodies swaps pairs' sides). Impacts, lasting contacts and stepped clusters record it.
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
   /// m/s: the shape's surface at `point`, v + w x r (r from the shape's pose origin).
   Eigen::Vector3d surface_velocity = Eigen::Vector3d::Zero();
 
@@ -82,8 +86,8 @@ ContactGeometry contactGeometry(const Eigen::Vector3d& centre, double radius,
                                 Approach&& approach) {
   constexpr double kEps = 2.220446049250313e-16;
   ContactGeometry result;
-  const auto surfaceVelocity = [&] {
-    result.point = centre + radius * result.normal;
+  const auto surfaceVelocity = [&](const Eigen::Vector3d& on_shape) {
+    result.point = 0.5 * (Eigen::Vector3d(centre + radius * result.normal) + on_shape);
     result.surface_velocity =
         placed.pose.velocityAt(result.point - placed.pose.transform.translation());
   };
@@ -92,7 +96,7 @@ ContactGeometry contactGeometry(const Eigen::Vector3d& centre, double radius,
     result.gap = plane->normal.dot(centre) - plane->offset - radius;
     result.tolerance = touchingBand(radius, contact_tolerance, centre, plane->offset);
     result.valid = true;
-    surfaceVelocity();
+    surfaceVelocity(centre + (result.gap + radius) * result.normal);
     return result;
   }
   const Sphere& sphere = std::get<Sphere>(placed.shape);
@@ -116,38 +120,8 @@ ContactGeometry contactGeometry(const Eigen::Vector3d& centre, double radius,
                           sphere.centre.lpNorm<Eigen::Infinity>() + contact_distance);
   result.valid = true;
   result.curvature = 1.0 / (result.gap + radius + sphere.radius);
-  surfaceVelocity();
+  surfaceVelocity(sphere.centre - sphere.radius * result.normal);
   return result;
-}
-
-// The contact point, as each stage records it today: three formulas, equal for touching
-// surfaces, apart by up to half the gap otherwise. Kept by name so that each record's point is
-// the bits it was.
-
-/// An impact's: from a's centre along the normal by its radius and half the gap (the middle of
-/// the gap).
-inline Eigen::Vector3d contactPointAcrossHalfGap(const Eigen::Vector3d& centre_a, double radius_a,
-                                                 const ContactGeometry& g) {
-  return centre_a + (radius_a + 0.5 * g.gap) * g.normal;
-}
-
-/// A lasting contact's: on the surface of the ball a, along the normal.
-inline Eigen::Vector3d contactPointOnSurfaceOfA(const Eigen::Vector3d& centre_a, double radius_a,
-                                                const Eigen::Vector3d& normal) {
-  return centre_a + radius_a * normal;
-}
-
-/// A stepped cluster's: on a flat shape, where the ball's surface is; between two spheres,
-/// half-way between their surface points along the line of centres, summed so that it is the
-/// same bits whichever sphere comes first in the pair. `centre_b()` gives the other sphere's
-/// centre (asked only for a curved pair).
-template <class CentreB>
-Eigen::Vector3d contactPointMidway(const Eigen::Vector3d& centre_a, double radius_a,
-                                   double radius_b, const ContactGeometry& g, CentreB&& centre_b) {
-  const Eigen::Vector3d on_first = centre_a + radius_a * g.normal;
-  if (g.flat()) return on_first;
-  const Eigen::Vector3d on_second = centre_b() - radius_b * g.normal;
-  return 0.5 * (on_first + on_second);
 }
 
 /// How a ball moves from an instant on: along a straight line, or (accelerates) a parabola.

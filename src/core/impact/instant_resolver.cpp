@@ -222,8 +222,7 @@ ImpactRecord impactRecord(const World& world, double time, const Pair& pair, con
   record.other_is_obstacle = world.isObstacle(pair.second);
   record.other = record.other_is_obstacle ? pair.second - world.bodyCount() : pair.second;
   record.normal = g.normal;
-  record.contact_point = contactPointAcrossHalfGap(positionAt<Motion>(world, pair.first, time),
-                                                   world.radius[pair.first], g);
+  record.contact_point = g.point;
   record.velocity_a_before = a_before.linear;
   record.velocity_b_before = b_before.linear;
   record.velocity_a_after = a_after.linear;
