@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <map>
+#include <variant>
 
 #include "collision_response/ros/conversions.h"
 
@@ -83,23 +84,26 @@ visualization_msgs::Marker bodyMarker(const core::BodySpec& body, int index,
 }
 
 visualization_msgs::Marker obstacleMarker(const core::ObstacleSpec& obstacle, int index,
-                                          const Eigen::Vector3d& position,
-                                          const Eigen::Vector3d& normal, const std::string& frame,
+                                          const core::Shape& shape, const std::string& frame,
                                           const ros::Time& stamp, const MarkerParams& params) {
-  const bool sphere = obstacle.shape == core::ObstacleShape::kSphere;
-  visualization_msgs::Marker marker = base(
-      kObstaclesNamespace, index,
-      sphere ? visualization_msgs::Marker::SPHERE : visualization_msgs::Marker::CUBE, frame, stamp);
-  marker.pose.position = toPointMsg(position);
-  marker.color = materialColour(obstacle.material);
-  marker.text = obstacle.id;
-  if (sphere) {
-    marker.scale.x = marker.scale.y = marker.scale.z = 2.0 * obstacle.radius;
+  const auto marker_of = [&](std::int32_t type) {
+    visualization_msgs::Marker marker = base(kObstaclesNamespace, index, type, frame, stamp);
+    marker.color = materialColour(obstacle.material);
+    marker.text = obstacle.id;
+    return marker;
+  };
+  if (const auto* sphere = std::get_if<core::Sphere>(&shape)) {
+    visualization_msgs::Marker marker = marker_of(visualization_msgs::Marker::SPHERE);
+    marker.pose.position = toPointMsg(sphere->centre);
+    marker.scale.x = marker.scale.y = marker.scale.z = 2.0 * sphere->radius;
     return marker;
   }
   // A thin square whose z axis is the plane's normal.
+  const core::Plane& plane = std::get<core::Plane>(shape);
+  visualization_msgs::Marker marker = marker_of(visualization_msgs::Marker::CUBE);
+  marker.pose.position = toPointMsg(Eigen::Vector3d(plane.offset * plane.normal));
   const Eigen::Quaterniond turn =
-      Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), normal.normalized());
+      Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), plane.normal.normalized());
   marker.pose.orientation.x = turn.x();
   marker.pose.orientation.y = turn.y();
   marker.pose.orientation.z = turn.z();
@@ -187,12 +191,8 @@ void appendSceneMarkers(const core::ImpactMonitor& monitor, double time, const s
   for (std::size_t i = 0; i < monitor.obstacleCount(); ++i) {
     const auto pose = monitor.obstaclePose(i);
     if (!pose) continue;  // a tf-attached obstacle not placed yet
-    const core::ObstacleSpec& spec = monitor.obstacle(i);
-    const Eigen::Vector3d position = spec.shape == core::ObstacleShape::kSphere
-                                         ? Eigen::Vector3d(pose->position)
-                                         : Eigen::Vector3d(pose->offset * pose->normal);
-    array.markers.push_back(
-        obstacleMarker(spec, static_cast<int>(i), position, pose->normal, frame, stamp, params));
+    array.markers.push_back(obstacleMarker(monitor.obstacle(i), static_cast<int>(i), pose->shape,
+                                           frame, stamp, params));
   }
 }
 

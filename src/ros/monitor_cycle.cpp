@@ -397,20 +397,12 @@ void MonitorCycle::updateObstacles(const ros::Time& stamp, double time, const tf
       continue;
     }
     placed_obstacles_.insert(i);
-    core::ObstaclePose pose;
-    pose.time = time;
-    pose.angular_velocity = motion->angular_velocity;
-    if (spec.shape == core::ObstacleShape::kSphere) {
-      pose.position = motion->point(spec.position);
-      pose.velocity = motion->velocity(spec.position, Eigen::Vector3d::Zero());
-    } else {
-      const Eigen::Vector3d unit_normal = spec.normal.stableNormalized();
-      pose.normal = motion->pose.linear() * unit_normal;
-      pose.position = motion->point(unit_normal * spec.offset);  // a point of the plane
-      pose.offset = pose.normal.dot(pose.position);
-      pose.velocity = motion->velocity(unit_normal * spec.offset, Eigen::Vector3d::Zero());
-    }
-    monitor_.setObstaclePose(i, pose);
+    core::RigidPose frame;  // the core places the obstacle's shape on it
+    frame.time = time;
+    frame.transform = motion->pose;
+    frame.velocity = motion->linear_velocity;
+    frame.angular_velocity = motion->angular_velocity;
+    monitor_.setObstaclePose(i, frame);
   }
 }
 

@@ -377,9 +377,9 @@ TraceLine play(const TraceRun& run) {
       for (std::size_t i = 0; i < monitor.obstacleCount(); ++i) {
         const ObstacleSpec& spec = monitor.obstacle(i);
         if (spec.frame != frame.frame) continue;
-        ObstaclePose pose;
+        RigidPose pose;  // the frame's; the obstacle's shape is placed on it
         pose.time = t;
-        pose.position = frame.position + frame.velocity * t + spec.position;
+        pose.transform.translation() = frame.position + frame.velocity * t;
         pose.velocity = frame.velocity;
         monitor.setObstaclePose(i, pose);
       }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "collision_response/core/scene.h"
+#include "collision_response/core/shape.h"
 
 namespace collision_response::core {
 namespace monitor {
@@ -42,16 +43,6 @@ struct BodyStateSample {
   std::size_t body = 0;  ///< index (ImpactMonitor::bodyIndex)
   double time = 0.0;     ///< s, on the monitor's time line
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
-  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
-  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
-};
-
-/// Where a (tf-attached) obstacle is at `time` and how it moves: a straight line from there.
-struct ObstaclePose {
-  double time = 0.0;
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< sphere: centre
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();   ///< plane: unit normal
-  double offset = 0.0;                                 ///< plane: normal.x = offset at `time`
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
 };
@@ -152,10 +143,13 @@ class ImpactMonitor {
   const ObstacleSpec& obstacle(std::size_t index) const;
   std::optional<std::size_t> bodyIndex(const std::string& id) const;
 
-  /// Where a tf-attached obstacle is, from `pose.time` on. Fixed obstacles are set from the scene.
-  void setObstaclePose(std::size_t obstacle, const ObstaclePose& pose);
-  /// Where an obstacle was last placed; empty for a tf-attached one not placed yet.
-  std::optional<ObstaclePose> obstaclePose(std::size_t obstacle) const;
+  /// Where a tf-attached obstacle's frame is (`frame`: the frame's motion, fixed <- frame), from
+  /// `frame.time` on: its shape is placed there and moves straight on. Fixed obstacles are set
+  /// from the scene.
+  void setObstaclePose(std::size_t obstacle, const RigidPose& frame);
+  /// Where an obstacle was last placed (its shape in the fixed frame, and its motion); empty for
+  /// a tf-attached one not placed yet.
+  std::optional<PlacedShape> obstaclePose(std::size_t obstacle) const;
 
   /// Live tuning (dynamic_reconfigure): the detection mode, the restitution threshold and the
   /// materials' coefficients (a new combine rule) from the next step on. The tracks are kept;

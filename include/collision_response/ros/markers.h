@@ -46,11 +46,10 @@ visualization_msgs::Marker bodyMarker(const core::BodySpec& body, int index,
                                       const std::optional<Eigen::Vector3d>& position,
                                       const std::string& frame, const ros::Time& stamp);
 
-/// An obstacle: a sphere, or a plane as a thin square of side `plane_size` centred on the
-/// plane's point nearest the origin (`position`) with its normal.
+/// An obstacle's `shape` (in `frame`): a sphere, or a plane as a thin square of side
+/// `plane_size` centred on the plane's point nearest the origin with its normal.
 visualization_msgs::Marker obstacleMarker(const core::ObstacleSpec& obstacle, int index,
-                                          const Eigen::Vector3d& position,
-                                          const Eigen::Vector3d& normal, const std::string& frame,
+                                          const core::Shape& shape, const std::string& frame,
                                           const ros::Time& stamp, const MarkerParams& params);
 
 /// An impact: an arrow from the contact point along the normal (towards body_b, the direction

@@ -130,8 +130,7 @@ std::vector<ForceContact> forceContactsOf(const World& world, const Candidates& 
     contact.a = participants.slot(pair.first);
     contact.b = participants.slot(pair.second);
     contact.normal = g.normal;
-    if (!world.isPlane(pair.second))
-      contact.curvature = 1.0 / (g.gap + world.radius[pair.first] + world.radius[pair.second]);
+    contact.curvature = g.curvature;
     if (world.friction_model && !frictionless) contact.friction = world.frictionOf(pair);
     contacts.push_back(contact);
   }
@@ -273,11 +272,10 @@ IntegratedMotion integrateGroup(const World& world, double time, const Candidate
   }
   std::vector<ConstrainedContact> step_contacts;
   for (const std::size_t k : pressed.contacts) {
-    const Pair& pair = candidates[k].first;
     ConstrainedContact c;
     c.a = motion.slot[solve.contacts[k].a];
     c.b = motion.slot[solve.contacts[k].b];
-    c.plane = world.isPlane(pair.second);
+    c.plane = candidates[k].second.flat();
     if (c.plane) c.plane_normal = -candidates[k].second.normal;
     c.friction = solve.contacts[k].friction;
     c.mode = solve.solution.contacts[k].mode;
@@ -323,13 +321,6 @@ bool frictionModesStopAtOnce(const World& world, double time, const GroupMotion&
                      [](const ForceContact& c) { return c.friction > 0; });
 }
 
-/// The point of a lasting contact: on the surface of the pair's first sphere, at `position_a`
-/// (radius `radius_a`), along the normal.
-Eigen::Vector3d contactPointOnSurfaceOfA(const Eigen::Vector3d& position_a, double radius_a,
-                                         const Eigen::Vector3d& normal) {
-  return position_a + radius_a * normal;
-}
-
 /// The pressed contacts last (from `time`, or from when they began to), with the forces of the
 /// solve; the separating ones end. The group's next event: a slip that stops, or the end of its
 /// integrated motion where its modes change.
@@ -345,8 +336,7 @@ void storeGroupContacts(World& world, double time, const Candidates& candidates,
     GroupContact contact;
     contact.pair = pair;
     contact.normal = candidates[k].second.normal;
-    contact.point =
-        contactPointOnSurfaceOfA(solve.positions[c.a], world.radius[pair.first], contact.normal);
+    contact.point = candidates[k].second.point;
     contact.force = force;
     const auto since = world.contact_since.emplace(pair, time).first;
     contact.since = since->second;

@@ -80,20 +80,6 @@ std::vector<Pair> nearPairs(const World& world, double time, double span,
   return pairs;
 }
 
-/// The point of a contact: on a plane, where the sphere touches it; between two spheres, half-way
-/// between their surface points along the line of centres, summed so that it is the same bits
-/// whichever sphere comes first in the pair (the solve's order of contacts comes from these
-/// points, and renaming bodies swaps pairs' sides).
-Eigen::Vector3d contactPointMidway(const World& world, const Pair& pair, const Geometry& g,
-                                   double time) {
-  const Eigen::Vector3d on_first =
-      positionAt<Motion>(world, pair.first, time) + world.radius[pair.first] * g.normal;
-  if (world.isPlane(pair.second)) return on_first;
-  const Eigen::Vector3d on_second =
-      positionAt<Motion>(world, pair.second, time) - world.radius[pair.second] * g.normal;
-  return 0.5 * (on_first + on_second);
-}
-
 /// A component's solve: its members (sorted) and their sub-step.
 struct Component {
   std::vector<std::size_t> members;
@@ -145,7 +131,7 @@ SteppedContacts steppedContactsOf(const World& world, double time, double span, 
     contact.a = participants.slot(pair.first);
     contact.b = participants.slot(pair.second);
     contact.normal = g.normal;
-    contact.point = contactPointMidway(world, pair, g, time);
+    contact.point = g.point;
     contact.gap = g.gap;
     contact.band = g.tolerance;
     contact.restitution = world.restitutionOf(pair);
@@ -434,7 +420,7 @@ void storeClusterContacts(World& world, double time, const Component& component,
     SteppedClusterContact contact;
     contact.pair = pair;
     contact.normal = g.normal;
-    contact.point = contactPointMidway(world, pair, g, time);
+    contact.point = g.point;
     contact.keeping_impulse = received.keeping_impulse;
     contact.friction_impulse = received.friction_impulse;
     contact.friction_direction = received.friction_direction;

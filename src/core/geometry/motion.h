@@ -6,6 +6,8 @@
 #include <optional>
 #include <vector>
 
+#include "collision_response/core/shape.h"
+
 namespace collision_response::core {
 
 /// p + v dt + (a/2) dt^2, evaluated as p + dt (v + (dt/2) a): with a = 0 it is p + dt v to the
@@ -20,12 +22,6 @@ inline Eigen::Vector3d velocityAfter(const Eigen::Vector3d& velocity,
                                      const Eigen::Vector3d& acceleration, double dt) {
   return velocity + dt * acceleration;
 }
-
-/// A fixed plane {x : normal.x = offset}, free on the side `normal` (unit) points to.
-struct Plane {
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
-  double offset = 0.0;
-};
 
 /// The slowest bounce off a plane that leaves the touching band: a ball leaving at u under the
 /// pressing acceleration g_n rises u^2 / (2 g_n); below sqrt(2 g_n band) it stays within `band`

@@ -124,7 +124,7 @@ double contactRestitution(World& world, double time, const InstantContact& conta
     // leave of it, less the turning of the line of centres (|v_perp|^2 / d).
     double pressing =
         -normal.dot(accelerationOf<Motion>(world, other) - accelerationOf<Motion>(world, a));
-    if (!world.isPlane(other)) {
+    if (!contact.geometry.flat()) {
       const Eigen::Vector3d relative =
           velocityAt<Motion>(world, other, time) - velocityAt<Motion>(world, a, time);
       const Eigen::Vector3d across = relative - relative.dot(normal) * normal;
@@ -222,8 +222,7 @@ ImpactRecord impactRecord(const World& world, double time, const Pair& pair, con
   record.other_is_obstacle = world.isObstacle(pair.second);
   record.other = record.other_is_obstacle ? pair.second - world.bodyCount() : pair.second;
   record.normal = g.normal;
-  record.contact_point = positionAt<Motion>(world, pair.first, time) +
-                         (world.radius[pair.first] + 0.5 * g.gap) * g.normal;
+  record.contact_point = g.point;
   record.velocity_a_before = a_before.linear;
   record.velocity_b_before = b_before.linear;
   record.velocity_a_after = a_after.linear;

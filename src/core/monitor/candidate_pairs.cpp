@@ -22,15 +22,7 @@ void allCandidatePairs(const World& world, std::vector<Pair>& pairs) {
 bool mayReachObstacle(const World& world, const Box& box, std::size_t obstacle) {
   const ObstacleSpec& spec = world.obstacles[obstacle];
   if (!spec.frame.empty()) return true;  // a moving obstacle: always a candidate
-  const ObstaclePose& pose = world.obstacle_tracks[obstacle].pose;
-  if (spec.shape == ObstacleShape::kPlane) {
-    // The box's lowest point along the normal: does it reach the plane?
-    const Eigen::Vector3d centre = 0.5 * (box.low + box.high);
-    const Eigen::Vector3d half = 0.5 * (box.high - box.low);
-    return pose.normal.dot(centre) - pose.normal.cwiseAbs().dot(half) <= pose.offset;
-  }
-  const Box post{pose.position.array() - spec.radius, pose.position.array() + spec.radius};
-  return post.overlaps(box);
+  return mayReach(world.obstacle_tracks[obstacle].placed, box);
 }
 
 namespace {

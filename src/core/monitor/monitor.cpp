@@ -610,7 +610,7 @@ ImpactMonitor::ImpactMonitor(const Scene& scene, const MonitorSettings& settings
     world.material.push_back(material_index(body.material));
   }
   for (const ObstacleSpec& obstacle : world.obstacles) {
-    world.radius.push_back(obstacle.shape == ObstacleShape::kSphere ? obstacle.radius : 0.0);
+    world.radius.push_back(contactRadius(shapeOf(obstacle)));
     world.material.push_back(material_index(obstacle.material));
   }
   computePairCoefficients(world, scene.materials);
@@ -620,11 +620,7 @@ ImpactMonitor::ImpactMonitor(const Scene& scene, const MonitorSettings& settings
   for (std::size_t i = 0; i < world.obstacles.size(); ++i) {
     const ObstacleSpec& obstacle = world.obstacles[i];
     if (!obstacle.frame.empty()) continue;  // placed by setObstaclePose from tf
-    ObstaclePose pose;
-    pose.position = obstacle.position;
-    pose.normal = obstacle.normal.normalized();
-    pose.offset = obstacle.offset;
-    world.obstacle_tracks[i] = monitor::ObstacleTrack{true, pose};
+    world.obstacle_tracks[i] = monitor::ObstacleTrack{true, placeFixed(obstacle)};
   }
   world.partners.assign(world.bodies.size(), {});
 }
@@ -658,9 +654,9 @@ void ImpactMonitor::tune(Detection detection, double restitution_threshold,
   computePairCoefficients(world, materials);
 }
 
-std::optional<ObstaclePose> ImpactMonitor::obstaclePose(std::size_t obstacle) const {
+std::optional<PlacedShape> ImpactMonitor::obstaclePose(std::size_t obstacle) const {
   if (!world_->obstacle_tracks[obstacle].known) return std::nullopt;
-  return world_->obstacle_tracks[obstacle].pose;
+  return world_->obstacle_tracks[obstacle].placed;
 }
 
 std::optional<std::size_t> ImpactMonitor::bodyIndex(const std::string& id) const {
@@ -669,8 +665,9 @@ std::optional<std::size_t> ImpactMonitor::bodyIndex(const std::string& id) const
   return found->second;
 }
 
-void ImpactMonitor::setObstaclePose(std::size_t obstacle, const ObstaclePose& pose) {
-  world_->obstacle_tracks[obstacle] = monitor::ObstacleTrack{true, pose};
+void ImpactMonitor::setObstaclePose(std::size_t obstacle, const RigidPose& frame) {
+  world_->obstacle_tracks[obstacle] =
+      monitor::ObstacleTrack{true, place(world_->obstacles[obstacle], frame)};
   world_->groups_current = false;
 }
 

@@ -24,6 +24,7 @@
 #include "contact/contact_forces.h"
 #include "geometry/broadphase.h"
 #include "geometry/motion.h"
+#include "geometry/narrow_phase.h"
 #include "impact/cluster_solver.h"
 
 namespace collision_response::core::monitor {
@@ -65,23 +66,14 @@ struct Track {
 
 struct ObstacleTrack {
   bool known = false;
-  ObstaclePose pose;
+  PlacedShape placed;
 };
 
 /// A body (index < bodyCount) and another participant: a body, or obstacle index + bodyCount.
 using Pair = std::pair<std::size_t, std::size_t>;
 
-/// Where two participants are relative to each other at one instant.
-struct Geometry {
-  Eigen::Vector3d normal;  ///< unit, a -> other
-  double gap = 0.0;        ///< m, surface to surface along the normal; < 0 overlapping
-  double tolerance = 0.0;  ///< m, |gap| within it is touching
-  bool valid = false;      ///< false: coincident centres and no approach: no line of impact
-  /// m: the band a bounce or a separation must rise out of under the pressing acceleration
-  /// (restSpeed): the touching band, or the overlap where the pair overlaps deeper (a contact
-  /// held where it is, or an impact that discrete detection found by overlap).
-  double band() const { return std::max(tolerance, -gap); }
-};
+/// Where two participants are relative to each other at one instant (the narrow phase's answer).
+using Geometry = ContactGeometry;
 
 /// A contact that lasts: the pair presses with a steady force (ContactForce), at `time`.
 struct GroupContact {
@@ -223,12 +215,13 @@ struct World {
 
   std::size_t bodyCount() const { return bodies.size(); }
   bool isObstacle(std::size_t participant) const { return participant >= bodies.size(); }
-  bool isPlane(std::size_t participant) const {
-    return isObstacle(participant) &&
-           obstacles[participant - bodies.size()].shape == ObstacleShape::kPlane;
+  /// An obstacle participant's shape where it was last placed.
+  const PlacedShape& placedShape(std::size_t participant) const {
+    return obstacle_tracks[participant - bodies.size()].placed;
   }
-  const ObstaclePose& obstaclePose(std::size_t participant) const {
-    return obstacle_tracks[participant - bodies.size()].pose;
+  /// An obstacle participant's motion from its last placement on.
+  const RigidPose& obstaclePose(std::size_t participant) const {
+    return placedShape(participant).pose;
   }
   bool known(std::size_t participant) const {
     return isObstacle(participant) ? obstacle_tracks[participant - bodies.size()].known

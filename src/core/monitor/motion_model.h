@@ -56,8 +56,7 @@ inline bool constrained(const World& world, std::size_t participant) {
 template <class Motion>
 Eigen::Vector3d positionAt(const World& world, std::size_t participant, double time) {
   if (world.isObstacle(participant)) {
-    const ObstaclePose& pose = world.obstaclePose(participant);
-    return pose.position + pose.velocity * (time - pose.time);
+    return originAt(world.obstaclePose(participant), time);
   }
   return Motion::position(world.tracks[participant], time);
 }
@@ -81,43 +80,33 @@ Eigen::Vector3d accelerationOf(const World& world, std::size_t participant) {
   return world.tracks[participant].acceleration;
 }
 
-/// Where the two participants of `pair` are relative to each other at `time`.
+/// A participant's shape at `time`: a body's sphere on its track, an obstacle's placed shape
+/// moved on along its pose.
+template <class Motion>
+PlacedShape shapeAt(const World& world, std::size_t participant, double time) {
+  if (world.isObstacle(participant)) return shapeAt(world.placedShape(participant), time);
+  PlacedShape placed;
+  const Eigen::Vector3d centre = positionAt<Motion>(world, participant, time);
+  placed.shape = Sphere{centre, world.radius[participant]};
+  placed.pose.time = time;
+  placed.pose.transform.translation() = centre;
+  placed.pose.velocity = velocityAt<Motion>(world, participant, time);
+  placed.pose.angular_velocity = angularVelocityAt<Motion>(world, participant, time);
+  return placed;
+}
+
+/// Where the two participants of `pair` are relative to each other at `time` (the narrow
+/// phase's contactGeometry). Coincident centres (a sample caught one body right through the
+/// other) have no line of centres; the line of impact is the direction of approach, if any.
 template <class Motion>
 Geometry geometry(const World& world, const Pair& pair, double time) {
   const auto [a, other] = pair;
-  const Eigen::Vector3d position_a = positionAt<Motion>(world, a, time);
-  Geometry result;
-  if (world.isPlane(other)) {
-    const ObstaclePose& plane = world.obstaclePose(other);
-    const double offset = plane.offset + plane.normal.dot(plane.velocity) * (time - plane.time);
-    result.normal = -plane.normal;  // from the body into the plane
-    result.gap = plane.normal.dot(position_a) - offset - world.radius[a];
-    result.tolerance =
-        touchingBand(world.radius[a], world.settings.contact_tolerance, position_a, offset);
-    result.valid = true;
-    return result;
-  }
-  const Eigen::Vector3d position_other = positionAt<Motion>(world, other, time);
-  const Eigen::Vector3d separation = position_other - position_a;
-  const double distance = separation.norm();
-  const double contact_distance = world.radius[a] + world.radius[other];
-  if (!(distance > 0)) {
-    // Coincident centres (a sample caught one body right through the other): no line of
-    // centres; the line of impact is the direction of approach, if there is one.
-    const Eigen::Vector3d approach =
-        velocityAt<Motion>(world, a, time) - velocityAt<Motion>(world, other, time);
-    if (!(approach.norm() > 0)) return result;
-    result.normal = approach.normalized();
-  } else {
-    result.normal = separation / distance;
-  }
-  result.gap = distance - contact_distance;
-  result.tolerance = world.settings.contact_tolerance * contact_distance +
-                     16 * kEps *
-                         (position_a.lpNorm<Eigen::Infinity>() +
-                          position_other.lpNorm<Eigen::Infinity>() + contact_distance);
-  result.valid = true;
-  return result;
+  return contactGeometry(positionAt<Motion>(world, a, time), world.radius[a],
+                         shapeAt<Motion>(world, other, time), world.settings.contact_tolerance,
+                         [&] {
+                           return Eigen::Vector3d(velocityAt<Motion>(world, a, time) -
+                                                  velocityAt<Motion>(world, other, time));
+                         });
 }
 
 template <class Motion>
@@ -153,7 +142,7 @@ std::optional<double> timeOfImpactAlongPaths(const World& world, const Pair& pai
   const Geometry start = geometry<Motion>(world, pair, from);
   if (start.gap < -start.tolerance) return std::nullopt;  // overlapping already: not an impact
   const double contact_at = start.gap > 0 ? 0.0 : 0.5 * (start.gap - start.tolerance);
-  const bool sphere = !world.isPlane(pair.second);
+  const bool curved = !start.flat();
   const double contact_distance = world.radius[pair.first] + world.radius[pair.second];
   const double accelerations =
       accelerationBound<Motion>(world, pair.first) + accelerationBound<Motion>(world, pair.second);
@@ -166,7 +155,7 @@ std::optional<double> timeOfImpactAlongPaths(const World& world, const Pair& pai
     const Eigen::Vector3d relative = velocityAt<Motion>(world, pair.second, previous_time) -
                                      velocityAt<Motion>(world, pair.first, previous_time);
     const double closing = std::max(0.0, -g.normal.dot(relative));
-    const double bound = accelerations + (sphere ? relative.squaredNorm() / contact_distance : 0.0);
+    const double bound = accelerations + (curved ? relative.squaredNorm() / contact_distance : 0.0);
     const double room = g.gap - contact_at;
     // Far enough that closing at `closing`, accelerating at `bound`, leaves half the room; near
     // the start (no room yet) twice the last step.
@@ -199,31 +188,14 @@ std::optional<double> timeOfImpact(const World& world, const Pair& pair, double 
       return timeOfImpactAlongPaths<Motion>(world, pair, from, horizon);
     }
   }
-  const Eigen::Vector3d relative_velocity =
-      velocityAt<Motion>(world, other, from) - velocityAt<Motion>(world, a, from);
-  if (world.isPlane(other)) {
-    const ObstaclePose& plane = world.obstaclePose(other);
-    const Geometry g = geometry<Motion>(world, pair, from);
-    const double rate = -plane.normal.dot(relative_velocity);
-    if constexpr (Motion::kAccelerates) {
-      return timeOfImpactPlaneBallistic(g.gap, rate, plane.normal.dot(world.tracks[a].acceleration),
-                                        horizon);
-    } else {
-      return timeOfImpactPlane(g.gap, rate, horizon);
-    }
-  }
-  const Eigen::Vector3d separation =
-      positionAt<Motion>(world, other, from) - positionAt<Motion>(world, a, from);
-  const double contact_distance = world.radius[a] + world.radius[other];
-  if constexpr (Motion::kAccelerates) {
-    // Two bodies under the same gravity keep the straight-line relative problem.
-    return timeOfImpactSpheresAccelerated(
-        separation, relative_velocity,
-        accelerationOf<Motion>(world, other) - world.tracks[a].acceleration, contact_distance,
-        horizon);
-  } else {
-    return timeOfImpactSpheres<double>(separation, relative_velocity, contact_distance, horizon);
-  }
+  BallMotion ball;
+  ball.centre = positionAt<Motion>(world, a, from);
+  ball.radius = world.radius[a];
+  ball.velocity = velocityAt<Motion>(world, a, from);
+  if constexpr (Motion::kAccelerates) ball.acceleration = world.tracks[a].acceleration;
+  const PlacedShape shape = shapeAt<Motion>(world, other, from);
+  return firstContact(ball, shape.shape, velocityAt<Motion>(world, other, from),
+                      accelerationOf<Motion>(world, other), Motion::kAccelerates, horizon);
 }
 
 /// How far apart the pair's surfaces can close within `horizon` from `from`, head-on and

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "collision_response/core/validation.h"
+#include "geometry/narrow_phase.h"
 
 namespace collision_response::core {
 
@@ -151,27 +152,10 @@ Status checkObstacles(const Scene& scene, const std::string& prefix, std::set<st
         return status;
       }
     }
-    if (obstacle.shape == ObstacleShape::kPlane) {
-      if (auto status = checkFinite(obstacle.normal, item(prefix, "obstacles", i, "normal"));
-          !status) {
-        return status;
-      }
-      if (obstacle.normal == Eigen::Vector3d::Zero()) {
-        return Error{item(prefix, "obstacles", i, "normal"), "must not be zero"};
-      }
-      if (auto status = checkFinite(obstacle.offset, item(prefix, "obstacles", i, "offset"));
-          !status) {
-        return status;
-      }
-    } else {
-      if (auto status = checkFinite(obstacle.position, item(prefix, "obstacles", i, "position"));
-          !status) {
-        return status;
-      }
-      if (auto status = checkRadius(obstacle.radius, item(prefix, "obstacles", i, "radius"));
-          !status) {
-        return status;
-      }
+    if (auto status = checkShape(
+            shapeOf(obstacle), [&](const char* key) { return item(prefix, "obstacles", i, key); });
+        !status) {
+      return status;
     }
   }
   return Ok{};
@@ -230,9 +214,7 @@ Status validateScene(const Scene& scene, const std::string& prefix) {
 }
 
 void normalizePlanes(Scene& scene) {
-  for (ObstacleSpec& obstacle : scene.obstacles) {
-    if (obstacle.shape == ObstacleShape::kPlane) obstacle.normal = unitVector(obstacle.normal);
-  }
+  for (ObstacleSpec& obstacle : scene.obstacles) setShape(obstacle, normalized(shapeOf(obstacle)));
 }
 
 }  // namespace collision_response::core

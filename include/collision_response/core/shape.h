@@ -1,0 +1,49 @@
+// The shapes an obstacle may have and where it is: a shape placed in the fixed frame and the
+// rigid motion it moves with. The contact geometry of a ball and a shape, and the first contact
+// along a ball's motion, are one dispatch on the shape (src/core/geometry/narrow_phase.h): a new
+// shape is a new alternative here and a branch of each query there.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <variant>
+
+namespace collision_response::core {
+
+/// A plane {x : normal.x = offset}, free on the side `normal` (unit) points to.
+struct Plane {
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  double offset = 0.0;
+};
+
+/// A sphere (a solid ball) about `centre`.
+struct Sphere {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  double radius = 0.0;
+};
+
+using Shape = std::variant<Plane, Sphere>;
+
+/// A rigid motion at one instant: the pose (fixed <- moving) at `time`, the velocity of the
+/// pose's origin and the angular velocity, both in the fixed frame.
+struct RigidPose {
+  double time = 0.0;
+  Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();          ///< m/s, of the origin
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  ///< rad/s
+
+  /// The velocity of the point at `offset` from the origin (in the fixed frame): v + w x r.
+  Eigen::Vector3d velocityAt(const Eigen::Vector3d& offset) const {
+    return velocity + angular_velocity.cross(offset);
+  }
+};
+
+/// An obstacle where it is: its shape in the fixed frame at `pose.time`, and the motion it has
+/// from there (straight on: the monitor moves obstacles in straight lines between placements).
+/// The pose's origin is the shape's reference point (a sphere's centre, a point of a plane).
+struct PlacedShape {
+  Shape shape;
+  RigidPose pose;
+};
+
+}  // namespace collision_response::core
