@@ -4,6 +4,7 @@
 # core's step, driven by fuzzed scenes, states and stamps, under an allocation cap), each
 # checking its invariants (fuzz/*.cpp).
 #   bash scripts/fuzz.sh [seconds per target, default 30]      e.g. bash scripts/fuzz.sh 600
+# The three targets run side by side, each for that long.
 # Writes a JUnit result per target under .ws/build/test_results/fuzz (read by the test count);
 # the corpora grow in .ws/fuzz and are kept between runs; fuzz/regressions holds the inputs
 # that once broke an invariant, run first every time.
@@ -43,27 +44,37 @@ for name in conversions frame_motion monitor_cycle state_intake time_line; do
     clang++ "${flags[@]}" -c "$source" -o "$object" &
 done
 wait
-status=0
-for target in fuzz_impact fuzz_time_of_impact fuzz_monitor; do
+# Each target built, then all three run side by side (each one process, for `seconds`).
+targets=(fuzz_impact fuzz_time_of_impact fuzz_monitor)
+declare -A limits
+for target in "${targets[@]}"; do
   echo "== $target: building"
   extra=()
-  limits=()
+  limits[$target]=""
   if [ "$target" = fuzz_monitor ]; then
     extra=("$out"/ros/*.o -ltf2 -lrostime -lcpp_common -lconsole_bridge -lxmlrpcpp)
     # Bounded work per message: no single allocation of 256 MB, no 2 GB of memory, no input
     # slower than 120 s (under the sanitizers; the target also caps what one message
     # allocates, kAllocationCap).
-    limits=(-malloc_limit_mb=256 -rss_limit_mb=2048 -timeout=120)
+    limits[$target]="-malloc_limit_mb=256 -rss_limit_mb=2048 -timeout=120"
   fi
   clang++ "${flags[@]}" -fsanitize=fuzzer "$repo/fuzz/$target.cpp" "${objects[@]}" "${extra[@]}" \
-    -o "$out/$target"
+    -o "$out/$target" &
+done
+wait
+declare -A runners
+for target in "${targets[@]}"; do
   mkdir -p "$out/corpus-$target"
   echo "== $target: running $seconds s"
-  set +e
-  (cd "$out" && ASAN_OPTIONS=detect_leaks=1 ./"$target" -max_total_time="$seconds" "${limits[@]}" \
-    -print_final_stats=1 "corpus-$target" "$repo/fuzz/regressions" >"$out/$target.log" 2>&1)
-  rc=$?
-  set -e
+  # shellcheck disable=SC2086  # the limits are separate words
+  (cd "$out" && ASAN_OPTIONS=detect_leaks=1 ./"$target" -max_total_time="$seconds" ${limits[$target]} \
+    -print_final_stats=1 "corpus-$target" "$repo/fuzz/regressions" >"$out/$target.log" 2>&1) &
+  runners[$target]=$!
+done
+status=0
+for target in "${targets[@]}"; do
+  rc=0
+  wait "${runners[$target]}" || rc=$?
   runs=$(grep -E 'stat::number_of_executed_units' "$out/$target.log" | awk '{print $2}' | tail -1 || true)
   echo "   $target: exit $rc, ${runs:-0} executions"
   if [ $rc -eq 0 ]; then
