@@ -50,17 +50,22 @@ TimeLine::Placed TimeLine::start(const std::string& source, std::int64_t first, 
 
 std::int64_t TimeLine::newOffset(std::int64_t at, std::int64_t clock, std::int64_t present) const {
   if (clock == 0 || std::abs(clock - at) <= jump_ns_) return 0;
-  // A clock another source keeps (heard within ~clock_jump_back of the node's clock) on which
-  // this stamp lands where that source is now: the two share it (two topics of one machine or
-  // of one bag), and instants across them stay exact. The closest such.
+  // A clock off the node's that another source keeps, which this stamp continues: on it, the
+  // stamp is no more than ~clock_jump_back before that source's last one, nor ahead of where
+  // that source is now (its last instant plus the node's time since). The two share it (two
+  // topics of one machine or of one bag, two `rostopic pub` of hand-made stamps), and instants
+  // across them stay exact. The node's own clock is never shared this way: a stamp off it is
+  // another clock. Of several, the one where that source is now closest.
   const Clock* shared = nullptr;
-  std::int64_t closest = jump_ns_;
+  std::int64_t closest = 0;
   for (const auto& entry : sources_) {
     for (const Clock& other : entry.second.clocks) {
-      if (other.last_clock == 0 || clock - other.last_clock > jump_ns_) continue;
+      if (other.offset == 0 || other.last_clock == 0) continue;
+      const std::int64_t line = at + other.offset - epoch_;
       const std::int64_t expected = other.last_line + (clock - other.last_clock);
-      const std::int64_t distance = std::abs(at + other.offset - epoch_ - expected);
-      if (distance <= closest) {
+      if (line < other.last_line - jump_ns_ || line > expected + jump_ns_) continue;
+      const std::int64_t distance = std::abs(line - expected);
+      if (shared == nullptr || distance < closest) {
         closest = distance;
         shared = &other;
       }

@@ -510,6 +510,26 @@ TEST(TimeLine, Issue27_Item3_AMachine5sBehindIsStillAligned) {
   EXPECT_EQ(line.offset("/tracker_b_imu"), 5.0);
 }
 
+// The README's "By hand" example: two `rostopic pub` (two publisher nodes, two sources) send
+// hand-made stamps 100 s and 101 s, far off the node's clock, typed 4 s apart. The second
+// continues the first's clock (not before its last stamp, not ahead of where it is now), so it
+// shares that clock's offset: the two states are 1 s apart on the line, as their stamps say,
+// not 4 s (which would let ~body_timeout forget the tracks before the impact is found). A
+// stamp off that clock too (5 s ahead of where it is now) still gets a clock of its own.
+TEST(TimeLine, TwoPublishersOfHandMadeStampsShareTheirClock) {
+  TimeLine line(1.0);
+  const ros::Time node(1796322132, 0);
+  const TimeLine::Placed first =
+      line.place("/body_states from /rostopic_1", ros::Time(100, 0), node, 0.0);
+  const TimeLine::Placed second = line.place("/body_states from /rostopic_2", ros::Time(101, 0),
+                                             node + ros::Duration(4.0), first.time);
+  EXPECT_EQ(second.clock_offset, first.clock_offset);
+  EXPECT_NEAR(second.time - first.time, 1.0, 1e-9);
+  const TimeLine::Placed odd = line.place("/body_states from /rostopic_3", ros::Time(110, 0),
+                                          node + ros::Duration(5.0), second.time);
+  EXPECT_NE(odd.clock_offset, first.clock_offset);
+}
+
 // Issue 13, item 7: the same id twice in one array was dropped as "not newer" without naming
 // the id or the duplicate.
 TEST_F(Cycle, Item7_TheSameIdTwiceInOneArrayIsNamed) {
