@@ -100,7 +100,9 @@ PlacedShape shapeAt(const World& world, std::size_t participant, double time) {
 /// other) have no line of centres; the line of impact is the direction of approach, if any.
 template <class Motion>
 Geometry geometry(const World& world, const Pair& pair, double time) {
-  const auto [a, other] = pair;
+  // Named copies rather than a structured binding: the lambda below captures them (C++17, and
+  // clang, allow no capture of a binding).
+  const std::size_t a = pair.first, other = pair.second;
   return contactGeometry(positionAt<Motion>(world, a, time), world.radius[a],
                          shapeAt<Motion>(world, other, time), world.settings.contact_tolerance,
                          [&] {
