@@ -16,6 +16,8 @@ CollisionResponseNode::CollisionResponseNode(const ros::NodeHandle& node,
 
 CollisionResponseNode::~CollisionResponseNode() {
   if (service_spinner_) service_spinner_->stop();
+  if (diagnostics_spinner_) diagnostics_spinner_->stop();
+  diagnostics_timer_.stop();
   compute_collision_server_.shutdown();
   estimate_restitution_server_.shutdown();
 }
@@ -71,8 +73,14 @@ bool CollisionResponseNode::start() {
         node_, ros::NodeHandle(private_node_, "diagnostic_updater"), private_node_.getNamespace());
     diagnostics_->setHardwareID("none");
     diagnostics_->add("impact monitor", monitor_.get(), &ImpactMonitorRos::diagnose);
-    diagnostics_timer_ = node_.createWallTimer(
+    // On a queue and thread of their own: published whatever an update is doing (a long
+    // one shows as "update in progress (s)").
+    ros::NodeHandle diagnostics_node(node_);
+    diagnostics_node.setCallbackQueue(&diagnostics_queue_);
+    diagnostics_timer_ = diagnostics_node.createWallTimer(
         ros::WallDuration(0.1), [this](const ros::WallTimerEvent&) { updateDiagnostics(); });
+    diagnostics_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &diagnostics_queue_);
+    diagnostics_spinner_->start();
 
     // Live tuning, starting from the scene's values.
     config_.detection = core::toString(scene->detection);

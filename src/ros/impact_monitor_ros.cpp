@@ -27,11 +27,15 @@ ImpactMonitorRos::ImpactMonitorRos(ros::NodeHandle node, const core::Scene& scen
   queue_timer_ = node_.createWallTimer(
       ros::WallDuration(0.005), [this](const ros::WallTimerEvent&) { processQueue(); },
       /*oneshot=*/false, /*autostart=*/false);
+  figures_ = MonitorFigures::of(cycle_);
 }
 
 void ImpactMonitorRos::onStateArray(const ros::MessageEvent<const BodyStateArray>& event) {
   const BodyStateArray::ConstPtr message = event.getConstMessage();
-  diagnostics_.received(message->states.size());
+  {
+    std::lock_guard<std::mutex> lock(diagnostics_mutex_);
+    diagnostics_.received(message->states.size());
+  }
   if (message->states.size() > static_cast<std::size_t>(params_.max_states)) {
     tell(array_topic_,
          {{Reason::kTooManyStates,
@@ -44,7 +48,10 @@ void ImpactMonitorRos::onStateArray(const ros::MessageEvent<const BodyStateArray
 
 void ImpactMonitorRos::onState(const ros::MessageEvent<const BodyState>& event,
                                const std::string& topic, const std::string& id) {
-  diagnostics_.received(1);
+  {
+    std::lock_guard<std::mutex> lock(diagnostics_mutex_);
+    diagnostics_.received(1);
+  }
   enqueue(Pending{ros::WallTime::now(),
                   topic,
                   event.getPublisherName(),
@@ -89,6 +96,10 @@ void ImpactMonitorRos::processQueue() {
     queued_states_ -= queue_.front().states().size();
     queue_.pop_front();
   }
+  {
+    std::lock_guard<std::mutex> lock(diagnostics_mutex_);
+    waiting_ = queue_.size();
+  }
   if (queue_.empty()) {
     queue_timer_.stop();
   } else {
@@ -101,12 +112,22 @@ bool ImpactMonitorRos::processHead() {
   const ros::WallTime began = ros::WallTime::now();
   const bool may_wait = (began - head.received).toSec() < params_.transform_timeout;
   const MonitorCycle::Input input{&head.states(), head.topic, head.publisher, head.own_body};
+  {
+    std::lock_guard<std::mutex> lock(diagnostics_mutex_);
+    update_began_ = began;
+  }
   const MonitorCycle::Update update = cycle_.process(input, ros::Time::now(), may_wait, tf_buffer_);
+  {
+    std::lock_guard<std::mutex> lock(diagnostics_mutex_);
+    update_began_ = ros::WallTime();
+    figures_ = MonitorFigures::of(cycle_);
+  }
   if (update.waiting) return false;
   tell(head.topic, update.reports);
   if (update.stepped) {
     publish(update);
     const ros::WallTime done = ros::WallTime::now();
+    std::lock_guard<std::mutex> lock(diagnostics_mutex_);
     diagnostics_.stepped((done - began).toSec(), (done - head.received).toSec(),
                          update.impacts.impacts.size());
   }
@@ -150,6 +171,7 @@ void ImpactMonitorRos::tell(const std::string& topic, const std::vector<Report>&
     std::size_t events = 0;
   };
   std::map<std::pair<Reason, int>, Group> groups;
+  std::unique_lock<std::mutex> lock(diagnostics_mutex_);
   for (const Report& report : reports) {
     diagnostics_.count(report.reason, report.count);
     if (report.reason == Reason::kBeyondResolution) diagnostics_.noteBeyondResolution(report.text);
@@ -157,6 +179,7 @@ void ImpactMonitorRos::tell(const std::string& topic, const std::vector<Report>&
     group.events += report.count;
     if (report.warn && group.first == nullptr) group.first = &report;
   }
+  lock.unlock();
   for (const auto& [key, group] : groups) {
     if (group.first == nullptr) continue;
     std::string text = group.first->text;
@@ -170,10 +193,16 @@ void ImpactMonitorRos::tell(const std::string& topic, const std::vector<Report>&
 void ImpactMonitorRos::tune(core::Detection detection, double restitution_threshold,
                             core::CombineRule rule) {
   cycle_.tune(detection, restitution_threshold, rule);
+  std::lock_guard<std::mutex> lock(diagnostics_mutex_);
+  figures_ = MonitorFigures::of(cycle_);
 }
 
 void ImpactMonitorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
-  diagnostics_.report(status, cycle_, queue_.size());
+  std::lock_guard<std::mutex> lock(diagnostics_mutex_);
+  const double running =
+      update_began_.isZero() ? 0.0 : (ros::WallTime::now() - update_began_).toSec();
+  // An update that has run for 1 s turns the summary to WARN.
+  diagnostics_.report(status, figures_, waiting_, running, 1.0);
 }
 
 }  // namespace collision_response

@@ -17,10 +17,22 @@ void MonitorDiagnostics::stepped(double step_seconds, double latency_seconds,
   impacts_published_ += impacts_published;
 }
 
-void MonitorDiagnostics::report(diagnostic_updater::DiagnosticStatusWrapper& status,
-                                const MonitorCycle& cycle, std::size_t waiting) {
-  const core::ImpactMonitor& monitor = cycle.monitor();
+MonitorFigures MonitorFigures::of(const MonitorCycle& cycle) {
+  MonitorFigures figures;
   const core::Scene& scene = cycle.scene();
+  figures.detection = core::toString(scene.detection);
+  figures.combine_rule = core::toString(scene.materials.combineRule());
+  figures.restitution_threshold = scene.restitution_threshold;
+  figures.bodies = cycle.monitor().bodyCount();
+  figures.tracked = cycle.monitor().trackedBodies();
+  figures.stepped = cycle.steppedBodies();
+  figures.sources = cycle.timeLine().sources();
+  return figures;
+}
+
+void MonitorDiagnostics::report(diagnostic_updater::DiagnosticStatusWrapper& status,
+                                const MonitorFigures& figures, std::size_t waiting, double running,
+                                double slow) {
   const double seconds = std::max((ros::WallTime::now() - period_.start).toSec(), 1e-9);
   std::string dropped;  // in this period, by reason
   for (int i = 0; i < kReasonCount; ++i) {
@@ -37,7 +49,10 @@ void MonitorDiagnostics::report(diagnostic_updater::DiagnosticStatusWrapper& sta
   };
   const std::uint64_t outputs_dropped =
       inPeriod(Reason::kImpactNotFinite) + inPeriod(Reason::kContactNotFinite);
-  if (!dropped.empty()) {
+  if (running >= slow) {
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                   "an update has been running for " + core::formatNumber(running) + " s");
+  } else if (!dropped.empty()) {
     status.summary(diagnostic_msgs::DiagnosticStatus::WARN,
                    std::string(outputs_dropped > 0 ? "dropped: " : "states dropped: ") + dropped);
   } else if (period_.messages == 0) {
@@ -45,15 +60,16 @@ void MonitorDiagnostics::report(diagnostic_updater::DiagnosticStatusWrapper& sta
                    "no states received in the last " + core::formatNumber(seconds) + " s");
   } else {
     status.summary(diagnostic_msgs::DiagnosticStatus::OK,
-                   std::to_string(monitor.trackedBodies()) + " bodies tracked");
+                   std::to_string(figures.tracked) + " bodies tracked");
   }
   const auto steps = static_cast<double>(period_.steps);
-  status.add("detection", core::toString(scene.detection));
-  status.add("restitution threshold (m/s)", scene.restitution_threshold);
-  status.add("combine rule", core::toString(scene.materials.combineRule()));
-  status.add("bodies in the scene", monitor.bodyCount());
-  status.add("bodies tracked", monitor.trackedBodies());
-  status.add("bodies in stepped clusters", cycle.steppedBodies());
+  status.add("detection", figures.detection);
+  status.add("restitution threshold (m/s)", figures.restitution_threshold);
+  status.add("combine rule", figures.combine_rule);
+  status.add("bodies in the scene", figures.bodies);
+  status.add("bodies tracked", figures.tracked);
+  status.add("bodies in stepped clusters", figures.stepped);
+  status.add("update in progress (s)", running);
   status.add("input messages per second", static_cast<double>(period_.messages) / seconds);
   status.add("states per second", static_cast<double>(period_.states) / seconds);
   status.add("impacts per second", static_cast<double>(period_.impacts) / seconds);
@@ -69,7 +85,7 @@ void MonitorDiagnostics::report(diagnostic_updater::DiagnosticStatusWrapper& sta
   status.add("obstacle transforms missing (total)", total(Reason::kObstacleTransform));
   // By source (at most TimeLine::kMaxSources): the clocks that are not the node's, and the
   // stamps dropped off its clock.
-  for (const auto& [source, clocks] : cycle.timeLine().sources()) {
+  for (const auto& [source, clocks] : figures.sources) {
     if (!clocks.offsets.empty() && clocks.offsets[0] != 0.0)
       status.add("clock offset of " + source + " (s)", clocks.offsets[0]);
     if (clocks.offsets.size() > 1)

@@ -68,6 +68,11 @@ class CollisionResponseNode {
   boost::recursive_mutex reconfigure_mutex_;  ///< the server's, so updateConfig is safe
   std::unique_ptr<dynamic_reconfigure::Server<MonitorConfig>> reconfigure_;
   MonitorConfig config_;  ///< the values in use
+  // The diagnostics' own queue and thread (their timer), so that /diagnostics is published
+  // while an update runs on the node's queue; declared after what it reads, so that its thread
+  // stops first.
+  ros::CallbackQueue diagnostics_queue_;
+  std::unique_ptr<ros::AsyncSpinner> diagnostics_spinner_;
   // The services' own queue and thread; declared last so that the thread stops first.
   ros::CallbackQueue service_queue_;
   ros::ServiceServer compute_collision_server_;

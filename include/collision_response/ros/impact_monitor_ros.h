@@ -6,7 +6,9 @@
 // Threads: every callback of this class, and every use of the cycle, runs on the callback queue
 // of the node handle it is given (the node's global queue, or a nodelet's single-threaded one),
 // one at a time: the monitor's state is only ever touched from there. The collision services
-// run on a thread of their own (CollisionResponseNode) and never touch the monitor.
+// run on a thread of their own (CollisionResponseNode) and never touch the monitor. diagnose()
+// is called from the diagnostics' own thread, so that /diagnostics is published while an update
+// runs: it reads only the counters and the figures copied after each update, under a mutex.
 #pragma once
 
 #include <diagnostic_updater/DiagnosticStatusWrapper.h>
@@ -15,6 +17,7 @@
 #include <tf2_ros/transform_listener.h>
 
 #include <deque>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -89,8 +92,14 @@ class ImpactMonitorRos {
   ros::WallTimer queue_timer_;
   std::deque<Pending> queue_;
   std::size_t queued_states_ = 0;
-  MonitorDiagnostics diagnostics_;
   ThrottledWarning warnings_;
+  /// Guards what diagnose() reads from the diagnostics' thread: the counters, the figures of
+  /// the monitor after its last update, the update in progress and the inputs waiting.
+  std::mutex diagnostics_mutex_;
+  MonitorDiagnostics diagnostics_;
+  MonitorFigures figures_;
+  ros::WallTime update_began_;  ///< zero: no update in progress
+  std::size_t waiting_ = 0;
 };
 
 }  // namespace collision_response

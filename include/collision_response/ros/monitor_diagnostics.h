@@ -7,6 +7,7 @@
 #include <ros/time.h>
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -15,6 +16,17 @@
 #include "collision_response/ros/state_intake.h"
 
 namespace collision_response {
+
+/// What the report shows of the monitor itself, copied from it after every update (and after
+/// live tuning) on the monitor's thread, so that /diagnostics can be published from a thread of
+/// its own while an update runs.
+struct MonitorFigures {
+  std::string detection, combine_rule;
+  double restitution_threshold = 0.0;
+  std::size_t bodies = 0, tracked = 0, stepped = 0;
+  std::map<std::string, TimeLine::SourceClocks> sources;
+  static MonitorFigures of(const MonitorCycle& cycle);
+};
 
 class MonitorDiagnostics {
  public:
@@ -36,8 +48,14 @@ class MonitorDiagnostics {
 
   /// Fills `status` (the summary: WARN while states or impacts are dropped, with the reasons
   /// and counts of the period; OK otherwise) and starts a new period.
+  /// `running`: how long the update in progress has run (s; 0: none), shown as "update in
+  /// progress (s)", and in the summary (WARN) from `slow` s on.
+  void report(diagnostic_updater::DiagnosticStatusWrapper& status, const MonitorFigures& figures,
+              std::size_t waiting, double running = 0.0, double slow = INFINITY);
   void report(diagnostic_updater::DiagnosticStatusWrapper& status, const MonitorCycle& cycle,
-              std::size_t waiting);
+              std::size_t waiting) {
+    report(status, MonitorFigures::of(cycle), waiting);
+  }
 
  private:
   struct Period {
