@@ -44,8 +44,8 @@ TEST(ConstrainedMotion, ASlidingContactsMotionEndsWhereItsSlipFallsToTheToleranc
   const double expected = (s0 - tolerance) / (3.5 * mu * g);
   EXPECT_NEAR(motion.end() - start, expected, 1e-6 * expected);
   // The slip there (the surface's velocity at the contact point, the sphere being still).
-  const V slip = motion.velocity(0, motion.end()) +
-                 motion.angularVelocity(0, motion.end()).cross(V(0, 0, -r));
+  const V slip =
+      motion.velocity(0, motion.end()) + motion.angularVelocity(0, motion.end()).cross(V(0, 0, -r));
   EXPECT_NEAR(slip.norm(), tolerance, 1e-3 * tolerance);
 }
 
