@@ -43,6 +43,7 @@ ConstrainedStep::ConstrainedStep(const std::vector<ForceBody>& bodies,
       movable_(movable),
       contacts_(contacts),
       start_(start),
+      until_(until),
       end_(start) {
   settings_.slip_tolerance = slip_tolerance;
   State initial(kPerBody * movable_);
@@ -59,21 +60,25 @@ ConstrainedStep::ConstrainedStep(const std::vector<ForceBody>& bodies,
   }
   initial_acceleration_.assign(at_start.acceleration.begin(),
                                at_start.acceleration.begin() + static_cast<long>(movable_));
+  integration_ = std::make_unique<Integration>(tolerance);
+  integration_->dense.initialize(initial, start_, std::max(step, 1e-9 * (until_ - start_)));
+  advanceTo(start_ + (until_ - start_) / 4096);
+}
+
+void ConstrainedStep::advanceTo(double time) const {
   const auto system = [this](const State& x, State& dxdt, double t) { derivative(x, dxdt, t); };
-  auto integration = std::make_unique<Integration>(tolerance);
-  integration->dense.initialize(initial, start_, std::max(step, 1e-9 * (until - start_)));
   // A motion takes at most this many steps; a stiffer one ends there and is solved again.
   constexpr int kMostSteps = 2000;
-  for (int taken = 0; end_ < until; ++taken) {
-    if (taken == kMostSteps) {
+  for (; end_ < until_ && end_ < time && !mode_changed_; ++taken_) {
+    if (taken_ == kMostSteps) {
       mode_changed_ = true;
       return;
     }
-    integration->dense.do_step(system);
-    const double stepped = integration->dense.current_time();
-    next_step_ = integration->dense.current_time_step();
-    steps_.push_back(std::make_unique<Integration>(*integration));
-    end_ = std::min(stepped, until);
+    integration_->dense.do_step(system);
+    const double stepped = integration_->dense.current_time();
+    next_step_ = integration_->dense.current_time_step();
+    steps_.push_back(std::make_unique<Integration>(*integration_));
+    end_ = std::min(stepped, until_);
     if (!(margin(stateAt(end_), end_) < 0)) continue;
     // A mode stops holding within the step: the first instant, by bisection (its margin is
     // continuous along the step; to 1e-12 of the step, or of the time line's rounding).
@@ -89,8 +94,10 @@ ConstrainedStep::ConstrainedStep(const std::vector<ForceBody>& bodies,
     }
     end_ = fails;
     mode_changed_ = true;
+    integration_.reset();  // the motion ends here: no more steps
     return;
   }
+  if (complete()) integration_.reset();
 }
 
 ContactForceSolution ConstrainedStep::forces(const State& state, double time) const {
@@ -198,7 +205,9 @@ ConstrainedStep::State ConstrainedStep::stateAt(double time) const {
 }
 
 const ConstrainedStep::State& ConstrainedStep::queriedStateAt(double time) const {
-  // The steps are all taken once the constructor returns, so a state once found stays right.
+  // Past the frontier, integrated on to it first; a state once found for an instant within the
+  // steps taken stays right (later steps only add to them).
+  if (time > end_ && !complete()) advanceTo(time);
   if (!(time == queried_time_)) {
     queried_state_ = stateAt(time);
     queried_time_ = time;

@@ -27,11 +27,18 @@ struct ConstrainedContact {
   Eigen::Vector3d slide_direction = Eigen::Vector3d::Zero();
 };
 
-/// One step of a group's motion: from `start` to end(), as Dormand-Prince 5(4) with error
+/// One step of a group's motion: from `start` to `until`, as Dormand-Prince 5(4) with error
 /// control (Boost.Odeint) gives it, or to the first instant within it where a mode stops
 /// holding (a pressed contact would pull, a sticking one needs more than mu N, a sliding one's
 /// slip stops), found by bisection on the step's dense output. The state of every movable
 /// participant (position, velocity, angular velocity) is known at any instant of the step.
+///
+/// Integrated as far as it is looked at: at first a 4096th of the way to `until`; a query past
+/// end() integrates on to it, and extend() reaches three times as far from the start. The steps
+/// are those one integration to `until` would take (the same calls of the same stepper), so the
+/// motion does not depend on how it was asked for; only the work does. An impact on one of its
+/// bodies replaces the step long before `until` (a settling pile: about 100 instants an update),
+/// and what was integrated past it was lost.
 class ConstrainedStep {
  public:
   /// `bodies` at `start` (the movable ones first, `movable` of them; the others move at constant
@@ -48,10 +55,16 @@ class ConstrainedStep {
   ConstrainedStep& operator=(const ConstrainedStep&) = delete;
 
   double start() const { return start_; }
+  /// How far it is integrated: where its mode changed, `until`, or (not complete()) the
+  /// frontier so far, past which it is integrated on demand.
   double end() const { return end_; }
   /// The motion ended before `until`: where a mode stopped holding, or after the most steps one
   /// motion takes (the group must be solved again there).
   bool modeChanged() const { return mode_changed_; }
+  /// Integrated to its end: `until`, or where its mode changed.
+  bool complete() const { return mode_changed_ || !(end_ < until_); }
+  /// Integrates on to three times as far from the start as end() (at most to `until`).
+  void extend() const { advanceTo(end_ + 2 * (end_ - start_)); }
   /// The size the integrator would take next.
   double nextStep() const { return next_step_; }
 
@@ -67,6 +80,8 @@ class ConstrainedStep {
   using State = std::vector<double>;
   struct Integration;  // Boost.Odeint's dense-output stepper, kept out of this header
 
+  /// Integrates on until end() >= `time`, the motion's end, or its mode changes.
+  void advanceTo(double time) const;
   void derivative(const State& state, State& rate, double time) const;
   ContactForceSolution forces(const State& state, double time) const;
   /// The least margin of the modes at a state: < 0 where one stops holding.
@@ -86,13 +101,17 @@ class ConstrainedStep {
   // slide, along its mode's direction, until the slip grows past the tolerance).
   std::vector<char> starts_to_slide_;
   std::vector<Eigen::Vector3d> initial_acceleration_;
-  double start_, end_;
-  double next_step_ = 0.0;
-  bool mode_changed_ = false;
+  double start_, until_;
+  // Integrated on demand (advanceTo) from queries on a const step: mutable.
+  mutable double end_;
+  mutable double next_step_ = 0.0;
+  mutable bool mode_changed_ = false;
+  mutable int taken_ = 0;                             // steps taken
+  mutable std::unique_ptr<Integration> integration_;  // the stepper, where it has got to
   double force_scale_ = 0.0;
   ContactForceSettings settings_;
-  std::vector<std::unique_ptr<Integration>> steps_;  // each step's dense output, in time order
-  mutable double queried_time_ = NAN;                // queriedStateAt's last instant
+  mutable std::vector<std::unique_ptr<Integration>> steps_;  // each step's dense output, in order
+  mutable double queried_time_ = NAN;                        // queriedStateAt's last instant
   mutable State queried_state_;
 };
 

@@ -329,6 +329,10 @@ void storeGroupContacts(World& world, double time, const Candidates& candidates,
   const GroupSolve& solve = motion.solve;
   contact_group.time = time;
   contact_group.next_event = INFINITY;
+  // A slot of a dissolved group may be reused: none of its integrated motion stays.
+  contact_group.step.reset();
+  contact_group.scheduled_to = INFINITY;
+  contact_group.step_event_taken = false;
   for (const std::size_t k : motion.pressed.contacts) {
     const ContactForce& force = solve.solution.contacts[k];
     const Pair& pair = candidates[k].first;
@@ -353,10 +357,9 @@ void storeGroupContacts(World& world, double time, const Candidates& candidates,
     }
   }
   contact_group.alive = !contact_group.contacts.empty();
-  if (const ConstrainedStep* step = motion.integrated.step.get()) {
-    if (step->modeChanged()) {
-      contact_group.next_event = std::min(contact_group.next_event, step->end());
-    }
+  if (motion.integrated.step) {
+    contact_group.step = motion.integrated.step;
+    contact_group.scheduled_to = motion.integrated.step->end();
     contact_group.curved = true;
   }
 }
@@ -585,12 +588,44 @@ void formAllGroups(World& world, double time, std::vector<std::size_t>& changed)
   world.groups_current = true;
 }
 
+namespace {
+
+/// Its integrated motion reaches past where its pairs were scheduled, or may be integrated on.
+bool beyondFrontier(const ContactGroup& group) {
+  return group.scheduled_to < group.step->end() || !group.step->complete();
+}
+
+}  // namespace
+
+double integratedEvent(const ContactGroup& group) {
+  if (!group.step || group.step_event_taken) return INFINITY;
+  if (beyondFrontier(group)) return group.scheduled_to;
+  return group.step->modeChanged() ? group.step->end() : INFINITY;
+}
+
+bool integrateFurther(World& world, std::size_t g, double when) {
+  ContactGroup& group = world.groups[g];
+  if (!group.step || group.step_event_taken || !beyondFrontier(group) ||
+      !(group.scheduled_to <= when) || !(group.scheduled_to < group.next_event)) {
+    return false;
+  }
+  // A query may have integrated it further already (ConstrainedStep's positions past its end).
+  if (!(group.step->end() > group.scheduled_to)) group.step->extend();
+  group.scheduled_to = group.step->end();
+  return true;
+}
+
+void takeGroupEvents(ContactGroup& group, double when) {
+  group.next_event = INFINITY;
+  if (integratedEvent(group) <= when) group.step_event_taken = true;
+}
+
 std::pair<double, std::size_t> nextGroupEvent(const World& world) {
   std::pair<double, std::size_t> next{INFINITY, 0};
   for (std::size_t g = 0; g < world.groups.size(); ++g) {
-    if (world.groups[g].alive && world.groups[g].next_event < next.first) {
-      next = {world.groups[g].next_event, g};
-    }
+    const ContactGroup& group = world.groups[g];
+    const double event = std::min(group.next_event, integratedEvent(group));
+    if (group.alive && event < next.first) next = {event, g};
   }
   return next;
 }

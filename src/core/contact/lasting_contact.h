@@ -43,6 +43,16 @@ inline double eventResolution(double when, double span) {
 /// The earliest event of any group and that group; {infinity, 0} when there is none.
 std::pair<double, std::size_t> nextGroupEvent(const World& world);
 
+/// A curved group's event from its integrated motion (ConstrainedStep): its end while it is
+/// integrated on demand (the frontier), or where its mode changed; infinity once complete or
+/// taken.
+double integratedEvent(const ContactGroup& group);
+
+bool integrateFurther(World& world, std::size_t group, double when);
+
+/// The group's events at `when` are taken (it is formed again, or goes on as it is).
+void takeGroupEvents(ContactGroup& group, double when);
+
 /// m/s: how fast the surfaces of `pair` move relative to each other at `time`: the norm of their
 /// relative velocity plus the first's radius times the norm of their relative turning.
 double surfaceSpeed(const World& world, const Pair& pair, double time);

@@ -166,6 +166,11 @@ struct StepProgress {
   std::vector<Pair> touching_pairs;  // the touching contacts' pairs outside stepped clusters
   std::vector<std::size_t> changed;
   std::vector<std::size_t> event_bodies;
+  /// A curved group integrated further at the instant (its frontier): its bodies, whose pairs
+  /// are scheduled again; `extension` when that is all the instant is (not an instant of the
+  /// step's budget).
+  std::vector<std::size_t> extended;
+  bool extension = false;
   bool stepped_due = false;
   std::size_t next_imposed = 0;
   int budget = 0;
@@ -292,6 +297,7 @@ void scheduleChanged(ContactSchedule<Motion>& schedule, bool first, const StepPr
     schedule.scheduleAll(at.instant, at.changed);
   } else {
     for (const std::size_t body : at.changed) schedule.reschedule(body, at.instant);
+    for (const std::size_t body : at.extended) schedule.reschedule(body, at.instant);
   }
 }
 
@@ -311,13 +317,18 @@ bool nextEvent(World& world, ContactSchedule<Motion>& schedule,
     next_stepped = monitor::nextSteppedEvent(world, time);
   }
   const double next = std::min({next_contact, next_state, next_group_event, next_stepped});
+  at.extension = false;
   if (!(next <= time)) return false;
   if (next_group_event == next || next_state == next || next_stepped == next) {
     at.instant = next;
     at.touching.clear();
-    if (next_group_event == next) {
+    if (next_group_event == next && monitor::integrateFurther(world, group, next)) {
+      // Integrated further: its bodies' pairs are scheduled again past the old frontier.
+      at.extended = world.groups[group].bodies;
+      at.extension = next_state != next && next_stepped != next;
+    } else if (next_group_event == next) {
       monitor::ContactGroup& changing = world.groups[group];
-      changing.next_event = INFINITY;
+      monitor::takeGroupEvents(changing, next);
       if (solvesAgain(changing, next, time - world.now)) at.event_bodies = changing.bodies;
     }
     at.stepped_due = next_stepped == next;
@@ -357,8 +368,8 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
   at.instant = world.now;
   at.budget = world.settings.max_instants_per_step;
   schedule.touchingAtStart(at.instant, at.touching);
-  for (int instants = 0;; ++instants) {
-    const bool first = instants == 0;
+  bool first = true;
+  for (int instants = 0;; instants += at.extension ? 0 : 1, first = false) {
     at.changed.clear();
     if (instants >= at.budget && !fallBack<Motion>(world, at, report)) break;
     resolveTouching<Motion>(world, schedule, at, report);
@@ -368,6 +379,7 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
     }
     at.event_bodies.clear();
     scheduleChanged<Motion>(schedule, first, at);
+    at.extended.clear();
     if (!nextEvent<Motion>(world, schedule, imposed, time, at)) break;
   }
   applyStates(world, states, report, true);
@@ -432,8 +444,9 @@ void advanceLastingContact(World& world, double time, StepReport& report) {
       settle(stepped);
       continue;
     }
+    if (monitor::integrateFurther(world, group, when)) continue;
     monitor::ContactGroup& changing = world.groups[group];
-    changing.next_event = INFINITY;
+    monitor::takeGroupEvents(changing, when);
     if (!solvesAgain(changing, when, time - world.now)) continue;
     seeds = changing.bodies;
     monitor::formGroups(world, when, seeds, index, changed);

@@ -93,6 +93,12 @@ struct ContactGroup {
   std::vector<GroupContact> contacts;  ///< the pressed ones, in the canonical order of pairs
   double next_event = std::numeric_limits<double>::infinity();
   bool curved = false;  ///< its motion is integrated, up to World::step_end
+  /// Curved: its integrated motion, and how far its bodies' pairs were scheduled along it (the
+  /// frontier: an event, integrateFurther). Where its mode changed, its end is an event too,
+  /// until taken (integratedEvent).
+  std::shared_ptr<const ConstrainedStep> step;
+  double scheduled_to = std::numeric_limits<double>::infinity();
+  bool step_event_taken = false;
 };
 
 /// A contact of a stepped cluster over its sub-step.

@@ -254,10 +254,17 @@ bool separating(const World& world, const Pair& pair, const Eigen::Vector3d& nor
 template <class Motion>
 Box sweptBox(const World& world, std::size_t body, double from, double to) {
   const Eigen::Vector3d start = positionAt<Motion>(world, body, from);
-  const Eigen::Vector3d end = positionAt<Motion>(world, body, to);
-  Box box{start.cwiseMin(end), start.cwiseMax(end)};
+  Box box{start, start};
+  bool integrated = false;
+  if constexpr (Motion::kAccelerates) integrated = constrained(world, body);
+  if (!integrated) {
+    // Integrated, not its position at `to`: that would integrate the step on to `to`, which it
+    // is only as far as something looks at it (ConstrainedStep).
+    const Eigen::Vector3d end = positionAt<Motion>(world, body, to);
+    box = Box{start.cwiseMin(end), start.cwiseMax(end)};
+  }
   if constexpr (Motion::kAccelerates) {
-    if (constrained(world, body)) {
+    if (integrated) {
       // Along the integrated step, sampled; beyond its end, as far as its speed and gravity and
       // the step's acceleration (twice) could carry it.
       const ConstrainedStep& step = *world.tracks[body].constrained;
