@@ -7,7 +7,8 @@
 #                                  trace, and ros_unit_tests): about a minute after the build.
 # The full run keeps its two cores busy with two lanes side by side: the rostests (two at a time,
 # each with its own master on a free port, as rostest starts them) and, at a lower priority, the
-# sanitizer build and the fuzzers, whose compiles fill the time the rostests spend waiting.
+# sanitizer build and the fuzzers (side by side too), whose compiles fill the time the rostests
+# spend waiting.
 set -euo pipefail
 quick=false
 case "${1:-}" in
@@ -61,6 +62,10 @@ fi
 lane="$ws/second-lane.log"
 (
   renice -n 10 -p "$BASHPID" >/dev/null
+  # The fuzzers' build and run beside the sanitizer build and its tests (which run one
+  # process at a time): together they keep both cores busy.
+  bash "$repo/scripts/fuzz.sh" "${FUZZ_SECONDS:-30}" >"$ws/fuzz-lane.log" 2>&1 &
+  fuzzers=$!
   bash "$repo/scripts/sanitize.sh" || true
   # catkin_lint on the package (warnings count as failures): one counted case.
   # Not in collision_response/: run_tests empties that folder when it starts.
@@ -73,7 +78,8 @@ lane="$ws/second-lane.log"
     printf '<testsuite><testcase classname="catkin_lint" name="package"><failure message="catkin_lint --strict reported problems (printed above)"/></testcase></testsuite>\n' \
       >"$ws/build/test_results/lint/catkin_lint.xml"
   fi
-  bash "$repo/scripts/fuzz.sh" "${FUZZ_SECONDS:-30}" || true
+  wait "$fuzzers" || true
+  cat "$ws/fuzz-lane.log"
 ) >"$lane" 2>&1 &
 second_lane=$!
 pids+=("$second_lane")
