@@ -85,13 +85,15 @@ class Group {
   template <class Visit>
   void respondToOne(std::size_t j, const V3& force, Visit visit) const {
     const ForceContact& source = contacts_[j];
-    Response r;
-    r.acceleration.assign(2, V3::Zero());
-    r.angular_acceleration.assign(2, V3::Zero());
+    // The two bodies' accelerations in fixed slots, not a Response: a column costs no
+    // allocation (this runs for every unknown of every solve, and the integrator of curved
+    // contact solves at every stage of every step).
+    V3 acceleration[2] = {V3::Zero(), V3::Zero()};
+    V3 angular_acceleration[2] = {V3::Zero(), V3::Zero()};
     const std::size_t moved[2] = {source.a, source.b};
-    pushAt(r, 1, source.b, force, -normal_[j]);
-    pushAt(r, 0, source.a, -force, normal_[j]);
-    const auto local = [&](std::size_t body, const std::vector<V3>& values) -> V3 {
+    accelerate(source.b, force, -normal_[j], acceleration[1], angular_acceleration[1]);
+    accelerate(source.a, -force, normal_[j], acceleration[0], angular_acceleration[0]);
+    const auto local = [&](std::size_t body, const V3* values) -> V3 {
       if (body == moved[0]) return values[0];
       if (body == moved[1]) return values[1];
       return V3::Zero();
@@ -105,11 +107,11 @@ class Group {
             bodies_[moved[0]].inverse_mass != 0.0) {
           continue;  // visited from a's side
         }
-        const V3 relative = local(contact.b, r.acceleration) - local(contact.a, r.acceleration);
+        const V3 relative = local(contact.b, acceleration) - local(contact.a, acceleration);
         const Real gap = normal_[k].dot(relative);
         const V3 slip =
-            relative - (Real(bodies_[contact.a].radius) * local(contact.a, r.angular_acceleration) +
-                        Real(bodies_[contact.b].radius) * local(contact.b, r.angular_acceleration))
+            relative - (Real(bodies_[contact.a].radius) * local(contact.a, angular_acceleration) +
+                        Real(bodies_[contact.b].radius) * local(contact.b, angular_acceleration))
                            .cross(normal_[k]);
         visit(k, gap, V3(slip - slip.dot(normal_[k]) * normal_[k]));
       }
@@ -164,14 +166,19 @@ class Group {
   /// push() into slot `slot` of `r` for body `i`.
   void pushAt(Response& r, std::size_t slot, std::size_t i, const V3& force,
               const V3& lever) const {
+    accelerate(i, force, lever, r.acceleration[slot], r.angular_acceleration[slot]);
+  }
+  /// What `force` at `lever` adds to body `i`'s accelerations.
+  void accelerate(std::size_t i, const V3& force, const V3& lever, V3& acceleration,
+                  V3& angular_acceleration) const {
     const ForceBody& body = bodies_[i];
     if (body.inverse_mass == 0.0) return;
-    r.acceleration[slot] += Real(body.inverse_mass) * force;
+    acceleration += Real(body.inverse_mass) * force;
     if (body.spin_factor != 0.0 && body.radius > 0.0) {
       // Moment r lever x F about the centre; angular acceleration moment / I, 1/I = w / (k r^2).
-      r.angular_acceleration[slot] +=
-          (Real(body.inverse_mass) * Real(body.spin_factor) / Real(body.radius)) *
-          lever.cross(force);
+      angular_acceleration += (Real(body.inverse_mass) * Real(body.spin_factor) /
+                               Real(body.radius)) *
+                              lever.cross(force);
     }
   }
 
