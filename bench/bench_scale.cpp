@@ -4,7 +4,8 @@
 // update of piles of up to 1,000 balls at rest in a box (lasting contact under gravity: one
 // layer 1 mm apart or touching, and a stack 10 high), against the same pile with gravity off
 // and against Bullet on the same pile; and the friction of one cluster of up to 1,000 touching,
-// spinning balls (the joint tangential solve alone).
+// spinning balls (the joint tangential solve alone); and a pile of 8 dropped into a box with
+// friction and spin, played as the scene player plays it, beside Bullet on piles of 8 to 1,000.
 // scripts/performance.sh runs it and writes doc/performance.md.
 #include <benchmark/benchmark.h>
 
@@ -23,6 +24,7 @@
 #include "collision_response/core/impact.h"
 #include "collision_response/core/monitor.h"
 #include "collision_response/core/playback.h"
+#include "dropped_pile.h"
 #include "impact/cluster_solver.h"
 #ifdef COLLISION_RESPONSE_WITH_BULLET
 #include <btBulletDynamicsCommon.h>
@@ -301,8 +303,109 @@ BENCHMARK(BM_FrictionCluster)
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.5);
 
+/// A pile dropped into a box with friction and spin (bench/dropped_pile.h: r = 0.05 m, e = 0.5,
+/// mu = 0.5), played for 0.6 s at 100 Hz as the scene player plays it, once (the pile is the
+/// run): the monitor's CPU per simulated second, its worst update, the played motion's CPU, and
+/// the deepest any ball went into another or a wall at the updates' instants.
+void BM_DroppedPile(benchmark::State& state) {
+  const int balls = static_cast<int>(state.range(0));
+  const double seconds = 0.6;
+  PileFigures figures;
+  for (auto _ : state) figures = playPile(droppedPile(balls, 0.5), seconds, 100.0);
+  state.counters["cpu_per_simulated_s"] = figures.monitor_cpu / seconds;
+  state.counters["worst_update_s"] = figures.worst_update;
+  state.counters["source_cpu_per_simulated_s"] = figures.source_cpu / seconds;
+  state.counters["impacts"] = static_cast<double>(figures.impacts);
+  state.counters["fallbacks"] = static_cast<double>(figures.fallbacks);
+  state.counters["deepest_m"] = figures.deepest;
+}
+BENCHMARK(BM_DroppedPile)->ArgName("balls")->Arg(8)->Iterations(1)->Unit(benchmark::kSecond);
+
 #ifdef COLLISION_RESPONSE_WITH_BULLET
 btScalar bt(double value) { return static_cast<btScalar>(value); }
+
+/// Bullet on the same dropped pile: one stepSimulation of 0.01 s per update for 0.6 s,
+/// restitution sqrt(0.5) and friction sqrt(0.5) on every body and wall (Bullet multiplies the
+/// two: e = 0.5, mu = 0.5), no sleeping; the CPU per simulated second, the worst step, and the
+/// deepest overlap at the steps' ends.
+void BM_BulletDroppedPile(benchmark::State& state) {
+  const core::Scene scene = droppedPile(static_cast<int>(state.range(0)), 0.5);
+  const double seconds = 0.6, size = -scene.obstacles[1].offset;
+  double cpu = 0, worst = 0, deepest = 0;
+  for (auto _ : state) {
+    btDefaultCollisionConfiguration configuration;
+    btCollisionDispatcher dispatcher(&configuration);
+    btDbvtBroadphase broadphase;
+    btSequentialImpulseConstraintSolver solver;
+    btDiscreteDynamicsWorld world(&dispatcher, &broadphase, &solver, &configuration);
+    world.setGravity(btVector3(0, 0, bt(-9.81)));
+    const btScalar half = bt(std::sqrt(0.5));
+    btSphereShape sphere(bt(0.05));
+    btVector3 inertia(0, 0, 0);
+    sphere.calculateLocalInertia(bt(0.1), inertia);
+    std::vector<std::unique_ptr<btDefaultMotionState>> motions;
+    std::vector<std::unique_ptr<btRigidBody>> bodies;
+    std::vector<std::unique_ptr<btCollisionShape>> planes;
+    for (const core::BodySpec& spec : scene.bodies) {
+      btTransform start;
+      start.setIdentity();
+      start.setOrigin(
+          btVector3(bt(spec.position.x()), bt(spec.position.y()), bt(spec.position.z())));
+      motions.push_back(std::make_unique<btDefaultMotionState>(start));
+      btRigidBody::btRigidBodyConstructionInfo info(bt(0.1), motions.back().get(), &sphere,
+                                                    inertia);
+      info.m_restitution = half;
+      info.m_friction = half;
+      bodies.push_back(std::make_unique<btRigidBody>(info));
+      bodies.back()->setActivationState(DISABLE_DEACTIVATION);
+      world.addRigidBody(bodies.back().get());
+    }
+    const std::size_t balls = bodies.size();
+    for (const core::ObstacleSpec& wall : scene.obstacles) {
+      planes.push_back(std::make_unique<btStaticPlaneShape>(
+          btVector3(bt(wall.normal.x()), bt(wall.normal.y()), bt(wall.normal.z())),
+          bt(wall.offset)));
+      btTransform identity;
+      identity.setIdentity();
+      motions.push_back(std::make_unique<btDefaultMotionState>(identity));
+      btRigidBody::btRigidBodyConstructionInfo info(0, motions.back().get(), planes.back().get());
+      info.m_restitution = half;
+      info.m_friction = half;
+      bodies.push_back(std::make_unique<btRigidBody>(info));
+      world.addRigidBody(bodies.back().get());
+    }
+    for (int k = 0; k < static_cast<int>(std::lround(seconds * 100)); ++k) {
+      const double began = cpuSeconds();
+      world.stepSimulation(bt(0.01), 1, bt(0.01));
+      const double took = cpuSeconds() - began;
+      cpu += took;
+      worst = std::max(worst, took);
+      for (std::size_t i = 0; i < balls; ++i) {
+        const btVector3 p = bodies[i]->getCenterOfMassPosition();
+        const V at(p.x(), p.y(), p.z());
+        for (int axis = 0; axis < 3; ++axis) {
+          deepest = std::max({deepest, 0.05 - at[axis], at[axis] + 0.05 - size});
+        }
+        for (std::size_t j = i + 1; j < balls; ++j) {
+          const btVector3 q = bodies[j]->getCenterOfMassPosition();
+          deepest = std::max(deepest, 0.1 - (V(q.x(), q.y(), q.z()) - at).norm());
+        }
+      }
+    }
+    for (const auto& body : bodies) world.removeRigidBody(body.get());
+  }
+  state.counters["cpu_per_simulated_s"] = cpu / seconds;
+  state.counters["worst_update_s"] = worst;
+  state.counters["deepest_m"] = deepest;
+}
+BENCHMARK(BM_BulletDroppedPile)
+    ->ArgName("balls")
+    ->Arg(8)
+    ->Arg(27)
+    ->Arg(100)
+    ->Arg(1000)
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
 
 void BM_BulletGasUpdate(benchmark::State& state) {
   const Gas gas = makeGas(static_cast<int>(state.range(0)));
