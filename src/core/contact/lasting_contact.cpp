@@ -617,7 +617,11 @@ bool integrateFurther(World& world, std::size_t g, double when) {
 
 void takeGroupEvents(ContactGroup& group, double when) {
   group.next_event = INFINITY;
-  if (integratedEvent(group) <= when) group.step_event_taken = true;
+  // Its mode change is taken with them; a frontier at the same instant is not (it is integrated
+  // further at its own event, should the group go on as it is).
+  if (group.step && !beyondFrontier(group) && integratedEvent(group) <= when) {
+    group.step_event_taken = true;
+  }
 }
 
 std::pair<double, std::size_t> nextGroupEvent(const World& world) {
