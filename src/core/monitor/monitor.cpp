@@ -444,7 +444,12 @@ void advanceLastingContact(World& world, double time, StepReport& report) {
       settle(stepped);
       continue;
     }
-    if (monitor::integrateFurther(world, group, when)) continue;
+    if (monitor::integrateFurther(world, group, when)) {
+      // Integrated further, not an event of the budget (bounded: each reaches on by one step
+      // at least, and a motion takes at most ConstrainedStep's most steps).
+      --events;
+      continue;
+    }
     monitor::ContactGroup& changing = world.groups[group];
     monitor::takeGroupEvents(changing, when);
     if (!solvesAgain(changing, when, time - world.now)) continue;
