@@ -56,7 +56,6 @@ ConstrainedStep::ConstrainedStep(const std::vector<ForceBody>& bodies,
   for (std::size_t k = 0; k < contacts_.size(); ++k) {
     force_scale_ = std::max(force_scale_, std::abs(at_start.contacts[k].normal));
     slip_direction_.push_back(at_start.contacts[k].slide_direction);
-    starts_to_slide_.push_back(at_start.contacts[k].slip.norm() <= slip_tolerance);
   }
   initial_acceleration_.assign(at_start.acceleration.begin(),
                                at_start.acceleration.begin() + static_cast<long>(movable_));
@@ -166,14 +165,6 @@ double ConstrainedStep::margin(const State& state, double time) const {
       // The slip stops (reverses by half the slip tolerance: a contact that starts to slide
       // has a slip of rounding size in no direction of its own).
       least = std::min(least, force.slip.dot(slip_direction_[k]) + 0.5 * settings_.slip_tolerance);
-      // The slip crosses the slip tolerance, where the sliding friction's direction switches
-      // between the slip's own and the one the contact started to slide along
-      // (solveContactForcesWithModes): the motion ends there and the group is solved again.
-      // Integrated across it, the rates jump where a slip hovers at the tolerance (a sliding
-      // contact whose slip friction is closing), and the steps shrank to 1e-10 s: 2,000 of them
-      // for 2e-7 s of motion, the bulk of the 8-ball pile's cost (doc/performance.md).
-      const double slip = force.slip.norm(), tolerance = settings_.slip_tolerance;
-      least = std::min(least, starts_to_slide_[k] ? tolerance - slip : slip - tolerance);
     }
   }
   return least;

@@ -97,9 +97,6 @@ class ConstrainedStep {
   std::size_t movable_;
   std::vector<ConstrainedContact> contacts_;
   std::vector<Eigen::Vector3d> slip_direction_;  // sliding contacts: the slip's at the start
-  // Sliding contacts: whether the slip was below the slip tolerance at the start (it starts to
-  // slide, along its mode's direction, until the slip grows past the tolerance).
-  std::vector<char> starts_to_slide_;
   std::vector<Eigen::Vector3d> initial_acceleration_;
   double start_, until_;
   // Integrated on demand (advanceTo) from queries on a const step: mutable.
