@@ -258,8 +258,8 @@ Box sweptBox(const World& world, std::size_t body, double from, double to) {
   bool integrated = false;
   if constexpr (Motion::kAccelerates) integrated = constrained(world, body);
   if (!integrated) {
-    // Integrated, not its position at `to`: that would integrate the step on to `to`, which it
-    // is only as far as something looks at it (ConstrainedStep).
+    // Its position at `to` only when its motion is not integrated: asking an integrated one
+    // would integrate it on to `to` (ConstrainedStep integrates only as far as it is looked at).
     const Eigen::Vector3d end = positionAt<Motion>(world, body, to);
     box = Box{start.cwiseMin(end), start.cwiseMax(end)};
   }
