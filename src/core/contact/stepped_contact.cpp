@@ -30,28 +30,33 @@ class ContactSpace {
  public:
   ContactSpace(const std::vector<SteppedBody>& bodies, const std::vector<SteppedContact>& contacts,
                const std::vector<std::size_t>& order)
-      : bodies_(bodies), contacts_(contacts), order_(order), change_(bodies.size()) {
+      : change_(bodies.size()) {
+    // What the operator reads of each contact, compact and in the solve's order: the solves
+    // apply it hundreds of times, and a contact's full record would be read each time.
+    rows_.reserve(order.size());
+    for (const std::size_t k : order) {
+      const SteppedContact& c = contacts[k];
+      rows_.push_back(Row{c.a, c.b, bodies[c.a].inverse_mass, bodies[c.b].inverse_mass, c.normal});
+    }
     std::vector<double> reach(bodies.size(), 0.0);  // sum over a body's contacts of w |n.n|
-    for (const std::size_t k : order_) {
-      reach[contacts_[k].a] += bodies_[contacts_[k].a].inverse_mass;
-      reach[contacts_[k].b] += bodies_[contacts_[k].b].inverse_mass;
+    for (const Row& row : rows_) {
+      reach[row.a] += row.inverse_mass_a;
+      reach[row.b] += row.inverse_mass_b;
     }
     // Gershgorin: |A| <= max_k sum_l |A_kl| <= max_k (reach_a + reach_b).
-    for (const std::size_t k : order_) {
-      norm_bound_ = std::max(norm_bound_, reach[contacts_[k].a] + reach[contacts_[k].b]);
-    }
+    for (const Row& row : rows_) norm_bound_ = std::max(norm_bound_, reach[row.a] + reach[row.b]);
   }
 
-  Eigen::Index size() const { return static_cast<Eigen::Index>(order_.size()); }
+  Eigen::Index size() const { return static_cast<Eigen::Index>(rows_.size()); }
   double normBound() const { return norm_bound_; }
 
   /// Each body's velocity change from the impulses x (in the order of the contacts).
   const std::vector<Eigen::Vector3d>& velocityChanges(const Eigen::VectorXd& x) const {
     std::fill(change_.begin(), change_.end(), Eigen::Vector3d::Zero());
     for (Eigen::Index i = 0; i < size(); ++i) {
-      const SteppedContact& c = contacts_[order_[static_cast<std::size_t>(i)]];
-      change_[c.a] -= (bodies_[c.a].inverse_mass * x[i]) * c.normal;
-      change_[c.b] += (bodies_[c.b].inverse_mass * x[i]) * c.normal;
+      const Row& row = rows_[static_cast<std::size_t>(i)];
+      change_[row.a] -= (row.inverse_mass_a * x[i]) * row.normal;
+      change_[row.b] += (row.inverse_mass_b * x[i]) * row.normal;
     }
     return change_;
   }
@@ -61,8 +66,8 @@ class ContactSpace {
     const std::vector<Eigen::Vector3d>& change = velocityChanges(x);
     y.resize(size());
     for (Eigen::Index i = 0; i < size(); ++i) {
-      const SteppedContact& c = contacts_[order_[static_cast<std::size_t>(i)]];
-      y[i] = c.normal.dot(change[c.b] - change[c.a]);
+      const Row& row = rows_[static_cast<std::size_t>(i)];
+      y[i] = row.normal.dot(change[row.b] - change[row.a]);
     }
   }
 
@@ -70,8 +75,8 @@ class ContactSpace {
   Eigen::VectorXd normalVelocities(const std::vector<Eigen::Vector3d>& v) const {
     Eigen::VectorXd d(size());
     for (Eigen::Index i = 0; i < size(); ++i) {
-      const SteppedContact& c = contacts_[order_[static_cast<std::size_t>(i)]];
-      d[i] = c.normal.dot(v[c.b] - v[c.a]);
+      const Row& row = rows_[static_cast<std::size_t>(i)];
+      d[i] = row.normal.dot(v[row.b] - v[row.a]);
     }
     return d;
   }
@@ -83,9 +88,12 @@ class ContactSpace {
   }
 
  private:
-  const std::vector<SteppedBody>& bodies_;
-  const std::vector<SteppedContact>& contacts_;
-  const std::vector<std::size_t>& order_;
+  struct Row {
+    std::size_t a, b;
+    double inverse_mass_a, inverse_mass_b;
+    Eigen::Vector3d normal;
+  };
+  std::vector<Row> rows_;
   mutable std::vector<Eigen::Vector3d> change_;
   double norm_bound_ = 0.0;
 };
