@@ -429,10 +429,20 @@ TEST(SteppedClusters, RenamingTheBodiesChangesNoBit) {
 
 // 32 balls stacked in two touching layers of 4 x 4 in a box that fits them exactly, at rest: one
 // stepped cluster. Nothing moves (each ball is held by the one below or the floor), and the
-// contacts with the floor carry the whole weight, 32 m g, each ball of the lower layer 2 m g.
-TEST(SteppedClusters, AStackedPileAtRestCarriesItsWeight) {
+// contacts with the floor carry the whole weight, 32 m g, each ball of the lower layer 2 m g;
+// frictionless, and with friction and spin (mu = 0.5: the friction sweeps start from the
+// sub-step before's impulses and find none needed).
+class SteppedPileAtRest : public ::testing::TestWithParam<bool> {};
+
+TEST_P(SteppedPileAtRest, AStackedPileAtRestCarriesItsWeight) {
   const double r = 0.05, m = 0.1;
   Scene scene = boxScene(8 * r);
+  if (GetParam()) {
+    scene.effects.friction = true;
+    scene.effects.spin = true;
+    scene.materials = MaterialTable::seed();
+    EXPECT_TRUE(scene.materials.addMaterial("pile", Material{0.5, 0.5}, "m").ok());
+  }
   std::vector<V> start;
   for (int i = 0; i < 32; ++i) {
     scene.bodies.push_back(ball(plainName(i), m, r));
@@ -469,6 +479,8 @@ TEST(SteppedClusters, AStackedPileAtRestCarriesItsWeight) {
   }
   EXPECT_NEAR(floor_force, 32 * m * kG, 1e-6 * m * kG);
 }
+
+INSTANTIATE_TEST_SUITE_P(FrictionOffAndOn, SteppedPileAtRest, ::testing::Bool());
 
 // Below the size a cluster needs (stepped_cluster_min_bodies), or with stepping off (0), the
 // exact model moves the bodies: no body is ever in a stepped cluster.

@@ -146,6 +146,10 @@ SteppedContacts steppedContactsOf(const World& world, double time, double span, 
     const auto force = world.stepping.keeping_force.find(pair);
     const bool known = warm_start && force != world.stepping.keeping_force.end();
     stepped.warm.push_back(known ? force->second * span : 0.0);
+    const auto friction = world.stepping.friction_force.find(pair);
+    if (warm_start && friction != world.stepping.friction_force.end()) {
+      stepped.contacts.back().friction_warm = friction->second * span;
+    }
     stepped.pairs.push_back(pair);
   }
   return stepped;
@@ -163,7 +167,7 @@ void solveComponent(const World& world, double time, double span, const std::vec
   SteppedSettings settings;
   settings.duration = span;
   settings.restitution_threshold = world.restitution_threshold;
-  if (world.friction_model) settings.friction = world.friction_model.cluster;
+  if (world.friction_model) settings.friction = world.friction_model.swept;
   component.outcome = solveSteppedSubstep(bodies, stepped.contacts, settings, stepped.warm);
 }
 
@@ -412,6 +416,12 @@ void storeClusterContacts(World& world, double time, const Component& component,
     } else {
       stepping.keeping_force.erase(pair);
     }
+    if (received.friction_impulse > 0) {
+      stepping.friction_force[pair] =
+          (received.friction_impulse / outcome.duration) * received.friction_direction;
+    } else {
+      stepping.friction_force.erase(pair);
+    }
     if (!(received.keeping_impulse > 0)) {
       world.contact_since.erase(pair);
       continue;
@@ -627,6 +637,7 @@ void clearStepped(World& world, double time) {
   }
   world.stepping.clusters.clear();
   world.stepping.keeping_force.clear();
+  world.stepping.friction_force.clear();
   world.stepping.arrival_speed.clear();
 }
 

@@ -471,21 +471,17 @@ BoundedSolution keepGapsFrom(const std::vector<SteppedBody>& bodies,
 }
 
 /// The contacts that carry a normal impulse (`keeping`: the gap keeping's, in the solve's
-/// order) and have friction, as the friction step takes them.
+/// order) and have friction, as the friction step takes them: in the solve's order, each with
+/// its bound mu J and its warm start.
 struct PressedContacts {
   std::vector<ClusterContact> contacts;
-  std::vector<FrictionContact> frictions;
+  std::vector<SweptFrictionContact> frictions;
   std::vector<std::size_t> index;  ///< each one's contact
 };
 
-/// The pressed contacts, each one's friction direction (against b's slip before friction)
-/// recorded in `outcome`.
-PressedContacts pressedContacts(const std::vector<SteppedBody>& bodies,
-                                const std::vector<SteppedContact>& contacts,
+PressedContacts pressedContacts(const std::vector<SteppedContact>& contacts,
                                 const std::vector<std::size_t>& order,
-                                const Eigen::VectorXd& keeping, SteppedOutcome& outcome) {
-  const std::vector<Eigen::Vector3d>& v = outcome.velocity;
-  const std::vector<Eigen::Vector3d>& w = outcome.angular_velocity;
+                                const Eigen::VectorXd& keeping, const SteppedOutcome& outcome) {
   PressedContacts pressed;
   for (std::size_t i = 0; i < order.size(); ++i) {
     const std::size_t k = order[i];
@@ -494,15 +490,8 @@ PressedContacts pressedContacts(const std::vector<SteppedBody>& bodies,
     if (!(normal > 0) || !(contacts[k].friction > 0)) continue;
     const SteppedContact& c = contacts[k];
     pressed.contacts.push_back(ClusterContact{c.a, c.b, c.normal, 0.0});
-    pressed.frictions.push_back(FrictionContact{c.friction, normal});
+    pressed.frictions.push_back(SweptFrictionContact{c.friction * normal, c.friction_warm});
     pressed.index.push_back(k);
-    // The slip before friction (b's surface against a's at the contact point): friction acts
-    // on b against it.
-    Eigen::Vector3d slip = v[c.b] - v[c.a];
-    if (bodies[c.b].spin_factor != 0.0) slip += w[c.b].cross(-bodies[c.b].radius * c.normal);
-    if (bodies[c.a].spin_factor != 0.0) slip -= w[c.a].cross(bodies[c.a].radius * c.normal);
-    slip -= slip.dot(c.normal) * c.normal;
-    if (slip.norm() > 0) outcome.contacts[k].friction_direction = -slip.normalized();
   }
   return pressed;
 }
@@ -523,17 +512,26 @@ void frictionThenGaps(const std::vector<SteppedBody>& bodies,
     cluster_bodies[i].spin_factor = bodies[i].spin_factor;
     cluster_bodies[i].radius = bodies[i].radius;
   }
-  const PressedContacts pressed = pressedContacts(bodies, contacts, order, kept.impulses, outcome);
+  const PressedContacts pressed = pressedContacts(contacts, order, kept.impulses, outcome);
   if (pressed.contacts.empty()) return;
-  std::vector<FrictionOutcome> friction_outcomes;
-  settings.friction(cluster_bodies, pressed.contacts, pressed.frictions, friction_outcomes);
+  std::vector<SweptFrictionOutcome> friction_outcomes;
+  const SweptFrictionReport swept =
+      settings.friction(cluster_bodies, pressed.contacts, pressed.frictions, tolerance,
+                        settings.max_friction_sweeps, friction_outcomes);
+  outcome.friction_sweeps += swept.sweeps;
+  outcome.friction_converged = outcome.friction_converged && swept.converged;
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     v[i] = cluster_bodies[i].velocity;
     w[i] = cluster_bodies[i].angular_velocity;
   }
-  for (std::size_t j = 0; j < pressed.index.size() && j < friction_outcomes.size(); ++j) {
-    outcome.contacts[pressed.index[j]].friction_impulse = friction_outcomes[j].impulse;
-    outcome.contacts[pressed.index[j]].sticking = friction_outcomes[j].sticking;
+  for (std::size_t j = 0; j < pressed.index.size(); ++j) {
+    SteppedContactOutcome& received = outcome.contacts[pressed.index[j]];
+    const Eigen::Vector3d& impulse = friction_outcomes[j].impulse;
+    received.friction_impulse = impulse.norm();
+    received.friction_direction = received.friction_impulse > 0
+                                      ? Eigen::Vector3d(impulse / received.friction_impulse)
+                                      : Eigen::Vector3d::Zero();
+    received.sticking = friction_outcomes[j].sticking;
   }
   const BoundedSolution again = keepGaps(
       bodies, contacts, order, Eigen::VectorXd::Zero(static_cast<Eigen::Index>(order.size())),

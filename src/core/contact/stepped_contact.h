@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "collision_response/core/friction.h"
+#include "contact/stepped_friction.h"
 
 namespace collision_response::core {
 
@@ -44,6 +45,9 @@ struct SteppedContact {
   /// there (SteppedContactOutcome::arrival_speed); 0 when it did not. Its bounce is e times
   /// this, not e times what that sub-step's gap keeping left of it.
   double arrival_speed = 0.0;
+  /// N s, on b: the friction impulse to start the friction sweeps from (the sub-step before's
+  /// friction force times this one's duration); zero for none.
+  Eigen::Vector3d friction_warm = Eigen::Vector3d::Zero();
 };
 
 struct SteppedSettings {
@@ -51,8 +55,10 @@ struct SteppedSettings {
   /// m/s: a touching contact approaching at least this fast bounces (restitution); slower ones
   /// only stop (the scene's restitution threshold).
   double restitution_threshold = 0.0;
-  /// Coulomb friction on the contacts (FrictionModel::cluster); null: frictionless.
-  ClusterFrictionStep friction = nullptr;
+  /// Coulomb friction on the contacts (FrictionModel::swept); null: frictionless.
+  SweptFrictionStep friction = nullptr;
+  /// Sweeps of the friction solve, at most.
+  int max_friction_sweeps = 64;
   /// Iterations of each complementarity solve, at most.
   int max_iterations = 20000;
 };
@@ -63,7 +69,7 @@ struct SteppedContactOutcome {
   double bounce_impulse = 0.0;    ///< N s at the start: compression and restitution (an impact)
   double keeping_impulse = 0.0;   ///< N s keeping the gap: a force of impulse / duration
   double friction_impulse = 0.0;  ///< N s, tangential, on b along friction_direction
-  Eigen::Vector3d friction_direction = Eigen::Vector3d::Zero();  ///< unit, against b's slip
+  Eigen::Vector3d friction_direction = Eigen::Vector3d::Zero();  ///< unit: the impulse's on b
   bool sticking = false;                                         ///< friction stopped the slip
   bool struck = false;  ///< touching and approaching at the threshold or faster
   /// m/s: not touching at the start, closed by the gap keeping within the sub-step: the speed
@@ -83,7 +89,11 @@ struct SteppedOutcome {
   /// No solve gave velocities that keep the gaps even for an instant: every movable body is held
   /// still over the sub-step.
   bool held = false;
-  int iterations = 0;  ///< of the complementarity solves, all together
+  int iterations = 0;       ///< of the complementarity solves, all together
+  int friction_sweeps = 0;  ///< of the friction solve (applyFrictionBySweeps)
+  /// The friction sweeps reached their tolerance (Coulomb's conditions to it); where not, the
+  /// impulses are still within their bounds and add no energy.
+  bool friction_converged = true;
 };
 
 /// One sub-step of a cluster (Stewart and Trinkle, "An implicit time-stepping scheme for rigid
@@ -105,7 +115,10 @@ struct SteppedOutcome {
 ///    line, so a pair that keeps it at both ends keeps it in between: no body goes into
 ///    another. This projection removes kinetic energy (its targets are <= 0).
 /// 4. Friction (with a friction step): Coulomb's impulses on the contacts that carry a normal
-///    impulse, then stage 3 again, so that the gaps hold whatever friction did.
+///    impulse (mu times it their bound), by the warm-started sweeps of applyFrictionBySweeps in
+///    the order of the contacts' points, to the solves' residual or `max_friction_sweeps`
+///    (within their bounds and adding no energy either way); then stage 3 again, so that the
+///    gaps hold whatever friction did.
 ///
 /// The complementarity problems are solved by MPRGP (Dostal and Schoeberl, "Minimizing quadratic
 /// functions subject to bound constraints with the rate of convergence and finite termination",

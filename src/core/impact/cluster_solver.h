@@ -8,6 +8,7 @@
 #include "collision_response/core/friction.h"
 #include "collision_response/core/scene.h"
 #include "collision_response/core/simultaneous.h"
+#include "contact/stepped_friction.h"
 
 namespace collision_response::core {
 
@@ -22,6 +23,8 @@ struct FrictionModel {
   FrictionOutcome (*contact)(ClusterBody& a, ClusterBody& b, const Eigen::Vector3d& normal,
                              double friction, double normal_impulse) = nullptr;
   ClusterFrictionStep cluster = nullptr;
+  /// A stepped cluster's sub-step: warm-started sweeps (applyFrictionBySweeps).
+  SweptFrictionStep swept = nullptr;
   explicit operator bool() const { return contact != nullptr; }
 };
 

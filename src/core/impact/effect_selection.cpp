@@ -7,8 +7,12 @@ Effects runnableEffects(const Effects& requested) { return requested; }
 
 FrictionModel frictionModelFor(const Effects& effects) {
   if (!effects.friction) return FrictionModel{};
-  if (effects.spin) return FrictionModel{&applyFriction<true>, &applyFrictionJointly<true>};
-  return FrictionModel{&applyFriction<false>, &applyFrictionJointly<false>};
+  if (effects.spin) {
+    return FrictionModel{&applyFriction<true>, &applyFrictionJointly<true>,
+                         &applyFrictionBySweeps<true>};
+  }
+  return FrictionModel{&applyFriction<false>, &applyFrictionJointly<false>,
+                       &applyFrictionBySweeps<false>};
 }
 
 }  // namespace collision_response::core

@@ -139,6 +139,9 @@ struct Stepping {
   std::vector<SteppedCluster> clusters;
   /// Per pair, the force that kept its gap over its last sub-step: the next one starts there.
   std::map<Pair, double> keeping_force;
+  /// Per pair, the friction force (N, on its b) of its last sub-step: the next one's friction
+  /// sweeps start there.
+  std::map<Pair, Eigen::Vector3d> friction_force;
   /// Per pair that came into contact in the last sub-step, the speed it closed at (m/s): its
   /// bounce, at the next sub-step, is e times that.
   std::map<Pair, double> arrival_speed;
