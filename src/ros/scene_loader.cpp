@@ -260,6 +260,8 @@ const KeyTable<Scene>& sceneTable() {
           [](Scene& s) -> int& { return s.stepped_cluster_min_bodies; }, 0),
       numberKey<Scene>("stepped_cluster_time_step",
                        [](Scene& s) -> double& { return s.stepped_cluster_time_step; }),
+      countKey<Scene>(
+          "exact_work_budget", [](Scene& s) -> int& { return s.exact_work_budget; }, 0),
       {"bodies", false,
        [](const XmlRpc::XmlRpcValue& value, const std::string& field, Scene& scene) {
          return readList(

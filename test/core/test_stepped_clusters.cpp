@@ -505,8 +505,88 @@ TEST(SteppedClusters, SmallerSetsAndSteppingOffStayExact) {
   }
 }
 
-// The two scene keys are checked once, at start-up, each error naming its key: a count of bodies
-// (0: never), and a sub-step in [1e-4, 1] s.
+/// Two balls of r 0.05 m and 0.1 kg in a box of 2 m: `a` resting on the floor at (1, 1, r), `b`
+/// dropped from rest at `dropped`; exact_work_budget `budget`; the monitor moving them at 100 Hz.
+ImpactMonitor twoBallsOverABudget(const V& dropped, int budget) {
+  Scene scene = boxScene(2.0);
+  scene.exact_work_budget = budget;
+  scene.bodies = {ball("a", 0.1, 0.05), ball("b", 0.1, 0.05)};
+  MonitorSettings settings;
+  settings.body_timeout = 1e9;
+  ImpactMonitor monitor(scene, settings);
+  std::vector<BodyStateSample> states(2);
+  states[0].body = *monitor.bodyIndex("a");
+  states[0].position = V(1.0, 1.0, 0.05);
+  states[1].body = *monitor.bodyIndex("b");
+  states[1].position = dropped;
+  monitor.step(0.0, states);
+  return monitor;
+}
+
+// A ball dropped onto the top of one resting on the floor bounces on it ever lower (e = 0.5): the
+// lower ball, struck and pressed into the floor at each bounce, runs over an exact_work_budget of
+// 4 within one update (named in the report, one fallback), and is stepped from there with the
+// ball near it, two bodies far below stepped_cluster_min_bodies; they stay so while they touch:
+// a stack at rest, the floor carrying 2 m g and the lower ball m g, never more than a quarter of
+// the band into either.
+TEST(SteppedClusters, BodiesOverTheirWorkBudgetAreSteppedWithTheBodiesNearThem) {
+  const double r = 0.05, m = 0.1;
+  ImpactMonitor monitor = twoBallsOverABudget(V(1.0, 1.0, 5 * r), 4);
+  std::vector<std::size_t> over_budget;
+  StepReport report;
+  for (int k = 1; k <= 100; ++k) {
+    const double t = k / 100.0;
+    report = monitor.step(t, {});
+    over_budget.insert(over_budget.end(), report.over_budget.begin(), report.over_budget.end());
+    EXPECT_EQ(report.fallbacks, report.over_budget.size()) << t;
+    const V a = monitor.predictedState(0, t)->first, b = monitor.predictedState(1, t)->first;
+    EXPECT_GE((b - a).norm() - 2 * r, -1e-9 * r) << t;
+    EXPECT_GE(std::min(a.z(), b.z()) - r, -1e-9 * r) << t;
+  }
+  ASSERT_FALSE(over_budget.empty());
+  for (const std::size_t body : over_budget) EXPECT_EQ(body, 0u);  // "a"
+  EXPECT_EQ(report.stepped_bodies, 2u);
+  ASSERT_EQ(report.contacts.size(), 2u);
+  for (const ContactRecord& contact : report.contacts) {
+    const double carried = contact.other_is_obstacle ? 2 * m * kG : m * kG;
+    EXPECT_NEAR(contact.normal_force, carried, 1e-6 * m * kG);
+  }
+}
+
+// The same ball dropped off-centre (the line of centres 30 degrees from the vertical) glances
+// off sideways; with an exact_work_budget of 1, the resting ball's bounces on the floor after the
+// blow pass it, and it is stepped alone (whatever the number near it). Near no other body, it is
+// back with the exact model at the next update, and both end exact; the dropped ball's flights
+// are the exact parabolas (a stepped flight falls g h t / 2 below them).
+TEST(SteppedClusters, ABodyOverItsBudgetNearNoOtherIsExactAgainAtTheNextUpdate) {
+  const double r = 0.05;
+  ImpactMonitor monitor = twoBallsOverABudget(V(1.0 + r, 1.0, 5 * r), 1);
+  std::size_t over_budget = 0;
+  int exact_after = 0;
+  StepReport report;
+  for (int k = 1; k <= 60; ++k) {
+    const double t = k / 100.0, h = 0.01;
+    report = monitor.step(t, {});
+    over_budget += report.over_budget.size();
+    const V a = monitor.predictedState(0, t)->first, b = monitor.predictedState(1, t)->first;
+    EXPECT_GE((b - a).norm() - 2 * r, -1e-9 * r) << t;
+    EXPECT_GE(std::min(a.z(), b.z()) - r, -1e-9 * r) << t;
+    const auto [position, velocity] = *monitor.predictedState(1, t);
+    const V expected = position + velocity * h + 0.5 * V(0, 0, -kG) * h * h;
+    if (over_budget > 0 && report.stepped_bodies == 0 && b.z() > 1.1 * r &&
+        expected.z() > 1.1 * r) {
+      // Back with the exact model and in flight over the next update: its parabola.
+      EXPECT_LE((monitor.predictedState(1, t + h)->first - expected).norm(), 1e-12) << t;
+      ++exact_after;
+    }
+  }
+  EXPECT_GE(over_budget, 1u);
+  EXPECT_EQ(report.stepped_bodies, 0u);
+  EXPECT_GE(exact_after, 3);
+}
+
+// The three scene keys are checked once, at start-up, each error naming its key: a count of
+// bodies (0: never), a sub-step in [1e-4, 1] s, and a work budget (0: none).
 TEST(SteppedClusters, TheSceneKeysAreChecked) {
   Scene scene = boxScene(1.0);
   EXPECT_TRUE(validateScene(scene, "scene").ok());
@@ -518,6 +598,13 @@ TEST(SteppedClusters, TheSceneKeysAreChecked) {
   EXPECT_EQ(negative.error().message(),
             "scene/stepped_cluster_min_bodies: must be 0 (never) or a number of bodies, got -1");
   scene.stepped_cluster_min_bodies = 32;
+  scene.exact_work_budget = -1;
+  const Status budget = validateScene(scene, "scene");
+  ASSERT_FALSE(budget.ok());
+  EXPECT_EQ(budget.error().message(),
+            "scene/exact_work_budget: must be 0 (no budget) or a number of solves, got -1");
+  scene.exact_work_budget = 0;
+  EXPECT_TRUE(validateScene(scene, "scene").ok());
   for (const double good : {1e-4, 0.01, 1.0}) {
     scene.stepped_cluster_time_step = good;
     EXPECT_TRUE(validateScene(scene, "scene").ok()) << good;

@@ -255,6 +255,9 @@ TEST(SceneLoader, SceneErrorsNameTheKey) {
     scene = fullScene();
     scene["stepped_cluster_min_bodies"] = counts[i];
     EXPECT_EQ(sceneErrorField(scene), "~scene/stepped_cluster_min_bodies") << "counts[" << i << "]";
+    scene = fullScene();
+    scene["exact_work_budget"] = counts[i];
+    EXPECT_EQ(sceneErrorField(scene), "~scene/exact_work_budget") << "counts[" << i << "]";
   }
   for (const double time_step : {0.0, -0.01, 9e-5, 1.5, std::numeric_limits<double>::quiet_NaN(),
                                  std::numeric_limits<double>::infinity()}) {
@@ -273,12 +276,13 @@ TEST(SceneLoader, SceneErrorsNameTheKey) {
 }
 
 // Stepped clusters' keys: the ends of their ranges load, and their absence leaves the
-// documented defaults (README, "Scene file": 32 bodies, 0.01 s).
+// documented defaults (README, "Scene file": 32 bodies, 0.01 s, a budget of 1024).
 TEST(SceneLoader, SteppedClusterKeysLoadAtTheEndsOfTheirRanges) {
   const auto defaults = loadScene(fullScene(), "~scene");
   ASSERT_TRUE(defaults.ok()) << defaults.error().message();
   EXPECT_EQ(defaults->stepped_cluster_min_bodies, 32);
   EXPECT_EQ(defaults->stepped_cluster_time_step, 0.01);
+  EXPECT_EQ(defaults->exact_work_budget, 1024);
   // The low ends: 0 (never) and 1e-4 s.
   auto scene = fullScene();
   scene["stepped_cluster_min_bodies"] = 0;
@@ -342,6 +346,7 @@ std::map<std::string, std::map<std::string, XmlRpc::XmlRpcValue>> examples() {
                      {"contact_integration_tolerance", 1e-6},
                      {"stepped_cluster_min_bodies", 40},
                      {"stepped_cluster_time_step", 0.005},
+                     {"exact_work_budget", 300},
                      {"restitution_combine", "max"}};
   values["materials.<name>"] = {{"restitution", 0.85}, {"friction", 0.9}};
   XmlRpc::XmlRpcValue pair;
@@ -453,6 +458,7 @@ TEST(SceneKeys, EveryDocumentedKeyLoadsWithItsValue) {
   EXPECT_EQ(loaded->contact_integration_tolerance, 1e-6);
   EXPECT_EQ(loaded->stepped_cluster_min_bodies, 40);
   EXPECT_EQ(loaded->stepped_cluster_time_step, 0.005);
+  EXPECT_EQ(loaded->exact_work_budget, 300);
   EXPECT_EQ(loaded->materials.combineRule(), core::CombineRule::kMax);
   EXPECT_EQ(*loaded->materials.restitution("rubber", "concrete"), 0.85);
   EXPECT_EQ(*loaded->materials.friction("rubber", "concrete"), 0.9);

@@ -101,6 +101,12 @@ struct StepReport {
   std::size_t fallbacks = 0;
   /// Bodies in stepped clusters at the step's end (doc/model.md, "Lasting contact").
   std::size_t stepped_bodies = 0;
+  /// Bodies whose exact work ran over the scene's exact_work_budget in this step: from that
+  /// instant they (and the bodies near them) are stepped. Each also counts in `fallbacks`.
+  std::vector<std::size_t> over_budget;
+  /// What the exact model spent in this step, in all (World::work's units: an instant a body's
+  /// motion changed, a solve of its curved lasting contact); with the gravity effect.
+  std::size_t exact_work = 0;
 };
 
 /// Watches the scene's bodies and obstacles and finds their impacts.

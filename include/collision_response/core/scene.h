@@ -76,6 +76,12 @@ struct Scene {
   int stepped_cluster_min_bodies = 32;
   /// s: the longest sub-step; each update's interval is split into equal sub-steps no longer.
   double stepped_cluster_time_step = 0.01;
+  /// Stepped clusters' other way in (gravity, stepping not off): what the exact model may spend
+  /// on one body in one update (World::work: each instant its motion changes, each solve of its
+  /// curved lasting contact's integration) before that body and the bodies near it are advanced
+  /// by time steps, from that instant until they part (doc/model.md, "Lasting contact"); 0: no
+  /// budget.
+  int exact_work_budget = 1024;
   MaterialTable materials = MaterialTable::seed();
   std::vector<BodySpec> bodies;
   std::vector<ObstacleSpec> obstacles;

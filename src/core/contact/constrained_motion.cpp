@@ -67,7 +67,7 @@ ConstrainedStep::ConstrainedStep(const std::vector<ForceBody>& bodies,
 void ConstrainedStep::advanceTo(double time) const {
   const auto system = [this](const State& x, State& dxdt, double t) { derivative(x, dxdt, t); };
   // A motion takes at most this many steps; a stiffer one ends there and is solved again.
-  constexpr int kMostSteps = 2000;
+  constexpr int kMostSteps = 256;
   for (; end_ < until_ && end_ < time && !mode_changed_; ++taken_) {
     if (taken_ == kMostSteps) {
       mode_changed_ = true;
@@ -100,6 +100,7 @@ void ConstrainedStep::advanceTo(double time) const {
 }
 
 ContactForceSolution ConstrainedStep::forces(const State& state, double time) const {
+  ++solves_;
   std::vector<ForceBody> bodies = bodies_;
   std::vector<Eigen::Vector3d> positions(bodies.size());
   for (std::size_t i = 0; i < bodies.size(); ++i) {

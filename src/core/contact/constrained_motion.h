@@ -67,6 +67,9 @@ class ConstrainedStep {
   void extend() const { advanceTo(end_ + 2 * (end_ - start_)); }
   /// The size the integrator would take next.
   double nextStep() const { return next_step_; }
+  /// How many times its contact forces were solved so far (each stage of each step, each
+  /// margin and bisection): the work it cost.
+  std::size_t solves() const { return solves_; }
 
   Eigen::Vector3d position(std::size_t body, double time) const;
   Eigen::Vector3d velocity(std::size_t body, double time) const;
@@ -110,6 +113,7 @@ class ConstrainedStep {
   mutable std::vector<std::unique_ptr<Integration>> steps_;  // each step's dense output, in order
   mutable double queried_time_ = NAN;                        // queriedStateAt's last instant
   mutable State queried_state_;
+  mutable std::size_t solves_ = 0;
 };
 
 }  // namespace collision_response::core::monitor

@@ -176,9 +176,9 @@ class Group {
     acceleration += Real(body.inverse_mass) * force;
     if (body.spin_factor != 0.0 && body.radius > 0.0) {
       // Moment r lever x F about the centre; angular acceleration moment / I, 1/I = w / (k r^2).
-      angular_acceleration += (Real(body.inverse_mass) * Real(body.spin_factor) /
-                               Real(body.radius)) *
-                              lever.cross(force);
+      angular_acceleration +=
+          (Real(body.inverse_mass) * Real(body.spin_factor) / Real(body.radius)) *
+          lever.cross(force);
     }
   }
 

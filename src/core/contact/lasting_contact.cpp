@@ -44,6 +44,7 @@ bool lastingCandidate(const World& world, const Pair& pair, double time, const G
 
 void dissolve(World& world, std::size_t group, std::vector<std::size_t>& members) {
   ContactGroup& dissolved = world.groups[group];
+  chargeIntegration(world, dissolved);
   dissolved.alive = false;
   for (const std::size_t body : dissolved.bodies) {
     world.tracks[body].group = -1;
@@ -331,6 +332,7 @@ void storeGroupContacts(World& world, double time, const Candidates& candidates,
   contact_group.next_event = INFINITY;
   // A slot of a dissolved group may be reused: none of its integrated motion stays.
   contact_group.step.reset();
+  contact_group.charged = 0;
   contact_group.scheduled_to = INFINITY;
   contact_group.step_event_taken = false;
   for (const std::size_t k : motion.pressed.contacts) {
@@ -547,7 +549,18 @@ ContactState groupContactState(const World& world, double time, const GroupConta
 
 }  // namespace
 
+void chargeIntegration(World& world, ContactGroup& group) {
+  if (!group.step || world.work.size() != world.bodies.size()) return;
+  const std::size_t solves = group.step->solves();
+  for (const std::size_t body : group.bodies) world.work[body] += solves - group.charged;
+  world.work_total += group.bodies.size() * (solves - group.charged);
+  group.charged = solves;
+}
+
 void clearGroups(World& world) {
+  for (ContactGroup& group : world.groups) {
+    if (group.alive) chargeIntegration(world, group);
+  }
   world.groups.clear();
   for (Track& track : world.tracks) track.group = -1;
   world.partners.assign(world.bodies.size(), {});

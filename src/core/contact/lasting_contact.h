@@ -70,4 +70,8 @@ void reportContacts(const World& world, double time, std::vector<ContactRecord>&
 /// Forgets every group (the tracks keep their motion).
 void clearGroups(World& world);
 
+/// The solves of the group's integrated motion since it was last charged, added to each of its
+/// bodies' World::work (and to World::work_total).
+void chargeIntegration(World& world, ContactGroup& group);
+
 }  // namespace collision_response::core::monitor

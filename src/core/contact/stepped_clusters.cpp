@@ -176,6 +176,7 @@ void leaveLastingGroup(World& world, std::size_t body, std::vector<std::size_t>&
   const int group = world.tracks[body].group;
   if (group < 0) return;
   ContactGroup& dissolved = world.groups[static_cast<std::size_t>(group)];
+  chargeIntegration(world, dissolved);
   dissolved.alive = false;
   for (const std::size_t member : dissolved.bodies) {
     world.tracks[member].group = -1;
@@ -209,8 +210,10 @@ std::vector<double> reachesOver(const World& world, double time, double horizon)
   return reach;
 }
 
-/// At the grid: the tracked bodies of the connected sets of near pairs with at least min_bodies.
-std::vector<char> gridMembers(const World& world, const std::vector<Pair>& near) {
+/// At the grid: the tracked bodies of the connected sets of near pairs with at least min_bodies,
+/// or with at least two and a body over its work budget (Track::over_budget); such a body near
+/// no other is unmarked, back with the exact model.
+std::vector<char> gridMembers(World& world, const std::vector<Pair>& near) {
   const std::size_t n = world.bodies.size();
   ConnectedSets sets(n);
   for (const Pair& pair : near) {
@@ -220,7 +223,11 @@ std::vector<char> gridMembers(const World& world, const std::vector<Pair>& near)
   }
   std::vector<char> member(n, 0);
   for (const std::vector<std::size_t>& set : sets.sets()) {
-    if (set.size() < world.stepping.min_bodies || !movable(world, set.front())) continue;
+    if (!movable(world, set.front())) continue;
+    const bool marked = std::any_of(
+        set.begin(), set.end(), [&](std::size_t body) { return world.tracks[body].over_budget; });
+    if (set.size() == 1) world.tracks[set.front()].over_budget = false;
+    if (set.size() < world.stepping.min_bodies && !(marked && set.size() >= 2)) continue;
     for (const std::size_t body : set) member[body] = world.tracks[body].known ? 1 : 0;
   }
   return member;
@@ -521,7 +528,10 @@ void advanceStepped(World& world, double time, std::vector<std::size_t>& changed
     }
     // Fewer bodies than a cluster needs and no cluster: nothing to look at (the exact model's
     // scenes pay nothing for the sub-steps).
-    if (tracked < stepping.min_bodies && stepping.clusters.empty()) return;
+    if (tracked < stepping.min_bodies && stepping.clusters.empty()) {
+      for (Track& track : world.tracks) track.over_budget = false;
+      return;
+    }
     solveRegion(world, time, stepping.instant(stepping.next), {}, true, changed, released, report);
     return;
   }
@@ -537,6 +547,20 @@ void advanceStepped(World& world, double time, std::vector<std::size_t>& changed
   if (any && end > time) {
     solveRegion(world, time, end, member, false, changed, released, report);
   }
+}
+
+void stepOverBudget(World& world, double time, const std::vector<std::size_t>& over_budget,
+                    std::vector<std::size_t>& changed, std::vector<std::size_t>& released,
+                    StepReport& report) {
+  Stepping& stepping = world.stepping;
+  const double end = stepping.instant(stepping.next);
+  std::vector<char> member(world.bodies.size(), 0);
+  for (const std::size_t body : over_budget) {
+    world.tracks[body].over_budget = true;
+    member[body] = 1;
+  }
+  if (!(end > time)) return;  // the grid's instant is now: the marked bodies are stepped there
+  solveRegion(world, time, end, member, false, changed, released, report);
 }
 
 void joinStepped(World& world, double time, const std::vector<std::size_t>& moved,

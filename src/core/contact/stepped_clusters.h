@@ -31,6 +31,16 @@ double nextSteppedEvent(const World& world, double time);
 void advanceStepped(World& world, double time, std::vector<std::size_t>& changed,
                     std::vector<std::size_t>& released, StepReport& report);
 
+/// The bodies of `over_budget` (exact work past World::work_budget in this step, none stepped
+/// yet), marked Track::over_budget, are stepped from `time` to the grid's next instant with the
+/// bodies near them, whatever their number; at the grid instants after, a connected set of near
+/// bodies with one so marked is stepped however small, until the marked body is near no other
+/// (then it goes back to the exact model, unmarked). Every body whose track changed is appended
+/// to `changed`, those that left a cluster also to `released` (advanceStepped).
+void stepOverBudget(World& world, double time, const std::vector<std::size_t>& over_budget,
+                    std::vector<std::size_t>& changed, std::vector<std::size_t>& released,
+                    StepReport& report);
+
 /// After the exact motion of the bodies of `moved` changed at `time` (an impact, a state, a
 /// group of lasting contact formed again): those that can now reach a body of a cluster before
 /// its sub-step ends join it, and it is solved again from `time`.

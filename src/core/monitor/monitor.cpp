@@ -289,6 +289,63 @@ void settleLastingContact(World& world, const monitor::PairIndex& index, bool fi
   at.changed.erase(std::unique(at.changed.begin(), at.changed.end()), at.changed.end());
 }
 
+/// What the instant cost the exact model (World::work): each body whose motion changed there, and
+/// the solves the curved groups' integration took since they were last charged. `charged`: the
+/// bodies charged (some more than once).
+void chargeInstant(World& world, const std::vector<std::size_t>& changed,
+                   std::vector<std::size_t>& charged) {
+  charged = changed;
+  for (const std::size_t body : changed) ++world.work[body];
+  world.work_total += changed.size();
+  for (monitor::ContactGroup& group : world.groups) {
+    if (!group.alive || !group.step) continue;
+    monitor::chargeIntegration(world, group);
+    charged.insert(charged.end(), group.bodies.begin(), group.bodies.end());
+  }
+}
+
+/// An update's exact work in all, at most this many bodies' budgets (World::work_budget).
+constexpr std::size_t kBudgetsPerUpdate = 16;
+
+/// The bodies (of those `charged` at the instant) whose exact work in this step ran over the
+/// budget, or, once the step's work in all has run over kBudgetsPerUpdate budgets, every body
+/// that spent a sixteenth of one (none stepped yet), are stepped from the instant with the bodies
+/// near them (stepOverBudget; counted in the report's fallbacks and named in its over_budget);
+/// what the stepped clusters let go of is resolved as at the grid (stepClusters). `changed` ends
+/// sorted, each once.
+template <class Motion>
+void stepOverBudget(World& world, const monitor::PairIndex& index, std::vector<std::size_t> charged,
+                    double instant, std::vector<std::size_t>& changed, StepReport& report) {
+  if (world.work_budget == 0 || !world.stepping.enabled()) return;
+  const bool all_spent = world.work_total > kBudgetsPerUpdate * world.work_budget;
+  if (all_spent) {
+    charged.clear();
+    for (std::size_t body = 0; body < world.bodies.size(); ++body) charged.push_back(body);
+  }
+  const std::size_t allowed = all_spent ? world.work_budget / kBudgetsPerUpdate : world.work_budget;
+  std::sort(charged.begin(), charged.end());
+  charged.erase(std::unique(charged.begin(), charged.end()), charged.end());
+  std::vector<std::size_t> over;
+  for (const std::size_t body : charged) {
+    const Track& track = world.tracks[body];
+    if (world.work[body] > allowed && track.known && track.stepped < 0 &&
+        world.inverse_mass[body] > 0) {
+      over.push_back(body);
+    }
+  }
+  if (over.empty()) return;
+  report.fallbacks += over.size();
+  report.over_budget.insert(report.over_budget.end(), over.begin(), over.end());
+  std::vector<std::size_t> released;
+  monitor::stepOverBudget(world, instant, over, changed, released, report);
+  if (!released.empty() && world.settings.detect_impacts) {
+    monitor::resolveInstant<Motion>(
+        world, instant, monitor::touchingPairsOf(world, instant, released, index), report, changed);
+  }
+  std::sort(changed.begin(), changed.end());
+  changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
+}
+
 /// The first contacts of the pairs of the bodies whose motion changed scheduled again (at the
 /// start: of every pair).
 template <class Motion>
@@ -361,6 +418,8 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
   StepReport report;
   world.step_end = time;
   world.stepping.beginStep(world.now, time);
+  world.work.assign(world.bodies.size(), 0);
+  world.work_total = 0;
   monitor::candidatePairs<Motion>(world, world.now, time, world.scratch.pairs);
   ContactSchedule<Motion> schedule(world, time);
   const monitor::PairIndex index{world.scratch.pairs, world.scratch.pairs_of};
@@ -368,6 +427,7 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
   at.instant = world.now;
   at.budget = world.settings.max_instants_per_step;
   schedule.touchingAtStart(at.instant, at.touching);
+  std::vector<std::size_t> charged;
   bool first = true;
   for (int instants = 0;; instants += at.extension ? 0 : 1, first = false) {
     at.changed.clear();
@@ -376,6 +436,8 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
     imposeStates(world, imposed, at);
     if constexpr (Motion::kAccelerates) {
       settleLastingContact<Motion>(world, index, first, at, report);
+      chargeInstant(world, at.changed, charged);
+      stepOverBudget<Motion>(world, index, charged, at.instant, at.changed, report);
     }
     at.event_bodies.clear();
     scheduleChanged<Motion>(schedule, first, at);
@@ -387,6 +449,7 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
   if constexpr (Motion::kAccelerates) {
     world.step_end = time;
     reportLastingContact(world, time, report);
+    report.exact_work = world.work_total;
   }
   return report;
 }
@@ -400,6 +463,8 @@ template <class Motion>
 void advanceLastingContact(World& world, double time, StepReport& report) {
   world.step_end = time;
   world.stepping.beginStep(world.now, time);
+  world.work.assign(world.bodies.size(), 0);
+  world.work_total = 0;
   // Without groups for these tracks, they are formed after the states at `time`; the stepped
   // clusters move on regardless.
   const bool lasting = world.groups_current;
@@ -422,6 +487,12 @@ void advanceLastingContact(World& world, double time, StepReport& report) {
   if (!seeds.empty()) monitor::formGroups(world, world.now, seeds, index, changed);
   // The stepped clusters' events and the groups' (at one instant, the cluster first), each
   // followed by the groups of the bodies whose motion changed and the clusters they now reach.
+  // What an instant cost, charged (World::work), and the bodies over the budget stepped.
+  std::vector<std::size_t> charged;
+  const auto budget = [&](double when) {
+    chargeInstant(world, changed, charged);
+    stepOverBudget<Motion>(world, index, charged, when, changed, report);
+  };
   const auto settle = [&](double when) {
     if (lasting && !changed.empty()) {
       const std::vector<std::size_t> changed_seeds = changed;
@@ -429,6 +500,7 @@ void advanceLastingContact(World& world, double time, StepReport& report) {
     }
     const std::vector<std::size_t> moved = changed;
     monitor::joinStepped(world, when, moved, changed, report);
+    budget(when);
   };
   changed.clear();
   stepClusters<Motion>(world, world.now, index, changed, report);
@@ -457,6 +529,7 @@ void advanceLastingContact(World& world, double time, StepReport& report) {
     monitor::formGroups(world, when, seeds, index, changed);
     const std::vector<std::size_t> moved = changed;
     monitor::joinStepped(world, when, moved, changed, report);
+    budget(when);
   }
 }
 
@@ -567,7 +640,10 @@ StepReport discreteStep(World& world, double time, const std::vector<BodyStateSa
     monitor::joinStepped(world, time, moved, changed, report);
   }
   rememberOverlapping<Motion>(world, time, pairs);
-  if constexpr (Motion::kAccelerates) reportLastingContact(world, time, report);
+  if constexpr (Motion::kAccelerates) {
+    reportLastingContact(world, time, report);
+    report.exact_work = world.work_total;
+  }
   return report;
 }
 
@@ -605,6 +681,7 @@ ImpactMonitor::ImpactMonitor(const Scene& scene, const MonitorSettings& settings
   if (world.effects.gravity) {
     world.stepping.min_bodies = static_cast<std::size_t>(scene.stepped_cluster_min_bodies);
     world.stepping.time_step = scene.stepped_cluster_time_step;
+    world.work_budget = static_cast<std::size_t>(std::max(scene.exact_work_budget, 0));
   }
   world.friction_model = frictionModelFor(world.effects);
 

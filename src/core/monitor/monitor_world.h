@@ -62,6 +62,9 @@ struct Track {
   double last_impact_time = kNever;
   /// World::steps of the step whose impact last changed its motion (0: none yet).
   std::uint64_t impact_step = 0;
+  /// Its exact work ran over Scene::exact_work_budget: it is stepped with the bodies near it (in
+  /// any number) until it is near none of them.
+  bool over_budget = false;
 };
 
 struct ObstacleTrack {
@@ -99,6 +102,8 @@ struct ContactGroup {
   std::shared_ptr<const ConstrainedStep> step;
   double scheduled_to = std::numeric_limits<double>::infinity();
   bool step_event_taken = false;
+  /// Of its step's solves (ConstrainedStep::solves), those charged to its bodies' work already.
+  std::size_t charged = 0;
 };
 
 /// A contact of a stepped cluster over its sub-step.
@@ -214,6 +219,12 @@ struct World {
   std::map<Pair, double> contact_since;            // every lasting pair's start, and those the
                                                    // rest rule set to begin at an instant
   bool groups_current = false;                     // the groups hold for the tracks at `now`
+  /// Per body, what the exact model spent on it in the step being taken: an instant at which its
+  /// motion changed (an impact, its group formed again) is 1, and so is each solve of the
+  /// contact forces integrating its group's curved motion.
+  std::vector<std::size_t> work;
+  std::size_t work_total = 0;   // the sum of `work`
+  std::size_t work_budget = 0;  // Scene::exact_work_budget; 0: none
   Scratch scratch;
   bool started = false;
   double now = 0.0;

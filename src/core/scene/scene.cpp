@@ -86,6 +86,11 @@ Status checkSettings(const Scene& scene, const std::string& prefix) {
     return Error{prefix + "/stepped_cluster_time_step",
                  "must be in [1e-4, 1] s, got " + formatNumber(scene.stepped_cluster_time_step)};
   }
+  if (!(scene.exact_work_budget >= 0)) {
+    return Error{prefix + "/exact_work_budget",
+                 "must be 0 (no budget) or a number of solves, got " +
+                     std::to_string(scene.exact_work_budget)};
+  }
   return Ok{};
 }
 
