@@ -175,6 +175,7 @@ void ImpactMonitorRos::tell(const std::string& topic, const std::vector<Report>&
   for (const Report& report : reports) {
     diagnostics_.count(report.reason, report.count);
     if (report.reason == Reason::kBeyondResolution) diagnostics_.noteBeyondResolution(report.text);
+    if (report.reason == Reason::kOverWorkBudget) diagnostics_.noteOverWorkBudget(report.text);
     Group& group = groups[{report.reason, report.variant}];
     group.events += report.count;
     if (report.warn && group.first == nullptr) group.first = &report;

@@ -302,17 +302,39 @@ void MonitorCycle::reportStep(const core::StepReport& step, Update& update) cons
          "too many impacts at one instant or in one step; " + std::to_string(step.fallbacks) +
              " fallback(s) (any held sub-step of a stepped cluster among them) resolved the "
              "rest inelastically or held the bodies, outside each other"});
-  } else if (step.fallbacks > 0) {
-    // Only stepped clusters fall back without truncating the step (core::StepReport): a
-    // sub-step whose solve found no velocities keeping every gap held its movable bodies still.
+  } else if (step.fallbacks > step.over_budget.size()) {
+    // Besides the work budget's, only stepped clusters fall back without truncating the step
+    // (core::StepReport): a sub-step whose solve found no velocities keeping every gap held its
+    // movable bodies still.
+    const std::size_t held = step.fallbacks - step.over_budget.size();
     update.reports.push_back(
         {Reason::kSteppedHeld,
          "a stepped cluster found no velocities that keep every gap open over " +
-             std::to_string(step.fallbacks) +
+             std::to_string(held) +
              " sub-step(s) (a body squeezed between immovable bodies or obstacles closing on "
              "it?): its bodies were held still there, and what closes on them may overlap them",
-         step.fallbacks});
+         held});
   }
+  if (!step.over_budget.empty()) update.reports.push_back(overBudgetReport(step));
+}
+
+Report MonitorCycle::overBudgetReport(const core::StepReport& step) const {
+  // Named, at most a few: the count says how many.
+  constexpr std::size_t kNamed = 8;
+  std::string names;
+  for (std::size_t i = 0; i < step.over_budget.size() && i < kNamed; ++i) {
+    names += (i ? ", '" : "'") + monitor_.body(step.over_budget[i]).id + "'";
+  }
+  if (step.over_budget.size() > kNamed) {
+    names += " and " + std::to_string(step.over_budget.size() - kNamed) + " more";
+  }
+  return {Reason::kOverWorkBudget,
+          "the exact model's work on " + names + " ran over ~scene/exact_work_budget (" +
+              std::to_string(scene_.exact_work_budget) +
+              ") in one update (an inelastic collapse, a chattering slip): from there they and "
+              "the bodies near them are a stepped cluster until they part (doc/model.md, "
+              "\"Lasting contact\")",
+          step.over_budget.size()};
 }
 
 void MonitorCycle::publishContacts(const core::StepReport& step, const ros::Time& newest,

@@ -100,6 +100,9 @@ void MonitorDiagnostics::report(diagnostic_updater::DiagnosticStatusWrapper& sta
   if (!last_beyond_resolution_.empty()) {
     status.add("last state beyond resolution", last_beyond_resolution_);
   }
+  if (!last_over_work_budget_.empty()) {
+    status.add("last bodies stepped over the exact work budget", last_over_work_budget_);
+  }
   status.add("impacts published (total)", impacts_published_);
   period_ = Period{};
   period_.totals = totals_;

@@ -94,6 +94,8 @@ const char* counterName(Reason reason) {
       return "steps truncated";
     case Reason::kSteppedHeld:
       return "stepped sub-steps held";
+    case Reason::kOverWorkBudget:
+      return "bodies stepped over the exact work budget";
     case Reason::kObstacleTransform:
       return "obstacle transform missing";
   }

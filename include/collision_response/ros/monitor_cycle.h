@@ -99,6 +99,8 @@ class MonitorCycle {
   void timeSamples(const TimeLine::Placed& placed, const ros::Time& newest);
   /// What the step dropped or fell back on, as reports.
   void reportStep(const core::StepReport& step, Update& update) const;
+  /// The warning naming the bodies the step handed to the stepped model over the work budget.
+  Report overBudgetReport(const core::StepReport& step) const;
   /// The step's contacts and impacts as messages, stamped in their states' clocks; one that
   /// the doubles or a ros::Time cannot hold is reported, not published.
   void publishContacts(const core::StepReport& step, const ros::Time& newest, Update& update) const;

@@ -40,6 +40,9 @@ class MonitorDiagnostics {
   /// The warning of the last state dropped as beyond resolution: it names the body and the
   /// field, and /diagnostics shows it (one entry, whatever the publisher sends).
   void noteBeyondResolution(const std::string& text) { last_beyond_resolution_ = text; }
+  /// The warning of the last update whose exact work ran over the scene's budget: it names the
+  /// bodies stepped from there (a few, and how many more), and /diagnostics shows it.
+  void noteOverWorkBudget(const std::string& text) { last_over_work_budget_ = text; }
   /// A processed input: the step's processing time and the arrival-to-publication latency (s).
   void stepped(double step_seconds, double latency_seconds, std::size_t impacts_published);
 
@@ -69,6 +72,7 @@ class MonitorDiagnostics {
   std::array<std::uint64_t, kReasonCount> totals_{};
   std::uint64_t impacts_published_ = 0;
   std::string last_beyond_resolution_;
+  std::string last_over_work_budget_;
 };
 
 }  // namespace collision_response

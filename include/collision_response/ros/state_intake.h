@@ -42,6 +42,7 @@ enum class Reason {
   kClockOffset,        ///< a source's (or a stamp's) clock differs: placed with an offset
   kStepTruncated,      ///< a guard of the monitor cut a step short
   kSteppedHeld,        ///< a stepped cluster held still over sub-steps it could not solve
+  kOverWorkBudget,     ///< bodies the exact model spent its budget on: stepped from then on
   kObstacleTransform,  ///< a tf-attached obstacle keeps its last known motion
 };
 inline constexpr int kReasonCount = static_cast<int>(Reason::kObstacleTransform) + 1;
