@@ -111,6 +111,10 @@ std::vector<SteppedBody> steppedBodiesOf(const World& world, double time,
   return bodies;
 }
 
+/// What a closure's round solved at the grid, per pair: its keeping impulse and its friction
+/// impulse (on b), for the next round to start from.
+using RoundImpulses = std::map<Pair, std::pair<double, Eigen::Vector3d>>;
+
 /// The sub-step's contacts, and each one's warm start: a force times the span.
 struct SteppedContacts {
   std::vector<SteppedContact> contacts;
@@ -119,10 +123,11 @@ struct SteppedContacts {
 };
 
 /// The component's pairs that have a line to keep apart along, as the sub-step's contacts
-/// (`warm_start`: with the arrivals and forces the last sub-step left).
+/// (`warm_start`: with the arrivals and forces the last sub-step left, or, for a pair the
+/// closure's round before solved, that round's impulses).
 SteppedContacts steppedContactsOf(const World& world, double time, double span, bool warm_start,
                                   const SolveParticipants& participants,
-                                  const std::vector<Pair>& pairs) {
+                                  const std::vector<Pair>& pairs, const RoundImpulses& before) {
   SteppedContacts stepped;
   for (const Pair& pair : pairs) {
     const Geometry g = geometry<Motion>(world, pair, time);
@@ -150,6 +155,11 @@ SteppedContacts steppedContactsOf(const World& world, double time, double span, 
     if (warm_start && friction != world.stepping.friction_force.end()) {
       stepped.contacts.back().friction_warm = friction->second * span;
     }
+    const auto solved = before.find(pair);
+    if (warm_start && solved != before.end()) {
+      stepped.warm.back() = solved->second.first;
+      stepped.contacts.back().friction_warm = solved->second.second;
+    }
     stepped.pairs.push_back(pair);
   }
   return stepped;
@@ -157,12 +167,12 @@ SteppedContacts steppedContactsOf(const World& world, double time, double span, 
 
 /// The solve of one component from `starts` over `span`.
 void solveComponent(const World& world, double time, double span, const std::vector<Start>& starts,
-                    bool warm_start, Component& component) {
+                    bool warm_start, const RoundImpulses& before, Component& component) {
   const SolveParticipants participants =
       solveParticipants(world, component.members, component.pairs);
   const std::vector<SteppedBody> bodies = steppedBodiesOf(world, time, participants, starts);
   SteppedContacts stepped =
-      steppedContactsOf(world, time, span, warm_start, participants, component.pairs);
+      steppedContactsOf(world, time, span, warm_start, participants, component.pairs, before);
   component.pairs = std::move(stepped.pairs);
   SteppedSettings settings;
   settings.duration = span;
@@ -480,12 +490,24 @@ void solveRegion(World& world, double time, double end, std::vector<char> member
   const std::vector<Pair> near = nearPairs(world, time, horizon, reach);
   Region region = setUpRegion(world, time, end, grid,
                               grid ? gridMembers(world, near) : std::move(member), near);
-  // The closure: the components solved, then near pairs again with the solved velocities.
+  // The closure: the components solved, then near pairs again with the solved velocities. At
+  // the grid a round starts from the round before's impulses: its region, like the first, is
+  // the same set of pairs whatever the bodies are called. (Within a sub-step the order of the
+  // events that brought bodies in may be a name's, and a warm start would carry it.)
   std::vector<Component> components;
+  RoundImpulses before;
   for (int closure = 0;; ++closure) {
     components = componentsOf(world, region);
     for (Component& component : components) {
-      solveComponent(world, time, span, region.starts, grid, component);
+      solveComponent(world, time, span, region.starts, grid, before, component);
+    }
+    before.clear();
+    for (const Component& component : components) {
+      for (std::size_t k = 0; k < component.pairs.size(); ++k) {
+        const SteppedContactOutcome& received = component.outcome.contacts[k];
+        before[component.pairs[k]] = {received.keeping_impulse,
+                                      received.friction_impulse * received.friction_direction};
+      }
     }
     if (closure + 1 >= kMaxClosures) break;
     widenReaches(components, reach);

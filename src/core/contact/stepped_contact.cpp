@@ -145,9 +145,16 @@ class Mprgp {
   bool conjugateGradientStep() {
     space_.apply(p_, ap_);
     const double curvature = p_.dot(ap_);
-    double feasible = std::numeric_limits<double>::infinity();  // longest step keeping x >= 0
+    // The longest step keeping x >= 0: the least x_i / p_i where p_i > 0 (a local, so that the
+    // running least stays in a register).
+    double feasible = std::numeric_limits<double>::infinity();
+    const double* x = x_.data();
+    const double* p = p_.data();
     for (Eigen::Index i = 0; i < space_.size(); ++i) {
-      if (p_[i] > 0) feasible = std::min(feasible, x_[i] / p_[i]);
+      if (p[i] > 0) {
+        const double ratio = x[i] / p[i];
+        if (ratio < feasible) feasible = ratio;
+      }
     }
     const double conjugate = curvature > 0 ? g_.dot(p_) / curvature : feasible;
     if (!std::isfinite(conjugate)) return false;
