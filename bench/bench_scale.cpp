@@ -5,15 +5,18 @@
 // layer 1 mm apart or touching, and a stack 10 high), against the same pile with gravity off
 // and against Bullet on the same pile; and the friction of one cluster of up to 1,000 touching,
 // spinning balls (the joint tangential solve alone); and a pile of 8 dropped into a box with
-// friction and spin, played as the scene player plays it, beside Bullet on piles of 8 to 1,000.
+// friction and spin, played as the scene player plays it, beside Bullet and MuJoCo on piles of
+// 8 to 1,000 (issue 26's piles: bench/dropped_pile.h).
 // scripts/performance.sh runs it and writes doc/performance.md.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <random>
 #include <string>
@@ -28,6 +31,11 @@
 #include "impact/cluster_solver.h"
 #ifdef COLLISION_RESPONSE_WITH_BULLET
 #include <btBulletDynamicsCommon.h>
+#endif
+#ifdef COLLISION_RESPONSE_WITH_MUJOCO
+#include <mujoco/mujoco.h>
+
+#include <cstring>
 #endif
 
 namespace collision_response::bench {
@@ -303,206 +311,177 @@ BENCHMARK(BM_FrictionCluster)
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.5);
 
-/// A pile dropped into a box with friction and spin (bench/dropped_pile.h: r = 0.05 m, e = 0.5,
-/// mu = 0.5), played for 0.6 s at 100 Hz as the scene player plays it, once (the pile is the
-/// run): the monitor's CPU per simulated second, its worst update, the played motion's CPU, and
-/// the deepest any ball went into another or a wall at the updates' instants.
+/// Issue 26's piles (bench/dropped_pile.h: r = 0.05 m, 0.1 kg, e = 0.5, dropped from a loose
+/// lattice into a closed box): 8, 27, 100 and 1,000 balls with friction and spin (mu = 0.5), and
+/// 1,000 frictionless. Arguments: balls, friction (1: mu = 0.5, friction and spin; 0: none).
+void droppedPiles(benchmark::internal::Benchmark* bench) {
+  bench->ArgNames({"balls", "friction"});
+  for (const int balls : {8, 27, 100, 1000}) bench->Args({balls, 1});
+  bench->Args({1000, 0});
+}
+
+/// The same piles for a peer, at 100 and 300 Hz (a third argument, "rate"); `thousand`: the
+/// piles of 1,000 too.
+void droppedPilesAtRates(benchmark::internal::Benchmark* bench, bool thousand) {
+  bench->ArgNames({"balls", "friction", "rate"});
+  for (const int rate : {100, 300}) {
+    for (const int balls : {8, 27, 100}) bench->Args({balls, 1, rate});
+    if (thousand) {
+      bench->Args({1000, 1, rate});
+      bench->Args({1000, 0, rate});
+    }
+  }
+}
+
+/// The pile's first simulated second, as every engine here is asked for it.
+constexpr double kPileSeconds = 1.0;
+
+/// Ours on a dropped pile, played for its first second at 100 Hz as the scene player plays it,
+/// once (the pile is the run): the monitor's CPU per simulated second, its worst update, the
+/// played motion's CPU (the scene player's share), the deepest any ball went into another or a
+/// wall at the updates' instants, and the bodies the exact work budget handed to stepping.
 void BM_DroppedPile(benchmark::State& state) {
   const int balls = static_cast<int>(state.range(0));
-  const double seconds = 0.6;
+  const double mu = state.range(1) != 0 ? 0.5 : 0.0;
   PileFigures figures;
-  for (auto _ : state) figures = playPile(droppedPile(balls, 0.5), seconds, 100.0);
-  state.counters["cpu_per_simulated_s"] = figures.monitor_cpu / seconds;
+  for (auto _ : state) figures = playPile(droppedPile(balls, mu), kPileSeconds, 100.0);
+  state.counters["cpu_per_simulated_s"] = figures.monitor_cpu / kPileSeconds;
   state.counters["worst_update_s"] = figures.worst_update;
-  state.counters["source_cpu_per_simulated_s"] = figures.source_cpu / seconds;
+  state.counters["source_cpu_per_simulated_s"] = figures.source_cpu / kPileSeconds;
   state.counters["impacts"] = static_cast<double>(figures.impacts);
   state.counters["fallbacks"] = static_cast<double>(figures.fallbacks);
   state.counters["deepest_m"] = figures.deepest;
 }
-BENCHMARK(BM_DroppedPile)->ArgName("balls")->Arg(8)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK(BM_DroppedPile)->Apply(droppedPiles)->Iterations(1)->Unit(benchmark::kSecond);
+
+/// What a peer did on a dropped pile: CPU per simulated second, its worst step, the deepest
+/// overlap at the steps' ends.
+void countPeerPile(benchmark::State& state, double cpu, double worst, double deepest) {
+  state.counters["cpu_per_simulated_s"] = cpu / kPileSeconds;
+  state.counters["worst_update_s"] = worst;
+  state.counters["deepest_m"] = deepest;
+}
 
 #ifdef COLLISION_RESPONSE_WITH_BULLET
 btScalar bt(double value) { return static_cast<btScalar>(value); }
 
-/// Bullet on the same dropped pile: one stepSimulation of 0.01 s per update for 0.6 s,
-/// restitution sqrt(0.5) and friction sqrt(0.5) on every body and wall (Bullet multiplies the
-/// two: e = 0.5, mu = 0.5), no sleeping; the CPU per simulated second, the worst step, and the
-/// deepest overlap at the steps' ends.
-void BM_BulletDroppedPile(benchmark::State& state) {
-  const core::Scene scene = droppedPile(static_cast<int>(state.range(0)), 0.5);
-  const double seconds = 0.6, size = -scene.obstacles[1].offset;
-  double cpu = 0, worst = 0, deepest = 0;
-  for (auto _ : state) {
-    btDefaultCollisionConfiguration configuration;
-    btCollisionDispatcher dispatcher(&configuration);
-    btDbvtBroadphase broadphase;
-    btSequentialImpulseConstraintSolver solver;
-    btDiscreteDynamicsWorld world(&dispatcher, &broadphase, &solver, &configuration);
-    world.setGravity(btVector3(0, 0, bt(-9.81)));
-    const btScalar half = bt(std::sqrt(0.5));
-    btSphereShape sphere(bt(0.05));
+/// A Bullet world of the scene's balls (spheres of one radius and mass) and plane obstacles,
+/// each body's restitution and friction the given ones (Bullet multiplies the two of a pair: pass
+/// the square roots of the pair's), every ball simulated (no sleeping: ours watches every ball).
+class BulletWorld {
+ public:
+  BulletWorld(const core::Scene& scene, double radius, double mass, double restitution,
+              double friction)
+      : world_(&dispatcher_, &broadphase_, &solver_, &configuration_), sphere_(bt(radius)) {
+    const V g = scene.effects.gravity ? scene.gravity : V::Zero();
+    world_.setGravity(btVector3(bt(g.x()), bt(g.y()), bt(g.z())));
     btVector3 inertia(0, 0, 0);
-    sphere.calculateLocalInertia(bt(0.1), inertia);
-    std::vector<std::unique_ptr<btDefaultMotionState>> motions;
-    std::vector<std::unique_ptr<btRigidBody>> bodies;
-    std::vector<std::unique_ptr<btCollisionShape>> planes;
+    sphere_.calculateLocalInertia(bt(mass), inertia);
     for (const core::BodySpec& spec : scene.bodies) {
       btTransform start;
       start.setIdentity();
       start.setOrigin(
           btVector3(bt(spec.position.x()), bt(spec.position.y()), bt(spec.position.z())));
-      motions.push_back(std::make_unique<btDefaultMotionState>(start));
-      btRigidBody::btRigidBodyConstructionInfo info(bt(0.1), motions.back().get(), &sphere,
-                                                    inertia);
-      info.m_restitution = half;
-      info.m_friction = half;
-      bodies.push_back(std::make_unique<btRigidBody>(info));
-      bodies.back()->setActivationState(DISABLE_DEACTIVATION);
-      world.addRigidBody(bodies.back().get());
+      add(bt(mass), start, &sphere_, inertia, restitution, friction);
+      bodies_.back()->setLinearVelocity(
+          btVector3(bt(spec.velocity.x()), bt(spec.velocity.y()), bt(spec.velocity.z())));
+      bodies_.back()->setActivationState(DISABLE_DEACTIVATION);
     }
-    const std::size_t balls = bodies.size();
+    balls_ = bodies_.size();
     for (const core::ObstacleSpec& wall : scene.obstacles) {
-      planes.push_back(std::make_unique<btStaticPlaneShape>(
+      planes_.push_back(std::make_unique<btStaticPlaneShape>(
           btVector3(bt(wall.normal.x()), bt(wall.normal.y()), bt(wall.normal.z())),
           bt(wall.offset)));
       btTransform identity;
       identity.setIdentity();
-      motions.push_back(std::make_unique<btDefaultMotionState>(identity));
-      btRigidBody::btRigidBodyConstructionInfo info(0, motions.back().get(), planes.back().get());
-      info.m_restitution = half;
-      info.m_friction = half;
-      bodies.push_back(std::make_unique<btRigidBody>(info));
-      world.addRigidBody(bodies.back().get());
+      add(0, identity, planes_.back().get(), btVector3(0, 0, 0), restitution, friction);
     }
-    for (int k = 0; k < static_cast<int>(std::lround(seconds * 100)); ++k) {
+  }
+  ~BulletWorld() {
+    for (const auto& body : bodies_) world_.removeRigidBody(body.get());
+  }
+  BulletWorld(const BulletWorld&) = delete;
+  BulletWorld& operator=(const BulletWorld&) = delete;
+
+  /// One stepSimulation of `dt` (one sub-step).
+  void step(double dt) { world_.stepSimulation(bt(dt), 1, bt(dt)); }
+  std::size_t balls() const { return balls_; }
+  V position(std::size_t ball) const {
+    const btVector3 p = bodies_[ball]->getCenterOfMassPosition();
+    return V(p.x(), p.y(), p.z());
+  }
+
+ private:
+  void add(btScalar mass, const btTransform& start, btCollisionShape* shape,
+           const btVector3& inertia, double restitution, double friction) {
+    motions_.push_back(std::make_unique<btDefaultMotionState>(start));
+    btRigidBody::btRigidBodyConstructionInfo info(mass, motions_.back().get(), shape, inertia);
+    info.m_restitution = bt(restitution);
+    info.m_friction = bt(friction);
+    bodies_.push_back(std::make_unique<btRigidBody>(info));
+    world_.addRigidBody(bodies_.back().get());
+  }
+
+  btDefaultCollisionConfiguration configuration_;
+  btCollisionDispatcher dispatcher_{&configuration_};
+  btDbvtBroadphase broadphase_;
+  btSequentialImpulseConstraintSolver solver_;
+  btDiscreteDynamicsWorld world_;
+  btSphereShape sphere_;
+  std::vector<std::unique_ptr<btDefaultMotionState>> motions_;
+  std::vector<std::unique_ptr<btRigidBody>> bodies_;
+  std::vector<std::unique_ptr<btCollisionShape>> planes_;
+  std::size_t balls_ = 0;
+};
+
+/// Bullet on the same dropped piles: one stepSimulation of 1 / rate per step for the first
+/// second, restitution and friction sqrt(0.5) on every body and wall (e = 0.5, mu = 0.5; mu = 0
+/// for the frictionless pile); the CPU per simulated second, the worst step, and the deepest
+/// overlap at the steps' ends.
+void BM_BulletDroppedPile(benchmark::State& state) {
+  const bool friction = state.range(1) != 0;
+  const core::Scene scene = droppedPile(static_cast<int>(state.range(0)), friction ? 0.5 : 0.0);
+  const double rate = static_cast<double>(state.range(2)), size = -scene.obstacles[1].offset;
+  double cpu = 0, worst = 0, deepest = 0;
+  for (auto _ : state) {
+    BulletWorld world(scene, 0.05, 0.1, std::sqrt(0.5), friction ? std::sqrt(0.5) : 0.0);
+    std::vector<V> positions(world.balls());
+    for (int k = 0; k < static_cast<int>(std::lround(kPileSeconds * rate)); ++k) {
       const double began = cpuSeconds();
-      world.stepSimulation(bt(0.01), 1, bt(0.01));
+      world.step(1 / rate);
       const double took = cpuSeconds() - began;
       cpu += took;
       worst = std::max(worst, took);
-      for (std::size_t i = 0; i < balls; ++i) {
-        const btVector3 p = bodies[i]->getCenterOfMassPosition();
-        const V at(p.x(), p.y(), p.z());
-        for (int axis = 0; axis < 3; ++axis) {
-          deepest = std::max({deepest, 0.05 - at[axis], at[axis] + 0.05 - size});
-        }
-        for (std::size_t j = i + 1; j < balls; ++j) {
-          const btVector3 q = bodies[j]->getCenterOfMassPosition();
-          deepest = std::max(deepest, 0.1 - (V(q.x(), q.y(), q.z()) - at).norm());
-        }
-      }
+      for (std::size_t i = 0; i < positions.size(); ++i) positions[i] = world.position(i);
+      deepest = std::max(deepest, deepestOverlap(positions, 0.05, size));
     }
-    for (const auto& body : bodies) world.removeRigidBody(body.get());
   }
-  state.counters["cpu_per_simulated_s"] = cpu / seconds;
-  state.counters["worst_update_s"] = worst;
-  state.counters["deepest_m"] = deepest;
+  countPeerPile(state, cpu, worst, deepest);
 }
 BENCHMARK(BM_BulletDroppedPile)
-    ->ArgName("balls")
-    ->Arg(8)
-    ->Arg(27)
-    ->Arg(100)
-    ->Arg(1000)
+    ->Apply([](benchmark::internal::Benchmark* bench) { droppedPilesAtRates(bench, true); })
     ->Iterations(1)
     ->Unit(benchmark::kSecond);
 
 void BM_BulletGasUpdate(benchmark::State& state) {
   const Gas gas = makeGas(static_cast<int>(state.range(0)));
-  btDefaultCollisionConfiguration configuration;
-  btCollisionDispatcher dispatcher(&configuration);
-  btDbvtBroadphase broadphase;
-  btSequentialImpulseConstraintSolver solver;
-  btDiscreteDynamicsWorld world(&dispatcher, &broadphase, &solver, &configuration);
-  world.setGravity(btVector3(0, 0, 0));
-  btSphereShape sphere(bt(0.05));
-  btVector3 inertia(0, 0, 0);
-  sphere.calculateLocalInertia(bt(0.1), inertia);
-  std::vector<std::unique_ptr<btDefaultMotionState>> motions;
-  std::vector<std::unique_ptr<btRigidBody>> bodies;
-  std::vector<std::unique_ptr<btCollisionShape>> planes;
-  for (const core::BodySpec& spec : gas.scene.bodies) {
-    btTransform start;
-    start.setIdentity();
-    start.setOrigin(btVector3(bt(spec.position.x()), bt(spec.position.y()), bt(spec.position.z())));
-    motions.push_back(std::make_unique<btDefaultMotionState>(start));
-    btRigidBody::btRigidBodyConstructionInfo info(bt(0.1), motions.back().get(), &sphere, inertia);
-    info.m_restitution = 1;
-    info.m_friction = 0;
-    bodies.push_back(std::make_unique<btRigidBody>(info));
-    bodies.back()->setLinearVelocity(
-        btVector3(bt(spec.velocity.x()), bt(spec.velocity.y()), bt(spec.velocity.z())));
-    bodies.back()->setActivationState(DISABLE_DEACTIVATION);
-    world.addRigidBody(bodies.back().get());
-  }
-  for (const core::ObstacleSpec& wall : gas.scene.obstacles) {
-    planes.push_back(std::make_unique<btStaticPlaneShape>(
-        btVector3(bt(wall.normal.x()), bt(wall.normal.y()), bt(wall.normal.z())), bt(wall.offset)));
-    btTransform identity;
-    identity.setIdentity();
-    motions.push_back(std::make_unique<btDefaultMotionState>(identity));
-    btRigidBody::btRigidBodyConstructionInfo info(0, motions.back().get(), planes.back().get());
-    info.m_restitution = 1;
-    bodies.push_back(std::make_unique<btRigidBody>(info));
-    world.addRigidBody(bodies.back().get());
-  }
-  for (auto _ : state) world.stepSimulation(bt(0.01), 1, bt(0.01));
+  BulletWorld world(gas.scene, 0.05, 0.1, 1.0, 0.0);
+  for (auto _ : state) world.step(0.01);
   state.counters["bodies"] = static_cast<double>(gas.scene.bodies.size());
-  for (const auto& body : bodies) world.removeRigidBody(body.get());
 }
 /// Bullet on the same piles, gravity on: one stepSimulation of 0.01 s per update, restitution
 /// sqrt(0.5) on every body and wall (Bullet multiplies the two), friction 0, no sleeping (every
 /// ball simulated, as ours watches every ball).
 void BM_BulletPileUpdate(benchmark::State& state) {
   const core::Scene scene = pileOf(state);
-  btDefaultCollisionConfiguration configuration;
-  btCollisionDispatcher dispatcher(&configuration);
-  btDbvtBroadphase broadphase;
-  btSequentialImpulseConstraintSolver solver;
-  btDiscreteDynamicsWorld world(&dispatcher, &broadphase, &solver, &configuration);
-  const V g = scene.effects.gravity ? scene.gravity : V::Zero();
-  world.setGravity(btVector3(bt(g.x()), bt(g.y()), bt(g.z())));
-  const btScalar restitution = bt(std::sqrt(0.5));
-  btSphereShape sphere(bt(kPileRadius));
-  btVector3 inertia(0, 0, 0);
-  sphere.calculateLocalInertia(bt(0.1), inertia);
-  std::vector<std::unique_ptr<btDefaultMotionState>> motions;
-  std::vector<std::unique_ptr<btRigidBody>> bodies;
-  std::vector<std::unique_ptr<btCollisionShape>> planes;
-  for (const core::BodySpec& spec : scene.bodies) {
-    btTransform start;
-    start.setIdentity();
-    start.setOrigin(btVector3(bt(spec.position.x()), bt(spec.position.y()), bt(spec.position.z())));
-    motions.push_back(std::make_unique<btDefaultMotionState>(start));
-    btRigidBody::btRigidBodyConstructionInfo info(bt(0.1), motions.back().get(), &sphere, inertia);
-    info.m_restitution = restitution;
-    info.m_friction = 0;
-    bodies.push_back(std::make_unique<btRigidBody>(info));
-    bodies.back()->setActivationState(DISABLE_DEACTIVATION);
-    world.addRigidBody(bodies.back().get());
-  }
-  const std::size_t balls = bodies.size();
-  for (const core::ObstacleSpec& wall : scene.obstacles) {
-    planes.push_back(std::make_unique<btStaticPlaneShape>(
-        btVector3(bt(wall.normal.x()), bt(wall.normal.y()), bt(wall.normal.z())), bt(wall.offset)));
-    btTransform identity;
-    identity.setIdentity();
-    motions.push_back(std::make_unique<btDefaultMotionState>(identity));
-    btRigidBody::btRigidBodyConstructionInfo info(0, motions.back().get(), planes.back().get());
-    info.m_restitution = restitution;
-    info.m_friction = 0;
-    bodies.push_back(std::make_unique<btRigidBody>(info));
-    world.addRigidBody(bodies.back().get());
-  }
-  for (auto _ : state) world.stepSimulation(bt(0.01), 1, bt(0.01));
+  BulletWorld world(scene, kPileRadius, 0.1, std::sqrt(0.5), 0.0);
+  for (auto _ : state) world.step(0.01);
   double drift = 0;
-  for (std::size_t i = 0; i < balls; ++i) {
-    const btVector3 p = bodies[i]->getCenterOfMassPosition();
-    drift = std::max(drift, (V(p.x(), p.y(), p.z()) - scene.bodies[i].position).norm());
+  for (std::size_t i = 0; i < world.balls(); ++i) {
+    drift = std::max(drift, (world.position(i) - scene.bodies[i].position).norm());
   }
   state.counters["drift_m"] = drift;
-  state.counters["bodies"] = static_cast<double>(balls);
-  for (const auto& body : bodies) world.removeRigidBody(body.get());
+  state.counters["bodies"] = static_cast<double>(world.balls());
 }
 BENCHMARK(BM_BulletPileUpdate)
     ->Apply([](benchmark::internal::Benchmark* bench) { pileArguments(bench, false); })
@@ -515,6 +494,96 @@ BENCHMARK(BM_BulletGasUpdate)
     ->Arg(100000)
     ->Unit(benchmark::kMillisecond)
     ->MinTime(1.0);
+#endif
+
+#ifdef COLLISION_RESPONSE_WITH_MUJOCO
+/// MuJoCo on the same dropped piles: every ball a body with a free joint and a sphere geom, the
+/// box six planes; friction mu = 0.5 with torsional and rolling friction off (condim 3: sliding
+/// friction, the balls turn), 0 and condim 1 for the frictionless pile; MuJoCo's default soft
+/// contact (it has no coefficient of restitution: bench/accuracy/mujoco.cpp), its default
+/// integrator and Newton solver, one mj_step of 1 / rate per step for the first second. The CPU
+/// per simulated second, the worst step, the deepest overlap at the steps' ends, and whether its
+/// contacts ever outgrew their room (then some were left out: contacts_full).
+std::string mujocoPileXml(const core::Scene& scene, double dt, bool friction) {
+  const auto number = [](double value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.17g", value);
+    return std::string(text);
+  };
+  const auto triple = [&](const V& v) {
+    return number(v.x()) + " " + number(v.y()) + " " + number(v.z());
+  };
+  // Room for four contacts a ball at once, a row each per dimension of the contact: MuJoCo 2.2
+  // preallocates dense njmax x njmax matrices (six a ball of 1,000 outgrew what it allocates).
+  const std::size_t contacts = 4 * scene.bodies.size() + 32;
+  const std::string room = std::to_string(contacts);
+  const std::string contact = friction ? "condim=\"3\" friction=\"0.5 0 0\"" : "condim=\"1\"";
+  std::string xml = "<mujoco model=\"pile\">\n  <option timestep=\"" + number(dt) +
+                    "\" gravity=\"" + triple(scene.gravity) + "\"/>\n  <size nconmax=\"" + room +
+                    "\" njmax=\"" + std::to_string((friction ? 3 : 1) * contacts) +
+                    "\"/>\n  <default><geom " + contact + "/></default>\n  <worldbody>\n";
+  for (const core::ObstacleSpec& wall : scene.obstacles) {
+    const V n = wall.normal.normalized();
+    xml += "    <geom type=\"plane\" size=\"0 0 1\" pos=\"" + triple(n * wall.offset) +
+           "\" zaxis=\"" + triple(n) + "\"/>\n";
+  }
+  for (const core::BodySpec& spec : scene.bodies) {
+    xml += "    <body pos=\"" + triple(spec.position) +
+           "\"><freejoint/><geom type=\"sphere\" size=\"" + number(spec.radius) + "\" mass=\"" +
+           number(spec.mass) + "\"/></body>\n";
+  }
+  return xml + "  </worldbody>\n</mujoco>\n";
+}
+
+void BM_MujocoDroppedPile(benchmark::State& state) {
+  const bool friction = state.range(1) != 0;
+  const core::Scene scene = droppedPile(static_cast<int>(state.range(0)), friction ? 0.5 : 0.0);
+  const double rate = static_cast<double>(state.range(2)), size = -scene.obstacles[1].offset;
+  const std::string xml = mujocoPileXml(scene, 1 / rate, friction);
+  mjVFS vfs;
+  mj_defaultVFS(&vfs);
+  if (mj_makeEmptyFileVFS(&vfs, "pile.xml", static_cast<int>(xml.size())) != 0) {
+    state.SkipWithError("MuJoCo: cannot make the virtual model file");
+    return;
+  }
+  std::memcpy(vfs.filedata[mj_findFileVFS(&vfs, "pile.xml")], xml.data(), xml.size());
+  char error[1000] = "";
+  mjModel* model = mj_loadXML("pile.xml", &vfs, error, sizeof error);
+  mj_deleteVFS(&vfs);
+  if (model == nullptr) {
+    state.SkipWithError(error);
+    return;
+  }
+  mjData* data = mj_makeData(model);
+  double cpu = 0, worst = 0, deepest = 0;
+  bool full = false;
+  for (auto _ : state) {
+    std::vector<V> positions(scene.bodies.size());
+    for (int k = 0; k < static_cast<int>(std::lround(kPileSeconds * rate)); ++k) {
+      const double began = cpuSeconds();
+      mj_step(model, data);
+      const double took = cpuSeconds() - began;
+      cpu += took;
+      worst = std::max(worst, took);
+      for (std::size_t i = 0; i < positions.size(); ++i) {
+        positions[i] = V(data->qpos[7 * i], data->qpos[7 * i + 1], data->qpos[7 * i + 2]);
+      }
+      deepest = std::max(deepest, deepestOverlap(positions, 0.05, size));
+    }
+    full =
+        data->warning[mjWARN_CONTACTFULL].number > 0 || data->warning[mjWARN_CNSTRFULL].number > 0;
+  }
+  countPeerPile(state, cpu, worst, deepest);
+  state.counters["contacts_full"] = full ? 1 : 0;
+  mj_deleteData(data);
+  mj_deleteModel(model);
+}
+// Not the piles of 1,000: Debian's MuJoCo 2.2 solves them densely (njmax x njmax), and one
+// simulated second of the pile of 1,000 with friction had not ended after 15 minutes of CPU.
+BENCHMARK(BM_MujocoDroppedPile)
+    ->Apply([](benchmark::internal::Benchmark* bench) { droppedPilesAtRates(bench, false); })
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
 #endif
 
 BENCHMARK(BM_PairResponse);

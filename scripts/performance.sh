@@ -16,7 +16,7 @@
 #   /usr/bin/python3 scripts/performance_report.py --pile-only .ws/pile.json doc/performance.md
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
-PACKAGES+=(libbenchmark-dev libbullet-dev libstd-srvs-dev ros-std-srvs linux-perf)
+PACKAGES+=(libbenchmark-dev libbullet-dev libmujoco-dev libstd-srvs-dev ros-std-srvs linux-perf)
 install_packages
 build_workspace >"$ws/build.log" 2>&1 || { tail -40 "$ws/build.log"; exit 1; }
 cmake --build "$ws/build" --target bench_scale node_benchmark empty_service -- -j2 \
