@@ -242,6 +242,30 @@ Scene yamlPile() {
   return scene;
 }
 
+// config/scenes/rough_pile.yaml
+Scene yamlRoughPile() {
+  Scene scene;
+  scene.effects.gravity = scene.effects.friction = scene.effects.spin = true;
+  scene.gravity = V(0.0, 0.0, -9.81);
+  addMaterial(scene, "rough_ball", Material{0.5, 0.5});
+  scene.bodies.push_back(ball("ball_0", 0.1, 0.05, "rough_ball", V(0.105, 0.108, 0.112)));
+  scene.bodies.push_back(ball("ball_1", 0.1, 0.05, "rough_ball", V(0.232, 0.113, 0.115)));
+  scene.bodies.push_back(ball("ball_2", 0.1, 0.05, "rough_ball", V(0.108, 0.227, 0.107)));
+  scene.bodies.push_back(ball("ball_3", 0.1, 0.05, "rough_ball", V(0.235, 0.232, 0.11)));
+  scene.bodies.push_back(ball("ball_4", 0.1, 0.05, "rough_ball", V(0.111, 0.106, 0.233)));
+  scene.bodies.push_back(ball("ball_5", 0.1, 0.05, "rough_ball", V(0.227, 0.111, 0.225)));
+  scene.bodies.push_back(ball("ball_6", 0.1, 0.05, "rough_ball", V(0.114, 0.225, 0.228)));
+  scene.bodies.push_back(ball("ball_7", 0.1, 0.05, "rough_ball", V(0.23, 0.23, 0.231)));
+  scene.obstacles.push_back(plane("floor", V(0.0, 0.0, 1.0), 0.0, "rough_ball"));
+  scene.obstacles.push_back(plane("ceiling", V(0.0, 0.0, -1.0), -0.34, "rough_ball"));
+  scene.obstacles.push_back(plane("wall_x0", V(1.0, 0.0, 0.0), 0.0, "rough_ball"));
+  scene.obstacles.push_back(plane("wall_x1", V(-1.0, 0.0, 0.0), -0.34, "rough_ball"));
+  scene.obstacles.push_back(plane("wall_y0", V(0.0, 1.0, 0.0), 0.0, "rough_ball"));
+  scene.obstacles.push_back(plane("wall_y1", V(0.0, -1.0, 0.0), -0.34, "rough_ball"));
+  normalizePlanes(scene);
+  return scene;
+}
+
 // config/scenes/stack.yaml
 Scene yamlStack() {
   Scene scene;
@@ -429,6 +453,7 @@ std::vector<TraceRun> traceRuns() {
                   100.0,
                   {{"paddle_link", V(1.0, 0.0, 0.0), V(-0.5, 0.0, 0.0)}}});
   runs.push_back({"scenes/pile", yamlPile(), 1.5, 100.0, {}});
+  runs.push_back({"scenes/rough_pile", yamlRoughPile(), 1.0, 100.0, {}});
   runs.push_back({"scenes/stack", yamlStack(), 1.0, 100.0, {}});
   runs.push_back({"scenes/two_balls_oblique", yamlTwoBallsOblique(), 1.0, 100.0, {}});
   // The accuracy benchmark's scenes at 100 Hz: each effect variant under both detections, the
