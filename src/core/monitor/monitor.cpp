@@ -309,16 +309,18 @@ constexpr std::size_t kBudgetsPerUpdate = 16;
 
 /// The bodies (of those `charged` at the instant) whose exact work in this step ran over the
 /// budget, or, once the step's work in all has run over kBudgetsPerUpdate budgets, every body
-/// that spent a sixteenth of one (none stepped yet), are stepped from the instant with the bodies
-/// near them (stepOverBudget; counted in the report's fallbacks and named in its over_budget);
-/// what the stepped clusters let go of is resolved as at the grid (stepClusters). `changed` ends
-/// sorted, each once.
+/// that spent a sixteenth of one (all of them looked at once, when that happens; after, those
+/// charged), none stepped yet, are stepped from the instant with the bodies near them
+/// (stepOverBudget; counted in the report's fallbacks and named in its over_budget); what the
+/// stepped clusters let go of is resolved as at the grid (stepClusters). `changed` ends sorted,
+/// each once.
 template <class Motion>
 void stepOverBudget(World& world, const monitor::PairIndex& index, std::vector<std::size_t> charged,
                     double instant, std::vector<std::size_t>& changed, StepReport& report) {
   if (world.work_budget == 0 || !world.stepping.enabled()) return;
   const bool all_spent = world.work_total > kBudgetsPerUpdate * world.work_budget;
-  if (all_spent) {
+  if (all_spent && !world.work_all_spent) {
+    world.work_all_spent = true;
     charged.clear();
     for (std::size_t body = 0; body < world.bodies.size(); ++body) charged.push_back(body);
   }
@@ -420,6 +422,7 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
   world.stepping.beginStep(world.now, time);
   world.work.assign(world.bodies.size(), 0);
   world.work_total = 0;
+  world.work_all_spent = false;
   monitor::candidatePairs<Motion>(world, world.now, time, world.scratch.pairs);
   ContactSchedule<Motion> schedule(world, time);
   const monitor::PairIndex index{world.scratch.pairs, world.scratch.pairs_of};
@@ -465,6 +468,7 @@ void advanceLastingContact(World& world, double time, StepReport& report) {
   world.stepping.beginStep(world.now, time);
   world.work.assign(world.bodies.size(), 0);
   world.work_total = 0;
+  world.work_all_spent = false;
   // Without groups for these tracks, they are formed after the states at `time`; the stepped
   // clusters move on regardless.
   const bool lasting = world.groups_current;

@@ -224,6 +224,7 @@ struct World {
   /// contact forces integrating its group's curved motion.
   std::vector<std::size_t> work;
   std::size_t work_total = 0;   // the sum of `work`
+  bool work_all_spent = false;  // work_total ran over the step's budget in all (monitor.cpp)
   std::size_t work_budget = 0;  // Scene::exact_work_budget; 0: none
   Scratch scratch;
   bool started = false;
