@@ -47,19 +47,24 @@ Engine oursEngine(core::Detection detection, int stepped_cluster_min_bodies) {
       run.stepped_bodies = static_cast<double>(report.stepped_bodies);
       playback.applyImpacts(monitor, report.impacts, exact_contact);
       for (const core::ImpactRecord& impact : report.impacts) {
+        // Where the source placed a body at the instant: continuous, at the contact, r along the
+        // normal from the impact's point (as Playback::applyImpact places it: no query, which
+        // would cost the source a replay of the update up to the instant, for every impact);
+        // discrete, where the source has it then.
+        const auto placed = [&](std::size_t body, double side) {
+          return exact_contact
+                     ? V(impact.contact_point + side * scene.bodies[body].radius * impact.normal)
+                     : playback.position(body, impact.time);
+        };
         ReportedImpact reported;
         reported.time = impact.time;
         reported.body = scene_index[impact.body_a];
-        // Where the source placed the body at the instant (continuous: at the contact).
-        if (play.impact_positions)
-          reported.position = playback.position(reported.body, impact.time);
+        if (play.impact_positions) reported.position = placed(reported.body, -1.0);
         reported.velocity_after = impact.velocity_a_after;
         reported.other_is_obstacle = impact.other_is_obstacle;
         if (!impact.other_is_obstacle) {
           reported.other = scene_index[impact.other];
-          if (play.impact_positions) {
-            reported.other_position = playback.position(reported.other, impact.time);
-          }
+          if (play.impact_positions) reported.other_position = placed(reported.other, 1.0);
           reported.other_velocity_after = impact.velocity_b_after;
         } else {
           reported.other = impact.other;
