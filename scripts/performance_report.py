@@ -2,8 +2,8 @@
 """Turns scripts/performance.sh's output into doc/performance.md.
 
 usage: performance_report.py OUT_DIR doc/performance.md
-       performance_report.py --pile-only SCALE_JSON doc/performance.md   (the pile's section
-       alone, from a run of `bench_scale --benchmark_filter=Pile`)
+       performance_report.py --pile-only SCALE_JSON doc/performance.md   (the piles' sections
+       alone, from a run of `bench_scale --benchmark_filter=Pile`: at rest, and dropped)
 """
 import json
 import pathlib
@@ -109,13 +109,120 @@ def pile_section(scale):
 
 
 DROPPED_PILE_TITLE = "## A pile dropped into a box, with friction and spin (profile)"
+DROPPED_TITLE = "## Piles dropped into a box: what keeping up costs"
+
+# Issue 26's targets: the monitor's CPU per simulated second of the pile with friction and spin
+# at 100 Hz (s), by balls.
+DROPPED_TARGETS = {8: 0.05, 100: 1.0, 1000: 5.0}
 
 
-def replace_pile_section(target, lines):
-    """Writes the pile's section into an existing doc/performance.md (before the node's)."""
+def dropped_rows(scale):
+    """BM_DroppedPile and its peers' rows by (engine, balls, friction, rate): the row's counters."""
+    rows = {}
+    for name, (_, row) in scale.items():
+        parts = name.split("/")
+        if not parts[0].endswith("DroppedPile"):
+            continue
+        if row.get("error_occurred"):
+            continue
+        args = dict(part.split(":") for part in parts[1:] if ":" in part)
+        engine = {"BM_DroppedPile": "ours", "BM_BulletDroppedPile": "Bullet",
+                  "BM_MujocoDroppedPile": "MuJoCo"}[parts[0]]
+        rows[(engine, int(args["balls"]), int(args["friction"]), int(args.get("rate", 100)))] = row
+    return rows
+
+
+def dropped_targets(scale):
+    """The Targets table's rows for the dropped piles."""
+    rows = dropped_rows(scale)
+    lines = []
+    for balls, target in DROPPED_TARGETS.items():
+        ours = rows.get(("ours", balls, 1, 100))
+        if ours is None:
+            continue
+        cpu = ours["cpu_per_simulated_s"]
+        lines.append(f"| a pile of {balls:,} dropped with friction and spin, 100 Hz: the monitor "
+                     f"at most {target:g} s of CPU per simulated second | {cpu:.3g} s (worst "
+                     f"update {ours['worst_update_s']:.3g} s; the scene player's motion "
+                     f"{ours['source_cpu_per_simulated_s']:.3g} s) | {'yes' if cpu <= target else 'no'} |")
+    return lines
+
+
+def dropped_section(scale):
+    """BM_DroppedPile beside BM_BulletDroppedPile and BM_MujocoDroppedPile."""
+    rows = dropped_rows(scale)
+    if not rows:
+        return []
+
+    def cell(row, key, digits=3):
+        return f"{row[key]:.{digits}g}" if row is not None and key in row else "not run"
+
+    lines = [
+        DROPPED_TITLE,
+        "",
+        "Issue 26's piles (`bench/dropped_pile.h`): balls of r = 0.05 m and 0.1 kg dropped from a "
+        "loose lattice 0.12 m apart (each nudged by up to 5 mm) into a closed box, e = 0.5, "
+        "`friction` and `spin` with mu = 0.5 (or frictionless), restitution threshold 0, their "
+        "first simulated second. Ours at 100 Hz as the scene player plays it (`core::Playback` "
+        "moves the bodies by the monitor's model, the monitor finds the impacts, the player applies "
+        "them): the monitor's CPU per simulated second, its worst update, the player's share, and "
+        "the bodies the exact work budget handed to stepping (doc/model.md, \"Lasting contact\"). "
+        "Bullet 3 (single precision, `btSequentialImpulseConstraintSolver`, no sleeping, "
+        "restitution and friction sqrt(0.5) on every body and wall, which Bullet multiplies) and "
+        "MuJoCo 2.2 (condim 3, mu 0.5, its default soft contact: it has no coefficient of "
+        "restitution) at 100 and 300 Hz, one step a period. Deepest: the deepest any ball went "
+        "into another or a wall at the updates' instants. `bench_scale "
+        "--benchmark_filter=DroppedPile` (one run).",
+        "",
+        "| pile | ours: CPU per simulated s | worst update | scene player per simulated s | "
+        "deepest | stepped over the budget | Bullet 100 Hz: CPU / deepest | Bullet 300 Hz | "
+        "MuJoCo 100 Hz | MuJoCo 300 Hz |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for balls, friction in ((8, 1), (27, 1), (100, 1), (1000, 1), (1000, 0)):
+        ours = rows.get(("ours", balls, friction, 100))
+        peers = []
+        for engine in ("Bullet", "MuJoCo"):
+            for rate in (100, 300):
+                peer = rows.get((engine, balls, friction, rate))
+                peers.append(f"{cell(peer, 'cpu_per_simulated_s')} s / "
+                             f"{peer['deepest_m'] * 1e3:.1f} mm" if peer else "not run")
+        label = f"{balls:,} balls, " + ("friction and spin" if friction else "frictionless")
+        lines.append(
+            f"| {label} | {cell(ours, 'cpu_per_simulated_s')} s | {cell(ours, 'worst_update_s')} s "
+            f"| {cell(ours, 'source_cpu_per_simulated_s')} s | {cell(ours, 'deepest_m', 2)} m | "
+            f"{cell(ours, 'fallbacks', 6)} | " + " | ".join(peers) + " |")
+    lines += [
+        "",
+        "MuJoCo is not run on the piles of 1,000: Debian's MuJoCo 2.2 solves its contacts "
+        "densely (njmax x njmax), and one simulated second of that pile with friction had not "
+        "ended after 15 minutes of CPU.",
+        "",
+    ]
+    return lines
+
+
+def replace_dropped_targets(target, rows):
+    """The dropped piles' rows of the Targets table of an existing doc/performance.md."""
+    if not rows:
+        return
+    text = target.read_text().split("\n")
+    kept = [line for line in text if not line.startswith("| a pile of ")]
+    start = kept.index("## Targets")
+    end = start + 1
+    while end < len(kept) and not (kept[end] == "" and kept[end - 1].startswith("|")):
+        end += 1
+    target.write_text("\n".join(kept[:end] + rows + kept[end:]))
+
+
+def replace_section(target, title, lines):
+    """Writes a section into an existing doc/performance.md in place of the one of that title
+    (else before the node's)."""
+    if not lines:
+        return
     text = target.read_text()
-    if PILE_TITLE in text:
-        head, rest = text.split(PILE_TITLE, 1)
+    if title in text:
+        head, rest = text.split(title, 1)
         tail = rest[rest.index("\n## "):] if "\n## " in rest else ""
         text = head + "\n".join(lines) + "\n" + tail.lstrip("\n")
     else:
@@ -126,8 +233,13 @@ def replace_pile_section(target, lines):
 
 def main():
     if sys.argv[1] == "--pile-only":
-        # Only the pile's benchmark was run: its section of the existing page.
-        replace_pile_section(pathlib.Path(sys.argv[3]), pile_section(read_scale(pathlib.Path(sys.argv[2]))))
+        # Only the piles' benchmarks were run: their sections of the existing page.
+        scale = read_scale(pathlib.Path(sys.argv[2]))
+        target = pathlib.Path(sys.argv[3])
+        if any(name.startswith("BM_PileUpdate") for name in scale):
+            replace_section(target, PILE_TITLE, pile_section(scale))
+        replace_section(target, DROPPED_TITLE, dropped_section(scale))
+        replace_dropped_targets(target, dropped_targets(scale))
         return
     out, target = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
     scale = read_scale(out / "scale.json")
@@ -166,6 +278,7 @@ def main():
         lines.append("| less time per update than Bullet on the same gas | " +
                      ", ".join(f"{r:.2f}x at {n:,}" for n, r in gas_ratio) +
                      f" | {'yes' if all(r < 1 for _, r in gas_ratio) else 'no'} |")
+    lines += dropped_targets(scale)
     lines += [
         "",
         "## Core (Google Benchmark)",
@@ -190,7 +303,7 @@ def main():
         lines.append(f"| {n:,} | {ours[0] * 1e3:.2f} ms | {ours[1].get('impacts/update', 0):.0f} | "
                      f"{bullet[0] * 1e3:.2f} ms | {ratio} |" if bullet else
                      f"| {n:,} | {ours[0] * 1e3:.2f} ms | {ours[1].get('impacts/update', 0):.0f} | n/a | n/a |")
-    lines += [""] + pile_section(scale)
+    lines += [""] + pile_section(scale) + dropped_section(scale)
     lines += [
         "## The node over ROS",
         "",
