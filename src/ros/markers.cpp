@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdint>
 #include <map>
+#include <optional>
+#include <type_traits>
 #include <variant>
 
 #include "collision_response/ros/conversions.h"
@@ -83,35 +85,82 @@ visualization_msgs::Marker bodyMarker(const core::BodySpec& body, int index,
   return marker;
 }
 
-visualization_msgs::Marker obstacleMarker(const core::ObstacleSpec& obstacle, int index,
-                                          const core::Shape& shape, const std::string& frame,
-                                          const ros::Time& stamp, const MarkerParams& params) {
+namespace {
+
+void setPose(visualization_msgs::Marker& marker, const Eigen::Vector3d& position,
+             const Eigen::Quaterniond& orientation) {
+  marker.pose.position = toPointMsg(position);
+  marker.pose.orientation.x = orientation.x();
+  marker.pose.orientation.y = orientation.y();
+  marker.pose.orientation.z = orientation.z();
+  marker.pose.orientation.w = orientation.w();
+}
+
+}  // namespace
+
+void appendObstacleMarkers(const core::ObstacleSpec& obstacle, int index,
+                           const core::PlacedShape& placed, const std::string& frame,
+                           const ros::Time& stamp, const MarkerParams& params,
+                           visualization_msgs::MarkerArray& array) {
   const auto marker_of = [&](std::int32_t type) {
     visualization_msgs::Marker marker = base(kObstaclesNamespace, index, type, frame, stamp);
     marker.color = materialColour(obstacle.material);
     marker.text = obstacle.id;
     return marker;
   };
-  if (const auto* sphere = std::get_if<core::Sphere>(&shape)) {
-    visualization_msgs::Marker marker = marker_of(visualization_msgs::Marker::SPHERE);
-    marker.pose.position = toPointMsg(sphere->centre);
-    marker.scale.x = marker.scale.y = marker.scale.z = 2.0 * sphere->radius;
-    return marker;
-  }
-  // A thin square whose z axis is the plane's normal.
-  const core::Plane& plane = std::get<core::Plane>(shape);
-  visualization_msgs::Marker marker = marker_of(visualization_msgs::Marker::CUBE);
-  marker.pose.position = toPointMsg(Eigen::Vector3d(plane.offset * plane.normal));
-  const Eigen::Quaterniond turn =
-      Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), plane.normal.normalized());
-  marker.pose.orientation.x = turn.x();
-  marker.pose.orientation.y = turn.y();
-  marker.pose.orientation.z = turn.z();
-  marker.pose.orientation.w = turn.w();
-  marker.scale.x = marker.scale.y = params.plane_size;
-  marker.scale.z = 1e-3 * params.plane_size;
-  marker.color.a = 0.4f;  // see-through, so bodies behind it show
-  return marker;
+  const Eigen::Vector3d& centre = placed.pose.transform.translation();
+  const Eigen::Quaterniond axes(placed.pose.transform.linear());
+  std::optional<visualization_msgs::Marker> capsule_ends;
+  visualization_msgs::Marker marker = std::visit(
+      [&](const auto& shape) {
+        using Kind = std::decay_t<decltype(shape)>;
+        if constexpr (std::is_same_v<Kind, core::Sphere>) {
+          visualization_msgs::Marker m = marker_of(visualization_msgs::Marker::SPHERE);
+          m.pose.position = toPointMsg(shape.centre);
+          m.scale.x = m.scale.y = m.scale.z = 2.0 * shape.radius;
+          return m;
+        } else if constexpr (std::is_same_v<Kind, core::Plane>) {
+          // A thin square whose z axis is the plane's normal.
+          visualization_msgs::Marker m = marker_of(visualization_msgs::Marker::CUBE);
+          setPose(m, Eigen::Vector3d(shape.offset * shape.normal),
+                  Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(),
+                                                     shape.normal.normalized()));
+          m.scale.x = m.scale.y = params.plane_size;
+          m.scale.z = 1e-3 * params.plane_size;
+          m.color.a = 0.4f;  // see-through, so bodies behind it show
+          return m;
+        } else if constexpr (std::is_same_v<Kind, core::Cuboid>) {
+          visualization_msgs::Marker m = marker_of(visualization_msgs::Marker::CUBE);
+          setPose(m, centre, axes);
+          m.scale.x = 2 * shape.half_size.x();
+          m.scale.y = 2 * shape.half_size.y();
+          m.scale.z = 2 * shape.half_size.z();
+          return m;
+        } else {
+          // A cylinder (rviz's is along its z, as ours); a capsule's segment as one, its ends as
+          // a sphere list in the namespace "obstacle_ends".
+          visualization_msgs::Marker m = marker_of(visualization_msgs::Marker::CYLINDER);
+          setPose(m, centre, axes);
+          m.scale.x = m.scale.y = 2 * shape.radius;
+          m.scale.z = 2 * shape.half_length;
+          if constexpr (std::is_same_v<Kind, core::Capsule>) {
+            visualization_msgs::Marker ends =
+                base(kObstacleEndsNamespace, index, visualization_msgs::Marker::SPHERE_LIST, frame,
+                     stamp);
+            ends.color = m.color;
+            const Eigen::Vector3d along = axes * Eigen::Vector3d::UnitZ();
+            ends.points = {toPointMsg(Eigen::Vector3d(centre + shape.half_length * along)),
+                           toPointMsg(Eigen::Vector3d(centre - shape.half_length * along))};
+            ends.scale.x = ends.scale.y = ends.scale.z = 2 * shape.radius;
+            ends.pose.orientation.w = 1.0;
+            capsule_ends = ends;
+          }
+          return m;
+        }
+      },
+      placed.shape);
+  array.markers.push_back(marker);
+  if (capsule_ends) array.markers.push_back(*capsule_ends);
 }
 
 void appendImpactMarkers(const Impact& impact, int id, const MarkerParams& params,
@@ -191,8 +240,8 @@ void appendSceneMarkers(const core::ImpactMonitor& monitor, double time, const s
   for (std::size_t i = 0; i < monitor.obstacleCount(); ++i) {
     const auto pose = monitor.obstaclePose(i);
     if (!pose) continue;  // a tf-attached obstacle not placed yet
-    array.markers.push_back(obstacleMarker(monitor.obstacle(i), static_cast<int>(i), pose->shape,
-                                           frame, stamp, params));
+    appendObstacleMarkers(monitor.obstacle(i), static_cast<int>(i), *pose, frame, stamp, params,
+                          array);
   }
 }
 

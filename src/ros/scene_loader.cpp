@@ -1,5 +1,7 @@
 #include "collision_response/ros/scene_loader.h"
 
+#include <Eigen/Geometry>
+#include <cmath>
 #include <optional>
 #include <utility>
 
@@ -150,6 +152,68 @@ const KeyTable<ObstacleSpec>& sphereKeys() {
   return kKeys;
 }
 
+/// `orientation: [x, y, z, w]`: a quaternion, not zero, normalised.
+core::Status readOrientation(const XmlRpc::XmlRpcValue& value, const std::string& field,
+                             ObstacleSpec& obstacle) {
+  if (value.getType() != XmlRpc::XmlRpcValue::TypeArray || value.size() != 4) {
+    return core::Error{field, "must be a list of four numbers [x, y, z, w] (a quaternion)"};
+  }
+  double q[4];
+  for (int i = 0; i < 4; ++i) {
+    const auto component = readDouble(value[i], indexKey(field, static_cast<std::size_t>(i)));
+    if (!component) return component.error();
+    if (!std::isfinite(*component)) {
+      return core::Error{indexKey(field, static_cast<std::size_t>(i)), "must be finite"};
+    }
+    q[i] = *component;
+  }
+  const Eigen::Quaterniond quaternion(q[3], q[0], q[1], q[2]);
+  if (!(quaternion.norm() > 1e-6)) {
+    return core::Error{field, "must not be zero (a rotation's quaternion has length 1)"};
+  }
+  obstacle.orientation = quaternion.normalized();
+  return core::Ok{};
+}
+
+/// `rpy: [roll, pitch, yaw]` (rad, about the fixed x, y, z in that order, as URDF's).
+core::Status readRollPitchYaw(const XmlRpc::XmlRpcValue& value, const std::string& field,
+                              ObstacleSpec& obstacle) {
+  const auto angles = readVector3(value, field);
+  if (!angles) return angles.error();
+  if (auto status = core::checkFinite(*angles, field); !status) return status;
+  obstacle.orientation = Eigen::AngleAxisd(angles->z(), Eigen::Vector3d::UnitZ()) *
+                         Eigen::AngleAxisd(angles->y(), Eigen::Vector3d::UnitY()) *
+                         Eigen::AngleAxisd(angles->x(), Eigen::Vector3d::UnitX());
+  return core::Ok{};
+}
+
+/// The keys of a finite shape: where its centre is, how it is turned, and `size_keys`.
+KeyTable<ObstacleSpec> finiteShapeKeys(const KeyTable<ObstacleSpec>& size_keys) {
+  KeyTable<ObstacleSpec> keys = commonObstacleKeys();
+  keys.push_back(vectorKey<ObstacleSpec>(
+      "position", [](ObstacleSpec& o) -> Eigen::Vector3d& { return o.position; }));
+  keys.push_back({"orientation", false, readOrientation});
+  keys.push_back({"rpy", false, readRollPitchYaw});
+  keys.insert(keys.end(), size_keys.begin(), size_keys.end());
+  return keys;
+}
+
+const KeyTable<ObstacleSpec>& boxKeys() {
+  static const KeyTable<ObstacleSpec> kKeys = finiteShapeKeys({vectorKey<ObstacleSpec>(
+      "size", [](ObstacleSpec& o) -> Eigen::Vector3d& { return o.size; }, true)});
+  return kKeys;
+}
+
+/// A cylinder's and a capsule's: radius and length (along the shape's z).
+const KeyTable<ObstacleSpec>& roundShapeKeys() {
+  static const KeyTable<ObstacleSpec> kKeys = finiteShapeKeys(
+      {numberKey<ObstacleSpec>(
+           "radius", [](ObstacleSpec& o) -> double& { return o.radius; }, nullptr, true),
+       numberKey<ObstacleSpec>(
+           "length", [](ObstacleSpec& o) -> double& { return o.length; }, nullptr, true)});
+  return kKeys;
+}
+
 core::Status readObstacle(const XmlRpc::XmlRpcValue& entry, const std::string& field,
                           ObstacleSpec& obstacle) {
   if (auto status = checkStruct(entry, field); !status) return status;
@@ -164,8 +228,18 @@ core::Status readObstacle(const XmlRpc::XmlRpcValue& entry, const std::string& f
     obstacle.shape = core::ObstacleShape::kSphere;
     return readKeys(entry, sphereKeys(), field, obstacle);
   }
-  return core::Error{joinKey(field, "type"),
-                     "unknown obstacle type '" + *type + "'; known: plane, sphere"};
+  if (*type == "box" || *type == "cylinder" || *type == "capsule") {
+    if (entry.hasMember("orientation") && entry.hasMember("rpy")) {
+      return core::Error{joinKey(field, "rpy"),
+                         "give the orientation as `orientation` or as `rpy`, not both"};
+    }
+    obstacle.shape = *type == "box"        ? core::ObstacleShape::kBox
+                     : *type == "cylinder" ? core::ObstacleShape::kCylinder
+                                           : core::ObstacleShape::kCapsule;
+    return readKeys(entry, *type == "box" ? boxKeys() : roundShapeKeys(), field, obstacle);
+  }
+  return core::Error{joinKey(field, "type"), "unknown obstacle type '" + *type +
+                                                 "'; known: plane, sphere, box, cylinder, capsule"};
 }
 
 /// A list whose every entry is read by `read_entry` into a new element of `list`.
@@ -293,6 +367,8 @@ std::map<std::string, std::vector<std::string>> sceneKeys() {
           {"bodies[]", keyNames(bodyKeys())},
           {"obstacles[] plane", keyNames(planeKeys())},
           {"obstacles[] sphere", keyNames(sphereKeys())},
+          {"obstacles[] box", keyNames(boxKeys())},
+          {"obstacles[] cylinder, capsule", keyNames(roundShapeKeys())},
           {"materials.<name>", keyNames(materialKeys())},
           {"pairs[]", keyNames(pairKeys())}};
 }

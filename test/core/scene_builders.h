@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <string>
 
 #include "collision_response/core/scene.h"
@@ -40,6 +41,20 @@ inline ObstacleSpec sphere(const std::string& id, const Eigen::Vector3d& centre,
   obstacle.shape = ObstacleShape::kSphere;
   obstacle.position = centre;
   obstacle.radius = radius;
+  obstacle.material = material;
+  return obstacle;
+}
+
+/// A box of edge lengths `size` centred at `centre`, turned by `orientation`.
+inline ObstacleSpec box(const std::string& id, const Eigen::Vector3d& centre,
+                        const Eigen::Vector3d& size, const std::string& material,
+                        const Eigen::Quaterniond& orientation = Eigen::Quaterniond::Identity()) {
+  ObstacleSpec obstacle;
+  obstacle.id = id;
+  obstacle.shape = ObstacleShape::kBox;
+  obstacle.position = centre;
+  obstacle.size = size;
+  obstacle.orientation = orientation;
   obstacle.material = material;
   return obstacle;
 }

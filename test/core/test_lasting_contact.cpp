@@ -755,6 +755,69 @@ TEST(LastingContact, RollsOffASphereAtTenSeventeenths) {
   EXPECT_LT(deepest, 1e-9 * d);
 }
 
+/// How far a ball's centre is inside the box grown by the ball (> 0: inside), by the box's own
+/// distance formula: |max(|p| - h, 0)| outside, minus the depth inside.
+double depthInBox(const V& centre, double radius, const V& half) {
+  const V outside = (centre.cwiseAbs() - half).cwiseMax(0.0);
+  const double inside = std::min(0.0, (centre.cwiseAbs() - half).maxCoeff());
+  return radius - outside.norm() - inside;
+}
+
+// A ball resting on a box's top face stays where it is, to the bit: at rest the balance is
+// exact, and nothing is integrated.
+TEST(LastingContact, RestsOnABoxFace) {
+  const double r = 0.1;
+  Scene scene = gravityScene(true, true);
+  addMaterial(scene, "wood", 0.5, 0.4);
+  scene.bodies = {ball("ball", 0.1, r, "wood")};
+  scene.obstacles = {scene_builders::box("table", V::Zero(), V(1, 1, 1), "wood")};
+  ImpactMonitor monitor(scene, longLived());
+  const V at(0.2, -0.3, 0.5 + r);
+  bool touching = true;
+  run(monitor, {state(monitor, "ball", at)}, 100, 1.0, [&](double, const StepReport& report) {
+    touching = touching && report.contacts.size() == 1 &&
+               report.contacts[0].state == ContactState::kResting;
+  });
+  EXPECT_TRUE(touching);
+  EXPECT_EQ(monitor.predictedState(0, 1.0)->first, at);
+  EXPECT_EQ(monitor.predictedState(0, 1.0)->second, V::Zero());
+}
+
+// A ball sliding (frictionless) along a box's top face towards its edge at v0 < sqrt(g r) pivots
+// about the edge, its centre on a circle of radius r: v^2 = v0^2 + 2 g r (1 - cos t), and the
+// edge lets go where g cos t = v^2 / r, cos t = (2 + v0^2 / (g r)) / 3 (the ball off a sphere
+// with R = 0). It flies on with the horizontal velocity sqrt(g r) cos^(3/2) t, never inside the
+// box; rolling (friction, spin, a solid ball), (7/10) v^2 = (7/10) v0^2 + g r (1 - cos t) and
+// cos t = (10 + 7 v0^2 / (g r)) / 17. It reaches the edge at 0.25 s and has left it by 0.5 s.
+void offABoxEdge(bool rolling) {
+  const double r = 0.1, v0 = 0.2;
+  Scene scene = gravityScene(rolling, rolling);
+  addMaterial(scene, "ice", 0.5, rolling ? 1e6 : 0.0);
+  scene.bodies = {ball("ball", 0.1, r, "ice")};
+  const V half(0.5, 0.5, 0.5);
+  scene.obstacles = {scene_builders::box("table", V::Zero(), 2 * half, "ice")};
+  ImpactMonitor monitor(scene, longLived());
+  double deepest = -1;
+  bool rolled = false;
+  run(monitor,
+      {state(monitor, "ball", V(0.45, 0, 0.5 + r), V(v0, 0, 0), V(0, rolling ? v0 / r : 0, 0))},
+      100, 1.0, [&](double t, const StepReport& report) {
+        deepest = std::max(deepest, depthInBox(monitor.predictedState(0, t)->first, r, half));
+        if (!report.contacts.empty() && report.contacts[0].state == ContactState::kRolling) {
+          rolled = true;
+        }
+      });
+  EXPECT_EQ(rolled, rolling);
+  const double g_r = kG * r;
+  const double leaves = rolling ? (10 + 7 * v0 * v0 / g_r) / 17 : (2 + v0 * v0 / g_r) / 3;
+  const double horizontal = std::sqrt(g_r) * std::pow(leaves, 1.5);
+  EXPECT_NEAR(monitor.predictedState(0, 1.0)->second.x(), horizontal, 1e-6 * horizontal);
+  EXPECT_LT(deepest, 1e-9 * r);
+}
+
+TEST(LastingContact, SlidesOffABoxEdgeAtTheClosedForm) { offABoxEdge(false); }
+TEST(LastingContact, RollsOffABoxEdgeAtTheClosedForm) { offABoxEdge(true); }
+
 // Balls dropped from a loose lattice (0.12 m apart, offsets up to 5 mm) into a box, e = 0.5,
 // settling for `duration` (frictionless, or with friction `mu` and spin): they bounce on the
 // floor, on each other and on balls that rest on others (curved lasting contact). Nothing may

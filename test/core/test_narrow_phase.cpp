@@ -84,12 +84,12 @@ TEST(NarrowPhase, FirstContactIsTheClosedForms) {
   ball.radius = 0.5;
   ball.velocity = V(1, 0, -3);
   ball.acceleration = V(0, 0, -9.81);
-  const Plane floor{V::UnitZ(), 0.0};
+  const PlacedShape floor = atRest(Plane{V::UnitZ(), 0.0}, V::Zero());
   EXPECT_EQ(firstContact(ball, floor, V::Zero(), V::Zero(), false, 10.0),
             timeOfImpactPlane(1.5, -3.0, 10.0));
   EXPECT_EQ(firstContact(ball, floor, V::Zero(), V::Zero(), true, 10.0),
             timeOfImpactPlaneBallistic(1.5, -3.0, -9.81, 10.0));
-  const Sphere post{V(2, 0, 0), 0.5};
+  const PlacedShape post = atRest(Sphere{V(2, 0, 0), 0.5}, V(2, 0, 0));
   EXPECT_EQ(firstContact(ball, post, V::Zero(), V::Zero(), false, 10.0),
             timeOfImpactSpheres<double>(V(2, 0, -2), V(-1, 0, 3), 1.0, 10.0));
   EXPECT_EQ(firstContact(ball, post, V::Zero(), V::Zero(), true, 10.0),

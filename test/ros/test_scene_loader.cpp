@@ -224,8 +224,58 @@ TEST(SceneLoader, SceneErrorsNameTheKey) {
   EXPECT_EQ(sceneErrorField(scene), "~scene/bodies[0]/colour");
 
   scene = fullScene();
-  scene["obstacles"][0]["type"] = "cylinder";
+  scene["obstacles"][0]["type"] = "torus";
   EXPECT_EQ(sceneErrorField(scene), "~scene/obstacles[0]/type");
+
+  // A box, cylinder or capsule: its sizes, its orientation given once and not zero.
+  const auto finite = [](const std::string& type) {
+    XmlRpc::XmlRpcValue with = fullScene(), shape;
+    shape["id"] = "table";
+    shape["type"] = type;
+    shape["material"] = "concrete";
+    if (type == "box") {
+      for (int i = 0; i < 3; ++i) shape["size"][i] = 0.5;
+    } else {
+      shape["radius"] = 0.1;
+      shape["length"] = 0.4;
+    }
+    with["obstacles"][2] = shape;
+    return with;
+  };
+  EXPECT_EQ(sceneErrorField(finite("box")), "");  // the base loads
+  scene = finite("box");
+  scene["obstacles"][2]["size"][1] = 0.0;  // a box of zero size has no inside
+  EXPECT_EQ(sceneErrorField(scene), "~scene/obstacles[2]/size");
+  scene = finite("box");
+  scene["obstacles"][2]["size"] = 0.5;  // not a list
+  EXPECT_EQ(sceneErrorField(scene), "~scene/obstacles[2]/size");
+  for (const std::string type : {"cylinder", "capsule"}) {
+    scene = finite(type);
+    scene["obstacles"][2]["radius"] = -0.1;
+    EXPECT_EQ(sceneErrorField(scene), "~scene/obstacles[2]/radius") << type;
+    scene = finite(type);
+    scene["obstacles"][2]["length"] = -1.0;
+    EXPECT_EQ(sceneErrorField(scene), "~scene/obstacles[2]/length") << type;
+  }
+  scene = finite("cylinder");
+  scene["obstacles"][2]["length"] = 0.0;  // a cylinder of no length has no inside
+  EXPECT_EQ(sceneErrorField(scene), "~scene/obstacles[2]/length");
+  scene = finite("capsule");
+  scene["obstacles"][2]["length"] = 0.0;  // a capsule of no length is a sphere
+  EXPECT_EQ(sceneErrorField(scene), "");
+  scene = finite("box");
+  for (int i = 0; i < 4; ++i) scene["obstacles"][2]["orientation"][i] = 0.0;
+  EXPECT_EQ(sceneErrorField(scene), "~scene/obstacles[2]/orientation");
+  scene = finite("box");
+  for (int i = 0; i < 3; ++i) scene["obstacles"][2]["orientation"][i] = 1.0;
+  EXPECT_EQ(sceneErrorField(scene), "~scene/obstacles[2]/orientation");  // three numbers
+  scene = finite("box");
+  for (int i = 0; i < 4; ++i) scene["obstacles"][2]["orientation"][i] = i == 3 ? 1.0 : 0.0;
+  for (int i = 0; i < 3; ++i) scene["obstacles"][2]["rpy"][i] = 0.0;
+  EXPECT_EQ(sceneErrorField(scene), "~scene/obstacles[2]/rpy");  // given twice
+  scene = finite("box");
+  scene["obstacles"][2]["normal"] = 1.0;  // a plane's key
+  EXPECT_EQ(sceneErrorField(scene), "~scene/obstacles[2]/normal");
 
   scene = fullScene();
   scene["obstacles"][0]["normal"][2] = 0.0;
@@ -368,6 +418,26 @@ std::map<std::string, std::map<std::string, XmlRpc::XmlRpcValue>> examples() {
   values["obstacles[] sphere"] = {{"id", "post"},           {"type", "sphere"},
                                   {"material", "concrete"}, {"frame", "post_link"},
                                   {"radius", 0.1},          {"position", list3(1, 1, 1)}};
+  XmlRpc::XmlRpcValue quaternion;
+  quaternion[0] = 0.0;
+  quaternion[1] = 0.0;
+  quaternion[2] = 0.0;
+  quaternion[3] = 2.0;  // normalised on load
+  values["obstacles[] box"] = {{"id", "table"},
+                               {"type", "box"},
+                               {"material", "concrete"},
+                               {"frame", "table_link"},
+                               {"position", list3(0, 0, 0.4)},
+                               {"orientation", quaternion},
+                               {"size", list3(1.5, 0.8, 0.05)}};
+  values["obstacles[] cylinder, capsule"] = {{"id", "paddle"},
+                                             {"type", "cylinder"},
+                                             {"material", "rubber"},
+                                             {"frame", "paddle_link"},
+                                             {"position", list3(0, 0, 0.1)},
+                                             {"rpy", list3(M_PI / 2, 0, 0)},
+                                             {"radius", 0.08},
+                                             {"length", 0.01}};
   values["player.frames[]"] = {{"frame", "paddle_link"},
                                {"parent", "world"},
                                {"position", list3(1, 0, 0)},
@@ -387,13 +457,16 @@ TEST(SceneKeys, EveryDocumentedKeyIsReadAndEveryReadKeyDocumented) {
     ASSERT_FALSE(row.empty()) << "a row of the scene key table names no key";
     auto [entity, key] = entityAndKey(row.front());
     if (entity == "obstacles[]") {
-      const auto& plane = read.at("obstacles[] plane");
-      const auto& sphere = read.at("obstacles[] sphere");
-      const bool in_plane = std::find(plane.begin(), plane.end(), key) != plane.end();
-      const bool in_sphere = std::find(sphere.begin(), sphere.end(), key) != sphere.end();
-      EXPECT_TRUE(in_plane || in_sphere) << row.front() << " is documented but not read";
-      if (in_plane) documented.emplace("obstacles[] plane", key);
-      if (in_sphere) documented.emplace("obstacles[] sphere", key);
+      // One row for a key of every obstacle type that has it.
+      bool in_any = false;
+      for (const auto& [table, keys] : read) {
+        if (table.rfind("obstacles[] ", 0) != 0) continue;
+        if (std::find(keys.begin(), keys.end(), key) != keys.end()) {
+          documented.emplace(table, key);
+          in_any = true;
+        }
+      }
+      EXPECT_TRUE(in_any) << row.front() << " is documented but not read";
       continue;
     }
     documented.emplace(entity, key);
@@ -416,7 +489,8 @@ TEST(SceneKeys, EveryDocumentedKeyLoadsWithItsValue) {
   ASSERT_FALSE(tables.empty());
   const auto values = examples();
   const auto read = sceneKeys();
-  XmlRpc::XmlRpcValue scene, body, plane, sphere, material, pair, frame;
+  XmlRpc::XmlRpcValue scene, body, material, pair, frame;
+  std::map<std::string, XmlRpc::XmlRpcValue> obstacles;  // by the loader's table
   const auto put = [&](XmlRpc::XmlRpcValue& target, const std::string& entity,
                        const std::string& key) {
     const auto found = values.find(entity);
@@ -433,21 +507,28 @@ TEST(SceneKeys, EveryDocumentedKeyLoadsWithItsValue) {
     if (entity == "pairs[]") put(pair, entity, key);
     if (entity == "player.frames[]") put(frame, entity, key);
     if (entity == "obstacles[]") {
-      const auto& plane_keys = read.at("obstacles[] plane");
-      if (std::find(plane_keys.begin(), plane_keys.end(), key) != plane_keys.end()) {
-        put(plane, "obstacles[] plane", key);
-      }
-      const auto& sphere_keys = read.at("obstacles[] sphere");
-      if (std::find(sphere_keys.begin(), sphere_keys.end(), key) != sphere_keys.end()) {
-        put(sphere, "obstacles[] sphere", key);
+      for (const auto& [table, keys] : read) {
+        if (table.rfind("obstacles[] ", 0) != 0) continue;
+        if (std::find(keys.begin(), keys.end(), key) == keys.end()) continue;
+        // An orientation is given one way or the other: the box's as a quaternion, the
+        // cylinder's as roll, pitch and yaw.
+        if ((table == "obstacles[] box" && key == "rpy") ||
+            (table == "obstacles[] cylinder, capsule" && key == "orientation")) {
+          continue;
+        }
+        put(obstacles[table], table, key);
       }
     }
   }
+  const XmlRpc::XmlRpcValue& plane = obstacles["obstacles[] plane"];
+  const XmlRpc::XmlRpcValue& sphere = obstacles["obstacles[] sphere"];
   scene["materials"]["rubber"] = material;
   scene["pairs"][0] = pair;
   scene["bodies"][0] = body;
   scene["obstacles"][0] = plane;
   scene["obstacles"][1] = sphere;
+  scene["obstacles"][2] = obstacles["obstacles[] box"];
+  scene["obstacles"][3] = obstacles["obstacles[] cylinder, capsule"];
   const auto loaded = loadScene(scene, "~scene");
   ASSERT_TRUE(loaded.ok()) << "a documented key is refused: " << loaded.error().message();
   // Each value arrived where it belongs.
@@ -475,13 +556,25 @@ TEST(SceneKeys, EveryDocumentedKeyLoadsWithItsValue) {
   EXPECT_EQ(ball.velocity, Eigen::Vector3d(4, 5, 6));
   EXPECT_EQ(ball.angular_velocity, Eigen::Vector3d(7, 8, 9));
   EXPECT_EQ(ball.inertia, core::Inertia::kHollow);  // once refused as an unknown key
-  ASSERT_EQ(loaded->obstacles.size(), 2u);
+  ASSERT_EQ(loaded->obstacles.size(), 4u);
   EXPECT_EQ(loaded->obstacles[0].frame, "floor_link");
   EXPECT_EQ(loaded->obstacles[0].normal, Eigen::Vector3d(0, 0, 1));  // scaled to unit length
   EXPECT_EQ(loaded->obstacles[0].offset, 0.5);
   EXPECT_EQ(loaded->obstacles[1].shape, core::ObstacleShape::kSphere);
   EXPECT_EQ(loaded->obstacles[1].radius, 0.1);
   EXPECT_EQ(loaded->obstacles[1].position, Eigen::Vector3d(1, 1, 1));
+  const core::ObstacleSpec& table = loaded->obstacles[2];
+  EXPECT_EQ(table.shape, core::ObstacleShape::kBox);
+  EXPECT_EQ(table.size, Eigen::Vector3d(1.5, 0.8, 0.05));
+  EXPECT_EQ(table.position, Eigen::Vector3d(0, 0, 0.4));
+  EXPECT_EQ(table.orientation.coeffs(), Eigen::Vector4d(0, 0, 0, 1));  // [x, y, z, w], unit
+  const core::ObstacleSpec& paddle = loaded->obstacles[3];
+  EXPECT_EQ(paddle.shape, core::ObstacleShape::kCylinder);
+  EXPECT_EQ(paddle.radius, 0.08);
+  EXPECT_EQ(paddle.length, 0.01);
+  // Roll pi/2 about x: the paddle's axis z lies along -y.
+  EXPECT_NEAR((paddle.orientation * Eigen::Vector3d::UnitZ() - Eigen::Vector3d(0, -1, 0)).norm(), 0,
+              1e-15);
 
   // The scene player's part of the file.
   XmlRpc::XmlRpcValue tree;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <string>
 #include <vector>
 
@@ -45,11 +46,12 @@ struct BodySpec {
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
 };
 
-enum class ObstacleShape { kPlane, kSphere };
+enum class ObstacleShape { kPlane, kSphere, kBox, kCylinder, kCapsule };
 
 /// An immovable obstacle: a plane {x : normal.x = offset} whose free side is the one `normal`
-/// points to, or a sphere. Given in `frame` (empty: the fixed frame); a frame that moves makes a
-/// moving obstacle.
+/// points to, a sphere, or a box, cylinder or capsule centred at `position` and turned by
+/// `orientation` (a cylinder's and a capsule's axis its z). Given in `frame` (empty: the fixed
+/// frame); a frame that moves makes a moving obstacle.
 struct ObstacleSpec {
   std::string id;
   ObstacleShape shape = ObstacleShape::kPlane;
@@ -57,8 +59,12 @@ struct ObstacleSpec {
   std::string frame;     ///< tf frame the geometry is given in; empty: the fixed frame
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();   ///< plane: unit (normalised on load)
   double offset = 0.0;                                 ///< plane: m, normal.x = offset
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< sphere: centre, m
-  double radius = 0.0;                                 ///< sphere: m
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< sphere, box, ...: centre, m
+  double radius = 0.0;                                 ///< sphere, cylinder, capsule: m
+  Eigen::Vector3d size = Eigen::Vector3d::Zero();      ///< box: edge lengths, m
+  double length = 0.0;  ///< cylinder: between the caps; capsule: of its segment (m)
+  /// box, cylinder, capsule: from the frame's axes to the shape's
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
 };
 
 struct Scene {

@@ -22,7 +22,27 @@ struct Sphere {
   double radius = 0.0;
 };
 
-using Shape = std::variant<Plane, Sphere>;
+/// A box (scene type `box`) about its pose's origin, its edges along the pose's axes.
+struct Cuboid {
+  Eigen::Vector3d half_size = Eigen::Vector3d::Zero();  ///< m, half the lengths of its edges
+};
+
+/// A solid cylinder about its pose's origin, its axis the pose's z.
+struct Cylinder {
+  double radius = 0.0;       ///< m
+  double half_length = 0.0;  ///< m, from the origin to each cap
+};
+
+/// A capsule: the points within `radius` of the segment along the pose's z from -half_length to
+/// half_length.
+struct Capsule {
+  double radius = 0.0;       ///< m
+  double half_length = 0.0;  ///< m, of the segment (the capsule is 2 (half_length + radius) long)
+};
+
+/// Planes and spheres are given in the fixed frame; the finite shapes (Cuboid, Cylinder, Capsule)
+/// in their pose's frame (PlacedShape::pose).
+using Shape = std::variant<Plane, Sphere, Cuboid, Cylinder, Capsule>;
 
 /// A rigid motion at one instant: the pose (fixed <- moving) at `time`, the velocity of the
 /// pose's origin and the angular velocity, both in the fixed frame.
@@ -40,7 +60,8 @@ struct RigidPose {
 
 /// An obstacle where it is: its shape in the fixed frame at `pose.time`, and the motion it has
 /// from there (straight on: the monitor moves obstacles in straight lines between placements).
-/// The pose's origin is the shape's reference point (a sphere's centre, a point of a plane).
+/// The pose's origin is the shape's reference point (a sphere's centre, a point of a plane, a
+/// finite shape's centre, its axes the pose's).
 struct PlacedShape {
   Shape shape;
   RigidPose pose;

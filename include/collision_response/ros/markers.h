@@ -31,6 +31,7 @@ struct MarkerParams {
 /// contact's is its index in the `contacts` array drawn.
 inline constexpr const char* kBodiesNamespace = "bodies";
 inline constexpr const char* kObstaclesNamespace = "obstacles";
+inline constexpr const char* kObstacleEndsNamespace = "obstacle_ends";
 inline constexpr const char* kImpactsNamespace = "impacts";
 inline constexpr const char* kContactsNamespace = "contacts";
 inline constexpr const char* kLastingContactsNamespace = "lasting_contacts";
@@ -46,11 +47,14 @@ visualization_msgs::Marker bodyMarker(const core::BodySpec& body, int index,
                                       const std::optional<Eigen::Vector3d>& position,
                                       const std::string& frame, const ros::Time& stamp);
 
-/// An obstacle's `shape` (in `frame`): a sphere, or a plane as a thin square of side
-/// `plane_size` centred on the plane's point nearest the origin with its normal.
-visualization_msgs::Marker obstacleMarker(const core::ObstacleSpec& obstacle, int index,
-                                          const core::Shape& shape, const std::string& frame,
-                                          const ros::Time& stamp, const MarkerParams& params);
+/// An obstacle where `placed` puts it (in `frame`), with id `index`: a sphere; a plane as a thin
+/// square of side `plane_size` centred on the plane's point nearest the origin with its normal;
+/// a box as a cube, a cylinder as a cylinder, both turned with the obstacle; a capsule as a
+/// cylinder (its segment) and its two ends as a sphere list in `kObstacleEndsNamespace`.
+void appendObstacleMarkers(const core::ObstacleSpec& obstacle, int index,
+                           const core::PlacedShape& placed, const std::string& frame,
+                           const ros::Time& stamp, const MarkerParams& params,
+                           visualization_msgs::MarkerArray& array);
 
 /// An impact: an arrow from the contact point along the normal (towards body_b, the direction
 /// of the impulse on body_b), impulse_scale m per N s long, and a sphere at the contact point;

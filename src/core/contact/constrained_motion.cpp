@@ -5,6 +5,8 @@
 #include <boost/numeric/odeint.hpp>
 #include <cmath>
 
+#include "geometry/narrow_phase.h"
+
 namespace collision_response::core::monitor {
 namespace {
 
@@ -123,6 +125,14 @@ ContactForceSolution ConstrainedStep::forces(const State& state, double time) co
     contact.slide_direction = c.slide_direction;
     if (c.plane) {
       contact.normal = -c.plane_normal;
+    } else if (c.shape) {
+      const ContactGeometry g =
+          contactGeometry(positions[c.a], bodies[c.a].radius, shapeAt(*c.shape, time), 0.0,
+                          [] { return Eigen::Vector3d(Eigen::Vector3d::Zero()); });
+      contact.normal = g.normal;
+      contact.curvature = g.curvature;
+      contact.turning_axis = g.turning_axis;
+      contact.axial_share = g.axial_share;
     } else {
       const Eigen::Vector3d centres = positions[c.b] - positions[c.a];
       const double distance = centres.norm();

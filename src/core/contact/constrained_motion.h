@@ -9,6 +9,7 @@
 #include <memory>
 #include <vector>
 
+#include "collision_response/core/shape.h"
 #include "contact/contact_forces.h"
 
 namespace collision_response::core::monitor {
@@ -21,6 +22,10 @@ struct ConstrainedContact {
   std::size_t b = 0;
   bool plane = false;
   Eigen::Vector3d plane_normal = Eigen::Vector3d::UnitZ();
+  /// Against a finite shape (a box, cylinder or capsule; b): the shape where it is placed, moving
+  /// straight on; the normal is to its nearest feature (narrow_phase.h), whichever that is as
+  /// the ball moves from a face over an edge.
+  std::shared_ptr<const PlacedShape> shape;
   double friction = 0.0;
   ContactMode mode = ContactMode::kSticking;  ///< held over the step
   /// Sliding: the direction of the slip it starts with (ContactForce::slide_direction).

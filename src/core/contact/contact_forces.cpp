@@ -65,9 +65,18 @@ class Group {
       const V3 slip_full = relative - turning.cross(normal);
       slip_.push_back(slip_full - slip_full.dot(normal) * normal);
       const Real curvature = contact.curvature;
-      centripetal_.push_back(curvature * across.squaredNorm());
-      // The normal turns at n' = v_perp / d: the slip changes by -(r_a w_a + r_b w_b) x n'.
-      turning_term_.push_back(-turning.cross(curvature * across));
+      if (contact.turning_axis.isZero()) {
+        centripetal_.push_back(curvature * across.squaredNorm());
+        // The normal turns at n' = v_perp / d: the slip changes by -(r_a w_a + r_b w_b) x n'.
+        turning_term_.push_back(-turning.cross(curvature * across));
+      } else {
+        // Along the turning axis at its share of the rate: n' = (v_perp - (1 - share)(a.v) a) / d.
+        const V3 axis = widen(contact.turning_axis);
+        const V3 turn =
+            curvature * (across - (1 - Real(contact.axial_share)) * axis.dot(across) * axis);
+        centripetal_.push_back(across.dot(turn));
+        turning_term_.push_back(-turning.cross(turn));
+      }
     }
     incident_.resize(bodies_.size());
     for (std::size_t k = 0; k < contacts_.size(); ++k) {

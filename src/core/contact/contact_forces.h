@@ -30,8 +30,14 @@ struct ForceContact {
   std::size_t b = 0;
   Eigen::Vector3d normal = Eigen::Vector3d::UnitX();  ///< unit, from a towards b
   /// 1 / (distance between the centres) for two spheres, whose line of centres turns as they
-  /// move; 0 against a plane.
+  /// move; 0 against a plane; against a finite shape, 1 / (the centre's distance from the
+  /// feature's core: an edge's line, a corner, a rim's circle; narrow_phase.h).
   double curvature = 0.0;
+  /// Where the normal turns only across a direction (an edge, a cylinder's side, a rim): that
+  /// direction (unit), along which it turns at `axial_share` of `curvature` (0 along a line);
+  /// zero: it turns alike every way.
+  Eigen::Vector3d turning_axis = Eigen::Vector3d::Zero();
+  double axial_share = 1.0;
   double friction = 0.0;  ///< Coulomb mu; 0 frictionless (or no friction effect)
   /// For solveContactForcesWithModes: the direction a sliding contact slips in while its slip
   /// is below the slip tolerance (it starts to slide: the direction its mode was chosen with).

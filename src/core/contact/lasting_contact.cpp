@@ -132,6 +132,8 @@ std::vector<ForceContact> forceContactsOf(const World& world, const Candidates& 
     contact.b = participants.slot(pair.second);
     contact.normal = g.normal;
     contact.curvature = g.curvature;
+    contact.turning_axis = g.turning_axis;
+    contact.axial_share = g.axial_share;
     if (world.friction_model && !frictionless) contact.friction = world.frictionOf(pair);
     contacts.push_back(contact);
   }
@@ -194,12 +196,14 @@ void solveGroupForces(const World& world, const std::vector<double>& gaps, Group
 
 /// Whether the pressed contact `k` curves the group's motion: two spheres whose line of centres
 /// turns (they move or accelerate relative to each other), or a sliding contact whose slip turns.
-bool curvesMotion(const World& world, const GroupSolve& solve, std::size_t k) {
+bool curvesMotion(const World& world, const GroupSolve& solve, std::size_t k, bool bounded) {
   const double speed_tolerance = lastingContactSettings(world).slip_tolerance;
   const double acceleration_tolerance = 1e-12 * world.gravity.norm();
   const ContactForce& force = solve.solution.contacts[k];
   const ForceContact& c = solve.contacts[k];
-  if (c.curvature > 0) {
+  // A finite shape's face (bounded) ends where the ball reaches an edge: a ball that moves on
+  // it is followed step by step too, from one feature to the next.
+  if (c.curvature > 0 || bounded) {
     const Eigen::Vector3d relative_velocity =
         solve.bodies[c.b].velocity - solve.bodies[c.a].velocity;
     const Eigen::Vector3d relative_acceleration =
@@ -234,7 +238,7 @@ Pressed pressedContacts(const World& world, const std::vector<std::size_t>& bodi
   for (std::size_t k = 0; k < candidates.size(); ++k) {
     if (solve.solution.contacts[k].mode == ContactMode::kSeparating) continue;
     pressed.contacts.push_back(k);
-    if (curvesMotion(world, solve, k)) pressed.curved = true;
+    if (curvesMotion(world, solve, k, candidates[k].second.bounded)) pressed.curved = true;
     const Pair& pair = candidates[k].first;
     for (const std::size_t p : {pair.first, pair.second}) {
       if (world.inverseMassOf(p) > 0) pressed.bodies[solve.participants.slot(p)] = 1;
@@ -276,8 +280,12 @@ IntegratedMotion integrateGroup(const World& world, double time, const Candidate
     ConstrainedContact c;
     c.a = motion.slot[solve.contacts[k].a];
     c.b = motion.slot[solve.contacts[k].b];
-    c.plane = candidates[k].second.flat();
-    if (c.plane) c.plane_normal = -candidates[k].second.normal;
+    const Geometry& g = candidates[k].second;
+    c.plane = g.flat() && !g.bounded;
+    if (c.plane) c.plane_normal = -g.normal;
+    if (g.bounded) {
+      c.shape = std::make_shared<const PlacedShape>(world.placedShape(candidates[k].first.second));
+    }
     c.friction = solve.contacts[k].friction;
     c.mode = solve.solution.contacts[k].mode;
     c.slide_direction = solve.solution.contacts[k].slide_direction;

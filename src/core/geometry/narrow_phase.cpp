@@ -2,6 +2,7 @@
 
 #include "collision_response/core/time_of_impact.h"
 #include "collision_response/core/validation.h"
+#include "geometry/finite_shapes.h"
 
 namespace collision_response::core {
 
@@ -35,6 +36,15 @@ Eigen::Vector3d pointVelocity(const RigidPose& frame, const Eigen::Vector3d& in_
          frame.angular_velocity.cross(offset);
 }
 
+/// A finite shape's length or radius: finite and > 0 (a zero one has no inside).
+Status positiveLength(double value, const std::string& field) {
+  if (!std::isfinite(value) || !(value > 0)) {
+    return Error{field, "must be a finite number > 0 m (a shape of zero size has no inside), got " +
+                            formatNumber(value)};
+  }
+  return Ok{};
+}
+
 }  // namespace
 
 Shape shapeOf(const ObstacleSpec& spec) {
@@ -43,6 +53,12 @@ Shape shapeOf(const ObstacleSpec& spec) {
       return Plane{spec.normal, spec.offset};
     case ObstacleShape::kSphere:
       return Sphere{spec.position, spec.radius};
+    case ObstacleShape::kBox:
+      return Cuboid{0.5 * spec.size};
+    case ObstacleShape::kCylinder:
+      return Cylinder{spec.radius, 0.5 * spec.length};
+    case ObstacleShape::kCapsule:
+      return Capsule{spec.radius, 0.5 * spec.length};
   }
   return Plane{};
 }
@@ -57,6 +73,20 @@ void setShape(ObstacleSpec& spec, const Shape& shape) {
                         spec.shape = ObstacleShape::kSphere;
                         spec.position = sphere.centre;
                         spec.radius = sphere.radius;
+                      },
+                      [&](const Cuboid& box) {
+                        spec.shape = ObstacleShape::kBox;
+                        spec.size = 2 * box.half_size;
+                      },
+                      [&](const Cylinder& cylinder) {
+                        spec.shape = ObstacleShape::kCylinder;
+                        spec.radius = cylinder.radius;
+                        spec.length = 2 * cylinder.half_length;
+                      },
+                      [&](const Capsule& capsule) {
+                        spec.shape = ObstacleShape::kCapsule;
+                        spec.radius = capsule.radius;
+                        spec.length = 2 * capsule.half_length;
                       }},
              shape);
 }
@@ -77,6 +107,37 @@ Status checkShape(const Shape& shape, const std::function<std::string(const char
                    return status;
                  }
                  return checkRadius(sphere.radius, field("radius"));
+               },
+               [&](const Cuboid& box) -> Status {
+                 if (auto status = checkFinite(box.half_size, field("size")); !status) {
+                   return status;
+                 }
+                 for (int i = 0; i < 3; ++i) {
+                   if (!(box.half_size[i] > 0)) {
+                     return Error{field("size"),
+                                  "every edge length must be > 0 m (a box of zero size has no "
+                                  "inside), got " +
+                                      formatNumber(2 * box.half_size[i]) + " along " + "xyz"[i]};
+                   }
+                 }
+                 return Ok{};
+               },
+               [&](const Cylinder& cylinder) -> Status {
+                 if (auto status = positiveLength(cylinder.radius, field("radius")); !status) {
+                   return status;
+                 }
+                 return positiveLength(2 * cylinder.half_length, field("length"));
+               },
+               [&](const Capsule& capsule) -> Status {
+                 if (auto status = positiveLength(capsule.radius, field("radius")); !status) {
+                   return status;
+                 }
+                 if (!(capsule.half_length >= 0) || !std::isfinite(capsule.half_length)) {
+                   return Error{field("length"),
+                                "must be a finite number >= 0 m (0: a sphere), got " +
+                                    formatNumber(2 * capsule.half_length)};
+                 }
+                 return Ok{};
                }},
       shape);
 }
@@ -85,7 +146,7 @@ Shape normalized(const Shape& shape) {
   return std::visit(Dispatch{[](const Plane& plane) -> Shape {
                                return Plane{unitVector(plane.normal), plane.offset};
                              },
-                             [](const Sphere& sphere) -> Shape { return sphere; }},
+                             [](const auto& other) -> Shape { return other; }},
                     shape);
 }
 
@@ -95,27 +156,39 @@ PlacedShape placeFixed(const ObstacleSpec& spec) {
   placed.shape = std::visit(Dispatch{[](const Plane& plane) -> Shape {
                                        return Plane{plane.normal.normalized(), plane.offset};
                                      },
-                                     [](const Sphere& sphere) -> Shape { return sphere; }},
+                                     [](const auto& other) -> Shape { return other; }},
                             shapeOf(spec));
+  if (spec.shape != ObstacleShape::kPlane && spec.shape != ObstacleShape::kSphere) {
+    placed.pose.transform.linear() = spec.orientation.normalized().toRotationMatrix();
+  }
   return placed;
 }
 
 PlacedShape place(const ObstacleSpec& spec, const RigidPose& frame) {
   return std::visit(
-      Dispatch{[&](const Plane& plane) {
-                 // Through its point nearest the frame's origin (in the frame), turned with it.
-                 const Eigen::Vector3d unit_normal = plane.normal.stableNormalized();
-                 const Eigen::Vector3d point_in_frame = unit_normal * plane.offset;
-                 const Eigen::Vector3d normal = frame.transform.linear() * unit_normal;
-                 const Eigen::Vector3d point = frame.transform * point_in_frame;
-                 return PlacedShape{Plane{normal, normal.dot(point)},
-                                    poseAt(frame, point, pointVelocity(frame, point_in_frame))};
-               },
-               [&](const Sphere& sphere) {
-                 const Eigen::Vector3d centre = frame.transform * sphere.centre;
-                 return PlacedShape{Sphere{centre, sphere.radius},
-                                    poseAt(frame, centre, pointVelocity(frame, sphere.centre))};
-               }},
+      Dispatch{
+          [&](const Plane& plane) {
+            // Through its point nearest the frame's origin (in the frame), turned with it.
+            const Eigen::Vector3d unit_normal = plane.normal.stableNormalized();
+            const Eigen::Vector3d point_in_frame = unit_normal * plane.offset;
+            const Eigen::Vector3d normal = frame.transform.linear() * unit_normal;
+            const Eigen::Vector3d point = frame.transform * point_in_frame;
+            return PlacedShape{Plane{normal, normal.dot(point)},
+                               poseAt(frame, point, pointVelocity(frame, point_in_frame))};
+          },
+          [&](const Sphere& sphere) {
+            const Eigen::Vector3d centre = frame.transform * sphere.centre;
+            return PlacedShape{Sphere{centre, sphere.radius},
+                               poseAt(frame, centre, pointVelocity(frame, sphere.centre))};
+          },
+          [&](const auto& finite) {
+            // Its centre and axes turned with the frame.
+            const Eigen::Vector3d centre = frame.transform * spec.position;
+            PlacedShape placed{finite, poseAt(frame, centre, pointVelocity(frame, spec.position))};
+            placed.pose.transform.linear() =
+                frame.transform.linear() * spec.orientation.normalized().toRotationMatrix();
+            return placed;
+          }},
       shapeOf(spec));
 }
 
@@ -127,16 +200,27 @@ PlacedShape shapeAt(const PlacedShape& placed, double time) {
                         plane.offset +=
                             plane.normal.dot(placed.pose.velocity) * (time - placed.pose.time);
                       },
-                      [&](Sphere& sphere) { sphere.centre = moved.pose.transform.translation(); }},
+                      [&](Sphere& sphere) { sphere.centre = moved.pose.transform.translation(); },
+                      [](auto&) {}},  // finite shapes are where their pose is
              moved.shape);
   return moved;
 }
 
-std::optional<double> firstContact(const BallMotion& ball, const Shape& shape,
+std::optional<double> firstContact(const BallMotion& ball, const PlacedShape& placed,
                                    const Eigen::Vector3d& shape_velocity,
                                    const Eigen::Vector3d& shape_acceleration, bool accelerates,
                                    double horizon) {
   const Eigen::Vector3d relative_velocity = shape_velocity - ball.velocity;
+  // A finite shape: the ball's motion in the shape's frame (the shape moves straight on).
+  const auto finite = [&](const auto& shape) {
+    const Eigen::Matrix3d to_shape = placed.pose.transform.linear().transpose();
+    RelativeMotion motion;
+    motion.centre = to_shape * (ball.centre - placed.pose.transform.translation());
+    motion.velocity = to_shape * -relative_velocity;
+    if (accelerates) motion.acceleration = to_shape * (ball.acceleration - shape_acceleration);
+    motion.radius = ball.radius;
+    return firstContactFinite(motion, shape, horizon);
+  };
   return std::visit(
       Dispatch{[&](const Plane& plane) -> std::optional<double> {
                  const double gap = plane.normal.dot(ball.centre) - plane.offset - ball.radius;
@@ -158,8 +242,57 @@ std::optional<double> firstContact(const BallMotion& ball, const Shape& shape,
                  }
                  return timeOfImpactSpheres<double>(separation, relative_velocity, contact_distance,
                                                     horizon);
-               }},
-      shape);
+               },
+               [&](const Cuboid& box) { return finite(box); },
+               [&](const Cylinder& cylinder) { return finite(cylinder); },
+               [&](const Capsule& capsule) { return finite(capsule); }},
+      placed.shape);
+}
+
+namespace {
+
+template <class Finite>
+ContactGeometry finiteGeometryOf(const Eigen::Vector3d& centre, double radius, const Finite& shape,
+                                 const RigidPose& pose, double contact_tolerance) {
+  constexpr double kEps = 2.220446049250313e-16;
+  const Eigen::Matrix3d& axes = pose.transform.linear();
+  const Eigen::Vector3d& origin = pose.transform.translation();
+  const NearestFeature nearest = nearestFeature(shape, axes.transpose() * (centre - origin));
+  ContactGeometry result;
+  result.normal = -(axes * nearest.outward);  // from the ball into the shape
+  result.gap = nearest.distance - radius;
+  result.tolerance = contact_tolerance * radius +
+                     16 * kEps *
+                         (centre.lpNorm<Eigen::Infinity>() + origin.lpNorm<Eigen::Infinity>() +
+                          boundingRadius(shape) + radius);
+  result.valid = true;
+  result.bounded = true;
+  if (std::isfinite(nearest.turning_radius) && nearest.turning_radius > 0) {
+    result.turning_radius = nearest.turning_radius;
+    result.curvature = 1.0 / nearest.turning_radius;
+    result.turning_axis = axes * nearest.axis;
+    result.axial_share = nearest.axial_share;
+  }
+  const Eigen::Vector3d on_shape = origin + axes * nearest.point;
+  result.point = 0.5 * (Eigen::Vector3d(centre + radius * result.normal) + on_shape);
+  result.surface_velocity = pose.velocityAt(result.point - origin);
+  return result;
+}
+
+}  // namespace
+
+ContactGeometry finiteGeometry(const Eigen::Vector3d& centre, double radius, const Cuboid& box,
+                               const RigidPose& pose, double contact_tolerance) {
+  return finiteGeometryOf(centre, radius, box, pose, contact_tolerance);
+}
+ContactGeometry finiteGeometry(const Eigen::Vector3d& centre, double radius,
+                               const Cylinder& cylinder, const RigidPose& pose,
+                               double contact_tolerance) {
+  return finiteGeometryOf(centre, radius, cylinder, pose, contact_tolerance);
+}
+ContactGeometry finiteGeometry(const Eigen::Vector3d& centre, double radius, const Capsule& capsule,
+                               const RigidPose& pose, double contact_tolerance) {
+  return finiteGeometryOf(centre, radius, capsule, pose, contact_tolerance);
 }
 
 bool mayReach(const PlacedShape& placed, const Box& box) {
@@ -175,14 +308,22 @@ bool mayReach(const PlacedShape& placed, const Box& box) {
                                const Box post{sphere.centre.array() - sphere.radius,
                                               sphere.centre.array() + sphere.radius};
                                return post.overlaps(box);
+                             },
+                             [&](const auto& finite) {
+                               // Its bounding sphere's box.
+                               const Eigen::Vector3d& centre = placed.pose.transform.translation();
+                               const double reach = boundingRadius(finite);
+                               const Box bound{centre.array() - reach, centre.array() + reach};
+                               return bound.overlaps(box);
                              }},
                     placed.shape);
 }
 
 double contactRadius(const Shape& shape) {
-  return std::visit(Dispatch{[](const Plane&) { return 0.0; },
-                             [](const Sphere& sphere) { return sphere.radius; }},
-                    shape);
+  return std::visit(
+      Dispatch{[](const Plane&) { return 0.0; }, [](const Sphere& sphere) { return sphere.radius; },
+               [](const auto&) { return 0.0; }},
+      shape);
 }
 
 }  // namespace collision_response::core

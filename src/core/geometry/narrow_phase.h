@@ -6,7 +6,8 @@
 //  - shapeAt: a placed shape moved on (straight on) to an instant;
 //  - contactGeometry: a ball and a shape at one instant (normal, gap, point, curvature, the
 //    surface's velocity at the point);
-//  - firstContact: the first contact along a ball's motion (time_of_impact.h's closed forms);
+//  - firstContact: the first contact along a ball's motion (time_of_impact.h's closed forms, and
+//    finite_shapes.h's certified roots for boxes, cylinders and capsules);
 //  - mayReach: whether a box may reach a fixed shape (the broad phase's test).
 #pragma once
 
@@ -36,6 +37,17 @@ struct ContactGeometry {
   /// 1/m: how the line of contact turns as the ball moves across it, 1 / (the distance between
   /// the centres) for a ball on a sphere, 0 on a flat shape.
   double curvature = 0.0;
+  /// m: 1 / curvature where it is not 0, computed as the distance itself (a sphere's gap plus
+  /// both radii), so that |v_perp|^2 / turning_radius is the same bits as before finite shapes.
+  double turning_radius = INFINITY;
+  /// Where the normal turns only across a direction (a ball on an edge, a cylinder's side, a
+  /// rim): that direction (unit; zero where it turns alike every way), along which it turns at
+  /// `axial_share` of its rate across it (0 along a line).
+  Eigen::Vector3d turning_axis = Eigen::Vector3d::Zero();
+  double axial_share = 1.0;
+  /// The contact is on a feature that ends (a finite shape's face, edge or side): a ball that
+  /// moves along it may reach another feature, so its motion is followed step by step.
+  bool bounded = false;
   /// The contact point: the middle of the gap along the normal, half-way between the ball's
   /// surface point and the shape's, summed so that it is the same bits whichever of two spheres
   /// is the ball (the stepped solve's order of contacts comes from these points, and renaming
@@ -46,6 +58,15 @@ struct ContactGeometry {
 
   /// The shape is flat here: the normal does not turn as the ball moves along it.
   bool flat() const { return curvature == 0; }
+  /// m/s^2: how fast the normal's turning pulls the surfaces apart for a ball moving at `across`
+  /// (perpendicular to the normal) relative to the shape, |across|^2 / d on a sphere; along a
+  /// turning axis only the share of that component counts.
+  double centripetal(const Eigen::Vector3d& across) const {
+    if (flat()) return 0.0;
+    if (turning_axis.isZero()) return across.squaredNorm() / turning_radius;
+    const double along = turning_axis.dot(across);
+    return (across.squaredNorm() - (1 - axial_share) * along * along) / turning_radius;
+  }
   /// m: the band a bounce or a separation must rise out of under the pressing acceleration
   /// (restSpeed): the touching band, or the overlap where the pair overlaps deeper (a contact
   /// held where it is, or an impact that discrete detection found by overlap).
@@ -76,30 +97,13 @@ inline Eigen::Vector3d originAt(const RigidPose& pose, double time) {
 /// between placements is not followed).
 PlacedShape shapeAt(const PlacedShape& placed, double time);
 
-/// A ball at `centre` of `radius` and `placed` (at the same instant). `contact_tolerance`: the
-/// touching band's share of the contact distance. Centres that coincide have no line of centres:
-/// the normal is then `approach()` normalised (the direction the ball approaches in), and none
-/// (valid false) if that is zero.
+/// contactGeometry against a sphere.
 template <class Approach>
-ContactGeometry contactGeometry(const Eigen::Vector3d& centre, double radius,
-                                const PlacedShape& placed, double contact_tolerance,
-                                Approach&& approach) {
+ContactGeometry sphereGeometry(const Eigen::Vector3d& centre, double radius, const Sphere& sphere,
+                               const PlacedShape& placed, double contact_tolerance,
+                               Approach&& approach) {
   constexpr double kEps = 2.220446049250313e-16;
   ContactGeometry result;
-  const auto surfaceVelocity = [&](const Eigen::Vector3d& on_shape) {
-    result.point = 0.5 * (Eigen::Vector3d(centre + radius * result.normal) + on_shape);
-    result.surface_velocity =
-        placed.pose.velocityAt(result.point - placed.pose.transform.translation());
-  };
-  if (const Plane* plane = std::get_if<Plane>(&placed.shape)) {
-    result.normal = -plane->normal;  // from the ball into the plane
-    result.gap = plane->normal.dot(centre) - plane->offset - radius;
-    result.tolerance = touchingBand(radius, contact_tolerance, centre, plane->offset);
-    result.valid = true;
-    surfaceVelocity(centre + (result.gap + radius) * result.normal);
-    return result;
-  }
-  const Sphere& sphere = std::get<Sphere>(placed.shape);
   const Eigen::Vector3d separation = sphere.centre - centre;
   const double distance = separation.norm();
   const double contact_distance = radius + sphere.radius;
@@ -119,9 +123,61 @@ ContactGeometry contactGeometry(const Eigen::Vector3d& centre, double radius,
                          (centre.lpNorm<Eigen::Infinity>() +
                           sphere.centre.lpNorm<Eigen::Infinity>() + contact_distance);
   result.valid = true;
-  result.curvature = 1.0 / (result.gap + radius + sphere.radius);
-  surfaceVelocity(sphere.centre - sphere.radius * result.normal);
+  result.turning_radius = result.gap + radius + sphere.radius;
+  result.curvature = 1.0 / result.turning_radius;
+  result.point = 0.5 * (Eigen::Vector3d(centre + radius * result.normal) +
+                        Eigen::Vector3d(sphere.centre - sphere.radius * result.normal));
+  result.surface_velocity =
+      placed.pose.velocityAt(result.point - placed.pose.transform.translation());
   return result;
+}
+
+/// contactGeometry against a finite shape at `pose`: the nearest point of its surface
+/// (finite_shapes.h), the normal from the ball's centre to it (continuous from a face to an edge
+/// to a corner), the normal's turning radius the centre's distance from the feature's core.
+ContactGeometry finiteGeometry(const Eigen::Vector3d& centre, double radius, const Cuboid& box,
+                               const RigidPose& pose, double contact_tolerance);
+ContactGeometry finiteGeometry(const Eigen::Vector3d& centre, double radius,
+                               const Cylinder& cylinder, const RigidPose& pose,
+                               double contact_tolerance);
+ContactGeometry finiteGeometry(const Eigen::Vector3d& centre, double radius, const Capsule& capsule,
+                               const RigidPose& pose, double contact_tolerance);
+
+/// A ball at `centre` of `radius` and `placed` (at the same instant). `contact_tolerance`: the
+/// touching band's share of the contact distance. Centres that coincide have no line of centres:
+/// the normal is then `approach()` normalised (the direction the ball approaches in), and none
+/// (valid false) if that is zero.
+template <class Approach>
+ContactGeometry contactGeometry(const Eigen::Vector3d& centre, double radius,
+                                const PlacedShape& placed, double contact_tolerance,
+                                Approach&& approach) {
+  ContactGeometry result;
+  const auto surfaceVelocity = [&](const Eigen::Vector3d& on_shape) {
+    result.point = 0.5 * (Eigen::Vector3d(centre + radius * result.normal) + on_shape);
+    result.surface_velocity =
+        placed.pose.velocityAt(result.point - placed.pose.transform.translation());
+  };
+  if (const Plane* plane = std::get_if<Plane>(&placed.shape)) {
+    result.normal = -plane->normal;  // from the ball into the plane
+    result.gap = plane->normal.dot(centre) - plane->offset - radius;
+    result.tolerance = touchingBand(radius, contact_tolerance, centre, plane->offset);
+    result.valid = true;
+    surfaceVelocity(centre + (result.gap + radius) * result.normal);
+    return result;
+  }
+  if (const Sphere* sphere = std::get_if<Sphere>(&placed.shape)) {
+    return sphereGeometry(centre, radius, *sphere, placed, contact_tolerance, approach);
+  }
+  return std::visit(
+      [&](const auto& shape) -> ContactGeometry {
+        using Kind = std::decay_t<decltype(shape)>;
+        if constexpr (std::is_same_v<Kind, Plane> || std::is_same_v<Kind, Sphere>) {
+          return result;  // answered above
+        } else {
+          return finiteGeometry(centre, radius, shape, placed.pose, contact_tolerance);
+        }
+      },
+      placed.shape);
 }
 
 /// How a ball moves from an instant on: along a straight line, or (accelerates) a parabola.
@@ -135,8 +191,9 @@ struct BallMotion {
 /// The first contact of `ball` with `shape` (placed at the same instant, moving at
 /// `shape_velocity` and accelerating at `shape_acceleration`) within `horizon`: straight lines
 /// (timeOfImpactPlane, timeOfImpactSpheres), or with `accelerates` parabolas
-/// (timeOfImpactPlaneBallistic, timeOfImpactSpheresAccelerated; a plane does not accelerate).
-std::optional<double> firstContact(const BallMotion& ball, const Shape& shape,
+/// (timeOfImpactPlaneBallistic, timeOfImpactSpheresAccelerated; a plane does not accelerate);
+/// a finite shape by its features' polynomials (finite_shapes.h, firstContactFinite).
+std::optional<double> firstContact(const BallMotion& ball, const PlacedShape& shape,
                                    const Eigen::Vector3d& shape_velocity,
                                    const Eigen::Vector3d& shape_acceleration, bool accelerates,
                                    double horizon);
@@ -145,7 +202,8 @@ std::optional<double> firstContact(const BallMotion& ball, const Shape& shape,
 bool mayReach(const PlacedShape& placed, const Box& box);
 
 /// m: the size of a shape about its pose's origin that a ball's contact distance counts (a
-/// sphere's radius; 0 for a plane, whose distance is along its normal).
+/// sphere's radius; 0 for a plane, whose distance is along its normal, and for a finite shape,
+/// whose distance is from the nearest point of its surface).
 double contactRadius(const Shape& shape);
 
 }  // namespace collision_response::core

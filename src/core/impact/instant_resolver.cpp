@@ -128,8 +128,7 @@ double contactRestitution(World& world, double time, const InstantContact& conta
       const Eigen::Vector3d relative =
           velocityAt<Motion>(world, other, time) - velocityAt<Motion>(world, a, time);
       const Eigen::Vector3d across = relative - relative.dot(normal) * normal;
-      pressing -=
-          across.squaredNorm() / (contact.geometry.gap + world.radius[a] + world.radius[other]);
+      pressing -= contact.geometry.centripetal(across);
     }
     if (pressing > 0 && restitution * approach_speed <=
                             restSpeed(pressing, world.riseBand(contact.geometry, pressing))) {

@@ -144,7 +144,8 @@ std::optional<double> timeOfImpactAlongPaths(const World& world, const Pair& pai
   const Geometry start = geometry<Motion>(world, pair, from);
   if (start.gap < -start.tolerance) return std::nullopt;  // overlapping already: not an impact
   const double contact_at = start.gap > 0 ? 0.0 : 0.5 * (start.gap - start.tolerance);
-  const bool curved = !start.flat();
+  // A finite shape's next feature may curve where this one is flat.
+  const bool curved = !start.flat() || start.bounded;
   const double contact_distance = world.radius[pair.first] + world.radius[pair.second];
   const double accelerations =
       accelerationBound<Motion>(world, pair.first) + accelerationBound<Motion>(world, pair.second);
@@ -196,7 +197,7 @@ std::optional<double> timeOfImpact(const World& world, const Pair& pair, double 
   ball.velocity = velocityAt<Motion>(world, a, from);
   if constexpr (Motion::kAccelerates) ball.acceleration = world.tracks[a].acceleration;
   const PlacedShape shape = shapeAt<Motion>(world, other, from);
-  return firstContact(ball, shape.shape, velocityAt<Motion>(world, other, from),
+  return firstContact(ball, shape, velocityAt<Motion>(world, other, from),
                       accelerationOf<Motion>(world, other), Motion::kAccelerates, horizon);
 }
 

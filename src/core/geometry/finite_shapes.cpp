@@ -1,0 +1,336 @@
+#include "geometry/finite_shapes.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <vector>
+
+#include "collision_response/core/time_of_impact.h"
+#include "geometry/polynomial_roots.h"
+
+namespace collision_response::core {
+
+namespace {
+
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+
+double signOf(double value) { return value < 0 ? -1.0 : 1.0; }
+
+/// A point's nearest feature where it is inside a shape or on its surface: the face it is least
+/// deep behind.
+NearestFeature insideFace(const Eigen::Vector3d& point, const Eigen::Vector3d& outward,
+                          double depth) {
+  NearestFeature feature;
+  feature.point = point;
+  feature.outward = outward;
+  feature.distance = -depth;
+  return feature;
+}
+
+/// A point at `offset` from a feature's core point `core` (an edge's nearest point, a corner, a
+/// rim's nearest point, an axis' nearest point) grown by `grown` (a capsule's radius; 0 for an
+/// edge or a corner).
+NearestFeature aroundCore(const Eigen::Vector3d& core, const Eigen::Vector3d& offset, double grown,
+                          const Eigen::Vector3d& fallback_outward) {
+  NearestFeature feature;
+  const double length = offset.norm();
+  feature.outward = length > 0 ? Eigen::Vector3d(offset / length) : fallback_outward;
+  feature.point = core + grown * feature.outward;
+  feature.distance = length - grown;
+  feature.turning_radius = length;
+  return feature;
+}
+
+/// A polynomial in t, lowest degree first, in long double.
+using Polynomial = std::vector<long double>;
+
+Polynomial operator*(const Polynomial& p, const Polynomial& q) {
+  Polynomial product(p.size() + q.size() - 1, 0.0L);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    for (std::size_t j = 0; j < q.size(); ++j) product[i + j] += p[i] * q[j];
+  }
+  return product;
+}
+
+Polynomial operator+(Polynomial p, const Polynomial& q) {
+  if (p.size() < q.size()) p.resize(q.size(), 0.0L);
+  for (std::size_t i = 0; i < q.size(); ++i) p[i] += q[i];
+  return p;
+}
+
+Polynomial operator*(long double factor, Polynomial p) {
+  for (long double& c : p) c *= factor;
+  return p;
+}
+
+/// The features' polynomials along one motion, in lengths scaled by a power of two `unit`
+/// (exact) so that their squares keep to the range of the doubles.
+class FeatureSearch {
+ public:
+  FeatureSearch(const RelativeMotion& motion, double size, double horizon)
+      : motion_(motion), horizon_(horizon) {
+    unit_ = powerOfTwoBelow(
+        std::max({motion.centre.lpNorm<Eigen::Infinity>(), size + motion.radius, motion.radius}));
+    radius_ = static_cast<long double>(motion.radius) / unit_;
+    slack_ = 8 * kEps * (motion.centre.lpNorm<Eigen::Infinity>() + size + motion.radius);
+  }
+
+  /// The centre's coordinate `axis` less `offset` (m), as a polynomial in t, scaled.
+  Polynomial coordinate(int axis, double offset = 0.0) const {
+    return {(static_cast<long double>(motion_.centre[axis]) - offset) / unit_,
+            static_cast<long double>(motion_.velocity[axis]) / unit_,
+            0.5L * static_cast<long double>(motion_.acceleration[axis]) / unit_};
+  }
+  long double scaled(double length) const { return static_cast<long double>(length) / unit_; }
+  long double radius() const { return radius_; }
+
+  /// (distance - grown)(distance + grown) at t = 0 from the distance itself: a gap of a few
+  /// ulps keeps its digits (as timeOfImpactSpheres' c).
+  static void startFromDistance(Polynomial& p, long double distance, long double grown) {
+    p[0] = (distance - grown) * (distance + grown);
+  }
+
+  Eigen::Vector3d positionAt(double t) const {
+    return motion_.centre + t * (motion_.velocity + (0.5 * t) * motion_.acceleration);
+  }
+  /// |value| <= bound, with the rounding of the positions.
+  bool within(double value, double bound) const { return std::abs(value) <= bound + slack_; }
+
+  /// A feature: its polynomial (> 0 outside it), and where along its surface the point must be.
+  void feature(const Polynomial& p, const std::function<bool(const Eigen::Vector3d&)>& region) {
+    visitRoots(p, horizon_, [&](const PolynomialRoot& root) {
+      if (best_ && root.time >= *best_) return true;  // no later root is the first
+      if (!root.falling) return false;
+      if (!region(positionAt(root.time))) return false;
+      best_ = root.time;
+      return true;
+    });
+  }
+  static bool anywhere(const Eigen::Vector3d&) { return true; }
+
+  const std::optional<double>& best() const { return best_; }
+
+ private:
+  RelativeMotion motion_;
+  double horizon_;
+  double unit_ = 1.0, slack_ = 0.0;
+  long double radius_ = 0;
+  std::optional<double> best_;
+};
+
+Polynomial square(const Polynomial& p) { return p * p; }
+
+/// The common start of every shape: already overlapping (none), touching and approaching (now),
+/// or out of reach within the horizon (none); otherwise the features are searched.
+template <class Shape>
+std::optional<double> search(const RelativeMotion& motion, const Shape& shape, double horizon,
+                             const std::function<void(FeatureSearch&)>& features) {
+  if (!(horizon >= 0)) return std::nullopt;
+  const NearestFeature start = nearestFeature(shape, motion.centre);
+  const double gap = start.distance - motion.radius;
+  const double size = boundingRadius(shape);
+  const double rounding =
+      16 * kEps * (motion.centre.lpNorm<Eigen::Infinity>() + size + motion.radius);
+  if (gap < -rounding) return std::nullopt;  // overlapping: its impact was when it began
+  if (gap <= rounding && start.outward.dot(motion.velocity) < 0) return 0.0;
+  const double reach =
+      (motion.velocity.norm() + 0.5 * motion.acceleration.norm() * horizon) * horizon;
+  if (gap > reach + rounding || !(horizon > 0)) return std::nullopt;
+  FeatureSearch search(motion, size, horizon);
+  features(search);
+  return search.best();
+}
+
+}  // namespace
+
+NearestFeature nearestFeature(const Cuboid& box, const Eigen::Vector3d& p) {
+  const Eigen::Vector3d& h = box.half_size;
+  const Eigen::Vector3d clamped = p.cwiseMax(-h).cwiseMin(h);
+  const Eigen::Vector3d offset = p - clamped;
+  int outside = 0;
+  for (int i = 0; i < 3; ++i) outside += offset[i] != 0;
+  if (outside == 0) {
+    int axis = 0;
+    for (int i = 1; i < 3; ++i) {
+      if (h[i] - std::abs(p[i]) < h[axis] - std::abs(p[axis])) axis = i;
+    }
+    Eigen::Vector3d point = p;
+    point[axis] = signOf(p[axis]) * h[axis];
+    return insideFace(point, signOf(p[axis]) * Eigen::Vector3d::Unit(axis),
+                      h[axis] - std::abs(p[axis]));
+  }
+  if (outside == 1) {
+    NearestFeature face;
+    for (int i = 0; i < 3; ++i) {
+      if (offset[i] != 0) {
+        face.outward = signOf(offset[i]) * Eigen::Vector3d::Unit(i);
+        face.distance = std::abs(offset[i]);
+      }
+    }
+    face.point = clamped;
+    return face;
+  }
+  NearestFeature feature = aroundCore(clamped, offset, 0.0, Eigen::Vector3d::UnitZ());
+  if (outside == 2) {
+    for (int i = 0; i < 3; ++i) {
+      if (offset[i] == 0) feature.axis = Eigen::Vector3d::Unit(i);
+    }
+    feature.axial_share = 0.0;
+  }
+  return feature;
+}
+
+NearestFeature nearestFeature(const Cylinder& cylinder, const Eigen::Vector3d& p) {
+  const double radial = std::hypot(p.x(), p.y());
+  const Eigen::Vector3d across =
+      radial > 0 ? Eigen::Vector3d(p.x() / radial, p.y() / radial, 0) : Eigen::Vector3d::UnitX();
+  const double side_depth = cylinder.radius - radial;
+  const double cap_depth = cylinder.half_length - std::abs(p.z());
+  const double end = signOf(p.z()) * cylinder.half_length;
+  if (side_depth >= 0 && cap_depth >= 0) {
+    if (cap_depth <= side_depth) {
+      return insideFace(Eigen::Vector3d(p.x(), p.y(), end),
+                        signOf(p.z()) * Eigen::Vector3d::UnitZ(), cap_depth);
+    }
+    return insideFace(cylinder.radius * across + p.z() * Eigen::Vector3d::UnitZ(), across,
+                      side_depth);
+  }
+  if (side_depth < 0 && cap_depth >= 0) {  // the side: a line's turning about the axis
+    NearestFeature side;
+    side.point = cylinder.radius * across + p.z() * Eigen::Vector3d::UnitZ();
+    side.outward = across;
+    side.distance = -side_depth;
+    side.turning_radius = radial;
+    side.axis = Eigen::Vector3d::UnitZ();
+    side.axial_share = 0.0;
+    return side;
+  }
+  if (side_depth >= 0) {  // a cap
+    NearestFeature cap;
+    cap.point = Eigen::Vector3d(p.x(), p.y(), end);
+    cap.outward = signOf(p.z()) * Eigen::Vector3d::UnitZ();
+    cap.distance = -cap_depth;
+    return cap;
+  }
+  // A rim: the circle's nearest point; along the circle the normal turns at (1 - R / radial)
+  // of its rate across it (the circle's own turning takes the rest).
+  const Eigen::Vector3d core = cylinder.radius * across + end * Eigen::Vector3d::UnitZ();
+  NearestFeature rim = aroundCore(core, p - core, 0.0, across);
+  rim.axis = Eigen::Vector3d::UnitZ().cross(across);
+  rim.axial_share = 1.0 - cylinder.radius / radial;
+  return rim;
+}
+
+NearestFeature nearestFeature(const Capsule& capsule, const Eigen::Vector3d& p) {
+  const double along = std::clamp(p.z(), -capsule.half_length, capsule.half_length);
+  const Eigen::Vector3d core(0, 0, along);
+  NearestFeature feature = aroundCore(core, p - core, capsule.radius, Eigen::Vector3d::UnitX());
+  if (std::abs(p.z()) <= capsule.half_length) {
+    feature.axis = Eigen::Vector3d::UnitZ();
+    feature.axial_share = 0.0;
+  }
+  return feature;
+}
+
+double boundingRadius(const Cuboid& box) { return box.half_size.norm(); }
+double boundingRadius(const Cylinder& cylinder) {
+  return std::hypot(cylinder.radius, cylinder.half_length);
+}
+double boundingRadius(const Capsule& capsule) { return capsule.radius + capsule.half_length; }
+
+std::optional<double> firstContactFinite(const RelativeMotion& motion, const Cuboid& box,
+                                         double horizon) {
+  return search(motion, box, horizon, [&](FeatureSearch& s) {
+    const Eigen::Vector3d& h = box.half_size;
+    const long double r = s.radius();
+    // Faces: s q_i = h_i + r, the point within the face's rectangle.
+    for (int i = 0; i < 3; ++i) {
+      const int j = (i + 1) % 3, k = (i + 2) % 3;
+      for (const double side : {-1.0, 1.0}) {
+        s.feature(
+            side * s.coordinate(i, side * h[i]) + Polynomial{-r},
+            [&](const Eigen::Vector3d& q) { return s.within(q[j], h[j]) && s.within(q[k], h[k]); });
+      }
+    }
+    // Edges along axis i: the line q_j = s_j h_j, q_k = s_k h_k, within the edge's length.
+    for (int i = 0; i < 3; ++i) {
+      const int j = (i + 1) % 3, k = (i + 2) % 3;
+      for (const double side_j : {-1.0, 1.0}) {
+        for (const double side_k : {-1.0, 1.0}) {
+          const Polynomial dj = s.coordinate(j, side_j * h[j]);
+          const Polynomial dk = s.coordinate(k, side_k * h[k]);
+          Polynomial p = square(dj) + square(dk);
+          FeatureSearch::startFromDistance(p, std::hypot(dj[0], dk[0]), r);
+          s.feature(p, [&](const Eigen::Vector3d& q) { return s.within(q[i], h[i]); });
+        }
+      }
+    }
+    // Corners.
+    for (const double x : {-1.0, 1.0}) {
+      for (const double y : {-1.0, 1.0}) {
+        for (const double z : {-1.0, 1.0}) {
+          const Polynomial dx = s.coordinate(0, x * h.x()), dy = s.coordinate(1, y * h.y()),
+                           dz = s.coordinate(2, z * h.z());
+          Polynomial p = square(dx) + square(dy) + square(dz);
+          FeatureSearch::startFromDistance(
+              p, std::sqrt(dx[0] * dx[0] + dy[0] * dy[0] + dz[0] * dz[0]), r);
+          s.feature(p, FeatureSearch::anywhere);
+        }
+      }
+    }
+  });
+}
+
+std::optional<double> firstContactFinite(const RelativeMotion& motion, const Cylinder& cylinder,
+                                         double horizon) {
+  return search(motion, cylinder, horizon, [&](FeatureSearch& s) {
+    const long double r = s.radius();
+    const long double big = s.scaled(cylinder.radius);
+    const Polynomial x = s.coordinate(0), y = s.coordinate(1);
+    // The side: q_x^2 + q_y^2 = (R + r)^2 between the caps.
+    Polynomial side = square(x) + square(y);
+    FeatureSearch::startFromDistance(side, std::hypot(x[0], y[0]), big + r);
+    s.feature(side,
+              [&](const Eigen::Vector3d& q) { return s.within(q.z(), cylinder.half_length); });
+    for (const double end : {-1.0, 1.0}) {
+      // A cap: end q_z = h + r, within the disc.
+      s.feature(end * s.coordinate(2, end * cylinder.half_length) + Polynomial{-r},
+                [&](const Eigen::Vector3d& q) {
+                  return s.within(std::hypot(q.x(), q.y()), cylinder.radius);
+                });
+      // A rim: the torus (|w|^2 + R^2 - r^2)^2 = 4 R^2 (w_x^2 + w_y^2), w = q - end h z, whose
+      // value at the start is (d^2 - r^2)((rho + R)^2 + w_z^2 - r^2), d the distance to the
+      // circle (so that a small gap keeps its digits).
+      const Polynomial z = s.coordinate(2, end * cylinder.half_length);
+      const Polynomial planar = square(x) + square(y);
+      const Polynomial inner = planar + square(z) + Polynomial{big * big - r * r};
+      Polynomial torus = square(inner) + (-4 * big * big) * planar;
+      const long double rho = std::hypot(x[0], y[0]);
+      const long double to_circle = std::hypot(rho - big, z[0]);
+      torus[0] =
+          (to_circle - r) * (to_circle + r) * ((rho + big) * (rho + big) + z[0] * z[0] - r * r);
+      s.feature(torus, FeatureSearch::anywhere);
+    }
+  });
+}
+
+std::optional<double> firstContactFinite(const RelativeMotion& motion, const Capsule& capsule,
+                                         double horizon) {
+  return search(motion, capsule, horizon, [&](FeatureSearch& s) {
+    const long double grown = s.scaled(capsule.radius) + s.radius();
+    const Polynomial x = s.coordinate(0), y = s.coordinate(1);
+    Polynomial side = square(x) + square(y);
+    FeatureSearch::startFromDistance(side, std::hypot(x[0], y[0]), grown);
+    s.feature(side, [&](const Eigen::Vector3d& q) { return s.within(q.z(), capsule.half_length); });
+    for (const double end : {-1.0, 1.0}) {
+      const Polynomial z = s.coordinate(2, end * capsule.half_length);
+      Polynomial ball = square(x) + square(y) + square(z);
+      FeatureSearch::startFromDistance(ball, std::sqrt(x[0] * x[0] + y[0] * y[0] + z[0] * z[0]),
+                                       grown);
+      s.feature(ball, FeatureSearch::anywhere);
+    }
+  });
+}
+
+}  // namespace collision_response::core
