@@ -74,6 +74,7 @@ class FeatureSearch {
         std::max({motion.centre.lpNorm<Eigen::Infinity>(), size + motion.radius, motion.radius}));
     radius_ = static_cast<long double>(motion.radius) / unit_;
     slack_ = 8 * kEps * (motion.centre.lpNorm<Eigen::Infinity>() + size + motion.radius);
+    travel_ = (motion.velocity.norm() + 0.5 * motion.acceleration.norm() * horizon) * horizon;
   }
 
   /// The centre's coordinate `axis` less `offset` (m), as a polynomial in t, scaled.
@@ -94,27 +95,52 @@ class FeatureSearch {
   Eigen::Vector3d positionAt(double t) const {
     return motion_.centre + t * (motion_.velocity + (0.5 * t) * motion_.acceleration);
   }
-  /// |value| <= bound, with the rounding of the positions.
-  bool within(double value, double bound) const { return std::abs(value) <= bound + slack_; }
+  /// |value| <= bound, with the rounding of the positions (and `more`).
+  bool within(double value, double bound, double more = 0.0) const {
+    return std::abs(value) <= bound + slack_ + more;
+  }
+  /// m: how far the centre can be from the chord of its motion between `low` and `high`, plus
+  /// how far along it it moves: a root in the bracket is within this of either end's point.
+  double spread(double low, double high) const {
+    const double span = high - low;
+    return span * (motion_.velocity.norm() + motion_.acceleration.norm() * (std::abs(high) + span));
+  }
 
   /// A feature: its polynomial (> 0 outside it), and where along its surface the point must be.
-  void feature(const Polynomial& p, const std::function<bool(const Eigen::Vector3d&)>& region) {
-    visitRoots(p, horizon_, [&](const PolynomialRoot& root) {
-      if (best_ && root.time >= *best_) return true;  // no later root is the first
-      if (!root.falling) return false;
-      if (!region(positionAt(root.time))) return false;
-      best_ = root.time;
-      return true;
-    });
+  /// `region(point, more)`: the point is on the feature's part of the surface, within `more`.
+  void feature(const Polynomial& p,
+               const std::function<bool(const Eigen::Vector3d&, double)>& region) {
+    // Only up to the earliest entry found so far (and a little past it, so that a feature
+    // entered at the same instant is not at the very end): a later one cannot be the first.
+    const double until = best_ ? std::min(horizon_, *best_ * (1 + 1e-9) + 1e-300) : horizon_;
+    visitRoots(
+        p, until,
+        [&](const PolynomialRoot& root) {
+          if (best_ && root.time >= *best_) return true;  // no later root is the first
+          if (!root.falling) return false;
+          if (!region(positionAt(root.time), 0.0)) return false;
+          best_ = root.time;
+          return true;
+        },
+        [&](double low, double high) {
+          // Somewhere in the bracket: near its first end's point, by what the motion spreads.
+          return (!best_ || low < *best_) && region(positionAt(low), spread(low, high));
+        });
   }
-  static bool anywhere(const Eigen::Vector3d&) { return true; }
+  static bool anywhere(const Eigen::Vector3d&, double) { return true; }
+
+  /// Whether a feature at `distance` (m) from the centre now, reached at `grown` (m) from it, can
+  /// be reached within the horizon at all (at the speed and acceleration, head-on all the way).
+  bool reachable(double distance, double grown) const {
+    return distance - grown <= travel_ + slack_;
+  }
 
   const std::optional<double>& best() const { return best_; }
 
  private:
   RelativeMotion motion_;
   double horizon_;
-  double unit_ = 1.0, slack_ = 0.0;
+  double unit_ = 1.0, slack_ = 0.0, travel_ = 0.0;
   long double radius_ = 0;
   std::optional<double> best_;
 };
@@ -248,9 +274,11 @@ std::optional<double> firstContactFinite(const RelativeMotion& motion, const Cub
     for (int i = 0; i < 3; ++i) {
       const int j = (i + 1) % 3, k = (i + 2) % 3;
       for (const double side : {-1.0, 1.0}) {
-        s.feature(
-            side * s.coordinate(i, side * h[i]) + Polynomial{-r},
-            [&](const Eigen::Vector3d& q) { return s.within(q[j], h[j]) && s.within(q[k], h[k]); });
+        if (!s.reachable(side * motion.centre[i] - h[i], motion.radius)) continue;
+        s.feature(side * s.coordinate(i, side * h[i]) + Polynomial{-r},
+                  [&](const Eigen::Vector3d& q, double more) {
+                    return s.within(q[j], h[j], more) && s.within(q[k], h[k], more);
+                  });
       }
     }
     // Edges along axis i: the line q_j = s_j h_j, q_k = s_k h_k, within the edge's length.
@@ -258,11 +286,17 @@ std::optional<double> firstContactFinite(const RelativeMotion& motion, const Cub
       const int j = (i + 1) % 3, k = (i + 2) % 3;
       for (const double side_j : {-1.0, 1.0}) {
         for (const double side_k : {-1.0, 1.0}) {
+          if (!s.reachable(
+                  std::hypot(motion.centre[j] - side_j * h[j], motion.centre[k] - side_k * h[k]),
+                  motion.radius)) {
+            continue;
+          }
           const Polynomial dj = s.coordinate(j, side_j * h[j]);
           const Polynomial dk = s.coordinate(k, side_k * h[k]);
           Polynomial p = square(dj) + square(dk);
           FeatureSearch::startFromDistance(p, std::hypot(dj[0], dk[0]), r);
-          s.feature(p, [&](const Eigen::Vector3d& q) { return s.within(q[i], h[i]); });
+          s.feature(
+              p, [&](const Eigen::Vector3d& q, double more) { return s.within(q[i], h[i], more); });
         }
       }
     }
@@ -270,6 +304,10 @@ std::optional<double> firstContactFinite(const RelativeMotion& motion, const Cub
     for (const double x : {-1.0, 1.0}) {
       for (const double y : {-1.0, 1.0}) {
         for (const double z : {-1.0, 1.0}) {
+          if (!s.reachable((motion.centre - Eigen::Vector3d(x, y, z).cwiseProduct(h)).norm(),
+                           motion.radius)) {
+            continue;
+          }
           const Polynomial dx = s.coordinate(0, x * h.x()), dy = s.coordinate(1, y * h.y()),
                            dz = s.coordinate(2, z * h.z());
           Polynomial p = square(dx) + square(dy) + square(dz);
@@ -291,13 +329,14 @@ std::optional<double> firstContactFinite(const RelativeMotion& motion, const Cyl
     // The side: q_x^2 + q_y^2 = (R + r)^2 between the caps.
     Polynomial side = square(x) + square(y);
     FeatureSearch::startFromDistance(side, std::hypot(x[0], y[0]), big + r);
-    s.feature(side,
-              [&](const Eigen::Vector3d& q) { return s.within(q.z(), cylinder.half_length); });
+    s.feature(side, [&](const Eigen::Vector3d& q, double more) {
+      return s.within(q.z(), cylinder.half_length, more);
+    });
     for (const double end : {-1.0, 1.0}) {
       // A cap: end q_z = h + r, within the disc.
       s.feature(end * s.coordinate(2, end * cylinder.half_length) + Polynomial{-r},
-                [&](const Eigen::Vector3d& q) {
-                  return s.within(std::hypot(q.x(), q.y()), cylinder.radius);
+                [&](const Eigen::Vector3d& q, double more) {
+                  return s.within(std::hypot(q.x(), q.y()), cylinder.radius, more);
                 });
       // A rim: the torus (|w|^2 + R^2 - r^2)^2 = 4 R^2 (w_x^2 + w_y^2), w = q - end h z, whose
       // value at the start is (d^2 - r^2)((rho + R)^2 + w_z^2 - r^2), d the distance to the
@@ -322,7 +361,9 @@ std::optional<double> firstContactFinite(const RelativeMotion& motion, const Cap
     const Polynomial x = s.coordinate(0), y = s.coordinate(1);
     Polynomial side = square(x) + square(y);
     FeatureSearch::startFromDistance(side, std::hypot(x[0], y[0]), grown);
-    s.feature(side, [&](const Eigen::Vector3d& q) { return s.within(q.z(), capsule.half_length); });
+    s.feature(side, [&](const Eigen::Vector3d& q, double more) {
+      return s.within(q.z(), capsule.half_length, more);
+    });
     for (const double end : {-1.0, 1.0}) {
       const Polynomial z = s.coordinate(2, end * capsule.half_length);
       Polynomial ball = square(x) + square(y) + square(z);

@@ -34,9 +34,14 @@ struct PolynomialRoot {
 /// polished by bisection until its bracket is two doubles wide. At most 4096 pieces are looked
 /// at (a polynomial within its rounding of 0 on a whole stretch: a ball rolling on the very
 /// surface): past that nothing more is visited.
-std::optional<PolynomialRoot> visitRoots(const std::vector<long double>& coefficients,
-                                         double horizon,
-                                         const std::function<bool(const PolynomialRoot&)>& visit);
+///
+/// `may_hold(low, high)`, if given, is asked once a simple root's bracket is a millionth of the
+/// horizon wide (or at once, for a double root's short interval): false skips the root without
+/// polishing it (a face's plane crossed outside the face), and it is not visited.
+std::optional<PolynomialRoot> visitRoots(
+    const std::vector<long double>& coefficients, double horizon,
+    const std::function<bool(const PolynomialRoot&)>& visit,
+    const std::function<bool(double low, double high)>& may_hold = nullptr);
 
 /// p(t) and p'(t) by Horner's rule in long double.
 long double polynomialValue(const std::vector<long double>& coefficients, long double t);
