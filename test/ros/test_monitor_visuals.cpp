@@ -175,7 +175,7 @@ TEST_F(Visuals, MarkersDiagnosticsAndLiveTuning) {
   const auto obstacles = markersIn("obstacles");
   std::map<int, visualization_msgs::Marker> shapes;
   for (const auto& marker : obstacles) shapes[marker.id] = marker;
-  ASSERT_EQ(shapes.size(), 2u);
+  ASSERT_EQ(shapes.size(), 4u);
   const auto& boulder = shapes[0];  // "boulder" < "floor"
   EXPECT_EQ(boulder.text, "boulder");
   EXPECT_EQ(boulder.type, visualization_msgs::Marker::SPHERE);
@@ -186,6 +186,29 @@ TEST_F(Visuals, MarkersDiagnosticsAndLiveTuning) {
   EXPECT_DOUBLE_EQ(floor.pose.orientation.w, 1.0);  // normal +z: no turn
   EXPECT_LT(floor.scale.z, floor.scale.x);
   EXPECT_EQ(floor.color.r, floor.color.g);  // concrete is grey
+  // A capsule (ids in name order: boulder, floor, rod, table): its segment a cylinder along z,
+  // its ends a sphere list.
+  const auto& rod = shapes[2];
+  EXPECT_EQ(rod.text, "rod");
+  EXPECT_EQ(rod.type, visualization_msgs::Marker::CYLINDER);
+  EXPECT_DOUBLE_EQ(rod.scale.x, 0.1);
+  EXPECT_DOUBLE_EQ(rod.scale.z, 0.4);
+  EXPECT_DOUBLE_EQ(rod.pose.position.x, -2.0);
+  const auto ends = markersIn("obstacle_ends");
+  ASSERT_FALSE(ends.empty());
+  ASSERT_EQ(ends.back().points.size(), 2u);
+  EXPECT_DOUBLE_EQ(ends.back().points[0].z, 1.2);
+  EXPECT_DOUBLE_EQ(ends.back().points[1].z, 0.8);
+  EXPECT_DOUBLE_EQ(ends.back().scale.x, 0.1);
+  // A box turned a quarter about z: a cube of its size, turned with it.
+  const auto& table = shapes[3];
+  EXPECT_EQ(table.type, visualization_msgs::Marker::CUBE);
+  EXPECT_DOUBLE_EQ(table.scale.x, 1.0);
+  EXPECT_DOUBLE_EQ(table.scale.y, 0.6);
+  EXPECT_DOUBLE_EQ(table.scale.z, 0.05);
+  EXPECT_DOUBLE_EQ(table.pose.position.z, 0.725);
+  EXPECT_NEAR(table.pose.orientation.z, std::sqrt(0.5), 1e-15);
+  EXPECT_NEAR(table.pose.orientation.w, std::sqrt(0.5), 1e-15);
 
   // Diagnostics: the node's health, with what it tracks and what it dropped.
   diagnostic_msgs::DiagnosticStatus status;
