@@ -10,6 +10,7 @@
 #include <random>
 #include <vector>
 
+#include "collision_response/core/monitor.h"
 #include "geometry/finite_shapes.h"
 #include "geometry/narrow_phase.h"
 #include "geometry/polynomial_roots.h"
@@ -313,6 +314,45 @@ TEST(FiniteShapes, ContactGeometryOfEachFeature) {
   EXPECT_NEAR(g.gap, 0.5 - kRadius, 1e-15);
   EXPECT_NEAR((g.turning_axis - V::UnitY()).norm(), 0, 1e-15);
   EXPECT_NEAR(g.axial_share, 0.5, 1e-15);  // 1 - 0.3 / 0.6
+}
+
+// A paddle (a thin box, its faces at x = +-0.01) turning about z at w = 10 rad/s on its frame,
+// and a ball (r = 0.05, e = 0.5 against it) moving at 0.5 m/s into its -x face at y = 0.1. The
+// face's point there moves at w x r = (0, 0, 10) x (-0.01, 0.1, 0) = (-1, -0.1, 0): the ball
+// meets a surface closing at 1 m/s, not a still one, and leaves along x at u_s + e (u_s - u_a)
+// = -1 + 0.5 (-1 - 0.5) = -1.75 m/s (without friction its y velocity stays 0).
+TEST(FiniteShapes, ATurningPaddleHitsWithItsSurfacesVelocity) {
+  Scene scene;
+  ASSERT_TRUE(scene.materials.addMaterial("wood", Material{0.5, 0.0}, "m").ok());
+  BodySpec ball;
+  ball.id = "ball";
+  ball.mass = 0.1;
+  ball.radius = 0.05;
+  ball.material = "wood";
+  scene.bodies = {ball};
+  ObstacleSpec paddle;
+  paddle.id = "paddle";
+  paddle.shape = ObstacleShape::kBox;
+  paddle.size = V(0.02, 0.3, 0.3);
+  paddle.frame = "paddle_link";
+  paddle.material = "wood";
+  scene.obstacles = {paddle};
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  RigidPose frame;
+  frame.angular_velocity = V(0, 0, 10);
+  monitor.setObstaclePose(0, frame);
+  BodyStateSample start;
+  start.body = 0;
+  start.position = V(-0.01 - 0.05 - 0.005, 0.1, 0);
+  start.velocity = V(0.5, 0, 0);
+  monitor.step(0.0, {start});
+  const StepReport report = monitor.step(0.02, {});
+  ASSERT_EQ(report.impacts.size(), 1u);
+  const ImpactRecord& impact = report.impacts[0];
+  EXPECT_TRUE(impact.other_is_obstacle);
+  EXPECT_NEAR(impact.time, 0.01, 1e-15);  // the paddle moves straight on (here: not at all)
+  EXPECT_NEAR((impact.velocity_b_before - V(-1, -0.1, 0)).norm(), 0, 1e-12);
+  EXPECT_NEAR((impact.velocity_a_after - V(-1.75, 0, 0)).norm(), 0, 1e-12);
 }
 
 /// Independent references: the distance from a point to each shape by its own formula.

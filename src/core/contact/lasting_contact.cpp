@@ -36,7 +36,7 @@ using Motion = UnderGravity;  // lasting contact needs a steady force: the gravi
 /// it until a sample sees it out, would fall back into it, where no impact is found again.
 bool lastingCandidate(const World& world, const Pair& pair, double time, const Geometry& g) {
   if (!g.valid || g.gap > g.tolerance) return false;
-  const NormalMotion motion = normalMotion<Motion>(world, pair, g.normal, time);
+  const NormalMotion motion = normalMotion<Motion>(world, pair, g, time);
   const double pressing = world.gravity.norm();
   return std::abs(motion.speed) <=
          restSpeed(pressing, world.riseBand(g, pressing)) + motion.rounding;

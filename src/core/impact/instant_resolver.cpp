@@ -43,11 +43,11 @@ std::vector<std::size_t> findStriking(const World& world, double time,
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     const Pair& pair = contacts[k].pair;
     const Geometry& g = contacts[k].geometry;
-    if (!approaching<Motion>(world, pair, g.normal, time)) continue;
+    if (!approaching<Motion>(world, pair, g, time)) continue;
     if constexpr (Motion::kAccelerates) {
       if (world.lasting(pair)) {
         const double closing = (velocityAt<Motion>(world, pair.first, time) -
-                                velocityAt<Motion>(world, pair.second, time))
+                                touchingVelocity<Motion>(world, pair, g, time))
                                    .dot(g.normal);
         if (closing <= restSpeed(world.gravity.norm(), g.tolerance)) continue;
       }
@@ -126,7 +126,8 @@ double contactRestitution(World& world, double time, const InstantContact& conta
         -normal.dot(accelerationOf<Motion>(world, other) - accelerationOf<Motion>(world, a));
     if (!contact.geometry.flat()) {
       const Eigen::Vector3d relative =
-          velocityAt<Motion>(world, other, time) - velocityAt<Motion>(world, a, time);
+          touchingVelocity<Motion>(world, contact.pair, contact.geometry, time) -
+          velocityAt<Motion>(world, a, time);
       const Eigen::Vector3d across = relative - relative.dot(normal) * normal;
       pressing -= contact.geometry.centripetal(across);
     }
@@ -149,6 +150,7 @@ PreparedCluster prepareCluster(World& world, double time,
                                const std::vector<char>& joined) {
   PreparedCluster prepared;
   std::vector<std::size_t>& members = prepared.members;
+  std::vector<std::pair<std::size_t, Eigen::Vector3d>> finite_members;  // member, its velocity
   const auto local = [&members](std::size_t participant) {
     const auto found = std::find(members.begin(), members.end(), participant);
     if (found != members.end()) return static_cast<std::size_t>(found - members.begin());
@@ -158,13 +160,23 @@ PreparedCluster prepareCluster(World& world, double time,
   for (const std::size_t k : cluster) {
     const InstantContact& instant_contact = contacts[k];
     const Pair& pair = instant_contact.pair;
+    const Geometry& g = instant_contact.geometry;
     ClusterContact contact;
     contact.a = local(pair.first);
-    contact.b = local(pair.second);
-    contact.normal = instant_contact.geometry.normal;
-    const double approach_speed =
-        (velocityAt<Motion>(world, pair.first, time) - velocityAt<Motion>(world, pair.second, time))
-            .dot(contact.normal);
+    if (g.bounded && world.isObstacle(pair.second)) {
+      // A finite shape: one member of its own for each of its contacts, moving as its surface
+      // does at the contact point (v + w x r), so that each contact sees the surface's own
+      // velocity; an immovable body's contacts do not act on each other.
+      members.push_back(pair.second);
+      contact.b = members.size() - 1;
+      finite_members.push_back({contact.b, g.surface_velocity});
+    } else {
+      contact.b = local(pair.second);
+    }
+    contact.normal = g.normal;
+    const double approach_speed = (velocityAt<Motion>(world, pair.first, time) -
+                                   touchingVelocity<Motion>(world, pair, g, time))
+                                      .dot(contact.normal);
     contact.restitution =
         joined[k] == 2 ? 0.0
                        : contactRestitution<Motion>(world, time, instant_contact, approach_speed);
@@ -180,6 +192,8 @@ PreparedCluster prepareCluster(World& world, double time,
     body.radius = world.radius[participant];
     prepared.bodies.push_back(body);
   }
+  // Its own angular velocity stays (as reported), acting on nothing: its radius is 0.
+  for (const auto& [member, velocity] : finite_members) prepared.bodies[member].velocity = velocity;
   return prepared;
 }
 
@@ -614,13 +628,13 @@ void resolveInstant(World& world, double time, const std::vector<Pair>& touching
     for (const std::size_t k : striking) {
       const Pair& pair = contacts[k].pair;
       const double approach = (velocityAt<Motion>(world, pair.first, time) -
-                               velocityAt<Motion>(world, pair.second, time))
+                               touchingVelocity<Motion>(world, pair, contacts[k].geometry, time))
                                   .dot(contacts[k].geometry.normal);
       joined[k] = progress.strikes(k, approach) ? 1 : 2;
     }
     for (std::size_t k = 0; k < contacts.size(); ++k) {
       if (plastic[k] && !joined[k] &&
-          !separating<Motion>(world, contacts[k].pair, contacts[k].geometry.normal, time)) {
+          !separating<Motion>(world, contacts[k].pair, contacts[k].geometry, time)) {
         striking.push_back(k);
         joined[k] = 2;
       }

@@ -66,7 +66,7 @@ void ContactSchedule<Motion>::schedule(std::size_t k, double from, const Geometr
   // in a straight line; under gravity it may (a ball that bounced falls back), so its next entry
   // is looked for, except on the plane it rests on.
   const bool touching_now = std::abs(g.gap) <= g.tolerance;
-  if (touching_now && approaching<Motion>(world_, pair, g.normal, from)) {
+  if (touching_now && approaching<Motion>(world_, pair, g, from)) {
     // Closing while it touches: an impact at this instant. The instant's resolver leaves none
     // of its pairs approaching; this is one whose motion changed after it (a group formed
     // again closes its contacts' normal velocities, which may turn a neighbouring touching pair

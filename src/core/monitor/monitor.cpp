@@ -572,7 +572,7 @@ void joinOverlappedBefore(const World& world, double time, std::vector<Pair>& ov
   };
   for (const Pair& pair : touching) {
     const Geometry g = monitor::geometry<Motion>(world, pair, time);
-    if (monitor::approaching<Motion>(world, pair, g.normal, time)) {
+    if (monitor::approaching<Motion>(world, pair, g, time)) {
       reach(pair.first);
       reach(pair.second);
     }

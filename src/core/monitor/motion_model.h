@@ -222,32 +222,41 @@ double reach(const World& world, const Pair& pair, double from, double horizon) 
   return distance;
 }
 
-/// The pair's relative velocity along `normal` at `time` (> 0: opening) and what rounding
-/// explains of it (kApproachTolerance of the speeds).
+/// The velocity at `time` of the pair's second participant where the pair touches (`g`): a
+/// body's, a plane's or a sphere's own (a sphere's turning is carried by its radius), and a
+/// finite shape's surface's at the contact point, v + w x r (its centre's unless it turns).
+template <class Motion>
+Eigen::Vector3d touchingVelocity(const World& world, const Pair& pair, const Geometry& g,
+                                 double time) {
+  if (g.bounded && world.isObstacle(pair.second)) return g.surface_velocity;
+  return velocityAt<Motion>(world, pair.second, time);
+}
+
+/// The pair's relative velocity along the normal of `g` at `time` (> 0: opening) and what
+/// rounding explains of it (kApproachTolerance of the speeds).
 struct NormalMotion {
   double speed = 0.0, rounding = 0.0;
 };
 template <class Motion>
-NormalMotion normalMotion(const World& world, const Pair& pair, const Eigen::Vector3d& normal,
-                          double time) {
+NormalMotion normalMotion(const World& world, const Pair& pair, const Geometry& g, double time) {
   const Eigen::Vector3d velocity_a = velocityAt<Motion>(world, pair.first, time);
-  const Eigen::Vector3d velocity_other = velocityAt<Motion>(world, pair.second, time);
-  return NormalMotion{(velocity_other - velocity_a).dot(normal),
+  const Eigen::Vector3d velocity_other = touchingVelocity<Motion>(world, pair, g, time);
+  return NormalMotion{(velocity_other - velocity_a).dot(g.normal),
                       kApproachTolerance * (velocity_a.lpNorm<Eigen::Infinity>() +
                                             velocity_other.lpNorm<Eigen::Infinity>())};
 }
 
-/// The pair closes along `normal` at `time` faster than rounding explains.
+/// The pair closes along the normal of `g` at `time` faster than rounding explains.
 template <class Motion>
-bool approaching(const World& world, const Pair& pair, const Eigen::Vector3d& normal, double time) {
-  const NormalMotion motion = normalMotion<Motion>(world, pair, normal, time);
+bool approaching(const World& world, const Pair& pair, const Geometry& g, double time) {
+  const NormalMotion motion = normalMotion<Motion>(world, pair, g, time);
   return motion.speed < -motion.rounding;
 }
 
-/// The pair opens along `normal` at `time` faster than rounding explains.
+/// The pair opens along the normal of `g` at `time` faster than rounding explains.
 template <class Motion>
-bool separating(const World& world, const Pair& pair, const Eigen::Vector3d& normal, double time) {
-  const NormalMotion motion = normalMotion<Motion>(world, pair, normal, time);
+bool separating(const World& world, const Pair& pair, const Geometry& g, double time) {
+  const NormalMotion motion = normalMotion<Motion>(world, pair, g, time);
   return motion.speed > motion.rounding;
 }
 
