@@ -4,7 +4,11 @@
 //    the sizes involved, plus the distance covered in two ulps of the time: the exact instant
 //    may not be a double, below the smallest subnormal say) and approach;
 //  - no time found although the spheres come clearly inside each other within the horizon (at
-//    their closest, at 1 - 1e-6 of the contact distance) is a miss: a bug.
+//    their closest, at 1 - 1e-6 of the contact distance) is a miss: a bug;
+//  - against a box, cylinder or capsule (firstContactFinite): a time found is in [0, horizon]
+//    with the ball touching the shape there (its distance by the shape's own formula, in long
+//    double); no time found while one of 64 instants along the motion is clearly inside the
+//    shape (1e-6 of the sizes), from a start clearly outside, is a miss.
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -12,6 +16,7 @@
 
 #include "collision_response/core/time_of_impact.h"
 #include "fuzz_input.h"
+#include "geometry/finite_shapes.h"
 
 using namespace collision_response;
 using V = Eigen::Vector3d;
@@ -56,6 +61,52 @@ void checkStraight(const Eigen::Matrix<Scalar, 3, 1>& s, const Eigen::Matrix<Sca
   if (closest.norm() < r - tolerance * scale) fail("missed a contact");
 }
 
+/// The distance from `p` to each finite shape, by its own formula (not the code's features).
+long double distanceTo(const core::Cuboid& box, const Eigen::Matrix<long double, 3, 1>& p) {
+  const Eigen::Matrix<long double, 3, 1> h = box.half_size.cast<long double>();
+  const Eigen::Matrix<long double, 3, 1> out = (p.cwiseAbs() - h).cwiseMax(0.0L);
+  return out.norm();
+}
+long double distanceTo(const core::Cylinder& c, const Eigen::Matrix<long double, 3, 1>& p) {
+  const long double radial = std::max(std::hypot(p.x(), p.y()) - c.radius, 0.0L);
+  const long double axial = std::max(std::abs(p.z()) - c.half_length, 0.0L);
+  return std::hypot(radial, axial);
+}
+long double distanceTo(const core::Capsule& c, const Eigen::Matrix<long double, 3, 1>& p) {
+  const long double z = std::clamp<long double>(p.z(), -c.half_length, c.half_length);
+  return std::max(std::hypot(std::hypot(p.x(), p.y()), p.z() - z) - c.radius, 0.0L);
+}
+
+template <class Shape>
+void checkFinite(const Shape& shape, const core::RelativeMotion& motion, double horizon) {
+  using L = Eigen::Matrix<long double, 3, 1>;
+  const L c = motion.centre.cast<long double>(), v = motion.velocity.cast<long double>(),
+          a = motion.acceleration.cast<long double>();
+  const auto at = [&](long double t) -> L { return c + t * (v + (t / 2) * a); };
+  const long double size = core::boundingRadius(shape) + motion.radius;
+  const auto t = core::firstContactFinite(motion, shape, horizon);
+  if (t) {
+    if (!std::isfinite(*t) || *t < 0 || *t > horizon) fail("finite: time outside [0, horizon]");
+    const long double tl = *t;
+    const long double time_ulp = std::nextafter(*t, INFINITY) - *t;
+    const long double scale = c.norm() + v.norm() * tl + a.norm() * tl * tl + size;
+    const long double speed = v.norm() + a.norm() * (tl + time_ulp);
+    if (std::abs(distanceTo(shape, at(tl)) - motion.radius) >
+        1e-6L * scale + 4 * speed * time_ulp) {
+      fail("finite: no contact at the time found");
+    }
+    return;
+  }
+  // A start clearly outside, and an instant clearly inside: a miss.
+  const long double start_scale = c.norm() + size;
+  if (distanceTo(shape, c) < motion.radius + 1e-6L * start_scale) return;
+  for (int k = 1; k <= 64; ++k) {
+    const long double s = horizon * static_cast<long double>(k) / 64;
+    const long double scale = c.norm() + v.norm() * s + a.norm() * s * s + size;
+    if (distanceTo(shape, at(s)) < motion.radius - 1e-6L * scale) fail("finite: missed a contact");
+  }
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -77,6 +128,32 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const float rf = static_cast<float>(radius), hf = static_cast<float>(horizon);
   if (sf.allFinite() && vf.allFinite() && std::isfinite(rf) && std::isfinite(hf)) {
     checkStraight<float>(sf, vf, rf, hf, 1e-3);
+  }
+
+  // A box, cylinder or capsule of the next numbers' sizes, straight or accelerating.
+  {
+    const double first = std::abs(in.number()), second = std::abs(in.number()),
+                 third = std::abs(in.number());
+    const int kind = static_cast<int>(in.byte() % 6);
+    if (std::isfinite(first) && std::isfinite(second) && std::isfinite(third) && first > 0 &&
+        second > 0 && third > 0) {
+      core::RelativeMotion motion;
+      motion.centre = s;
+      motion.velocity = v;
+      if (kind >= 3) motion.acceleration = a;
+      motion.radius = radius;
+      switch (kind % 3) {
+        case 0:
+          checkFinite(core::Cuboid{V(first, second, third)}, motion, horizon);
+          break;
+        case 1:
+          checkFinite(core::Cylinder{first, second}, motion, horizon);
+          break;
+        default:
+          checkFinite(core::Capsule{first, second}, motion, horizon);
+          break;
+      }
+    }
   }
 
   // Ballistic, against a plane: gap(t) = gap + rate t + (acc/2) t^2.

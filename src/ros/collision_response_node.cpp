@@ -45,10 +45,15 @@ bool CollisionResponseNode::start() {
     return false;
   }
   if (tree.getType() == XmlRpc::XmlRpcValue::TypeStruct && tree.hasMember("scene")) {
-    auto scene = loadScene(tree["scene"], joinKey(ns, "scene"));
+    std::vector<std::string> skipped;
+    auto scene = loadScene(tree["scene"], joinKey(ns, "scene"),
+                           parameterServerUrdf(joinKey(ns, "scene")), &skipped);
     if (!scene) {
       ROS_FATAL_STREAM("collision_response: bad scene: " << scene.error().message());
       return false;
+    }
+    for (const std::string& left_out : skipped) {
+      ROS_WARN_STREAM("collision_response: robot: " << left_out);
     }
     if (auto status = checkBodyTopics(*scene, node_.getNamespace(),
                                       node_.resolveName("body_states"), joinKey(ns, "scene"));

@@ -1,5 +1,8 @@
 #include "collision_response/ros/scene_loader.h"
 
+#include <ros/names.h>
+#include <ros/param.h>
+
 #include <Eigen/Geometry>
 #include <cmath>
 #include <optional>
@@ -7,6 +10,7 @@
 
 #include "collision_response/core/validation.h"
 #include "collision_response/ros/parameters.h"
+#include "collision_response/ros/robot_obstacles.h"
 
 namespace collision_response {
 namespace {
@@ -259,6 +263,41 @@ core::Status readList(const XmlRpc::XmlRpcValue& value, const std::string& field
   return core::Ok{};
 }
 
+const KeyTable<RobotLinks>& robotKeys() {
+  static const KeyTable<RobotLinks> kKeys = {
+      textKey<RobotLinks>(
+          "description", [](RobotLinks& r) -> std::string& { return r.description; },
+          [](const std::string& name, const std::string& field) -> core::Status {
+            if (name.empty()) return core::Error{field, "must name a parameter"};
+            return core::Ok{};
+          }),
+      {"links", false,
+       [](const XmlRpc::XmlRpcValue& value, const std::string& field, RobotLinks& robot) {
+         if (value.getType() == XmlRpc::XmlRpcValue::TypeString) {
+           if (static_cast<std::string>(const_cast<XmlRpc::XmlRpcValue&>(value)) == "all") {
+             robot.all_links = true;
+             return core::Status(core::Ok{});
+           }
+           return core::Status(core::Error{field, "must be `all` or a list of link names"});
+         }
+         if (auto status = checkArray(value, field); !status) return status;
+         if (value.size() == 0) return core::Status(core::Error{field, "names no link"});
+         robot.all_links = false;
+         for (int i = 0; i < value.size(); ++i) {
+           const auto name = readString(value[i], indexKey(field, static_cast<std::size_t>(i)));
+           if (!name) return core::Status(name.error());
+           robot.links.push_back(*name);
+         }
+         return core::Status(core::Ok{});
+       }},
+      textKey<RobotLinks>(
+          "material", [](RobotLinks& r) -> std::string& { return r.material; }, nullptr, true),
+      numberKey<RobotLinks>(
+          "padding", [](RobotLinks& r) -> double& { return r.padding; }, checkNonNegative),
+  };
+  return kKeys;
+}
+
 const KeyTable<Scene>& sceneTable() {
   // The material keys first: bodies and pairs name materials.
   static const KeyTable<Scene> kKeys = {
@@ -348,15 +387,49 @@ const KeyTable<Scene>& sceneTable() {
        [](const XmlRpc::XmlRpcValue& value, const std::string& field, Scene& scene) {
          return readList(value, field, scene.obstacles, readObstacle);
        }},
+      {"robot", false,
+       [](const XmlRpc::XmlRpcValue&, const std::string&, Scene&) {
+         return core::Status(core::Ok{});  // read by loadScene, with the URDF it names
+       }},
   };
   return kKeys;
 }
 
 }  // namespace
 
-core::Expected<core::Scene> loadScene(const XmlRpc::XmlRpcValue& value, const std::string& field) {
+UrdfSource parameterServerUrdf(const std::string& field) {
+  return [field](const std::string& parameter) -> core::Expected<std::string> {
+    std::string xml;
+    if (!ros::param::get(parameter, xml)) {
+      return core::Error{joinKey(joinKey(field, "robot"), "description"),
+                         "no string parameter '" + ros::names::resolve(parameter) +
+                             "' (the robot's URDF, as robot_state_publisher reads it)"};
+    }
+    return xml;
+  };
+}
+
+core::Expected<core::Scene> loadScene(const XmlRpc::XmlRpcValue& value, const std::string& field,
+                                      const UrdfSource& urdf, std::vector<std::string>* skipped) {
   Scene scene;
   if (auto status = readKeys(value, sceneTable(), field, scene); !status) return status.error();
+  if (value.hasMember("robot")) {
+    const std::string robot_field = joinKey(field, "robot");
+    RobotLinks robot;
+    if (auto status = readKeys(value["robot"], robotKeys(), robot_field, robot); !status) {
+      return status.error();
+    }
+    if (!urdf) {
+      return core::Error{robot_field, "a robot's links need the parameter server's URDF"};
+    }
+    const auto xml = urdf(robot.description);
+    if (!xml) return xml.error();
+    std::vector<std::string> left_out;
+    auto obstacles = robotObstacles(*xml, robot, robot_field, left_out);
+    if (!obstacles) return obstacles.error();
+    scene.obstacles.insert(scene.obstacles.end(), obstacles->begin(), obstacles->end());
+    if (skipped) skipped->insert(skipped->end(), left_out.begin(), left_out.end());
+  }
   if (auto status = core::validateScene(scene, field); !status) return status.error();
   core::normalizePlanes(scene);
   return scene;
@@ -370,7 +443,8 @@ std::map<std::string, std::vector<std::string>> sceneKeys() {
           {"obstacles[] box", keyNames(boxKeys())},
           {"obstacles[] cylinder, capsule", keyNames(roundShapeKeys())},
           {"materials.<name>", keyNames(materialKeys())},
-          {"pairs[]", keyNames(pairKeys())}};
+          {"pairs[]", keyNames(pairKeys())},
+          {"robot", keyNames(robotKeys())}};
 }
 
 }  // namespace collision_response

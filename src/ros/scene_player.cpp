@@ -119,7 +119,9 @@ bool ScenePlayer::initialize() {
     ROS_FATAL_STREAM("scene_player: bad parameter: " << params.error().message());
     return false;
   }
-  auto scene = loadScene(tree["scene"], joinKey(ns, "scene"));
+  // The robot's links too: the impacts the node publishes name them.
+  auto scene =
+      loadScene(tree["scene"], joinKey(ns, "scene"), parameterServerUrdf(joinKey(ns, "scene")));
   if (!scene) {
     ROS_FATAL_STREAM("scene_player: bad scene: " << scene.error().message());
     return false;

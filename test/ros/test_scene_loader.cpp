@@ -446,7 +446,7 @@ std::map<std::string, std::map<std::string, XmlRpc::XmlRpcValue>> examples() {
 }
 
 /// The containers: documented as keys of the scene, filled by the entries of their entity.
-const std::set<std::string> kContainers = {"materials", "pairs", "bodies", "obstacles"};
+const std::set<std::string> kContainers = {"materials", "pairs", "bodies", "obstacles", "robot"};
 
 TEST(SceneKeys, EveryDocumentedKeyIsReadAndEveryReadKeyDocumented) {
   const auto tables = testing::readmeTables("### Scene file");

@@ -3,6 +3,7 @@
 
 #include <XmlRpcValue.h>
 
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -17,10 +18,21 @@ namespace collision_response {
 /// (`field`/bodies[2]/mass) and the reason: an unknown key, a wrong type, a missing required
 /// key, an unknown material, effect, detection or obstacle type, a duplicate name, a value out
 /// of range.
-core::Expected<core::Scene> loadScene(const XmlRpc::XmlRpcValue& scene, const std::string& field);
+///
+/// With `robot:` the links of the URDF that `urdf` returns for the parameter it names become
+/// obstacles (robot_obstacles.h); what they leave out (meshes) is added to `skipped`.
+using UrdfSource = std::function<core::Expected<std::string>(const std::string& parameter)>;
+core::Expected<core::Scene> loadScene(const XmlRpc::XmlRpcValue& scene, const std::string& field,
+                                      const UrdfSource& urdf = nullptr,
+                                      std::vector<std::string>* skipped = nullptr);
+
+/// The URDF from the parameter server (a name relative to the node's namespace); an error names
+/// `field`/robot/description.
+UrdfSource parameterServerUrdf(const std::string& field);
 
 /// The keys loadScene reads, by entity, as the README's tables name them: "scene", "bodies[]",
-/// "obstacles[] plane", "obstacles[] sphere", "materials.<name>", "pairs[]". These are the key
+/// "obstacles[] plane", "obstacles[] sphere", "obstacles[] box", "obstacles[] cylinder, capsule",
+/// "materials.<name>", "pairs[]", "robot". These are the key
 /// tables the loader reads and checks with: a key is accepted exactly when it is listed here.
 std::map<std::string, std::vector<std::string>> sceneKeys();
 

@@ -1,0 +1,35 @@
+// A robot's own links as obstacles (scene key `robot:`): every <collision> of the chosen links of
+// the URDF on the parameter server becomes an obstacle attached to its link's tf frame, moving
+// with it (README, "A robot's links").
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "collision_response/core/expected.h"
+#include "collision_response/core/scene.h"
+
+namespace collision_response {
+
+/// The scene's `robot:` entry.
+struct RobotLinks {
+  std::string description = "robot_description";  ///< the parameter holding the URDF
+  bool all_links = true;                          ///< `links: all`
+  std::vector<std::string> links;                 ///< otherwise these
+  std::string material;                           ///< required: every link's
+  double padding = 0.0;  ///< m, >= 0: every shape grown by it (a box by it on each side)
+};
+
+/// The obstacles of `urdf` (the URDF's XML) for `robot`: one per <collision> of each chosen link,
+/// in link-name order, named `<link>/<index>` (`<link>` alone when it has one), in the link's
+/// frame at the collision's <origin>: a URDF box (`size` full lengths), cylinder (along z,
+/// `length` full) and sphere as the scene's box, cylinder and sphere, grown by `padding`. A
+/// <mesh> is not an obstacle yet: it is left out and `skipped` says which (link, index and
+/// resource). Errors name `field`'s keys: a URDF that does not parse (field/description), a chosen
+/// link the URDF does not have or without a <collision> (field/links[i]).
+core::Expected<std::vector<core::ObstacleSpec>> robotObstacles(const std::string& urdf,
+                                                               const RobotLinks& robot,
+                                                               const std::string& field,
+                                                               std::vector<std::string>& skipped);
+
+}  // namespace collision_response

@@ -1,0 +1,157 @@
+// The scene's `robot:` key: a URDF's <collision> elements as obstacles on their links' frames,
+// named and placed as the URDF says (sizes in full lengths, a cylinder along z), grown by
+// `padding`; a mesh left out and named; every error named by its key.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "collision_response/ros/robot_obstacles.h"
+#include "collision_response/ros/scene_loader.h"
+
+namespace collision_response {
+namespace {
+
+const std::string kArm = R"(<?xml version="1.0"?>
+<robot name="arm">
+  <link name="base_link"/>
+  <link name="upper_arm">
+    <collision>
+      <origin xyz="0 0 0.2" rpy="1.5707963267948966 0 0"/>
+      <geometry><cylinder radius="0.04" length="0.4"/></geometry>
+    </collision>
+  </link>
+  <link name="paddle">
+    <collision>
+      <origin xyz="0.1 0 0" rpy="0 0 0"/>
+      <geometry><box size="0.02 0.3 0.2"/></geometry>
+    </collision>
+    <collision>
+      <origin xyz="0 0 0.3"/>
+      <geometry><sphere radius="0.05"/></geometry>
+    </collision>
+    <collision>
+      <geometry><mesh filename="package://arm/meshes/grip.stl" scale="1 1 1"/></geometry>
+    </collision>
+  </link>
+  <joint name="shoulder" type="revolute">
+    <parent link="base_link"/><child link="upper_arm"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="1" velocity="1"/>
+  </joint>
+  <joint name="wrist" type="fixed">
+    <parent link="upper_arm"/><child link="paddle"/><origin xyz="0 0 0.4"/>
+  </joint>
+</robot>)";
+
+TEST(RobotObstacles, EveryCollisionOfTheLinksNamedAndPlacedAsTheUrdfSays) {
+  RobotLinks robot;
+  robot.material = "wooden_ball";
+  std::vector<std::string> skipped;
+  const auto obstacles = robotObstacles(kArm, robot, "~scene/robot", skipped);
+  ASSERT_TRUE(obstacles.ok()) << obstacles.error().message();
+  // In link-name order: paddle (three collisions, the mesh left out), upper_arm (one).
+  ASSERT_EQ(obstacles->size(), 3u);
+  const core::ObstacleSpec& box = (*obstacles)[0];
+  EXPECT_EQ(box.id, "paddle/0");
+  EXPECT_EQ(box.frame, "paddle");
+  EXPECT_EQ(box.material, "wooden_ball");
+  EXPECT_EQ(box.shape, core::ObstacleShape::kBox);
+  EXPECT_EQ(box.size, Eigen::Vector3d(0.02, 0.3, 0.2));  // URDF sizes are full lengths
+  EXPECT_EQ(box.position, Eigen::Vector3d(0.1, 0, 0));
+  const core::ObstacleSpec& ball = (*obstacles)[1];
+  EXPECT_EQ(ball.id, "paddle/1");
+  EXPECT_EQ(ball.shape, core::ObstacleShape::kSphere);
+  EXPECT_EQ(ball.radius, 0.05);
+  EXPECT_EQ(ball.position, Eigen::Vector3d(0, 0, 0.3));
+  const core::ObstacleSpec& arm = (*obstacles)[2];
+  EXPECT_EQ(arm.id, "upper_arm");  // its only collision: the link's name alone
+  EXPECT_EQ(arm.frame, "upper_arm");
+  EXPECT_EQ(arm.shape, core::ObstacleShape::kCylinder);
+  EXPECT_EQ(arm.radius, 0.04);
+  EXPECT_EQ(arm.length, 0.4);
+  EXPECT_EQ(arm.position, Eigen::Vector3d(0, 0, 0.2));
+  // Roll pi/2: the cylinder's axis z turned onto -y.
+  EXPECT_NEAR((arm.orientation * Eigen::Vector3d::UnitZ() - Eigen::Vector3d(0, -1, 0)).norm(), 0,
+              1e-12);
+  ASSERT_EQ(skipped.size(), 1u);
+  EXPECT_NE(skipped[0].find("link 'paddle' <collision> 2: mesh 'package://arm/meshes/grip.stl'"),
+            std::string::npos)
+      << skipped[0];
+}
+
+TEST(RobotObstacles, ChosenLinksAndPadding) {
+  RobotLinks robot;
+  robot.material = "concrete";
+  robot.all_links = false;
+  robot.links = {"upper_arm"};
+  robot.padding = 0.01;
+  std::vector<std::string> skipped;
+  const auto obstacles = robotObstacles(kArm, robot, "~scene/robot", skipped);
+  ASSERT_TRUE(obstacles.ok());
+  ASSERT_EQ(obstacles->size(), 1u);
+  EXPECT_DOUBLE_EQ((*obstacles)[0].radius, 0.05);
+  EXPECT_DOUBLE_EQ((*obstacles)[0].length, 0.42);
+  EXPECT_TRUE(skipped.empty());
+}
+
+TEST(RobotObstacles, ErrorsNameTheKey) {
+  RobotLinks robot;
+  robot.material = "concrete";
+  std::vector<std::string> skipped;
+  auto result = robotObstacles("<robot", robot, "~scene/robot", skipped);
+  ASSERT_FALSE(result.ok());
+  EXPECT_EQ(result.error().field, "~scene/robot/description");
+  robot.all_links = false;
+  robot.links = {"upper_arm", "elbow"};
+  result = robotObstacles(kArm, robot, "~scene/robot", skipped);
+  ASSERT_FALSE(result.ok());
+  EXPECT_EQ(result.error().field, "~scene/robot/links[1]");  // no such link
+  robot.links = {"base_link"};
+  result = robotObstacles(kArm, robot, "~scene/robot", skipped);
+  ASSERT_FALSE(result.ok());
+  EXPECT_EQ(result.error().field, "~scene/robot/links[0]");  // no <collision>
+  EXPECT_NE(result.error().message().find("has no <collision>"), std::string::npos);
+}
+
+TEST(RobotObstacles, TheSceneKeyReadsTheUrdfItNames) {
+  XmlRpc::XmlRpcValue scene;
+  scene["robot"]["description"] = "arm_description";
+  scene["robot"]["links"] = "all";
+  scene["robot"]["material"] = "concrete";
+  std::string asked;
+  const UrdfSource source = [&](const std::string& parameter) -> core::Expected<std::string> {
+    asked = parameter;
+    return kArm;
+  };
+  std::vector<std::string> skipped;
+  const auto loaded = loadScene(scene, "~scene", source, &skipped);
+  ASSERT_TRUE(loaded.ok()) << loaded.error().message();
+  EXPECT_EQ(asked, "arm_description");
+  EXPECT_EQ(loaded->obstacles.size(), 3u);
+  EXPECT_EQ(skipped.size(), 1u);
+  // Without a source (no parameter server), and with a bad key, named errors.
+  EXPECT_EQ(loadScene(scene, "~scene").error().field, "~scene/robot");
+  scene["robot"]["padding"] = -1.0;
+  EXPECT_EQ(loadScene(scene, "~scene", source).error().field, "~scene/robot/padding");
+  scene["robot"]["padding"] = 0.0;
+  scene["robot"]["links"] = "some";
+  EXPECT_EQ(loadScene(scene, "~scene", source).error().field, "~scene/robot/links");
+  scene["robot"]["links"] = "all";
+  scene["robot"]["colour"] = "red";
+  EXPECT_EQ(loadScene(scene, "~scene", source).error().field, "~scene/robot/colour");
+  // A robot link's id taken by a body: ids are shared.
+  XmlRpc::XmlRpcValue clash;
+  clash["robot"]["material"] = "concrete";
+  clash["bodies"][0]["id"] = "upper_arm";
+  clash["bodies"][0]["mass"] = 1.0;
+  clash["bodies"][0]["radius"] = 0.1;
+  clash["bodies"][0]["material"] = "tennis_ball";
+  const auto clashed = loadScene(clash, "~scene", source);
+  ASSERT_FALSE(clashed.ok());
+  EXPECT_NE(clashed.error().message().find("upper_arm"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace collision_response
