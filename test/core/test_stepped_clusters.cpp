@@ -306,7 +306,9 @@ BodySpec ball(const std::string& id, double mass, double radius) {
 }
 
 /// A closed box [0, size]^3 of six planes, e = 0.5 for every pair, gravity (0, 0, -g).
-Scene boxScene(double size) {
+/// `box_floor`: the floor is the top face of a box (0.2 m thick, reaching past the walls) rather
+/// than a plane.
+Scene boxScene(double size, bool box_floor = false) {
   Scene scene;
   scene.effects.gravity = true;
   scene.gravity = V(0, 0, -kG);
@@ -318,6 +320,11 @@ Scene boxScene(double size) {
     wall.normal = normals[w];
     wall.offset = w % 2 ? -size : 0.0;
     wall.material = "pile";
+    if (box_floor && w == 4) {
+      wall.shape = ObstacleShape::kBox;
+      wall.size = V(size + 1, size + 1, 0.2);
+      wall.position = V(0.5 * size, 0.5 * size, -0.1);
+    }
     scene.obstacles.push_back(wall);
   }
   return scene;
@@ -332,10 +339,11 @@ struct PileRun {
 /// 64 balls (r 0.05 m, 0.1 kg) on a loose 4 x 4 x 4 lattice (0.12 m apart, offsets up to 5 mm)
 /// dropped into a box of 0.58 m, the monitor moving them itself at 100 Hz for `duration` s.
 /// `name(i)`: ball i's id. At every step: the deepest overlap of any pair or wall, the energy.
-PileRun dropPile(double duration, const std::function<std::string(int)>& name) {
+PileRun dropPile(double duration, const std::function<std::string(int)>& name,
+                 bool box_floor = false) {
   const int side = 4, count = side * side * side;
   const double r = 0.05, m = 0.1, spacing = 0.12, size = spacing * side + 0.1;
-  Scene scene = boxScene(size);
+  Scene scene = boxScene(size, box_floor);
   std::mt19937_64 engine(11);
   std::uniform_real_distribution<double> offset(-0.005, 0.005);
   std::vector<V> start;
@@ -413,6 +421,17 @@ TEST(SteppedClusters, APileSettlesInABoxNeverInsideAnything) {
   EXPECT_LE(run.deepest_into_wall, 0.25 * 1e-9 * 0.05 + 1e-16);
   EXPECT_LE(run.gain, 1e-12 * run.released);
   EXPECT_LE(run.kinetic_end, 1e-6 * run.released);
+}
+
+// The same pile on the top face of a box instead of a floor plane (the stepped sub-steps keep
+// their gaps to the box's face as to a plane's: the same contact geometry), over 2 s.
+TEST(SteppedClusters, APileOnABoxFloorNeverInsideIt) {
+  const PileRun run = dropPile(2.0, plainName, true);
+  EXPECT_GE(run.most_stepped, 32u);
+  EXPECT_EQ(run.fallbacks, 0u);
+  EXPECT_LE(run.deepest_into_ball, 0.25 * 1e-9 * 0.1);
+  EXPECT_LE(run.deepest_into_wall, 0.25 * 1e-9 * 0.05 + 1e-16);
+  EXPECT_LE(run.gain, 1e-12 * run.released);
 }
 
 // The same pile with every ball named otherwise (the monitor indexes bodies by sorted id, so the
