@@ -13,12 +13,86 @@ constexpr std::size_t kMaxDegree = 8;
 constexpr int kMaxPieces = 4096;
 constexpr std::size_t kMaxLevels = 128;
 
-/// A stretch [low, high] of u = t / horizon and the Bernstein coefficients of p on it.
-/// Trivial (no initialisers): a stack of them is not cleared at every call.
+/// A stretch [low, high] of u = t / horizon, the Bernstein coefficients of p on it, and a bound
+/// on their rounding. Trivial (no initialisers): a stack of them is not cleared at every call.
 struct Piece {
   std::array<long double, kMaxDegree + 1> b;
-  long double low, high;
+  long double low, high, error;
 };
+
+/// Pascal's triangle, once.
+const std::array<std::array<long double, kMaxDegree + 1>, kMaxDegree + 1>& binomials() {
+  static const auto table = [] {
+    std::array<std::array<long double, kMaxDegree + 1>, kMaxDegree + 1> t{};
+    for (std::size_t i = 0; i <= kMaxDegree; ++i) {
+      t[i][0] = 1;
+      for (std::size_t k = 1; k <= i; ++k) t[i][k] = t[i - 1][k - 1] + (k < i ? t[i - 1][k] : 0);
+    }
+    return t;
+  }();
+  return table;
+}
+
+/// The piece [low, high] of p(u) = sum a_k u^k (0 <= low): its coefficients from the monomial
+/// ones each time (not by subdividing another piece's), so that their rounding is that of the
+/// terms on the piece, sum |a_k| high^k, and not that of the whole horizon's (a root at 1e-200
+/// of a long horizon keeps its digits). p(low + w s) = sum_j c_j s^j with c_j = w^j sum_{k >= j}
+/// C(k, j) a_k low^(k - j) (Taylor's shift), then b_i = sum_{j <= i} C(i, j) / C(n, j) c_j
+/// (Farouki and Rajan, "On the numerical condition of polynomials in Bernstein form", CAGD 4,
+/// 1987, eq. 8).
+Piece pieceOf(const std::vector<long double>& a, std::size_t degree, long double low,
+              long double high) {
+  const auto& choose = binomials();
+  Piece piece;
+  piece.low = low;
+  piece.high = high;
+  const long double width = high - low;
+  std::array<long double, kMaxDegree + 1> shifted{};
+  long double size = 0, reach = 1, width_power = 1;
+  for (std::size_t k = 0; k <= degree; ++k) {
+    size += std::abs(a[k]) * reach;
+    reach *= high;
+  }
+  for (std::size_t j = 0; j <= degree; ++j) {
+    long double sum = 0, low_power = 1;
+    for (std::size_t k = j; k <= degree; ++k) {
+      sum += choose[k][j] * a[k] * low_power;
+      low_power *= low;
+    }
+    shifted[j] = sum * width_power;
+    width_power *= width;
+  }
+  for (std::size_t i = 0; i <= degree; ++i) {
+    long double sum = 0;
+    for (std::size_t j = 0; j <= i; ++j) sum += choose[i][j] / choose[degree][j] * shifted[j];
+    piece.b[i] = sum;
+  }
+  // The shift's and the conversion's roundings: sums of at most n + 1 terms each, every term at
+  // most `size` (the binomial theorem: sum_j sum_k C(k, j) |a_k| low^(k-j) w^j = sum |a_k|
+  // high^k), with room.
+  constexpr long double kEps = std::numeric_limits<long double>::epsilon();
+  piece.error = 8 * static_cast<long double>((degree + 2) * (degree + 2)) * kEps * size;
+  return piece;
+}
+
+/// Bezier clipping (Sederberg and Nishita, "Curve intersection using Bezier clipping", CAD 22,
+/// 1990), one side at a time: p lies on or above the lower hull of its control points (i / n, b_i),
+/// which is convex and so above its tangent at the first point; where b_0 > error, no root lies
+/// before the fraction at which that tangent falls to `error` (mirrored for b_0 < -error). 0 where
+/// nothing can be cut; 1 where the hull never falls.
+long double rootFreeStart(const std::array<long double, kMaxDegree + 1>& b, std::size_t degree,
+                          long double error) {
+  const long double start = b[0];
+  if (std::abs(start) <= error) return 0;
+  const long double sign = start > 0 ? 1 : -1;
+  long double steepest = 0;  // the most negative slope towards 0 (signed by the start's side)
+  for (std::size_t i = 1; i <= degree; ++i) {
+    const long double at = static_cast<long double>(i) / static_cast<long double>(degree);
+    steepest = std::min(steepest, sign * (b[i] - start) / at);
+  }
+  if (!(steepest < 0)) return 1;
+  return std::clamp((sign * start - error) / -steepest, 0.0L, 1.0L);
+}
 
 int signOf(long double value, long double error) {
   if (value > error) return 1;
@@ -61,32 +135,9 @@ std::optional<PolynomialRoot> visitRoots(
     size += std::abs(scaled[k]);
   }
   if (!std::isfinite(size) || !(size > 0)) return std::nullopt;
-  // b_i = sum_{k <= i} C(i, k) / C(n, k) a_k (Farouki and Rajan, eq. 8).
-  Piece whole;
-  whole.low = 0;
-  whole.high = 1;
-  // Pascal's triangle, once.
-  static const auto choose = [] {
-    std::array<std::array<long double, kMaxDegree + 1>, kMaxDegree + 1> table{};
-    for (std::size_t i = 0; i <= kMaxDegree; ++i) {
-      table[i][0] = 1;
-      for (std::size_t k = 1; k <= i; ++k) {
-        table[i][k] = table[i - 1][k - 1] + (k < i ? table[i - 1][k] : 0);
-      }
-    }
-    return table;
-  }();
-  for (std::size_t i = 0; i <= degree; ++i) {
-    long double sum = 0;
-    for (std::size_t k = 0; k <= i; ++k) sum += choose[i][k] / choose[degree][k] * scaled[k];
-    whole.b[i] = sum;
-  }
-  // The rounding of a coefficient: the conversion's (n + 1 terms of a sum of at most `size`) and
-  // each subdivision's (an average of two: one rounding, and at most 128 levels deep), with
-  // room.
-  constexpr long double kEps = std::numeric_limits<long double>::epsilon();
-  const long double error =
-      4 * (static_cast<long double>(degree + 1) * (degree + 1) + 128) * kEps * size;
+  // The shortest piece worth dividing: two doubles of t apart where it ends, and no less than the
+  // smallest double of time.
+  const long double shortest_time = std::numeric_limits<double>::denorm_min();
 
   // Exactly one root in (low, high), where p changes sign from `start_sign`: Newton's steps kept
   // inside the bracket (a bisection where one would leave it), the bracket closed on each
@@ -133,9 +184,10 @@ std::optional<PolynomialRoot> visitRoots(
   // (pieces end at widths of 1e-30, about 2^-100).
   std::array<Piece, kMaxLevels> stack;
   std::size_t waiting = 0;
-  stack[waiting++] = whole;
+  stack[waiting++] = pieceOf(scaled, degree, 0, 1);
   for (int pieces = 0; waiting > 0 && pieces < kMaxPieces; ++pieces) {
     const Piece piece = stack[--waiting];
+    const long double error = piece.error;
     bool positive = true, negative = true;
     int changes = 0, last = 0;
     bool uncertain = false;
@@ -150,50 +202,80 @@ std::optional<PolynomialRoot> visitRoots(
       }
     }
     if (positive || negative) continue;  // no root here
+    long double largest = 0;
+    for (std::size_t i = 0; i <= degree; ++i) largest = std::max(largest, std::abs(piece.b[i]));
+    if (largest <= 2 * error) {
+      // p within its rounding of 0 on the whole piece (a double root is only known to the
+      // square root of the rounding; dividing on would visit that whole stretch): a double
+      // root where the piece begins.
+      if (may_hold && !may_hold(static_cast<double>(piece.low * horizon),
+                                static_cast<double>(piece.high * horizon))) {
+        continue;
+      }
+      PolynomialRoot root;
+      root.time = static_cast<double>(piece.low * horizon);
+      root.simple = false;
+      root.falling = polynomialSlope(scaled, piece.low) <= error;
+      if (visit(root)) return root;
+      continue;
+    }
     if (!uncertain && changes == 1) {
       const auto root = polish(piece.low, piece.high, signOf(piece.b[0], error));
       if (root && visit(*root)) return root;
       continue;
     }
     const long double width = piece.high - piece.low;
-    if (width <= 4 * std::numeric_limits<double>::epsilon() * piece.high + 1e-30L) {
-      // Too short to divide. Where p's values at its ends differ in sign, a root crosses here
-      // (on a subdivision's point, or at the end of the horizon): polished as any.
-      const int at_low = signOf(polynomialValue(scaled, piece.low), 0);
-      const int at_high = signOf(polynomialValue(scaled, piece.high), 0);
-      if (at_low != 0 && at_high != 0 && at_low != at_high) {
-        const auto root = polish(piece.low, piece.high, at_low);
-        if (root && visit(*root)) return root;
+    const bool too_short =
+        width * horizon <=
+            4 * std::numeric_limits<double>::epsilon() * (piece.high * horizon) + shortest_time ||
+        waiting + 2 > stack.size();
+    if (!too_short) {
+      // Clipped from both ends where the hull shows no root (converging on a simple root
+      // quadratically, and on one a trillionth of the way into the piece at once); divided in
+      // the middle where clipping cuts less than half (more than one root, or a double one).
+      long double from = rootFreeStart(piece.b, degree, error);
+      std::array<long double, kMaxDegree + 1> reversed;
+      for (std::size_t i = 0; i <= degree; ++i) reversed[i] = piece.b[degree - i];
+      long double to = 1 - rootFreeStart(reversed, degree, error);
+      // A little less than the hull allows: the fractions are rounded.
+      from = std::max(0.0L, from - 1e-12L);
+      to = std::min(1.0L, to + 1e-12L);
+      if (!(from < to)) continue;  // no root on the piece
+      const long double width_now = piece.high - piece.low;
+      if (to - from <= 0.5L) {
+        stack[waiting++] =
+            pieceOf(scaled, degree, piece.low + from * width_now, piece.low + to * width_now);
         continue;
       }
-      if (may_hold && !may_hold(static_cast<double>(piece.low * horizon),
-                                static_cast<double>(piece.high * horizon))) {
-        continue;
-      }
-      // Otherwise p is within its rounding of 0 somewhere here: a double root.
-      const long double middle = 0.5L * (piece.low + piece.high);
-      PolynomialRoot root;
-      root.time = static_cast<double>(middle * horizon);
-      root.simple = false;
-      root.falling = polynomialSlope(scaled, middle) <= error;
-      if (visit(root)) return root;
+      const long double middle = piece.low + 0.5L * width_now;
+      stack[waiting++] = pieceOf(scaled, degree, middle, piece.high);
+      stack[waiting++] = pieceOf(scaled, degree, piece.low, middle);
       continue;
     }
-    // De Casteljau at the middle: the left half's coefficients are the first of each row of
-    // averages, the right half's the last.
-    Piece left, right;
-    left.low = piece.low;
-    left.high = right.low = 0.5L * (piece.low + piece.high);
-    right.high = piece.high;
-    std::array<long double, kMaxDegree + 1> row = piece.b;
-    for (std::size_t level = 0; level <= degree; ++level) {
-      left.b[level] = row[0];
-      right.b[degree - level] = row[degree - level];
-      for (std::size_t i = 0; i + level < degree; ++i) row[i] = 0.5L * (row[i] + row[i + 1]);
+    // Too short to divide. Where p's values at its ends differ in sign, a root crosses here
+    // (on a split's point, or at the end of the horizon): polished as any.
+    const long double at_low = polynomialValue(scaled, piece.low);
+    const long double at_high = polynomialValue(scaled, piece.high);
+    if (signOf(at_low, 0) != 0 && signOf(at_high, 0) != 0 &&
+        signOf(at_low, 0) != signOf(at_high, 0)) {
+      const auto root = polish(piece.low, piece.high, signOf(at_low, 0));
+      if (root && visit(*root)) return root;
+      continue;
     }
-    if (waiting + 2 > stack.size()) break;  // deeper than widths of 1e-30: not reached
-    stack[waiting++] = right;
-    stack[waiting++] = left;
+    // Otherwise a double root only where p is within its rounding of 0 here (its control points
+    // alone may straddle 0 where p does not).
+    const long double middle = 0.5L * (piece.low + piece.high);
+    const long double at_middle = polynomialValue(scaled, middle);
+    if (std::min({std::abs(at_low), std::abs(at_middle), std::abs(at_high)}) > error) continue;
+    if (may_hold && !may_hold(static_cast<double>(piece.low * horizon),
+                              static_cast<double>(piece.high * horizon))) {
+      continue;
+    }
+    PolynomialRoot root;
+    root.time = static_cast<double>(middle * horizon);
+    root.simple = false;
+    root.falling = polynomialSlope(scaled, middle) <= error;
+    if (visit(root)) return root;
   }
   return std::nullopt;
 }
