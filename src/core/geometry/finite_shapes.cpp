@@ -147,8 +147,8 @@ class FeatureSearch {
           // double root (a graze) is known only to the square root of the polynomial's
           // rounding, and where the motion's terms cancel (1e275 m less 1e275 m) or span 300
           // orders of magnitude that rounding hid gaps of 1e271 m (the fuzzer's finds,
-          // fuzz/regressions/time-of-impact-*-false-graze).
-          // (Written to refuse a NaN: a centre past the doubles touches nothing.)
+          // fuzz/regressions/time-of-impact-box-* and -cylinder-*). Written to refuse a NaN: a
+          // centre past the doubles touches nothing.
           if (!(std::abs(static_cast<long double>(gap_at_(at))) <= 1e-8L * reach(root.time))) {
             return false;
           }
