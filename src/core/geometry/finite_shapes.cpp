@@ -37,7 +37,8 @@ NearestFeature aroundCore(const Eigen::Vector3d& core, const Eigen::Vector3d& of
   NearestFeature feature;
   // Scaled by its largest component: the squares of 1e185 m overflow (norm() gave infinity).
   const double largest = offset.lpNorm<Eigen::Infinity>();
-  const double length = largest > 0 ? largest * (offset / largest).norm() : 0.0;
+  // (A NaN or an infinity stays one: a distance of 0 would be a touch.)
+  const double length = largest == 0 ? 0.0 : largest * (offset / largest).norm();
   feature.outward = length > 0 ? Eigen::Vector3d(offset / length) : fallback_outward;
   feature.point = core + grown * feature.outward;
   feature.distance = length - grown;
@@ -142,16 +143,18 @@ class FeatureSearch {
           if (best_ && root.time >= *best_) return true;  // no later root is the first
           if (!root.falling) return false;
           const Eigen::Vector3d at = positionAt(root.time);
-          if (!region(at, 0.0)) return false;
-          // A root must be a touch by the distance itself, to 1e-8 of the sizes in play: a
-          // double root (a graze) is known only to the square root of the polynomial's
-          // rounding, and where the motion's terms cancel (1e275 m less 1e275 m) or span 300
-          // orders of magnitude that rounding hid gaps of 1e271 m (the fuzzer's finds,
-          // fuzz/regressions/time-of-impact-box-* and -cylinder-*). Written to refuse a NaN: a
-          // centre past the doubles touches nothing.
-          if (!(std::abs(static_cast<long double>(gap_at_(at))) <= 1e-8L * reach(root.time))) {
-            return false;
-          }
+          if (!at.allFinite() || !region(at, 0.0)) return false;  // past the doubles: nothing
+          // A root must be a touch by the distance itself: to 1e-8 of the sizes in play, and a
+          // double root (a graze, known only to the square root of the polynomial's rounding:
+          // a rim of a radius far below the ball's is a near-perfect square) to 1e-5 of the ball
+          // and the shape besides. Where the motion's terms cancel (1e275 m less 1e275 m) or
+          // span 300 orders of magnitude the polynomial's rounding hid gaps of 1e271 m (the
+          // fuzzer's finds, fuzz/regressions/time-of-impact-box-* and -cylinder-*). Written to
+          // refuse a NaN.
+          const long double allowed =
+              1e-8L * reach(root.time) +
+              (root.simple ? 0.0L : 1e-5L * (static_cast<long double>(motion_.radius) + size_));
+          if (!(std::abs(static_cast<long double>(gap_at_(at))) <= allowed)) return false;
           best_ = root.time;
           return true;
         },
@@ -378,6 +381,17 @@ std::optional<double> firstContactFinite(const RelativeMotion& motion, const Cyl
       // value at the start is (d^2 - r^2)((rho + R)^2 + w_z^2 - r^2), d the distance to the
       // circle (so that a small gap keeps its digits).
       const Polynomial z = s.coordinate(2, end * cylinder.half_length);
+      if (big <= 1e-6L * r) {
+        // A rim far smaller than the ball (a thin rod's end): the torus is then a near-perfect
+        // square whose double roots are known only to the square root of the rounding (the
+        // fuzzer missed a contact there); the sphere of radius r about the cap's centre, within
+        // R (at most 1e-6 r) of the torus everywhere, is the rim instead.
+        Polynomial point = square(x) + square(y) + square(z);
+        FeatureSearch::startFromDistance(point, std::sqrt(x[0] * x[0] + y[0] * y[0] + z[0] * z[0]),
+                                         r);
+        s.feature(point, FeatureSearch::anywhere);
+        continue;
+      }
       const Polynomial planar = square(x) + square(y);
       const Polynomial inner = planar + square(z) + Polynomial{big * big - r * r};
       Polynomial torus = square(inner) + (-4 * big * big) * planar;

@@ -212,10 +212,24 @@ std::optional<PolynomialRoot> visitRoots(
                                 static_cast<double>(piece.high * horizon))) {
         continue;
       }
+      // Where on the piece: where |p| is least, the slope's sign change if it has one (a
+      // near-square's touch), else the end nearer 0.
+      long double at = std::abs(polynomialValue(scaled, piece.low)) <=
+                               std::abs(polynomialValue(scaled, piece.high))
+                           ? piece.low
+                           : piece.high;
+      if (polynomialSlope(scaled, piece.low) < 0 && polynomialSlope(scaled, piece.high) > 0) {
+        long double falling_end = piece.low, rising_end = piece.high;
+        for (int iteration = 0; iteration < 64; ++iteration) {
+          const long double middle = 0.5L * (falling_end + rising_end);
+          (polynomialSlope(scaled, middle) < 0 ? falling_end : rising_end) = middle;
+        }
+        at = 0.5L * (falling_end + rising_end);
+      }
       PolynomialRoot root;
-      root.time = static_cast<double>(piece.low * horizon);
+      root.time = static_cast<double>(at * horizon);
       root.simple = false;
-      root.falling = polynomialSlope(scaled, piece.low) <= error;
+      root.falling = polynomialSlope(scaled, at) <= error;
       if (visit(root)) return root;
       continue;
     }
