@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace collision_response::core {
 
@@ -100,6 +101,199 @@ int signOf(long double value, long double error) {
   return 0;
 }
 
+/// The signs of a piece's Bernstein coefficients, each within its rounding or not.
+struct Signs {
+  bool positive = true, negative = true;  ///< every coefficient above (below) its rounding
+  bool uncertain = false;                 ///< one within its rounding
+  int changes = 0;                        ///< sign changes among the certain ones
+  long double largest = 0;                ///< the largest coefficient's size
+};
+
+Signs signsOf(const Piece& piece, std::size_t degree) {
+  Signs signs;
+  int last = 0;
+  for (std::size_t i = 0; i <= degree; ++i) {
+    const int sign = signOf(piece.b[i], piece.error);
+    signs.positive = signs.positive && sign > 0;
+    signs.negative = signs.negative && sign < 0;
+    signs.largest = std::max(signs.largest, std::abs(piece.b[i]));
+    if (sign == 0) {
+      signs.uncertain = true;
+      continue;
+    }
+    if (last != 0 && sign != last) ++signs.changes;
+    last = sign;
+  }
+  return signs;
+}
+
+/// The search of one polynomial's roots on [0, horizon], in u = t / horizon: pieces looked at
+/// leftmost first (a piece's right part waits below its left), each either root-free, or one
+/// simple root (polished), or a double root (placed), or clipped or halved into more pieces.
+class RootSearch {
+ public:
+  RootSearch(std::vector<long double> scaled, std::size_t degree, double horizon,
+             const std::function<bool(double, double)>& may_hold)
+      : scaled_(std::move(scaled)), degree_(degree), horizon_(horizon), may_hold_(may_hold) {
+    stack_[waiting_++] = pieceOf(scaled_, degree_, 0, 1);
+  }
+
+  /// The next piece to look at; none when all are, or after kMaxPieces.
+  std::optional<Piece> next() {
+    if (waiting_ == 0 || looked_at_ >= kMaxPieces) return std::nullopt;
+    ++looked_at_;
+    return stack_[--waiting_];
+  }
+
+  /// The root `piece` holds, if it holds one alone; otherwise its parts are left to look at.
+  std::optional<PolynomialRoot> examine(const Piece& piece) {
+    const Signs signs = signsOf(piece, degree_);
+    if (signs.positive || signs.negative) return std::nullopt;  // no root here
+    // p within its rounding of 0 on the whole piece (a double root is only known to the square
+    // root of the rounding; dividing on would visit that whole stretch): one double root.
+    if (signs.largest <= 2 * piece.error) return doubleRoot(piece, leastOn(piece));
+    if (!signs.uncertain && signs.changes == 1) {
+      return polish(piece.low, piece.high, signOf(piece.b[0], piece.error));
+    }
+    if (!tooShort(piece)) {
+      divide(piece);
+      return std::nullopt;
+    }
+    return onShortPiece(piece);
+  }
+
+ private:
+  /// Exactly one root in (low, high), where p changes sign from `start_sign`: Newton's steps kept
+  /// inside the bracket (a bisection where one would leave it), the bracket closed on each
+  /// evaluation, until it is two doubles wide. A step shorter than a double's spacing is
+  /// lengthened to one, so that the next evaluation lands across the root and closes the
+  /// bracket from the other side. None where `may_hold` refuses the bracket once it is a
+  /// millionth of the horizon wide.
+  std::optional<PolynomialRoot> polish(long double low, long double high, int start_sign) const {
+    long double x = 0.5L * (low + high);
+    bool asked = !may_hold_;
+    for (int iteration = 0; iteration < 256; ++iteration) {
+      if (!asked && high - low <= 1e-6L) {
+        asked = true;
+        if (!mayHold(low, high)) return std::nullopt;
+      }
+      const double low_time = static_cast<double>(low * horizon_);
+      const double high_time = static_cast<double>(high * horizon_);
+      if (std::nextafter(low_time, INFINITY) >= high_time) break;
+      const long double value = polynomialValue(scaled_, x);
+      const int sign = signOf(value, 0);
+      if (sign == 0) {
+        low = high = x;
+        break;
+      }
+      (sign == start_sign ? low : high) = x;
+      const long double slope = polynomialSlope(scaled_, x);
+      const long double step = slope != 0 ? value / slope : 0;
+      const double t = static_cast<double>(x * horizon_);
+      const long double spacing = (std::nextafter(t, INFINITY) - t) / horizon_;
+      long double next = std::abs(step) < spacing ? x - std::copysign(spacing, step) : x - step;
+      if (!(next > low && next < high) || slope == 0) next = 0.5L * (low + high);
+      x = next;
+    }
+    PolynomialRoot root;
+    root.time = static_cast<double>(0.5L * (low + high) * horizon_);
+    root.simple = true;
+    root.falling = start_sign > 0;
+    return root;
+  }
+
+  /// A double root of the piece at `at`, unless `may_hold` refuses the piece.
+  std::optional<PolynomialRoot> doubleRoot(const Piece& piece, long double at) const {
+    if (!mayHold(piece.low, piece.high)) return std::nullopt;
+    PolynomialRoot root;
+    root.time = static_cast<double>(at * horizon_);
+    root.simple = false;
+    root.falling = polynomialSlope(scaled_, at) <= piece.error;
+    return root;
+  }
+
+  /// Where |p| is least on the piece: its slope's sign change if it has one (a near-square's
+  /// touch), else the end nearer 0.
+  long double leastOn(const Piece& piece) const {
+    if (polynomialSlope(scaled_, piece.low) < 0 && polynomialSlope(scaled_, piece.high) > 0) {
+      long double falling_end = piece.low, rising_end = piece.high;
+      for (int iteration = 0; iteration < 64; ++iteration) {
+        const long double middle = 0.5L * (falling_end + rising_end);
+        (polynomialSlope(scaled_, middle) < 0 ? falling_end : rising_end) = middle;
+      }
+      return 0.5L * (falling_end + rising_end);
+    }
+    return std::abs(polynomialValue(scaled_, piece.low)) <=
+                   std::abs(polynomialValue(scaled_, piece.high))
+               ? piece.low
+               : piece.high;
+  }
+
+  /// Too short to divide: two doubles of t wide where it ends (and no less than the smallest
+  /// double of time), or the stack is full.
+  bool tooShort(const Piece& piece) const {
+    const long double width = (piece.high - piece.low) * horizon_;
+    return width <= 4 * std::numeric_limits<double>::epsilon() * (piece.high * horizon_) +
+                        std::numeric_limits<double>::denorm_min() ||
+           waiting_ + 2 > stack_.size();
+  }
+
+  /// Clipped from both ends where the hull shows no root (converging on a simple root
+  /// quadratically, and on one a trillionth of the way into the piece at once); halved where
+  /// clipping cuts less than half (more than one root, or a double one).
+  void divide(const Piece& piece) {
+    long double from = rootFreeStart(piece.b, degree_, piece.error);
+    std::array<long double, kMaxDegree + 1> reversed;
+    for (std::size_t i = 0; i <= degree_; ++i) reversed[i] = piece.b[degree_ - i];
+    long double to = 1 - rootFreeStart(reversed, degree_, piece.error);
+    // A little less than the hull allows: the fractions are rounded.
+    from = std::max(0.0L, from - 1e-12L);
+    to = std::min(1.0L, to + 1e-12L);
+    if (!(from < to)) return;  // no root on the piece
+    const long double width = piece.high - piece.low;
+    if (to - from <= 0.5L) {
+      stack_[waiting_++] =
+          pieceOf(scaled_, degree_, piece.low + from * width, piece.low + to * width);
+      return;
+    }
+    const long double middle = piece.low + 0.5L * width;
+    stack_[waiting_++] = pieceOf(scaled_, degree_, middle, piece.high);
+    stack_[waiting_++] = pieceOf(scaled_, degree_, piece.low, middle);
+  }
+
+  /// A piece too short to divide. Where p's values at its ends differ in sign, a root crosses
+  /// here (on a split's point, or at the end of the horizon): polished as any. Otherwise a double
+  /// root only where p is within its rounding of 0 here (its control points alone may straddle 0
+  /// where p does not).
+  std::optional<PolynomialRoot> onShortPiece(const Piece& piece) const {
+    const long double at_low = polynomialValue(scaled_, piece.low);
+    const long double at_high = polynomialValue(scaled_, piece.high);
+    const int low_sign = signOf(at_low, 0), high_sign = signOf(at_high, 0);
+    if (low_sign != 0 && high_sign != 0 && low_sign != high_sign) {
+      return polish(piece.low, piece.high, low_sign);
+    }
+    const long double middle = 0.5L * (piece.low + piece.high);
+    const long double at_middle = polynomialValue(scaled_, middle);
+    if (std::min({std::abs(at_low), std::abs(at_middle), std::abs(at_high)}) > piece.error) {
+      return std::nullopt;
+    }
+    return doubleRoot(piece, middle);
+  }
+
+  bool mayHold(long double low, long double high) const {
+    return !may_hold_ ||
+           may_hold_(static_cast<double>(low * horizon_), static_cast<double>(high * horizon_));
+  }
+
+  std::vector<long double> scaled_;  ///< a_k = c_k horizon^k: p on u in [0, 1]
+  std::size_t degree_;
+  double horizon_;
+  const std::function<bool(double, double)>& may_hold_;
+  std::array<Piece, kMaxLevels> stack_;
+  std::size_t waiting_ = 0;
+  int looked_at_ = 0;
+};
+
 }  // namespace
 
 long double polynomialValue(const std::vector<long double>& coefficients, long double t) {
@@ -127,7 +321,7 @@ std::optional<PolynomialRoot> visitRoots(
   }
   --degree;  // now the degree
   // On u in [0, 1]: a_k = c_k horizon^k.
-  std::vector<long double> scaled(degree + 1);  // Horner's rule on it below
+  std::vector<long double> scaled(degree + 1);
   long double power = 1, size = 0;
   for (std::size_t k = 0; k <= degree; ++k) {
     scaled[k] = coefficients[k] * power;
@@ -135,161 +329,10 @@ std::optional<PolynomialRoot> visitRoots(
     size += std::abs(scaled[k]);
   }
   if (!std::isfinite(size) || !(size > 0)) return std::nullopt;
-  // The shortest piece worth dividing: two doubles of t apart where it ends, and no less than the
-  // smallest double of time.
-  const long double shortest_time = std::numeric_limits<double>::denorm_min();
-
-  // Exactly one root in (low, high), where p changes sign from `start_sign`: Newton's steps kept
-  // inside the bracket (a bisection where one would leave it), the bracket closed on each
-  // evaluation, until it is two doubles wide. A step shorter than a double's spacing is
-  // lengthened to one, so that the next evaluation lands across the root and closes the bracket
-  // from the other side.
-  const auto polish = [&](long double low, long double high,
-                          int start_sign) -> std::optional<PolynomialRoot> {
-    long double x = 0.5L * (low + high);
-    bool asked = !may_hold;
-    for (int iteration = 0; iteration < 256; ++iteration) {
-      if (!asked && high - low <= 1e-6L) {
-        asked = true;
-        if (!may_hold(static_cast<double>(low * horizon), static_cast<double>(high * horizon))) {
-          return std::nullopt;
-        }
-      }
-      const double low_time = static_cast<double>(low * horizon);
-      const double high_time = static_cast<double>(high * horizon);
-      if (std::nextafter(low_time, INFINITY) >= high_time) break;
-      const long double value = polynomialValue(scaled, x);
-      const int sign = signOf(value, 0);
-      if (sign == 0) {
-        low = high = x;
-        break;
-      }
-      (sign == start_sign ? low : high) = x;
-      const long double slope = polynomialSlope(scaled, x);
-      const long double step = slope != 0 ? value / slope : 0;
-      const double t = static_cast<double>(x * horizon);
-      const long double spacing = (std::nextafter(t, INFINITY) - t) / horizon;
-      long double next = std::abs(step) < spacing ? x - std::copysign(spacing, step) : x - step;
-      if (!(next > low && next < high) || slope == 0) next = 0.5L * (low + high);
-      x = next;
-    }
-    PolynomialRoot root;
-    root.time = static_cast<double>(0.5L * (low + high) * horizon);
-    root.simple = true;
-    root.falling = start_sign > 0;
-    return root;
-  };
-
-  // Leftmost first: a piece's right half waits below its left. At most one piece waits per level
-  // (pieces end at widths of 1e-30, about 2^-100).
-  std::array<Piece, kMaxLevels> stack;
-  std::size_t waiting = 0;
-  stack[waiting++] = pieceOf(scaled, degree, 0, 1);
-  for (int pieces = 0; waiting > 0 && pieces < kMaxPieces; ++pieces) {
-    const Piece piece = stack[--waiting];
-    const long double error = piece.error;
-    bool positive = true, negative = true;
-    int changes = 0, last = 0;
-    bool uncertain = false;
-    for (std::size_t i = 0; i <= degree; ++i) {
-      const int sign = signOf(piece.b[i], error);
-      positive = positive && sign > 0;
-      negative = negative && sign < 0;
-      if (sign == 0) uncertain = true;
-      if (sign != 0) {
-        if (last != 0 && sign != last) ++changes;
-        last = sign;
-      }
-    }
-    if (positive || negative) continue;  // no root here
-    long double largest = 0;
-    for (std::size_t i = 0; i <= degree; ++i) largest = std::max(largest, std::abs(piece.b[i]));
-    if (largest <= 2 * error) {
-      // p within its rounding of 0 on the whole piece (a double root is only known to the
-      // square root of the rounding; dividing on would visit that whole stretch): a double
-      // root where the piece begins.
-      if (may_hold && !may_hold(static_cast<double>(piece.low * horizon),
-                                static_cast<double>(piece.high * horizon))) {
-        continue;
-      }
-      // Where on the piece: where |p| is least, the slope's sign change if it has one (a
-      // near-square's touch), else the end nearer 0.
-      long double at = std::abs(polynomialValue(scaled, piece.low)) <=
-                               std::abs(polynomialValue(scaled, piece.high))
-                           ? piece.low
-                           : piece.high;
-      if (polynomialSlope(scaled, piece.low) < 0 && polynomialSlope(scaled, piece.high) > 0) {
-        long double falling_end = piece.low, rising_end = piece.high;
-        for (int iteration = 0; iteration < 64; ++iteration) {
-          const long double middle = 0.5L * (falling_end + rising_end);
-          (polynomialSlope(scaled, middle) < 0 ? falling_end : rising_end) = middle;
-        }
-        at = 0.5L * (falling_end + rising_end);
-      }
-      PolynomialRoot root;
-      root.time = static_cast<double>(at * horizon);
-      root.simple = false;
-      root.falling = polynomialSlope(scaled, at) <= error;
-      if (visit(root)) return root;
-      continue;
-    }
-    if (!uncertain && changes == 1) {
-      const auto root = polish(piece.low, piece.high, signOf(piece.b[0], error));
-      if (root && visit(*root)) return root;
-      continue;
-    }
-    const long double width = piece.high - piece.low;
-    const bool too_short =
-        width * horizon <=
-            4 * std::numeric_limits<double>::epsilon() * (piece.high * horizon) + shortest_time ||
-        waiting + 2 > stack.size();
-    if (!too_short) {
-      // Clipped from both ends where the hull shows no root (converging on a simple root
-      // quadratically, and on one a trillionth of the way into the piece at once); divided in
-      // the middle where clipping cuts less than half (more than one root, or a double one).
-      long double from = rootFreeStart(piece.b, degree, error);
-      std::array<long double, kMaxDegree + 1> reversed;
-      for (std::size_t i = 0; i <= degree; ++i) reversed[i] = piece.b[degree - i];
-      long double to = 1 - rootFreeStart(reversed, degree, error);
-      // A little less than the hull allows: the fractions are rounded.
-      from = std::max(0.0L, from - 1e-12L);
-      to = std::min(1.0L, to + 1e-12L);
-      if (!(from < to)) continue;  // no root on the piece
-      const long double width_now = piece.high - piece.low;
-      if (to - from <= 0.5L) {
-        stack[waiting++] =
-            pieceOf(scaled, degree, piece.low + from * width_now, piece.low + to * width_now);
-        continue;
-      }
-      const long double middle = piece.low + 0.5L * width_now;
-      stack[waiting++] = pieceOf(scaled, degree, middle, piece.high);
-      stack[waiting++] = pieceOf(scaled, degree, piece.low, middle);
-      continue;
-    }
-    // Too short to divide. Where p's values at its ends differ in sign, a root crosses here
-    // (on a split's point, or at the end of the horizon): polished as any.
-    const long double at_low = polynomialValue(scaled, piece.low);
-    const long double at_high = polynomialValue(scaled, piece.high);
-    if (signOf(at_low, 0) != 0 && signOf(at_high, 0) != 0 &&
-        signOf(at_low, 0) != signOf(at_high, 0)) {
-      const auto root = polish(piece.low, piece.high, signOf(at_low, 0));
-      if (root && visit(*root)) return root;
-      continue;
-    }
-    // Otherwise a double root only where p is within its rounding of 0 here (its control points
-    // alone may straddle 0 where p does not).
-    const long double middle = 0.5L * (piece.low + piece.high);
-    const long double at_middle = polynomialValue(scaled, middle);
-    if (std::min({std::abs(at_low), std::abs(at_middle), std::abs(at_high)}) > error) continue;
-    if (may_hold && !may_hold(static_cast<double>(piece.low * horizon),
-                              static_cast<double>(piece.high * horizon))) {
-      continue;
-    }
-    PolynomialRoot root;
-    root.time = static_cast<double>(middle * horizon);
-    root.simple = false;
-    root.falling = polynomialSlope(scaled, middle) <= error;
-    if (visit(root)) return root;
+  RootSearch search(std::move(scaled), degree, horizon, may_hold);
+  while (const auto piece = search.next()) {
+    const auto root = search.examine(*piece);
+    if (root && visit(*root)) return root;
   }
   return std::nullopt;
 }
