@@ -9,6 +9,7 @@
 #include <type_traits>
 #include <variant>
 
+#include "collision_response/core/triangle_mesh.h"
 #include "collision_response/ros/conversions.h"
 
 namespace collision_response {
@@ -135,6 +136,27 @@ void appendObstacleMarkers(const core::ObstacleSpec& obstacle, int index,
           m.scale.x = 2 * shape.half_size.x();
           m.scale.y = 2 * shape.half_size.y();
           m.scale.z = 2 * shape.half_size.z();
+          return m;
+        } else if constexpr (std::is_same_v<Kind, core::Mesh>) {
+          // rviz loads the mesh's own resource, scaled as the scene says; a mesh built without
+          // one (by a program) is drawn as its triangles.
+          if (!obstacle.resource.empty()) {
+            visualization_msgs::Marker m = marker_of(visualization_msgs::Marker::MESH_RESOURCE);
+            setPose(m, centre, axes);
+            m.mesh_resource = obstacle.resource;
+            m.scale.x = obstacle.scale.x();
+            m.scale.y = obstacle.scale.y();
+            m.scale.z = obstacle.scale.z();
+            return m;
+          }
+          visualization_msgs::Marker m = marker_of(visualization_msgs::Marker::TRIANGLE_LIST);
+          setPose(m, centre, axes);
+          m.scale.x = m.scale.y = m.scale.z = 1.0;
+          for (const core::TriangleMesh::Triangle& t : shape.triangles->triangles()) {
+            for (const std::uint32_t v : t) {
+              m.points.push_back(toPointMsg(shape.triangles->vertices()[v]));
+            }
+          }
           return m;
         } else {
           // A cylinder (rviz's is along its z, as ours); a capsule's segment as one, its ends as

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -14,6 +15,7 @@
 #include "geometry/finite_shapes.h"
 #include "geometry/narrow_phase.h"
 #include "geometry/polynomial_roots.h"
+#include "scene_builders.h"
 
 namespace collision_response::core {
 namespace {
@@ -104,33 +106,48 @@ constexpr double kRadius = 0.1;
 constexpr double kG = 9.81;
 constexpr double kUlps = 4;
 
-TEST(FiniteShapes, BoxFaceHeadOnAndOblique) {
+// The box's features, hit as a box and as a mesh of its 12 triangles (scene_builders::cubeMesh):
+// the same closed forms, to the same few ulps (a mesh's axis-aligned faces have exact normals).
+class BoxOrMeshCube : public ::testing::TestWithParam<bool> {
+ protected:
+  Shape box() const {
+    if (!GetParam()) return kBox;
+    static const Shape mesh = Mesh{scene_builders::cubeMesh(kBox.half_size)};
+    return mesh;
+  }
+};
+INSTANTIATE_TEST_SUITE_P(FiniteShapes, BoxOrMeshCube, ::testing::Bool(),
+                         [](const ::testing::TestParamInfo<bool>& param) {
+                           return param.param ? "MeshCube" : "Box";
+                         });
+
+TEST_P(BoxOrMeshCube, BoxFaceHeadOnAndOblique) {
   // Towards the face z = 0.75 at 3 m/s from z = 2: (2 - 0.75 - 0.1) / 3.
   const LD head_on = (2.0L - 0.75L - LD(kRadius)) / 3.0L;
-  const auto t = thrown(kBox, V(0, 0, 2), V(0, 0, -3), kRadius);
+  const auto t = thrown(box(), V(0, 0, 2), V(0, 0, -3), kRadius);
   ASSERT_TRUE(t);
   EXPECT_LE(ulps(*t, head_on), kUlps);
   // Obliquely: the same instant, the point still on the face.
-  const auto oblique = thrown(kBox, V(-0.2, 0.1, 2), V(0.3, -0.1, -3), kRadius);
+  const auto oblique = thrown(box(), V(-0.2, 0.1, 2), V(0.3, -0.1, -3), kRadius);
   ASSERT_TRUE(oblique);
   EXPECT_LE(ulps(*oblique, head_on), kUlps);
   // Towards the face x = -0.5 from x = -1.3 at 0.7 m/s.
-  const auto side = thrown(kBox, V(-1.3, 0.2, -0.6), V(0.7, 0, 0), kRadius);
+  const auto side = thrown(box(), V(-1.3, 0.2, -0.6), V(0.7, 0, 0), kRadius);
   ASSERT_TRUE(side);
   EXPECT_LE(ulps(*side, (1.3L - 0.5L - LD(kRadius)) / 0.7L), kUlps);
 }
 
-TEST(FiniteShapes, BoxEdgeAndCornerHeadOn) {
+TEST_P(BoxOrMeshCube, BoxEdgeAndCornerHeadOn) {
   // Along the diagonal towards the edge x = 0.5, z = 0.75: the centre's distance from the edge's
   // line is sqrt(2) (d - u t), in contact at r: t = (d - r / sqrt(2)) / u.
   const double d = 0.7, u = 1.3;
-  const auto edge = thrown(kBox, V(0.5 + d, 0.1, 0.75 + d), V(-u, 0, -u), kRadius);
+  const auto edge = thrown(box(), V(0.5 + d, 0.1, 0.75 + d), V(-u, 0, -u), kRadius);
   ASSERT_TRUE(edge);
   const LD dx = LD(0.5 + d) - 0.5L;  // the double's own offset
   EXPECT_LE(ulps(*edge, (dx - LD(kRadius) / std::sqrt(2.0L)) / LD(u)), kUlps);
   // Towards the corner (0.5, 0.25, 0.75) along (-1, -1, -1): sqrt(3) (d - u t) = r.
   const V corner(0.5, 0.25, 0.75);
-  const auto hit = thrown(kBox, corner + V(d, d, d), V(-u, -u, -u), kRadius);
+  const auto hit = thrown(box(), corner + V(d, d, d), V(-u, -u, -u), kRadius);
   ASSERT_TRUE(hit);
   const LD offset = LD(0.25 + d) - 0.25L;  // the same in every axis? not quite: take each
   const LD ox = LD(0.5 + d) - 0.5L, oz = LD(0.75 + d) - 0.75L;
@@ -139,31 +156,31 @@ TEST(FiniteShapes, BoxEdgeAndCornerHeadOn) {
   EXPECT_LE(ulps(*hit, (offset - LD(kRadius) / std::sqrt(3.0L)) / LD(u)), kUlps);
 }
 
-TEST(FiniteShapes, BoxFeaturesUnderGravity) {
+TEST_P(BoxOrMeshCube, BoxFeaturesUnderGravity) {
   const V gravity(0, 0, -kG);
   const double top = 0.75, z0 = 1.9;
   // Dropped from rest onto the face: z0 - g t^2 / 2 = top + r.
-  const auto face = thrown(kBox, V(0.1, -0.05, z0), V::Zero(), kRadius, gravity);
+  const auto face = thrown(box(), V(0.1, -0.05, z0), V::Zero(), kRadius, gravity);
   ASSERT_TRUE(face);
   EXPECT_LE(ulps(*face, std::sqrt(2 * (LD(z0) - LD(top) - LD(kRadius)) / LD(kG))), kUlps);
   // Dropped beside the edge x = 0.5 (delta < r outside): it meets the edge's cylinder where
   // (z - top)^2 + delta^2 = r^2.
   const double delta = 0.06;
-  const auto edge = thrown(kBox, V(0.5 + delta, 0.0, z0), V::Zero(), kRadius, gravity);
+  const auto edge = thrown(box(), V(0.5 + delta, 0.0, z0), V::Zero(), kRadius, gravity);
   ASSERT_TRUE(edge);
   const LD dx = LD(0.5 + delta) - 0.5L;
   const LD edge_height = LD(top) + std::sqrt(LD(kRadius) * LD(kRadius) - dx * dx);
   EXPECT_LE(ulps(*edge, std::sqrt(2 * (LD(z0) - edge_height) / LD(kG))), kUlps);
   // Beside the corner (0.5, 0.25): (z - top)^2 + dx^2 + dy^2 = r^2.
   const double dy_off = 0.05;
-  const auto corner = thrown(kBox, V(0.5 + delta, 0.25 + dy_off, z0), V::Zero(), kRadius, gravity);
+  const auto corner = thrown(box(), V(0.5 + delta, 0.25 + dy_off, z0), V::Zero(), kRadius, gravity);
   ASSERT_TRUE(corner);
   const LD dy = LD(0.25 + dy_off) - 0.25L;
   const LD corner_height = LD(top) + std::sqrt(LD(kRadius) * LD(kRadius) - dx * dx - dy * dy);
   EXPECT_LE(ulps(*corner, std::sqrt(2 * (LD(z0) - corner_height) / LD(kG))), kUlps);
   // Thrown up and over: it rises past the box's top and comes down on it (the second crossing
   // of the face's height is the entry).
-  const auto lob = thrown(kBox, V(-1.0, 0.0, 1.0), V(1.0, 0, 4.0), kRadius, gravity);
+  const auto lob = thrown(box(), V(-1.0, 0.0, 1.0), V(1.0, 0, 4.0), kRadius, gravity);
   ASSERT_TRUE(lob);
   // x reaches -0.5 - r at t = 0.4 with z = 1 + 1.6 - 0.7848 = 1.8152 > 0.85: over the edge; the
   // face z = 0.85: 1 + 4 t - 4.905 t^2 = 0.85, the later root.
@@ -172,45 +189,45 @@ TEST(FiniteShapes, BoxFeaturesUnderGravity) {
   EXPECT_LE(ulps(*lob, later), kUlps);
 }
 
-TEST(FiniteShapes, TurnedAndMovingBox) {
+TEST_P(BoxOrMeshCube, TurnedAndMovingBox) {
   // The box turned 90 degrees about x (its y half-size 0.25 now along z), moving up at 2 m/s
   // towards a ball at rest above it: 3 - 0.25 - r = 2 t.
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.linear() = Eigen::AngleAxisd(M_PI / 2, V::UnitX()).toRotationMatrix();
-  const auto t = thrown(kBox, V(0, 0, 3), V::Zero(), kRadius, V::Zero(), 10.0, pose, V(0, 0, 2));
+  const auto t = thrown(box(), V(0, 0, 3), V::Zero(), kRadius, V::Zero(), 10.0, pose, V(0, 0, 2));
   ASSERT_TRUE(t);
   // The turned half-size along z is 0.25 to within the rotation's rounding (cos 90 deg = 6e-17).
   EXPECT_NEAR(*t, (3 - 0.25 - kRadius) / 2, 1e-15);
 }
 
-TEST(FiniteShapes, NoImpactWhereNoneBegins) {
+TEST_P(BoxOrMeshCube, NoImpactWhereNoneBegins) {
   // Sliding past the face just clear of it: no entry.
-  EXPECT_FALSE(thrown(kBox, V(-2, 0, 0.75 + kRadius + 1e-9), V(1, 0, 0), kRadius));
+  EXPECT_FALSE(thrown(box(), V(-2, 0, 0.75 + kRadius + 1e-9), V(1, 0, 0), kRadius));
   // At the very contact distance it grazes the edge x = -0.5 as it arrives over it (at 1.5 s):
   // a touch without approach, as two spheres that graze (timeOfImpactSpheres).
-  const auto graze = thrown(kBox, V(-2, 0, 0.75 + kRadius), V(1, 0, 0), kRadius);
+  const auto graze = thrown(box(), V(-2, 0, 0.75 + kRadius), V(1, 0, 0), kRadius);
   ASSERT_TRUE(graze);
   EXPECT_NEAR(*graze, 1.5, 1e-6);  // a double root: known to the square root of its rounding
   // Passing beside the box, clear of its edges.
-  EXPECT_FALSE(thrown(kBox, V(-2, 0.25 + kRadius + 1e-9, 2), V(1, 0, -1), kRadius));
+  EXPECT_FALSE(thrown(box(), V(-2, 0.25 + kRadius + 1e-9, 2), V(1, 0, -1), kRadius));
   // Overlapping already: its impact was when it began.
-  EXPECT_FALSE(thrown(kBox, V(0, 0, 0.8), V(0, 0, -1), kRadius));
+  EXPECT_FALSE(thrown(box(), V(0, 0, 0.8), V(0, 0, -1), kRadius));
   // Touching and leaving.
-  EXPECT_FALSE(thrown(kBox, V(0, 0, 0.75 + kRadius), V(0, 0, 1), kRadius));
+  EXPECT_FALSE(thrown(box(), V(0, 0, 0.75 + kRadius), V(0, 0, 1), kRadius));
   // Touching and approaching: now.
-  EXPECT_EQ(thrown(kBox, V(0, 0, 0.75 + kRadius), V(0, 0, -1), kRadius), 0.0);
+  EXPECT_EQ(thrown(box(), V(0, 0, 0.75 + kRadius), V(0, 0, -1), kRadius), 0.0);
   // Too far for the horizon.
-  EXPECT_FALSE(thrown(kBox, V(0, 0, 2), V(0, 0, -1), kRadius, V::Zero(), 1.0));
+  EXPECT_FALSE(thrown(box(), V(0, 0, 2), V(0, 0, -1), kRadius, V::Zero(), 1.0));
 }
 
-TEST(FiniteShapes, ExactlyOnAnEdgeTheFaceAndTheEdgeAgree) {
+TEST_P(BoxOrMeshCube, ExactlyOnAnEdgeTheFaceAndTheEdgeAgree) {
   // Falling straight down exactly over the edge x = 0.5: the face's and the edge's instants are
   // one, and the normal turns continuously from the face to the edge.
-  const auto t = thrown(kBox, V(0.5, 0, 2), V(0, 0, -3), kRadius);
+  const auto t = thrown(box(), V(0.5, 0, 2), V(0, 0, -3), kRadius);
   ASSERT_TRUE(t);
   EXPECT_LE(ulps(*t, (2.0L - 0.75L - LD(kRadius)) / 3.0L), kUlps);
   PlacedShape placed;
-  placed.shape = kBox;
+  placed.shape = box();
   for (const double dx : {-1e-9, 0.0, 1e-9}) {
     const ContactGeometry g =
         contactGeometry(V(0.5 + dx, 0, 0.75 + kRadius), kRadius, placed, 1e-9, kNoApproach);
@@ -375,6 +392,73 @@ LD distanceTo(const Capsule& c, const Eigen::Matrix<LD, 3, 1>& p) {
       std::sqrt(p.x() * p.x() + p.y() * p.y() + (p.z() - z) * (p.z() - z)) - LD(c.radius), 0.0L);
 }
 
+/// A mesh's: the least distance to its triangles, each by projection onto its plane (inside the
+/// triangle by the signs of three cross products) or else to the nearest of its three sides
+/// (another route than TriangleMesh::nearest's Voronoi regions), in long double.
+LD distanceTo(const Mesh& mesh, const Eigen::Matrix<LD, 3, 1>& p) {
+  using LV = Eigen::Matrix<LD, 3, 1>;
+  const auto to_segment = [&](const LV& a, const LV& b) {
+    const LV ab = b - a;
+    const LD s = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0L, 1.0L);
+    return (p - (a + s * ab)).norm();
+  };
+  LD least = INFINITY;
+  for (const TriangleMesh::Triangle& t : mesh.triangles->triangles()) {
+    const LV a = mesh.triangles->vertices()[t[0]].cast<LD>();
+    const LV b = mesh.triangles->vertices()[t[1]].cast<LD>();
+    const LV c = mesh.triangles->vertices()[t[2]].cast<LD>();
+    const LV n = (b - a).cross(c - a).normalized();
+    const LV q = p - n.dot(p - a) * n;
+    const bool over = n.dot((b - a).cross(q - a)) >= 0 && n.dot((c - b).cross(q - b)) >= 0 &&
+                      n.dot((a - c).cross(q - c)) >= 0;
+    const LD d = over ? std::abs(n.dot(p - a))
+                      : std::min({to_segment(a, b), to_segment(b, c), to_segment(c, a)});
+    least = std::min(least, d);
+  }
+  return least;
+}
+
+/// The convex hull of a few points as a mesh: every triangle of them with all the others on one
+/// side (by brute force), facing out.
+std::shared_ptr<const TriangleMesh> convexHull(const std::vector<V>& points) {
+  std::vector<TriangleMesh::Triangle> triangles;
+  V centre = V::Zero();
+  for (const V& p : points) centre += p / points.size();
+  const auto n = static_cast<std::uint32_t>(points.size());
+  for (std::uint32_t i = 0; i < n; ++i) {
+    for (std::uint32_t j = i + 1; j < n; ++j) {
+      for (std::uint32_t k = j + 1; k < n; ++k) {
+        const V normal = (points[j] - points[i]).cross(points[k] - points[i]);
+        int above = 0, below = 0;
+        for (std::uint32_t m = 0; m < n; ++m) {
+          const double side = normal.dot(points[m] - points[i]);
+          above += side > 1e-12;
+          below += side < -1e-12;
+        }
+        if (above == 0 || below == 0) triangles.push_back({i, j, k});
+      }
+    }
+  }
+  return scene_builders::facingOut(points, triangles, centre);
+}
+
+/// An icosahedron stretched to 1.0 x 0.6 x 0.8 and turned: faces, edges and vertices in no
+/// axis' direction.
+std::shared_ptr<const TriangleMesh> stretchedIcosahedron() {
+  const double phi = (1 + std::sqrt(5.0)) / 2;
+  std::vector<V> points;
+  for (const double a : {-1.0, 1.0}) {
+    for (const double b : {-phi, phi}) {
+      points.emplace_back(0, a, b);
+      points.emplace_back(a, b, 0);
+      points.emplace_back(b, 0, a);
+    }
+  }
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.3, V(1, 2, 3).normalized()).toRotationMatrix();
+  for (V& p : points) p = turn * V(0.5, 0.3, 0.4).cwiseProduct(p) / phi;
+  return convexHull(points);
+}
+
 struct Reference {
   bool hit = false;
   LD time = 0;
@@ -467,6 +551,8 @@ TEST(FiniteShapes, RandomThrowsMissNothingAndInventNothing) {
   const char* asked = std::getenv("FINITE_SHAPE_THROWS");
   const int throws = asked ? std::max(1000, std::atoi(asked)) : 20000;
   throwAtRandom("box", kBox, throws, 1);
+  throwAtRandom("mesh cube", Mesh{scene_builders::cubeMesh(kBox.half_size)}, throws, 4);
+  throwAtRandom("mesh icosahedron", Mesh{stretchedIcosahedron()}, throws, 5);
   throwAtRandom("cylinder", kCylinder, throws, 2);
   throwAtRandom("capsule", kCapsule, throws, 3);
 }

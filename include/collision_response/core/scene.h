@@ -4,12 +4,14 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "collision_response/core/expected.h"
 #include "collision_response/core/friction.h"
 #include "collision_response/core/materials.h"
+#include "collision_response/core/shape.h"
 
 namespace collision_response::core {
 
@@ -46,7 +48,7 @@ struct BodySpec {
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
 };
 
-enum class ObstacleShape { kPlane, kSphere, kBox, kCylinder, kCapsule };
+enum class ObstacleShape { kPlane, kSphere, kBox, kCylinder, kCapsule, kMesh };
 
 /// An immovable obstacle: a plane {x : normal.x = offset} whose free side is the one `normal`
 /// points to, a sphere, or a box, cylinder or capsule centred at `position` and turned by
@@ -63,8 +65,13 @@ struct ObstacleSpec {
   double radius = 0.0;                                 ///< sphere, cylinder, capsule: m
   Eigen::Vector3d size = Eigen::Vector3d::Zero();      ///< box: edge lengths, m
   double length = 0.0;  ///< cylinder: between the caps; capsule: of its segment (m)
-  /// box, cylinder, capsule: from the frame's axes to the shape's
+  /// box, cylinder, capsule, mesh: from the frame's axes to the shape's
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+  /// mesh: its triangles, scaled, in the shape's frame (the ROS layer loads them from
+  /// `resource`, a package:// or file:// address, scaled by `scale` along the mesh's axes)
+  std::shared_ptr<const TriangleMesh> mesh;
+  std::string resource;
+  Eigen::Vector3d scale = Eigen::Vector3d::Ones();
 };
 
 struct Scene {

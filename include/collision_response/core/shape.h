@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <memory>
 #include <variant>
 
 namespace collision_response::core {
@@ -40,9 +41,17 @@ struct Capsule {
   double half_length = 0.0;  ///< m, of the segment (the capsule is 2 (half_length + radius) long)
 };
 
-/// Planes and spheres are given in the fixed frame; the finite shapes (Cuboid, Cylinder, Capsule)
-/// in their pose's frame (PlacedShape::pose).
-using Shape = std::variant<Plane, Sphere, Cuboid, Cylinder, Capsule>;
+class TriangleMesh;  // collision_response/core/triangle_mesh.h
+
+/// A triangle mesh (scene type `mesh`) in its pose's frame, shared: a million triangles are not
+/// copied with each placement.
+struct Mesh {
+  std::shared_ptr<const TriangleMesh> triangles;
+};
+
+/// Planes and spheres are given in the fixed frame; the finite shapes (Cuboid, Cylinder, Capsule,
+/// Mesh) in their pose's frame (PlacedShape::pose).
+using Shape = std::variant<Plane, Sphere, Cuboid, Cylinder, Capsule, Mesh>;
 
 /// A rigid motion at one instant: the pose (fixed <- moving) at `time`, the velocity of the
 /// pose's origin and the angular velocity, both in the fixed frame.

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "collision_response/core/time_of_impact.h"
+#include "collision_response/core/triangle_mesh.h"
 #include "geometry/polynomial_roots.h"
 
 namespace collision_response::core {
@@ -113,6 +114,9 @@ class FeatureSearch {
   bool within(double value, double bound, double more = 0.0) const {
     return std::abs(value) <= bound + slack_ + more;
   }
+  /// value <= 0, with the rounding of the positions (and `more`).
+  bool below(double value, double more = 0.0) const { return value <= slack_ + more; }
+  double slack() const { return slack_; }
   /// m: the sizes in play at `t`: where the centre starts, how far it has moved, the shape's.
   /// In long double: at 1e308 m their sum is past the doubles.
   long double reach(double t) const {
@@ -303,6 +307,45 @@ double boundingRadius(const Cylinder& cylinder) {
   return std::hypot(cylinder.radius, cylinder.half_length);
 }
 double boundingRadius(const Capsule& capsule) { return capsule.radius + capsule.half_length; }
+double boundingRadius(const Mesh& mesh) { return mesh.triangles->boundingRadius(); }
+
+NearestFeature nearestFeature(const Mesh& mesh, const Eigen::Vector3d& p) {
+  const TriangleMesh& triangles = *mesh.triangles;
+  const TriangleMesh::NearestPoint near = triangles.nearest(p);
+  const TriangleMesh::Triangle& corners = triangles.triangles()[near.triangle];
+  NearestFeature feature;
+  feature.point = near.point;
+  if (near.part == TriangleMesh::Part::kFace) {
+    // A face: the distance along its normal, signed.
+    const Eigen::Vector3d& normal = triangles.normal(near.triangle);
+    feature.outward = normal;
+    feature.distance = normal.dot(p - triangles.vertices()[corners[0]]);
+    return feature;
+  }
+  const bool edge = near.part == TriangleMesh::Part::kEdge;
+  const TriangleMesh::Edge* on_edge = edge ? &triangles.edgeOf(near.triangle, near.index) : nullptr;
+  const std::uint32_t vertex = corners[near.index];
+  const Eigen::Vector3d& pseudo_normal =
+      edge ? on_edge->pseudo_normal : triangles.vertexPseudoNormal(vertex);
+  const bool reachable = edge ? on_edge->reachable : triangles.vertexReachable(vertex);
+  const Eigen::Vector3d offset = p - near.point;
+  const bool inside = offset.dot(pseudo_normal) < 0;
+  if (near.distance > 0) {
+    feature.outward = (inside ? -offset : offset) / near.distance;
+  } else {
+    feature.outward = pseudo_normal.stableNormalized();
+  }
+  feature.distance = inside ? -near.distance : near.distance;
+  if (reachable && !inside && near.distance > 0) {
+    feature.turning_radius = near.distance;
+    if (edge) {
+      feature.axis =
+          (triangles.vertices()[on_edge->to] - triangles.vertices()[on_edge->from]).normalized();
+      feature.axial_share = 0.0;
+    }
+  }
+  return feature;
+}
 
 std::optional<double> firstContactFinite(const RelativeMotion& motion, const Cuboid& box,
                                          double horizon) {
@@ -420,6 +463,108 @@ std::optional<double> firstContactFinite(const RelativeMotion& motion, const Cap
       FeatureSearch::startFromDistance(ball, std::sqrt(x[0] * x[0] + y[0] * y[0] + z[0] * z[0]),
                                        grown);
       s.feature(ball, FeatureSearch::anywhere);
+    }
+  });
+}
+
+std::optional<double> firstContactFinite(const RelativeMotion& motion, const Mesh& mesh,
+                                         double horizon) {
+  const TriangleMesh& triangles = *mesh.triangles;
+  const std::vector<Eigen::Vector3d>& vertices = triangles.vertices();
+  return search(motion, mesh, horizon, [&](FeatureSearch& s) {
+    const long double r = s.radius();
+    const double radius = motion.radius;
+    // Pieces of the path about four radii long (at most 256): the triangles near each.
+    const double travel =
+        (motion.velocity.norm() + 0.5 * motion.acceleration.norm() * horizon) * horizon;
+    const double piece_length = std::max(4 * radius, 1e-9 * (travel + triangles.boundingRadius()));
+    const int pieces = static_cast<int>(std::clamp(std::ceil(travel / piece_length), 1.0, 256.0));
+    std::vector<std::uint32_t> near;
+    std::vector<std::uint32_t> seen_triangles, seen_edges, seen_vertices;
+    const auto first_time = [](std::vector<std::uint32_t>& seen, std::uint32_t index) {
+      if (std::find(seen.begin(), seen.end(), index) != seen.end()) return false;
+      seen.push_back(index);
+      return true;
+    };
+    for (int piece = 0; piece < pieces; ++piece) {
+      const double from = horizon * piece / pieces;
+      const double to = piece + 1 == pieces ? horizon : horizon * (piece + 1) / pieces;
+      // The path's box over the piece (its ends, and where a coordinate turns back under the
+      // acceleration), grown by the ball and the rounding.
+      Eigen::Vector3d low = s.positionAt(from).cwiseMin(s.positionAt(to));
+      Eigen::Vector3d high = s.positionAt(from).cwiseMax(s.positionAt(to));
+      for (int i = 0; i < 3; ++i) {
+        if (motion.acceleration[i] == 0) continue;
+        const double turn = -motion.velocity[i] / motion.acceleration[i];
+        if (turn > from && turn < to) {
+          low[i] = std::min(low[i], s.positionAt(turn)[i]);
+          high[i] = std::max(high[i], s.positionAt(turn)[i]);
+        }
+      }
+      const double grow = radius + 2 * s.slack() + 1e-12 * (high - low).norm();
+      near.clear();
+      triangles.overlapping(low.array() - grow, high.array() + grow, near);
+      for (const std::uint32_t t : near) {
+        if (!first_time(seen_triangles, t)) continue;
+        const TriangleMesh::Triangle& corners = triangles.triangles()[t];
+        const Eigen::Vector3d& a = vertices[corners[0]];
+        const Eigen::Vector3d& normal = triangles.normal(t);
+        // The face: n.(q - a) = r on its outer side, q over the triangle.
+        if (s.reachable(normal.dot(motion.centre - a), radius)) {
+          Polynomial face{-r};
+          for (int i = 0; i < 3; ++i) {
+            face = face + static_cast<long double>(normal[i]) * s.coordinate(i, a[i]);
+          }
+          s.feature(face, [&](const Eigen::Vector3d& q, double more) {
+            for (int k = 0; k < 3; ++k) {
+              const Eigen::Vector3d& u = vertices[corners[k]];
+              const Eigen::Vector3d across =
+                  (vertices[corners[(k + 1) % 3]] - u).cross(normal).normalized();
+              if (!s.below(across.dot(q - u), more)) return false;
+            }
+            return true;
+          });
+        }
+        // Its edges: |w x u|^2 = r^2, w = q - from, u the edge's direction (for an edge along
+        // an axis two of the products are the plain coordinates: a box's polynomial), within the
+        // edge's length.
+        for (int k = 0; k < 3; ++k) {
+          const std::uint32_t index = triangles.edgeIndex(t, k);
+          const TriangleMesh::Edge& edge = triangles.edge(index);
+          if (!edge.reachable || !first_time(seen_edges, index)) continue;
+          const Eigen::Vector3d& start = vertices[edge.from];
+          const Eigen::Vector3d along = vertices[edge.to] - start;
+          const double length = along.norm();
+          const Eigen::Vector3d unit = along / length;
+          const Eigen::Vector3d to_centre = motion.centre - start;
+          const double from_line = (to_centre - to_centre.dot(unit) * unit).norm();
+          if (!s.reachable(from_line, radius)) continue;
+          const Polynomial wx = s.coordinate(0, start.x()), wy = s.coordinate(1, start.y()),
+                           wz = s.coordinate(2, start.z());
+          const long double ux = unit.x(), uy = unit.y(), uz = unit.z();
+          const Polynomial cx = uz * wy + (-uy) * wz, cy = ux * wz + (-uz) * wx,
+                           cz = uy * wx + (-ux) * wy;
+          Polynomial p = square(cx) + square(cy) + square(cz);
+          FeatureSearch::startFromDistance(
+              p, std::sqrt(cx[0] * cx[0] + cy[0] * cy[0] + cz[0] * cz[0]), r);
+          s.feature(p, [&](const Eigen::Vector3d& q, double more) {
+            return s.within(unit.dot(q - start) - 0.5 * length, 0.5 * length, more);
+          });
+        }
+        // Its vertices: |q - v| = r.
+        for (const std::uint32_t v : corners) {
+          if (!triangles.vertexReachable(v) || !first_time(seen_vertices, v)) continue;
+          const Eigen::Vector3d& corner = vertices[v];
+          if (!s.reachable((motion.centre - corner).stableNorm(), radius)) continue;
+          const Polynomial dx = s.coordinate(0, corner.x()), dy = s.coordinate(1, corner.y()),
+                           dz = s.coordinate(2, corner.z());
+          Polynomial p = square(dx) + square(dy) + square(dz);
+          FeatureSearch::startFromDistance(
+              p, std::sqrt(dx[0] * dx[0] + dy[0] * dy[0] + dz[0] * dz[0]), r);
+          s.feature(p, FeatureSearch::anywhere);
+        }
+      }
+      if (s.best() && *s.best() <= to) break;  // a later piece's contact is later
     }
   });
 }

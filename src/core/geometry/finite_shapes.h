@@ -32,11 +32,17 @@ struct NearestFeature {
 NearestFeature nearestFeature(const Cuboid& box, const Eigen::Vector3d& p);
 NearestFeature nearestFeature(const Cylinder& cylinder, const Eigen::Vector3d& p);
 NearestFeature nearestFeature(const Capsule& capsule, const Eigen::Vector3d& p);
+/// A mesh's: the nearest point of its triangles (TriangleMesh::nearest), inside where the point
+/// is behind the pseudo-normal of the face, edge or vertex it is on (Baerentzen and Aanaes); an
+/// edge or vertex a ball cannot touch first (between coplanar faces, in a groove) turns the
+/// normal no more than a face does.
+NearestFeature nearestFeature(const Mesh& mesh, const Eigen::Vector3d& p);
 
 /// m: the radius of the smallest sphere about the shape's origin that holds it.
 double boundingRadius(const Cuboid& box);
 double boundingRadius(const Cylinder& cylinder);
 double boundingRadius(const Capsule& capsule);
+double boundingRadius(const Mesh& mesh);
 
 /// The ball's motion relative to a finite shape, in the shape's frame: its centre at
 /// centre + velocity t + (acceleration / 2) t^2 from the instant both were placed.
@@ -61,6 +67,13 @@ std::optional<double> firstContactFinite(const RelativeMotion& motion, const Cub
 std::optional<double> firstContactFinite(const RelativeMotion& motion, const Cylinder& cylinder,
                                          double horizon);
 std::optional<double> firstContactFinite(const RelativeMotion& motion, const Capsule& capsule,
+                                         double horizon);
+/// A mesh's features are its faces (each a plane, on its outer side, within its triangle), the
+/// edges and vertices a ball can touch first (TriangleMesh), those of the triangles near the
+/// ball's path only: the path is cut into pieces a few ball radii long, looked at in order, each
+/// asking the hierarchy for the triangles within the ball's reach of it, until a piece holds the
+/// first contact.
+std::optional<double> firstContactFinite(const RelativeMotion& motion, const Mesh& mesh,
                                          double horizon);
 
 }  // namespace collision_response::core

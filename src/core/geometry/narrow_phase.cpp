@@ -59,6 +59,8 @@ Shape shapeOf(const ObstacleSpec& spec) {
       return Cylinder{spec.radius, 0.5 * spec.length};
     case ObstacleShape::kCapsule:
       return Capsule{spec.radius, 0.5 * spec.length};
+    case ObstacleShape::kMesh:
+      return Mesh{spec.mesh};
   }
   return Plane{};
 }
@@ -87,6 +89,10 @@ void setShape(ObstacleSpec& spec, const Shape& shape) {
                         spec.shape = ObstacleShape::kCapsule;
                         spec.radius = capsule.radius;
                         spec.length = 2 * capsule.half_length;
+                      },
+                      [&](const Mesh& mesh) {
+                        spec.shape = ObstacleShape::kMesh;
+                        spec.mesh = mesh.triangles;
                       }},
              shape);
 }
@@ -137,6 +143,11 @@ Status checkShape(const Shape& shape, const std::function<std::string(const char
                                 "must be a finite number >= 0 m (0: a sphere), got " +
                                     formatNumber(2 * capsule.half_length)};
                  }
+                 return Ok{};
+               },
+               [&](const Mesh& mesh) -> Status {
+                 // (Its vertices and triangles were checked as it was built: TriangleMesh::build.)
+                 if (!mesh.triangles) return Error{field("resource"), "names no loaded mesh"};
                  return Ok{};
                }},
       shape);
@@ -245,7 +256,8 @@ std::optional<double> firstContact(const BallMotion& ball, const PlacedShape& pl
                },
                [&](const Cuboid& box) { return finite(box); },
                [&](const Cylinder& cylinder) { return finite(cylinder); },
-               [&](const Capsule& capsule) { return finite(capsule); }},
+               [&](const Capsule& capsule) { return finite(capsule); },
+               [&](const Mesh& mesh) { return finite(mesh); }},
       placed.shape);
 }
 
@@ -293,6 +305,10 @@ ContactGeometry finiteGeometry(const Eigen::Vector3d& centre, double radius,
 ContactGeometry finiteGeometry(const Eigen::Vector3d& centre, double radius, const Capsule& capsule,
                                const RigidPose& pose, double contact_tolerance) {
   return finiteGeometryOf(centre, radius, capsule, pose, contact_tolerance);
+}
+ContactGeometry finiteGeometry(const Eigen::Vector3d& centre, double radius, const Mesh& mesh,
+                               const RigidPose& pose, double contact_tolerance) {
+  return finiteGeometryOf(centre, radius, mesh, pose, contact_tolerance);
 }
 
 bool mayReach(const PlacedShape& placed, const Box& box) {

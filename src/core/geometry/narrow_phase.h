@@ -142,6 +142,8 @@ ContactGeometry finiteGeometry(const Eigen::Vector3d& centre, double radius,
                                double contact_tolerance);
 ContactGeometry finiteGeometry(const Eigen::Vector3d& centre, double radius, const Capsule& capsule,
                                const RigidPose& pose, double contact_tolerance);
+ContactGeometry finiteGeometry(const Eigen::Vector3d& centre, double radius, const Mesh& mesh,
+                               const RigidPose& pose, double contact_tolerance);
 
 /// A ball at `centre` of `radius` and `placed` (at the same instant). `contact_tolerance`: the
 /// touching band's share of the contact distance. Centres that coincide have no line of centres:

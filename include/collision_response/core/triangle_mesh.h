@@ -1,0 +1,110 @@
+// A triangle mesh obstacle (scene type `mesh`): its triangles in the mesh's own frame under a
+// bounding-volume hierarchy of axis-aligned boxes, so that a query near a few of 1,000,000
+// triangles looks at O(log n) of them.
+//
+// The mesh bounds a solid on the side its triangles' normals point away from (counter-clockwise
+// seen from outside, the convention of STL and COLLADA): a closed mesh is the solid it encloses,
+// an open one (a floor) is free on the side its normals point to, as a plane is. A ball against
+// it is a ball against its features grown by the ball's radius: faces are planes, edges
+// cylinders, vertices spheres. Only the features a ball can touch first are kept: an edge
+// between two faces in one plane, or in a groove (concave), lies inside the grown solid, and so
+// does a vertex all of whose edges do; that is why a ball rolling across a tessellated flat floor
+// never meets an internal edge (the "ghost collisions" of engines that test each triangle
+// alone).
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "collision_response/core/expected.h"
+
+namespace collision_response::core {
+
+class TriangleMesh {
+ public:
+  using Triangle = std::array<std::uint32_t, 3>;
+
+  /// The part of a triangle a point is nearest: its face, its edge k (from vertex k to vertex
+  /// k + 1 mod 3) or its vertex k.
+  enum class Part { kFace, kEdge, kVertex };
+  struct NearestPoint {
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();  ///< on the triangle
+    double distance = 0.0;                            ///< m, unsigned
+    std::uint32_t triangle = 0;
+    Part part = Part::kFace;
+    int index = 0;  ///< the edge's or the vertex's, 0..2
+  };
+  struct Edge {
+    std::uint32_t from = 0, to = 0;  ///< vertex indices
+    /// The sum of the unit normals of the faces that share it (the angle-weighted pseudo-normal
+    /// of Baerentzen and Aanaes, "Signed distance computation using the angle weighted
+    /// pseudonormal", IEEE TVCG 11(3), 2005): which side of it is outside.
+    Eigen::Vector3d pseudo_normal = Eigen::Vector3d::Zero();
+    bool reachable = true;  ///< not between coplanar faces nor in a groove
+  };
+
+  /// Builds the mesh from its vertices (m, the mesh's frame) and triangles (vertex indices,
+  /// counter-clockwise seen from outside). Refused by name (`field`): a non-finite vertex, an
+  /// index out of range, no triangle left. Vertices at the same position are joined (an STL file
+  /// repeats them in every triangle), so that neighbouring triangles share their edge. Triangles of zero area (collinear or repeated
+  /// vertices) have no face and no outside: they are left out, and their indices are appended to
+  /// `zero_area` for the caller to name.
+  static Expected<std::shared_ptr<const TriangleMesh>> build(
+      const std::vector<Eigen::Vector3d>& vertices, const std::vector<Triangle>& triangles,
+      const std::string& field, std::vector<std::size_t>* zero_area = nullptr);
+
+  const std::vector<Eigen::Vector3d>& vertices() const { return vertices_; }
+  /// The triangles kept (those of nonzero area), in the hierarchy's order.
+  const std::vector<Triangle>& triangles() const { return triangles_; }
+  const Eigen::Vector3d& normal(std::uint32_t triangle) const { return normals_[triangle]; }
+  const Edge& edgeOf(std::uint32_t triangle, int k) const {
+    return edges_[triangle_edges_[triangle][k]];
+  }
+  std::uint32_t edgeIndex(std::uint32_t triangle, int k) const {
+    return triangle_edges_[triangle][k];
+  }
+  const Edge& edge(std::uint32_t index) const { return edges_[index]; }
+  /// The angle-weighted sum of the unit normals of the faces around a vertex (Baerentzen and
+  /// Aanaes), and whether a ball can touch it first.
+  const Eigen::Vector3d& vertexPseudoNormal(std::uint32_t vertex) const {
+    return vertex_normals_[vertex];
+  }
+  bool vertexReachable(std::uint32_t vertex) const { return vertex_reachable_[vertex] != 0; }
+
+  /// m: the radius of the smallest sphere about the mesh's origin that holds it.
+  double boundingRadius() const { return bounding_radius_; }
+
+  /// The point of the triangles nearest `p`; branch and bound down the hierarchy.
+  NearestPoint nearest(const Eigen::Vector3d& p) const;
+  /// Appends every triangle whose bounding box overlaps [low, high].
+  void overlapping(const Eigen::Vector3d& low, const Eigen::Vector3d& high,
+                   std::vector<std::uint32_t>& out) const;
+  /// How many of the hierarchy's boxes and triangles the last queries of this thread looked at
+  /// (for the benchmark of the query's growth with the triangle count).
+  static std::size_t& visitedCount();
+
+ private:
+  struct Node {
+    Eigen::Vector3d low, high;
+    std::uint32_t first = 0;  ///< leaf: first triangle; inner: the right child (left is next)
+    std::uint32_t count = 0;  ///< leaf: triangle count; inner: 0
+  };
+  std::uint32_t buildNode(std::uint32_t first, std::uint32_t count,
+                          std::vector<Eigen::Vector3d>& centroids);
+
+  std::vector<Eigen::Vector3d> vertices_;
+  std::vector<Triangle> triangles_;
+  std::vector<Eigen::Vector3d> normals_;
+  std::vector<std::array<std::uint32_t, 3>> triangle_edges_;
+  std::vector<Edge> edges_;
+  std::vector<Eigen::Vector3d> vertex_normals_;
+  std::vector<char> vertex_reachable_;
+  std::vector<Node> nodes_;
+  double bounding_radius_ = 0.0;
+};
+
+}  // namespace collision_response::core
