@@ -45,15 +45,15 @@ bool CollisionResponseNode::start() {
     return false;
   }
   if (tree.getType() == XmlRpc::XmlRpcValue::TypeStruct && tree.hasMember("scene")) {
-    std::vector<std::string> skipped;
+    std::vector<std::string> warnings;
     auto scene = loadScene(tree["scene"], joinKey(ns, "scene"),
-                           parameterServerUrdf(joinKey(ns, "scene")), &skipped);
+                           parameterServerUrdf(joinKey(ns, "scene")), &warnings);
     if (!scene) {
       ROS_FATAL_STREAM("collision_response: bad scene: " << scene.error().message());
       return false;
     }
-    for (const std::string& left_out : skipped) {
-      ROS_WARN_STREAM("collision_response: robot: " << left_out);
+    for (const std::string& left_out : warnings) {
+      ROS_WARN_STREAM("collision_response: scene: " << left_out);
     }
     if (auto status = checkBodyTopics(*scene, node_.getNamespace(),
                                       node_.resolveName("body_states"), joinKey(ns, "scene"));

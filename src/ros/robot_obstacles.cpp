@@ -6,15 +6,19 @@
 #include <algorithm>
 #include <map>
 
+#include "collision_response/ros/mesh_resource.h"
 #include "collision_response/ros/parameters.h"
 
 namespace collision_response {
 
 namespace {
 
-/// A <collision> as an obstacle of the scene, or none (a mesh: `skipped` says so).
-bool toObstacle(const urdf::Collision& collision, const RobotLinks& robot,
-                core::ObstacleSpec& obstacle) {
+/// A <collision> as an obstacle of the scene: false when it has no geometry; a mesh is loaded
+/// (mesh_resource.h), and what that leaves out, or a padding it cannot take, is said in
+/// `warnings`.
+core::Expected<bool> toObstacle(const urdf::Collision& collision, const RobotLinks& robot,
+                                const std::string& where, const std::string& field,
+                                core::ObstacleSpec& obstacle, std::vector<std::string>& warnings) {
   const urdf::Geometry* geometry = collision.geometry.get();
   if (geometry == nullptr) return false;
   const double pad = robot.padding;
@@ -37,6 +41,28 @@ bool toObstacle(const urdf::Collision& collision, const RobotLinks& robot,
       obstacle.length = cylinder->length + 2 * pad;
       break;
     }
+    case urdf::Geometry::MESH: {
+      const auto* mesh = static_cast<const urdf::Mesh*>(geometry);
+      obstacle.shape = core::ObstacleShape::kMesh;
+      obstacle.resource = mesh->filename;
+      obstacle.scale = Eigen::Vector3d(mesh->scale.x, mesh->scale.y, mesh->scale.z);
+      std::vector<std::string> left_out;
+      auto triangles = loadMeshResource(obstacle.resource, obstacle.scale, "mesh", left_out);
+      if (!triangles) {
+        // Named as the URDF names it: the <mesh>'s filename or scale.
+        const bool scale = triangles.error().field.rfind("mesh/scale", 0) == 0;
+        return core::Error{
+            joinKey(field, "description"),
+            where + ", <mesh> " + (scale ? "scale" : "filename") + ": " + triangles.error().reason};
+      }
+      obstacle.mesh = *triangles;
+      for (const std::string& warning : left_out) warnings.push_back(where + ": " + warning);
+      if (pad > 0) {
+        warnings.push_back(where + ": mesh '" + mesh->filename +
+                           "' is not grown by the padding (only spheres, boxes and cylinders are)");
+      }
+      break;
+    }
     default:
       return false;
   }
@@ -53,7 +79,7 @@ bool toObstacle(const urdf::Collision& collision, const RobotLinks& robot,
 core::Expected<std::vector<core::ObstacleSpec>> robotObstacles(const std::string& urdf,
                                                                const RobotLinks& robot,
                                                                const std::string& field,
-                                                               std::vector<std::string>& skipped) {
+                                                               std::vector<std::string>& warnings) {
   urdf::Model model;
   if (urdf.empty() || !model.initString(urdf)) {
     return core::Error{joinKey(field, "description"),
@@ -86,13 +112,15 @@ core::Expected<std::vector<core::ObstacleSpec>> robotObstacles(const std::string
       obstacle.id = collisions.size() == 1 ? name : name + "/" + std::to_string(i);
       obstacle.frame = name;
       obstacle.material = robot.material;
-      if (!collisions[i] || !toObstacle(*collisions[i], robot, obstacle)) {
-        const auto* mesh = collisions[i] && collisions[i]->geometry
-                               ? dynamic_cast<const urdf::Mesh*>(collisions[i]->geometry.get())
-                               : nullptr;
-        skipped.push_back("link '" + name + "' <collision> " + std::to_string(i) + ": " +
-                          (mesh ? "mesh '" + mesh->filename + "'" : std::string("no geometry")) +
-                          " is not an obstacle (meshes are not supported yet)");
+      const std::string where = "link '" + name + "' <collision> " + std::to_string(i);
+      if (!collisions[i]) {
+        warnings.push_back(where + ": no geometry, not an obstacle");
+        continue;
+      }
+      const auto made = toObstacle(*collisions[i], robot, where, field, obstacle, warnings);
+      if (!made) return made.error();
+      if (!*made) {
+        warnings.push_back(where + ": no geometry, not an obstacle");
         continue;
       }
       obstacles.push_back(obstacle);

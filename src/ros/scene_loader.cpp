@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "collision_response/core/validation.h"
+#include "collision_response/ros/mesh_resource.h"
 #include "collision_response/ros/parameters.h"
 #include "collision_response/ros/robot_obstacles.h"
 
@@ -208,6 +209,21 @@ const KeyTable<ObstacleSpec>& boxKeys() {
   return kKeys;
 }
 
+/// A mesh's: its resource (a package:// or file:// address) and its scale along its own axes.
+const KeyTable<ObstacleSpec>& meshKeys() {
+  static const KeyTable<ObstacleSpec> kKeys = finiteShapeKeys(
+      {{"resource", true,
+        [](const XmlRpc::XmlRpcValue& value, const std::string& field, ObstacleSpec& obstacle) {
+          const auto text = readString(value, field);
+          if (!text) return core::Status(text.error());
+          obstacle.resource = *text;
+          return core::Status(core::Ok{});
+        }},
+       vectorKey<ObstacleSpec>("scale",
+                               [](ObstacleSpec& o) -> Eigen::Vector3d& { return o.scale; })});
+  return kKeys;
+}
+
 /// A cylinder's and a capsule's: radius and length (along the shape's z).
 const KeyTable<ObstacleSpec>& roundShapeKeys() {
   static const KeyTable<ObstacleSpec> kKeys = finiteShapeKeys(
@@ -232,18 +248,24 @@ core::Status readObstacle(const XmlRpc::XmlRpcValue& entry, const std::string& f
     obstacle.shape = core::ObstacleShape::kSphere;
     return readKeys(entry, sphereKeys(), field, obstacle);
   }
-  if (*type == "box" || *type == "cylinder" || *type == "capsule") {
+  if (*type == "box" || *type == "cylinder" || *type == "capsule" || *type == "mesh") {
     if (entry.hasMember("orientation") && entry.hasMember("rpy")) {
       return core::Error{joinKey(field, "rpy"),
                          "give the orientation as `orientation` or as `rpy`, not both"};
     }
     obstacle.shape = *type == "box"        ? core::ObstacleShape::kBox
                      : *type == "cylinder" ? core::ObstacleShape::kCylinder
-                                           : core::ObstacleShape::kCapsule;
-    return readKeys(entry, *type == "box" ? boxKeys() : roundShapeKeys(), field, obstacle);
+                     : *type == "capsule"  ? core::ObstacleShape::kCapsule
+                                           : core::ObstacleShape::kMesh;
+    return readKeys(entry,
+                    *type == "box"    ? boxKeys()
+                    : *type == "mesh" ? meshKeys()
+                                      : roundShapeKeys(),
+                    field, obstacle);
   }
-  return core::Error{joinKey(field, "type"), "unknown obstacle type '" + *type +
-                                                 "'; known: plane, sphere, box, cylinder, capsule"};
+  return core::Error{
+      joinKey(field, "type"),
+      "unknown obstacle type '" + *type + "'; known: plane, sphere, box, cylinder, capsule, mesh"};
 }
 
 /// A list whose every entry is read by `read_entry` into a new element of `list`.
@@ -410,9 +432,20 @@ UrdfSource parameterServerUrdf(const std::string& field) {
 }
 
 core::Expected<core::Scene> loadScene(const XmlRpc::XmlRpcValue& value, const std::string& field,
-                                      const UrdfSource& urdf, std::vector<std::string>* skipped) {
+                                      const UrdfSource& urdf, std::vector<std::string>* warnings) {
   Scene scene;
   if (auto status = readKeys(value, sceneTable(), field, scene); !status) return status.error();
+  // The meshes' triangles, from their resources.
+  for (std::size_t i = 0; i < scene.obstacles.size(); ++i) {
+    ObstacleSpec& obstacle = scene.obstacles[i];
+    if (obstacle.shape != core::ObstacleShape::kMesh) continue;
+    std::vector<std::string> left_out;
+    auto triangles = loadMeshResource(obstacle.resource, obstacle.scale,
+                                      indexKey(joinKey(field, "obstacles"), i), left_out);
+    if (!triangles) return triangles.error();
+    obstacle.mesh = *triangles;
+    if (warnings) warnings->insert(warnings->end(), left_out.begin(), left_out.end());
+  }
   if (value.hasMember("robot")) {
     const std::string robot_field = joinKey(field, "robot");
     RobotLinks robot;
@@ -428,7 +461,7 @@ core::Expected<core::Scene> loadScene(const XmlRpc::XmlRpcValue& value, const st
     auto obstacles = robotObstacles(*xml, robot, robot_field, left_out);
     if (!obstacles) return obstacles.error();
     scene.obstacles.insert(scene.obstacles.end(), obstacles->begin(), obstacles->end());
-    if (skipped) skipped->insert(skipped->end(), left_out.begin(), left_out.end());
+    if (warnings) warnings->insert(warnings->end(), left_out.begin(), left_out.end());
   }
   if (auto status = core::validateScene(scene, field); !status) return status.error();
   core::normalizePlanes(scene);
@@ -442,6 +475,7 @@ std::map<std::string, std::vector<std::string>> sceneKeys() {
           {"obstacles[] sphere", keyNames(sphereKeys())},
           {"obstacles[] box", keyNames(boxKeys())},
           {"obstacles[] cylinder, capsule", keyNames(roundShapeKeys())},
+          {"obstacles[] mesh", keyNames(meshKeys())},
           {"materials.<name>", keyNames(materialKeys())},
           {"pairs[]", keyNames(pairKeys())},
           {"robot", keyNames(robotKeys())}};

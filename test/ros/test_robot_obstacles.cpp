@@ -1,20 +1,31 @@
 // The scene's `robot:` key: a URDF's <collision> elements as obstacles on their links' frames,
 // named and placed as the URDF says (sizes in full lengths, a cylinder along z), grown by
-// `padding`; a mesh left out and named; every error named by its key.
+// `padding`; a mesh loaded from its filename at its scale; every error named by its key.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <set>
 #include <string>
+#include <tuple>
 #include <vector>
 
+#include "collision_response/core/triangle_mesh.h"
 #include "collision_response/ros/robot_obstacles.h"
 #include "collision_response/ros/scene_loader.h"
 
 namespace collision_response {
 namespace {
 
-const std::string kArm = R"(<?xml version="1.0"?>
+/// A test mesh (test/meshes) as a file:// address.
+std::string meshFile(const std::string& name) {
+  return "file://" + std::string(COLLISION_RESPONSE_TEST_MESHES) + "/" + name;
+}
+
+/// The arm, its paddle's grip the mesh `grip` (test/meshes/grip.stl: a box 0.0625 x 0.125 x
+/// 0.09375 m about its origin) at scale 2 along x.
+std::string arm(const std::string& grip = meshFile("grip.stl")) {
+  return R"(<?xml version="1.0"?>
 <robot name="arm">
   <link name="base_link"/>
   <link name="upper_arm">
@@ -33,7 +44,9 @@ const std::string kArm = R"(<?xml version="1.0"?>
       <geometry><sphere radius="0.05"/></geometry>
     </collision>
     <collision>
-      <geometry><mesh filename="package://arm/meshes/grip.stl" scale="1 1 1"/></geometry>
+      <origin xyz="0 0.2 0"/>
+      <geometry><mesh filename=")" +
+         grip + R"(" scale="2 1 1"/></geometry>
     </collision>
   </link>
   <joint name="shoulder" type="revolute">
@@ -44,6 +57,8 @@ const std::string kArm = R"(<?xml version="1.0"?>
     <parent link="upper_arm"/><child link="paddle"/><origin xyz="0 0 0.4"/>
   </joint>
 </robot>)";
+}
+const std::string kArm = arm();
 
 TEST(RobotObstacles, EveryCollisionOfTheLinksNamedAndPlacedAsTheUrdfSays) {
   RobotLinks robot;
@@ -51,8 +66,8 @@ TEST(RobotObstacles, EveryCollisionOfTheLinksNamedAndPlacedAsTheUrdfSays) {
   std::vector<std::string> skipped;
   const auto obstacles = robotObstacles(kArm, robot, "~scene/robot", skipped);
   ASSERT_TRUE(obstacles.ok()) << obstacles.error().message();
-  // In link-name order: paddle (three collisions, the mesh left out), upper_arm (one).
-  ASSERT_EQ(obstacles->size(), 3u);
+  // In link-name order: paddle (three collisions), upper_arm (one).
+  ASSERT_EQ(obstacles->size(), 4u);
   const core::ObstacleSpec& box = (*obstacles)[0];
   EXPECT_EQ(box.id, "paddle/0");
   EXPECT_EQ(box.frame, "paddle");
@@ -65,20 +80,71 @@ TEST(RobotObstacles, EveryCollisionOfTheLinksNamedAndPlacedAsTheUrdfSays) {
   EXPECT_EQ(ball.shape, core::ObstacleShape::kSphere);
   EXPECT_EQ(ball.radius, 0.05);
   EXPECT_EQ(ball.position, Eigen::Vector3d(0, 0, 0.3));
-  const core::ObstacleSpec& arm = (*obstacles)[2];
-  EXPECT_EQ(arm.id, "upper_arm");  // its only collision: the link's name alone
-  EXPECT_EQ(arm.frame, "upper_arm");
-  EXPECT_EQ(arm.shape, core::ObstacleShape::kCylinder);
-  EXPECT_EQ(arm.radius, 0.04);
-  EXPECT_EQ(arm.length, 0.4);
-  EXPECT_EQ(arm.position, Eigen::Vector3d(0, 0, 0.2));
+  const core::ObstacleSpec& grip = (*obstacles)[2];
+  EXPECT_EQ(grip.id, "paddle/2");
+  EXPECT_EQ(grip.shape, core::ObstacleShape::kMesh);
+  EXPECT_EQ(grip.resource, meshFile("grip.stl"));
+  EXPECT_EQ(grip.scale, Eigen::Vector3d(2, 1, 1));
+  EXPECT_EQ(grip.position, Eigen::Vector3d(0, 0.2, 0));
+  ASSERT_TRUE(grip.mesh);
+  // The STL's 12 triangles, its 8 corners (each repeated in the file) joined, the x scaled by 2:
+  // every corner at (+-0.0625, +-0.0625, +-0.046875), exact in the file's single precision.
+  EXPECT_EQ(grip.mesh->triangles().size(), 12u);
+  std::set<std::tuple<double, double, double>> corners;
+  for (const auto& triangle : grip.mesh->triangles()) {
+    for (const std::uint32_t v : triangle) {
+      const Eigen::Vector3d& p = grip.mesh->vertices()[v];
+      corners.insert({p.x(), p.y(), p.z()});
+      EXPECT_EQ(p.cwiseAbs(), Eigen::Vector3d(0.0625, 0.0625, 0.046875)) << p.transpose();
+    }
+  }
+  EXPECT_EQ(corners.size(), 8u);
+  const core::ObstacleSpec& arm_link = (*obstacles)[3];
+  EXPECT_EQ(arm_link.id, "upper_arm");  // its only collision: the link's name alone
+  EXPECT_EQ(arm_link.frame, "upper_arm");
+  EXPECT_EQ(arm_link.shape, core::ObstacleShape::kCylinder);
+  EXPECT_EQ(arm_link.radius, 0.04);
+  EXPECT_EQ(arm_link.length, 0.4);
+  EXPECT_EQ(arm_link.position, Eigen::Vector3d(0, 0, 0.2));
   // Roll pi/2: the cylinder's axis z turned onto -y.
-  EXPECT_NEAR((arm.orientation * Eigen::Vector3d::UnitZ() - Eigen::Vector3d(0, -1, 0)).norm(), 0,
-              1e-12);
-  ASSERT_EQ(skipped.size(), 1u);
-  EXPECT_NE(skipped[0].find("link 'paddle' <collision> 2: mesh 'package://arm/meshes/grip.stl'"),
+  EXPECT_NEAR((arm_link.orientation * Eigen::Vector3d::UnitZ() - Eigen::Vector3d(0, -1, 0)).norm(),
+              0, 1e-12);
+  EXPECT_TRUE(skipped.empty());
+}
+
+TEST(RobotObstacles, AMeshIsNotPaddedAndItsZeroAreaTrianglesAreNamed) {
+  RobotLinks robot;
+  robot.material = "concrete";
+  robot.padding = 0.01;
+  std::vector<std::string> warnings;
+  const auto obstacles =
+      robotObstacles(arm(meshFile("zero_area.stl")), robot, "~scene/robot", warnings);
+  ASSERT_TRUE(obstacles.ok()) << obstacles.error().message();
+  ASSERT_EQ(warnings.size(), 2u);
+  EXPECT_NE(warnings[0].find("link 'paddle' <collision> 2: "), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[0].find("zero_area.stl': 1 triangle(s) of zero area left out"),
             std::string::npos)
-      << skipped[0];
+      << warnings[0];
+  EXPECT_NE(warnings[1].find("is not grown by the padding"), std::string::npos) << warnings[1];
+  EXPECT_EQ((*obstacles)[2].mesh->triangles().size(), 12u);
+}
+
+TEST(RobotObstacles, AMeshThatDoesNotLoadIsNamedWithItsReason) {
+  RobotLinks robot;
+  robot.material = "concrete";
+  std::vector<std::string> warnings;
+  const std::string missing = meshFile("no_such_grip.stl");
+  auto result = robotObstacles(arm(missing), robot, "~scene/robot", warnings);
+  ASSERT_FALSE(result.ok());
+  EXPECT_EQ(result.error().field, "~scene/robot/description");
+  EXPECT_NE(result.error().reason.find("link 'paddle' <collision> 2, <mesh> filename: '" + missing +
+                                       "' does not load: "),
+            std::string::npos)
+      << result.error().reason;
+  result = robotObstacles(arm(meshFile("not_a_mesh.stl")), robot, "~scene/robot", warnings);
+  ASSERT_FALSE(result.ok());
+  EXPECT_NE(result.error().reason.find("is not a mesh assimp reads"), std::string::npos)
+      << result.error().reason;
 }
 
 TEST(RobotObstacles, ChosenLinksAndPadding) {
@@ -129,8 +195,8 @@ TEST(RobotObstacles, TheSceneKeyReadsTheUrdfItNames) {
   const auto loaded = loadScene(scene, "~scene", source, &skipped);
   ASSERT_TRUE(loaded.ok()) << loaded.error().message();
   EXPECT_EQ(asked, "arm_description");
-  EXPECT_EQ(loaded->obstacles.size(), 3u);
-  EXPECT_EQ(skipped.size(), 1u);
+  EXPECT_EQ(loaded->obstacles.size(), 4u);
+  EXPECT_TRUE(skipped.empty());
   // Without a source (no parameter server), and with a bad key, named errors.
   EXPECT_EQ(loadScene(scene, "~scene").error().field, "~scene/robot");
   scene["robot"]["padding"] = -1.0;

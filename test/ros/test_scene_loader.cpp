@@ -15,12 +15,26 @@
 #include <utility>
 #include <vector>
 
+#include "collision_response/core/triangle_mesh.h"
 #include "collision_response/ros/scene_loader.h"
 #include "collision_response/ros/scene_player.h"
 #include "readme_tables.h"
 
 namespace collision_response {
 namespace {
+
+XmlRpc::XmlRpcValue list3(double x, double y, double z) {
+  XmlRpc::XmlRpcValue value;
+  value[0] = x;
+  value[1] = y;
+  value[2] = z;
+  return value;
+}
+
+/// A test mesh (test/meshes) as a file:// address.
+std::string testMesh(const std::string& name) {
+  return "file://" + std::string(COLLISION_RESPONSE_TEST_MESHES) + "/" + name;
+}
 
 XmlRpc::XmlRpcValue sceneWithRubber() {
   XmlRpc::XmlRpcValue scene;
@@ -277,6 +291,47 @@ TEST(SceneLoader, SceneErrorsNameTheKey) {
   scene["obstacles"][2]["normal"] = 1.0;  // a plane's key
   EXPECT_EQ(sceneErrorField(scene), "~scene/obstacles[2]/normal");
 
+  // A mesh: its resource required, loaded (or named with the address and the reason), its scale
+  // positive.
+  const auto mesh = [&](const std::string& resource) {
+    XmlRpc::XmlRpcValue with = finite("box");
+    with["obstacles"][2] = XmlRpc::XmlRpcValue();
+    with["obstacles"][2]["id"] = "grip";
+    with["obstacles"][2]["type"] = "mesh";
+    with["obstacles"][2]["material"] = "concrete";
+    if (!resource.empty()) with["obstacles"][2]["resource"] = resource;
+    return with;
+  };
+  EXPECT_EQ(sceneErrorField(mesh(testMesh("grip.stl"))), "");            // the base loads
+  EXPECT_EQ(sceneErrorField(mesh("")), "~scene/obstacles[2]/resource");  // required
+  for (const std::string& bad : {testMesh("no_such.stl"), testMesh("not_a_mesh.stl"),
+                                std::string("package://no_such_package/grip.stl"),
+                                std::string("http://example.com/grip.stl")}) {
+    const auto loaded = loadScene(mesh(bad), "~scene");
+    ASSERT_FALSE(loaded.ok()) << bad;
+    EXPECT_EQ(loaded.error().field, "~scene/obstacles[2]/resource") << bad;
+    EXPECT_NE(loaded.error().reason.find("'" + bad + "'"), std::string::npos)
+        << loaded.error().reason;
+  }
+  scene = mesh(testMesh("grip.stl"));
+  scene["obstacles"][2]["scale"] = list3(1, 0, 1);
+  EXPECT_EQ(sceneErrorField(scene), "~scene/obstacles[2]/scale[1]");
+  scene["obstacles"][2]["scale"] = list3(1, 1, -2);
+  EXPECT_EQ(sceneErrorField(scene), "~scene/obstacles[2]/scale[2]");
+  scene = mesh(testMesh("grip.stl"));
+  scene["obstacles"][2]["size"] = list3(1, 1, 1);  // a box's key
+  EXPECT_EQ(sceneErrorField(scene), "~scene/obstacles[2]/size");
+  // Zero-area triangles are left out, and said.
+  std::vector<std::string> warnings;
+  const auto with_zero_area =
+      loadScene(mesh(testMesh("zero_area.stl")), "~scene", nullptr, &warnings);
+  ASSERT_TRUE(with_zero_area.ok()) << with_zero_area.error().message();
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("~scene/obstacles[2]/resource '" + testMesh("zero_area.stl") +
+                             "': 1 triangle(s) of zero area left out"),
+            std::string::npos)
+      << warnings[0];
+
   scene = fullScene();
   scene["obstacles"][0]["normal"][2] = 0.0;
   EXPECT_EQ(sceneErrorField(scene), "~scene/obstacles[0]/normal");
@@ -373,14 +428,6 @@ std::pair<std::string, std::string> entityAndKey(const std::string& documented) 
   return {documented.substr(0, dot), documented.substr(dot + 1)};
 }
 
-XmlRpc::XmlRpcValue list3(double x, double y, double z) {
-  XmlRpc::XmlRpcValue value;
-  value[0] = x;
-  value[1] = y;
-  value[2] = z;
-  return value;
-}
-
 /// A valid value for every key a scene may have, by entity and key: the test of "every
 /// documented key loads" needs one for each documented key (a key without one fails it).
 std::map<std::string, std::map<std::string, XmlRpc::XmlRpcValue>> examples() {
@@ -438,6 +485,19 @@ std::map<std::string, std::map<std::string, XmlRpc::XmlRpcValue>> examples() {
                                              {"rpy", list3(M_PI / 2, 0, 0)},
                                              {"radius", 0.08},
                                              {"length", 0.01}};
+  XmlRpc::XmlRpcValue turned;  // a quarter turn about z: [0, 0, sin(pi/4), cos(pi/4)]
+  turned[0] = 0.0;
+  turned[1] = 0.0;
+  turned[2] = std::sqrt(0.5);
+  turned[3] = std::sqrt(0.5);
+  values["obstacles[] mesh"] = {{"id", "grip"},
+                                {"type", "mesh"},
+                                {"material", "rubber"},
+                                {"frame", "grip_link"},
+                                {"position", list3(0, 0.2, 0)},
+                                {"orientation", turned},
+                                {"resource", testMesh("grip.stl")},
+                                {"scale", list3(2, 1, 1)}};
   values["player.frames[]"] = {{"frame", "paddle_link"},
                                {"parent", "world"},
                                {"position", list3(1, 0, 0)},
@@ -512,7 +572,7 @@ TEST(SceneKeys, EveryDocumentedKeyLoadsWithItsValue) {
         if (std::find(keys.begin(), keys.end(), key) == keys.end()) continue;
         // An orientation is given one way or the other: the box's as a quaternion, the
         // cylinder's as roll, pitch and yaw.
-        if ((table == "obstacles[] box" && key == "rpy") ||
+        if (((table == "obstacles[] box" || table == "obstacles[] mesh") && key == "rpy") ||
             (table == "obstacles[] cylinder, capsule" && key == "orientation")) {
           continue;
         }
@@ -529,6 +589,7 @@ TEST(SceneKeys, EveryDocumentedKeyLoadsWithItsValue) {
   scene["obstacles"][1] = sphere;
   scene["obstacles"][2] = obstacles["obstacles[] box"];
   scene["obstacles"][3] = obstacles["obstacles[] cylinder, capsule"];
+  scene["obstacles"][4] = obstacles["obstacles[] mesh"];
   const auto loaded = loadScene(scene, "~scene");
   ASSERT_TRUE(loaded.ok()) << "a documented key is refused: " << loaded.error().message();
   // Each value arrived where it belongs.
@@ -556,7 +617,7 @@ TEST(SceneKeys, EveryDocumentedKeyLoadsWithItsValue) {
   EXPECT_EQ(ball.velocity, Eigen::Vector3d(4, 5, 6));
   EXPECT_EQ(ball.angular_velocity, Eigen::Vector3d(7, 8, 9));
   EXPECT_EQ(ball.inertia, core::Inertia::kHollow);  // once refused as an unknown key
-  ASSERT_EQ(loaded->obstacles.size(), 4u);
+  ASSERT_EQ(loaded->obstacles.size(), 5u);
   EXPECT_EQ(loaded->obstacles[0].frame, "floor_link");
   EXPECT_EQ(loaded->obstacles[0].normal, Eigen::Vector3d(0, 0, 1));  // scaled to unit length
   EXPECT_EQ(loaded->obstacles[0].offset, 0.5);
@@ -575,6 +636,18 @@ TEST(SceneKeys, EveryDocumentedKeyLoadsWithItsValue) {
   // Roll pi/2 about x: the paddle's axis z lies along -y.
   EXPECT_NEAR((paddle.orientation * Eigen::Vector3d::UnitZ() - Eigen::Vector3d(0, -1, 0)).norm(), 0,
               1e-15);
+  const core::ObstacleSpec& grip = loaded->obstacles[4];
+  EXPECT_EQ(grip.shape, core::ObstacleShape::kMesh);
+  EXPECT_EQ(grip.frame, "grip_link");
+  EXPECT_EQ(grip.resource, testMesh("grip.stl"));
+  EXPECT_EQ(grip.scale, Eigen::Vector3d(2, 1, 1));
+  EXPECT_EQ(grip.position, Eigen::Vector3d(0, 0.2, 0));
+  EXPECT_NEAR((grip.orientation * Eigen::Vector3d::UnitX() - Eigen::Vector3d(0, 1, 0)).norm(), 0,
+              1e-15);
+  ASSERT_TRUE(grip.mesh);
+  EXPECT_EQ(grip.mesh->triangles().size(), 12u);  // its x scaled: the corners at x = +-0.0625
+  EXPECT_EQ(grip.mesh->vertices()[grip.mesh->triangles()[0][0]].cwiseAbs(),
+            Eigen::Vector3d(0.0625, 0.0625, 0.046875));
 
   // The scene player's part of the file.
   XmlRpc::XmlRpcValue tree;

@@ -23,13 +23,16 @@ struct RobotLinks {
 /// The obstacles of `urdf` (the URDF's XML) for `robot`: one per <collision> of each chosen link,
 /// in link-name order, named `<link>/<index>` (`<link>` alone when it has one), in the link's
 /// frame at the collision's <origin>: a URDF box (`size` full lengths), cylinder (along z,
-/// `length` full) and sphere as the scene's box, cylinder and sphere, grown by `padding`. A
-/// <mesh> is not an obstacle yet: it is left out and `skipped` says which (link, index and
-/// resource). Errors name `field`'s keys: a URDF that does not parse (field/description), a chosen
-/// link the URDF does not have or without a <collision> (field/links[i]).
+/// `length` full) and sphere as the scene's box, cylinder and sphere, grown by `padding`; a
+/// <mesh> as a mesh obstacle, loaded from its filename at its scale (mesh_resource.h), not grown.
+/// `warnings` says what is left out: a <collision> without geometry, a mesh's zero-area
+/// triangles, a padding a mesh does not take. Errors name `field`'s keys: a URDF that does not
+/// parse (field/description), a mesh that does not load (field/description, with the link, the
+/// filename and the reason), a chosen link the URDF does not have or without a <collision>
+/// (field/links[i]).
 core::Expected<std::vector<core::ObstacleSpec>> robotObstacles(const std::string& urdf,
                                                                const RobotLinks& robot,
                                                                const std::string& field,
-                                                               std::vector<std::string>& skipped);
+                                                               std::vector<std::string>& warnings);
 
 }  // namespace collision_response

@@ -19,12 +19,14 @@ namespace collision_response {
 /// key, an unknown material, effect, detection or obstacle type, a duplicate name, a value out
 /// of range.
 ///
-/// With `robot:` the links of the URDF that `urdf` returns for the parameter it names become
-/// obstacles (robot_obstacles.h); what they leave out (meshes) is added to `skipped`.
+/// A mesh obstacle's triangles are loaded from its `resource` (mesh_resource.h). With `robot:` the
+/// links of the URDF that `urdf` returns for the parameter it names become obstacles
+/// (robot_obstacles.h). What the scene leaves out (a mesh's zero-area triangles, a <collision>
+/// without geometry) is added to `warnings`, for the caller to log.
 using UrdfSource = std::function<core::Expected<std::string>(const std::string& parameter)>;
 core::Expected<core::Scene> loadScene(const XmlRpc::XmlRpcValue& scene, const std::string& field,
                                       const UrdfSource& urdf = nullptr,
-                                      std::vector<std::string>* skipped = nullptr);
+                                      std::vector<std::string>* warnings = nullptr);
 
 /// The URDF from the parameter server (a name relative to the node's namespace); an error names
 /// `field`/robot/description.
@@ -32,8 +34,8 @@ UrdfSource parameterServerUrdf(const std::string& field);
 
 /// The keys loadScene reads, by entity, as the README's tables name them: "scene", "bodies[]",
 /// "obstacles[] plane", "obstacles[] sphere", "obstacles[] box", "obstacles[] cylinder, capsule",
-/// "materials.<name>", "pairs[]", "robot". These are the key
-/// tables the loader reads and checks with: a key is accepted exactly when it is listed here.
+/// "obstacles[] mesh", "materials.<name>", "pairs[]", "robot". These are the key tables the loader
+/// reads and checks with: a key is accepted exactly when it is listed here.
 std::map<std::string, std::vector<std::string>> sceneKeys();
 
 }  // namespace collision_response
