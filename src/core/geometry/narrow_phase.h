@@ -93,9 +93,14 @@ inline Eigen::Vector3d originAt(const RigidPose& pose, double time) {
   return pose.transform.translation() + pose.velocity * (time - pose.time);
 }
 
-/// A placed shape moved straight on to `time` (its pose's velocity; the turning of an obstacle
-/// between placements is not followed).
+/// A placed shape moved on to `time`: its origin straight on at its pose's velocity, a finite
+/// shape turned about its origin at its pose's angular velocity (a plane's and a sphere's
+/// turning is not followed).
 PlacedShape shapeAt(const PlacedShape& placed, double time);
+
+/// m: how far from its pose's origin a shape's points turn with it: a finite shape's bounding
+/// radius; 0 for a plane and a sphere, whose turning is not followed (shapeAt).
+double turningReach(const Shape& shape);
 
 /// contactGeometry against a sphere.
 template <class Approach>
@@ -194,7 +199,8 @@ struct BallMotion {
 /// `shape_velocity` and accelerating at `shape_acceleration`) within `horizon`: straight lines
 /// (timeOfImpactPlane, timeOfImpactSpheres), or with `accelerates` parabolas
 /// (timeOfImpactPlaneBallistic, timeOfImpactSpheresAccelerated; a plane does not accelerate);
-/// a finite shape by its features' polynomials (finite_shapes.h, firstContactFinite).
+/// a finite shape by its features' polynomials (finite_shapes.h, firstContactFinite), or, where
+/// it turns (its pose's angular velocity), by conservative advancement on the distance.
 std::optional<double> firstContact(const BallMotion& ball, const PlacedShape& shape,
                                    const Eigen::Vector3d& shape_velocity,
                                    const Eigen::Vector3d& shape_acceleration, bool accelerates,

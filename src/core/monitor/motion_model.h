@@ -209,10 +209,16 @@ double reach(const World& world, const Pair& pair, double from, double horizon) 
     // An integrated step's accelerations vary: no bound, the root is looked for.
     if (constrained(world, pair.first) || constrained(world, pair.second)) return INFINITY;
   }
-  const double speed =
-      (velocityAt<Motion>(world, pair.second, from) - velocityAt<Motion>(world, pair.first, from))
-          .norm();
-  double distance = speed * horizon;
+  const Eigen::Vector3d own = velocityAt<Motion>(world, pair.first, from);
+  const Eigen::Vector3d other = velocityAt<Motion>(world, pair.second, from);
+  double distance = (other - own).norm() * horizon;
+  // A finite obstacle that turns (shapeAt): its origin's velocity turns with it, and its
+  // surface's points move up to |w| R faster.
+  if (world.isObstacle(pair.second)) {
+    const PlacedShape& placed = world.placedShape(pair.second);
+    const double turning = placed.pose.angular_velocity.norm() * turningReach(placed.shape);
+    if (turning > 0) distance = (own.norm() + other.norm() + turning) * horizon;
+  }
   if constexpr (Motion::kAccelerates) {
     distance += 0.5 *
                 (accelerationOf<Motion>(world, pair.second) - world.tracks[pair.first].acceleration)
