@@ -465,6 +465,10 @@ core::Expected<core::Scene> loadScene(const XmlRpc::XmlRpcValue& value, const st
   }
   if (auto status = core::validateScene(scene, field); !status) return status.error();
   core::normalizePlanes(scene);
+  if (warnings) {
+    const auto inside = core::bodiesStartingInside(scene);
+    warnings->insert(warnings->end(), inside.begin(), inside.end());
+  }
   return scene;
 }
 

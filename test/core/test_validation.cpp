@@ -9,7 +9,9 @@
 
 #include "collision_response/core/collision.h"
 #include "collision_response/core/restitution.h"
+#include "collision_response/core/scene.h"
 #include "collision_response/core/validation.h"
+#include "scene_builders.h"
 
 namespace collision_response::core {
 namespace {
@@ -273,6 +275,30 @@ TEST(Validation, APositionPastTheMonitorsResolutionIsRefusedNamingTheCoordinate)
   const auto nan = checkResolvablePosition(Eigen::Vector3d(0, 0, kNan), "p");
   ASSERT_FALSE(nan.ok());
   EXPECT_EQ(nan.error().message(), "p.z: must be a finite number, got nan");
+}
+
+// A body placed inside a fixed obstacle is named with the obstacle and its depth; one touching
+// it, one outside, and one inside an obstacle on a tf frame (placed only at run time) are not.
+TEST(Validation, BodiesStartingInsideAFixedObstacleAreNamed) {
+  using Eigen::Vector3d;
+  Scene scene;
+  scene.bodies = {scene_builders::ball("deep", 0.1, 0.1, "concrete"),
+                  scene_builders::ball("resting", 0.1, 0.1, "concrete"),
+                  scene_builders::ball("below", 0.1, 0.1, "concrete")};
+  scene.bodies[0].position = Vector3d(0.2, 0, 0.7);    // the box's top at 0.75: 0.15 m in
+  scene.bodies[1].position = Vector3d(-0.2, 0, 0.85);  // on the top, touching
+  scene.bodies[2].position = Vector3d(3, 0, -0.25);    // under the floor by 0.35
+  scene.obstacles = {
+      scene_builders::box("table", Vector3d(0, 0, 0.5), Vector3d(1, 1, 0.5), "concrete"),
+      scene_builders::plane("floor", Vector3d(0, 0, 1), 0.0, "concrete")};
+  ObstacleSpec moving =
+      scene_builders::box("paddle", Vector3d(0.2, 0, 0.7), Vector3d(1, 1, 1), "concrete");
+  moving.frame = "paddle_link";
+  scene.obstacles.push_back(moving);
+  const std::vector<std::string> warnings = bodiesStartingInside(scene);
+  ASSERT_EQ(warnings.size(), 2u);
+  EXPECT_EQ(warnings[0], "body 'deep' at [0.2, 0, 0.7] starts 0.15 m inside obstacle 'table'");
+  EXPECT_EQ(warnings[1], "body 'below' at [3, 0, -0.25] starts 0.35 m inside obstacle 'floor'");
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <optional>
 #include <set>
@@ -216,6 +217,28 @@ Status validateScene(const Scene& scene, const std::string& prefix) {
   if (auto status = checkBodies(scene, prefix, ids); !status) return status;
   if (auto status = checkObstacles(scene, prefix, ids); !status) return status;
   return checkEveryPairHasRestitution(scene, prefix);
+}
+
+std::vector<std::string> bodiesStartingInside(const Scene& scene) {
+  const auto depth = [](double metres) {  // six figures: a depth to read, not to parse
+    char text[32];
+    std::snprintf(text, sizeof text, "%.6g", metres);
+    return std::string(text);
+  };
+  std::vector<std::string> warnings;
+  for (const ObstacleSpec& obstacle : scene.obstacles) {
+    if (!obstacle.frame.empty()) continue;
+    const PlacedShape placed = placeFixed(obstacle);
+    for (const BodySpec& body : scene.bodies) {
+      const ContactGeometry g = contactGeometry(body.position, body.radius, placed, 1e-9, [] {
+        return Eigen::Vector3d(Eigen::Vector3d::Zero());
+      });
+      if (!(g.gap < -g.tolerance)) continue;
+      warnings.push_back("body '" + body.id + "' at " + formatVector(body.position) + " starts " +
+                         depth(-g.gap) + " m inside obstacle '" + obstacle.id + "'");
+    }
+  }
+  return warnings;
 }
 
 void normalizePlanes(Scene& scene) {
