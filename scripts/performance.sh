@@ -14,12 +14,16 @@
 #   .ws/devel/lib/collision_response/bench_scale --benchmark_filter=Pile \
 #     --benchmark_format=json --benchmark_out=.ws/pile.json
 #   /usr/bin/python3 scripts/performance_report.py --pile-only .ws/pile.json doc/performance.md
+# The shapes' first contact (doc/model.md, "Finite obstacles"), after a run of this script:
+#   .ws/devel/lib/collision_response/bench_scale --benchmark_filter=FirstContact
+#   .ws/devel/lib/collision_response/bench_arm     # a ball against a seven-joint arm, beside
+#                                                  # Bullet and FCL
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
-PACKAGES+=(libbenchmark-dev libbullet-dev libmujoco-dev libstd-srvs-dev ros-std-srvs linux-perf)
+PACKAGES+=(libbenchmark-dev libbullet-dev libfcl-dev libmujoco-dev libstd-srvs-dev ros-std-srvs linux-perf)
 install_packages
 build_workspace >"$ws/build.log" 2>&1 || { tail -40 "$ws/build.log"; exit 1; }
-cmake --build "$ws/build" --target bench_scale node_benchmark empty_service -- -j2 \
+cmake --build "$ws/build" --target bench_scale bench_arm node_benchmark empty_service -- -j2 \
   >>"$ws/build.log" 2>&1 || { tail -40 "$ws/build.log"; exit 1; }
 source_workspace
 bin="$ws/devel/lib/collision_response"
