@@ -10,7 +10,8 @@ of another (a mirror image in a symmetric scene) is dotted over that body's spee
 legend entry names the other. With the scene file, each
 body is drawn at its start and its end as a disc of its radius, and the fixed obstacles are
 drawn too: a plane across the drawing plane as a line (the billiards table's cushions, the drop
-test's floor), a sphere as a circle. Impacts are marked at their contact points, with a short
+test's floor), a sphere as a circle, a box along the axes as a rectangle (obstacles on tf frames,
+a robot's links among them, are not drawn: their impacts are). Impacts are marked at their contact points, with a short
 line along the normal.
 """
 import argparse
@@ -69,6 +70,13 @@ def read_scene(scene_path):
     return radii, scene.get("obstacles", [])
 
 
+def turned(obstacle):
+    """Whether a box is turned from its frame's axes (such a box is not drawn)."""
+    quaternion = [float(c) for c in obstacle.get("orientation", [0, 0, 0, 1])]
+    angles = [float(c) for c in obstacle.get("rpy", [0, 0, 0])]
+    return quaternion[:3] != [0.0, 0.0, 0.0] or any(angles)
+
+
 def view_box(paths, axes, radii, obstacles):
     """The drawn region: every path with its discs, and the planes close to it."""
     lows, highs = [], []
@@ -119,6 +127,14 @@ def draw_obstacles(plane, obstacles, axes, box):
             shift = 0.02 * max(u1 - u0, v1 - v0)
             plane.text(mu + nu * shift, mv + nv * shift, name, fontsize=7, color="saddlebrown",
                        ha="center", va="center", rotation=0 if abs(nv) >= abs(nu) else 90)
+        elif kind == "box" and not obstacle.get("frame") and not turned(obstacle):
+            centre = [float(c) for c in obstacle.get("position", [0, 0, 0])]
+            size = [float(c) for c in obstacle["size"]]
+            corner = (centre[axes[0]] - size[axes[0]] / 2, centre[axes[1]] - size[axes[1]] / 2)
+            plane.add_patch(plt.Rectangle(corner, size[axes[0]], size[axes[1]],
+                                          color="saddlebrown", alpha=0.4, zorder=1))
+            plane.text(centre[axes[0]], centre[axes[1]], name, fontsize=7, ha="center",
+                       va="center")
         elif kind == "sphere" and not obstacle.get("frame"):
             centre = [float(c) for c in obstacle.get("position", [0, 0, 0])]
             plane.add_patch(plt.Circle((centre[axes[0]], centre[axes[1]]),

@@ -3,6 +3,8 @@
 # rosbag, and draws the paths, obstacles, speeds and impacts from the bag with matplotlib.
 #   bash scripts/plot_scene.sh [scene] [duration_s]         -> .ws/plots/<scene>.png (and .bag)
 #   bash scripts/plot_scene.sh --doc [scene] [duration_s]   -> doc/<scene>.png, the README's picture
+# A scene with a robot (`robot:`, config/scenes/paddle_arm.yaml) is played by paddle_arm.launch,
+# which publishes its URDF and joints; the others by demo.launch.
 # Without --doc nothing tracked is written: the picture goes beside the bag in the ignored .ws/.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
@@ -27,10 +29,15 @@ rm -f "$out/$scene.bag"
 rosbag record -O "$out/$scene.bag" /body_states /impacts >"$out/rosbag.log" 2>&1 &
 recorder=$!
 pids+=("$recorder")
-echo "== roslaunch collision_response demo.launch scene:=$scene duration:=$duration, recorded by rosbag"
+echo "== scene $scene for $duration s with the node, recorded by rosbag"
 # The player waits a second so that the recorder is connected before the first state.
-roslaunch collision_response demo.launch scene:="$scene" duration:="$duration" start_delay:=1.0 \
-  report_restitution:=false >"$out/demo.log" 2>&1
+if grep -q '^  robot:' "$repo/config/scenes/$scene.yaml"; then
+  roslaunch collision_response paddle_arm.launch scene_file:="$repo/config/scenes/$scene.yaml" \
+    duration:="$duration" >"$out/demo.log" 2>&1
+else
+  roslaunch collision_response demo.launch scene:="$scene" duration:="$duration" start_delay:=1.0 \
+    report_restitution:=false >"$out/demo.log" 2>&1
+fi
 stop_process "$recorder"
 rosbag info "$out/$scene.bag" | grep -E '^(duration|messages|topics)|^ +/' || true
 /usr/bin/python3 "$repo/scripts/plot_bag.py" "$out/$scene.bag" "$picture" "$scene" \
