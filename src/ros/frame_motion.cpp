@@ -11,6 +11,19 @@ Eigen::Vector3d FrameMotion::velocity(const Eigen::Vector3d& in_frame,
   return pose.linear() * velocity_in_frame + linear_velocity + angular_velocity.cross(offset);
 }
 
+namespace {
+
+/// The chord velocities of a frame between two of its poses `dt` apart: its origin's, and its
+/// turning's (R_later = exp([w] dt) R_earlier: the rotation between them, as an angle-axis).
+void chord(const Eigen::Isometry3d& later, const Eigen::Isometry3d& earlier, double dt,
+           Eigen::Vector3d& linear, Eigen::Vector3d& angular) {
+  linear = (later.translation() - earlier.translation()) / dt;
+  const Eigen::AngleAxisd turn(later.linear() * earlier.linear().transpose());
+  angular = turn.axis() * (turn.angle() / dt);
+}
+
+}  // namespace
+
 core::Expected<FrameMotion> lookupFrameMotion(const tf2::BufferCore& buffer,
                                               const std::string& fixed_frame,
                                               const std::string& frame, const ros::Time& stamp,
@@ -26,10 +39,23 @@ core::Expected<FrameMotion> lookupFrameMotion(const tf2::BufferCore& buffer,
         tf2::transformToEigen(buffer.lookupTransform(fixed_frame, frame, earlier_stamp));
     const double dt = (stamp - earlier_stamp).toSec();
     motion.pose = now;
-    motion.linear_velocity = (now.translation() - earlier.translation()) / dt;
-    // R_now = exp([w] dt) R_earlier: the rotation between the two, as an angle-axis, over dt.
-    const Eigen::AngleAxisd turn(now.linear() * earlier.linear().transpose());
-    motion.angular_velocity = turn.axis() * (turn.angle() / dt);
+    chord(now, earlier, dt, motion.linear_velocity, motion.angular_velocity);
+    // A chord's velocity is the frame's half an interval back: with the chord before it, the
+    // velocity now to second order in the interval, v1 + (v1 - v2) / 2 (exact at constant
+    // velocity; a frame that accelerates, as a swinging arm's links do, is off by a third of its
+    // jerk times the interval squared instead of half its acceleration times the interval).
+    // Where tf has no pose that far back yet, the chord alone.
+    if (earlier_stamp > ros::Time(0) + ros::Duration(dt)) {
+      const ros::Time earliest_stamp = earlier_stamp - ros::Duration(dt);
+      if (buffer.canTransform(fixed_frame, frame, earliest_stamp)) {
+        const Eigen::Isometry3d earliest =
+            tf2::transformToEigen(buffer.lookupTransform(fixed_frame, frame, earliest_stamp));
+        Eigen::Vector3d linear_before, angular_before;
+        chord(earlier, earliest, dt, linear_before, angular_before);
+        motion.linear_velocity += 0.5 * (motion.linear_velocity - linear_before);
+        motion.angular_velocity += 0.5 * (motion.angular_velocity - angular_before);
+      }
+    }
     return motion;
   } catch (const tf2::TransformException& error) {
     return core::Error{frame, "no transform to '" + fixed_frame + "' at " +

@@ -154,8 +154,11 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
   update.stamp = newest;
   update.time = placed.time;
   timeSamples(placed, newest);
+  std::vector<core::ImpactRecord> earlier_impacts;
+  stepMovingObstacles(placed, newest, tf, earlier_impacts, update);
   updateObstacles(newest, placed.time, tf, update);
-  const core::StepReport step = monitor_.step(placed.time, timed_);
+  core::StepReport step = monitor_.step(placed.time, timed_);
+  step.impacts.insert(step.impacts.begin(), earlier_impacts.begin(), earlier_impacts.end());
   update.stepped = true;
   ++steps_;
   reportStep(step, update);
@@ -400,6 +403,32 @@ std::int64_t MonitorCycle::clockOf(double time, std::size_t body_a, std::size_t 
   if (other_is_obstacle) return a;
   const std::int64_t b = clockOfBody(other);
   return a != b && b == 0 ? b : a;
+}
+
+void MonitorCycle::stepMovingObstacles(const TimeLine::Placed& placed, const ros::Time& newest,
+                                       const tf2::BufferCore& tf,
+                                       std::vector<core::ImpactRecord>& impacts, Update& update) {
+  const double period = params_.obstacle_update_period;
+  if (!(period > 0) || !monitor_.started()) return;
+  const bool moving = std::any_of(scene_.obstacles.begin(), scene_.obstacles.end(),
+                                  [](const core::ObstacleSpec& o) { return !o.frame.empty(); });
+  if (!moving) return;
+  // Up to the update's first state (the monitor takes states in time order), at most 1,000
+  // placements an update.
+  double until = placed.time;
+  for (const core::BodyStateSample& sample : timed_) until = std::min(until, sample.time);
+  const double from = monitor_.now();
+  const double span = until - from;
+  if (!(span > period)) return;
+  const int count = static_cast<int>(std::min(std::ceil(span / period), 1000.0));
+  for (int k = 1; k < count; ++k) {
+    const double time = from + span * k / count;
+    const ros::Time stamp = newest - ros::Duration(placed.time - time);
+    updateObstacles(stamp, time, tf, update);
+    const core::StepReport step = monitor_.step(time, {});
+    reportStep(step, update);
+    impacts.insert(impacts.end(), step.impacts.begin(), step.impacts.end());
+  }
 }
 
 void MonitorCycle::updateObstacles(const ros::Time& stamp, double time, const tf2::BufferCore& tf,

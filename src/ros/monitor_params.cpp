@@ -38,6 +38,9 @@ const KeyTable<MonitorParams>& MonitorParams::keys() {
           "frame_velocity_interval", [](P& p) -> double& { return p.frame_velocity_interval; },
           checkDuration),
       numberKey<P>(
+          "obstacle_update_period", [](P& p) -> double& { return p.obstacle_update_period; },
+          checkDurationOrZero),
+      numberKey<P>(
           "body_timeout", [](P& p) -> double& { return p.body_timeout; }, checkDuration),
       numberKey<P>(
           "contact_tolerance", [](P& p) -> double& { return p.contact_tolerance; },

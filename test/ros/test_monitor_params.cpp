@@ -37,6 +37,7 @@ std::map<std::string, XmlRpc::XmlRpcValue> nodeExamples() {
           {"player", XmlRpc::XmlRpcValue()},
           {"transform_timeout", 0.25},
           {"frame_velocity_interval", 0.02},
+          {"obstacle_update_period", 0.005},
           {"body_timeout", 2.0},
           {"contact_tolerance", 1e-6},
           {"clock_jump_back", 3},  // an integer is a number
@@ -100,6 +101,7 @@ TEST(MonitorParams, EveryDocumentedParameterLoadsAndEveryReadOneIsDocumented) {
   ASSERT_TRUE(params.ok()) << "a documented parameter is refused: " << params.error().message();
   EXPECT_EQ(params->transform_timeout, 0.25);
   EXPECT_EQ(params->frame_velocity_interval, 0.02);
+  EXPECT_EQ(params->obstacle_update_period, 0.005);
   EXPECT_EQ(params->body_timeout, 2.0);
   EXPECT_EQ(params->contact_tolerance, 1e-6);
   EXPECT_EQ(params->clock_jump_back, 3.0);
@@ -186,6 +188,7 @@ TEST(MonitorParams, ValuesOutOfRangeAreErrors) {
       {"future_stamp_tolerance", 0.0},
       {"marker_rate", std::numeric_limits<double>::infinity()},
       {"frame_velocity_interval", 0.0},
+      {"obstacle_update_period", -0.001},
       {"diagnostic_period", -1.0}};
   for (const auto& [key, value] : cases) {
     XmlRpc::XmlRpcValue tree;
@@ -236,9 +239,10 @@ std::string topicError(const std::vector<std::string>& topics, const std::string
 // key; `~frame_velocity_interval: 1e10` and `~impact_marker_lifetime: 1e10` made every message
 // an internal error. Every duration is now checked at start-up, the key named: 2147483647 s
 // (exactly representable) is the longest accepted, and one nanosecond the shortest nonzero.
-const std::vector<std::string> kDurationKeys = {
-    "transform_timeout",      "frame_velocity_interval", "body_timeout",     "clock_jump_back",
-    "future_stamp_tolerance", "impact_marker_lifetime",  "diagnostic_period"};
+const std::vector<std::string> kDurationKeys = {"transform_timeout",      "frame_velocity_interval",
+                                                "body_timeout",           "clock_jump_back",
+                                                "future_stamp_tolerance", "impact_marker_lifetime",
+                                                "diagnostic_period",      "obstacle_update_period"};
 
 std::string durationError(const std::string& key, double seconds) {
   XmlRpc::XmlRpcValue tree;
@@ -259,7 +263,8 @@ TEST(MonitorParams, EveryDurationIsBoundedByWhatARosDurationHolds) {
               kNs + "/" + key +
                   ": 1e-10 s is shorter than a ros::Duration can hold (1e-09 s, one nanosecond)");
   }
-  EXPECT_EQ(durationError("transform_timeout", 0.0), "");  // 0: never wait, as before
+  EXPECT_EQ(durationError("transform_timeout", 0.0), "");       // 0: never wait, as before
+  EXPECT_EQ(durationError("obstacle_update_period", 0.0), "");  // 0: once an update
   EXPECT_EQ(durationError("diagnostic_period", 0.0),
             kNs + "/diagnostic_period: must be a finite number of seconds > 0, got 0");
 }

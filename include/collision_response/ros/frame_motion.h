@@ -25,10 +25,11 @@ struct FrameMotion {
                            const Eigen::Vector3d& velocity_in_frame) const;
 };
 
-/// Looks up `frame` in `fixed_frame` at `stamp` and at `stamp - interval` (the velocity is the
-/// finite difference: exact for a frame moving at constant velocity, as tf interpolates linearly
-/// between its samples). A frame equal to the fixed frame, or empty, is the identity at rest.
-/// The error says which frames and why (not yet available, not connected, ...).
+/// Looks up `frame` in `fixed_frame` at `stamp`, `stamp - interval` and `stamp - 2 interval`:
+/// the velocity is the backward finite difference of second order (exact for a frame moving at
+/// constant velocity, as tf interpolates linearly between its samples; first order where tf has
+/// no pose two intervals back yet). A frame equal to the fixed frame, or empty, is the identity at
+/// rest. The error says which frames and why (not yet available, not connected, ...).
 core::Expected<FrameMotion> lookupFrameMotion(const tf2::BufferCore& buffer,
                                               const std::string& fixed_frame,
                                               const std::string& frame, const ros::Time& stamp,

@@ -108,6 +108,12 @@ class MonitorCycle {
   /// Places the tf-attached obstacles at `stamp` (line time `time`).
   void updateObstacles(const ros::Time& stamp, double time, const tf2::BufferCore& tf,
                        Update& update);
+  /// Steps the monitor (no states) through the update's time before its first state, every
+  /// ~obstacle_update_period, placing the tf-attached obstacles again from tf at each; the
+  /// impacts found are gathered in `impacts`, what the steps report in `update`.
+  void stepMovingObstacles(const TimeLine::Placed& placed, const ros::Time& newest,
+                           const tf2::BufferCore& tf, std::vector<core::ImpactRecord>& impacts,
+                           Update& update);
 
   core::Scene scene_;
   MonitorParams params_;

@@ -17,6 +17,9 @@ namespace collision_response {
 struct MonitorParams {
   double transform_timeout = 0.1;         ///< s (wall): how long a state waits for its transform
   double frame_velocity_interval = 0.01;  ///< s: finite difference for a moving frame's velocity
+  /// s: within an update, tf-attached obstacles are placed again from tf at least this often
+  /// (0: once an update, at its end)
+  double obstacle_update_period = 0.001;
   double body_timeout = 1.0;              ///< s: a body with no state this long is forgotten
   double contact_tolerance = 1e-9;        ///< fraction of the contact distance that is touching
   double clock_jump_back = 1.0;           ///< s: a source's stamps this much older are a jump
