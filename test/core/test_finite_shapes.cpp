@@ -393,6 +393,68 @@ TEST(FiniteShapes, ATurningPaddleIsMetWhereItHasTurnedAndHitsWithItsSurfacesVelo
   EXPECT_NEAR((impact.velocity_a_after - after.cast<double>()).norm(), 0, 1e-12);
 }
 
+// The turning paddle above with friction and spin (mu large enough that the contact point
+// stops slipping within the impact: sticking) spins the ball. At the contact the ball's point
+// slips across the face at s = (v - v_s).t (t = (-n_y, n_x, 0), the face's direction in the
+// plane of turning; the ball has no spin yet). A solid ball (I = 2/5 m r^2) stops slipping after
+// the tangential impulse -(2/7) m s t: its velocity along t changes by -(2/7) s, and it turns at
+// r n x J / I = -(5/7) (s / r) z. Along n, u_s + e (u_s - u_a) as before.
+TEST(FiniteShapes, ATurningPaddleSpinsTheBallWithFriction) {
+  Scene scene;
+  scene.effects.friction = true;
+  scene.effects.spin = true;
+  ASSERT_TRUE(scene.materials.addMaterial("rubber", Material{0.5, 1e6}, "m").ok());
+  BodySpec ball;
+  ball.id = "ball";
+  ball.mass = 0.1;
+  ball.radius = 0.05;
+  ball.material = "rubber";
+  scene.bodies = {ball};
+  ObstacleSpec paddle;
+  paddle.id = "paddle";
+  paddle.shape = ObstacleShape::kBox;
+  paddle.size = V(0.02, 0.3, 0.3);
+  paddle.frame = "paddle_link";
+  paddle.material = "rubber";
+  scene.obstacles = {paddle};
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  RigidPose frame;
+  const double w = 10, x0 = -0.065, y0 = 0.1, v = 0.5, e = 0.5, r = 0.05;
+  frame.angular_velocity = V(0, 0, w);
+  monitor.setObstaclePose(0, frame);
+  BodyStateSample start;
+  start.body = 0;
+  start.position = V(x0, y0, 0);
+  start.velocity = V(v, 0, 0);
+  monitor.step(0.0, {start});
+  const StepReport report = monitor.step(0.02, {});
+  ASSERT_EQ(report.impacts.size(), 1u);
+  const ImpactRecord& impact = report.impacts[0];
+  LD t = 0.0033L;  // the instant, as in the test above
+  for (int i = 0; i < 50; ++i) {
+    const LD f = (x0 + v * t) * std::cos(w * t) + y0 * std::sin(w * t) + 0.06L;
+    const LD slope =
+        v * std::cos(w * t) - w * (x0 + v * t) * std::sin(w * t) + w * y0 * std::cos(w * t);
+    t -= f / slope;
+  }
+  const LD angle = w * t;
+  const Eigen::Matrix<LD, 3, 1> n(std::cos(angle), std::sin(angle), 0);
+  const Eigen::Matrix<LD, 3, 1> across(-std::sin(angle), std::cos(angle), 0);
+  const LD along_face = -(x0 + v * t) * std::sin(angle) + y0 * std::cos(angle);
+  const Eigen::Matrix<LD, 3, 1> point = -0.01L * n + along_face * across;
+  const Eigen::Matrix<LD, 3, 1> surface(-w * point.y(), w * point.x(), 0);
+  const Eigen::Matrix<LD, 3, 1> before(v, 0, 0);
+  const LD u_a = before.dot(n), u_s = surface.dot(n), slip = (before - surface).dot(across);
+  const Eigen::Matrix<LD, 3, 1> after =
+      before + (u_s + e * (u_s - u_a) - u_a) * n - (2.0L / 7) * slip * across;
+  EXPECT_NEAR((impact.velocity_a_after - after.cast<double>()).norm(), 0, 1e-12);
+  EXPECT_NEAR((impact.angular_velocity_a_after - V(0, 0, double(-(5.0L / 7) * slip / r))).norm(), 0,
+              1e-11);
+  // Most of the slip is the face's: w x r along it is -0.1 m/s at 0.01 m from the axis, the
+  // ball's own velocity along it 0.5 sin(angle) = 0.017 m/s.
+  EXPECT_GT(std::abs(double(slip)), 0.08);
+}
+
 // A paddle swung about a hinge: the box (faces at x = +-0.01) centred at (0, 0.25, 0) on a frame
 // that turns about z through its origin at w = 2 rad/s from theta0 = -0.5 rad; a ball (r = 0.033)
 // at rest at p = (-0.06, 0.25, 0). The paddle's centre moves on the circle about the hinge (the

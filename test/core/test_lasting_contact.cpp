@@ -831,6 +831,43 @@ void offABoxEdge(bool rolling, bool as_mesh) {
 TEST_P(OnABoxOrItsMesh, SlidesOffAnEdgeAtTheClosedForm) { offABoxEdge(false, GetParam()); }
 TEST_P(OnABoxOrItsMesh, RollsOffAnEdgeAtTheClosedForm) { offABoxEdge(true, GetParam()); }
 
+// A ball of clay (e = 0, no friction) dropped off-centre into the groove between two boxes (their
+// top faces at z = 0, their near edges at x = -w/2 and w/2, w = 0.06 < 2 r): it lands on one
+// edge, slides round it into the groove and comes to rest on both edges, its centre on the
+// groove's middle at z = sqrt(r^2 - (w/2)^2), each edge pushing along the line to the centre,
+// at phi = asin(w / (2 r)) from the vertical: N = m g / (2 cos phi). Never inside either box;
+// the same with the boxes as meshes.
+TEST_P(OnABoxOrItsMesh, ComesToRestInTheGrooveBetweenTwoBoxes) {
+  const double r = 0.05, m = 0.2, w = 0.06;
+  const V half(0.5, 0.5, 0.25);
+  Scene scene = gravityScene();
+  addMaterial(scene, "clay", 0.0, 0.0);
+  scene.bodies = {ball("ball", m, r, "clay")};
+  ObstacleSpec left = table(GetParam(), half, "clay"), right = left;
+  left.id = "left";
+  left.position = V(-0.5 - w / 2, 0, -0.25);
+  right.id = "right";
+  right.position = V(0.5 + w / 2, 0, -0.25);
+  scene.obstacles = {left, right};
+  ImpactMonitor monitor(scene, longLived());
+  double deepest = -1;
+  StepReport last;
+  run(monitor, {state(monitor, "ball", V(0.004, 0, 0.2))}, 100, 4.0,
+      [&](double t, const StepReport& report) {
+        const V centre = monitor.predictedState(0, t)->first;
+        deepest = std::max({deepest, depthInBox(centre - left.position, r, half),
+                            depthInBox(centre - right.position, r, half)});
+        last = report;
+      });
+  EXPECT_LT(deepest, 1e-9 * r);
+  const V rest(0, 0, std::sqrt(r * r - w * w / 4));
+  EXPECT_LT((monitor.predictedState(0, 4.0)->first - rest).norm(), 1e-8 * r);
+  ASSERT_EQ(last.contacts.size(), 2u);
+  const double cos_phi = std::sqrt(1 - w * w / (4 * r * r));
+  EXPECT_NEAR(last.contacts[0].normal_force, m * kG / (2 * cos_phi), 1e-9);
+  EXPECT_NEAR(last.contacts[1].normal_force, m * kG / (2 * cos_phi), 1e-9);
+}
+
 // A ball rolling across a tessellated floor (8 x 8 squares of two triangles, 2 m across) as on
 // the plane it tessellates: no impact, its centre at z = r and its velocity unchanged to 1e-15
 // (its contact is integrated as on any finite shape, not the plane's closed form), rolling over
