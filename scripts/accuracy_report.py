@@ -172,6 +172,23 @@ SCENES = [
                  ("penetration", "deepest penetration (m)", fmt),
                  ("energy_gain", "energy gain (J)", fmt)],
      "headline": ("drift", "drift of the centres from r, 3r, 5r (m)")},
+    {"scene": "ball_off_edge", "duration": 0.8,
+     "short": "ball off a table's edge (a box; lasting contact)",
+     "title": "Lasting contact on a finite shape: a ball slides along a table (a box) and off its "
+              "edge",
+     "reference": "closed form: frictionless cos theta = 2/3 + v0^2/(3 g r); in flight "
+                  "v_x = sqrt(g r) cos^(3/2) theta",
+     "note": "A ball (r = 0.05 m) sliding frictionless at v0 = 0.2 m/s along the top face of a "
+             "box (1 x 1 x 0.5 m) from 5 cm before its edge: it pivots about the edge and leaves "
+             "it where the normal force vanishes, cos theta = (2 + v0^2 / g r) / 3 (the ball off "
+             "a sphere of radius 0), then flies with the horizontal velocity sqrt(g r) "
+             "cos^(3/2) theta (0.405 m/s); 0.8 s. Error: the horizontal velocity at the last "
+             "state; penetration: the deepest into the box at any state. Box2D's box has a skin "
+             "of b2_polygonRadius (1 cm), so its edge is a rounded corner.",
+     "columns": [("flight_vx", "horizontal velocity error in flight (m/s)", fmt),
+                 ("penetration_box", "penetration into the box (m)", fmt),
+                 ("energy_gain", "energy gain (J)", fmt)],
+     "headline": ("flight_vx", "horizontal velocity error after the edge (m/s)")},
     {"scene": "ball_pile_27", "group": "pile", "variant": "27 balls", "duration": 2.0,
      "short": "27 balls settling in a box",
      "title": "A pile of 27 balls settling in a box", "reference": "at rest: kinetic energy 0, "

@@ -121,6 +121,7 @@ Engine box2dEngine() {
       fixture.restitutionThreshold = 0.0f;
       b2EdgeShape edge;
       b2CircleShape circle;
+      b2PolygonShape box;
       if (spec.shape == core::ObstacleShape::kPlane) {
         const V n = spec.normal.normalized();
         const b2Vec2 normal = in2d(n), along(-normal.y, normal.x);
@@ -128,6 +129,12 @@ Engine box2dEngine() {
         const float half_length = 100.0f;
         edge.SetTwoSided(point - half_length * along, point + half_length * along);
         fixture.shape = &edge;
+      } else if (spec.shape == core::ObstacleShape::kBox) {
+        // Along the axes, its skin (b2_polygonRadius) inside the scene's size.
+        const b2Vec2 half = in2d(V(0.5 * spec.size));
+        box.SetAsBox(half.x - b2_polygonRadius, half.y - b2_polygonRadius, in2d(spec.position),
+                     0.0f);
+        fixture.shape = &box;
       } else {
         circle.m_p = in2d(spec.position);
         circle.m_radius = static_cast<float>(spec.radius);

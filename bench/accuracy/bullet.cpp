@@ -68,14 +68,15 @@ Engine bulletEngine(bool recommended) {
       if (spec.shape == core::ObstacleShape::kPlane) {
         const V n = spec.normal.normalized();
         shapes.push_back(std::make_unique<btStaticPlaneShape>(bt(n), bt(spec.offset)));
+      } else if (spec.shape == core::ObstacleShape::kBox) {  // along the axes (the scenes' boxes)
+        shapes.push_back(std::make_unique<btBoxShape>(bt(V(0.5 * spec.size))));
+        shapes.back()->setMargin(0);
       } else {
         shapes.push_back(std::make_unique<btSphereShape>(bt(spec.radius)));
       }
       btTransform start;
       start.setIdentity();
-      if (spec.shape == core::ObstacleShape::kSphere) {
-        start.setOrigin(bt(spec.position));
-      }
+      if (spec.shape != core::ObstacleShape::kPlane) start.setOrigin(bt(spec.position));
       motions.push_back(std::make_unique<btDefaultMotionState>(start));
       btRigidBody::btRigidBodyConstructionInfo info(0, motions.back().get(), shapes.back().get());
       info.m_restitution = bt(restitution.obstacles[o]);

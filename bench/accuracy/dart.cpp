@@ -90,6 +90,9 @@ Engine dartEngine() {
         geometry = std::make_shared<dart::dynamics::BoxShape>(V(kWidth, kWidth, kThickness));
         placed.linear() = Eigen::Quaterniond::FromTwoVectors(V::UnitZ(), n).toRotationMatrix();
         placed.translation() = n * (spec.offset - 0.5 * kThickness);
+      } else if (spec.shape == core::ObstacleShape::kBox) {  // along the axes
+        geometry = std::make_shared<dart::dynamics::BoxShape>(spec.size);
+        placed.translation() = spec.position;
       } else {
         geometry = std::make_shared<dart::dynamics::SphereShape>(spec.radius);
         placed.translation() = spec.position;

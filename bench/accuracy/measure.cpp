@@ -275,6 +275,11 @@ Penetration penetrationAt(const core::Scene& scene, const Run& run, std::size_t 
       if (obstacle.shape == core::ObstacleShape::kPlane) {
         const V n = obstacle.normal.normalized();
         deepest.planes = std::max(deepest.planes, r - (n.dot(p) - obstacle.offset));
+      } else if (obstacle.shape == core::ObstacleShape::kBox) {
+        // Along the axes (the scenes' boxes): counted with the spheres, as a finite obstacle.
+        const V q = (p - obstacle.position).cwiseAbs() - 0.5 * obstacle.size;
+        const double outside = q.cwiseMax(0.0).norm(), inside = std::min(0.0, q.maxCoeff());
+        deepest.spheres = std::max(deepest.spheres, r - outside - inside);
       } else {
         deepest.spheres =
             std::max(deepest.spheres, r + obstacle.radius - (p - obstacle.position).norm());
@@ -426,6 +431,16 @@ Metrics ballOffSphere(const std::string& name, const core::Scene& scene, const R
           {"energy_gain", energyGain(scene, run)}};
 }
 
+// A ball sliding off a box's edge: its horizontal velocity in flight at the last state, against
+// sqrt(g r) cos^(3/2) theta (the leaving angle's closed form); penetration into the box.
+Metrics ballOffEdge(const std::string& name, const core::Scene& scene, const Run& run,
+                    const References& refs) {
+  const double vx = run.samples() > 0 ? run.velocity(run.samples() - 1, 0).x() : kNaN;
+  return {{"flight_vx", std::abs(vx - refs.value(name, "flight_vx"))},
+          {"penetration_box", deepestPenetration(scene, run).spheres},
+          {"energy_gain", energyGain(scene, run)}};
+}
+
 // A stack at rest: the largest distance of any centre from its resting place at any sampled
 // instant, penetration, the energy's rise.
 Metrics ballStack(const std::string& name, const core::Scene& scene, const Run& run,
@@ -475,6 +490,7 @@ Metrics measure(const BenchScene& bench, const std::string& effects, const Run& 
   if (bench.name == "tunnelling") return tunnelling(name, scene, run, references);
   if (bench.name == "ball_corner") return ballCorner(name, scene, run, references);
   if (bench.name == "ball_off_sphere") return ballOffSphere(name, scene, run, references);
+  if (bench.name == "ball_off_edge") return ballOffEdge(name, scene, run, references);
   if (bench.name == "ball_stack") return ballStack(name, scene, run, references);
   if (bench.name.rfind("ball_pile", 0) == 0) return ballPile(scene, run);
   if (bench.name.rfind("bounce_", 0) == 0) return bounces(name, scene, run, references);

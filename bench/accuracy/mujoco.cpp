@@ -100,6 +100,10 @@ std::string modelXml(const core::Scene& scene, double dt, bool restitution_on) {
       xml += "    <geom name=\"o" + std::to_string(o) + "\" type=\"plane\" size=\"0 0 1\" pos=\"" +
              triple(n * spec.offset) + "\" zaxis=\"" + triple(n) +
              "\" contype=\"0\" conaffinity=\"0\"/>\n";
+    } else if (spec.shape == core::ObstacleShape::kBox) {  // along the axes
+      xml += "    <geom name=\"o" + std::to_string(o) + "\" type=\"box\" size=\"" +
+             triple(0.5 * spec.size) + "\" pos=\"" + triple(spec.position) +
+             "\" contype=\"0\" conaffinity=\"0\"/>\n";
     } else {
       xml += "    <geom name=\"o" + std::to_string(o) + "\" type=\"sphere\" size=\"" +
              number(spec.radius) + "\" pos=\"" + triple(spec.position) +

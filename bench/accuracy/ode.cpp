@@ -60,6 +60,9 @@ Engine odeEngine() {
       if (spec.shape == core::ObstacleShape::kPlane) {
         const V n = spec.normal.normalized();
         geom = dCreatePlane(w.space, n.x(), n.y(), n.z(), spec.offset);
+      } else if (spec.shape == core::ObstacleShape::kBox) {  // along the axes
+        geom = dCreateBox(w.space, spec.size.x(), spec.size.y(), spec.size.z());
+        dGeomSetPosition(geom, spec.position.x(), spec.position.y(), spec.position.z());
       } else {
         geom = dCreateSphere(w.space, spec.radius);
         dGeomSetPosition(geom, spec.position.x(), spec.position.y(), spec.position.z());

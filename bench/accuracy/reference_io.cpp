@@ -81,6 +81,9 @@ void exportScenes(const std::vector<BenchScene>& scenes, const std::string& path
         if (obstacle.shape == core::ObstacleShape::kPlane) {
           out << "plane " << obstacle.id << " " << obstacle.material << " "
               << hex(obstacle.normal.normalized()) << " " << hex(obstacle.offset) << "\n";
+        } else if (obstacle.shape == core::ObstacleShape::kBox) {  // along the axes
+          out << "box " << obstacle.id << " " << obstacle.material << " " << hex(obstacle.position)
+              << " " << hex(obstacle.size) << "\n";
         } else {
           out << "sphere " << obstacle.id << " " << obstacle.material << " "
               << hex(obstacle.position) << " " << hex(obstacle.radius) << "\n";

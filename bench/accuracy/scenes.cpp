@@ -202,6 +202,27 @@ BenchScene ballOffSphereScene() {
   return bench;
 }
 
+// A ball (r = 0.05 m) sliding frictionless at v0 = 0.2 m/s along a box's top face (a table,
+// 1 x 1 x 0.5 m, its top at z = 0, its edge at x = 0) from 5 cm before its edge: it pivots about
+// the edge and leaves it where cos theta = (2 + v0^2 / (g r)) / 3, then flies on with the
+// horizontal velocity sqrt(g r) cos^(3/2) theta; 0.8 s (no floor).
+BenchScene ballOffEdgeScene() {
+  BenchScene bench{"ball_off_edge", {}, 0.8, kRates, false, true, {}, "lasting"};
+  core::Scene& scene = bench.scene;
+  scene.effects.gravity = true;
+  scene.materials = lastingMaterials();
+  const double r = 0.05;
+  scene.bodies.push_back(ball("ball", 0.1, r, kLastingMaterial, V(-0.05, 0, r), V(0.2, 0, 0)));
+  core::ObstacleSpec table;
+  table.id = "table";
+  table.shape = core::ObstacleShape::kBox;
+  table.size = V(1.0, 1.0, 0.5);
+  table.position = V(-0.5, 0, -0.25);
+  table.material = kLastingMaterial;
+  scene.obstacles.push_back(table);
+  return bench;
+}
+
 // Three balls (r = 0.05 m) stacked on a floor, centres at r, 3r, 5r: at rest, for 2 s.
 BenchScene ballStackScene() {
   BenchScene bench{"ball_stack", {}, 2.0, kRates, false, true, {"friction, spin"}, "lasting"};
@@ -258,6 +279,7 @@ std::vector<BenchScene> benchScenes() {
   off_sphere.integration_tolerances = {1e-6, 1e-8, 1e-10, 1e-12};
   scenes.push_back(off_sphere);
   scenes.push_back(ballStackScene());
+  scenes.push_back(ballOffEdgeScene());
   // Long runs (restitution fidelity): 1,000 bounces; e < 1 stops where the bounces accumulate
   // (t = 0.4515 (1 + e) / (1 - e) s), half a second later; e = 1: after the 1,000th bounce's apex.
   scenes.push_back(bounceScene("bounce_e0.5", 0.5, 1.9));

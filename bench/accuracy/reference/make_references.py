@@ -101,7 +101,7 @@ class Scene:
             sys.exit(f"{name}: a restitution threshold is not in this reference")
         self.own = {}       # material -> own coefficient (against concrete)
         self.own_friction = {}  # material -> Coulomb mu against itself
-        self.bodies, self.planes, self.spheres = [], [], []
+        self.bodies, self.planes, self.spheres, self.boxes = [], [], [], []
 
     def restitution(self, first, second):
         if first == "concrete":
@@ -137,6 +137,8 @@ def read_scenes(path):
         elif kind == "sphere":
             scene.spheres.append((words[1], words[2], vec(words[3:6]),
                                   mpf(float.fromhex(words[6]))))
+        elif kind == "box":  # along the axes: centre, size
+            scene.boxes.append((words[1], words[2], vec(words[3:6]), vec(words[6:9])))
         elif kind == "end":
             scenes.append(scene)
     return scenes
@@ -588,6 +590,25 @@ def ball_off_sphere(scene, out):
     out.append(f"{scene.name} leave_cos_rolling_limit {num(mpf(10) / 17)}")
 
 
+def ball_off_edge(scene, out):
+    """A ball sliding frictionless along a box's top face off its edge (R = 0 of the ball off a
+    sphere): with v^2 = v0^2 + 2 g r (1 - cos(theta)) it leaves where g cos(theta) = v^2 / r,
+    cos(theta) = (2 + v0^2 / g r) / 3, and flies on with the horizontal velocity
+    v cos(theta) = sqrt(g r) cos(theta)^(3/2)."""
+    (body,) = scene.bodies
+    (_, _, centre, size) = scene.boxes[0]
+    g = mpmath.sqrt(dot(scene.gravity, scene.gravity))
+    r = body.radius
+    top = centre[2] + size[2] / 2
+    check(abs(body.position[2] - top - r) < mpf("1e-15"), f"{scene.name}: not on the top")
+    check(body.position[0] < centre[0] + size[0] / 2, f"{scene.name}: not before the edge")
+    check(body.velocity[1] == 0 and body.velocity[2] == 0, f"{scene.name}: not along x")
+    v0_squared = dot(body.velocity, body.velocity)
+    leave = (2 + v0_squared / (g * r)) / 3
+    out.append(f"{scene.name} leave_cos {num(leave)}")
+    out.append(f"{scene.name} flight_vx {num(mpmath.sqrt(g * r) * leave ** mpf(1.5))}")
+
+
 def lasting(scene, out):
     """The closed forms of the lasting-contact scenes (where they come to rest, or leave)."""
     base = scene.name.split("+")[0]
@@ -595,6 +616,8 @@ def lasting(scene, out):
         ball_corner(scene, out)
     elif base == "ball_off_sphere":
         ball_off_sphere(scene, out)
+    elif base == "ball_off_edge":
+        ball_off_edge(scene, out)
     elif base == "ball_stack":
         # At rest where they are: each centre on the one below (r, 3r, 5r): the inputs.
         for i, body in enumerate(scene.bodies):
