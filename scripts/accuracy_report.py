@@ -189,6 +189,20 @@ SCENES = [
                  ("penetration_box", "penetration into the box (m)", fmt),
                  ("energy_gain", "energy gain (J)", fmt)],
      "headline": ("flight_vx", "horizontal velocity error after the edge (m/s)")},
+    {"scene": "ball_on_mesh_floor", "duration": 1.0,
+     "short": "ball across a tessellated floor (a mesh)",
+     "title": "A ball sliding across a tessellated floor (a triangle mesh), over its internal edges",
+     "reference": "closed form: as on the plane, z = r and the velocity unchanged",
+     "note": "A ball (r = 0.05 m) sliding frictionless at (1.5, 0.9, 0) m/s across a flat floor "
+             "mesh of 8 x 8 squares of two triangles (2 m across) for 1 s, crossing about 20 "
+             "internal edges. Height: the largest distance of the centre from z = r at any state "
+             "(a ghost collision off an internal edge lifts it); velocity error: at the end. "
+             "Bullet: btBvhTriangleMeshShape; ODE: dGeomTriMesh; MuJoCo and DART: no meshes in "
+             "this harness; Box2D: not planar.",
+     "columns": [("height_off", "height off z = r (m)", fmt),
+                 ("velocity_error", "velocity error at the end (m/s)", fmt),
+                 ("penetration_floor", "penetration into the floor (m)", fmt)],
+     "headline": ("velocity_error", "velocity error after 1 s (m/s)")},
     {"scene": "ball_pile_27", "group": "pile", "variant": "27 balls", "duration": 2.0,
      "short": "27 balls settling in a box",
      "title": "A pile of 27 balls settling in a box", "reference": "at rest: kinetic energy 0, "

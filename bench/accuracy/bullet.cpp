@@ -3,6 +3,7 @@
 
 #include <memory>
 
+#include "collision_response/core/triangle_mesh.h"
 #include "harness.h"
 
 namespace collision_response::bench {
@@ -35,6 +36,7 @@ Engine bulletEngine(bool recommended) {
     // (btManifoldResult::calculateCombinedRestitution).
     const ProductRestitutions restitution = productRestitutions(scene);
     std::vector<std::unique_ptr<btCollisionShape>> shapes;
+    std::vector<std::unique_ptr<btTriangleMesh>> meshes;
     std::vector<std::unique_ptr<btDefaultMotionState>> motions;
     std::vector<std::unique_ptr<btRigidBody>> bodies, obstacles;
     for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
@@ -68,6 +70,14 @@ Engine bulletEngine(bool recommended) {
       if (spec.shape == core::ObstacleShape::kPlane) {
         const V n = spec.normal.normalized();
         shapes.push_back(std::make_unique<btStaticPlaneShape>(bt(n), bt(spec.offset)));
+      } else if (spec.shape == core::ObstacleShape::kMesh) {
+        // btBvhTriangleMeshShape over the mesh's triangles (its own hierarchy).
+        meshes.push_back(std::make_unique<btTriangleMesh>());
+        const auto corner = [&](std::uint32_t v) { return bt(spec.mesh->vertices()[v]); };
+        for (const auto& t : spec.mesh->triangles()) {
+          meshes.back()->addTriangle(corner(t[0]), corner(t[1]), corner(t[2]));
+        }
+        shapes.push_back(std::make_unique<btBvhTriangleMeshShape>(meshes.back().get(), true));
       } else if (spec.shape == core::ObstacleShape::kBox) {  // along the axes (the scenes' boxes)
         shapes.push_back(std::make_unique<btBoxShape>(bt(V(0.5 * spec.size))));
         shapes.back()->setMargin(0);

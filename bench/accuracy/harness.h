@@ -72,6 +72,14 @@ struct Run {
   }
 };
 
+/// Whether a scene has a mesh obstacle (an engine without meshes in this harness says so).
+inline bool hasMesh(const core::Scene& scene) {
+  for (const core::ObstacleSpec& obstacle : scene.obstacles) {
+    if (obstacle.shape == core::ObstacleShape::kMesh) return true;
+  }
+  return false;
+}
+
 /// Plays a scene.
 using Engine = std::function<Run(const core::Scene& scene, const Play& play)>;
 

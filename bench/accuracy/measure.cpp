@@ -275,6 +275,8 @@ Penetration penetrationAt(const core::Scene& scene, const Run& run, std::size_t 
       if (obstacle.shape == core::ObstacleShape::kPlane) {
         const V n = obstacle.normal.normalized();
         deepest.planes = std::max(deepest.planes, r - (n.dot(p) - obstacle.offset));
+      } else if (obstacle.shape == core::ObstacleShape::kMesh) {
+        continue;  // its scene's own metric (ballOnMeshFloor)
       } else if (obstacle.shape == core::ObstacleShape::kBox) {
         // Along the axes (the scenes' boxes): counted with the spheres, as a finite obstacle.
         const V q = (p - obstacle.position).cwiseAbs() - 0.5 * obstacle.size;
@@ -441,6 +443,24 @@ Metrics ballOffEdge(const std::string& name, const core::Scene& scene, const Run
           {"energy_gain", energyGain(scene, run)}};
 }
 
+// A ball sliding across a tessellated floor: how far its centre left z = r (a ghost bounce lifts
+// it, sinking takes it in) and its velocity at the end against the start's, at any state.
+Metrics ballOnMeshFloor(const std::string& name, const Run& run, const References& refs) {
+  const auto& start = refs.rows(name, "velocity").front();
+  const V velocity(start.at(0), start.at(1), start.at(2));
+  const double height = refs.value(name, "height");
+  double off = 0, sink = 0;
+  for (std::size_t k = 0; k < run.samples(); ++k) {
+    const double z = run.position(k, 0).z();
+    off = std::max(off, std::abs(z - height));
+    sink = std::max(sink, height - z);
+  }
+  const double speed =
+      run.samples() > 0 ? (run.velocity(run.samples() - 1, 0) - velocity).norm() : kNaN;
+  return {
+      {"height_off", off}, {"penetration_floor", std::max(0.0, sink)}, {"velocity_error", speed}};
+}
+
 // A stack at rest: the largest distance of any centre from its resting place at any sampled
 // instant, penetration, the energy's rise.
 Metrics ballStack(const std::string& name, const core::Scene& scene, const Run& run,
@@ -491,6 +511,7 @@ Metrics measure(const BenchScene& bench, const std::string& effects, const Run& 
   if (bench.name == "ball_corner") return ballCorner(name, scene, run, references);
   if (bench.name == "ball_off_sphere") return ballOffSphere(name, scene, run, references);
   if (bench.name == "ball_off_edge") return ballOffEdge(name, scene, run, references);
+  if (bench.name == "ball_on_mesh_floor") return ballOnMeshFloor(name, run, references);
   if (bench.name == "ball_stack") return ballStack(name, scene, run, references);
   if (bench.name.rfind("ball_pile", 0) == 0) return ballPile(scene, run);
   if (bench.name.rfind("bounce_", 0) == 0) return bounces(name, scene, run, references);

@@ -1,8 +1,10 @@
 // ODE on the benchmark's scenes (only in the benchmark; the product never links ODE).
 #include <ode/ode.h>
 
+#include <list>
 #include <map>
 
+#include "collision_response/core/triangle_mesh.h"
 #include "harness.h"
 
 namespace collision_response::bench {
@@ -55,11 +57,28 @@ Engine odeEngine() {
       w.material[geom] = spec.material;
       bodies.push_back(body);
     }
+    std::list<std::pair<std::vector<double>, std::vector<dTriIndex>>> trimesh_arrays;
+    std::vector<dTriMeshDataID> trimesh_data;
     for (const core::ObstacleSpec& spec : scene.obstacles) {
       dGeomID geom;
       if (spec.shape == core::ObstacleShape::kPlane) {
         const V n = spec.normal.normalized();
         geom = dCreatePlane(w.space, n.x(), n.y(), n.z(), spec.offset);
+      } else if (spec.shape == core::ObstacleShape::kMesh) {
+        // dGeomTriMesh over the mesh's triangles (its data kept until the run ends).
+        auto& [vertices, indices] = trimesh_arrays.emplace_back();
+        for (const V& p : spec.mesh->vertices())
+          vertices.insert(vertices.end(), {p.x(), p.y(), p.z()});
+        for (const auto& t : spec.mesh->triangles()) {
+          indices.insert(indices.end(), {static_cast<dTriIndex>(t[0]), static_cast<dTriIndex>(t[1]),
+                                         static_cast<dTriIndex>(t[2])});
+        }
+        const dTriMeshDataID data = dGeomTriMeshDataCreate();
+        dGeomTriMeshDataBuildDouble(data, vertices.data(), 3 * sizeof(double),
+                                    static_cast<int>(vertices.size() / 3), indices.data(),
+                                    static_cast<int>(indices.size()), 3 * sizeof(dTriIndex));
+        trimesh_data.push_back(data);
+        geom = dCreateTriMesh(w.space, data, nullptr, nullptr, nullptr);
       } else if (spec.shape == core::ObstacleShape::kBox) {  // along the axes
         geom = dCreateBox(w.space, spec.size.x(), spec.size.y(), spec.size.z());
         dGeomSetPosition(geom, spec.position.x(), spec.position.y(), spec.position.z());
@@ -90,6 +109,7 @@ Engine odeEngine() {
     }
     dJointGroupDestroy(w.contacts);
     dSpaceDestroy(w.space);
+    for (const dTriMeshDataID data : trimesh_data) dGeomTriMeshDataDestroy(data);
     dWorldDestroy(w.world);
     return run;
   };

@@ -81,6 +81,8 @@ void exportScenes(const std::vector<BenchScene>& scenes, const std::string& path
         if (obstacle.shape == core::ObstacleShape::kPlane) {
           out << "plane " << obstacle.id << " " << obstacle.material << " "
               << hex(obstacle.normal.normalized()) << " " << hex(obstacle.offset) << "\n";
+        } else if (obstacle.shape == core::ObstacleShape::kMesh) {  // its triangles: not needed
+          out << "mesh " << obstacle.id << " " << obstacle.material << "\n";
         } else if (obstacle.shape == core::ObstacleShape::kBox) {  // along the axes
           out << "box " << obstacle.id << " " << obstacle.material << " " << hex(obstacle.position)
               << " " << hex(obstacle.size) << "\n";

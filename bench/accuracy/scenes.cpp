@@ -1,6 +1,7 @@
 #include <cmath>
 #include <random>
 
+#include "collision_response/core/triangle_mesh.h"
 #include "harness.h"
 
 namespace collision_response::bench {
@@ -223,6 +224,39 @@ BenchScene ballOffEdgeScene() {
   return bench;
 }
 
+// A ball (r = 0.05 m) sliding frictionless at (1.5, 0.9, 0) m/s across a floor that is a mesh of
+// 8 x 8 squares of two triangles (2 m across, at z = 0), over its internal edges, for 1 s: as on
+// the plane it tessellates, it stays at z = r at its velocity. An engine that tests each
+// triangle alone bounces off internal edges ("ghost collisions").
+BenchScene ballOnMeshFloorScene() {
+  BenchScene bench{"ball_on_mesh_floor", {}, 1.0, kRates, false, true, {}, "lasting"};
+  core::Scene& scene = bench.scene;
+  scene.effects.gravity = true;
+  scene.materials = lastingMaterials();
+  const double r = 0.05;
+  scene.bodies.push_back(ball("ball", 0.1, r, kLastingMaterial, V(-0.9, -0.7, r), V(1.5, 0.9, 0)));
+  const int n = 8;
+  std::vector<V> vertices;
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i <= n; ++i) vertices.emplace_back(0.25 * i - 1.0, 0.25 * j - 1.0, 0.0);
+  }
+  std::vector<core::TriangleMesh::Triangle> triangles;
+  const auto at = [n](int i, int j) { return static_cast<std::uint32_t>(j * (n + 1) + i); };
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  }
+  core::ObstacleSpec floor;
+  floor.id = "floor";
+  floor.shape = core::ObstacleShape::kMesh;
+  floor.mesh = *core::TriangleMesh::build(vertices, triangles, "floor");
+  floor.material = kLastingMaterial;
+  scene.obstacles.push_back(floor);
+  return bench;
+}
+
 // Three balls (r = 0.05 m) stacked on a floor, centres at r, 3r, 5r: at rest, for 2 s.
 BenchScene ballStackScene() {
   BenchScene bench{"ball_stack", {}, 2.0, kRates, false, true, {"friction, spin"}, "lasting"};
@@ -280,6 +314,7 @@ std::vector<BenchScene> benchScenes() {
   scenes.push_back(off_sphere);
   scenes.push_back(ballStackScene());
   scenes.push_back(ballOffEdgeScene());
+  scenes.push_back(ballOnMeshFloorScene());
   // Long runs (restitution fidelity): 1,000 bounces; e < 1 stops where the bounces accumulate
   // (t = 0.4515 (1 + e) / (1 - e) s), half a second later; e = 1: after the 1,000th bounce's apex.
   scenes.push_back(bounceScene("bounce_e0.5", 0.5, 1.9));

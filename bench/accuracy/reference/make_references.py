@@ -137,6 +137,8 @@ def read_scenes(path):
         elif kind == "sphere":
             scene.spheres.append((words[1], words[2], vec(words[3:6]),
                                   mpf(float.fromhex(words[6]))))
+        elif kind == "mesh":  # a floor mesh: its scene's reference needs only the plane
+            pass
         elif kind == "box":  # along the axes: centre, size
             scene.boxes.append((words[1], words[2], vec(words[3:6]), vec(words[6:9])))
         elif kind == "end":
@@ -609,6 +611,16 @@ def ball_off_edge(scene, out):
     out.append(f"{scene.name} flight_vx {num(mpmath.sqrt(g * r) * leave ** mpf(1.5))}")
 
 
+def ball_on_mesh_floor(scene, out):
+    """A ball sliding frictionless across a flat floor mesh at z = 0 as across the plane: at its
+    height r, at its velocity."""
+    (body,) = scene.bodies
+    check(body.position[2] == body.radius and body.velocity[2] == 0,
+          f"{scene.name}: not sliding on z = 0")
+    out.append(f"{scene.name} height {num(body.radius)}")
+    out.append(f"{scene.name} velocity " + " ".join(num(x) for x in body.velocity))
+
+
 def lasting(scene, out):
     """The closed forms of the lasting-contact scenes (where they come to rest, or leave)."""
     base = scene.name.split("+")[0]
@@ -618,6 +630,8 @@ def lasting(scene, out):
         ball_off_sphere(scene, out)
     elif base == "ball_off_edge":
         ball_off_edge(scene, out)
+    elif base == "ball_on_mesh_floor":
+        ball_on_mesh_floor(scene, out)
     elif base == "ball_stack":
         # At rest where they are: each centre on the one below (r, 3r, 5r): the inputs.
         for i, body in enumerate(scene.bodies):
