@@ -189,6 +189,19 @@ SCENES = [
                  ("penetration_box", "penetration into the box (m)", fmt),
                  ("energy_gain", "energy gain (J)", fmt)],
      "headline": ("flight_vx", "horizontal velocity error after the edge (m/s)")},
+    {"scene": "ball_off_moving_paddle", "duration": 0.5,
+     "short": "ball off a moving paddle (a box on a moving frame)",
+     "title": "A ball off a moving paddle: a thin box moving at -0.5 m/s strikes a ball at 1 m/s",
+     "reference": "closed form: v' = v_p + e (v_p - v)",
+     "note": "A ball (r = 0.033 m, 0.057 kg) flying at 1 m/s along x into a paddle (a box 0.02 x "
+             "0.3 x 0.3 m) that moves at -0.5 m/s towards it, e = 0.3, no gravity: it leaves at "
+             "v_p + e (v_p - v) = -0.95 m/s; 0.5 s. Ours moves the paddle on a frame (as tf "
+             "does); Bullet and ODE as a kinematic body; MuJoCo, DART and Box2D: no moving "
+             "obstacles in this harness. Error: the ball's velocity at the last state; "
+             "penetration: the deepest into the moving paddle at any state.",
+     "columns": [("velocity_after", "velocity error after (m/s)", fmt),
+                 ("penetration_paddle", "penetration into the paddle (m)", fmt)],
+     "headline": ("velocity_after", "velocity error after the paddle (m/s)")},
     {"scene": "ball_on_mesh_floor", "duration": 1.0,
      "short": "ball across a tessellated floor (a mesh)",
      "title": "A ball sliding across a tessellated floor (a triangle mesh), over its internal edges",

@@ -77,6 +77,11 @@ class PairRestitution : public b2ContactListener {
 
 Engine box2dEngine() {
   return [](const core::Scene& scene, const Play& play) {
+    if (movesObstacles(play)) {
+      Run run;
+      run.unsupported = "no moving obstacles in this harness";
+      return run;
+    }
     Run run;
     const std::optional<std::array<int, 2>> plane = planeOf(scene);
     if (!plane) {

@@ -92,6 +92,12 @@ Engine bulletEngine(bool recommended) {
       info.m_restitution = bt(restitution.obstacles[o]);
       info.m_friction = 0;
       obstacles.push_back(std::make_unique<btRigidBody>(info));
+      if (o < play.obstacle_velocities.size() && play.obstacle_velocities[o] != V::Zero()) {
+        // A kinematic body: Bullet takes its velocity from its motion state's successive poses.
+        obstacles.back()->setCollisionFlags(obstacles.back()->getCollisionFlags() |
+                                            btCollisionObject::CF_KINEMATIC_OBJECT);
+        obstacles.back()->setActivationState(DISABLE_DEACTIVATION);
+      }
       world.addRigidBody(obstacles.back().get());
     }
 
@@ -100,7 +106,18 @@ Engine bulletEngine(bool recommended) {
     const double dt = 1.0 / play.rate;
     std::vector<V> positions(bodies.size()), velocities(bodies.size());
     for (long k = 0; k <= updates; ++k) {
-      if (k > 0) world.stepSimulation(bt(dt), 1, bt(dt));
+      if (k > 0) {
+        // Moving obstacles: their motion states at the step's end.
+        for (std::size_t o = 0; o < play.obstacle_velocities.size(); ++o) {
+          if (play.obstacle_velocities[o] == V::Zero()) continue;
+          btTransform pose;
+          pose.setIdentity();
+          pose.setOrigin(bt(V(scene.obstacles[o].position +
+                              static_cast<double>(k) * dt * play.obstacle_velocities[o])));
+          motions[scene.bodies.size() + o]->setWorldTransform(pose);
+        }
+        world.stepSimulation(bt(dt), 1, bt(dt));
+      }
       for (std::size_t i = 0; i < bodies.size(); ++i) {
         const btVector3 p = bodies[i]->getCenterOfMassPosition();
         const btVector3 v = bodies[i]->getLinearVelocity();

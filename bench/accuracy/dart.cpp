@@ -48,6 +48,11 @@ Engine dartEngine() {
   auto detector = dart::collision::FCLCollisionDetector::create();
   detector->setPrimitiveShapeType(dart::collision::FCLCollisionDetector::PRIMITIVE);
   return [detector](const core::Scene& scene, const Play& play) {
+    if (movesObstacles(play)) {
+      Run run;
+      run.unsupported = "no moving obstacles in this harness";
+      return run;
+    }
     if (hasMesh(scene)) {
       Run run;
       run.unsupported = "no triangle meshes in this harness";

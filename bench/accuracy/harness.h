@@ -30,6 +30,10 @@ struct Play {
   /// apexes). A query of the source at a past instant costs it a replay: scenes that use no
   /// impact positions (lasting contact, piles of thousands of impacts) leave them out.
   bool impact_positions = true;
+  /// m/s: obstacles that move at a constant velocity, by index (empty, or zero: fixed). Such an
+  /// obstacle has a `frame` (ours places it on that frame, at its scene position plus v t; the
+  /// peers move a kinematic body).
+  std::vector<V> obstacle_velocities = {};
 };
 
 /// An impact an engine reported (ours: every one, at its instant).
@@ -109,7 +113,17 @@ struct BenchScene {
   /// not played. Its sub-step is each update's interval, split evenly when longer than
   /// Scene::stepped_cluster_time_step (0.01 s): 1 / rate from 100 Hz up.
   std::vector<double> stepped_rates = {};
+  /// m/s: obstacles moving at a constant velocity, by index (Play::obstacle_velocities).
+  std::vector<V> obstacle_velocities = {};
 };
+
+/// Whether a run moves obstacles (an engine without moving obstacles in this harness says so).
+inline bool movesObstacles(const Play& play) {
+  for (const V& v : play.obstacle_velocities) {
+    if (v != V::Zero()) return true;
+  }
+  return false;
+}
 
 /// Every scene, short ones first; names are unique. The one list: the benchmark, the exported
 /// inputs of the references and the report all follow it.

@@ -146,7 +146,8 @@ core::Scene sceneOf(const BenchScene& bench, const Case& c) {
 /// runs.
 void addShortRun(const BenchScene& bench, const Case& c, Row& row, const References& references) {
   const core::Scene scene = sceneOf(bench, c);
-  const Play play{c.rate, bench.duration, bench.record_all, bench.reference != "lasting"};
+  const Play play{c.rate, bench.duration, bench.record_all, bench.reference != "lasting",
+                  bench.obstacle_velocities};
   const Engine engine = c.setting->play;
   const Run run = engine(scene, play);
   row.unsupported = run.unsupported;
@@ -167,10 +168,11 @@ void addShortRun(const BenchScene& bench, const Case& c, Row& row, const Referen
 void addLongRun(const BenchScene& bench, const Case& c, std::shared_ptr<std::vector<Row>> rows,
                 std::size_t index, const References& references) {
   const core::Scene scene = sceneOf(bench, c);
-  const Play play{c.rate, bench.duration, bench.record_all, bench.reference != "lasting"};
+  const Play play{c.rate, bench.duration, bench.record_all, bench.reference != "lasting",
+                  bench.obstacle_velocities};
   const Engine engine = c.setting->play;
   // A run of no time: does the engine play this scene at all (Box2D: planar ones only)?
-  const Run probe = engine(scene, Play{c.rate, 0.0, false});
+  const Run probe = engine(scene, Play{c.rate, 0.0, false, true, bench.obstacle_velocities});
   if (!probe.unsupported.empty()) {
     (*rows)[index].unsupported = probe.unsupported;
     return;

@@ -461,6 +461,25 @@ Metrics ballOnMeshFloor(const std::string& name, const Run& run, const Reference
       {"height_off", off}, {"penetration_floor", std::max(0.0, sink)}, {"velocity_error", speed}};
 }
 
+// A ball off a moving paddle: its velocity at the last state against v_p + e (v_p - v); how far
+// it went into the paddle (the box at its start plus v t) at any state.
+Metrics ballOffMovingPaddle(const BenchScene& bench, const std::string& name,
+                            const core::Scene& scene, const Run& run, const References& refs) {
+  const core::ObstacleSpec& paddle = scene.obstacles.at(0);
+  const V& v = bench.obstacle_velocities.at(0);
+  const double r = scene.bodies.front().radius;
+  double deepest = 0;
+  for (std::size_t k = 0; k < run.samples(); ++k) {
+    const V q =
+        (run.position(k, 0) - paddle.position - run.times[k] * v).cwiseAbs() - 0.5 * paddle.size;
+    const double outside = q.cwiseMax(0.0).norm(), inside = std::min(0.0, q.maxCoeff());
+    deepest = std::max(deepest, r - outside - inside);
+  }
+  const double vx = run.samples() > 0 ? run.velocity(run.samples() - 1, 0).x() : kNaN;
+  return {{"velocity_after", std::abs(vx - refs.value(name, "velocity_after"))},
+          {"penetration_paddle", deepest}};
+}
+
 // A stack at rest: the largest distance of any centre from its resting place at any sampled
 // instant, penetration, the energy's rise.
 Metrics ballStack(const std::string& name, const core::Scene& scene, const Run& run,
@@ -512,6 +531,9 @@ Metrics measure(const BenchScene& bench, const std::string& effects, const Run& 
   if (bench.name == "ball_off_sphere") return ballOffSphere(name, scene, run, references);
   if (bench.name == "ball_off_edge") return ballOffEdge(name, scene, run, references);
   if (bench.name == "ball_on_mesh_floor") return ballOnMeshFloor(name, run, references);
+  if (bench.name == "ball_off_moving_paddle") {
+    return ballOffMovingPaddle(bench, name, scene, run, references);
+  }
   if (bench.name == "ball_stack") return ballStack(name, scene, run, references);
   if (bench.name.rfind("ball_pile", 0) == 0) return ballPile(scene, run);
   if (bench.name.rfind("bounce_", 0) == 0) return bounces(name, scene, run, references);

@@ -160,6 +160,11 @@ Engine mujocoEngine(bool restitution) {
   // are timed: a user compiles once and steps many times.
   auto models = std::make_shared<std::map<std::string, Compiled>>();
   return [restitution, models](const core::Scene& scene, const Play& play) {
+    if (movesObstacles(play)) {
+      Run run;
+      run.unsupported = "no moving obstacles in this harness";
+      return run;
+    }
     if (hasMesh(scene)) {
       Run run;
       run.unsupported = "no triangle meshes in this harness (MuJoCo collides a mesh's convex hull)";

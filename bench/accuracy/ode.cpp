@@ -59,7 +59,8 @@ Engine odeEngine() {
     }
     std::list<std::pair<std::vector<double>, std::vector<dTriIndex>>> trimesh_arrays;
     std::vector<dTriMeshDataID> trimesh_data;
-    for (const core::ObstacleSpec& spec : scene.obstacles) {
+    for (std::size_t o = 0; o < scene.obstacles.size(); ++o) {
+      const core::ObstacleSpec& spec = scene.obstacles[o];
       dGeomID geom;
       if (spec.shape == core::ObstacleShape::kPlane) {
         const V n = spec.normal.normalized();
@@ -87,6 +88,15 @@ Engine odeEngine() {
         dGeomSetPosition(geom, spec.position.x(), spec.position.y(), spec.position.z());
       }
       w.material[geom] = spec.material;
+      if (o < play.obstacle_velocities.size() && play.obstacle_velocities[o] != V::Zero()) {
+        // A kinematic body carries it at its velocity.
+        const dBodyID carrier = dBodyCreate(w.world);
+        dBodySetKinematic(carrier);
+        dBodySetPosition(carrier, spec.position.x(), spec.position.y(), spec.position.z());
+        const V& v = play.obstacle_velocities[o];
+        dBodySetLinearVel(carrier, v.x(), v.y(), v.z());
+        dGeomSetBody(geom, carrier);
+      }
     }
 
     Run run;

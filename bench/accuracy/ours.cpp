@@ -42,6 +42,15 @@ Engine oursEngine(core::Detection detection, int stepped_cluster_min_bodies) {
         // With spin, a rolling ball's spin is part of its state (zero would say it slips).
         states[i].angular_velocity = playback.angularVelocity(i, t);
       }
+      // Moving obstacles: their frames at t (the obstacle at its scene position plus v t).
+      for (std::size_t o = 0; o < play.obstacle_velocities.size(); ++o) {
+        if (play.obstacle_velocities[o] == V::Zero()) continue;
+        core::RigidPose frame;
+        frame.time = t;
+        frame.transform.translation() = t * play.obstacle_velocities[o];
+        frame.velocity = play.obstacle_velocities[o];
+        monitor.setObstaclePose(o, frame);
+      }
       const core::StepReport report = monitor.step(t, states);
       run.truncated = run.truncated || report.truncated;
       run.stepped_bodies = static_cast<double>(report.stepped_bodies);

@@ -91,6 +91,10 @@ void exportScenes(const std::vector<BenchScene>& scenes, const std::string& path
               << hex(obstacle.position) << " " << hex(obstacle.radius) << "\n";
         }
       }
+      for (std::size_t o = 0; o < bench.obstacle_velocities.size(); ++o) {
+        out << "obstacle_velocity " << scene.obstacles[o].id << " "
+            << hex(bench.obstacle_velocities[o]) << "\n";
+      }
       out << "end\n";
     }
   }

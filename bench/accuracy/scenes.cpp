@@ -224,6 +224,27 @@ BenchScene ballOffEdgeScene() {
   return bench;
 }
 
+// A ball (r = 0.05 m) flying at 1 m/s along x into a paddle (a thin box, 0.02 x 0.3 x 0.3 m,
+// its face 0.257 m ahead of the ball's surface) moving at -0.5 m/s towards it, no gravity: it
+// leaves at v_p + e (v_p - v) = -0.5 - 1.5 e (e = 0.3: -0.95 m/s), 0.5 s. The paddle moves as a
+// tf frame does for ours, as a kinematic body for the peers.
+BenchScene ballOffMovingPaddleScene() {
+  BenchScene bench{"ball_off_moving_paddle", {}, 0.5, kRates, false, true, {}, "lasting"};
+  core::Scene& scene = bench.scene;
+  scene.materials = lastingMaterials();
+  scene.bodies.push_back(ball("ball", 0.057, 0.033, kLastingMaterial, V(0, 0, 0), V(1, 0, 0)));
+  core::ObstacleSpec paddle;
+  paddle.id = "paddle";
+  paddle.shape = core::ObstacleShape::kBox;
+  paddle.size = V(0.02, 0.3, 0.3);
+  paddle.position = V(0.3, 0, 0);
+  paddle.frame = "paddle_link";
+  paddle.material = kLastingMaterial;
+  scene.obstacles.push_back(paddle);
+  bench.obstacle_velocities = {V(-0.5, 0, 0)};
+  return bench;
+}
+
 // A ball (r = 0.05 m) sliding frictionless at (1.5, 0.9, 0) m/s across a floor that is a mesh of
 // 8 x 8 squares of two triangles (2 m across, at z = 0), over its internal edges, for 1 s: as on
 // the plane it tessellates, it stays at z = r at its velocity. An engine that tests each
@@ -315,6 +336,7 @@ std::vector<BenchScene> benchScenes() {
   scenes.push_back(ballStackScene());
   scenes.push_back(ballOffEdgeScene());
   scenes.push_back(ballOnMeshFloorScene());
+  scenes.push_back(ballOffMovingPaddleScene());
   // Long runs (restitution fidelity): 1,000 bounces; e < 1 stops where the bounces accumulate
   // (t = 0.4515 (1 + e) / (1 - e) s), half a second later; e = 1: after the 1,000th bounce's apex.
   scenes.push_back(bounceScene("bounce_e0.5", 0.5, 1.9));

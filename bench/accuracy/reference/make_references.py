@@ -102,6 +102,7 @@ class Scene:
         self.own = {}       # material -> own coefficient (against concrete)
         self.own_friction = {}  # material -> Coulomb mu against itself
         self.bodies, self.planes, self.spheres, self.boxes = [], [], [], []
+        self.obstacle_velocities = {}
 
     def restitution(self, first, second):
         if first == "concrete":
@@ -137,6 +138,8 @@ def read_scenes(path):
         elif kind == "sphere":
             scene.spheres.append((words[1], words[2], vec(words[3:6]),
                                   mpf(float.fromhex(words[6]))))
+        elif kind == "obstacle_velocity":
+            scene.obstacle_velocities[words[1]] = vec(words[2:5])
         elif kind == "mesh":  # a floor mesh: its scene's reference needs only the plane
             pass
         elif kind == "box":  # along the axes: centre, size
@@ -621,6 +624,20 @@ def ball_on_mesh_floor(scene, out):
     out.append(f"{scene.name} velocity " + " ".join(num(x) for x in body.velocity))
 
 
+def ball_off_moving_paddle(scene, out):
+    """A ball flying along x into a paddle (a box) moving along x: it meets the paddle's face
+    when the gap closes, gap / (v - v_p), and leaves at v_p + e (v_p - v)."""
+    (body,) = scene.bodies
+    (name, material, centre, size) = scene.boxes[0]
+    v_p = scene.obstacle_velocities[name][0]
+    v = body.velocity[0]
+    e = scene.restitution(body.material, material)
+    gap = centre[0] - size[0] / 2 - body.position[0] - body.radius
+    check(gap > 0 and v > v_p, f"{scene.name}: no approach")
+    out.append(f"{scene.name} impact_time {num(gap / (v - v_p))}")
+    out.append(f"{scene.name} velocity_after {num(v_p + e * (v_p - v))}")
+
+
 def lasting(scene, out):
     """The closed forms of the lasting-contact scenes (where they come to rest, or leave)."""
     base = scene.name.split("+")[0]
@@ -632,6 +649,8 @@ def lasting(scene, out):
         ball_off_edge(scene, out)
     elif base == "ball_on_mesh_floor":
         ball_on_mesh_floor(scene, out)
+    elif base == "ball_off_moving_paddle":
+        ball_off_moving_paddle(scene, out)
     elif base == "ball_stack":
         # At rest where they are: each centre on the one below (r, 3r, 5r): the inputs.
         for i, body in enumerate(scene.bodies):
