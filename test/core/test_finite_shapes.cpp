@@ -696,8 +696,6 @@ void throwAtRandom(const char* name, const Finite& shape, int throws, std::uint3
   EXPECT_LT(ambiguous, throws / 100);
 }
 
-// 20,000 throws a shape in the suite; FINITE_SHAPE_THROWS=1000000 for the long run (about 20 s a
-// shape; doc/model.md, "Finite obstacles", gives its last result).
 // Shapes that turn (up to 20 rad/s about random axes through their origins), where the contact
 // is no polynomial's root: 2,000 throws a shape (FINITE_SHAPE_THROWS for more), against the
 // reference advanced along the ball's path in the shape's turning axes.
@@ -710,6 +708,9 @@ TEST(FiniteShapes, RandomThrowsAtTurningShapesMissNothingAndInventNothing) {
   throwAtRandom("turning mesh icosahedron", Mesh{stretchedIcosahedron()}, throws, 14, 20.0);
 }
 
+// 20,000 throws a shape in the suite; FINITE_SHAPE_THROWS=1000000 for the long run (about 33
+// minutes for the five, and 100,000 at each turning shape above; doc/model.md, "Finite
+// obstacles", gives its last result).
 TEST(FiniteShapes, RandomThrowsMissNothingAndInventNothing) {
   const char* asked = std::getenv("FINITE_SHAPE_THROWS");
   const int throws = asked ? std::max(1000, std::atoi(asked)) : 20000;
