@@ -462,13 +462,22 @@ std::vector<TraceRun> traceRuns() {
     const double duration = traceDuration(bench);
     std::vector<std::string> variants = {"none"};
     variants.insert(variants.end(), bench.effect_variants.begin(), bench.effect_variants.end());
+    // Obstacles moving at a constant velocity (the moving paddle): on their frames, as
+    // bench/accuracy/ours.cpp places them.
+    std::vector<MovingFrame> frames;
+    for (std::size_t o = 0; o < bench.obstacle_velocities.size(); ++o) {
+      MovingFrame frame;
+      frame.frame = bench.scene.obstacles[o].frame;
+      frame.velocity = bench.obstacle_velocities[o];
+      frames.push_back(frame);
+    }
     for (const std::string& effects : variants) {
       const std::string name = "bench/" + bench::referenceName(bench, effects);
       Scene scene = bench::withEffects(bench, effects);
       scene.detection = Detection::kContinuous;
-      runs.push_back({name + "/continuous", scene, duration, 100.0, {}});
+      runs.push_back({name + "/continuous", scene, duration, 100.0, frames});
       scene.detection = Detection::kDiscrete;
-      runs.push_back({name + "/discrete", scene, duration, 100.0, {}});
+      runs.push_back({name + "/discrete", scene, duration, 100.0, frames});
     }
     if (!bench.stepped_rates.empty()) {
       Scene scene = bench.scene;
