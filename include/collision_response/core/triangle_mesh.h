@@ -50,9 +50,9 @@ class TriangleMesh {
   /// Builds the mesh from its vertices (m, the mesh's frame) and triangles (vertex indices,
   /// counter-clockwise seen from outside). Refused by name (`field`): a non-finite vertex, an
   /// index out of range, no triangle left. Vertices at the same position are joined (an STL file
-  /// repeats them in every triangle), so that neighbouring triangles share their edge. Triangles of zero area (collinear or repeated
-  /// vertices) have no face and no outside: they are left out, and their indices are appended to
-  /// `zero_area` for the caller to name.
+  /// repeats them in every triangle), so that neighbouring triangles share their edge. Triangles of
+  /// zero area (collinear or repeated vertices) have no face and no outside: they are left out, and
+  /// their indices are appended to `zero_area` for the caller to name.
   static Expected<std::shared_ptr<const TriangleMesh>> build(
       const std::vector<Eigen::Vector3d>& vertices, const std::vector<Triangle>& triangles,
       const std::string& field, std::vector<std::size_t>* zero_area = nullptr);
