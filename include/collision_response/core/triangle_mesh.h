@@ -93,6 +93,14 @@ class TriangleMesh {
     std::uint32_t first = 0;  ///< leaf: first triangle; inner: the right child (left is next)
     std::uint32_t count = 0;  ///< leaf: triangle count; inner: 0
   };
+  /// build's stages: the triangles of nonzero area, their vertices joined (an error names the
+  /// triangle whose index is out of range); the hierarchy; the edges and whether each is
+  /// reachable; the vertices' pseudo-normals, reachability and the bounding radius.
+  Status keepFacedTriangles(const std::vector<Triangle>& triangles, const std::string& field,
+                            std::vector<std::size_t>* zero_area);
+  void buildHierarchy();
+  void buildEdges();
+  void buildVertices();
   std::uint32_t buildNode(std::uint32_t first, std::uint32_t count,
                           std::vector<Eigen::Vector3d>& centroids);
 

@@ -467,101 +467,124 @@ std::optional<double> firstContactFinite(const RelativeMotion& motion, const Cap
   });
 }
 
+namespace {
+
+/// The box the ball's path sweeps over [from, to] (its ends, and where a coordinate turns back
+/// under the acceleration), grown by the ball and the rounding: the mesh's triangles it may meet.
+void pathBox(const FeatureSearch& s, const RelativeMotion& motion, double from, double to,
+             Eigen::Vector3d& low, Eigen::Vector3d& high) {
+  low = s.positionAt(from).cwiseMin(s.positionAt(to));
+  high = s.positionAt(from).cwiseMax(s.positionAt(to));
+  for (int i = 0; i < 3; ++i) {
+    if (motion.acceleration[i] == 0) continue;
+    const double turn = -motion.velocity[i] / motion.acceleration[i];
+    if (turn > from && turn < to) {
+      low[i] = std::min(low[i], s.positionAt(turn)[i]);
+      high[i] = std::max(high[i], s.positionAt(turn)[i]);
+    }
+  }
+  const double grow = motion.radius + 2 * s.slack() + 1e-12 * (high - low).norm();
+  low.array() -= grow;
+  high.array() += grow;
+}
+
+/// A triangle's face: n.(q - a) = r on its outer side, q over the triangle.
+void meshFace(FeatureSearch& s, const RelativeMotion& motion, const TriangleMesh& triangles,
+              std::uint32_t t) {
+  const std::vector<Eigen::Vector3d>& vertices = triangles.vertices();
+  const TriangleMesh::Triangle& corners = triangles.triangles()[t];
+  const Eigen::Vector3d& a = vertices[corners[0]];
+  const Eigen::Vector3d& normal = triangles.normal(t);
+  if (!s.reachable(normal.dot(motion.centre - a), motion.radius)) return;
+  Polynomial face{-s.radius()};
+  for (int i = 0; i < 3; ++i) {
+    face = face + static_cast<long double>(normal[i]) * s.coordinate(i, a[i]);
+  }
+  s.feature(face, [&](const Eigen::Vector3d& q, double more) {
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d& u = vertices[corners[k]];
+      const Eigen::Vector3d across =
+          (vertices[corners[(k + 1) % 3]] - u).cross(normal).normalized();
+      if (!s.below(across.dot(q - u), more)) return false;
+    }
+    return true;
+  });
+}
+
+/// An edge: |w x u|^2 = r^2, w = q - from, u the edge's direction (for an edge along an axis two
+/// of the products are the plain coordinates: a box's polynomial), within the edge's length.
+void meshEdge(FeatureSearch& s, const RelativeMotion& motion, const TriangleMesh& triangles,
+              const TriangleMesh::Edge& edge) {
+  const Eigen::Vector3d& start = triangles.vertices()[edge.from];
+  const Eigen::Vector3d along = triangles.vertices()[edge.to] - start;
+  const double length = along.norm();
+  const Eigen::Vector3d unit = along / length;
+  const Eigen::Vector3d to_centre = motion.centre - start;
+  if (!s.reachable((to_centre - to_centre.dot(unit) * unit).norm(), motion.radius)) return;
+  const Polynomial wx = s.coordinate(0, start.x()), wy = s.coordinate(1, start.y()),
+                   wz = s.coordinate(2, start.z());
+  const long double ux = unit.x(), uy = unit.y(), uz = unit.z();
+  const Polynomial cx = uz * wy + (-uy) * wz, cy = ux * wz + (-uz) * wx, cz = uy * wx + (-ux) * wy;
+  Polynomial p = square(cx) + square(cy) + square(cz);
+  FeatureSearch::startFromDistance(p, std::sqrt(cx[0] * cx[0] + cy[0] * cy[0] + cz[0] * cz[0]),
+                                   s.radius());
+  s.feature(p, [&](const Eigen::Vector3d& q, double more) {
+    return s.within(unit.dot(q - start) - 0.5 * length, 0.5 * length, more);
+  });
+}
+
+/// A vertex: |q - v| = r.
+void meshVertex(FeatureSearch& s, const RelativeMotion& motion, const Eigen::Vector3d& corner) {
+  if (!s.reachable((motion.centre - corner).stableNorm(), motion.radius)) return;
+  const Polynomial dx = s.coordinate(0, corner.x()), dy = s.coordinate(1, corner.y()),
+                   dz = s.coordinate(2, corner.z());
+  Polynomial p = square(dx) + square(dy) + square(dz);
+  FeatureSearch::startFromDistance(p, std::sqrt(dx[0] * dx[0] + dy[0] * dy[0] + dz[0] * dz[0]),
+                                   s.radius());
+  s.feature(p, FeatureSearch::anywhere);
+}
+
+/// Appends `index` to `seen` and says so, unless it is there already.
+bool firstTime(std::vector<std::uint32_t>& seen, std::uint32_t index) {
+  if (std::find(seen.begin(), seen.end(), index) != seen.end()) return false;
+  seen.push_back(index);
+  return true;
+}
+
+}  // namespace
+
 std::optional<double> firstContactFinite(const RelativeMotion& motion, const Mesh& mesh,
                                          double horizon) {
   const TriangleMesh& triangles = *mesh.triangles;
-  const std::vector<Eigen::Vector3d>& vertices = triangles.vertices();
   return search(motion, mesh, horizon, [&](FeatureSearch& s) {
-    const long double r = s.radius();
-    const double radius = motion.radius;
-    // Pieces of the path about four radii long (at most 256): the triangles near each.
+    // Pieces of the path about four radii long (at most 256): the triangles near each, each
+    // feature once, the reachable ones only.
     const double travel =
         (motion.velocity.norm() + 0.5 * motion.acceleration.norm() * horizon) * horizon;
-    const double piece_length = std::max(4 * radius, 1e-9 * (travel + triangles.boundingRadius()));
+    const double piece_length =
+        std::max(4 * motion.radius, 1e-9 * (travel + triangles.boundingRadius()));
     const int pieces = static_cast<int>(std::clamp(std::ceil(travel / piece_length), 1.0, 256.0));
-    std::vector<std::uint32_t> near;
-    std::vector<std::uint32_t> seen_triangles, seen_edges, seen_vertices;
-    const auto first_time = [](std::vector<std::uint32_t>& seen, std::uint32_t index) {
-      if (std::find(seen.begin(), seen.end(), index) != seen.end()) return false;
-      seen.push_back(index);
-      return true;
-    };
+    std::vector<std::uint32_t> near, seen_triangles, seen_edges, seen_vertices;
     for (int piece = 0; piece < pieces; ++piece) {
       const double from = horizon * piece / pieces;
       const double to = piece + 1 == pieces ? horizon : horizon * (piece + 1) / pieces;
-      // The path's box over the piece (its ends, and where a coordinate turns back under the
-      // acceleration), grown by the ball and the rounding.
-      Eigen::Vector3d low = s.positionAt(from).cwiseMin(s.positionAt(to));
-      Eigen::Vector3d high = s.positionAt(from).cwiseMax(s.positionAt(to));
-      for (int i = 0; i < 3; ++i) {
-        if (motion.acceleration[i] == 0) continue;
-        const double turn = -motion.velocity[i] / motion.acceleration[i];
-        if (turn > from && turn < to) {
-          low[i] = std::min(low[i], s.positionAt(turn)[i]);
-          high[i] = std::max(high[i], s.positionAt(turn)[i]);
-        }
-      }
-      const double grow = radius + 2 * s.slack() + 1e-12 * (high - low).norm();
+      Eigen::Vector3d low, high;
+      pathBox(s, motion, from, to, low, high);
       near.clear();
-      triangles.overlapping(low.array() - grow, high.array() + grow, near);
+      triangles.overlapping(low, high, near);
       for (const std::uint32_t t : near) {
-        if (!first_time(seen_triangles, t)) continue;
-        const TriangleMesh::Triangle& corners = triangles.triangles()[t];
-        const Eigen::Vector3d& a = vertices[corners[0]];
-        const Eigen::Vector3d& normal = triangles.normal(t);
-        // The face: n.(q - a) = r on its outer side, q over the triangle.
-        if (s.reachable(normal.dot(motion.centre - a), radius)) {
-          Polynomial face{-r};
-          for (int i = 0; i < 3; ++i) {
-            face = face + static_cast<long double>(normal[i]) * s.coordinate(i, a[i]);
-          }
-          s.feature(face, [&](const Eigen::Vector3d& q, double more) {
-            for (int k = 0; k < 3; ++k) {
-              const Eigen::Vector3d& u = vertices[corners[k]];
-              const Eigen::Vector3d across =
-                  (vertices[corners[(k + 1) % 3]] - u).cross(normal).normalized();
-              if (!s.below(across.dot(q - u), more)) return false;
-            }
-            return true;
-          });
-        }
-        // Its edges: |w x u|^2 = r^2, w = q - from, u the edge's direction (for an edge along
-        // an axis two of the products are the plain coordinates: a box's polynomial), within the
-        // edge's length.
+        if (!firstTime(seen_triangles, t)) continue;
+        meshFace(s, motion, triangles, t);
         for (int k = 0; k < 3; ++k) {
           const std::uint32_t index = triangles.edgeIndex(t, k);
-          const TriangleMesh::Edge& edge = triangles.edge(index);
-          if (!edge.reachable || !first_time(seen_edges, index)) continue;
-          const Eigen::Vector3d& start = vertices[edge.from];
-          const Eigen::Vector3d along = vertices[edge.to] - start;
-          const double length = along.norm();
-          const Eigen::Vector3d unit = along / length;
-          const Eigen::Vector3d to_centre = motion.centre - start;
-          const double from_line = (to_centre - to_centre.dot(unit) * unit).norm();
-          if (!s.reachable(from_line, radius)) continue;
-          const Polynomial wx = s.coordinate(0, start.x()), wy = s.coordinate(1, start.y()),
-                           wz = s.coordinate(2, start.z());
-          const long double ux = unit.x(), uy = unit.y(), uz = unit.z();
-          const Polynomial cx = uz * wy + (-uy) * wz, cy = ux * wz + (-uz) * wx,
-                           cz = uy * wx + (-ux) * wy;
-          Polynomial p = square(cx) + square(cy) + square(cz);
-          FeatureSearch::startFromDistance(
-              p, std::sqrt(cx[0] * cx[0] + cy[0] * cy[0] + cz[0] * cz[0]), r);
-          s.feature(p, [&](const Eigen::Vector3d& q, double more) {
-            return s.within(unit.dot(q - start) - 0.5 * length, 0.5 * length, more);
-          });
+          if (triangles.edge(index).reachable && firstTime(seen_edges, index)) {
+            meshEdge(s, motion, triangles, triangles.edge(index));
+          }
         }
-        // Its vertices: |q - v| = r.
-        for (const std::uint32_t v : corners) {
-          if (!triangles.vertexReachable(v) || !first_time(seen_vertices, v)) continue;
-          const Eigen::Vector3d& corner = vertices[v];
-          if (!s.reachable((motion.centre - corner).stableNorm(), radius)) continue;
-          const Polynomial dx = s.coordinate(0, corner.x()), dy = s.coordinate(1, corner.y()),
-                           dz = s.coordinate(2, corner.z());
-          Polynomial p = square(dx) + square(dy) + square(dz);
-          FeatureSearch::startFromDistance(
-              p, std::sqrt(dx[0] * dx[0] + dy[0] * dy[0] + dz[0] * dz[0]), r);
-          s.feature(p, FeatureSearch::anywhere);
+        for (const std::uint32_t v : triangles.triangles()[t]) {
+          if (triangles.vertexReachable(v) && firstTime(seen_vertices, v)) {
+            meshVertex(s, motion, triangles.vertices()[v]);
+          }
         }
       }
       if (s.best() && *s.best() <= to) break;  // a later piece's contact is later

@@ -62,6 +62,29 @@ std::size_t& TriangleMesh::visitedCount() {
   return count;
 }
 
+namespace {
+
+/// For each vertex, the first vertex at its position (an STL file repeats each vertex in every
+/// triangle): joined, neighbouring triangles share their edges.
+std::vector<std::uint32_t> firstAtSamePosition(const std::vector<Eigen::Vector3d>& vertices) {
+  std::vector<std::uint32_t> order(vertices.size()), same(vertices.size());
+  std::iota(order.begin(), order.end(), 0u);
+  std::sort(order.begin(), order.end(), [&](std::uint32_t i, std::uint32_t j) {
+    const Eigen::Vector3d &p = vertices[i], &q = vertices[j];
+    if (p.x() != q.x()) return p.x() < q.x();
+    if (p.y() != q.y()) return p.y() < q.y();
+    if (p.z() != q.z()) return p.z() < q.z();
+    return i < j;
+  });
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    same[order[i]] =
+        i > 0 && vertices[order[i]] == vertices[order[i - 1]] ? same[order[i - 1]] : order[i];
+  }
+  return same;
+}
+
+}  // namespace
+
 Expected<std::shared_ptr<const TriangleMesh>> TriangleMesh::build(
     const std::vector<Eigen::Vector3d>& vertices, const std::vector<Triangle>& triangles,
     const std::string& field, std::vector<std::size_t>* zero_area) {
@@ -72,34 +95,31 @@ Expected<std::shared_ptr<const TriangleMesh>> TriangleMesh::build(
   }
   auto mesh = std::make_shared<TriangleMesh>();
   mesh->vertices_ = vertices;
-  // Vertices at the same position are one vertex (an STL file repeats them in every triangle):
-  // each is named by the first of its position, so that neighbouring triangles share edges.
-  std::vector<std::uint32_t> order(vertices.size()), same(vertices.size());
-  std::iota(order.begin(), order.end(), 0u);
-  const auto position_less = [&](std::uint32_t i, std::uint32_t j) {
-    const Eigen::Vector3d &p = vertices[i], &q = vertices[j];
-    if (p.x() != q.x()) return p.x() < q.x();
-    if (p.y() != q.y()) return p.y() < q.y();
-    if (p.z() != q.z()) return p.z() < q.z();
-    return i < j;
-  };
-  std::sort(order.begin(), order.end(), position_less);
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    same[order[i]] =
-        i > 0 && vertices[order[i]] == vertices[order[i - 1]] ? same[order[i - 1]] : order[i];
+  if (auto status = mesh->keepFacedTriangles(triangles, field, zero_area); !status) {
+    return status.error();
   }
+  mesh->buildHierarchy();
+  mesh->buildEdges();
+  mesh->buildVertices();
+  return std::shared_ptr<const TriangleMesh>(std::move(mesh));
+}
+
+Status TriangleMesh::keepFacedTriangles(const std::vector<Triangle>& triangles,
+                                        const std::string& field,
+                                        std::vector<std::size_t>* zero_area) {
+  const std::vector<std::uint32_t> same = firstAtSamePosition(vertices_);
   for (std::size_t t = 0; t < triangles.size(); ++t) {
     Triangle triangle = triangles[t];
     for (std::uint32_t& v : triangle) {
-      if (v >= vertices.size()) {
+      if (v >= vertices_.size()) {
         return Error{
             field + " triangle " + std::to_string(t),
-            "names vertex " + std::to_string(v) + " of " + std::to_string(vertices.size())};
+            "names vertex " + std::to_string(v) + " of " + std::to_string(vertices_.size())};
       }
       v = same[v];
     }
-    const Eigen::Vector3d& a = vertices[triangle[0]];
-    const Eigen::Vector3d ab = vertices[triangle[1]] - a, ac = vertices[triangle[2]] - a;
+    const Eigen::Vector3d& a = vertices_[triangle[0]];
+    const Eigen::Vector3d ab = vertices_[triangle[1]] - a, ac = vertices_[triangle[2]] - a;
     const Eigen::Vector3d cross = ab.cross(ac);
     const double longest = std::max(ab.squaredNorm(), ac.squaredNorm());
     // Zero area up to the rounding of the cross product: collinear or repeated vertices.
@@ -107,39 +127,45 @@ Expected<std::shared_ptr<const TriangleMesh>> TriangleMesh::build(
       if (zero_area) zero_area->push_back(t);
       continue;
     }
-    mesh->triangles_.push_back(triangle);
-    mesh->normals_.push_back(cross.stableNormalized());
+    triangles_.push_back(triangle);
+    normals_.push_back(cross.stableNormalized());
   }
-  if (mesh->triangles_.empty()) {
+  if (triangles_.empty()) {
     return Error{field, "has no triangle of nonzero area (" + std::to_string(triangles.size()) +
-                            " triangles, " + std::to_string(vertices.size()) + " vertices)"};
+                            " triangles, " + std::to_string(vertices_.size()) + " vertices)"};
   }
-  // The hierarchy: median splits along the widest spread of the triangles' centroids.
-  std::vector<Eigen::Vector3d> centroids;
-  centroids.reserve(mesh->triangles_.size());
-  for (const Triangle& t : mesh->triangles_) {
-    centroids.push_back((vertices[t[0]] + vertices[t[1]] + vertices[t[2]]) / 3.0);
-  }
-  mesh->nodes_.reserve(2 * mesh->triangles_.size() / kLeafSize + 1);
-  mesh->buildNode(0, static_cast<std::uint32_t>(mesh->triangles_.size()), centroids);
+  return Ok{};
+}
 
-  // Edges: each pair of vertices once, with the faces that share it.
+void TriangleMesh::buildHierarchy() {
+  // Median splits along the widest spread of the triangles' centroids.
+  std::vector<Eigen::Vector3d> centroids;
+  centroids.reserve(triangles_.size());
+  for (const Triangle& t : triangles_) {
+    centroids.push_back((vertices_[t[0]] + vertices_[t[1]] + vertices_[t[2]]) / 3.0);
+  }
+  nodes_.reserve(2 * triangles_.size() / kLeafSize + 1);
+  buildNode(0, static_cast<std::uint32_t>(triangles_.size()), centroids);
+}
+
+void TriangleMesh::buildEdges() {
+  // Each pair of vertices once, with the faces that share it.
   struct HalfEdge {
     std::uint32_t low, high, triangle;
     int k;
   };
   std::vector<HalfEdge> half_edges;
-  half_edges.reserve(3 * mesh->triangles_.size());
-  for (std::uint32_t t = 0; t < mesh->triangles_.size(); ++t) {
+  half_edges.reserve(3 * triangles_.size());
+  for (std::uint32_t t = 0; t < triangles_.size(); ++t) {
     for (int k = 0; k < 3; ++k) {
-      const std::uint32_t u = mesh->triangles_[t][k], v = mesh->triangles_[t][(k + 1) % 3];
+      const std::uint32_t u = triangles_[t][k], v = triangles_[t][(k + 1) % 3];
       half_edges.push_back({std::min(u, v), std::max(u, v), t, k});
     }
   }
   std::sort(half_edges.begin(), half_edges.end(), [](const HalfEdge& x, const HalfEdge& y) {
     return x.low != y.low ? x.low < y.low : x.high < y.high;
   });
-  mesh->triangle_edges_.resize(mesh->triangles_.size());
+  triangle_edges_.resize(triangles_.size());
   for (std::size_t i = 0; i < half_edges.size();) {
     std::size_t j = i;
     while (j < half_edges.size() && half_edges[j].low == half_edges[i].low &&
@@ -149,54 +175,55 @@ Expected<std::shared_ptr<const TriangleMesh>> TriangleMesh::build(
     Edge edge;
     edge.from = half_edges[i].low;
     edge.to = half_edges[i].high;
-    const auto index = static_cast<std::uint32_t>(mesh->edges_.size());
+    const auto index = static_cast<std::uint32_t>(edges_.size());
     for (std::size_t h = i; h < j; ++h) {
-      edge.pseudo_normal += mesh->normals_[half_edges[h].triangle];
-      mesh->triangle_edges_[half_edges[h].triangle][half_edges[h].k] = index;
+      edge.pseudo_normal += normals_[half_edges[h].triangle];
+      triangle_edges_[half_edges[h].triangle][half_edges[h].k] = index;
     }
     if (j - i == 2) {
       // Two faces: reachable only across a convex fold, their winding consistent (the edge run
       // in opposite directions), the second face's far vertex below the first face's plane.
       const HalfEdge& first = half_edges[i];
       const HalfEdge& second = half_edges[i + 1];
-      const Triangle& t1 = mesh->triangles_[first.triangle];
-      const Triangle& t2 = mesh->triangles_[second.triangle];
+      const Triangle& t1 = triangles_[first.triangle];
+      const Triangle& t2 = triangles_[second.triangle];
       const bool opposite = t1[first.k] != t2[second.k];
-      const Eigen::Vector3d& n1 = mesh->normals_[first.triangle];
-      const Eigen::Vector3d& far = vertices[t2[(second.k + 2) % 3]];
-      const Eigen::Vector3d& on_edge = vertices[edge.from];
+      const Eigen::Vector3d& n1 = normals_[first.triangle];
+      const Eigen::Vector3d& far = vertices_[t2[(second.k + 2) % 3]];
+      const Eigen::Vector3d& on_edge = vertices_[edge.from];
       const double rise = n1.dot(far - on_edge);
-      const bool coplanar = (n1 - mesh->normals_[second.triangle]).norm() <= 1e-12;
+      const bool coplanar = (n1 - normals_[second.triangle]).norm() <= 1e-12;
       // (Faces back to back, a knife's edge, rise 0 with opposite normals: reachable.)
       if (opposite && (coplanar || rise > 1e-12 * (far - on_edge).norm())) {
         edge.reachable = false;
       }
     }
-    mesh->edges_.push_back(edge);
+    edges_.push_back(edge);
     i = j;
   }
-  // Vertices: their pseudo-normals weighted by each face's angle there; reachable when one of
-  // their edges is.
-  mesh->vertex_normals_.assign(vertices.size(), Eigen::Vector3d::Zero());
-  mesh->vertex_reachable_.assign(vertices.size(), 0);
-  for (std::uint32_t t = 0; t < mesh->triangles_.size(); ++t) {
+}
+
+void TriangleMesh::buildVertices() {
+  // Pseudo-normals weighted by each face's angle there; reachable when one of their edges is.
+  vertex_normals_.assign(vertices_.size(), Eigen::Vector3d::Zero());
+  vertex_reachable_.assign(vertices_.size(), 0);
+  for (std::uint32_t t = 0; t < triangles_.size(); ++t) {
     for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector3d& v = vertices[mesh->triangles_[t][k]];
-      const Eigen::Vector3d to_next = vertices[mesh->triangles_[t][(k + 1) % 3]] - v;
-      const Eigen::Vector3d to_previous = vertices[mesh->triangles_[t][(k + 2) % 3]] - v;
+      const Eigen::Vector3d& v = vertices_[triangles_[t][k]];
+      const Eigen::Vector3d to_next = vertices_[triangles_[t][(k + 1) % 3]] - v;
+      const Eigen::Vector3d to_previous = vertices_[triangles_[t][(k + 2) % 3]] - v;
       const double angle = std::atan2(to_next.cross(to_previous).norm(), to_next.dot(to_previous));
-      mesh->vertex_normals_[mesh->triangles_[t][k]] += angle * mesh->normals_[t];
+      vertex_normals_[triangles_[t][k]] += angle * normals_[t];
     }
   }
-  for (const Edge& edge : mesh->edges_) {
-    if (edge.reachable) mesh->vertex_reachable_[edge.from] = mesh->vertex_reachable_[edge.to] = 1;
+  for (const Edge& edge : edges_) {
+    if (edge.reachable) vertex_reachable_[edge.from] = vertex_reachable_[edge.to] = 1;
   }
-  for (const Triangle& t : mesh->triangles_) {
+  for (const Triangle& t : triangles_) {
     for (const std::uint32_t v : t) {
-      mesh->bounding_radius_ = std::max(mesh->bounding_radius_, vertices[v].stableNorm());
+      bounding_radius_ = std::max(bounding_radius_, vertices_[v].stableNorm());
     }
   }
-  return std::shared_ptr<const TriangleMesh>(std::move(mesh));
 }
 
 std::uint32_t TriangleMesh::buildNode(std::uint32_t first, std::uint32_t count,
