@@ -105,6 +105,10 @@ const KeyTable<BodySpec>& bodyKeys() {
       vectorKey<BodySpec>("velocity", [](BodySpec& b) -> Eigen::Vector3d& { return b.velocity; }),
       vectorKey<BodySpec>("angular_velocity",
                           [](BodySpec& b) -> Eigen::Vector3d& { return b.angular_velocity; }),
+      numberKey<BodySpec>("drag_coefficient",
+                          [](BodySpec& b) -> double& { return b.drag_coefficient; }),
+      numberKey<BodySpec>("lift_coefficient",
+                          [](BodySpec& b) -> double& { return b.lift_coefficient; }),
       {"inertia", false,
        [](const XmlRpc::XmlRpcValue& value, const std::string& field, BodySpec& body) {
          const auto name = readString(value, field);
@@ -389,6 +393,9 @@ const KeyTable<Scene>& sceneTable() {
                        [](Scene& s) -> double& { return s.restitution_threshold; }),
       numberKey<Scene>("contact_integration_tolerance",
                        [](Scene& s) -> double& { return s.contact_integration_tolerance; }),
+      numberKey<Scene>("air_density", [](Scene& s) -> double& { return s.air_density; }),
+      numberKey<Scene>("flight_integration_tolerance",
+                       [](Scene& s) -> double& { return s.flight_integration_tolerance; }),
       // Stepped clusters (README, "Scene file"): the time step's range is validateScene's.
       countKey<Scene>(
           "stepped_cluster_min_bodies",

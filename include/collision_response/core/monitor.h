@@ -153,6 +153,9 @@ class ImpactMonitor {
   /// `frame.time` on: its shape is placed there and moves straight on. Fixed obstacles are set
   /// from the scene.
   void setObstaclePose(std::size_t obstacle, const RigidPose& frame);
+  /// Places an obstacle's shape where `placed` says, moving on as it says (another monitor's
+  /// obstaclePose: a prediction starts where the live monitor's obstacles are).
+  void placeObstacle(std::size_t obstacle, const PlacedShape& placed);
   /// Where an obstacle was last placed (its shape in the fixed frame, and its motion); empty for
   /// a tf-attached one not placed yet.
   std::optional<PlacedShape> obstaclePose(std::size_t obstacle) const;

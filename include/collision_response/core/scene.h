@@ -26,11 +26,25 @@ struct Effects {
   bool gravity = false;
   bool friction = false;
   bool spin = false;
+  /// Quadratic air drag on a body in flight, F = -1/2 rho C_d A |v| v (doc/model.md, "Air").
+  bool drag = false;
+  /// The Magnus force of a spinning body in flight, F = 1/2 rho C_L A |v| (w/|w| x v); needs spin.
+  bool magnus = false;
+  /// Drag or Magnus: flight has no closed form and is integrated.
+  bool air() const { return drag || magnus; }
 };
-/// Adds the effect `name` ("gravity" | "friction" | "spin") to `effects`; unknown or repeated
-/// names are errors naming `field`.
+/// Adds the effect `name` ("gravity" | "friction" | "spin" | "drag" | "magnus") to `effects`;
+/// unknown or repeated names are errors naming `field`.
 Status addEffect(const std::string& name, const std::string& field, Effects& effects);
 std::string toString(const Effects& effects);
+
+/// The air's defaults (doc/model.md, "Air"): a smooth sphere's drag coefficient between Reynolds
+/// numbers 1e3 and 2e5; a lift coefficient of a ball spinning at a spin parameter r|w|/|v| of
+/// about 0.2 (Nathan, "The effect of spin on the flight of a baseball", Am. J. Phys. 76, 119,
+/// 2008); dry air at 20 degrees C and sea level.
+inline constexpr double kDefaultDragCoefficient = 0.47;
+inline constexpr double kDefaultLiftCoefficient = 0.2;
+inline constexpr double kDefaultAirDensity = 1.204;
 
 /// A body the monitor tracks. `position` and `velocity` are its initial state for the scene
 /// player; the monitor takes states from topics.
@@ -41,6 +55,10 @@ struct BodySpec {
   std::string material;  ///< required
   std::string topic;     ///< its own BodyState topic; empty: only `body_states`
   Inertia inertia = Inertia::kSolid;  ///< with the spin effect: I = 2/5 m r^2 or 2/3 m r^2
+  /// C_d of F = -1/2 rho C_d A |v| v (drag effect): a smooth sphere's, subcritical (0.47).
+  double drag_coefficient = kDefaultDragCoefficient;
+  /// C_L of F = 1/2 rho C_L A |v| (w/|w| x v) (magnus effect), taken as constant.
+  double lift_coefficient = kDefaultLiftCoefficient;
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< m, initial, in the fixed frame
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< m/s, initial, in the fixed frame
   /// rad/s, initial, in the fixed frame; nonzero only with the spin effect (without it the
@@ -83,6 +101,11 @@ struct Scene {
   /// Curved lasting contact (a ball rolling on a sphere) is integrated: the error allowed per
   /// integrator step, absolute (m, m/s, rad/s) and relative.
   double contact_integration_tolerance = 1e-9;
+  /// kg/m^3: the air's density, for the drag and magnus effects.
+  double air_density = kDefaultAirDensity;
+  /// Flight under drag or Magnus is integrated (Dormand-Prince): the error allowed per step,
+  /// absolute (m, m/s) and relative.
+  double flight_integration_tolerance = 1e-9;
   /// Stepped clusters (gravity; doc/model.md, "Lasting contact"): a connected set of at least
   /// this many bodies near each other (within what they can move in a sub-step) is advanced by time
   /// steps instead of event by event; 0: never (every contact exact, at whatever cost).

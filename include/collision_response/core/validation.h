@@ -32,6 +32,8 @@ Status checkFrameId(const std::string& frame, const std::string& field);
 Status checkFriction(double friction, const std::string& field);
 /// The restitution threshold, m/s: a finite number >= 0 (an approach at or above it bounces).
 Status checkRestitutionThreshold(double threshold, const std::string& field);
+/// A drag or lift coefficient (C_d, C_L): a finite number >= 0.
+Status checkAirCoefficient(double coefficient, const std::string& field);
 /// Surfaces within this fraction of their contact distance touch: finite, >= 0 and < 1.
 Status checkContactTolerance(double tolerance, const std::string& field);
 

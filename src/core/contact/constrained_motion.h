@@ -11,6 +11,7 @@
 
 #include "collision_response/core/shape.h"
 #include "contact/contact_forces.h"
+#include "geometry/integrated_motion.h"
 
 namespace collision_response::core::monitor {
 
@@ -44,7 +45,7 @@ struct ConstrainedContact {
 /// motion does not depend on how it was asked for; only the work does. An impact on one of its
 /// bodies replaces the step long before `until` (a settling pile: about 100 instants an update),
 /// and what was integrated past it was lost.
-class ConstrainedStep {
+class ConstrainedStep final : public IntegratedMotion {
  public:
   /// `bodies` at `start` (the movable ones first, `movable` of them; the others move at constant
   /// velocity), their `positions` then; the motion is integrated from `start` to `until` (or
@@ -55,14 +56,12 @@ class ConstrainedStep {
                   const std::vector<Eigen::Vector3d>& positions, std::size_t movable,
                   const std::vector<ConstrainedContact>& contacts, double start, double until,
                   double tolerance, double slip_tolerance, double step);
-  ~ConstrainedStep();
-  ConstrainedStep(const ConstrainedStep&) = delete;
-  ConstrainedStep& operator=(const ConstrainedStep&) = delete;
+  ~ConstrainedStep() override;
 
   double start() const { return start_; }
   /// How far it is integrated: where its mode changed, `until`, or (not complete()) the
   /// frontier so far, past which it is integrated on demand.
-  double end() const { return end_; }
+  double end() const override { return end_; }
   /// The motion ended before `until`: where a mode stopped holding, or after the most steps one
   /// motion takes (the group must be solved again there).
   bool modeChanged() const { return mode_changed_; }
@@ -76,9 +75,14 @@ class ConstrainedStep {
   /// margin and bisection): the work it cost.
   std::size_t solves() const { return solves_; }
 
-  Eigen::Vector3d position(std::size_t body, double time) const;
-  Eigen::Vector3d velocity(std::size_t body, double time) const;
-  Eigen::Vector3d angularVelocity(std::size_t body, double time) const;
+  Eigen::Vector3d position(std::size_t body, double time) const override;
+  Eigen::Vector3d velocity(std::size_t body, double time) const override;
+  Eigen::Vector3d angularVelocity(std::size_t body, double time) const override;
+  /// Gravity and the step's initial acceleration, each twice: the contact forces change over the
+  /// step, by less than they are.
+  double accelerationBound(std::size_t body, double gravity, double, double) const override {
+    return 2 * (gravity + initial_acceleration_[body].norm());
+  }
   /// The acceleration at the step's start (for bounds).
   const Eigen::Vector3d& initialAcceleration(std::size_t body) const {
     return initial_acceleration_[body];

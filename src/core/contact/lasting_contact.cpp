@@ -404,6 +404,7 @@ void storeGroupTracks(World& world, double time, const std::vector<std::size_t>&
       }
     } else {
       track.group = -1;
+      startFlight(world, body);
     }
     changed.push_back(body);
   }
@@ -534,7 +535,7 @@ void fallFreely(World& world, double time, const std::vector<std::size_t>& bodie
   for (const std::size_t body : bodies) {
     Track& track = world.tracks[body];
     if (track.acceleration == world.gravity && track.angular_acceleration.isZero() &&
-        !track.constrained) {
+        (!track.constrained || track.constrained->free())) {
       continue;
     }
     track.position = positionAt<Motion>(world, body, time);
@@ -544,6 +545,7 @@ void fallFreely(World& world, double time, const std::vector<std::size_t>& bodie
     track.acceleration = world.gravity;
     track.angular_acceleration.setZero();
     track.constrained = nullptr;
+    startFlight(world, body);
     changed.push_back(body);
   }
 }

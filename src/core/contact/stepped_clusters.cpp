@@ -36,7 +36,8 @@ struct Start {
 double reachBefore(const World& world, std::size_t body, double time, double span) {
   const double speed = velocityAt<Motion>(world, body, time).norm();
   if (world.inverse_mass[body] == 0.0) return speed * span;
-  const double acceleration = world.stepped(body) ? 0.0 : accelerationBound<Motion>(world, body);
+  const double acceleration =
+      world.stepped(body) ? 0.0 : accelerationBound<Motion>(world, body, time, time + span);
   return (speed + world.gravity.norm() * span) * span + 0.5 * acceleration * span * span;
 }
 
@@ -380,6 +381,7 @@ void replaceClusters(World& world, const Region& region, std::vector<std::size_t
       track.acceleration = world.gravity;
       track.angular_acceleration.setZero();
       track.stepped = -1;
+      startFlight(world, body);
       changed.push_back(body);
       released.push_back(body);
     }
@@ -679,6 +681,7 @@ void clearStepped(World& world, double time) {
         track.acceleration = world.gravity;
       }
       track.stepped = -1;
+      if (track.known) startFlight(world, body);
     }
   }
   world.stepping.clusters.clear();

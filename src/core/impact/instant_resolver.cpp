@@ -212,6 +212,7 @@ void storeVelocities(World& world, double time, const PreparedCluster& prepared,
     track.last_impact_time = time;
     track.impact_step = world.steps;
     track.constrained = nullptr;
+    startFlight(world, participant);
     changed.push_back(participant);
   }
 }
@@ -601,6 +602,7 @@ void storeInelasticVelocities(World& world, double time,
     track.last_impact_time = time;
     track.impact_step = world.steps;
     track.constrained = nullptr;
+    startFlight(world, p);
     changed.push_back(p);
   }
 }

@@ -33,7 +33,8 @@ namespace {
 /// Calls `f` with the motion model the scene's effects call for: the one place it is chosen.
 template <class F>
 auto withMotionModel(const World& world, F&& f) {
-  return world.effects.gravity ? f(UnderGravity{}) : f(StraightLine{});
+  // Drag and Magnus without gravity accelerate too: their flights are integrated (AirFlight).
+  return world.effects.gravity || world.effects.air() ? f(UnderGravity{}) : f(StraightLine{});
 }
 
 /// Fills the restitution and friction tables from the materials: impacts look them up by index.
@@ -118,6 +119,7 @@ void applyStates(World& world, const std::vector<BodyStateSample>& states, StepR
       releaseFromState(world, state.body);
       world.groups_current = false;
     }
+    monitor::startFlight(world, state.body);
   }
 }
 
@@ -682,6 +684,7 @@ ImpactMonitor::ImpactMonitor(const Scene& scene, const MonitorSettings& settings
   world.effects = runnableEffects(scene.effects);
   if (world.effects.gravity) world.gravity = scene.gravity;
   world.integration_tolerance = scene.contact_integration_tolerance;
+  world.flight_tolerance = scene.flight_integration_tolerance;
   if (world.effects.gravity) {
     world.stepping.min_bodies = static_cast<std::size_t>(scene.stepped_cluster_min_bodies);
     world.stepping.time_step = scene.stepped_cluster_time_step;
@@ -707,6 +710,11 @@ ImpactMonitor::ImpactMonitor(const Scene& scene, const MonitorSettings& settings
         world.effects.spin ? spinFactor(world.inverse_mass.back(), body.radius, body.inertia)
                            : 0.0);
     world.material.push_back(material_index(body.material));
+    if (world.effects.air()) {
+      world.air.push_back(airFactors(scene.air_density, body.radius, world.inverse_mass.back(),
+                                     world.effects.drag ? body.drag_coefficient : 0.0,
+                                     world.effects.magnus ? body.lift_coefficient : 0.0));
+    }
   }
   for (const ObstacleSpec& obstacle : world.obstacles) {
     world.radius.push_back(contactRadius(shapeOf(obstacle)));
@@ -767,6 +775,11 @@ std::optional<std::size_t> ImpactMonitor::bodyIndex(const std::string& id) const
 void ImpactMonitor::setObstaclePose(std::size_t obstacle, const RigidPose& frame) {
   world_->obstacle_tracks[obstacle] =
       monitor::ObstacleTrack{true, place(world_->obstacles[obstacle], frame)};
+  world_->groups_current = false;
+}
+
+void ImpactMonitor::placeObstacle(std::size_t obstacle, const PlacedShape& placed) {
+  world_->obstacle_tracks[obstacle] = monitor::ObstacleTrack{true, placed};
   world_->groups_current = false;
 }
 

@@ -22,6 +22,7 @@
 #include "collision_response/core/scene.h"
 #include "contact/constrained_motion.h"
 #include "contact/contact_forces.h"
+#include "geometry/air_flight.h"
 #include "geometry/broadphase.h"
 #include "geometry/motion.h"
 #include "geometry/narrow_phase.h"
@@ -47,9 +48,10 @@ struct Track {
   Eigen::Vector3d acceleration = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_acceleration = Eigen::Vector3d::Zero();  ///< rolling: from friction
   int group = -1;  ///< its group of lasting contact (World::groups), -1: none
-  /// Curved lasting contact: the integrated step its motion follows (body `slot` of it), which
-  /// replaces the parabola; null otherwise.
-  std::shared_ptr<const ConstrainedStep> constrained;
+  /// Curved lasting contact: the integrated step its motion follows (body `slot` of it); with
+  /// the drag or magnus effect, a free body's flight through air (AirFlight). Either replaces the
+  /// parabola; null otherwise.
+  std::shared_ptr<const IntegratedMotion> constrained;
   std::size_t slot = 0;
   double integration_step = 0.0;  ///< the integrator's last step size, a guess for the next
   /// Its stepped cluster (World::stepping), -1: none. Its motion is then a straight line over
@@ -205,6 +207,8 @@ struct World {
   Effects effects;                   // what this build runs of the scene's (runnableEffects)
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  // zero without the gravity effect
   double integration_tolerance = 1e-9;                // curved lasting contact
+  std::vector<AirFactors> air;                        // per body; empty without drag or magnus
+  double flight_tolerance = 1e-9;                     // flight through air
   FrictionModel friction_model;                       // empty without the friction effect
   std::vector<std::string> material_names;            // the scene's materials, indexed
   std::vector<std::size_t> material;                  // per participant, into restitution
@@ -283,5 +287,18 @@ struct World {
     return std::find(others.begin(), others.end(), pair.second) != others.end();
   }
 };
+
+/// With the drag or magnus effect, a movable body that moves freely from its track's state on
+/// (not in a stepped cluster) flies through air from there: its track follows an AirFlight from
+/// its position, velocity and spin. Without either effect nothing changes: the parabola (or the
+/// straight line) is its motion, and no flight is ever made.
+inline void startFlight(World& world, std::size_t body) {
+  if (world.air.empty()) return;
+  Track& track = world.tracks[body];
+  if (world.inverse_mass[body] == 0.0 || track.stepped >= 0) return;
+  track.constrained = std::make_shared<AirFlight>(track.time, track.position, track.velocity,
+                                                  track.angular_velocity, world.gravity,
+                                                  world.air[body], world.flight_tolerance);
+}
 
 }  // namespace collision_response::core::monitor

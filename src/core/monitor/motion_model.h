@@ -114,14 +114,14 @@ Geometry geometry(const World& world, const Pair& pair, double time) {
 template <class Motion>
 Geometry geometry(const World& world, const Pair& pair, double time);
 
-/// A bound on a participant's acceleration: a free body's own; along an integrated step, gravity
-/// and the step's initial acceleration, each twice (as sweptBox bounds the step's reach).
+/// A bound on a participant's acceleration over [from, to]: a free body's own; along an
+/// integrated motion, that motion's bound (IntegratedMotion::accelerationBound).
 template <class Motion>
-double accelerationBound(const World& world, std::size_t participant) {
+double accelerationBound(const World& world, std::size_t participant, double from, double to) {
   if (world.isObstacle(participant)) return 0.0;
   const Track& track = world.tracks[participant];
   if (track.constrained) {
-    return 2 * (world.gravity.norm() + track.constrained->initialAcceleration(track.slot).norm());
+    return track.constrained->accelerationBound(track.slot, world.gravity.norm(), from, to);
   }
   return track.acceleration.norm();
 }
@@ -147,8 +147,8 @@ std::optional<double> timeOfImpactAlongPaths(const World& world, const Pair& pai
   // A finite shape's next feature may curve where this one is flat.
   const bool curved = !start.flat() || start.bounded;
   const double contact_distance = world.radius[pair.first] + world.radius[pair.second];
-  const double accelerations =
-      accelerationBound<Motion>(world, pair.first) + accelerationBound<Motion>(world, pair.second);
+  const double accelerations = accelerationBound<Motion>(world, pair.first, from, end) +
+                               accelerationBound<Motion>(world, pair.second, from, end);
   const double span = end - from;
   const double shortest = 1e-12 * span + 4 * kEps * std::abs(end);
   constexpr int kMaxSamples = 4096;
@@ -281,21 +281,26 @@ Box sweptBox(const World& world, std::size_t body, double from, double to) {
   }
   if constexpr (Motion::kAccelerates) {
     if (integrated) {
-      // Along the integrated step, sampled; beyond its end, as far as its speed and gravity and
-      // the step's acceleration (twice) could carry it.
-      const ConstrainedStep& step = *world.tracks[body].constrained;
-      const double inside = std::clamp(to, from, step.end());
+      // Along the integrated motion, sampled; beyond its end, as far as its speed and its
+      // acceleration's bound could carry it.
+      const IntegratedMotion& motion = *world.tracks[body].constrained;
+      const std::size_t slot = world.tracks[body].slot;
+      const double inside = std::clamp(to, from, motion.end());
       for (int i = 1; i <= 16; ++i) {
         const Eigen::Vector3d point =
             positionAt<Motion>(world, body, from + (inside - from) * i / 16);
         box.low = box.low.cwiseMin(point);
         box.high = box.high.cwiseMax(point);
       }
+      const double bound = motion.accelerationBound(slot, world.gravity.norm(), from, to);
       const double beyond = to - inside;
-      const double distance =
-          velocityAt<Motion>(world, body, inside).norm() * beyond +
-          (world.gravity.norm() + step.initialAcceleration(world.tracks[body].slot).norm()) *
-              beyond * beyond;
+      double distance =
+          velocityAt<Motion>(world, body, inside).norm() * beyond + 0.5 * bound * beyond * beyond;
+      if (motion.free()) {
+        // A flight bends between the samples by at most a chord's sagitta, bound h^2 / 8.
+        const double h = (inside - from) / 16;
+        distance += bound * h * h / 8;
+      }
       box.low.array() -= distance;
       box.high.array() += distance;
     } else {

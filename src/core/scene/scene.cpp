@@ -28,8 +28,11 @@ Status addEffect(const std::string& name, const std::string& field, Effects& eff
   if (name == "gravity") flag = &effects.gravity;
   if (name == "friction") flag = &effects.friction;
   if (name == "spin") flag = &effects.spin;
+  if (name == "drag") flag = &effects.drag;
+  if (name == "magnus") flag = &effects.magnus;
   if (flag == nullptr) {
-    return Error{field, "unknown effect '" + name + "'; known: gravity, friction, spin"};
+    return Error{field,
+                 "unknown effect '" + name + "'; known: gravity, friction, spin, drag, magnus"};
   }
   if (*flag) return Error{field, "effect '" + name + "' is listed twice"};
   *flag = true;
@@ -41,6 +44,8 @@ std::string toString(const Effects& effects) {
   if (effects.gravity) text += "gravity";
   if (effects.friction) text += std::string(text.empty() ? "" : ", ") + "friction";
   if (effects.spin) text += std::string(text.empty() ? "" : ", ") + "spin";
+  if (effects.drag) text += std::string(text.empty() ? "" : ", ") + "drag";
+  if (effects.magnus) text += std::string(text.empty() ? "" : ", ") + "magnus";
   return text.empty() ? "none (the seed's model)" : text;
 }
 
@@ -55,6 +60,27 @@ Status checkMaterial(const MaterialTable& materials, const std::string& name,
                      const std::string& field) {
   if (name.empty()) return Error{field, "is required (a material name)"};
   return materials.checkMaterial(name, field);
+}
+
+/// The air (drag and magnus effects): a density, an integrator tolerance the integrator can meet
+/// (as the contact integrator's), and Magnus only with the spin that makes it.
+Status checkAir(const Scene& scene, const std::string& prefix) {
+  if (!(std::isfinite(scene.air_density) && scene.air_density >= 0)) {
+    return Error{prefix + "/air_density",
+                 "must be a finite density >= 0 (kg/m^3), got " + formatNumber(scene.air_density)};
+  }
+  if (!(scene.flight_integration_tolerance >= 1e-14 &&
+        scene.flight_integration_tolerance <= 1e-3)) {
+    return Error{
+        prefix + "/flight_integration_tolerance",
+        "must be in [1e-14, 1e-3], got " + formatNumber(scene.flight_integration_tolerance)};
+  }
+  if (scene.effects.magnus && !scene.effects.spin) {
+    return Error{prefix + "/effects",
+                 "names magnus without spin: the Magnus force comes from the spin, which only "
+                 "the spin effect carries (add spin)"};
+  }
+  return Ok{};
 }
 
 /// The scene-wide settings: frame, gravity, threshold, integrator tolerance, stepped clusters.
@@ -76,6 +102,7 @@ Status checkSettings(const Scene& scene, const std::string& prefix) {
         prefix + "/contact_integration_tolerance",
         "must be in [1e-14, 1e-3], got " + formatNumber(scene.contact_integration_tolerance)};
   }
+  if (auto status = checkAir(scene, prefix); !status) return status;
   // Stepped clusters: a count of bodies (0: never), and a sub-step from 0.1 ms (far above the
   // resolution of a time line of ROS stamps, 2.4e-7 s in 2026) to a second.
   if (!(scene.stepped_cluster_min_bodies >= 0)) {
@@ -121,6 +148,16 @@ Status checkBodies(const Scene& scene, const std::string& prefix, std::set<std::
       return status;
     }
     if (auto status = checkFinite(body.velocity, item(prefix, "bodies", i, "velocity")); !status) {
+      return status;
+    }
+    if (auto status = checkAirCoefficient(body.drag_coefficient,
+                                          item(prefix, "bodies", i, "drag_coefficient"));
+        !status) {
+      return status;
+    }
+    if (auto status = checkAirCoefficient(body.lift_coefficient,
+                                          item(prefix, "bodies", i, "lift_coefficient"));
+        !status) {
       return status;
     }
     const std::string angular = item(prefix, "bodies", i, "angular_velocity");

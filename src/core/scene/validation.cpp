@@ -98,6 +98,13 @@ Status checkRestitutionThreshold(double threshold, const std::string& field) {
   return Ok{};
 }
 
+Status checkAirCoefficient(double coefficient, const std::string& field) {
+  if (!std::isfinite(coefficient) || coefficient < 0.0) {
+    return Error{field, "must be a finite coefficient >= 0, got " + formatNumber(coefficient)};
+  }
+  return Ok{};
+}
+
 Status checkContactTolerance(double tolerance, const std::string& field) {
   if (!std::isfinite(tolerance) || tolerance < 0.0 || tolerance >= 1.0) {
     return Error{field,

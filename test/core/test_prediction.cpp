@@ -1,0 +1,236 @@
+// Predictions ahead of time (prediction.h): gravity-only ones equal the monitor's own motion to
+// the bit and the closed forms; budgets and every bad request named.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "collision_response/core/prediction.h"
+#include "scene_builders.h"
+
+namespace collision_response::core {
+namespace {
+
+using V = Eigen::Vector3d;
+using scene_builders::ball;
+using scene_builders::box;
+using scene_builders::plane;
+
+constexpr double kG = 9.81;
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+
+/// A ball (the seed's hollow hard plastic ball, e = 0.688 on concrete) over a concrete floor and
+/// a concrete table 0.76 m high.
+Scene tableScene() {
+  Scene scene;
+  scene.effects.gravity = true;
+  scene.gravity = V(0, 0, -kG);
+  scene.bodies = {ball("ball", 0.0027, 0.02, "hollow_hard_plastic_ball")};
+  scene.obstacles = {plane("floor", V::UnitZ(), 0.0, "concrete"),
+                     box("table", V(0, 0, 0.745), V(2.74, 1.525, 0.03), "concrete")};
+  return scene;
+}
+
+PredictionRequest requestFor(const Scene& scene, const V& position, const V& velocity,
+                             double horizon, std::size_t max_impacts) {
+  PredictionRequest request;
+  request.body = scene.bodies[0];
+  request.state.position = position;
+  request.state.velocity = velocity;
+  request.horizon = horizon;
+  request.max_impacts = max_impacts;
+  request.effects = scene.effects;
+  return request;
+}
+
+/// A monitor given `request`'s state at 0 and advanced by its own motion (no further states) at
+/// the updates `period` apart up to `horizon`: its impacts, and the state at `horizon`.
+std::pair<std::vector<ImpactRecord>, std::pair<V, V>> played(const Scene& scene,
+                                                             const PredictionRequest& request,
+                                                             double period, double horizon) {
+  MonitorSettings settings;
+  settings.body_timeout = INFINITY;  // no further states: the motion is the monitor's own
+  ImpactMonitor monitor(scene, settings);
+  BodyStateSample state;
+  state.position = request.state.position;
+  state.velocity = request.state.velocity;
+  monitor.step(0.0, {state});
+  std::vector<ImpactRecord> impacts;
+  const int updates = static_cast<int>(std::lround(horizon / period));
+  for (int k = 1; k <= updates; ++k) {
+    const auto report = monitor.advance(k == updates ? horizon : k * period, {});
+    impacts.insert(impacts.end(), report.impacts.begin(), report.impacts.end());
+  }
+  return {impacts, *monitor.predictedState(0, horizon)};
+}
+
+// The prediction is the monitor's own motion. Advanced over the horizon at once, the monitor
+// finds the same impacts and ends in the same state, bit for bit. Advanced at the node's updates
+// (1 kHz) it finds them to a few ulps: each root is taken from its update's start, so its last
+// bits depend on where the updates fall.
+TEST(Prediction, GravityOnlyEqualsTheMonitorToTheBit) {
+  const Scene scene = tableScene();
+  const auto request = requestFor(scene, V(-1.2, 0.1, 1.0), V(4.0, 0.2, 1.0), 2.0, 50);
+  const auto prediction = predictImpacts(scene, nullptr, MonitorSettings{}, request);
+  ASSERT_TRUE(prediction.ok()) << prediction.error().message();
+  ASSERT_GE(prediction->impacts.size(), 3u);
+
+  const auto [at_once, end] = played(scene, request, 2.0, 2.0);
+  ASSERT_EQ(at_once.size(), prediction->impacts.size());
+  for (std::size_t i = 0; i < at_once.size(); ++i) {
+    EXPECT_EQ(at_once[i].time, prediction->impacts[i].time) << i;
+    EXPECT_EQ(at_once[i].contact_point, prediction->impacts[i].contact_point) << i;
+    EXPECT_EQ(at_once[i].velocity_a_before, prediction->impacts[i].velocity_a_before) << i;
+    EXPECT_EQ(at_once[i].velocity_a_after, prediction->impacts[i].velocity_a_after) << i;
+  }
+  EXPECT_EQ(prediction->final_state.position, end.first);
+  EXPECT_EQ(prediction->final_state.velocity, end.second);
+  EXPECT_EQ(prediction->final_state.time, 2.0);
+
+  const auto [updated, updated_end] = played(scene, request, 1e-3, 2.0);
+  ASSERT_EQ(updated.size(), prediction->impacts.size());
+  for (std::size_t i = 0; i < updated.size(); ++i) {
+    EXPECT_NEAR(updated[i].time, prediction->impacts[i].time, 8 * kEps) << i;
+    EXPECT_EQ(updated[i].other, prediction->impacts[i].other) << i;  // the same obstacles
+    EXPECT_LE((updated[i].velocity_a_after - prediction->impacts[i].velocity_a_after).norm(),
+              8 * kEps * prediction->impacts[i].velocity_a_after.norm())
+        << i;
+  }
+  EXPECT_LE((updated_end.first - prediction->final_state.position).norm(), 8 * kEps * 8);
+}
+
+// Dropped from rest at H over the table's top (0.76 m): it falls h = H - 0.76 - r in
+// t1 = sqrt(2 h / g), arrives at -sqrt(2 g h) and leaves at e sqrt(2 g h); each later flight
+// lasts 2 u / g for the speed u it left at, each bounce multiplies u by e.
+TEST(Prediction, BouncesOnTheTableAtTheClosedForms) {
+  const Scene scene = tableScene();
+  const double e = *scene.materials.restitution("hollow_hard_plastic_ball", "concrete");
+  const double h = 1.2 - 0.76 - 0.02;
+  const auto prediction = predictImpacts(scene, nullptr, MonitorSettings{},
+                                         requestFor(scene, V(0.3, 0.2, 1.2), V::Zero(), 2.0, 4));
+  ASSERT_TRUE(prediction.ok()) << prediction.error().message();
+  ASSERT_EQ(prediction->impacts.size(), 4u);
+  double time = std::sqrt(2 * h / kG), speed = std::sqrt(2 * kG * h);
+  for (std::size_t i = 0; i < 4; ++i) {
+    const ImpactRecord& impact = prediction->impacts[i];
+    EXPECT_EQ(prediction->model->obstacle(impact.other).id, "table");
+    EXPECT_NEAR(impact.time, time, 16 * kEps * time) << i;
+    EXPECT_NEAR(impact.velocity_a_before.z(), -speed, 16 * kEps * speed) << i;
+    EXPECT_NEAR(impact.velocity_a_after.z(), e * speed, 16 * kEps * speed) << i;
+    speed *= e;
+    time += 2 * speed / kG;
+  }
+  // max_impacts reached: the prediction ends at the fourth impact, not at the horizon.
+  EXPECT_EQ(prediction->final_state.time, prediction->impacts[3].time);
+  EXPECT_FALSE(prediction->cut_short);
+}
+
+// Thrown along x at 3 m/s from x = -1: it crosses the plane x = 1 at t = 2/3 s whatever gravity
+// does, at z = z0 + vz t - g t^2 / 2 (no impact before: it starts 30 m up).
+TEST(Prediction, FirstCrossingOfAPlaneIsTheClosedForm) {
+  Scene scene = tableScene();
+  scene.obstacles.pop_back();
+  auto request = requestFor(scene, V(-1, 0, 30), V(3, 0, 1), 1.0, 10);
+  request.crossing = Plane{V::UnitX(), 1.0};
+  request.sample_period = 0.1;
+  const auto prediction = predictImpacts(scene, nullptr, MonitorSettings{}, request);
+  ASSERT_TRUE(prediction.ok()) << prediction.error().message();
+  ASSERT_TRUE(prediction->crossing);
+  const double t = 2.0 / 3.0;
+  EXPECT_NEAR(prediction->crossing->time, t, 4 * kEps);
+  EXPECT_NEAR(prediction->crossing->position.x(), 1.0, 8 * kEps);
+  EXPECT_NEAR(prediction->crossing->position.z(), 30 + t - 0.5 * kG * t * t, 64 * kEps);
+  // Samples every 0.1 s from 0 to 1 s, on the parabola.
+  ASSERT_EQ(prediction->samples.size(), 11u);
+  for (const BodyStateSample& sample : prediction->samples) {
+    const double s = sample.time;
+    EXPECT_NEAR(sample.position.x(), -1 + 3 * s, 16 * kEps);
+    EXPECT_NEAR(sample.position.z(), 30 + s - 0.5 * kG * s * s, 64 * kEps);
+  }
+}
+
+// A ball at rest on the floor is held where the live monitor has it: thrown along x at 2 m/s
+// (no gravity) from 1 m away, the thrown ball meets it when the gap of 1 - 2 r closes, at
+// t = (1 - 2 r) / 2.
+TEST(Prediction, OtherBodiesAreHeldWhereTheLiveMonitorHasThem) {
+  Scene scene;
+  scene.bodies = {ball("ball", 1, 0.1, "steel_ball_bearing"),
+                  ball("target", 1, 0.1, "steel_ball_bearing")};
+  ImpactMonitor live(scene, MonitorSettings{});
+  BodyStateSample target;
+  target.body = *live.bodyIndex("target");
+  target.position = V(1, 0, 0);
+  live.step(0.0, {target});
+  auto request = requestFor(scene, V::Zero(), V(2, 0, 0), 1.0, 1);
+  const auto prediction = predictImpacts(scene, &live, MonitorSettings{}, request);
+  ASSERT_TRUE(prediction.ok()) << prediction.error().message();
+  ASSERT_EQ(prediction->impacts.size(), 1u);
+  EXPECT_EQ(prediction->model->obstacle(prediction->impacts[0].other).id, "target");
+  EXPECT_NEAR(prediction->impacts[0].time, 0.4, 4 * kEps);
+}
+
+TEST(Prediction, BudgetsAnswerWithWhatWasFoundAndSaySo) {
+  const Scene scene = tableScene();
+  auto request = requestFor(scene, V(5, 0, 1.0), V::Zero(), 100.0, 5000);
+  const auto prediction = predictImpacts(scene, nullptr, MonitorSettings{}, request);
+  ASSERT_TRUE(prediction.ok()) << prediction.error().message();
+  EXPECT_TRUE(prediction->cut_short);
+  EXPECT_NE(prediction->message.find("horizon is cut to 60 s"), std::string::npos);
+  EXPECT_NE(prediction->message.find("impacts are cut to 1000"), std::string::npos);
+  EXPECT_EQ(prediction->final_state.time, 60.0);
+  // At rest on the floor by then: a ball bouncing to rest, by the lasting-contact model.
+  EXPECT_EQ(prediction->final_state.velocity, V::Zero());
+  EXPECT_NEAR(prediction->final_state.position.z(), 0.02, 1e-12);
+  EXPECT_EQ(prediction->contacts.size(), 1u);
+}
+
+TEST(Prediction, EveryBadRequestIsNamed) {
+  const Scene scene = tableScene();
+  const auto good = requestFor(scene, V(0, 0, 1.2), V::Zero(), 1.0, 2);
+  const auto refused = [&](PredictionRequest request) {
+    const auto prediction = predictImpacts(scene, nullptr, MonitorSettings{}, request);
+    return prediction.ok() ? std::string("accepted") : prediction.error().field;
+  };
+  auto request = good;
+  request.state.position.x() = NAN;
+  EXPECT_EQ(refused(request), "body.position.x");
+  request = good;
+  request.state.velocity.z() = INFINITY;
+  EXPECT_EQ(refused(request), "body.velocity.z");
+  request = good;
+  request.horizon = 0;
+  EXPECT_EQ(refused(request), "horizon");
+  request.horizon = NAN;
+  EXPECT_EQ(refused(request), "horizon");
+  request = good;
+  request.max_impacts = 0;
+  EXPECT_EQ(refused(request), "max_impacts");
+  request = good;
+  request.state.position = V(0, 0, 0.75);  // inside the table
+  EXPECT_EQ(refused(request), "body.position");
+  request = good;
+  request.body.mass = -1;
+  EXPECT_EQ(refused(request), "body.mass");
+  request = good;
+  request.body.material = "unobtainium";
+  EXPECT_EQ(refused(request), "body.material");
+  request = good;
+  request.effects.magnus = true;
+  EXPECT_EQ(refused(request), "effects");
+  request = good;
+  request.state.angular_velocity = V(0, 1, 0);
+  EXPECT_EQ(refused(request), "body.angular_velocity");
+  request = good;
+  request.sample_period = -1;
+  EXPECT_EQ(refused(request), "sample_period");
+  request = good;
+  request.crossing = Plane{V::Zero(), 0.0};
+  EXPECT_EQ(refused(request), "crossing_normal");
+  request = good;
+  request.body.drag_coefficient = -0.1;
+  EXPECT_EQ(refused(request), "drag_coefficient");
+  EXPECT_EQ(refused(good), "accepted");
+}
+
+}  // namespace
+}  // namespace collision_response::core
