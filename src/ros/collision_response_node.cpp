@@ -96,6 +96,8 @@ bool CollisionResponseNode::start() {
     reconfigure_->updateConfig(config_);
     reconfigure_->setCallback(
         [this](MonitorConfig& config, std::uint32_t level) { onReconfigure(config, level); });
+    predict_impacts_server_ = private_node_.advertiseService(
+        "predict_impacts", &CollisionResponseNode::onPredictImpacts, this);
   } else {
     ROS_WARN_STREAM("collision_response: no " << joinKey(ns, "scene")
                                               << " parameter: serving the services with the "
@@ -112,6 +114,18 @@ bool CollisionResponseNode::start() {
   service_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &service_queue_);
   service_spinner_->start();
   return true;
+}
+
+bool CollisionResponseNode::onPredictImpacts(PredictImpacts::Request& request,
+                                             PredictImpacts::Response& response) {
+  try {
+    monitor_->predict(request, response);
+  } catch (const std::exception& error) {
+    response = PredictImpacts::Response();
+    response.message = std::string("internal error: ") + error.what();
+    ROS_ERROR_STREAM_THROTTLE(1.0, "predict_impacts: " << response.message);
+  }
+  return true;  // a refused request is answered (success false), not failed
 }
 
 std::shared_ptr<const core::MaterialTable> CollisionResponseNode::materials() const {

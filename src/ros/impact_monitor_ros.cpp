@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "collision_response/core/validation.h"
+#include "collision_response/ros/prediction_service.h"
 
 namespace collision_response {
 
@@ -204,6 +205,11 @@ void ImpactMonitorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& sta
       update_began_.isZero() ? 0.0 : (ros::WallTime::now() - update_began_).toSec();
   // An update that has run for 1 s turns the summary to WARN.
   diagnostics_.report(status, figures_, waiting_, running, 1.0);
+}
+
+void ImpactMonitorRos::predict(const PredictImpacts::Request& request,
+                               PredictImpacts::Response& response) const {
+  answerPredictImpacts(request, cycle_, tf_buffer_, ros::Time::now(), response);
 }
 
 }  // namespace collision_response

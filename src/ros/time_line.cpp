@@ -230,6 +230,12 @@ bool TimeLine::stampOf(double time, std::int64_t clock_offset, ros::Time& stamp)
   return true;
 }
 
+bool TimeLine::lineTimeOf(const ros::Time& stamp, double& time) const {
+  if (!started_) return false;
+  time = static_cast<double>(nanoseconds(stamp) - epoch_) * 1e-9;
+  return true;
+}
+
 double TimeLine::offset(const std::string& source) const {
   const auto found = sources_.find(source);
   if (found == sources_.end() || found->second.clocks.empty()) return 0.0;

@@ -21,6 +21,7 @@
 #include "collision_response/ComputeCollision.h"
 #include "collision_response/EstimateRestitution.h"
 #include "collision_response/MonitorConfig.h"
+#include "collision_response/PredictImpacts.h"
 #include "collision_response/core/materials.h"
 #include "collision_response/ros/impact_monitor_ros.h"
 #include "collision_response/ros/monitor_params.h"
@@ -43,6 +44,7 @@ class CollisionResponseNode {
   bool onComputeCollision(ComputeCollision::Request& request, ComputeCollision::Response& response);
   bool onEstimateRestitution(EstimateRestitution::Request& request,
                              EstimateRestitution::Response& response);
+  bool onPredictImpacts(PredictImpacts::Request& request, PredictImpacts::Response& response);
   void logScene(const core::Scene& scene, const MonitorParams& params) const;
   /// dynamic_reconfigure: checks each value as the scene file's; a refused value is put back
   /// to the one in use (in `config`, which the server then reports) with an error naming it.
@@ -68,6 +70,8 @@ class CollisionResponseNode {
   boost::recursive_mutex reconfigure_mutex_;  ///< the server's, so updateConfig is safe
   std::unique_ptr<dynamic_reconfigure::Server<MonitorConfig>> reconfigure_;
   MonitorConfig config_;  ///< the values in use
+  /// ~predict_impacts, on the monitor's queue: it reads the monitor between its updates.
+  ros::ServiceServer predict_impacts_server_;
   // The diagnostics' own queue and thread (their timer), so that /diagnostics is published
   // while an update runs on the node's queue; declared after what it reads, so that its thread
   // stops first.

@@ -24,6 +24,7 @@
 #include "collision_response/BodyState.h"
 #include "collision_response/BodyStateArray.h"
 #include "collision_response/ImpactArray.h"
+#include "collision_response/PredictImpacts.h"
 #include "collision_response/core/scene.h"
 #include "collision_response/ros/markers.h"
 #include "collision_response/ros/monitor_cycle.h"
@@ -42,6 +43,9 @@ class ImpactMonitorRos {
   /// Live tuning (dynamic_reconfigure), validated by the caller: see core::ImpactMonitor::tune.
   void tune(core::Detection detection, double restitution_threshold, core::CombineRule rule);
 
+  /// ~predict_impacts (prediction_service.h): reads the monitor, so it is called on the
+  /// monitor's queue, between updates.
+  void predict(const PredictImpacts::Request& request, PredictImpacts::Response& response) const;
   /// The monitor's status for /diagnostics: rates, bodies tracked, drops by reason, timing.
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 

@@ -81,6 +81,8 @@ class TimeLine {
   /// ros::Time (not finite, before 0 or past 2^32 s).
   bool stampOf(double time, std::int64_t clock_offset, ros::Time& stamp) const;
   bool stampOf(double time, ros::Time& stamp) const { return stampOf(time, 0, stamp); }
+  /// The instant of the line a stamp of the node's clock is at; false before the line started.
+  bool lineTimeOf(const ros::Time& stamp, double& time) const;
 
   bool started() const { return started_; }
   /// s the source's stamps are shifted by, on its clock heard last (0: none, or unknown).

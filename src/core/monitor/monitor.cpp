@@ -55,7 +55,8 @@ void computePairCoefficients(World& world, const MaterialTable& materials) {
 }
 
 /// The body's track starts again from `state`: known, at the state's time, position and
-/// velocities, and no longer in a constrained motion.
+/// velocities, and no longer in a constrained motion (in flight through air, with drag or
+/// Magnus).
 Track& restartTrack(World& world, const BodyStateSample& state) {
   Track& track = world.tracks[state.body];
   track.known = true;
@@ -64,6 +65,7 @@ Track& restartTrack(World& world, const BodyStateSample& state) {
   track.velocity = state.velocity;
   track.angular_velocity = state.angular_velocity;
   track.constrained = nullptr;
+  monitor::startFlight(world, state.body);  // drag or magnus: its flight through air
   return track;
 }
 
@@ -119,7 +121,6 @@ void applyStates(World& world, const std::vector<BodyStateSample>& states, StepR
       releaseFromState(world, state.body);
       world.groups_current = false;
     }
-    monitor::startFlight(world, state.body);
   }
 }
 

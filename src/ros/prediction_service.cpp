@@ -1,0 +1,164 @@
+#include "collision_response/ros/prediction_service.h"
+
+#include <cmath>
+#include <string>
+
+#include "collision_response/core/prediction.h"
+#include "collision_response/core/validation.h"
+#include "collision_response/ros/conversions.h"
+#include "collision_response/ros/frame_motion.h"
+
+namespace collision_response {
+namespace {
+
+/// The body the request names: a scene body's own values (mass 0), or every field its own.
+core::Expected<core::BodySpec> requestedBody(const Body& body, const core::Scene& scene) {
+  if (body.mass == 0.0) {
+    for (const core::BodySpec& spec : scene.bodies) {
+      if (spec.id == body.id) return spec;
+    }
+    return core::Error{"body.mass", "is 0, which takes the scene body '" + body.id +
+                                        "' as it is, but the scene has no body of that id "
+                                        "(give the body's mass, radius and material)"};
+  }
+  core::BodySpec spec;
+  spec.id = body.id;
+  spec.mass = body.mass;
+  spec.radius = body.radius;
+  spec.material = body.material;
+  if (!body.inertia.empty()) {
+    const auto inertia = core::parseInertia(body.inertia, "body.inertia");
+    if (!inertia) return inertia.error();
+    spec.inertia = *inertia;
+  }
+  return spec;
+}
+
+/// What the request asks for, in the scene's fixed frame, on the monitor's time line: an error
+/// names the field.
+core::Expected<core::PredictionRequest> requestInFixedFrame(const PredictImpacts::Request& request,
+                                                            const MonitorCycle& cycle,
+                                                            const tf2::BufferCore& tf,
+                                                            const ros::Time& stamp, double time) {
+  const core::Scene& scene = cycle.scene();
+  core::PredictionRequest predict;
+  auto body = requestedBody(request.body, scene);
+  if (!body) return body.error();
+  predict.body = *body;
+  if (request.body.mass != 0.0) {
+    predict.body.drag_coefficient =
+        request.drag_coefficient == 0.0 ? core::kDefaultDragCoefficient : request.drag_coefficient;
+    predict.body.lift_coefficient =
+        request.lift_coefficient == 0.0 ? core::kDefaultLiftCoefficient : request.lift_coefficient;
+  }
+  if (request.effects.empty()) predict.effects = scene.effects;
+  for (std::size_t i = 0; i < request.effects.size(); ++i) {
+    const std::string field = "effects[" + std::to_string(i) + "]";
+    if (auto status = core::addEffect(request.effects[i], field, predict.effects); !status) {
+      return status.error();
+    }
+  }
+  const std::string frame =
+      request.header.frame_id.empty() ? scene.fixed_frame : request.header.frame_id;
+  const auto motion = lookupFrameMotion(tf, scene.fixed_frame, frame, stamp,
+                                        ros::Duration(cycle.params().frame_velocity_interval));
+  if (!motion) return core::Error{"header.frame_id", motion.error().message()};
+  const Eigen::Vector3d position = toEigen(request.body.position);
+  predict.state.time = time;
+  predict.state.position = motion->point(position);
+  predict.state.velocity = motion->velocity(position, toEigen(request.body.velocity));
+  predict.state.angular_velocity =
+      motion->pose.linear() * toEigen(request.body.angular_velocity) + motion->angular_velocity;
+  predict.horizon = request.horizon;
+  predict.max_impacts = request.max_impacts;
+  predict.sample_period = request.sample_period;
+  const Eigen::Vector3d normal = toEigen(request.crossing_normal);
+  if (!normal.isZero()) {
+    if (auto status = core::checkFinite(normal, "crossing_normal"); !status) return status.error();
+    const Eigen::Vector3d point = toEigen(request.crossing_point);
+    if (auto status = core::checkFinite(point, "crossing_point"); !status) return status.error();
+    const Eigen::Vector3d fixed_normal = motion->pose.linear() * normal.normalized();
+    predict.crossing = core::Plane{fixed_normal, fixed_normal.dot(motion->point(point))};
+  }
+  return predict;
+}
+
+/// A state as a BodyState message, stamped `stamp`, in `frame`.
+BodyState stateMessage(const core::BodyStateSample& sample, const std::string& id,
+                       const std::string& frame, const ros::Time& stamp) {
+  BodyState state;
+  state.header.stamp = stamp;
+  state.header.frame_id = frame;
+  state.id = id;
+  state.pose.position = toPointMsg(sample.position);
+  state.pose.orientation.w = 1.0;
+  state.twist.linear = toVector3Msg(sample.velocity);
+  state.twist.angular = toVector3Msg(sample.angular_velocity);
+  return state;
+}
+
+void refuse(const core::Error& error, PredictImpacts::Response& response) {
+  response = PredictImpacts::Response{};
+  response.success = false;
+  response.message = error.message();
+}
+
+}  // namespace
+
+void answerPredictImpacts(const PredictImpacts::Request& request, const MonitorCycle& cycle,
+                          const tf2::BufferCore& tf, const ros::Time& clock,
+                          PredictImpacts::Response& response) {
+  const core::ImpactMonitor& live = cycle.monitor();
+  const TimeLine& line = cycle.timeLine();
+  // The request's instant: on the monitor's line once it has one; before, its own line from 0.
+  ros::Time stamp = request.header.stamp;
+  double time = 0.0;
+  if (stamp.isZero()) {
+    if (live.started() && line.stampOf(live.now(), stamp)) {
+      time = live.now();
+    } else {
+      stamp = clock;
+    }
+  } else if (!line.lineTimeOf(stamp, time)) {
+    time = 0.0;
+  }
+  auto predict = requestInFixedFrame(request, cycle, tf, stamp, time);
+  if (!predict) return refuse(predict.error(), response);
+  const core::MonitorSettings settings{cycle.params().contact_tolerance,
+                                       cycle.params().body_timeout};
+  const auto prediction =
+      core::predictImpacts(cycle.scene(), live.started() ? &live : nullptr, settings, *predict);
+  if (!prediction) return refuse(prediction.error(), response);
+
+  const std::string& fixed = cycle.scene().fixed_frame;
+  const auto stampAt = [&](double at) { return stamp + ros::Duration(at - time); };
+  const core::ImpactMonitor& model = *prediction->model;
+  for (const core::ImpactRecord& record : prediction->impacts) {
+    auto message = toImpactMessage(record, model, stampAt(record.time), fixed);
+    if (!message) return refuse(message.error(), response);
+    response.impacts.push_back(*message);
+  }
+  for (const core::ContactRecord& record : prediction->contacts) {
+    auto message = toContactMessage(record, model, stampAt(record.since));
+    if (!message) return refuse(message.error(), response);
+    response.final_contacts.push_back(*message);
+  }
+  const std::string& id = predict->body.id;
+  response.final_state =
+      stateMessage(prediction->final_state, id, fixed, stampAt(prediction->final_state.time));
+  if (prediction->crossing) {
+    response.crossed = true;
+    response.crossing =
+        stateMessage(*prediction->crossing, id, fixed, stampAt(prediction->crossing->time));
+  }
+  for (const core::BodyStateSample& sample : prediction->samples) {
+    response.samples.push_back(stateMessage(sample, id, fixed, stampAt(sample.time)));
+  }
+  response.success = true;
+  response.message = std::to_string(response.impacts.size()) + " impact(s) in " +
+                     core::formatNumber(prediction->final_state.time - time) + " s, effects " +
+                     core::toString(predict->effects);
+  if (prediction->cut_short) response.message += "; cut short: " + prediction->message;
+}
+
+}  // namespace collision_response
