@@ -131,7 +131,7 @@ void answerPredictImpacts(const PredictImpacts::Request& request, const MonitorC
   if (!prediction) return refuse(prediction.error(), response);
 
   const std::string& fixed = cycle.scene().fixed_frame;
-  const auto stampAt = [&](double at) { return stamp + ros::Duration(at - time); };
+  const auto stampAt = [&](double after) { return stamp + ros::Duration(after); };
   const core::ImpactMonitor& model = *prediction->model;
   for (const core::ImpactRecord& record : prediction->impacts) {
     auto message = toImpactMessage(record, model, stampAt(record.time), fixed);
@@ -156,7 +156,7 @@ void answerPredictImpacts(const PredictImpacts::Request& request, const MonitorC
   }
   response.success = true;
   response.message = std::to_string(response.impacts.size()) + " impact(s) in " +
-                     core::formatNumber(prediction->final_state.time - time) + " s, effects " +
+                     core::formatNumber(prediction->final_state.time) + " s, effects " +
                      core::toString(predict->effects);
   if (prediction->cut_short) response.message += "; cut short: " + prediction->message;
 }

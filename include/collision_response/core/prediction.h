@@ -38,10 +38,13 @@ struct PredictionRequest {
   std::optional<Plane> crossing;
 };
 
+/// Every instant of a prediction (impacts, states, contacts) is in s after the request's state:
+/// the prediction runs on a time line of its own, from 0.
 struct Prediction {
   /// The impacts, in time order (each as the monitor reports them; `model` names their ids).
   std::vector<ImpactRecord> impacts;
-  /// The state at the end: at the horizon, or at the instant of the last impact asked for.
+  /// The state at the end: at the horizon, or at the instant of the last impact asked for (4 ulps
+  /// after it).
   BodyStateSample final_state;
   /// The lasting contacts at the end (resting, sliding, rolling).
   std::vector<ContactRecord> contacts;

@@ -115,13 +115,16 @@ Status placeObstacles(ImpactMonitor& model, const ImpactMonitor* live,
     if (!obstacle.frame.empty()) {
       const auto found = live_index.find(obstacle.id);
       if (found == live_index.end()) continue;
-      if (const auto placed = live->obstaclePose(found->second)) model.placeObstacle(i, *placed);
+      if (auto placed = live->obstaclePose(found->second)) {
+        placed->pose.time -= request.state.time;  // onto the prediction's line, from 0
+        model.placeObstacle(i, *placed);
+      }
     }
     const auto placed = model.obstaclePose(i);
     if (!placed) continue;  // on a frame tf has not given yet
-    const ContactGeometry g = contactGeometry(
-        request.state.position, request.body.radius, shapeAt(*placed, request.state.time),
-        contact_tolerance, [] { return Eigen::Vector3d(Eigen::Vector3d::Zero()); });
+    const ContactGeometry g =
+        contactGeometry(request.state.position, request.body.radius, shapeAt(*placed, 0.0),
+                        contact_tolerance, [] { return Eigen::Vector3d(Eigen::Vector3d::Zero()); });
     if (g.gap < -g.tolerance) {
       return Error{"body.position", "is " + formatNumber(-g.gap) + " m inside obstacle '" +
                                         obstacle.id + "' (a prediction starts in free space)"};
@@ -178,9 +181,11 @@ Expected<Prediction> predictImpacts(const Scene& scene, const ImpactMonitor* liv
   if (auto status = placeObstacles(*model, live, request, settings.contact_tolerance); !status) {
     return status.error();
   }
-  const double start = request.state.time;
+  // The prediction's own time line starts at the state (0), where its instants hold every digit.
+  const double start = 0.0;
   BodyStateSample state = request.state;
   state.body = 0;
+  state.time = start;
   model->step(start, {state});
 
   Prediction prediction;
@@ -218,8 +223,11 @@ Expected<Prediction> predictImpacts(const Scene& scene, const ImpactMonitor* liv
     truncated = truncated || report.truncated;
     const std::size_t room = max_impacts - prediction.impacts.size();
     if (report.impacts.size() >= room) {
-      // The last impact asked for: the prediction ends at its instant, with every impact there.
-      const double last = report.impacts[room - 1].time;
+      // The last impact asked for: the prediction ends at its instant, with every impact there
+      // (advanced 4 ulps past it, so that the root found again from the same start is inside).
+      const double impact_time = report.impacts[room - 1].time;
+      const double last = impact_time + 4 * std::numeric_limits<double>::epsilon() *
+                                            std::max(std::abs(impact_time), 1e-300);
       *model = before;
       report = model->advance(last, {});
       prediction.impacts.insert(prediction.impacts.end(), report.impacts.begin(),

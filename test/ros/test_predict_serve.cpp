@@ -1,0 +1,247 @@
+// ~predict_impacts over the real master (test/ros/predict_serve.test): the node runs the serve
+// of config/scenes/serve.yaml, played by the scene player.
+//  - the served ball (the scene's body, mass 0 in the request) from its scene state: its two
+//    bounces on the table and its crossing of the robot's plane x = 1.6 against an independent
+//    40-digit solution of the same equations (bench/accuracy/reference/serve_reference.py), within
+//    1e-7 (s, m, m/s): the integrator's error at the scene's tolerance 1e-9 (doc/prediction.md);
+//  - gravity only, a ball of its own given in the frame `court` (0.25 m above the world's): it
+//    falls from z = 1.0 at vz = -2.25 m/s onto the table top (centre at 0.78), so it meets it
+//    when 4.905 t^2 + 2.25 t - 0.22 = 0, t = 2 (0.22) / (2.25 + sqrt(2.25^2 + 2 (9.81) 0.22))
+//    (the cancellation-free root), to a few ulps;
+//  - every bad request answered success = false, naming its field, and the node still serving;
+//  - the impacts the node publishes as the serve is played come where the prediction said.
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "collision_response/BodyStateArray.h"
+#include "collision_response/ImpactArray.h"
+#include "collision_response/PredictImpacts.h"
+
+namespace {
+
+using collision_response::PredictImpacts;
+
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+
+std::map<std::string, std::vector<double>> reference() {
+  std::map<std::string, std::vector<double>> values;
+  std::ifstream file(ros::NodeHandle("~").param<std::string>("reference", ""));
+  std::string line;
+  while (std::getline(file, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    std::string name;
+    fields >> name;
+    for (double x; fields >> x;) values[name].push_back(x);
+  }
+  return values;
+}
+
+geometry_msgs::Vector3 vector(const std::vector<double>& x) {
+  geometry_msgs::Vector3 v;
+  v.x = x.at(0);
+  v.y = x.at(1);
+  v.z = x.at(2);
+  return v;
+}
+
+geometry_msgs::Point point(const std::vector<double>& x) {
+  geometry_msgs::Point p;
+  p.x = x.at(0);
+  p.y = x.at(1);
+  p.z = x.at(2);
+  return p;
+}
+
+double distance(const geometry_msgs::Point& p, const std::vector<double>& x) {
+  return std::hypot(p.x - x.at(0), p.y - x.at(1), p.z - x.at(2));
+}
+
+double distance(const geometry_msgs::Vector3& v, const std::vector<double>& x) {
+  return std::hypot(v.x - x.at(0), v.y - x.at(1), v.z - x.at(2));
+}
+
+PredictImpacts servedBall(const std::map<std::string, std::vector<double>>& ref) {
+  PredictImpacts call;
+  call.request.header.frame_id = "world";
+  call.request.body.id = "ball";  // mass 0: the scene's ball
+  call.request.body.position = point(ref.at("initial_position"));
+  call.request.body.velocity = vector(ref.at("initial_velocity"));
+  call.request.body.angular_velocity = vector(ref.at("angular_velocity"));
+  call.request.horizon = 1.2;
+  call.request.max_impacts = 2;
+  call.request.crossing_normal.x = 1.0;
+  call.request.crossing_point.x = 1.6;
+  return call;
+}
+
+bool callService(PredictImpacts& call) {
+  return ros::service::call("/collision_response/predict_impacts", call);
+}
+
+TEST(PredictServe, TheServesBouncesAndCrossingMatchTheReference) {
+  ASSERT_TRUE(ros::service::waitForService("/collision_response/predict_impacts", 30000));
+  const auto ref = reference();
+  ASSERT_EQ(ref.count("crossing_position"), 1u) << "no reference file";
+  PredictImpacts call = servedBall(ref);
+  call.request.header.stamp = ros::Time(100.0);
+  ASSERT_TRUE(callService(call));
+  ASSERT_TRUE(call.response.success) << call.response.message;
+  ASSERT_EQ(call.response.impacts.size(), 2u);
+  for (int bounce = 1; bounce <= 2; ++bounce) {
+    const std::string name = "bounce" + std::to_string(bounce);
+    const auto& impact = call.response.impacts[static_cast<std::size_t>(bounce - 1)];
+    EXPECT_EQ(impact.body_b, "table");
+    EXPECT_NEAR((impact.header.stamp - ros::Time(100.0)).toSec(), ref.at(name + "_time").at(0),
+                1e-7);
+    EXPECT_LT(distance(impact.velocity_a_before.linear, ref.at(name + "_velocity_before")), 1e-7);
+    EXPECT_LT(distance(impact.velocity_a_after.linear, ref.at(name + "_velocity_after")), 1e-7);
+    geometry_msgs::Point centre = impact.contact_point;
+    centre.z += 0.02;  // the ball's centre, r above the top it touches
+    EXPECT_LT(distance(centre, ref.at(name + "_position")), 1e-7);
+  }
+  // The second impact was the last asked for: it ends there, not at the plane.
+  EXPECT_FALSE(call.response.crossed);
+  call.request.max_impacts = 10;
+  ASSERT_TRUE(callService(call));
+  ASSERT_TRUE(call.response.success) << call.response.message;
+  ASSERT_TRUE(call.response.crossed);
+  const auto& crossing = call.response.crossing;
+  EXPECT_NEAR((crossing.header.stamp - ros::Time(100.0)).toSec(), ref.at("crossing_time").at(0),
+              1e-7);
+  EXPECT_LT(distance(crossing.pose.position, ref.at("crossing_position")), 1e-7);
+  EXPECT_LT(distance(crossing.twist.linear, ref.at("crossing_velocity")), 1e-7);
+  EXPECT_EQ(crossing.header.frame_id, "world");
+}
+
+TEST(PredictServe, GravityOnlyInAFrameOfItsOwnIsTheBallisticRoot) {
+  ASSERT_TRUE(ros::service::waitForService("/collision_response/predict_impacts", 30000));
+  PredictImpacts call;
+  call.request.header.frame_id = "court";
+  call.request.header.stamp = ros::Time(200.0);
+  call.request.body.id = "probe";
+  call.request.body.mass = 0.0027;
+  call.request.body.radius = 0.02;
+  call.request.body.material = "celluloid";
+  call.request.body.position.x = -1.2;
+  call.request.body.position.z = 0.75;  // 1.0 in the world
+  call.request.body.velocity.x = 3.75;
+  call.request.body.velocity.z = -2.25;
+  call.request.effects = {"gravity"};
+  call.request.horizon = 0.5;
+  call.request.max_impacts = 1;
+  // tf may need a moment for the static frame.
+  for (int i = 0; i < 50 && (!callService(call) || !call.response.success); ++i) {
+    ros::WallDuration(0.1).sleep();
+  }
+  ASSERT_TRUE(call.response.success) << call.response.message;
+  ASSERT_EQ(call.response.impacts.size(), 1u);
+  const double t = 2 * 0.22 / (2.25 + std::sqrt(2.25 * 2.25 + 2 * 9.81 * 0.22));
+  const auto& impact = call.response.impacts[0];
+  EXPECT_EQ(impact.body_b, "table");
+  // A ros::Time holds whole nanoseconds: the stamp is the instant to the nanosecond.
+  EXPECT_NEAR((impact.header.stamp - ros::Time(200.0)).toSec(), t, 1e-9);
+  EXPECT_NEAR(impact.contact_point.x, -1.2 + 3.75 * t, 16 * kEps);
+  EXPECT_NEAR(impact.velocity_a_before.linear.z, -2.25 - 9.81 * t, 16 * kEps);
+  EXPECT_NEAR(impact.velocity_a_after.linear.z, 0.9 * (2.25 + 9.81 * t), 16 * kEps);
+  EXPECT_EQ(impact.velocity_a_after.linear.x, 3.75);
+}
+
+TEST(PredictServe, EveryBadRequestIsNamedAndTheNodeKeepsServing) {
+  ASSERT_TRUE(ros::service::waitForService("/collision_response/predict_impacts", 30000));
+  const auto ref = reference();
+  const auto refusal = [&](PredictImpacts call) {
+    if (!callService(call)) return std::string("no answer");
+    if (call.response.success) return std::string("accepted");
+    EXPECT_TRUE(call.response.impacts.empty());
+    return call.response.message.substr(0, call.response.message.find(':'));
+  };
+  PredictImpacts call = servedBall(ref);
+  call.request.horizon = 0.0;
+  EXPECT_EQ(refusal(call), "horizon");
+  call = servedBall(ref);
+  call.request.body.position.x = std::nan("");
+  EXPECT_EQ(refusal(call), "body.position.x");
+  call = servedBall(ref);
+  call.request.header.frame_id = "no_such_frame";
+  EXPECT_EQ(refusal(call), "header.frame_id");
+  call = servedBall(ref);
+  call.request.effects = {"gravity", "wind"};
+  EXPECT_EQ(refusal(call), "effects[1]");
+  call = servedBall(ref);
+  call.request.body.position.z = 0.75;  // inside the table
+  EXPECT_EQ(refusal(call), "body.position");
+  call = servedBall(ref);
+  call.request.body.id = "stranger";
+  EXPECT_EQ(refusal(call), "body.mass");
+  call = servedBall(ref);
+  call.request.effects = {"gravity", "magnus"};
+  call.request.body.angular_velocity = geometry_msgs::Vector3();
+  EXPECT_EQ(refusal(call), "effects");
+  call = servedBall(ref);
+  call.request.max_impacts = 0;
+  EXPECT_EQ(refusal(call), "max_impacts");
+  EXPECT_EQ(refusal(servedBall(ref)), "accepted");
+}
+
+/// What the played serve brought on the topics, heard from the test's start (main): the ball's
+/// first state's stamp (the serve's instant 0) and the impacts.
+/// Guarded by played_mutex: written by the spinner's thread.
+std::mutex played_mutex;
+ros::Time played_start;
+std::vector<collision_response::Impact> played;
+
+void hearImpacts(const collision_response::ImpactArray::ConstPtr& array) {
+  std::lock_guard<std::mutex> lock(played_mutex);
+  played.insert(played.end(), array->impacts.begin(), array->impacts.end());
+}
+
+void hearStates(const collision_response::BodyStateArray::ConstPtr& array) {
+  std::lock_guard<std::mutex> lock(played_mutex);
+  if (played_start.isZero() && !array->states.empty()) played_start = array->states[0].header.stamp;
+}
+
+TEST(PredictServe, ThePlayedServesImpactsComeWhereThePredictionSaid) {
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(60.0);
+  const auto heard = [] {
+    std::lock_guard<std::mutex> lock(played_mutex);
+    return std::make_pair(played_start, played);
+  };
+  while (ros::ok() && ros::WallTime::now() < end && heard().second.size() < 2) {
+    ros::WallDuration(0.01).sleep();
+  }
+  const auto [start, impacts] = heard();
+  ASSERT_GE(impacts.size(), 2u) << "the played serve's bounces were not heard";
+  ASSERT_FALSE(start.isZero());
+  const auto ref = reference();
+  for (int bounce = 1; bounce <= 2; ++bounce) {
+    const std::string name = "bounce" + std::to_string(bounce);
+    const auto& impact = impacts[static_cast<std::size_t>(bounce - 1)];
+    EXPECT_EQ(impact.body_b, "table");
+    EXPECT_NEAR((impact.header.stamp - start).toSec(), ref.at(name + "_time").at(0), 1e-7);
+    EXPECT_LT(distance(impact.velocity_a_after.linear, ref.at(name + "_velocity_after")), 1e-7);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "predict_serve_test");
+  ros::NodeHandle node;
+  ros::Subscriber impacts = node.subscribe("impacts", 100, &hearImpacts);
+  ros::Subscriber states = node.subscribe("body_states", 100, &hearStates);
+  ros::AsyncSpinner spinner(1);  // heard while the other tests call the service
+  spinner.start();
+  return RUN_ALL_TESTS();
+}
