@@ -1,8 +1,8 @@
 // libFuzzer target: the monitor's update cycle (MonitorCycle: intake, time line, the monitor's
 // step, the finiteness check of every impact) on a scene and a stream of messages made from the
-// fuzzer's bytes: masses, radii, effects, detection, obstacles, stepped clusters; ids (the
-// scene's, unknown, empty, repeated), stamps (any seconds and nanoseconds, the clock's zero),
-// frames, and every number of every state. Invariants:
+// fuzzer's bytes: masses, radii, effects (drag and Magnus too), detection, obstacles, stepped
+// clusters; ids (the scene's, unknown, empty, repeated), stamps (any seconds and nanoseconds, the
+// clock's zero), frames, and every number of every state. Invariants:
 //  - every impact in an update has only finite numbers; every report (a named drop or notice)
 //    has a text, and a refused impact names its field;
 //  - the work of one message is bounded: at most kAllocationCap bytes are allocated while it
@@ -84,7 +84,15 @@ core::Scene makeScene(fuzz::FuzzInput& in) {
     body.mass = in.byte() % 8 == 0 ? core::kImmovableMass : std::abs(in.number());
     body.radius = std::abs(in.number());
     body.material = core::seedTable()[in.byte() % core::seedTable().size()].material;
-    body.inertia = in.byte() % 2 ? core::Inertia::kSolid : core::Inertia::kHollow;
+    const std::uint8_t shape = in.byte();
+    body.inertia = shape % 2 ? core::Inertia::kSolid : core::Inertia::kHollow;
+    if (i == 0) {
+      // The first body's byte carries the air's effects in its upper bits (older inputs, whose
+      // bits there were unused, decode as before).
+      scene.effects.drag = (shape & 2) != 0;
+      scene.effects.magnus = (shape & 4) != 0 && scene.effects.spin;
+      scene.air_density = (shape & 8) != 0 ? 1e3 : core::kDefaultAirDensity;  // a liquid too
+    }
     scene.bodies.push_back(body);
   }
   if (flags & 32) {

@@ -151,5 +151,26 @@ TEST(Air, WithTheEffectsOffTheFlightIsTheParabola) {
   EXPECT_NEAR(integrated[0].time, exact, 1e-10);
 }
 
+// Hostile speeds: at 1e200 m/s drag's acceleration overflows the doubles. The flight stalls (it
+// holds its last finite state: doc/model.md, "Effects in detail") rather than integrating
+// without end or giving NaN; at 1e-300 m/s the air does nothing measurable. Either way every
+// number out is finite and the ball is never below the floor.
+TEST(Air, HugeAndTinySpeedsStayFinite) {
+  Scene scene = airScene(true, true, true);
+  scene.obstacles = {plane("floor", V::UnitZ(), 0.0, "concrete")};
+  for (const double speed : {1e200, 1e150, 1e-300}) {
+    std::vector<ImpactRecord> impacts;
+    const auto [position, velocity] =
+        flown(scene, V(0, 0, 1), V(speed, 0, -speed), V(0, 300, 0), 0.5, &impacts);
+    EXPECT_TRUE(position.allFinite()) << speed;
+    EXPECT_TRUE(velocity.allFinite()) << speed;
+    EXPECT_GE(position.z(), 0.02 * (1 - 1e-9)) << speed;
+    for (const ImpactRecord& impact : impacts) {
+      EXPECT_TRUE(impact.velocity_a_after.allFinite()) << speed;
+      EXPECT_TRUE(std::isfinite(impact.time)) << speed;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace collision_response::core

@@ -67,7 +67,8 @@ class Playback {
                                         const std::vector<ImpactRecord>& impacts,
                                         bool exact_contact);
 
-  /// The flights whose highest point is at or before `time` and not yet reported.
+  /// The flights whose highest point is at or before `time` and not yet reported (under gravity
+  /// without drag or Magnus: a parabola's apex).
   std::vector<Apex> apexesUntil(double time);
 
   std::optional<std::size_t> bodyIndex(const std::string& id) const;

@@ -5,6 +5,7 @@
 #include <array>
 #include <boost/numeric/odeint.hpp>
 #include <cmath>
+#include <exception>
 #include <limits>
 
 namespace collision_response::core {
@@ -16,10 +17,10 @@ using Dense = boost::numeric::odeint::result_of::make_dense_output<Stepper>::typ
 using Vector6 = Eigen::Matrix<double, 6, 1>;
 
 constexpr double kPi = 3.14159265358979323846;
-/// The steps one flight may take: far more than any flight between two updates or within a
-/// prediction's horizon needs (a 1 s serve at tolerance 1e-12 takes about 300); past it the
-/// flight holds its last state rather than integrating without end.
-constexpr std::size_t kMaxSteps = 1u << 20;
+/// The steps one flight may take (each kept, about 1 kB): far more than a flight between two
+/// updates or within a prediction's 60 s horizon takes (a 1 s serve at tolerance 1e-9 takes
+/// about 60); past it the flight holds its last state rather than integrating without end.
+constexpr std::size_t kMaxSteps = 1u << 14;
 
 }  // namespace
 
@@ -50,6 +51,7 @@ struct AirFlight::Integration {
   std::vector<Dense> steps;
   Vector6 initial;
   double queried_time = std::numeric_limits<double>::quiet_NaN();
+  bool stalled = false;  ///< no further step: the last one reached is held
   Vector6 queried = Vector6::Zero();
 
   Integration(double tolerance)
@@ -93,11 +95,29 @@ const Vector6& AirFlight::stateAt(double time) const {
   const auto system = [&integration](const State& x, State& rate, double) {
     integration.derivative(x, rate);
   };
-  while ((integration.steps.empty() || integration.steps.back().current_time() < time) &&
-         integration.steps.size() < kMaxSteps) {
-    integration.dense.do_step(system);
+  while (!integration.stalled &&
+         (integration.steps.empty() || integration.steps.back().current_time() < time)) {
+    // Past the steps a flight may take, or where the integrator fails (a speed so large that
+    // drag's acceleration overflows, the error control shrinking the step for ever), the flight
+    // stalls: it holds its last finite state (doc/model.md, "Effects in detail").
+    if (integration.steps.size() >= kMaxSteps) {
+      integration.stalled = true;
+      break;
+    }
+    try {
+      integration.dense.do_step(system);
+    } catch (const std::exception&) {
+      integration.stalled = true;
+      break;
+    }
+    const State& reached = integration.dense.current_state();
+    if (!std::all_of(reached.begin(), reached.end(), [](double x) { return std::isfinite(x); })) {
+      integration.stalled = true;
+      break;
+    }
     integration.steps.push_back(integration.dense);
   }
+  if (integration.steps.empty()) return integration.initial;
   const auto covering =
       std::lower_bound(integration.steps.begin(), integration.steps.end(), time,
                        [](const Dense& step, double t) { return step.current_time() < t; });

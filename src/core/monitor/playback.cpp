@@ -190,7 +190,9 @@ std::vector<std::size_t> Playback::applyImpacts(const ImpactMonitor& monitor,
 std::vector<Apex> Playback::apexesUntil(double time) {
   std::vector<Apex> apexes;
   const double g = gravity_.norm();
-  if (!(g > 0)) return apexes;
+  // The apex of a parabola: through air (drag, Magnus) a flight's is not (and e from its
+  // heights would not be the coefficient of restitution), so none is reported.
+  if (!(g > 0) || scene_.effects.air()) return apexes;
   const Eigen::Vector3d up = -gravity_ / g;
   for (std::size_t i = 0; i < flights_.size(); ++i) {
     Flight& flight = flights_[i];
