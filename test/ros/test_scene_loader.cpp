@@ -164,6 +164,61 @@ TEST(SceneLoader, WholeScene) {
   EXPECT_EQ(scene->obstacles[1].frame, "paddle_link");
 }
 
+// The air (drag and magnus effects): the scene's density and flight tolerance, each body's
+// coefficients, their defaults, and every bad value named.
+TEST(SceneLoader, AirKeys) {
+  auto tree = fullScene();
+  tree["effects"][0] = "drag";
+  const auto defaults = loadScene(tree, "~scene");
+  ASSERT_TRUE(defaults.ok()) << defaults.error().message();
+  EXPECT_TRUE(defaults->effects.drag);
+  EXPECT_EQ(defaults->air_density, 1.204);
+  EXPECT_EQ(defaults->flight_integration_tolerance, 1e-9);
+  EXPECT_EQ(defaults->bodies[0].drag_coefficient, 0.47);
+  EXPECT_EQ(defaults->bodies[0].lift_coefficient, 0.2);
+
+  tree["effects"][1] = "spin";
+  tree["effects"][2] = "magnus";
+  tree["air_density"] = 1.2;
+  tree["flight_integration_tolerance"] = 1e-12;
+  tree["bodies"][0]["drag_coefficient"] = 0.5;
+  tree["bodies"][0]["lift_coefficient"] = 0;
+  const auto scene = loadScene(tree, "~scene");
+  ASSERT_TRUE(scene.ok()) << scene.error().message();
+  EXPECT_TRUE(scene->effects.magnus);
+  EXPECT_EQ(scene->air_density, 1.2);
+  EXPECT_EQ(scene->flight_integration_tolerance, 1e-12);
+  EXPECT_EQ(scene->bodies[0].drag_coefficient, 0.5);
+  EXPECT_EQ(scene->bodies[0].lift_coefficient, 0.0);
+
+  auto bad = tree;
+  bad["air_density"] = -1.0;
+  EXPECT_EQ(sceneErrorField(bad), "~scene/air_density");
+  bad = tree;
+  bad["flight_integration_tolerance"] = 0.1;
+  EXPECT_EQ(sceneErrorField(bad), "~scene/flight_integration_tolerance");
+  bad = tree;
+  bad["bodies"][0]["drag_coefficient"] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(sceneErrorField(bad), "~scene/bodies[0]/drag_coefficient");
+  bad = tree;
+  bad["bodies"][1]["lift_coefficient"] = -0.2;
+  EXPECT_EQ(sceneErrorField(bad), "~scene/bodies[1]/lift_coefficient");
+  bad = tree;
+  bad["bodies"][0]["drag_coefficient"] = "smooth";
+  EXPECT_EQ(sceneErrorField(bad), "~scene/bodies[0]/drag_coefficient");
+  // Magnus needs the spin that makes it.
+  bad = tree;
+  bad["effects"][1] = "gravity";
+  EXPECT_EQ(sceneErrorField(bad), "~scene/effects");
+  // Unknown effect names list the five.
+  bad = tree;
+  bad["effects"][2] = "wind";
+  const auto unknown = loadScene(bad, "~scene");
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_EQ(unknown.error().field, "~scene/effects[2]");
+  EXPECT_NE(unknown.error().reason.find("drag, magnus"), std::string::npos);
+}
+
 // Issue 27, item 2: a body's initial spin (a draw shot, topspin) is a key of its own, in rad/s in
 // the fixed frame, finite, and only with the spin effect (without it nothing would spin).
 TEST(SceneLoader, BodyAngularVelocity) {
@@ -449,6 +504,8 @@ std::map<std::string, std::map<std::string, XmlRpc::XmlRpcValue>> examples() {
                      {"gravity", list3(0, 0, -9.8)},
                      {"restitution_threshold", 0.25},
                      {"contact_integration_tolerance", 1e-6},
+                     {"air_density", 1.1},
+                     {"flight_integration_tolerance", 1e-7},
                      {"stepped_cluster_min_bodies", 40},
                      {"stepped_cluster_time_step", 0.005},
                      {"exact_work_budget", 300},
@@ -466,7 +523,9 @@ std::map<std::string, std::map<std::string, XmlRpc::XmlRpcValue>> examples() {
                         {"position", list3(1, 2, 3)},
                         {"velocity", list3(4, 5, 6)},
                         {"angular_velocity", list3(7, 8, 9)},
-                        {"inertia", "hollow"}};
+                        {"inertia", "hollow"},
+                        {"drag_coefficient", 0.5},
+                        {"lift_coefficient", 0.25}};
   values["obstacles[] plane"] = {
       {"id", "floor"},         {"type", "plane"},          {"material", "concrete"},
       {"frame", "floor_link"}, {"normal", list3(0, 0, 2)}, {"offset", 0.5}};
@@ -606,6 +665,8 @@ TEST(SceneKeys, EveryDocumentedKeyLoadsWithItsValue) {
   EXPECT_EQ(loaded->gravity, Eigen::Vector3d(0, 0, -9.8));
   EXPECT_EQ(loaded->restitution_threshold, 0.25);
   EXPECT_EQ(loaded->contact_integration_tolerance, 1e-6);
+  EXPECT_EQ(loaded->air_density, 1.1);
+  EXPECT_EQ(loaded->flight_integration_tolerance, 1e-7);
   EXPECT_EQ(loaded->stepped_cluster_min_bodies, 40);
   EXPECT_EQ(loaded->stepped_cluster_time_step, 0.005);
   EXPECT_EQ(loaded->exact_work_budget, 300);
@@ -625,6 +686,8 @@ TEST(SceneKeys, EveryDocumentedKeyLoadsWithItsValue) {
   EXPECT_EQ(ball.velocity, Eigen::Vector3d(4, 5, 6));
   EXPECT_EQ(ball.angular_velocity, Eigen::Vector3d(7, 8, 9));
   EXPECT_EQ(ball.inertia, core::Inertia::kHollow);  // once refused as an unknown key
+  EXPECT_EQ(ball.drag_coefficient, 0.5);
+  EXPECT_EQ(ball.lift_coefficient, 0.25);
   ASSERT_EQ(loaded->obstacles.size(), 5u);
   EXPECT_EQ(loaded->obstacles[0].frame, "floor_link");
   EXPECT_EQ(loaded->obstacles[0].normal, Eigen::Vector3d(0, 0, 1));  // scaled to unit length
