@@ -16,8 +16,9 @@ void impact(benchmark::State& state, const std::vector<std::string>& effects) {
   }
 }
 
-void update(benchmark::State& state, bool gravity, bool friction, bool spin) {
-  BoxRun run(gravity, friction, spin);
+void update(benchmark::State& state, bool gravity, bool friction, bool spin, bool drag = false,
+            bool magnus = false) {
+  BoxRun run(gravity, friction, spin, drag, magnus);
   std::size_t impacts = 0;
   for (auto _ : state) impacts += run.update();
   state.counters["impacts/update"] =
@@ -38,6 +39,8 @@ void BM_UpdateGravity(benchmark::State& s) { update(s, true, false, false); }
 void BM_UpdateFriction(benchmark::State& s) { update(s, false, true, false); }
 void BM_UpdateFrictionSpin(benchmark::State& s) { update(s, false, true, true); }
 void BM_UpdateAll(benchmark::State& s) { update(s, true, true, true); }
+void BM_UpdateGravityDrag(benchmark::State& s) { update(s, true, false, false, true); }
+void BM_UpdateGravityAir(benchmark::State& s) { update(s, true, false, true, true, true); }
 
 BENCHMARK(BM_ImpactNone);
 BENCHMARK(BM_ImpactFriction);
@@ -47,6 +50,8 @@ BENCHMARK(BM_UpdateGravity)->Unit(benchmark::kMicrosecond)->Iterations(kUpdates)
 BENCHMARK(BM_UpdateFriction)->Unit(benchmark::kMicrosecond)->Iterations(kUpdates);
 BENCHMARK(BM_UpdateFrictionSpin)->Unit(benchmark::kMicrosecond)->Iterations(kUpdates);
 BENCHMARK(BM_UpdateAll)->Unit(benchmark::kMicrosecond)->Iterations(kUpdates);
+BENCHMARK(BM_UpdateGravityDrag)->Unit(benchmark::kMicrosecond)->Iterations(kUpdates);
+BENCHMARK(BM_UpdateGravityAir)->Unit(benchmark::kMicrosecond)->Iterations(kUpdates);
 
 }  // namespace
 }  // namespace collision_response::bench

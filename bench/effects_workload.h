@@ -30,11 +30,13 @@ inline core::CollisionRequest ballOnFloor(const std::vector<std::string>& effect
 }
 
 /// 100 balls in a closed 2 m box, random velocities, the given effects.
-inline core::Scene boxScene(bool gravity, bool friction, bool spin) {
+inline core::Scene boxScene(bool gravity, bool friction, bool spin, bool drag, bool magnus) {
   core::Scene scene;
   scene.effects.gravity = gravity;
   scene.effects.friction = friction;
   scene.effects.spin = spin;
+  scene.effects.drag = drag;
+  scene.effects.magnus = magnus;
   const double size = 2.0;
   addBoxWalls(scene, size, "billiard_ball");
   for (int i = 0; i < 100; ++i) {
@@ -53,8 +55,9 @@ inline core::Scene boxScene(bool gravity, bool friction, bool spin) {
 /// source that applies the responses publishes them.
 class BoxRun {
  public:
-  BoxRun(bool gravity, bool friction, bool spin)
-      : scene_(boxScene(gravity, friction, spin)), monitor_(scene_, core::MonitorSettings{}) {
+  BoxRun(bool gravity, bool friction, bool spin, bool drag = false, bool magnus = false)
+      : scene_(boxScene(gravity, friction, spin, drag, magnus)),
+        monitor_(scene_, core::MonitorSettings{}) {
     std::mt19937_64 engine(1);
     std::uniform_real_distribution<double> speed(-2.0, 2.0);
     states_.resize(scene_.bodies.size());

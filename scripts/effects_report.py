@@ -47,7 +47,9 @@ def main():
     for label, name in [("none", "BM_UpdateNone"), ("gravity", "BM_UpdateGravity"),
                         ("friction", "BM_UpdateFriction"),
                         ("friction + spin", "BM_UpdateFrictionSpin"),
-                        ("gravity + friction + spin", "BM_UpdateAll")]:
+                        ("gravity + friction + spin", "BM_UpdateAll"),
+                        ("gravity + drag", "BM_UpdateGravityDrag"),
+                        ("gravity + spin + drag + magnus", "BM_UpdateGravityAir")]:
         cpu, impacts = times[name]
         lines.append(f"| {label} | {cpu * 1e6:.0f} us | {cpu / update_none:.2f} | {impacts:.2f} |")
     lines += [
