@@ -12,7 +12,8 @@ body is drawn at its start and its end as a disc of its radius, and the fixed ob
 drawn too: a plane across the drawing plane as a line (the billiards table's cushions, the drop
 test's floor), a sphere as a circle, a box along the axes as a rectangle (obstacles on tf frames,
 a robot's links among them, are not drawn: their impacts are). Impacts are marked at their contact points, with a short
-line along the normal.
+line along the normal. A prediction recorded beside them (/predicted_path, the markers of
+examples/predict_serve.py) is drawn as a dashed orange line, its impacts as orange circles.
 """
 import argparse
 import collections
@@ -49,16 +50,27 @@ def same_speeds(speeds, drawn):
 def read_bag(bag_path):
     paths = collections.defaultdict(list)  # id -> [(t, x, y, z, speed)]
     impacts = []
+    predicted = {"path": [], "impacts": []}  # the last prediction drawn: points
     with rosbag.Bag(bag_path) as bag:
-        for topic, message, _ in bag.read_messages(topics=["/body_states", "/impacts"]):
-            if topic == "/body_states":
+        for topic, message, _ in bag.read_messages(
+                topics=["/body_states", "/impacts", "/predicted_path"]):
+            if topic == "/predicted_path":
+                for marker in message.markers:
+                    points = [(p.x, p.y, p.z) for p in marker.points]
+                    if marker.ns == "predicted":
+                        predicted["path"] = points
+                    elif marker.ns == "predicted impacts":
+                        p = marker.pose.position
+                        predicted["impacts"].append((p.x, p.y, p.z))
+                predicted["impacts"] = list(dict.fromkeys(predicted["impacts"]))
+            elif topic == "/body_states":
                 for state in message.states:
                     p, v = state.pose.position, state.twist.linear
                     speed = math.sqrt(v.x ** 2 + v.y ** 2 + v.z ** 2)
                     paths[state.id].append((state.header.stamp.to_sec(), p.x, p.y, p.z, speed))
             else:
                 impacts.extend(message.impacts)
-    return paths, impacts
+    return paths, impacts, predicted
 
 
 def read_scene(scene_path):
@@ -149,7 +161,7 @@ def main():
     parser.add_argument("title", nargs="?")
     parser.add_argument("--scene", help="the scene file: bodies' radii and fixed obstacles")
     args = parser.parse_args()
-    paths, impacts = read_bag(args.bag)
+    paths, impacts, predicted = read_bag(args.bag)
     if not paths:
         sys.exit(f"{args.bag}: no /body_states recorded")
     radii, obstacles = read_scene(args.scene)
@@ -197,6 +209,14 @@ def main():
         plane.plot([cu], [cv], "kx", ms=4, mew=0.8, zorder=5)
         plane.plot([cu, cu + tick * nu], [cv, cv + tick * nv], "k-", lw=0.8, zorder=5)
         timeline.axvline(impact.header.stamp.to_sec() - start, color="0.85", lw=0.6, zorder=0)
+    if predicted["path"]:
+        plane.plot([p[axes[0]] for p in predicted["path"]], [p[axes[1]] for p in predicted["path"]],
+                   color="darkorange", ls="--", lw=1.6, zorder=6,
+                   label="predicted (~predict_impacts, from the first state)")
+        plane.plot([p[axes[0]] for p in predicted["impacts"]],
+                   [p[axes[1]] for p in predicted["impacts"]], "o", mfc="none",
+                   mec="darkorange", ms=9, zorder=6, label="predicted impacts")
+        plane.legend(fontsize=7, loc="upper right")
     plane.set_xlim(*box[0])
     plane.set_ylim(*box[1])
     plane.set_xlabel(f"{AXES[axes[0]]} (m)")
