@@ -25,7 +25,7 @@ inline constexpr std::size_t kPredictionMaxImpacts = 1000;
 inline constexpr std::size_t kPredictionMaxSamples = 100000;
 /// Without samples, the first crossing of a plane is looked for at this period, then bisected to
 /// the last bit of its instant: a crossing and a return within one period are not seen.
-inline constexpr double kCrossingSearchPeriod = 0.005;  ///< s
+inline constexpr double kCrossingSearchPeriod = 0.02;  ///< s
 
 struct PredictionRequest {
   BodySpec body;                ///< the body predicted (id, mass, radius, material, coefficients)

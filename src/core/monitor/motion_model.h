@@ -47,9 +47,14 @@ struct UnderGravity {
   }
 };
 
-/// The participant moves along an integrated step (curved lasting contact).
+/// The participant moves along an integrated step (curved lasting contact, flight through air).
 inline bool constrained(const World& world, std::size_t participant) {
   return !world.isObstacle(participant) && world.tracks[participant].constrained != nullptr;
+}
+
+/// The participant flies through air (drag, Magnus): an AirFlight.
+inline bool freeFlight(const World& world, std::size_t participant) {
+  return constrained(world, participant) && world.tracks[participant].constrained->free();
 }
 
 /// A participant's position at `time`: a body along its track, an obstacle along its pose.
@@ -133,6 +138,13 @@ double accelerationBound(const World& world, std::size_t participant, double fro
 /// or past contact is bisected. A pair touching at `from` (just resolved) is looked at as it
 /// separates and comes back: its contact is where its gap falls half-way from its start to the
 /// touching band's edge, inside the band, so the instant's resolver sees it touch.
+///
+/// A free flight through air (AirFlight) bounces again and again off what it left: half-way to
+/// the band's edge each time would drift its contacts to that edge and, one rounding later, past
+/// it (a ball bouncing on a floor for seconds, then through it). Its contact is where its gap
+/// comes back to 0, or to its start where it started inside, never deeper; the instant returned
+/// is the last one before it, bisected until the gap there is within half the band of it, so
+/// the next bounce starts no deeper than this one.
 template <class Motion>
 std::optional<double> timeOfImpactAlongPaths(const World& world, const Pair& pair, double from,
                                              double horizon) {
@@ -143,7 +155,10 @@ std::optional<double> timeOfImpactAlongPaths(const World& world, const Pair& pai
   if (!(end > from)) return std::nullopt;
   const Geometry start = geometry<Motion>(world, pair, from);
   if (start.gap < -start.tolerance) return std::nullopt;  // overlapping already: not an impact
-  const double contact_at = start.gap > 0 ? 0.0 : 0.5 * (start.gap - start.tolerance);
+  const bool flying = freeFlight(world, pair.first) || freeFlight(world, pair.second);
+  const double contact_at = flying          ? std::min(0.0, start.gap)
+                            : start.gap > 0 ? 0.0
+                                            : 0.5 * (start.gap - start.tolerance);
   // A finite shape's next feature may curve where this one is flat.
   const bool curved = !start.flat() || start.bounded;
   const double contact_distance = world.radius[pair.first] + world.radius[pair.second];
@@ -152,7 +167,7 @@ std::optional<double> timeOfImpactAlongPaths(const World& world, const Pair& pai
   const double span = end - from;
   const double shortest = 1e-12 * span + 4 * kEps * std::abs(end);
   constexpr int kMaxSamples = 4096;
-  double previous_time = from, step = shortest;
+  double previous_time = from, step = shortest, previous_gap = start.gap;
   Geometry g = start;
   for (int samples = 0; samples < kMaxSamples && previous_time < end; ++samples) {
     const Eigen::Vector3d relative = velocityAt<Motion>(world, pair.second, previous_time) -
@@ -169,14 +184,23 @@ std::optional<double> timeOfImpactAlongPaths(const World& world, const Pair& pai
     const double t = std::min(previous_time + advance, end);
     g = geometry<Motion>(world, pair, t);
     if (g.gap <= contact_at) {
-      double open = previous_time, closed = t;
-      while (closed - open > 1e-13 * span + 4e-16 * std::abs(closed)) {
+      double open = previous_time, closed = t, open_gap = previous_gap;
+      while (closed - open > 1e-13 * span + 4e-16 * std::abs(closed) ||
+             (flying && open_gap - contact_at > 0.5 * start.tolerance)) {
         const double middle = 0.5 * (open + closed);
-        (geometry<Motion>(world, pair, middle).gap > contact_at ? open : closed) = middle;
+        if (!(middle > open && middle < closed)) break;  // no double between them
+        const double gap = geometry<Motion>(world, pair, middle).gap;
+        if (gap > contact_at) {
+          open = middle;
+          open_gap = gap;
+        } else {
+          closed = middle;
+        }
       }
-      return closed - from;
+      return (flying ? open : closed) - from;
     }
     previous_time = t;
+    previous_gap = g.gap;
   }
   return std::nullopt;
 }
