@@ -186,6 +186,9 @@ class ImpactMonitor {
   /// A body's predicted position and velocity at `time`; empty when it is not tracked.
   std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> predictedState(std::size_t body,
                                                                             double time) const;
+  /// The instant a body's predicted motion holds from (its last state, impact, or change of
+  /// lasting contact): predictedState is that one motion from there on.
+  double motionSince(std::size_t body) const;
   /// A body's predicted angular velocity at `time` (zero when it is not tracked).
   Eigen::Vector3d predictedAngularVelocity(std::size_t body, double time) const;
 

@@ -22,7 +22,7 @@ namespace collision_response::core {
 /// was found within them, and says so.
 inline constexpr double kPredictionMaxHorizon = 60.0;  ///< s
 inline constexpr std::size_t kPredictionMaxImpacts = 1000;
-inline constexpr std::size_t kPredictionMaxSamples = 100000;
+inline constexpr std::size_t kPredictionMaxSamples = 10000;
 /// Without samples, the first crossing of a plane is looked for at this period, then bisected to
 /// the last bit of its instant: a crossing and a return within one period are not seen.
 inline constexpr double kCrossingSearchPeriod = 0.02;  ///< s

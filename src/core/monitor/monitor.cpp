@@ -834,6 +834,8 @@ std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> ImpactMonitor::predic
   });
 }
 
+double ImpactMonitor::motionSince(std::size_t body) const { return world_->tracks[body].time; }
+
 Eigen::Vector3d ImpactMonitor::predictedAngularVelocity(std::size_t body, double time) const {
   const World& world = *world_;
   if (!world.tracks[body].known) return Eigen::Vector3d::Zero();

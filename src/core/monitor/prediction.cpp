@@ -166,99 +166,171 @@ BodyStateSample bisectCrossing(const ImpactMonitor& before, const Plane& plane, 
   return stateOf(probe, closed);
 }
 
+/// The first crossing of `plane` within (from, to] where `model` (at `to`) has moved the body
+/// by one motion all along (its track starts at or before `from`): bisected on that motion.
+BodyStateSample bisectCrossingAlong(const ImpactMonitor& model, const Plane& plane, double from,
+                                    double to) {
+  const double side = across(plane, stateOf(model, from).position);
+  double open = from, closed = to;
+  for (int i = 0; i < 200; ++i) {
+    const double middle = open + 0.5 * (closed - open);
+    if (!(middle > open && middle < closed)) break;
+    const double now = across(plane, stateOf(model, middle).position);
+    ((now > 0) == (side > 0) && now != 0 ? open : closed) = middle;
+  }
+  return stateOf(model, closed);
+}
+
+/// One prediction run: the model advanced piece by piece (at the sample period, the crossing's
+/// search period, or the whole horizon at once), each piece's impacts, samples and crossing
+/// gathered. A piece is never advanced twice on the same model: where its work must be looked at
+/// again (the last impact asked for falls in it, or the crossing does after the body's motion
+/// changed in it), a fresh model is advanced through the same pieces to its start, which gives
+/// the same motion to the bit.
+class PredictionRun {
+ public:
+  PredictionRun(const Scene& ahead, const MonitorSettings& settings, const ImpactMonitor* live,
+                const PredictionRequest& request)
+      : ahead_(ahead), settings_(settings), live_(live), request_(request) {}
+
+  /// A model at the state's instant, 0.
+  std::shared_ptr<ImpactMonitor> fresh() const {
+    auto model = std::make_shared<ImpactMonitor>(ahead_, settings_);
+    placeObstacles(*model, live_, request_, settings_.contact_tolerance);  // checked before
+    BodyStateSample state = request_.state;
+    state.body = 0;
+    state.time = 0.0;
+    model->step(0.0, {state});
+    return model;
+  }
+
+  Prediction run(std::vector<std::string>& cut) {
+    budget(cut);
+    Prediction prediction;
+    auto model = fresh();
+    if (request_.sample_period > 0) prediction.samples.push_back(stateOf(*model, 0.0));
+    double now = 0.0;
+    bool truncated = false;
+    for (std::size_t piece = 1; piece <= pieces_ && now < horizon_; ++piece) {
+      const double next = pieceEnd(piece);
+      const Eigen::Vector3d from = stateOf(*model, now).position;
+      StepReport report = model->advance(next, {});
+      truncated = truncated || report.truncated;
+      const std::size_t room = max_impacts_ - prediction.impacts.size();
+      std::shared_ptr<const ImpactMonitor> before;
+      if (report.impacts.size() >= room) {
+        // The last impact asked for: the prediction ends at its instant, with every impact there
+        // (advanced 4 ulps past it, so that the root found again from the same start is inside).
+        const double impact_time = report.impacts[room - 1].time;
+        const double last = impact_time + 4 * std::numeric_limits<double>::epsilon() *
+                                              std::max(std::abs(impact_time), 1e-300);
+        before = replayTo(piece);
+        model = std::make_shared<ImpactMonitor>(*before);
+        report = model->advance(last, {});
+        truncated = truncated || report.truncated;
+        next_ = last;
+      } else {
+        next_ = next;
+      }
+      prediction.impacts.insert(prediction.impacts.end(), report.impacts.begin(),
+                                report.impacts.end());
+      prediction.contacts = report.contacts;
+      findCrossing(*model, before, piece, now, from, prediction);
+      now = next_;
+      if (before) break;
+      if (request_.sample_period > 0) prediction.samples.push_back(stateOf(*model, now));
+    }
+    if (truncated) cut.push_back("the monitor's guard on impacts at one instant ran out");
+    prediction.final_state = stateOf(*model, now);
+    prediction.model = std::move(model);
+    return prediction;
+  }
+
+ private:
+  /// The horizon, impacts and pieces within the budgets (kPredictionMax*); what was cut is said.
+  void budget(std::vector<std::string>& cut) {
+    horizon_ = request_.horizon;
+    if (horizon_ > kPredictionMaxHorizon) {
+      horizon_ = kPredictionMaxHorizon;
+      cut.push_back("the horizon is cut to " + formatNumber(kPredictionMaxHorizon) + " s");
+    }
+    max_impacts_ = request_.max_impacts;
+    if (max_impacts_ > kPredictionMaxImpacts) {
+      max_impacts_ = kPredictionMaxImpacts;
+      cut.push_back("impacts are cut to " + std::to_string(kPredictionMaxImpacts));
+    }
+    period_ = request_.sample_period > 0 ? request_.sample_period
+              : request_.crossing        ? kCrossingSearchPeriod
+                                         : horizon_;
+    pieces_ = static_cast<std::size_t>(std::ceil(horizon_ / period_));
+    if (request_.sample_period > 0 && pieces_ > kPredictionMaxSamples) {
+      period_ = horizon_ / static_cast<double>(kPredictionMaxSamples);
+      pieces_ = kPredictionMaxSamples;
+      cut.push_back("samples are cut to " + std::to_string(kPredictionMaxSamples) + ", every " +
+                    formatNumber(period_) + " s");
+    }
+  }
+
+  double pieceEnd(std::size_t piece) const {
+    return piece == pieces_ ? horizon_ : std::min(horizon_, period_ * static_cast<double>(piece));
+  }
+
+  /// A fresh model advanced through the pieces before `piece`: where the run's model was then.
+  std::shared_ptr<ImpactMonitor> replayTo(std::size_t piece) const {
+    auto model = fresh();
+    for (std::size_t k = 1; k < piece; ++k) model->advance(pieceEnd(k), {});
+    return model;
+  }
+
+  /// The plane's first crossing within the piece just advanced (from `now` to next_), if its
+  /// centre changed sides: on the body's one motion where it had one all along the piece, else
+  /// by models advanced afresh from the piece's start (`before`, or replayed).
+  void findCrossing(const ImpactMonitor& model, std::shared_ptr<const ImpactMonitor> before,
+                    std::size_t piece, double now, const Eigen::Vector3d& from,
+                    Prediction& prediction) const {
+    if (!request_.crossing || prediction.crossing) return;
+    const Plane& plane = *request_.crossing;
+    if ((across(plane, from) > 0) == (across(plane, stateOf(model, next_).position) > 0)) return;
+    if (!before && model.motionSince(0) <= now) {
+      prediction.crossing = bisectCrossingAlong(model, plane, now, next_);
+      return;
+    }
+    if (!before) before = replayTo(piece);
+    prediction.crossing = bisectCrossing(*before, plane, now, next_);
+  }
+
+  const Scene& ahead_;
+  MonitorSettings settings_;
+  const ImpactMonitor* live_;
+  const PredictionRequest& request_;
+  double horizon_ = 0.0, period_ = 0.0, next_ = 0.0;
+  std::size_t max_impacts_ = 0, pieces_ = 0;
+};
+
 }  // namespace
 
 Expected<Prediction> predictImpacts(const Scene& scene, const ImpactMonitor* live,
                                     const MonitorSettings& settings,
                                     const PredictionRequest& request) {
   if (auto status = checkRequest(scene, request); !status) return status.error();
-  Scene ahead = sceneAhead(scene, live, request);
+  const Scene ahead = sceneAhead(scene, live, request);
   if (auto status = validateScene(ahead, "request"); !status) return status.error();
   MonitorSettings model_settings = settings;
   model_settings.body_timeout = std::numeric_limits<double>::infinity();
   model_settings.detect_impacts = true;
-  auto model = std::make_shared<ImpactMonitor>(ahead, model_settings);
-  if (auto status = placeObstacles(*model, live, request, settings.contact_tolerance); !status) {
-    return status.error();
+  {
+    ImpactMonitor check(ahead, model_settings);
+    if (auto status = placeObstacles(check, live, request, settings.contact_tolerance); !status) {
+      return status.error();
+    }
   }
   // The prediction's own time line starts at the state (0), where its instants hold every digit.
-  const double start = 0.0;
-  BodyStateSample state = request.state;
-  state.body = 0;
-  state.time = start;
-  model->step(start, {state});
-
-  Prediction prediction;
   std::vector<std::string> cut;
-  double horizon = request.horizon;
-  if (horizon > kPredictionMaxHorizon) {
-    horizon = kPredictionMaxHorizon;
-    cut.push_back("the horizon is cut to " + formatNumber(kPredictionMaxHorizon) + " s");
-  }
-  std::size_t max_impacts = request.max_impacts;
-  if (max_impacts > kPredictionMaxImpacts) {
-    max_impacts = kPredictionMaxImpacts;
-    cut.push_back("impacts are cut to " + std::to_string(kPredictionMaxImpacts));
-  }
-  const double end = start + horizon;
-  // Advanced piece by piece where samples or a crossing are asked for, else at once.
-  double period = request.sample_period > 0 ? request.sample_period
-                  : request.crossing        ? kCrossingSearchPeriod
-                                            : horizon;
-  std::size_t pieces = static_cast<std::size_t>(std::ceil(horizon / period));
-  if (request.sample_period > 0 && pieces > kPredictionMaxSamples) {
-    period = horizon / static_cast<double>(kPredictionMaxSamples);
-    pieces = kPredictionMaxSamples;
-    cut.push_back("samples are cut to " + std::to_string(kPredictionMaxSamples) + ", every " +
-                  formatNumber(period) + " s");
-  }
-  if (request.sample_period > 0) prediction.samples.push_back(stateOf(*model, start));
-  double now = start;
-  bool truncated = false;
-  for (std::size_t piece = 1; piece <= pieces && now < end; ++piece) {
-    const double next =
-        piece == pieces ? end : std::min(end, start + period * static_cast<double>(piece));
-    const ImpactMonitor before = *model;
-    StepReport report = model->advance(next, {});
-    truncated = truncated || report.truncated;
-    const std::size_t room = max_impacts - prediction.impacts.size();
-    if (report.impacts.size() >= room) {
-      // The last impact asked for: the prediction ends at its instant, with every impact there
-      // (advanced 4 ulps past it, so that the root found again from the same start is inside).
-      const double impact_time = report.impacts[room - 1].time;
-      const double last = impact_time + 4 * std::numeric_limits<double>::epsilon() *
-                                            std::max(std::abs(impact_time), 1e-300);
-      *model = before;
-      report = model->advance(last, {});
-      prediction.impacts.insert(prediction.impacts.end(), report.impacts.begin(),
-                                report.impacts.end());
-      prediction.contacts = report.contacts;
-      now = last;
-      if (request.crossing && !prediction.crossing &&
-          (across(*request.crossing, stateOf(before, before.now()).position) > 0) !=
-              (across(*request.crossing, stateOf(*model, now).position) > 0)) {
-        prediction.crossing = bisectCrossing(before, *request.crossing, before.now(), now);
-      }
-      break;
-    }
-    prediction.impacts.insert(prediction.impacts.end(), report.impacts.begin(),
-                              report.impacts.end());
-    prediction.contacts = report.contacts;
-    if (request.crossing && !prediction.crossing &&
-        (across(*request.crossing, stateOf(before, before.now()).position) > 0) !=
-            (across(*request.crossing, stateOf(*model, next).position) > 0)) {
-      prediction.crossing = bisectCrossing(before, *request.crossing, before.now(), next);
-    }
-    now = next;
-    if (request.sample_period > 0) prediction.samples.push_back(stateOf(*model, now));
-  }
-  if (truncated) cut.push_back("the monitor's guard on impacts at one instant ran out");
-  prediction.final_state = stateOf(*model, now);
+  Prediction prediction = PredictionRun(ahead, model_settings, live, request).run(cut);
   prediction.cut_short = !cut.empty();
   for (const std::string& reason : cut) {
     prediction.message += (prediction.message.empty() ? "" : "; ") + reason;
   }
-  prediction.model = std::move(model);
   return prediction;
 }
 
