@@ -43,8 +43,8 @@ struct PredictionRequest {
 struct Prediction {
   /// The impacts, in time order (each as the monitor reports them; `model` names their ids).
   std::vector<ImpactRecord> impacts;
-  /// The state at the end: at the horizon, or at the instant of the last impact asked for (4 ulps
-  /// after it).
+  /// The state at the end: at the horizon, or at the instant of the last impact asked for (a hair
+  /// after it: 1e-12 of the piece it fell in, 16 ulps).
   BodyStateSample final_state;
   /// The lasting contacts at the end (resting, sliding, rolling).
   std::vector<ContactRecord> contacts;

@@ -219,11 +219,14 @@ class PredictionRun {
       const std::size_t room = max_impacts_ - prediction.impacts.size();
       std::shared_ptr<const ImpactMonitor> before;
       if (report.impacts.size() >= room) {
-        // The last impact asked for: the prediction ends at its instant, with every impact there
-        // (advanced 4 ulps past it, so that the root found again from the same start is inside).
+        // The last impact asked for: the prediction ends at its instant, with every impact
+        // there. Advanced afresh from the piece's start to a hair past it (1e-12 of the piece, 16
+        // ulps): found again over a shorter span, an instant on an integrated path (a flight
+        // through air) moves by its bisection's resolution, 1e-13 of the span.
         const double impact_time = report.impacts[room - 1].time;
-        const double last = impact_time + 4 * std::numeric_limits<double>::epsilon() *
-                                              std::max(std::abs(impact_time), 1e-300);
+        const double last =
+            std::min(next, impact_time + 1e-12 * (next - now) +
+                               16 * std::numeric_limits<double>::epsilon() * std::abs(impact_time));
         before = replayTo(piece);
         model = std::make_shared<ImpactMonitor>(*before);
         report = model->advance(last, {});
