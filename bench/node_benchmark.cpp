@@ -7,6 +7,14 @@
 //          "service" calls ~service (a compute_collision service) and the empty service alternately
 //          ~calls times
 //                    each over persistent connections and reports both round trips.
+//          "predict" calls ~service (a predict_impacts service, default
+//                    /collision_response/predict_impacts, its node on config/scenes/serve.yaml)
+//                    and empty_service's ~echo_prediction (the same bytes, no physics)
+//                    alternately ~calls times each with the serve's request, over persistent
+//                    connections; reports both round trips, both messages' sizes, the CPU per
+//                    call of the node's main thread (which answers; ~pid, if given) and the cost
+//                    of the answer in this process (the core's prediction on the node's scene,
+//                    read from its ~scene).
 //          "burden"  the work of one hard message (issue 13, item 9), ~kind: "stamps" publishes
 //                    every body of ~scene in one array whose states' stamps are 10 us apart
 //                    (~messages such arrays); "cluster" publishes the bodies of ~scene (a lattice
@@ -22,6 +30,7 @@
 #include <ros/ros.h>
 #include <std_srvs/Empty.h>
 
+#include <time.h>
 #include <unistd.h>
 #include <algorithm>
 #include <atomic>
@@ -40,11 +49,14 @@
 #include "collision_response/BodyStateArray.h"
 #include "collision_response/ComputeCollision.h"
 #include "collision_response/ImpactArray.h"
+#include "collision_response/PredictImpacts.h"
 #include "collision_response/core/materials.h"
 #include "collision_response/core/playback.h"
+#include "collision_response/core/prediction.h"
 #include "collision_response/ros/collision_services.h"
 #include "collision_response/ros/conversions.h"
 #include "collision_response/ros/monitor_cycle.h"
+#include "collision_response/ros/prediction_service.h"
 #include "collision_response/ros/scene_loader.h"
 #include "seed_request.h"
 
@@ -258,6 +270,163 @@ int service(ros::NodeHandle& node, ros::NodeHandle& private_node) {
   return 0;
 }
 
+/// CPU seconds (user + system) used so far by the calling thread.
+double threadCpuSeconds() {
+  timespec now{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+  return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
+}
+
+double average(const std::vector<double>& values) {
+  double sum = 0;
+  for (const double x : values) sum += x;
+  return sum / static_cast<double>(values.size());
+}
+
+/// The serve of config/scenes/serve.yaml asked of ~predict_impacts: the scene's ball (mass 0)
+/// from its initial state, its first two impacts (both on the table) within 1.2 s.
+PredictImpacts::Request serveRequest() {
+  PredictImpacts::Request request;
+  request.header.frame_id = "world";
+  request.body.id = "ball";
+  request.body.position.x = -1.2;
+  request.body.position.z = 1.0;
+  request.body.velocity.x = 3.75;
+  request.body.velocity.y = 0.25;
+  request.body.velocity.z = -2.25;
+  request.body.angular_velocity.y = 150.0;
+  request.horizon = 1.2;
+  request.max_impacts = 2;
+  return request;
+}
+
+template <typename Message>
+std::size_t serializedBytes(const Message& message) {
+  return ros::serialization::serializationLength(message);
+}
+
+int predict(ros::NodeHandle& node, ros::NodeHandle& private_node) {
+  const int calls = private_node.param("calls", 2000);
+  const std::string service_name =
+      private_node.param<std::string>("service", "/collision_response/predict_impacts");
+  ros::ServiceClient predictor = node.serviceClient<PredictImpacts>(service_name, true);
+  ros::ServiceClient echo =
+      node.serviceClient<PredictImpacts>("/empty_service/echo_prediction", true);
+  if (!predictor.waitForExistence(ros::Duration(20)) || !echo.waitForExistence(ros::Duration(20)))
+    return 2;
+  // The node's scene, from its ~scene (the service's namespace), for the answer in this process.
+  XmlRpc::XmlRpcValue value;
+  const std::string scene_parameter = ros::names::parentNamespace(service_name) + "/scene";
+  if (!node.getParam(scene_parameter, value)) {
+    std::fprintf(stderr, "no scene at %s\n", scene_parameter.c_str());
+    return 2;
+  }
+  const auto scene = loadScene(value, scene_parameter);
+  if (!scene) {
+    std::fprintf(stderr, "%s\n", scene.error().message().c_str());
+    return 2;
+  }
+  const int pid = private_node.param("pid", 0);
+  PredictImpacts prediction, echoed;
+  prediction.request = echoed.request = serveRequest();
+  std::vector<double> predict_times, echo_times;
+  using Clock = std::chrono::steady_clock;
+  // The first 100 calls of each warm up; the order alternates so that neither service always
+  // follows the other. The node's main thread is idle but for the calls.
+  double node_cpu = 0.0;
+  for (int i = 0; i < 2 * (calls + 100); ++i) {
+    if (i == 200 && pid) node_cpu = -cpuSeconds(pid, pid);
+    const bool call_predict = (i % 4 == 0) || (i % 4 == 3);
+    const auto t0 = Clock::now();
+    if (call_predict ? !predictor.call(prediction) || !prediction.response.success
+                     : !echo.call(echoed) || !echoed.response.success) {
+      std::fprintf(stderr, "call %d failed: %s\n", i,
+                   (call_predict ? prediction : echoed).response.message.c_str());
+      return 3;
+    }
+    const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    if (i < 200) continue;
+    (call_predict ? predict_times : echo_times).push_back(seconds);
+  }
+  // JSON's null without ~pid.
+  char node_cpu_per_call[32] = "null";
+  if (pid) {
+    std::snprintf(node_cpu_per_call, sizeof node_cpu_per_call, "%g",
+                  (node_cpu + cpuSeconds(pid, pid)) / static_cast<double>(calls));
+  }
+
+  // The answer in this process (this thread's CPU), 10,000 times in five batches of each, the
+  // two kinds alternating; the best batch of each stands for it (the machine is shared: a batch
+  // slowed by another process's load is not the answer's cost).
+  //   core:   core::predictImpacts on the node's scene, with the node's defaults (MonitorParams)
+  //           and no live monitor (the node has had no body state);
+  //   answer: the node's whole answer: deserialising the request, answerPredictImpacts on a cycle
+  //           of the same scene (the request in the fixed frame), serialising the answer.
+  core::PredictionRequest core_request;
+  const auto body = std::find_if(scene->bodies.begin(), scene->bodies.end(),
+                                 [&](const core::BodySpec& spec) { return spec.id == "ball"; });
+  if (body == scene->bodies.end()) {
+    std::fprintf(stderr, "the scene at %s has no body 'ball'\n", scene_parameter.c_str());
+    return 2;
+  }
+  core_request.body = *body;
+  core_request.state.position = toEigen(prediction.request.body.position);
+  core_request.state.velocity = toEigen(prediction.request.body.velocity);
+  core_request.state.angular_velocity = toEigen(prediction.request.body.angular_velocity);
+  core_request.horizon = prediction.request.horizon;
+  core_request.max_impacts = prediction.request.max_impacts;
+  core_request.effects = scene->effects;
+  const MonitorParams params;
+  const core::MonitorSettings settings{params.contact_tolerance, params.body_timeout};
+  const MonitorCycle cycle(*scene, params);
+  const tf2::BufferCore tf;
+  const auto request_bytes = ros::serialization::serializeMessage(prediction.request);
+  constexpr int kBatches = 5, kBatch = 2000;
+  std::size_t core_impacts = 0;
+  double in_process = INFINITY, in_process_answer = INFINITY;
+  for (int batch = 0; batch < kBatches; ++batch) {
+    const double c0 = threadCpuSeconds();
+    for (int i = 0; i < kBatch; ++i) {
+      const auto answer = core::predictImpacts(*scene, nullptr, settings, core_request);
+      if (!answer) {
+        std::fprintf(stderr, "%s\n", answer.error().message().c_str());
+        return 3;
+      }
+      core_impacts = answer->impacts.size();
+    }
+    in_process = std::min(in_process, (threadCpuSeconds() - c0) / kBatch);
+    const double a0 = threadCpuSeconds();
+    for (int i = 0; i < kBatch; ++i) {
+      PredictImpacts::Request request;
+      ros::serialization::IStream in(request_bytes.message_start,
+                                     static_cast<std::uint32_t>(request_bytes.num_bytes - 4));
+      ros::serialization::deserialize(in, request);
+      PredictImpacts::Response response;
+      answerPredictImpacts(request, cycle, tf, ros::Time(1.0), response);
+      if (!response.success) {
+        std::fprintf(stderr, "%s\n", response.message.c_str());
+        return 3;
+      }
+      ros::serialization::serializeMessage(response);
+    }
+    in_process_answer = std::min(in_process_answer, (threadCpuSeconds() - a0) / kBatch);
+  }
+  std::printf(
+      "{\"calls\": %d, \"predict_mean\": %g, \"predict_p50\": %g, \"predict_p99\": %g, "
+      "\"echo_mean\": %g, \"echo_p50\": %g, \"echo_p99\": %g, \"in_process\": %g, "
+      "\"in_process_answer\": %g, \"node_cpu_per_call\": %s, \"impacts\": %zu, "
+      "\"core_impacts\": %zu, "
+      "\"predict_request_bytes\": %zu, \"predict_response_bytes\": %zu, "
+      "\"echo_request_bytes\": %zu, \"echo_response_bytes\": %zu, \"message\": \"%s\"}\n",
+      calls, average(predict_times), percentile(predict_times, 0.5),
+      percentile(predict_times, 0.99), average(echo_times), percentile(echo_times, 0.5),
+      percentile(echo_times, 0.99), in_process, in_process_answer, node_cpu_per_call,
+      prediction.response.impacts.size(), core_impacts, serializedBytes(prediction.request),
+      serializedBytes(prediction.response), serializedBytes(echoed.request),
+      serializedBytes(echoed.response), prediction.response.message.c_str());
+  return 0;
+}
+
 /// Calls `service` (compute_collision, the seed's request) without pause until stopped, keeping
 /// the worst round trip.
 class ServiceProbe {
@@ -449,6 +618,7 @@ int main(int argc, char** argv) {
   ros::NodeHandle private_node("~");
   const std::string mode = private_node.param<std::string>("mode", "load");
   if (mode == "service") return service(node, private_node);
+  if (mode == "predict") return predict(node, private_node);
   if (mode == "burden") return burden(node, private_node);
   if (mode == "startup") return startup(private_node);
   return load(node, private_node);

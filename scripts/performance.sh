@@ -3,6 +3,7 @@
 # balls at rest in a box (lasting contact: one layer, a stack 10 high) with gravity on and off,
 # beside Bullet (Google Benchmark); the node over ROS with 10,000 bodies at 100 Hz (CPU share,
 # latency, memory over a long run); the collision service's round trip beside an empty service;
+# the prediction service's round trip on the table-tennis serve beside an echo of the same bytes;
 # the work of one hard message (an array of 10,000 distinct stamps, a cluster of 1,000 touching
 # balls: the monitor's CPU, and the service's worst round trip meanwhile) and start-up from
 # 1,000 to 30,000 bodies.
@@ -14,6 +15,13 @@
 #   .ws/devel/lib/collision_response/bench_scale --benchmark_filter=Pile \
 #     --benchmark_format=json --benchmark_out=.ws/pile.json
 #   /usr/bin/python3 scripts/performance_report.py --pile-only .ws/pile.json doc/performance.md
+# The prediction service's section alone, into the existing doc/performance.md, with a master,
+# empty_service and a node on config/scenes/serve.yaml (`rosparam load config/scenes/serve.yaml
+# /collision_response_predict`, then collision_response_node __name:=collision_response_predict)
+# running:
+#   .ws/devel/lib/collision_response/node_benchmark _mode:=predict \
+#     _service:=/collision_response_predict/predict_impacts >.ws/performance/predict_1.json
+#   /usr/bin/python3 scripts/performance_report.py --predict-only .ws/performance doc/performance.md
 # The shapes' first contact (doc/model.md, "Finite obstacles"), after a run of this script:
 #   .ws/devel/lib/collision_response/bench_scale --benchmark_filter=FirstContact
 #   .ws/devel/lib/collision_response/bench_arm     # a ball against a seven-joint arm, beside
@@ -30,7 +38,8 @@ bin="$ws/devel/lib/collision_response"
 out="$ws/performance"
 mkdir -p "$out"
 # A run without the memory part (MEMORY_SECONDS=0) keeps the last memory run's table.
-rm -f "$out"/scale.json "$out"/service*.json "$out"/load.json "$out"/burden_*.json "$out"/startup.json
+rm -f "$out"/scale.json "$out"/service*.json "$out"/predict*.json "$out"/load.json "$out"/burden_*.json \
+  "$out"/startup.json
 [ "${MEMORY_SECONDS:-600}" -gt 0 ] && rm -f "$out/memory.json"
 
 echo "== core: 1k, 10k, 100k bodies, and Bullet on the same gas; a pile at rest, gravity on and off"
@@ -85,6 +94,22 @@ for round in 1 2 3; do
   "$bin/node_benchmark" _mode:=service _calls:=5000 _service:=/collision_response_services/compute_collision \
     >"$out/service_$round.json"
 done
+# ~predict_impacts on a third node, serving the table-tennis serve (config/scenes/serve.yaml; its
+# topics moved aside, so that the gas's states do not reach it), beside empty_service's
+# ~echo_prediction, which answers the same bytes without physics. Stopped after its rounds.
+rosparam load "$repo/config/scenes/serve.yaml" /collision_response_predict
+"$bin/collision_response_node" __name:=collision_response_predict body_states:=/predict/body_states \
+  impacts:=/predict/impacts contacts:=/predict/contacts >"$out/predict_node.log" 2>&1 &
+predict_pid=$!
+pids+=($predict_pid)
+until rosservice list 2>/dev/null | grep -q /collision_response_predict/predict_impacts &&
+  rosservice list 2>/dev/null | grep -q /empty_service/echo_prediction; do sleep 0.2; done
+echo "== prediction round trips: the serve, beside an echo of the same bytes (three rounds)"
+for round in 1 2 3; do
+  "$bin/node_benchmark" _mode:=predict _calls:=2000 _service:=/collision_response_predict/predict_impacts \
+    _pid:="$predict_pid" >"$out/predict_$round.json"
+done
+stop_process "$predict_pid"
 echo "== ${bodies} bodies at 100 Hz for 20 s"
 "$bin/node_benchmark" _mode:=load _rate:=100 _seconds:=20 _pid:="$node_pid" >"$out/load.json"
 # Where the node's time goes: perf samples the node for 8 s of a second load run (not the
