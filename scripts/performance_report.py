@@ -164,7 +164,8 @@ def predict_section(out):
         + (f" The node's main thread, which answers, spent {run['node_cpu_per_call'] * 1e6:.0f} "
            "us of CPU per call over the timed calls (`/proc/<pid>/task/<pid>/stat`)."
            if run.get("node_cpu_per_call") is not None else "")
-        + " Where the node's extra CPU went (measured by hand on this machine: `perf record -t` "
+        + " Where the node's extra CPU went (measured by hand once, on 2026-12-05, not by this "
+        "script: `perf record -t` "
         "of the node's main thread): glibc gave the heap freed after each answer back to the "
         "kernel (`brk`, whose TLB flush reaches the CPUs of the node's other threads) and "
         "faulted it in again on the next; the same node started with "
