@@ -67,8 +67,10 @@ core::Expected<core::PredictionRequest> requestInFixedFrame(const PredictImpacts
   predict.state.time = time;
   predict.state.position = motion->point(position);
   predict.state.velocity = motion->velocity(position, toEigen(request.body.velocity));
-  predict.state.angular_velocity =
-      motion->pose.linear() * toEigen(request.body.angular_velocity) + motion->angular_velocity;
+  // The frame's own turning is the body's spin only where the model carries spin (as on the
+  // topics, where the monitor then ignores it); without it a spin given is the core's error.
+  predict.state.angular_velocity = motion->pose.linear() * toEigen(request.body.angular_velocity);
+  if (predict.effects.spin) predict.state.angular_velocity += motion->angular_velocity;
   predict.horizon = request.horizon;
   predict.max_impacts = request.max_impacts;
   predict.sample_period = request.sample_period;
@@ -77,7 +79,8 @@ core::Expected<core::PredictionRequest> requestInFixedFrame(const PredictImpacts
     if (auto status = core::checkFinite(normal, "crossing_normal"); !status) return status.error();
     const Eigen::Vector3d point = toEigen(request.crossing_point);
     if (auto status = core::checkFinite(point, "crossing_point"); !status) return status.error();
-    const Eigen::Vector3d fixed_normal = motion->pose.linear() * normal.normalized();
+    // Any nonzero length, 1e-200 or 1e200, without under- or overflow.
+    const Eigen::Vector3d fixed_normal = motion->pose.linear() * core::unitVector(normal);
     predict.crossing = core::Plane{fixed_normal, fixed_normal.dot(motion->point(point))};
   }
   return predict;

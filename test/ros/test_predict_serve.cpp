@@ -113,6 +113,7 @@ TEST(PredictServe, TheServesBouncesAndCrossingMatchTheReference) {
   // The second impact was the last asked for: it ends there, not at the plane.
   EXPECT_FALSE(call.response.crossed);
   call.request.max_impacts = 10;
+  call.request.crossing_normal.x = 1e200;  // any nonzero length
   ASSERT_TRUE(callService(call));
   ASSERT_TRUE(call.response.success) << call.response.message;
   ASSERT_TRUE(call.response.crossed);
