@@ -17,16 +17,15 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <optional>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "accuracy/reference/serve_reference.h"
 #include "collision_response/core/prediction.h"
 #ifdef COLLISION_RESPONSE_WITH_BULLET
 #include <btBulletDynamicsCommon.h>
@@ -58,43 +57,8 @@ constexpr double kHorizon = 1.0;      // s: the query's horizon
 const V kTableCentre(0, 0, 0.745);
 const V kTableSize(2.74, 1.525, 0.03);
 
-/// The serve's reference: each line a name and its numbers ('#' lines are comments).
-class Reference {
- public:
-  static Reference read(const std::string& path) {
-    std::ifstream file(path);
-    if (!file) throw std::runtime_error("cannot read the serve's reference " + path);
-    Reference reference;
-    std::string line;
-    while (std::getline(file, line)) {
-      if (line.empty() || line[0] == '#') continue;
-      std::istringstream fields(line);
-      std::string name;
-      fields >> name;
-      for (double x; fields >> x;) reference.values_[name].push_back(x);
-    }
-    return reference;
-  }
-  double value(const std::string& name) const { return at(name, 1)[0]; }
-  V vector(const std::string& name) const {
-    const std::vector<double>& x = at(name, 3);
-    return V(x[0], x[1], x[2]);
-  }
-
- private:
-  const std::vector<double>& at(const std::string& name, std::size_t size) const {
-    const auto found = values_.find(name);
-    if (found == values_.end() || found->second.size() != size) {
-      throw std::runtime_error("the serve's reference has no " + name + " of " +
-                               std::to_string(size) + " numbers");
-    }
-    return found->second;
-  }
-  std::map<std::string, std::vector<double>> values_;
-};
-
-const Reference& reference() {
-  static const Reference read = Reference::read(COLLISION_RESPONSE_SERVE_REFERENCE);
+const ServeReference& reference() {
+  static const ServeReference read = ServeReference::read(COLLISION_RESPONSE_SERVE_REFERENCE);
   return read;
 }
 
@@ -114,7 +78,7 @@ struct ServeAnswer {
 /// its centre (m), the velocity after it (m/s), the centre at the plane's crossing (m; when
 /// measured).
 void setErrorCounters(benchmark::State& state, const ServeAnswer& answer) {
-  const Reference& ref = reference();
+  const ServeReference& ref = reference();
   state.counters["bounce2_time_error"] = std::abs(answer.bounce_time - ref.value("bounce2_time"));
   state.counters["bounce2_position_error"] =
       (answer.bounce_position - ref.vector("bounce2_position")).norm();
@@ -193,7 +157,7 @@ core::Scene serveScene(double tolerance) {
 /// The serve's query: from the reference's initial state, over kHorizon, up to 10 impacts, with
 /// the first crossing of the plane x = kPlaneX.
 core::PredictionRequest serveRequest(const core::Scene& scene, double horizon = kHorizon) {
-  const Reference& ref = reference();
+  const ServeReference& ref = reference();
   core::PredictionRequest request;
   request.body = scene.bodies[0];
   request.state.position = ref.vector("initial_position");
@@ -320,7 +284,7 @@ double dampingRate() {
 /// x = kPlaneX, its crossing interpolated linearly between the two steps around it.
 template <typename Step>
 ServeAnswer stepServe(double rate, bool to_crossing, Step&& step) {
-  const Reference& ref = reference();
+  const ServeReference& ref = reference();
   ServeAnswer answer;
   V position = ref.vector("initial_position"), velocity = ref.vector("initial_velocity");
   int bounces = 0;
@@ -385,7 +349,7 @@ V eigen(const btVector3& v) { return V(v.x(), v.y(), v.z()); }
 /// the two), no friction. Bullet's linear damping d scales the velocity by (1 - d)^dt each step
 /// (btRigidBody::applyDamping): d = 1 - exp(-c) makes that exp(-c dt), the linear drag's decay.
 ServeAnswer bulletServe(double rate, bool to_crossing) {
-  const Reference& ref = reference();
+  const ServeReference& ref = reference();
   btDefaultCollisionConfiguration configuration;
   btCollisionDispatcher dispatcher(&configuration);
   btDbvtBroadphase broadphase;
@@ -479,7 +443,7 @@ void odeNearCallback(void* data, dGeomID first, dGeomID second) {
 /// velocity by 1 - s after each step (dxStepBody): s = 1 - exp(-c dt) makes that exp(-c dt),
 /// the linear drag's decay over the step.
 ServeAnswer odeServe(double rate, bool to_crossing) {
-  const Reference& ref = reference();
+  const ServeReference& ref = reference();
   const double dt = 1.0 / rate;
   OdeWorld w{dWorldCreate(), dJointGroupCreate(0)};
   const dSpaceID space = dHashSpaceCreate(nullptr);

@@ -147,38 +147,19 @@ double across(const Plane& plane, const Eigen::Vector3d& position) {
   return plane.normal.dot(position) - plane.offset;
 }
 
-/// The first crossing of `plane` within (from, to] by the model `before` (at `from`) advanced:
-/// bisected on the instant, the model advanced afresh from `before` to each middle.
-BodyStateSample bisectCrossing(const ImpactMonitor& before, const Plane& plane, double from,
-                               double to) {
-  const double side = across(plane, stateOf(before, from).position);
+/// The first crossing of `plane` within (from, to] (the centre changes sides there) by the body
+/// whose state at an instant is `stateAt(t)`: bisected to the last bit of the instant.
+template <class StateAt>
+BodyStateSample bisectCrossing(const Plane& plane, double from, double to, StateAt stateAt) {
+  const double side = across(plane, stateAt(from).position);
   double open = from, closed = to;
   for (int i = 0; i < 200; ++i) {
     const double middle = open + 0.5 * (closed - open);
     if (!(middle > open && middle < closed)) break;
-    ImpactMonitor probe = before;
-    probe.advance(middle, {});
-    const double now = across(plane, stateOf(probe, middle).position);
+    const double now = across(plane, stateAt(middle).position);
     ((now > 0) == (side > 0) && now != 0 ? open : closed) = middle;
   }
-  ImpactMonitor probe = before;
-  probe.advance(closed, {});
-  return stateOf(probe, closed);
-}
-
-/// The first crossing of `plane` within (from, to] where `model` (at `to`) has moved the body
-/// by one motion all along (its track starts at or before `from`): bisected on that motion.
-BodyStateSample bisectCrossingAlong(const ImpactMonitor& model, const Plane& plane, double from,
-                                    double to) {
-  const double side = across(plane, stateOf(model, from).position);
-  double open = from, closed = to;
-  for (int i = 0; i < 200; ++i) {
-    const double middle = open + 0.5 * (closed - open);
-    if (!(middle > open && middle < closed)) break;
-    const double now = across(plane, stateOf(model, middle).position);
-    ((now > 0) == (side > 0) && now != 0 ? open : closed) = middle;
-  }
-  return stateOf(model, closed);
+  return stateAt(closed);
 }
 
 /// One prediction run: the model advanced piece by piece (at the sample period, the crossing's
@@ -295,11 +276,18 @@ class PredictionRun {
     const Plane& plane = *request_.crossing;
     if ((across(plane, from) > 0) == (across(plane, stateOf(model, next_).position) > 0)) return;
     if (!before && model.motionSince(0) <= now) {
-      prediction.crossing = bisectCrossingAlong(model, plane, now, next_);
+      // One motion all along the piece: the model at its end has it.
+      prediction.crossing =
+          bisectCrossing(plane, now, next_, [&](double t) { return stateOf(model, t); });
       return;
     }
     if (!before) before = replayTo(piece);
-    prediction.crossing = bisectCrossing(*before, plane, now, next_);
+    prediction.crossing = bisectCrossing(plane, now, next_, [&](double t) {
+      if (t == now) return stateOf(*before, t);
+      ImpactMonitor probe = *before;  // the model at the piece's start, advanced afresh to t
+      probe.advance(t, {});
+      return stateOf(probe, t);
+    });
   }
 
   const Scene& ahead_;
