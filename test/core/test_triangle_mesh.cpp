@@ -3,11 +3,15 @@
 // (no internal edge is ever met: the same instants to the ulp, a flat normal across the edges).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <set>
 #include <vector>
 
+#include "collision_response/core/monitor.h"
+#include "collision_response/core/prediction.h"
+#include "collision_response/core/scene.h"
 #include "collision_response/core/triangle_mesh.h"
 #include "geometry/finite_shapes.h"
 #include "geometry/narrow_phase.h"
@@ -18,6 +22,7 @@ namespace {
 
 using V = Eigen::Vector3d;
 using LD = long double;
+constexpr double kG = 9.81;
 
 const auto kNoApproach = [] { return V(V::Zero()); };
 
@@ -211,6 +216,231 @@ TEST(TriangleMesh, ACubesEdgeAndCornerTurnTheNormal) {
   const ContactGeometry inside = contactGeometry(V(0.1, 0.0, 0.45), r, cube, 1e-9, kNoApproach);
   EXPECT_EQ(inside.normal, V(0, 0, -1));
   EXPECT_NEAR(inside.gap, -0.05 - r, 1e-15);
+}
+
+// Open meshes (issue 39): a mesh none of whose edges is open and whose winding agrees across
+// every edge is closed and bounds the solid it encloses; any other is a surface, which nothing
+// beside, below or above it is inside (its distance is the plain distance to its triangles, and a
+// ball meets either side of it). Before, the sign of the nearest boundary edge's pseudo-normal
+// put everything below an open floor's plane inside it, metres beside its triangles.
+
+/// The open square [x0, x1] x [y0, y1] at height z as two triangles facing up, in the frame of
+/// the obstacle (placed at the origin: the mesh's bounding sphere about it reaches the balls).
+std::shared_ptr<const TriangleMesh> openSquare(double x0, double x1, double y0, double y1,
+                                               double z) {
+  const std::vector<V> corners{V(x0, y0, z), V(x1, y0, z), V(x1, y1, z), V(x0, y1, z)};
+  return *TriangleMesh::build(corners, {{0, 1, 2}, {0, 2, 3}}, "open floor");
+}
+
+Scene droppedBeside(const std::shared_ptr<const TriangleMesh>& open_floor,
+                    const std::vector<V>& drops, double r) {
+  Scene scene;
+  scene.effects.gravity = true;
+  scene.gravity = V(0, 0, -kG);
+  for (std::size_t i = 0; i < drops.size(); ++i) {
+    scene.bodies.push_back(
+        scene_builders::ball("ball_" + std::to_string(i), 0.057, r, "tennis_ball", drops[i]));
+  }
+  scene.obstacles = {scene_builders::plane("floor", V::UnitZ(), 0.0, "concrete"),
+                     scene_builders::mesh("open", open_floor, V::Zero(), "concrete")};
+  return scene;
+}
+
+/// Runs `monitor` on its own motion from `start` at 100 Hz to `end`: every impact.
+std::vector<ImpactRecord> playAlone(ImpactMonitor& monitor, const std::vector<V>& start,
+                                    double end) {
+  std::vector<BodyStateSample> states;
+  for (std::size_t i = 0; i < start.size(); ++i) {
+    BodyStateSample sample;
+    sample.body = i;
+    sample.position = start[i];
+    states.push_back(sample);
+  }
+  std::vector<ImpactRecord> impacts;
+  monitor.step(0.0, states);
+  const int steps = static_cast<int>(std::lround(end * 100));
+  for (int k = 1; k <= steps; ++k) {
+    const StepReport report = monitor.step(k / 100.0, {});
+    impacts.insert(impacts.end(), report.impacts.begin(), report.impacts.end());
+  }
+  return impacts;
+}
+
+MonitorSettings ownMotion() {
+  MonitorSettings settings;
+  settings.body_timeout = 1e9;  // no states after the first: the monitor's own motion
+  return settings;
+}
+
+TEST(TriangleMesh, OnlyAMeshClosedAtEveryEdgeIsClosed) {
+  EXPECT_TRUE(scene_builders::cubeMesh(V(0.5, 0.5, 0.5))->closed());
+  EXPECT_FALSE(scene_builders::floorMesh(8, 2.0)->closed());
+  EXPECT_FALSE(openSquare(14, 16, -1, 1, 0.26)->closed());
+  // The cube without its top (10 triangles): open.
+  const auto cube = scene_builders::cubeMesh(V(0.5, 0.5, 0.5));
+  std::vector<TriangleMesh::Triangle> no_top;
+  for (std::uint32_t t = 0; t < cube->triangles().size(); ++t) {
+    if (!(cube->normal(t).z() > 0.5)) no_top.push_back(cube->triangles()[t]);
+  }
+  ASSERT_EQ(no_top.size(), 10u);
+  EXPECT_FALSE((*TriangleMesh::build(cube->vertices(), no_top, "box without a top"))->closed());
+  // The cube with one triangle turned inside out: its winding disagrees across three edges.
+  std::vector<TriangleMesh::Triangle> flipped = cube->triangles();
+  std::swap(flipped[0][1], flipped[0][2]);
+  EXPECT_FALSE((*TriangleMesh::build(cube->vertices(), flipped, "cube turned"))->closed());
+}
+
+// The open square's distance beside, below and above it: the plain distance to its triangles,
+// the normal from the ball to their nearest point. A ball thrown up under it meets its back.
+TEST(TriangleMesh, AnOpenMeshIsASurfaceWithNoInside) {
+  PlacedShape placed;
+  placed.shape = Mesh{openSquare(14, 16, -1, 1, 0.26)};
+  const double r = 0.05;
+  // Beside and below its plane, 1 m from its edge x = 14 across and 0.21 m down.
+  const ContactGeometry beside = contactGeometry(V(13, 0.1, 0.05), r, placed, 1e-9, kNoApproach);
+  const double d = std::sqrt(1.0 + 0.21 * 0.21);
+  EXPECT_NEAR(beside.gap, d - r, 1e-15);
+  EXPECT_NEAR((beside.normal - V(1, 0, 0.21) / d).norm(), 0, 1e-15);
+  // Under its face, 0.16 m below it: 0.16 m away, the normal up into it.
+  const ContactGeometry under = contactGeometry(V(15, 0.1, 0.1), r, placed, 1e-9, kNoApproach);
+  EXPECT_NEAR(under.gap, 0.16 - r, 1e-15);
+  EXPECT_EQ(under.normal, V(0, 0, 1));
+  // Above it, as before.
+  const ContactGeometry over = contactGeometry(V(15, 0.1, 0.36), r, placed, 1e-9, kNoApproach);
+  EXPECT_NEAR(over.gap, 0.1 - r, 1e-15);
+  EXPECT_EQ(over.normal, V(0, 0, -1));
+  // Thrown up at 2 m/s from 0.1 m under it: it meets the face's back at (0.26 - r - 0.1) / 2.
+  const auto up = thrown(placed.shape, V(15, 0.1, 0.1), V(0, 0, 2), r);
+  ASSERT_TRUE(up);
+  EXPECT_LE(ulps(*up, (LD(0.26) - LD(r) - LD(0.1)) / 2), 4);
+  // Thrown sideways under it: it passes (0.16 m below the plane, r = 0.05).
+  EXPECT_FALSE(thrown(placed.shape, V(13, 0.1, 0.1), V(2, 0, 0), r));
+  // Beside it, falling from 1 m: nothing (before, it was 1 m inside once below z = 0.26).
+  EXPECT_FALSE(thrown(placed.shape, V(13, 0.1, 1.0), V::Zero(), r, V(0, 0, -kG), 1.0));
+}
+
+// Issue 39: a 2 x 2 m open floor mesh (x in [14, 16], at z = 0.26 or 0.5) beside a floor plane;
+// balls dropped from z0 = 1 at x = -5, 0.05, 3, 7 and 13 meet the plane under themselves at the
+// ballistic instant sqrt(2 (z0 - r) / g) (0.44009 s; before, at 0.44257 s at (14.05, 0.1, 0): they
+// were moved onto the mesh's boundary edge).
+TEST(TriangleMesh, BallsDroppedBesideAnOpenFloorMeshMeetTheFloorUnderThem) {
+  const double r = 0.05, z0 = 1.0;
+  const double meets = static_cast<double>(std::sqrt(2 * (LD(z0) - LD(r)) / LD(kG)));
+  for (const double height : {0.26, 0.5}) {
+    std::vector<V> drops;
+    for (const double x : {-5.0, 0.05, 3.0, 7.0, 13.0}) drops.emplace_back(x, 0.1, z0);
+    const Scene scene = droppedBeside(openSquare(14, 16, -1, 1, height), drops, r);
+    ImpactMonitor monitor(scene, ownMotion());
+    const auto impacts = playAlone(monitor, drops, 0.5);
+    for (std::size_t i = 0; i < drops.size(); ++i) {
+      const auto first =
+          std::find_if(impacts.begin(), impacts.end(),
+                       [&](const ImpactRecord& impact) { return impact.body_a == i; });
+      ASSERT_NE(first, impacts.end()) << "no impact at x = " << drops[i].x();
+      ASSERT_TRUE(first->other_is_obstacle) << drops[i].x();
+      EXPECT_EQ(monitor.obstacle(first->other).id, "floor") << drops[i].x();
+      EXPECT_NEAR(first->time, meets, 1e-12) << drops[i].x() << " at z " << height;
+      EXPECT_LE((first->contact_point - V(drops[i].x(), 0.1, 0)).norm(), 1e-12)
+          << drops[i].x() << ": " << first->contact_point.transpose();
+      EXPECT_NEAR(first->velocity_a_before.z(), -kG * meets, 1e-12) << drops[i].x();
+      // And it stays over its own x.
+      const auto end = monitor.predictedState(i, 0.5);
+      EXPECT_EQ(end->first.x(), drops[i].x());
+      EXPECT_EQ(end->first.y(), 0.1);
+    }
+  }
+}
+
+// A ball dropped onto a box 14 m from such a mesh (its top at 0.2 m, under the mesh's plane, and
+// at 0.4 m, over it) meets the box's top at sqrt(2 (z0 - r - top) / g) (before: it passed through
+// the box, or bounced off a phantom of the mesh at (14.05, 0.1, 0.26)).
+TEST(TriangleMesh, ABallDroppedOnABoxBesideAnOpenMeshBouncesOffTheBox) {
+  const double r = 0.05, z0 = 1.0;
+  for (const double top : {0.2, 0.4}) {
+    Scene scene = droppedBeside(openSquare(14, 16, -1, 1, 0.26), {V(0, 0.1, z0)}, r);
+    scene.obstacles.push_back(
+        scene_builders::box("box", V(0, 0.1, top - 0.1), V(0.4, 0.4, 0.2), "concrete"));
+    ImpactMonitor monitor(scene, ownMotion());
+    const auto impacts = playAlone(monitor, {V(0, 0.1, z0)}, 0.5);
+    ASSERT_FALSE(impacts.empty()) << "top " << top;
+    const double meets = static_cast<double>(std::sqrt(2 * (LD(z0) - LD(r) - LD(top)) / LD(kG)));
+    ASSERT_TRUE(impacts[0].other_is_obstacle) << top;
+    EXPECT_EQ(monitor.obstacle(impacts[0].other).id, "box") << top;
+    EXPECT_NEAR(impacts[0].time, meets, 1e-12) << top;
+    EXPECT_LE((impacts[0].contact_point - V(0, 0.1, top)).norm(), 1e-12)
+        << impacts[0].contact_point.transpose();
+    EXPECT_EQ(impacts[0].normal, V(0, 0, -1));
+  }
+}
+
+// No start-up warning for balls resting on the floor beside an open mesh, under its plane
+// (before: "starts 9.55 m inside" it); a ball inside a closed mesh is still warned of.
+TEST(TriangleMesh, NoBallBesideAnOpenMeshStartsInsideIt) {
+  const double r = 0.05;
+  Scene scene = droppedBeside(openSquare(14, 16, -1, 1, 0.5),
+                              {V(4.45, 0, r), V(10, 0, 0.3), V(13, 0.1, r), V(15, 0, 0.3)}, r);
+  EXPECT_TRUE(bodiesStartingInside(scene).empty());
+  scene.obstacles.push_back(scene_builders::mesh(
+      "crate", scene_builders::cubeMesh(V(0.5, 0.5, 0.5)), V(-3, 0, 0.5), "concrete"));
+  scene.bodies.push_back(scene_builders::ball("crated", 0.057, r, "tennis_ball", V(-3, 0, 0.6)));
+  const auto warnings = bodiesStartingInside(scene);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("'crated'"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[0].find("starts 0.45 m inside obstacle 'crate'"), std::string::npos)
+      << warnings[0];
+}
+
+// A ball rolling at v0 = 5 m/s (r = 0.05, friction and spin) off the edge x = 10 of an open
+// 10 x 10 m floor mesh at z = 0 (its origin at its centre, (5, 0, 0)): as v0^2 > g r, the edge
+// cannot hold it, and it flies from the edge on the parabola x = 8 + v0 t,
+// z = r - g (t - 0.4)^2 / 2, as off the same floor as a box (before, the mesh pulled it back
+// under itself: x 11 -> 8.8, z -58 m at 4 s, no impact), in the monitor and in predictImpacts.
+TEST(TriangleMesh, ABallRollsOffAnOpenFloorMeshsEdgeAsOffABox) {
+  const double r = 0.05, v0 = 5.0, horizon = 4.0;
+  const V start(8, 0, r), velocity(v0, 0, 0), spin = V(0, 0, 1).cross(velocity) / r;
+  const V lands(8 + v0 * horizon, 0, r - 0.5 * kG * (horizon - 0.4) * (horizon - 0.4));
+  for (const bool as_box : {false, true}) {
+    Scene scene;
+    scene.effects.gravity = scene.effects.friction = scene.effects.spin = true;
+    scene.gravity = V(0, 0, -kG);
+    scene.bodies = {scene_builders::ball("ball", 0.057, r, "tennis_ball")};
+    scene.obstacles = {
+        as_box
+            ? scene_builders::box("floor", V(5, 0, -0.5), V(10, 10, 1), "concrete")
+            : scene_builders::mesh("floor", openSquare(-5, 5, -5, 5, 0), V(5, 0, 0), "concrete")};
+    ImpactMonitor monitor(scene, ownMotion());
+    BodyStateSample state;
+    state.position = start;
+    state.velocity = velocity;
+    state.angular_velocity = spin;
+    monitor.step(0.0, {state});
+    std::size_t impacts = 0;
+    for (int k = 1; k <= 400; ++k) impacts += monitor.step(k / 100.0, {}).impacts.size();
+    EXPECT_EQ(impacts, 0u) << (as_box ? "box" : "mesh");
+    const auto end = monitor.predictedState(0, horizon);
+    EXPECT_LE((end->first - lands).norm(), 1e-9)
+        << (as_box ? "box: " : "mesh: ") << end->first.transpose();
+
+    PredictionRequest request;
+    request.body = scene.bodies[0];
+    request.state = state;
+    request.horizon = horizon;
+    request.max_impacts = 10;
+    request.effects = scene.effects;
+    request.sample_period = 0.1;  // the path at 10 Hz (without, it was right before too)
+    const auto prediction = predictImpacts(scene, nullptr, MonitorSettings{}, request);
+    ASSERT_TRUE(prediction.ok()) << prediction.error().message();
+    EXPECT_TRUE(prediction->impacts.empty()) << (as_box ? "box" : "mesh");
+    EXPECT_LE((prediction->final_state.position - lands).norm(), 1e-9)
+        << (as_box ? "box: " : "mesh: ") << prediction->final_state.position.transpose();
+    ASSERT_EQ(prediction->samples.size(), 41u);
+    for (const BodyStateSample& sample : prediction->samples) {
+      const double t = sample.time, fallen = std::max(0.0, t - 0.4);
+      const V there(8 + v0 * t, 0, r - 0.5 * kG * fallen * fallen);
+      EXPECT_LE((sample.position - there).norm(), 1e-9)
+          << (as_box ? "box" : "mesh") << " at " << t << ": " << sample.position.transpose();
+    }
+  }
 }
 
 }  // namespace

@@ -2,15 +2,20 @@
 // bounding-volume hierarchy of axis-aligned boxes, so that a query near a few of 1,000,000
 // triangles looks at O(log n) of them.
 //
-// The mesh bounds a solid on the side its triangles' normals point away from (counter-clockwise
-// seen from outside, the convention of STL and COLLADA): a closed mesh is the solid it encloses,
-// an open one (a floor) is free on the side its normals point to, as a plane is. A ball against
-// it is a ball against its features grown by the ball's radius: faces are planes, edges
+// A closed mesh (every edge shared by exactly two triangles whose winding agrees across it, run
+// in opposite directions) bounds the solid it encloses, on the side its triangles' normals point
+// away from (counter-clockwise seen from outside, the convention of STL and COLLADA). Any other
+// mesh (a floor, a box without a lid, one with a crack or a triangle wound the other way) is
+// open: a surface of no thickness with no inside, which a ball meets from either side; nothing
+// beside, below or above it is inside it (the sign of a pseudo-normal tells inside from outside
+// only on a closed, consistently wound surface: Baerentzen and Aanaes 2005). A ball against a
+// mesh is a ball against its features grown by the ball's radius: faces are planes, edges
 // cylinders, vertices spheres. Only the features a ball can touch first are kept: an edge
-// between two faces in one plane, or in a groove (concave), lies inside the grown solid, and so
-// does a vertex all of whose edges do; that is why a ball rolling across a tessellated flat floor
-// never meets an internal edge (the "ghost collisions" of engines that test each triangle
-// alone).
+// between two faces in one plane lies inside the grown solid, and so, on a closed mesh, does an
+// edge in a groove (concave: on an open mesh the groove's other side is convex and its edge is
+// kept), and a vertex all of whose edges do; that is why a ball rolling across a tessellated
+// flat floor never meets an internal edge (the "ghost collisions" of engines that test each
+// triangle alone).
 #pragma once
 
 #include <Eigen/Core>
@@ -44,7 +49,8 @@ class TriangleMesh {
     /// of Baerentzen and Aanaes, "Signed distance computation using the angle weighted
     /// pseudonormal", IEEE TVCG 11(3), 2005): which side of it is outside.
     Eigen::Vector3d pseudo_normal = Eigen::Vector3d::Zero();
-    bool reachable = true;  ///< not between coplanar faces nor in a groove
+    /// Not between faces in one plane, nor (on a closed mesh) in a groove.
+    bool reachable = true;
   };
 
   /// Builds the mesh from its vertices (m, the mesh's frame) and triangles (vertex indices,
@@ -75,6 +81,10 @@ class TriangleMesh {
   }
   bool vertexReachable(std::uint32_t vertex) const { return vertex_reachable_[vertex] != 0; }
 
+  /// Whether every edge is shared by exactly two triangles run along it in opposite directions
+  /// (their winding agrees): the mesh then encloses a solid. Otherwise it is a surface.
+  bool closed() const { return closed_; }
+
   /// m: the radius of the smallest sphere about the mesh's origin that holds it.
   double boundingRadius() const { return bounding_radius_; }
 
@@ -94,8 +104,9 @@ class TriangleMesh {
     std::uint32_t count = 0;  ///< leaf: triangle count; inner: 0
   };
   /// build's stages: the triangles of nonzero area, their vertices joined (an error names the
-  /// triangle whose index is out of range); the hierarchy; the edges and whether each is
-  /// reachable; the vertices' pseudo-normals, reachability and the bounding radius.
+  /// triangle whose index is out of range); the hierarchy; the edges, whether the mesh is closed
+  /// and whether each edge is reachable; the vertices' pseudo-normals, reachability and the
+  /// bounding radius.
   Status keepFacedTriangles(const std::vector<Triangle>& triangles, const std::string& field,
                             std::vector<std::size_t>* zero_area);
   void buildHierarchy();
@@ -113,6 +124,7 @@ class TriangleMesh {
   std::vector<char> vertex_reachable_;
   std::vector<Node> nodes_;
   double bounding_radius_ = 0.0;
+  bool closed_ = true;
 };
 
 }  // namespace collision_response::core

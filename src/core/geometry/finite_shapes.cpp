@@ -316,10 +316,13 @@ NearestFeature nearestFeature(const Mesh& mesh, const Eigen::Vector3d& p) {
   NearestFeature feature;
   feature.point = near.point;
   if (near.part == TriangleMesh::Part::kFace) {
-    // A face: the distance along its normal, signed.
+    // A face: the distance along its normal, signed; on an open mesh (a surface) its size, the
+    // normal turned to the side the point is on.
     const Eigen::Vector3d& normal = triangles.normal(near.triangle);
-    feature.outward = normal;
-    feature.distance = normal.dot(p - triangles.vertices()[corners[0]]);
+    const double along = normal.dot(p - triangles.vertices()[corners[0]]);
+    const bool behind = !triangles.closed() && along < 0;
+    feature.outward = behind ? Eigen::Vector3d(-normal) : normal;
+    feature.distance = behind ? -along : along;
     return feature;
   }
   const bool edge = near.part == TriangleMesh::Part::kEdge;
@@ -329,11 +332,15 @@ NearestFeature nearestFeature(const Mesh& mesh, const Eigen::Vector3d& p) {
       edge ? on_edge->pseudo_normal : triangles.vertexPseudoNormal(vertex);
   const bool reachable = edge ? on_edge->reachable : triangles.vertexReachable(vertex);
   const Eigen::Vector3d offset = p - near.point;
-  const bool inside = offset.dot(pseudo_normal) < 0;
+  // Inside only a closed mesh, behind the pseudo-normal; an open one has no inside.
+  const bool inside = triangles.closed() && offset.dot(pseudo_normal) < 0;
   if (near.distance > 0) {
     feature.outward = (inside ? -offset : offset) / near.distance;
-  } else {
+  } else if (triangles.closed()) {
     feature.outward = pseudo_normal.stableNormalized();
+  } else {
+    // On an open mesh's edge or vertex: its triangle's side (faces back to back sum to zero).
+    feature.outward = triangles.normal(near.triangle);
   }
   feature.distance = inside ? -near.distance : near.distance;
   if (reachable && !inside && near.distance > 0) {
@@ -488,17 +495,18 @@ void pathBox(const FeatureSearch& s, const RelativeMotion& motion, double from, 
   high.array() += grow;
 }
 
-/// A triangle's face: n.(q - a) = r on its outer side, q over the triangle.
+/// A triangle's face: side n.(q - a) = r, q over the triangle; `side` +1 its outer side, -1 its
+/// back (an open mesh's, a surface met from either side).
 void meshFace(FeatureSearch& s, const RelativeMotion& motion, const TriangleMesh& triangles,
-              std::uint32_t t) {
+              std::uint32_t t, double side) {
   const std::vector<Eigen::Vector3d>& vertices = triangles.vertices();
   const TriangleMesh::Triangle& corners = triangles.triangles()[t];
   const Eigen::Vector3d& a = vertices[corners[0]];
   const Eigen::Vector3d& normal = triangles.normal(t);
-  if (!s.reachable(normal.dot(motion.centre - a), motion.radius)) return;
+  if (!s.reachable(side * normal.dot(motion.centre - a), motion.radius)) return;
   Polynomial face{-s.radius()};
   for (int i = 0; i < 3; ++i) {
-    face = face + static_cast<long double>(normal[i]) * s.coordinate(i, a[i]);
+    face = face + static_cast<long double>(side * normal[i]) * s.coordinate(i, a[i]);
   }
   s.feature(face, [&](const Eigen::Vector3d& q, double more) {
     for (int k = 0; k < 3; ++k) {
@@ -574,7 +582,8 @@ std::optional<double> firstContactFinite(const RelativeMotion& motion, const Mes
       triangles.overlapping(low, high, near);
       for (const std::uint32_t t : near) {
         if (!firstTime(seen_triangles, t)) continue;
-        meshFace(s, motion, triangles, t);
+        meshFace(s, motion, triangles, t, 1.0);
+        if (!triangles.closed()) meshFace(s, motion, triangles, t, -1.0);
         for (int k = 0; k < 3; ++k) {
           const std::uint32_t index = triangles.edgeIndex(t, k);
           if (triangles.edge(index).reachable && firstTime(seen_edges, index)) {

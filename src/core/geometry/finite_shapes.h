@@ -32,10 +32,12 @@ struct NearestFeature {
 NearestFeature nearestFeature(const Cuboid& box, const Eigen::Vector3d& p);
 NearestFeature nearestFeature(const Cylinder& cylinder, const Eigen::Vector3d& p);
 NearestFeature nearestFeature(const Capsule& capsule, const Eigen::Vector3d& p);
-/// A mesh's: the nearest point of its triangles (TriangleMesh::nearest), inside where the point
-/// is behind the pseudo-normal of the face, edge or vertex it is on (Baerentzen and Aanaes); an
-/// edge or vertex a ball cannot touch first (between coplanar faces, in a groove) turns the
-/// normal no more than a face does.
+/// A mesh's: the nearest point of its triangles (TriangleMesh::nearest). A closed mesh's is
+/// inside where the point is behind the pseudo-normal of the face, edge or vertex it is on
+/// (Baerentzen and Aanaes); an open mesh (a surface) has no inside: the distance is the plain
+/// distance, the normal from the nearest point to the point. An edge or vertex a ball cannot
+/// touch first (between coplanar faces, in a closed mesh's groove) turns the normal no more than
+/// a face does.
 NearestFeature nearestFeature(const Mesh& mesh, const Eigen::Vector3d& p);
 
 /// m: the radius of the smallest sphere about the shape's origin that holds it.
@@ -68,11 +70,11 @@ std::optional<double> firstContactFinite(const RelativeMotion& motion, const Cyl
                                          double horizon);
 std::optional<double> firstContactFinite(const RelativeMotion& motion, const Capsule& capsule,
                                          double horizon);
-/// A mesh's features are its faces (each a plane, on its outer side, within its triangle), the
-/// edges and vertices a ball can touch first (TriangleMesh), those of the triangles near the
-/// ball's path only: the path is cut into pieces a few ball radii long, looked at in order, each
-/// asking the hierarchy for the triangles within the ball's reach of it, until a piece holds the
-/// first contact.
+/// A mesh's features are its faces (each a plane, on its outer side, an open mesh's on its back
+/// as well, within its triangle), the edges and vertices a ball can touch first (TriangleMesh),
+/// those of the triangles near the ball's path only: the path is cut into pieces a few ball radii
+/// long, looked at in order, each asking the hierarchy for the triangles within the ball's reach
+/// of it, until a piece holds the first contact.
 std::optional<double> firstContactFinite(const RelativeMotion& motion, const Mesh& mesh,
                                          double horizon);
 

@@ -166,6 +166,10 @@ void TriangleMesh::buildEdges() {
     return x.low != y.low ? x.low < y.low : x.high < y.high;
   });
   triangle_edges_.resize(triangles_.size());
+  // Per edge: between two faces in one plane (flat), or in a groove seen from the faces' outer
+  // side; whether it is reachable depends on whether the whole mesh is closed, known at the end.
+  std::vector<char> flat, groove;
+  closed_ = true;
   for (std::size_t i = 0; i < half_edges.size();) {
     std::size_t j = i;
     while (j < half_edges.size() && half_edges[j].low == half_edges[i].low &&
@@ -180,26 +184,36 @@ void TriangleMesh::buildEdges() {
       edge.pseudo_normal += normals_[half_edges[h].triangle];
       triangle_edges_[half_edges[h].triangle][half_edges[h].k] = index;
     }
+    bool is_flat = false, is_groove = false, opposite = false;
     if (j - i == 2) {
-      // Two faces: reachable only across a convex fold, their winding consistent (the edge run
-      // in opposite directions), the second face's far vertex below the first face's plane.
+      // Two faces. Their winding agrees when they run the edge in opposite directions; then they
+      // lie in one plane when their normals are one, and form a groove when the second face's
+      // far vertex rises above the first face's plane. Where the winding disagrees they lie in
+      // one plane when their normals are opposite. (Faces back to back, a knife's edge, rise 0
+      // with opposite normals and agreeing winding: neither.)
       const HalfEdge& first = half_edges[i];
       const HalfEdge& second = half_edges[i + 1];
       const Triangle& t1 = triangles_[first.triangle];
       const Triangle& t2 = triangles_[second.triangle];
-      const bool opposite = t1[first.k] != t2[second.k];
+      opposite = t1[first.k] != t2[second.k];
       const Eigen::Vector3d& n1 = normals_[first.triangle];
+      const Eigen::Vector3d& n2 = normals_[second.triangle];
       const Eigen::Vector3d& far = vertices_[t2[(second.k + 2) % 3]];
       const Eigen::Vector3d& on_edge = vertices_[edge.from];
       const double rise = n1.dot(far - on_edge);
-      const bool coplanar = (n1 - normals_[second.triangle]).norm() <= 1e-12;
-      // (Faces back to back, a knife's edge, rise 0 with opposite normals: reachable.)
-      if (opposite && (coplanar || rise > 1e-12 * (far - on_edge).norm())) {
-        edge.reachable = false;
-      }
+      is_flat = opposite ? (n1 - n2).norm() <= 1e-12 : (n1 + n2).norm() <= 1e-12;
+      is_groove = opposite && !is_flat && rise > 1e-12 * (far - on_edge).norm();
     }
+    if (!(j - i == 2 && opposite)) closed_ = false;
+    flat.push_back(is_flat);
+    groove.push_back(is_groove);
     edges_.push_back(edge);
     i = j;
+  }
+  // A groove's edge lies inside the grown solid of a closed mesh; on an open one (a surface) the
+  // groove's other side is a convex fold, whose edge a ball can touch first.
+  for (std::size_t e = 0; e < edges_.size(); ++e) {
+    edges_[e].reachable = !(flat[e] || (closed_ && groove[e]));
   }
 }
 
