@@ -721,5 +721,47 @@ TEST(FiniteShapes, RandomThrowsMissNothingAndInventNothing) {
   throwAtRandom("capsule", kCapsule, throws, 3);
 }
 
+/// The stretched icosahedron without the five triangles about one vertex: a bowl (an open mesh)
+/// whose inside is met through its pentagonal opening, on its faces' backs.
+std::shared_ptr<const TriangleMesh> openIcosahedron() {
+  const auto whole = stretchedIcosahedron();
+  const std::uint32_t top = whole->triangles()[0][0];
+  std::vector<TriangleMesh::Triangle> kept;
+  for (const TriangleMesh::Triangle& t : whole->triangles()) {
+    if (t[0] != top && t[1] != top && t[2] != top) kept.push_back(t);
+  }
+  return *TriangleMesh::build(whole->vertices(), kept, "open icosahedron");
+}
+
+/// A sheet folded five times (a zigzag 1.2 m along x, 0.8 m along y, 0.3 m deep), turned: its
+/// folds are convex on one side and grooves on the other, every one met from its convex side.
+std::shared_ptr<const TriangleMesh> foldedSheet() {
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.4, V(3, 1, 2).normalized()).toRotationMatrix();
+  std::vector<V> vertices;
+  for (int i = 0; i <= 6; ++i) {
+    for (const double y : {-0.4, 0.4}) {
+      vertices.push_back(turn * V(-0.6 + 0.2 * i, y, i % 2 ? 0.15 : -0.15));
+    }
+  }
+  std::vector<TriangleMesh::Triangle> triangles;
+  for (std::uint32_t i = 0; i < 6; ++i) {
+    triangles.push_back({2 * i, 2 * i + 2, 2 * i + 3});
+    triangles.push_back({2 * i, 2 * i + 3, 2 * i + 1});
+  }
+  return *TriangleMesh::build(vertices, triangles, "folded sheet");
+}
+
+// Open meshes are surfaces, met from either side: a bowl (the icosahedron without a cap) and a
+// folded sheet, 3,000 throws each against the plain distance to their triangles (the reference
+// of every mesh here).
+TEST(FiniteShapes, RandomThrowsAtOpenMeshesMeetEitherSide) {
+  const char* asked = std::getenv("FINITE_SHAPE_THROWS");
+  const int throws = asked ? std::max(1000, std::atoi(asked) / 4) : 3000;
+  EXPECT_FALSE(openIcosahedron()->closed());
+  EXPECT_FALSE(foldedSheet()->closed());
+  throwAtRandom("open icosahedron", Mesh{openIcosahedron()}, throws, 6);
+  throwAtRandom("folded sheet", Mesh{foldedSheet()}, throws, 7);
+}
+
 }  // namespace
 }  // namespace collision_response::core
