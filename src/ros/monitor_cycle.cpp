@@ -297,6 +297,29 @@ void MonitorCycle::reportStep(const core::StepReport& step, Update& update) cons
                                   " state(s) not newer than their body's last state",
                               step.stale_states});
   }
+  if (step.states_set_aside > 0) {
+    update.reports.push_back(
+        {Reason::kSetAside,
+         "dropped " + std::to_string(step.states_set_aside) +
+             " state(s) older than their body's motion in the monitor (an impact or a change of "
+             "lasting contact it found after the state's instant, in the same update): the "
+             "monitor's motion from there is kept",
+         step.states_set_aside});
+  }
+  for (const core::ContradictedImpact& contradicted : step.contradicted) {
+    // One a body and update, throttled with the others of its reason (doc/model.md, "Bad
+    // input, in full").
+    update.reports.push_back(
+        {Reason::kImpactContradicted,
+         "the state of '" + monitor_.body(contradicted.body).id + "' " +
+             core::formatNumber(contradicted.state_time - contradicted.impact_time) +
+             " s after its impact lacks it (its velocity falls short of the one after the "
+             "impact by " +
+             core::formatNumber(contradicted.missing) +
+             " m/s along the impact's change, more than half of it): the state is its motion from "
+             "there, the impact stays published (a source that applies the impacts sends that "
+             "state before it hears of it; any other source says the impact did not happen)"});
+  }
   if (step.truncated) {
     // What remained was resolved by a fallback that puts no body into another
     // (doc/model.md, "Lasting contact"): as one inelastic cluster, or the step's bodies held.

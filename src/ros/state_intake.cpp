@@ -74,6 +74,8 @@ const char* counterName(Reason reason) {
       return "dropped: transform missing";
     case Reason::kStale:
       return "dropped: stamp not newer than the body's last";
+    case Reason::kSetAside:
+      return "dropped: state older than its body's motion";
     case Reason::kStampOffClock:
       return "dropped: stamp off its source's clock";
     case Reason::kTooManyStates:
@@ -98,6 +100,10 @@ const char* counterName(Reason reason) {
       return "bodies stepped over the exact work budget";
     case Reason::kObstacleTransform:
       return "obstacle transform missing";
+    case Reason::kImpactContradicted:
+      return "impacts a later state lacks";
+    case Reason::kFlightStalled:
+      return "flights through air stalled";
   }
   return "unknown";
 }

@@ -119,12 +119,13 @@ TEST(Monitor, ImpactAlreadyAppliedBySourceIsFound) {
   EXPECT_NEAR(report.impacts[0].contact_point.z(), 0.0, 4 * kEps);
 }
 
-TEST(Monitor, ImpactAtTheStepsStartIsNotUndoneByTheSourcesNextState) {
+TEST(Monitor, ImpactAtTheStepsStartStaysReportedAndTheStateLackingItIsSaid) {
   // The source puts the ball on the floor, falling at 1 m/s, at t = 0.1 (say a stepped cluster
-  // let it go there). Its impact is at that instant, but found by the step that starts there,
-  // after the source sampled its state at 0.2 from the ball's unbounced motion: that state
-  // (0.05 m into the floor, still falling) is not the ball's motion. Without it, the monitor's
-  // own: e = 0.5, leaving at 0.5 m/s, 0.05 + 0.5 x 0.1 = 0.1 m up at 0.2.
+  // let it go there). Its impact is at that instant, found by the step that starts there, after
+  // the source sampled its state at 0.2 from the ball's unbounced motion (0.05 m into the floor,
+  // still falling). The impact is reported (e = 0.5: leaving at 0.5 m/s); the state is taken
+  // (a monitor follows its input) and said to lack it: it falls short of the velocity after
+  // the impact, 0.5 m/s, by 1.5 m/s, all of the impact's change (more than half of it).
   ImpactMonitor monitor(ballOnFloorScene(0.5), MonitorSettings{});
   monitor.step(0.0, {state(monitor, "ball", 0.0, V(0, 0, 1), V(0, 0, 0))});
   EXPECT_TRUE(
@@ -134,13 +135,88 @@ TEST(Monitor, ImpactAtTheStepsStartIsNotUndoneByTheSourcesNextState) {
   ASSERT_EQ(report.impacts.size(), 1u);
   EXPECT_EQ(report.impacts[0].time, 0.1);
   EXPECT_EQ(report.impacts[0].velocity_a_after, V(0, 0, 0.5));
+  ASSERT_EQ(report.contradicted.size(), 1u);
+  EXPECT_EQ(report.contradicted[0].body, *monitor.bodyIndex("ball"));
+  EXPECT_EQ(report.contradicted[0].impact_time, 0.1);
+  EXPECT_EQ(report.contradicted[0].state_time, 0.2);
+  EXPECT_EQ(report.contradicted[0].missing, 1.5);
   const auto predicted = monitor.predictedState(*monitor.bodyIndex("ball"), 0.2);
   ASSERT_TRUE(predicted);
-  EXPECT_NEAR(predicted->first.z(), 0.1, 4 * kEps);
-  EXPECT_EQ(predicted->second, V(0, 0, 0.5));
-  // The source, told of the impact, sends its bounced state next: that one is taken.
-  monitor.step(0.3, {state(monitor, "ball", 0.3, V(0, 0, 0.15), V(0, 0, 0.5))});
+  EXPECT_EQ(predicted->first, V(0, 0, -0.05));
+  EXPECT_EQ(predicted->second, V(0, 0, -1));
+  // The source, told of the impact, sends its bounced state next: taken, nothing to say, and
+  // no impact again (the ball overlapped the floor).
+  const StepReport next =
+      monitor.step(0.3, {state(monitor, "ball", 0.3, V(0, 0, 0.15), V(0, 0, 0.5))});
+  EXPECT_TRUE(next.impacts.empty());
+  EXPECT_TRUE(next.contradicted.empty());
   EXPECT_NEAR(monitor.predictedState(*monitor.bodyIndex("ball"), 0.4)->first.z(), 0.2, 4 * kEps);
+}
+
+// Issue 39, item 4: a ball (r = 0.05 m, e = 0.5, gravity g = 9.81, the floor z = 0) thrown from
+// (0, 0, 1) at (5, 0, -5) m/s every 0.7 s, its states at 100 Hz. The state after a bounce of the
+// monitor's ball was not used: the monitor's ball bounced on where no ball was. Each throw
+// meets the floor s = (sqrt(25 + 2 g (1 - r)) - 5) / g after it, at x = 5 s (closed form), and
+// its impact is reported once; every state is the ball's track from its instant. A source whose
+// ball bounces (e = 0.5, as the monitor's) says nothing more; one whose ball passes through
+// the floor (a tracker that never saw the bounce) lacks each impact, said once a throw.
+TEST(Monitor, Issue39_Item4_EveryThrowIsFollowedAndAStateLackingTheBounceIsSaid) {
+  const double g = 9.81, r = 0.05, e = 0.5, period = 0.7;
+  const int throws = 6, per_throw = 70;
+  const double s = (std::sqrt(25 + 2 * g * (1 - r)) - 5) / g;  // the floor, after each throw
+  const double up = e * (5 + g * s);                           // leaving it
+  for (const bool bounces : {true, false}) {
+    SCOPED_TRACE(bounces ? "the source's ball bounces" : "the source's ball passes through");
+    Scene scene = ballOnFloorScene(e);
+    scene.effects.gravity = true;
+    scene.gravity = V(0, 0, -g);
+    ImpactMonitor monitor(scene, MonitorSettings{});
+    std::vector<ImpactRecord> impacts;
+    std::size_t contradicted = 0;
+    for (int k = 0; k < throws * per_throw; ++k) {
+      const double t = 0.01 * k, since = 0.01 * (k % per_throw);
+      V position(5 * since, 0, 1 - 5 * since - 0.5 * g * since * since);
+      V velocity(5, 0, -5 - g * since);
+      if (bounces && since > s) {
+        const double u = since - s;
+        position.z() = r + up * u - 0.5 * g * u * u;
+        velocity.z() = up - g * u;
+      }
+      const StepReport report = monitor.step(t, {state(monitor, "ball", t, position, velocity)});
+      impacts.insert(impacts.end(), report.impacts.begin(), report.impacts.end());
+      contradicted += report.contradicted.size();
+      EXPECT_EQ(report.states_set_aside, 0u);
+      // The monitor follows its input: the track is the state.
+      const auto predicted = monitor.predictedState(0, t);
+      ASSERT_TRUE(predicted);
+      EXPECT_EQ(predicted->first, position) << "t = " << t;
+      EXPECT_EQ(predicted->second, velocity) << "t = " << t;
+    }
+    ASSERT_EQ(impacts.size(), static_cast<std::size_t>(throws));
+    for (int i = 0; i < throws; ++i) {
+      const ImpactRecord& impact = impacts[static_cast<std::size_t>(i)];
+      EXPECT_NEAR(impact.time, period * i + s, 1e-12) << "throw " << i;
+      EXPECT_NEAR(impact.contact_point.x(), 5 * s, 1e-11) << "throw " << i;
+      EXPECT_NEAR(impact.velocity_a_after.z(), up, 1e-12) << "throw " << i;
+    }
+    EXPECT_EQ(contradicted, bounces ? 0u : static_cast<std::size_t>(throws));
+  }
+}
+
+// Issue 39, item 4: whatever the monitor sets aside is counted. A ball 0.25 m up (0.2 m above the
+// floor) falling at 1 m/s from t = 0 meets the floor at 0.2; an update to 0.3 whose state is
+// stamped 0.1 (earlier than that impact, found from the track before it) is set aside: the
+// motion after the impact (e = 0.8: up at 0.8 m/s) is kept, and the state counted.
+TEST(Monitor, Issue39_Item4_AStateOlderThanAnImpactFoundAfterItIsSetAsideAndCounted) {
+  ImpactMonitor monitor(ballOnFloorScene(0.8), MonitorSettings{});
+  monitor.step(0.0, {state(monitor, "ball", 0.0, V(0, 0, 0.25), V(0, 0, -1))});
+  const StepReport report =
+      monitor.step(0.3, {state(monitor, "ball", 0.1, V(0, 0, 0.15), V(0, 0, -1))});
+  ASSERT_EQ(report.impacts.size(), 1u);
+  EXPECT_NEAR(report.impacts[0].time, 0.2, 4 * kEps);
+  EXPECT_EQ(report.states_set_aside, 1u);
+  EXPECT_TRUE(report.contradicted.empty());
+  EXPECT_EQ(monitor.predictedState(0, 0.3)->second, V(0, 0, 0.8));
 }
 
 TEST(Monitor, DiscreteFindsTheImpactAtTheSampleAfter) {

@@ -87,12 +87,32 @@ struct ContactRecord {
   double since = 0.0;  ///< s, the instant the contact began to last
 };
 
+/// A state taken after an impact that the monitor applied to its body, which lacks that impact
+/// (StepReport::contradicted).
+struct ContradictedImpact {
+  std::size_t body = 0;
+  double impact_time = 0.0;  ///< s: the impact's instant (the impact was reported)
+  double state_time = 0.0;   ///< s: the state's
+  /// m/s: how much of the impact's velocity change the state lacks, along it (more than half).
+  double missing = 0.0;
+};
+
 struct StepReport {
   std::vector<ImpactRecord> impacts;
   /// The lasting contacts at the step's time (with the gravity effect), in the order of their
   /// pairs.
   std::vector<ContactRecord> contacts;
   std::size_t stale_states = 0;  ///< states not newer than their body's last one: dropped
+  /// States older than their body's motion in the monitor (it starts at an impact or a change
+  /// of lasting contact found after the state's instant, within the same step): set aside, the
+  /// motion kept.
+  std::size_t states_set_aside = 0;
+  /// States taken although they lack an impact found since their body's previous state: the
+  /// body's velocity falls short of the model's after the impact by more than half the impact's
+  /// change, back towards before it. The state is the body's track; the impact stays reported.
+  /// (A source that applies the impacts samples the state after one before it hears of it; any
+  /// other source says the impact did not happen.)
+  std::vector<ContradictedImpact> contradicted;
   /// A guard of MonitorSettings ran out (rounds at an instant, instants in the step).
   bool truncated = false;
   /// What the fallbacks did when a guard ran out, so that no body goes into another: a cluster
@@ -131,9 +151,11 @@ struct StepReport {
 ///   act at impacts (applyFriction). An effect that is off is not on any path: the motion model
 ///   is a template parameter chosen once per step, the friction step a function chosen at
 ///   construction.
-/// - a state older than its body's track, or a state right after an impact that the monitor
-///   applied to that body, does not replace the track (the monitor's post-impact motion is the
-///   newer knowledge); the next state does.
+/// - a state newer than its body's last one replaces its track (a monitor follows its input),
+///   but for one older than the track's motion (an impact or a change of lasting contact found
+///   after the state's instant in the same step), which is set aside and counted. A state that
+///   lacks an impact found since its body's previous state is taken and reported
+///   (StepReport::contradicted); the impact stays reported.
 class ImpactMonitor {
  public:
   ImpactMonitor(const Scene& scene, const MonitorSettings& settings);

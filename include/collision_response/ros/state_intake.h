@@ -22,30 +22,33 @@ namespace collision_response {
 /// reason is one counter in diagnostics and one throttled warning per input topic, so the
 /// warnings' key space is these reasons times the node's topics, whatever a publisher sends.
 enum class Reason {
-  kEmptyId,            ///< a state with no id
-  kUnknownId,          ///< an id that is not one of the scene's bodies
-  kIdMismatch,         ///< on a body's own topic, another body's id
-  kDuplicateId,        ///< the same body twice in one message
-  kZeroStamp,          ///< header.stamp zero
-  kStampAhead,         ///< header.stamp too far ahead of the node's clock
-  kNonFinite,          ///< a NaN or infinite number
-  kBeyondResolution,   ///< a position past core::kMaxResolvedCoordinate: no contact resolved there
-  kTransformMissing,   ///< no transform from the state's frame, after waiting
-  kStale,              ///< not newer than the body's last state
-  kStampOffClock,      ///< a stamp back from its source's clock, the next one continuing it
-  kTooManyStates,      ///< a message with more than ~max_states states
-  kQueueFull,          ///< the oldest waiting input, dropped for a new one
-  kInternalError,      ///< an exception while processing a message
-  kImpactNotFinite,    ///< an impact whose numbers the doubles cannot hold: not published
-  kContactNotFinite,   ///< a lasting contact whose numbers the doubles cannot hold: not published
-  kClockJumpedBack,    ///< a source's stamps went back: every track reset
-  kClockOffset,        ///< a source's (or a stamp's) clock differs: placed with an offset
-  kStepTruncated,      ///< a guard of the monitor cut a step short
-  kSteppedHeld,        ///< a stepped cluster held still over sub-steps it could not solve
-  kOverWorkBudget,     ///< bodies the exact model spent its budget on: stepped from then on
-  kObstacleTransform,  ///< a tf-attached obstacle keeps its last known motion
+  kEmptyId,             ///< a state with no id
+  kUnknownId,           ///< an id that is not one of the scene's bodies
+  kIdMismatch,          ///< on a body's own topic, another body's id
+  kDuplicateId,         ///< the same body twice in one message
+  kZeroStamp,           ///< header.stamp zero
+  kStampAhead,          ///< header.stamp too far ahead of the node's clock
+  kNonFinite,           ///< a NaN or infinite number
+  kBeyondResolution,    ///< a position past core::kMaxResolvedCoordinate: no contact resolved there
+  kTransformMissing,    ///< no transform from the state's frame, after waiting
+  kStale,               ///< not newer than the body's last state
+  kSetAside,            ///< older than its body's motion in the monitor (found after it)
+  kStampOffClock,       ///< a stamp back from its source's clock, the next one continuing it
+  kTooManyStates,       ///< a message with more than ~max_states states
+  kQueueFull,           ///< the oldest waiting input, dropped for a new one
+  kInternalError,       ///< an exception while processing a message
+  kImpactNotFinite,     ///< an impact whose numbers the doubles cannot hold: not published
+  kContactNotFinite,    ///< a lasting contact whose numbers the doubles cannot hold: not published
+  kClockJumpedBack,     ///< a source's stamps went back: every track reset
+  kClockOffset,         ///< a source's (or a stamp's) clock differs: placed with an offset
+  kStepTruncated,       ///< a guard of the monitor cut a step short
+  kSteppedHeld,         ///< a stepped cluster held still over sub-steps it could not solve
+  kOverWorkBudget,      ///< bodies the exact model spent its budget on: stepped from then on
+  kObstacleTransform,   ///< a tf-attached obstacle keeps its last known motion
+  kImpactContradicted,  ///< a state taken after an impact lacks it (the impact stays published)
+  kFlightStalled,       ///< a flight through air the integrator could not carry on: held
 };
-inline constexpr int kReasonCount = static_cast<int>(Reason::kObstacleTransform) + 1;
+inline constexpr int kReasonCount = static_cast<int>(Reason::kFlightStalled) + 1;
 
 /// The counter's name, as diagnostics shows it: "dropped: unknown id", "clock jumped back", ...
 const char* counterName(Reason reason);

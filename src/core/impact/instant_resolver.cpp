@@ -206,6 +206,8 @@ void storeVelocities(World& world, double time, const PreparedCluster& prepared,
     if (world.isObstacle(participant) || world.inverseMassOf(participant) == 0.0) continue;
     Track& track = world.tracks[participant];
     track.position = positionAt<Motion>(world, participant, time);  // before the velocity changes
+    noteImpactChange(world, track, time,
+                     prepared.bodies[m].velocity - velocityAt<Motion>(world, participant, time));
     track.time = time;
     track.velocity = prepared.bodies[m].velocity;
     track.angular_velocity = prepared.bodies[m].angular_velocity;
@@ -596,6 +598,8 @@ void storeInelasticVelocities(World& world, double time,
     if (world.isObstacle(p) || world.inverseMassOf(p) == 0.0) continue;
     Track& track = world.tracks[p];
     track.position = positionAt<Motion>(world, p, time);
+    noteImpactChange(world, track, time,
+                     impact.after[i].linear - velocityAt<Motion>(world, p, time));
     track.time = time;
     track.velocity = impact.after[i].linear;
     if (world.spin_factor[p] != 0.0) track.angular_velocity = impact.after[i].angular;

@@ -84,9 +84,12 @@ bool releaseFromState(World& world, std::size_t body) {
 }
 
 /// Takes the received states as the bodies' tracks, oldest first: a state not newer than its
-/// body's last one is stale (counted, dropped); a state older than the track, or the first after
-/// an impact the monitor applied to the body, does not replace the track (the monitor's
-/// post-impact motion is the newer knowledge). `in_step`: the states end the step being taken.
+/// body's last one is stale (counted, dropped); a state older than the track's motion (found
+/// after the state's instant) is set aside (counted); every other replaces the track. One that
+/// follows an impact the monitor applied to the body since the body's previous state (or found
+/// in this step at its very start, `in_step`: the step the states end) and lacks more than half
+/// of the impact's velocity change is reported as contradicting it, but at the impact's own
+/// instant, where it is the motion just before the impact and the monitor keeps the one after.
 void applyStates(World& world, const std::vector<BodyStateSample>& states, StepReport& report,
                  bool in_step) {
   const auto earlier = [](const BodyStateSample& x, const BodyStateSample& y) {
@@ -109,13 +112,30 @@ void applyStates(World& world, const std::vector<BodyStateSample>& states, StepR
     }
     const double previous_state_time = track.last_state_time;
     track.last_state_time = state.time;
-    // The source sampled this state before it heard of the impacts this step found: one since
-    // its previous state, or one at that very instant found only now (a body a stepped cluster
-    // let go of at the step's start, closing on the floor), is not in it.
+    if (track.known && state.time < track.time) {
+      ++report.states_set_aside;
+      continue;
+    }
+    // An impact since the previous state (or at its instant, which kept the monitor's motion
+    // after it), or one at that very instant found only now (a body a stepped cluster let go of
+    // at the step's start, closing on the floor).
     const bool impact_since_previous_state =
-        (track.last_impact_time > previous_state_time && track.last_impact_time <= state.time) ||
+        (track.last_impact_time >= previous_state_time && track.last_impact_time <= state.time) ||
         (in_step && track.impact_step == world.steps);
-    if (track.known && (state.time < track.time || impact_since_previous_state)) continue;
+    if (track.known && impact_since_previous_state &&
+        track.impact_change != Eigen::Vector3d::Zero()) {
+      const auto predicted = withMotionModel(world, [&](auto motion) {
+        return monitor::velocityAt<decltype(motion)>(world, state.body, state.time);
+      });
+      const double change = track.impact_change.norm();
+      const double missing = -(state.velocity - predicted).dot(track.impact_change) / change;
+      if (missing > 0.5 * change) {
+        // At the impact's very instant the motion before it is as true as the one after: the
+        // monitor's after is kept (taken, the pair would strike again there).
+        if (state.time == track.last_impact_time) continue;
+        report.contradicted.push_back({state.body, track.last_impact_time, state.time, missing});
+      }
+    }
     restartTrack(world, state);
     if (world.effects.gravity) {
       releaseFromState(world, state.body);
@@ -233,6 +253,7 @@ void imposeStates(World& world, const std::vector<BodyStateSample>& imposed, Ste
     const bool stepped = releaseFromState(world, state.body);
     at.stepped_due = at.stepped_due || stepped;
     track.last_impact_time = state.time;
+    track.impact_change.setZero();  // the state is the motion after it: nothing to contradict
     // It is a state too: one given later at its own instant is newer than it.
     track.last_state_time = std::max(track.last_state_time, state.time);
     at.changed.push_back(state.body);

@@ -64,6 +64,9 @@ struct Track {
   double last_impact_time = kNever;
   /// World::steps of the step whose impact last changed its motion (0: none yet).
   std::uint64_t impact_step = 0;
+  /// m/s: what the impacts at last_impact_time changed its velocity by (zero: none, or a state
+  /// imposed): a state after it lacking half of that contradicts it (applyStates).
+  Eigen::Vector3d impact_change = Eigen::Vector3d::Zero();
   /// Its exact work ran over Scene::exact_work_budget: it is stepped with the bodies near it (in
   /// any number) until it is near none of them.
   bool over_budget = false;
@@ -292,6 +295,14 @@ struct World {
 /// (not in a stepped cluster) flies through air from there: its track follows an AirFlight from
 /// its position, velocity and spin. Without either effect nothing changes: the parabola (or the
 /// straight line) is its motion, and no flight is ever made.
+/// An impact at `time` changes a body's velocity by `change`: summed over the rounds of one
+/// instant in one step (a cradle's ball struck twice), from zero at a new instant.
+inline void noteImpactChange(const World& world, Track& track, double time,
+                             const Eigen::Vector3d& change) {
+  const bool same_instant = track.last_impact_time == time && track.impact_step == world.steps;
+  track.impact_change = (same_instant ? track.impact_change : Eigen::Vector3d::Zero()) + change;
+}
+
 inline void startFlight(World& world, std::size_t body) {
   if (world.air.empty()) return;
   Track& track = world.tracks[body];
