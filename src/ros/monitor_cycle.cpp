@@ -320,6 +320,15 @@ void MonitorCycle::reportStep(const core::StepReport& step, Update& update) cons
              "there, the impact stays published (a source that applies the impacts sends that "
              "state before it hears of it; any other source says the impact did not happen)"});
   }
+  for (const core::StalledFlight& flight : step.stalled) {
+    update.reports.push_back(
+        {Reason::kFlightStalled,
+         "the flight through air of '" + monitor_.body(flight.body).id + "' stalled " +
+             core::formatNumber(monitor_.now() - flight.stalled) +
+             " s before this update's end: its integrator could take no further step (a speed "
+             "or an air factor too large for it), and the body is held where it got to until "
+             "its next state or impact"});
+  }
   if (step.truncated) {
     // What remained was resolved by a fallback that puts no body into another
     // (doc/model.md, "Lasting contact"): as one inelastic cluster, or the step's bodies held.

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "collision_response/core/monitor.h"
+#include "collision_response/core/validation.h"
 #include "scene_builders.h"
 
 namespace collision_response::core {
@@ -203,6 +204,77 @@ TEST(Air, HugeAndTinySpeedsStayFinite) {
       EXPECT_TRUE(std::isfinite(impact.time)) << speed;
     }
   }
+}
+
+// Issue 39, item 5: a throw at 1e50 m/s (drag's acceleration k v^2 = 1e100 m/s^2 and more: the
+// integrator finds no step it can take) froze the ball without a word. The flight stalls at its
+// start and holds the state there (doc/model.md, "Effects in detail"), and the monitor says so
+// once, naming the body and the instant, whatever the steps after.
+TEST(Air, Issue39_Item5_AFlightThatStallsIsReportedOnce) {
+  Scene scene = airScene(true, true, false);
+  MonitorSettings settings;
+  settings.body_timeout = INFINITY;
+  ImpactMonitor monitor(scene, settings);
+  BodyStateSample state;
+  state.position = V(0, 0, 1);
+  state.velocity = V(1e50, 0, 0);
+  monitor.step(0.0, {state});
+  std::vector<StalledFlight> stalled;
+  for (int k = 1; k <= 10; ++k) {
+    const StepReport report = monitor.advance(0.01 * k, {});
+    stalled.insert(stalled.end(), report.stalled.begin(), report.stalled.end());
+  }
+  ASSERT_EQ(stalled.size(), 1u);
+  EXPECT_EQ(stalled[0].body, 0u);
+  EXPECT_EQ(stalled[0].stalled, 0.0);
+  EXPECT_EQ(monitor.predictedState(0, 0.1)->first, V(0, 0, 1));
+  // A new state starts a new flight, which goes on (and says nothing).
+  state.time = 0.2;
+  state.velocity = V(1, 0, 0);
+  EXPECT_TRUE(monitor.step(0.2, {state}).stalled.empty());
+  EXPECT_TRUE(monitor.advance(0.3, {}).stalled.empty());
+}
+
+// Issue 39, item 5: a C_d, a C_L or an air density of 1e300 froze the body at its first step
+// (the scene accepted them). Each is refused at its key, with the reason. At the bound itself,
+// an air factor k = rho C_d A / (2 m) of kMaxAirFactor = 1e3 1/m, a ball thrown at 30 m/s flies
+// the prediction's whole 60 s horizon without stalling and falls at its terminal speed
+// sqrt(g / k) (dv/dt = g - k v^2 = 0).
+TEST(Air, Issue39_Item5_AirTooStiffToIntegrateIsRefusedAtItsKey) {
+  Scene drag = airScene(true, true, false);
+  drag.bodies[0].drag_coefficient = 1e300;
+  const Status by_drag = validateScene(drag, "scene");
+  ASSERT_FALSE(by_drag.ok());
+  EXPECT_EQ(by_drag.error().field, "scene/bodies[0]/drag_coefficient");
+  EXPECT_NE(by_drag.error().reason.find("could not be integrated"), std::string::npos)
+      << by_drag.error().reason;
+  Scene lift = airScene(true, true, true);
+  lift.bodies[0].lift_coefficient = 1e300;
+  const Status by_lift = validateScene(lift, "scene");
+  ASSERT_FALSE(by_lift.ok());
+  EXPECT_EQ(by_lift.error().field, "scene/bodies[0]/lift_coefficient");
+  Scene dense = airScene(true, true, false);
+  dense.air_density = 1e300;
+  const Status by_density = validateScene(dense, "scene");
+  ASSERT_FALSE(by_density.ok());
+  EXPECT_EQ(by_density.error().field, "scene/air_density");
+  // Without the effect the coefficient is not used: nothing to refuse.
+  Scene off = airScene(true, false, false);
+  off.bodies[0].drag_coefficient = 1e300;
+  EXPECT_TRUE(validateScene(off, "scene").ok());
+
+  Scene bound = airScene(true, true, false);
+  bound.flight_integration_tolerance = 1e-9;
+  bound.bodies[0].drag_coefficient = kMaxAirFactor / factor(bound, 1.0);
+  ASSERT_TRUE(validateScene(bound, "scene").ok());
+  MonitorSettings settings;
+  settings.body_timeout = INFINITY;
+  ImpactMonitor monitor(bound, settings);
+  BodyStateSample state;
+  state.velocity = V(30, 0, 0);
+  monitor.step(0.0, {state});
+  EXPECT_TRUE(monitor.advance(60.0, {}).stalled.empty());
+  EXPECT_NEAR(monitor.predictedState(0, 60.0)->second.z(), -std::sqrt(kG / kMaxAirFactor), 1e-9);
 }
 
 }  // namespace

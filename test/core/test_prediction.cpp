@@ -265,6 +265,21 @@ TEST(Prediction, BudgetsAnswerWithWhatWasFoundAndSaySo) {
   EXPECT_EQ(prediction->contacts.size(), 1u);
 }
 
+// Issue 39, item 5: a ball thrown at 1e50 m/s through air answered success with the ball at its
+// initial state at the horizon, and no word. Its flight stalls at once (no step the integrator
+// can take): the answer says so, and that the ball is held there.
+TEST(Prediction, Issue39_Item5_AFlightThatStallsIsSaidInTheMessage) {
+  Scene scene = tableScene();
+  scene.effects.drag = true;
+  auto request = requestFor(scene, V(5, 0, 1.0), V(1e50, 0, 0), 1.0, 3);
+  const auto prediction = predictImpacts(scene, nullptr, MonitorSettings{}, request);
+  ASSERT_TRUE(prediction.ok()) << prediction.error().message();
+  EXPECT_TRUE(prediction->cut_short);
+  EXPECT_NE(prediction->message.find("the flight through air stalled at +0 s"), std::string::npos)
+      << prediction->message;
+  EXPECT_EQ(prediction->final_state.position, V(5, 0, 1.0));
+}
+
 TEST(Prediction, EveryBadRequestIsNamed) {
   const Scene scene = tableScene();
   const auto good = requestFor(scene, V(0, 0, 1.2), V::Zero(), 1.0, 2);

@@ -1066,6 +1066,44 @@ TEST_F(ThrowCycle, Issue39_Item4_EveryThrowIsFollowedAndTheStateLackingItsBounce
   EXPECT_EQ(diagnosticValue(status, "impacts a later state lacks (total)"), std::to_string(throws));
 }
 
+// Issue 39, item 5: a ball thrown at 1e50 m/s through air (drag) froze without a word: its flight
+// stalls at once (the integrator finds no step). Said once, naming the ball, and counted in
+// diagnostics; the next state starts a flight that goes on.
+core::Scene airScene() {
+  core::Scene scene = throwScene();
+  scene.effects.drag = true;
+  return scene;
+}
+
+class AirCycle : public Cycle {
+ protected:
+  AirCycle() : Cycle(airScene()) {}
+};
+
+TEST_F(AirCycle, Issue39_Item5_AFlightThatStallsIsSaidAndCounted) {
+  const ros::Time start(1000, 0);
+  send({state("ball", start, {0, 0, 1}, {1e50, 0, 0})});
+  for (int k = 1; k <= 5; ++k) send({state("ball", at(start, 0.01 * k), {0, 0, 1}, {1e50, 0, 0})});
+  // Each state's flight stalls at its start, said by the update after it (which integrates it).
+  EXPECT_EQ(reportsOf(Reason::kFlightStalled), 5u);
+  const Report* report = firstReport(Reason::kFlightStalled);
+  ASSERT_NE(report, nullptr);
+  EXPECT_EQ(report->text.find("the flight through air of 'ball' stalled 0.01 s before"), 0u)
+      << report->text;
+  EXPECT_FALSE(isDrop(Reason::kFlightStalled));
+  MonitorDiagnostics diagnostics;
+  for (const Report& item : reports_) diagnostics.count(item.reason, item.count);
+  diagnostic_updater::DiagnosticStatusWrapper status;
+  diagnostics.report(status, cycle_, 0);
+  EXPECT_EQ(diagnosticValue(status, "flights through air stalled (total)"), "5");
+  reports_.clear();
+  send({state("ball", at(start, 0.06), {0, 0, 1}, {5, 0, 0})});
+  EXPECT_EQ(reportsOf(Reason::kFlightStalled), 1u) << "the flight of the state at 0.05 s";
+  reports_.clear();
+  for (int k = 7; k <= 10; ++k) send({state("ball", at(start, 0.01 * k), {0, 0, 1}, {5, 0, 0})});
+  EXPECT_EQ(reportsOf(Reason::kFlightStalled), 0u);
+}
+
 TEST_F(Cycle, EveryReasonHasItsOwnCounter) {
   std::set<std::string> names;
   for (int i = 0; i < kReasonCount; ++i) names.insert(counterName(static_cast<Reason>(i)));

@@ -97,6 +97,12 @@ struct ContradictedImpact {
   double missing = 0.0;
 };
 
+/// A body's flight through air that its integrator could not carry on (StepReport::stalled).
+struct StalledFlight {
+  std::size_t body = 0;
+  double stalled = 0.0;  ///< s: from here the body is held where its flight got to
+};
+
 struct StepReport {
   std::vector<ImpactRecord> impacts;
   /// The lasting contacts at the step's time (with the gravity effect), in the order of their
@@ -113,6 +119,10 @@ struct StepReport {
   /// (A source that applies the impacts samples the state after one before it hears of it; any
   /// other source says the impact did not happen.)
   std::vector<ContradictedImpact> contradicted;
+  /// Flights through air (drag, magnus) that stalled in this step (a speed or an air factor
+  /// too large for the integrator, or its steps run out): the body is held where the flight got
+  /// to until its motion starts again (a state, an impact). Each flight once.
+  std::vector<StalledFlight> stalled;
   /// A guard of MonitorSettings ran out (rounds at an instant, instants in the step).
   bool truncated = false;
   /// What the fallbacks did when a guard ran out, so that no body goes into another: a cluster

@@ -71,6 +71,16 @@ inline constexpr double kMaxResolvedCoordinate = 0x1p1022;
 /// error names the coordinate (`field`.x) and the bound.
 Status checkResolvablePosition(const Eigen::Vector3d& position, const std::string& field);
 
+/// The densest air the drag and magnus effects take, kg/m^3: denser than any liquid (mercury,
+/// 13,546 kg/m^3), where a flight's speed would be spent at once.
+inline constexpr double kMaxAirDensity = 2e4;
+/// The largest air factor of a body, rho C A / (2 m) (drag's or lift's, 1/m; AirFactors), its
+/// flight is integrated with: there the terminal speed sqrt(|g| / k) is 0.099 m/s and a flight
+/// of the prediction's 60 s horizon takes about 3,800 of the integrator's steps; at 1e5 1/m
+/// (explicit steps held by the drag's stiffness) the 16,384 a flight may take run out at 27 s
+/// (doc/model.md, "Effects in detail").
+inline constexpr double kMaxAirFactor = 1e3;
+
 /// Mass, radius, position, velocity and angular velocity of one body; `prefix` names it ("a").
 Status checkBody(const Body& body, const std::string& prefix);
 

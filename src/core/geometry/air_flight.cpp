@@ -152,4 +152,10 @@ double AirFlight::accelerationBound(std::size_t, double gravity, double from, do
 
 std::size_t AirFlight::steps() const { return integration_->steps.size(); }
 
+double AirFlight::stalledAt() const {
+  const Integration& integration = *integration_;
+  if (!integration.stalled) return std::numeric_limits<double>::infinity();
+  return integration.steps.empty() ? start_ : integration.steps.back().current_time();
+}
+
 }  // namespace collision_response::core

@@ -51,6 +51,9 @@ class AirFlight final : public IntegratedMotion {
   /// without drag by its start plus |g| (to - from).
   double accelerationBound(std::size_t slot, double gravity, double from, double to) const override;
   bool free() const override { return true; }
+  /// Where the integrator could not go on (a step it could not take, a state past the doubles,
+  /// or kMaxSteps taken), the flight holds its last state reached from then on.
+  double stalledAt() const override;
   /// The integrator's steps taken so far (the work it cost).
   std::size_t steps() const;
 

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <limits>
 
 namespace collision_response::core {
 
@@ -26,6 +27,9 @@ class IntegratedMotion {
                                    double to) const = 0;
   /// A flight (no lasting contact): the body is free until it meets something.
   virtual bool free() const { return false; }
+  /// The instant from which the motion could not be integrated further and holds its last state
+  /// (a flight through air that stalled), as far as it has been asked; infinity: none.
+  virtual double stalledAt() const { return std::numeric_limits<double>::infinity(); }
 };
 
 }  // namespace collision_response::core

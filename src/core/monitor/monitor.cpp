@@ -144,6 +144,21 @@ void applyStates(World& world, const std::vector<BodyStateSample>& states, StepR
   }
 }
 
+/// The flights through air that stalled up to `time` (each integrated that far: the same steps
+/// as when it is asked later), and those left since the last report, into the report.
+template <class Motion>
+void reportStalledFlights(World& world, double time, StepReport& report) {
+  if (world.air.empty()) return;
+  for (std::size_t body = 0; body < world.tracks.size(); ++body) {
+    const Track& track = world.tracks[body];
+    if (!track.known || !track.constrained || !track.constrained->free()) continue;
+    monitor::positionAt<Motion>(world, body, time);
+    monitor::noteStall(world, body);
+  }
+  report.stalled.insert(report.stalled.end(), world.stalled.begin(), world.stalled.end());
+  world.stalled.clear();
+}
+
 void forgetStaleBodies(World& world, double time) {
   for (Track& track : world.tracks) {
     if (track.known && time - track.last_state_time > world.settings.body_timeout) {
@@ -471,6 +486,7 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
     at.extended.clear();
     if (!nextEvent<Motion>(world, schedule, imposed, time, at)) break;
   }
+  reportStalledFlights<Motion>(world, time, report);
   applyStates(world, states, report, true);
   world.now = time;
   if constexpr (Motion::kAccelerates) {
@@ -668,6 +684,7 @@ StepReport discreteStep(World& world, double time, const std::vector<BodyStateSa
     monitor::joinStepped(world, time, moved, changed, report);
   }
   rememberOverlapping<Motion>(world, time, pairs);
+  reportStalledFlights<Motion>(world, time, report);
   if constexpr (Motion::kAccelerates) {
     reportLastingContact(world, time, report);
     report.exact_work = world.work_total;
@@ -815,6 +832,7 @@ void ImpactMonitor::reset() {
   monitor::clearStepped(world, world.now);
   monitor::clearGroups(world);
   world.contact_since.clear();
+  world.stalled.clear();
   world.started = false;
   world.now = 0.0;
 }

@@ -67,6 +67,8 @@ struct Track {
   /// m/s: what the impacts at last_impact_time changed its velocity by (zero: none, or a state
   /// imposed): a state after it lacking half of that contradicts it (applyStates).
   Eigen::Vector3d impact_change = Eigen::Vector3d::Zero();
+  /// Its flight through air (constrained) stalled and was reported (World::stalled).
+  bool stall_reported = false;
   /// Its exact work ran over Scene::exact_work_budget: it is stepped with the bodies near it (in
   /// any number) until it is near none of them.
   bool over_budget = false;
@@ -238,6 +240,8 @@ struct World {
   double now = 0.0;
   /// Steps taken (ImpactMonitor::step from the start on): the current one while it runs.
   std::uint64_t steps = 0;
+  /// Flights through air that stalled since the last step's report (noteStall).
+  std::vector<StalledFlight> stalled;
   double step_end = 0.0;  // the end of the step being taken (curved motion is integrated to it)
   double sample_period = 0.0;  // discrete: the time from the step before to this one
 
@@ -303,9 +307,22 @@ inline void noteImpactChange(const World& world, Track& track, double time,
   track.impact_change = (same_instant ? track.impact_change : Eigen::Vector3d::Zero()) + change;
 }
 
+/// A body's flight through air that has stalled (as far as it was asked), not reported yet,
+/// noted in World::stalled.
+inline void noteStall(World& world, std::size_t body) {
+  Track& track = world.tracks[body];
+  if (!track.constrained || !track.constrained->free() || track.stall_reported) return;
+  const double stalled = track.constrained->stalledAt();
+  if (!(stalled < std::numeric_limits<double>::infinity())) return;
+  track.stall_reported = true;
+  world.stalled.push_back({body, stalled});
+}
+
 inline void startFlight(World& world, std::size_t body) {
   if (world.air.empty()) return;
   Track& track = world.tracks[body];
+  noteStall(world, body);  // the flight it leaves
+  track.stall_reported = false;
   if (world.inverse_mass[body] == 0.0 || track.stepped >= 0) return;
   track.constrained = std::make_shared<AirFlight>(track.time, track.position, track.velocity,
                                                   track.angular_velocity, world.gravity,

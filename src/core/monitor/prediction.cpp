@@ -192,11 +192,13 @@ class PredictionRun {
     if (request_.sample_period > 0) prediction.samples.push_back(stateOf(*model, 0.0));
     double now = 0.0;
     bool truncated = false;
+    double stalled_at = INFINITY;  // the earliest stall of the body's flight through air
     for (std::size_t piece = 1; piece <= pieces_ && now < horizon_; ++piece) {
       const double next = pieceEnd(piece);
       const Eigen::Vector3d from = stateOf(*model, now).position;
       StepReport report = model->advance(next, {});
       truncated = truncated || report.truncated;
+      noteStalls(report, stalled_at);
       const std::size_t room = max_impacts_ - prediction.impacts.size();
       std::shared_ptr<const ImpactMonitor> before;
       if (report.impacts.size() >= room) {
@@ -212,6 +214,7 @@ class PredictionRun {
         model = std::make_shared<ImpactMonitor>(*before);
         report = model->advance(last, {});
         truncated = truncated || report.truncated;
+        noteStalls(report, stalled_at);
         next_ = last;
       } else {
         next_ = next;
@@ -225,12 +228,24 @@ class PredictionRun {
       if (request_.sample_period > 0) prediction.samples.push_back(stateOf(*model, now));
     }
     if (truncated) cut.push_back("the monitor's guard on impacts at one instant ran out");
+    if (stalled_at < INFINITY) {
+      cut.push_back("the flight through air stalled at +" + formatNumber(stalled_at) +
+                    " s (its integrator could take no further step: a speed or an air factor "
+                    "too large for it); the body is held where it got to from there, its state "
+                    "at the horizon too");
+    }
     prediction.final_state = stateOf(*model, now);
     prediction.model = std::move(model);
     return prediction;
   }
 
  private:
+  static void noteStalls(const StepReport& report, double& stalled_at) {
+    for (const StalledFlight& flight : report.stalled) {
+      stalled_at = std::min(stalled_at, flight.stalled);
+    }
+  }
+
   /// The horizon, impacts and pieces within the budgets (kPredictionMax*); what was cut is said.
   void budget(std::vector<std::string>& cut) {
     horizon_ = request_.horizon;

@@ -6,9 +6,11 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <tuple>
 #include <utility>
 
 #include "collision_response/core/validation.h"
+#include "geometry/air_flight.h"
 #include "geometry/narrow_phase.h"
 
 namespace collision_response::core {
@@ -75,10 +77,42 @@ Status checkAir(const Scene& scene, const std::string& prefix) {
         prefix + "/flight_integration_tolerance",
         "must be in [1e-14, 1e-3], got " + formatNumber(scene.flight_integration_tolerance)};
   }
+  if (scene.effects.air() && scene.air_density > kMaxAirDensity) {
+    return Error{prefix + "/air_density",
+                 "must be at most " + formatNumber(kMaxAirDensity) +
+                     " kg/m^3 (denser than any liquid: a flight through it could not be "
+                     "integrated), got " +
+                     formatNumber(scene.air_density)};
+  }
   if (scene.effects.magnus && !scene.effects.spin) {
     return Error{prefix + "/effects",
                  "names magnus without spin: the Magnus force comes from the spin, which only "
                  "the spin effect carries (add spin)"};
+  }
+  return Ok{};
+}
+
+/// A body's flight through air (drag, magnus) within what its integrator can follow: each air
+/// factor rho C A / (2 m) at most kMaxAirFactor (a C_d or C_L of 1e300 froze the body, the
+/// integrator stalled at its first step).
+Status checkAirFactors(const Scene& scene, const BodySpec& body, const std::string& prefix,
+                       std::size_t i) {
+  if (!scene.effects.air()) return Ok{};
+  const AirFactors air = airFactors(scene.air_density, body.radius, inverseMass(body.mass),
+                                    scene.effects.drag ? body.drag_coefficient : 0.0,
+                                    scene.effects.magnus ? body.lift_coefficient : 0.0);
+  for (const auto& [factor, key, symbol] : {std::make_tuple(air.drag, "drag_coefficient", "C_d"),
+                                            std::make_tuple(air.lift, "lift_coefficient", "C_L")}) {
+    if (factor <= kMaxAirFactor) continue;
+    return Error{item(prefix, "bodies", i, key),
+                 std::string("with air_density ") + formatNumber(scene.air_density) +
+                     " kg/m^3, radius " + formatNumber(body.radius) + " m and mass " +
+                     formatNumber(body.mass) + " kg, the air factor rho " + symbol +
+                     " pi r^2 / (2 m) is " + formatNumber(factor) + " 1/m, above " +
+                     formatNumber(kMaxAirFactor) +
+                     " 1/m: a flight that stiff could not be integrated (it would stall, the "
+                     "body held still); lower " +
+                     symbol + " or the density, or raise the mass"};
   }
   return Ok{};
 }
@@ -160,6 +194,7 @@ Status checkBodies(const Scene& scene, const std::string& prefix, std::set<std::
         !status) {
       return status;
     }
+    if (auto status = checkAirFactors(scene, body, prefix, i); !status) return status;
     const std::string angular = item(prefix, "bodies", i, "angular_velocity");
     if (auto status = checkFinite(body.angular_velocity, angular); !status) return status;
     if (!scene.effects.spin && body.angular_velocity != Eigen::Vector3d::Zero()) {
