@@ -475,6 +475,8 @@ core::Expected<core::Scene> loadScene(const XmlRpc::XmlRpcValue& value, const st
   if (warnings) {
     const auto inside = core::bodiesStartingInside(scene);
     warnings->insert(warnings->end(), inside.begin(), inside.end());
+    const auto coarse = core::obstaclesBeyondResolution(scene, field);
+    warnings->insert(warnings->end(), coarse.begin(), coarse.end());
   }
   return scene;
 }

@@ -277,6 +277,63 @@ TEST(Validation, APositionPastTheMonitorsResolutionIsRefusedNamingTheCoordinate)
   EXPECT_EQ(nan.error().message(), "p.z: must be a finite number, got nan");
 }
 
+// Issue 39, item 6: a box at x = 1e300 with a ball 1.1 m above it reported impacts at +0 s and
+// +0.2 s, the ball 1.1 and 0.5 m away, with no word: a body near it has a touching band of
+// 2^-48 (|x_ball| + |x_box| + ...) = 7e285 m. As a body's contacts are coarse from |x| = 2^47 r on,
+// an obstacle's are from 2^47 times its bounding radius, where that band is as wide as the whole
+// obstacle: the scene warns, naming the field. A box of edges 2, 2 and 1 m holds in a sphere of
+// radius sqrt(1 + 1 + 1/4) = 1.5 m: |x| < 2^47 x 1.5 = 211106232532992 m (exactly). As a body's
+// coordinates, a plane's offset, every extent and a position are refused from 2^1022 on.
+TEST(Validation, Issue39_Item6_AnObstacleBeyondItsResolutionIsWarnedOrRefusedNamingTheField) {
+  using Eigen::Vector3d;
+  const double bound = 211106232532992.0;
+  Scene scene;
+  scene.obstacles = {
+      scene_builders::box("table", Vector3d(1e300, 0, 0), Vector3d(2, 2, 1), "concrete")};
+  ASSERT_TRUE(validateScene(scene, "scene").ok());
+  std::vector<std::string> warnings = obstaclesBeyondResolution(scene, "scene");
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_EQ(warnings[0],
+            "scene/obstacles[0]/position.x: 1e+300 m is beyond where a contact with this obstacle "
+            "resolves (|x| must be below 2^47 times its bounding radius 1.5 m, 211106232532992 m: "
+            "from there the touching band of a body near it, 2^-48 (|x_body| + |x| + ...), is as "
+            "wide as the whole obstacle): a body touches obstacle 'table' from as far as it is "
+            "large (its contacts are coarse)");
+  scene.obstacles[0].position = Vector3d(0, 0, -bound);
+  warnings = obstaclesBeyondResolution(scene, "scene");
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_EQ(warnings[0].find("scene/obstacles[0]/position.z: "), 0u) << warnings[0];
+  scene.obstacles[0].position = Vector3d(0, 0, -std::nextafter(bound, 0.0));
+  EXPECT_TRUE(obstaclesBeyondResolution(scene, "scene").empty());
+  // A sphere's bound is its radius's; a point (radius 0) is held as a body of radius 0 is.
+  scene.obstacles = {scene_builders::sphere("post", Vector3d(0, 0.5 * 0x1p47, 0), 1.0, "concrete")};
+  EXPECT_TRUE(obstaclesBeyondResolution(scene, "scene").empty());
+  scene.obstacles[0].position.y() = 0x1p47;
+  EXPECT_EQ(obstaclesBeyondResolution(scene, "scene").size(), 1u);
+  scene.obstacles[0].radius = 0.0;
+  EXPECT_TRUE(obstaclesBeyondResolution(scene, "scene").empty());
+  // Refused, as a body's position is: from 2^1022 on.
+  scene.obstacles[0].position.y() = 0x1p1022;
+  const Status post = validateScene(scene, "scene");
+  ASSERT_FALSE(post.ok());
+  EXPECT_EQ(post.error().message(),
+            "scene/obstacles[0]/position.y: 4.49423283715579e+307 m is beyond where the monitor "
+            "can resolve a contact (|y| must be below 2^1022 = 4.49423283715579e+307 m: past "
+            "2^1023 the sum of two bodies' coordinates overflows)");
+  scene.obstacles = {
+      scene_builders::box("table", Vector3d::Zero(), Vector3d(2, 1e308, 1), "concrete")};
+  EXPECT_EQ(validateScene(scene, "scene").error().field, "scene/obstacles[0]/size");
+  scene.obstacles = {scene_builders::plane("floor", Vector3d::UnitZ(), 1.7e308, "concrete")};
+  const Status plane = validateScene(scene, "scene");
+  ASSERT_FALSE(plane.ok());
+  EXPECT_EQ(plane.error().message(),
+            "scene/obstacles[0]/offset: 1.7e+308 m is beyond where the monitor can resolve a "
+            "contact (its magnitude must be below 2^1022 = 4.49423283715579e+307 m: past 2^1023 "
+            "the sum of two coordinates overflows)");
+  scene.obstacles[0].offset = std::nextafter(0x1p1022, 0.0);
+  EXPECT_TRUE(validateScene(scene, "scene").ok());
+}
+
 // A body placed inside a fixed obstacle is named with the obstacle and its depth; one touching
 // it, one outside, and one inside an obstacle on a tf frame (placed only at run time) are not.
 TEST(Validation, BodiesStartingInsideAFixedObstacleAreNamed) {

@@ -771,6 +771,51 @@ TEST(SceneLoader, ABodyPlacedPastTheMonitorsResolutionIsRefusedNamingTheCoordina
   EXPECT_EQ(sceneErrorField(scene), "");
 }
 
+// Issue 39, item 6: a box placed at x = 1e300 was loaded and met a ball 1.1 m above it at once,
+// with no word. An obstacle whose position is at or beyond 2^47 times its bounding radius (where
+// the touching band of a body near it is as wide as the obstacle) is a start-up warning naming
+// the field; a plane's offset from 2^1022 on is refused, as a body's position is.
+TEST(SceneLoader, Issue39_Item6_AnObstacleBeyondItsResolutionIsNamed) {
+  auto scene = fullScene();
+  XmlRpc::XmlRpcValue box;
+  box["id"] = "far_table";
+  box["type"] = "box";
+  box["material"] = "concrete";
+  box["position"][0] = 1e300;
+  box["position"][1] = 0.0;
+  box["position"][2] = 0.0;
+  box["size"][0] = 2.0;
+  box["size"][1] = 2.0;
+  box["size"][2] = 1.0;
+  const int index = scene["obstacles"].size();
+  scene["obstacles"][index] = box;
+  // (The scene's two balls start inside its floor: warned too.)
+  const std::string named = "~scene/obstacles[" + std::to_string(index) + "]/position.x: ";
+  const auto about = [&named](const std::vector<std::string>& warnings) {
+    std::vector<std::string> found;
+    for (const std::string& warning : warnings) {
+      if (warning.rfind(named, 0) == 0) found.push_back(warning);
+    }
+    return found;
+  };
+  std::vector<std::string> warnings;
+  ASSERT_TRUE(loadScene(scene, "~scene", nullptr, &warnings).ok());
+  ASSERT_EQ(about(warnings).size(), 1u);
+  EXPECT_EQ(
+      about(warnings)[0].find(named + "1e+300 m is beyond where a contact with this obstacle "
+                                      "resolves (|x| must be below 2^47 times its bounding radius "
+                                      "1.5 m, 211106232532992 m"),
+      0u)
+      << about(warnings)[0];
+  scene["obstacles"][index]["position"][0] = 1e14;
+  warnings.clear();
+  ASSERT_TRUE(loadScene(scene, "~scene", nullptr, &warnings).ok());
+  EXPECT_TRUE(about(warnings).empty());
+  scene = fullScene();
+  scene["obstacles"][0]["offset"] = 1.7e308;
+  EXPECT_EQ(sceneErrorField(scene), "~scene/obstacles[0]/offset");
+}
+
 TEST(SceneLoader, FramesWithALeadingSlashAreRefused) {
   auto scene = fullScene();
   scene["fixed_frame"] = "/world";

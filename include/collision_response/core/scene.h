@@ -136,6 +136,13 @@ Status validateScene(const Scene& scene, const std::string& prefix);
 /// began), but the user most likely placed it wrongly. For a scene validateScene accepted.
 std::vector<std::string> bodiesStartingInside(const Scene& scene);
 
+/// A warning for each obstacle (but a plane) whose position has a coordinate at or beyond 2^47
+/// times its bounding radius (checkResolvableObstaclePosition): a body near it touches it from
+/// as far as the obstacle is large, as a ball of radius r is coarse from |x| = 2^47 r on (README,
+/// "Bad input on the topics"). Named as scene keys under `prefix`: "~scene/obstacles[0]/position.x:
+/// 1e+300 m is beyond where a contact with this obstacle resolves (...)".
+std::vector<std::string> obstaclesBeyondResolution(const Scene& scene, const std::string& prefix);
+
 /// Scales every plane's normal to unit length without under- or overflow (a normal of length
 /// 1e-200 or 1e200 is as good as any other nonzero one). For a scene validateScene accepted.
 void normalizePlanes(Scene& scene);

@@ -81,6 +81,20 @@ inline constexpr double kMaxAirDensity = 2e4;
 /// (doc/model.md, "Effects in detail").
 inline constexpr double kMaxAirFactor = 1e3;
 
+/// A length of an obstacle, m (a plane's offset, a box's edge, a radius or a length): its
+/// magnitude below kMaxResolvedCoordinate, as a body's coordinates (their sums overflow past it).
+Status checkResolvableLength(double length, const std::string& field);
+/// An obstacle's position (its centre, a mesh's origin), where its contacts resolve: as a body's
+/// (checkResolvablePosition), and each coordinate below 2^47 times `reach`, the radius of the
+/// smallest sphere about the position that holds the obstacle (0: a point, no such bound). From
+/// there on a body near it has a touching band, 2^-48 (|x_body| + |x| + reach + r), as wide as
+/// the whole obstacle (a box at x = 1e300 met a ball 1.1 m above it at once): the bound that
+/// makes contacts with a ball of radius r coarse from |x| = 2^47 r on (README, "Bad input on
+/// the topics") holds the obstacle's own size. The error names the coordinate (`field`.x); a
+/// scene warns with it (obstaclesBeyondResolution), as its bodies are coarse there, not lost.
+Status checkResolvableObstaclePosition(const Eigen::Vector3d& position, double reach,
+                                       const std::string& field);
+
 /// Mass, radius, position, velocity and angular velocity of one body; `prefix` names it ("a").
 Status checkBody(const Body& body, const std::string& prefix);
 

@@ -8,9 +8,11 @@
 #include <set>
 #include <tuple>
 #include <utility>
+#include <variant>
 
 #include "collision_response/core/validation.h"
 #include "geometry/air_flight.h"
+#include "geometry/finite_shapes.h"
 #include "geometry/narrow_phase.h"
 
 namespace collision_response::core {
@@ -207,6 +209,42 @@ Status checkBodies(const Scene& scene, const std::string& prefix, std::set<std::
   return Ok{};
 }
 
+/// The radius of the smallest sphere about an obstacle's position that holds it (0: a plane, a
+/// point).
+double reachOf(const Shape& shape) {
+  if (const auto* sphere = std::get_if<Sphere>(&shape)) return sphere->radius;
+  if (const auto* box = std::get_if<Cuboid>(&shape)) return boundingRadius(*box);
+  if (const auto* cylinder = std::get_if<Cylinder>(&shape)) return boundingRadius(*cylinder);
+  if (const auto* capsule = std::get_if<Capsule>(&shape)) return boundingRadius(*capsule);
+  if (const auto* mesh = std::get_if<Mesh>(&shape)) return boundingRadius(*mesh);
+  return 0.0;
+}
+
+/// An obstacle's numbers where the monitor resolves its contacts, as a body's position is
+/// checked (kMaxResolvedCoordinate): a plane's offset, every extent, and the position.
+template <class Field>
+Status checkResolvableObstacle(const ObstacleSpec& obstacle, const Field& field) {
+  if (obstacle.shape == ObstacleShape::kPlane) {
+    return checkResolvableLength(obstacle.offset, field("offset"));
+  }
+  if (obstacle.shape == ObstacleShape::kBox) {
+    for (int axis = 0; axis < 3; ++axis) {
+      if (auto status = checkResolvableLength(obstacle.size[axis], field("size")); !status) {
+        return status;
+      }
+    }
+  }
+  if (obstacle.shape != ObstacleShape::kMesh) {
+    if (auto status = checkResolvableLength(obstacle.radius, field("radius")); !status) {
+      return status;
+    }
+    if (auto status = checkResolvableLength(obstacle.length, field("length")); !status) {
+      return status;
+    }
+  }
+  return checkResolvablePosition(obstacle.position, field("position"));
+}
+
 /// Each obstacle: an id unique among bodies and obstacles, a material, a frame, and its shape's
 /// numbers (a plane's nonzero normal and offset, a sphere's centre and radius).
 Status checkObstacles(const Scene& scene, const std::string& prefix, std::set<std::string>& ids) {
@@ -230,11 +268,9 @@ Status checkObstacles(const Scene& scene, const std::string& prefix, std::set<st
         return status;
       }
     }
-    if (auto status = checkShape(
-            shapeOf(obstacle), [&](const char* key) { return item(prefix, "obstacles", i, key); });
-        !status) {
-      return status;
-    }
+    const auto field = [&](const char* key) { return item(prefix, "obstacles", i, key); };
+    if (auto status = checkShape(shapeOf(obstacle), field); !status) return status;
+    if (auto status = checkResolvableObstacle(obstacle, field); !status) return status;
   }
   return Ok{};
 }
@@ -308,6 +344,21 @@ std::vector<std::string> bodiesStartingInside(const Scene& scene) {
       if (!(g.gap < -g.tolerance)) continue;
       warnings.push_back("body '" + body.id + "' at " + formatVector(body.position) + " starts " +
                          depth(-g.gap) + " m inside obstacle '" + obstacle.id + "'");
+    }
+  }
+  return warnings;
+}
+
+std::vector<std::string> obstaclesBeyondResolution(const Scene& scene, const std::string& prefix) {
+  std::vector<std::string> warnings;
+  for (std::size_t i = 0; i < scene.obstacles.size(); ++i) {
+    const ObstacleSpec& obstacle = scene.obstacles[i];
+    if (obstacle.shape == ObstacleShape::kPlane) continue;
+    const Status status = checkResolvableObstaclePosition(
+        obstacle.position, reachOf(shapeOf(obstacle)), item(prefix, "obstacles", i, "position"));
+    if (!status) {
+      warnings.push_back(status.error().message() + ": a body touches obstacle '" + obstacle.id +
+                         "' from as far as it is large (its contacts are coarse)");
     }
   }
   return warnings;

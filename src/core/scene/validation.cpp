@@ -137,6 +137,37 @@ Status checkResolvablePosition(const Eigen::Vector3d& position, const std::strin
   return Ok{};
 }
 
+Status checkResolvableLength(double length, const std::string& field) {
+  if (auto status = checkFinite(length, field); !status) return status;
+  if (std::abs(length) < kMaxResolvedCoordinate) return Ok{};
+  return Error{field, formatNumber(length) +
+                          " m is beyond where the monitor can resolve a contact (its magnitude "
+                          "must be below 2^1022 = " +
+                          formatNumber(kMaxResolvedCoordinate) +
+                          " m: past 2^1023 the sum of two coordinates overflows)"};
+}
+
+Status checkResolvableObstaclePosition(const Eigen::Vector3d& position, double reach,
+                                       const std::string& field) {
+  if (auto status = checkResolvablePosition(position, field); !status) return status;
+  if (!(reach > 0)) return Ok{};
+  constexpr double kBandsPerReach = 0x1p47;  // 2^-48 (|x| + |x|) = reach at |x| = 2^47 reach
+  const double bound = kBandsPerReach * reach;
+  static const std::array<const char*, 3> kAxes = {"x", "y", "z"};
+  for (int axis = 0; axis < 3; ++axis) {
+    if (std::abs(position[axis]) < bound) continue;
+    const std::string axis_name = kAxes[axis];
+    return Error{field + "." + axis_name,
+                 formatNumber(position[axis]) +
+                     " m is beyond where a contact with this obstacle resolves (|" + axis_name +
+                     "| must be below 2^47 times its bounding radius " + formatNumber(reach) +
+                     " m, " + formatNumber(bound) +
+                     " m: from there the touching band of a body near it, 2^-48 (|x_body| + |" +
+                     axis_name + "| + ...), is as wide as the whole obstacle)"};
+  }
+  return Ok{};
+}
+
 Status checkBody(const Body& body, const std::string& prefix) {
   if (auto status = checkMass(body.mass, prefix + ".mass"); !status) return status;
   if (auto status = checkRadius(body.radius, prefix + ".radius"); !status) return status;
