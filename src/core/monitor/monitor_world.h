@@ -295,10 +295,6 @@ struct World {
   }
 };
 
-/// With the drag or magnus effect, a movable body that moves freely from its track's state on
-/// (not in a stepped cluster) flies through air from there: its track follows an AirFlight from
-/// its position, velocity and spin. Without either effect nothing changes: the parabola (or the
-/// straight line) is its motion, and no flight is ever made.
 /// An impact at `time` changes a body's velocity by `change`: summed over the rounds of one
 /// instant in one step (a cradle's ball struck twice), from zero at a new instant.
 inline void noteImpactChange(const World& world, Track& track, double time,
@@ -318,6 +314,10 @@ inline void noteStall(World& world, std::size_t body) {
   world.stalled.push_back({body, stalled});
 }
 
+/// With the drag or magnus effect, a movable body that moves freely from its track's state on
+/// (not in a stepped cluster) flies through air from there: its track follows an AirFlight from
+/// its position, velocity and spin. Without either effect nothing changes: the parabola (or the
+/// straight line) is its motion, and no flight is ever made.
 inline void startFlight(World& world, std::size_t body) {
   if (world.air.empty()) return;
   Track& track = world.tracks[body];
