@@ -109,7 +109,7 @@ show_progress() {
             echo "   [$(elapsed)] ended: ${name%.xml*}"
             printed=true
             ;;
-          *FAILURE* | *'[  FAILED  ]'*)
+          *'FAILURES: '[1-9]* | *'ERRORS: '[1-9]* | *'[  FAILED  ]'*)
             echo "   [$(elapsed)] $line"
             printed=true
             ;;
@@ -122,7 +122,7 @@ show_progress() {
       while IFS= read -r line; do
         echo "   [$(elapsed)] second lane: ${line#== }"
         printed=true
-      done < <(sed -n "$((second_shown + 1)),${lines}p" "$lane" | grep -E '^== |^\[  (PASSED|FAILED)|^   fuzz_|exit [0-9]' || true)
+      done < <(sed -n "$((second_shown + 1)),${lines}p" "$lane" | grep -E '^== |^ *\[  (PASSED|FAILED)|^ *fuzz_[a-z_]*: exit' | grep -v 'Debian packages are installed' || true)
       second_shown=$lines
     fi
     if $printed; then
