@@ -1,24 +1,30 @@
 #!/usr/bin/env bash
-# Every test, in two tiers; both install, build with warnings as errors, and end with one line
+# Every test, in tiers; each installs, builds with warnings as errors, and ends with one line
 # "N passed, N failed".
 #   bash scripts/test.sh           CI's: the gtest and rostest suites, the unit tests under ASan
-#                                  and UBSan, catkin_lint, and the fuzzers briefly.
+#                                  and UBSan, each fuzzer's saved inputs replayed, catkin_lint.
 #   bash scripts/test.sh --quick   the unit tests that need no master only (core_tests, with the
-#                                  trace, and ros_unit_tests): about a minute after the build.
-# The full run keeps its two cores busy with two lanes side by side: the rostests (two at a time,
-# each with its own master on a free port, as rostest starts them) and, at a lower priority, the
-# sanitizer build and the fuzzers (side by side too), whose compiles fill the time the rostests
-# spend waiting.
+#                                  trace, and ros_unit_tests). The first run after the demo's build
+#                                  compiles these two test programs first (about 3 minutes on 2
+#                                  cores); then about 40 s.
+#   bash scripts/test.sh --long    the full run, with each fuzzer fuzzing for FUZZ_SECONDS
+#                                  (default 600) instead of replaying: a nightly run.
+# The full run keeps its two cores busy with two lanes side by side: the gtests and rostests (two
+# at a time, each with its own master on a free port, as rostest starts them) and, at a lower
+# priority, the one clang sanitizer build, the sanitized unit tests, the fuzzers and catkin_lint.
+# It prints each test program as it ends, and a line at least every minute.
 set -euo pipefail
-quick=false
+mode=full
 case "${1:-}" in
-  --quick) quick=true ;;
+  --quick) mode=quick ;;
+  --long) mode=long ;;
   "") ;;
   *)
-    echo "usage: bash scripts/test.sh [--quick]" >&2
+    echo "usage: bash scripts/test.sh [--quick | --long]" >&2
     exit 2
     ;;
 esac
+started=$SECONDS
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 install_packages
 if ! build_package; then
@@ -31,7 +37,7 @@ results="$ws/build/test_results/collision_response"
 mkdir -p "$results"
 status=0
 
-if $quick; then
+if [ "$mode" = quick ]; then
   echo "== building and running the unit tests without a master (log: $ws/test.log)"
   if ! cmake --build "$ws/build" --target core_tests ros_unit_tests -- -j2 >"$ws/test.log" 2>&1; then
     tail -40 "$ws/test.log"
@@ -55,20 +61,21 @@ if $quick; then
   exit
 fi
 
-# The second lane: the unit tests again under AddressSanitizer and UndefinedBehaviorSanitizer
-# (their own build), catkin_lint, and a short run of each fuzzer (bash scripts/fuzz.sh 600 for a
-# long one). Its output is printed once it is done, after the first lane's. Their results join
+# The second lane: the one clang build with the sanitizers, the unit tests under them, the
+# fuzzers (replaying their saved inputs; fuzzing with --long) and catkin_lint. Its results join
 # the count.
 lane="$ws/second-lane.log"
 (
   renice -n 10 -p "$BASHPID" >/dev/null
-  # The fuzzers' build and run beside the sanitizer build and its tests (which run one
-  # process at a time): together they keep both cores busy.
-  bash "$repo/scripts/fuzz.sh" "${FUZZ_SECONDS:-30}" >"$ws/fuzz-lane.log" 2>&1 &
-  fuzzers=$!
   bash "$repo/scripts/sanitize.sh" || true
+  if [ "$mode" = long ]; then
+    bash "$repo/scripts/fuzz.sh" "${FUZZ_SECONDS:-600}" || true
+  else
+    bash "$repo/scripts/fuzz.sh" --replay || true
+  fi
   # catkin_lint on the package (warnings count as failures): one counted case.
   # Not in collision_response/: run_tests empties that folder when it starts.
+  echo "== catkin_lint --strict"
   mkdir -p "$ws/build/test_results/lint"
   if lint=$(catkin_lint --strict "$repo" 2>&1); then
     printf '<testsuite><testcase classname="catkin_lint" name="package"/></testsuite>\n' \
@@ -78,15 +85,65 @@ lane="$ws/second-lane.log"
     printf '<testsuite><testcase classname="catkin_lint" name="package"><failure message="catkin_lint --strict reported problems (printed above)"/></testcase></testsuite>\n' \
       >"$ws/build/test_results/lint/catkin_lint.xml"
   fi
-  wait "$fuzzers" || true
-  cat "$ws/fuzz-lane.log"
+  echo "== second lane done"
 ) >"$lane" 2>&1 &
 second_lane=$!
 pids+=("$second_lane")
 
+# Each of the two lanes' logs, as it grows: a line for each test program that ends (catkin's
+# "verify result" of its result file) and each stage of the second lane; and a line at least
+# every minute saying what still runs.   usage: show_progress PID  (until PID ends)
+show_progress() {
+  local pid=$1 first_shown=0 second_shown=0 lines quiet_since=$SECONDS printed
+  local tests_done=0 name
+  while kill -0 "$pid" 2>/dev/null; do
+    sleep 5
+    printed=false
+    if [ -f "$ws/test.log" ]; then
+      lines=$(wc -l <"$ws/test.log")
+      while IFS= read -r line; do
+        case "$line" in
+          *'verify result'*)
+            tests_done=$((tests_done + 1))
+            name=${line##*/}
+            echo "   [$(elapsed)] ended: ${name%.xml*}"
+            printed=true
+            ;;
+          *'FAILURES: '[1-9]* | *'ERRORS: '[1-9]* | *'[  FAILED  ]'*)
+            echo "   [$(elapsed)] $line"
+            printed=true
+            ;;
+        esac
+      done < <(sed -n "$((first_shown + 1)),${lines}p" "$ws/test.log")
+      first_shown=$lines
+    fi
+    if [ -f "$lane" ]; then
+      lines=$(wc -l <"$lane")
+      while IFS= read -r line; do
+        echo "   [$(elapsed)] second lane: ${line#== }"
+        printed=true
+      done < <(sed -n "$((second_shown + 1)),${lines}p" "$lane" | grep -E '^== |^ *\[  (PASSED|FAILED)|^ *fuzz_[a-z_]*: exit' | grep -v 'Debian packages are installed' || true)
+      second_shown=$lines
+    fi
+    if $printed; then
+      quiet_since=$SECONDS
+    elif [ $((SECONDS - quiet_since)) -ge 55 ]; then
+      echo "   [$(elapsed)] still running: $tests_done test programs of the first lane ended"
+      quiet_since=$SECONDS
+    fi
+  done
+}
+elapsed() {
+  local seconds=$((SECONDS - started))
+  printf '%d:%02d' $((seconds / 60)) $((seconds % 60))
+}
+
 echo "== building and running the gtest and rostest suites, two at a time (log: $ws/test.log)"
-echo "   beside them: the sanitizer build, catkin_lint and the fuzzers (log: $lane)"
-cmake --build "$ws/build" --target run_tests -- -j2 >"$ws/test.log" 2>&1 || status=$?
+echo "   beside them: the sanitizer build, its tests, the fuzzers and catkin_lint (log: $lane)"
+cmake --build "$ws/build" --target run_tests -- -j2 >"$ws/test.log" 2>&1 &
+first_lane=$!
+show_progress "$first_lane"
+wait "$first_lane" || status=$?
 grep -E '^\[ *(RUN|OK|FAILED|PASSED) *\]|FAILURE|ERROR|^\[(ROS)?TEST\]' "$ws/test.log" | grep -v -E '^\[ *(RUN|OK) ' || true
 if [ "$status" -ne 0 ]; then
   tail -40 "$ws/test.log"
@@ -103,6 +160,10 @@ descendants() {
 }
 # shellcheck disable=SC2046  # one pid a word
 renice -n 0 -p "$second_lane" $(descendants "$second_lane") >/dev/null 2>&1 || true
+echo "== the first lane is done ($(elapsed)); the second lane goes on"
+show_progress "$second_lane"
 wait "$second_lane" || true
-cat "$lane"
+echo "== the second lane's whole log ($lane):"
+sed 's/^/   /' "$lane"
+echo "== $(elapsed) in all (minutes:seconds)"
 /usr/bin/python3 "$repo/scripts/count_results.py" "$ws/build/test_results" "$status"

@@ -7,6 +7,18 @@
 namespace collision_response::bench {
 namespace {
 
+// Three draws for one vector, in a stated order. The arguments of one call are evaluated in an
+// order the language leaves open (g++ right to left, clang left to right), so V(d(e), d(e), d(e))
+// was another scene under each compiler; z, then y, then x is the order g++ gave them, which
+// the trace digest (test/core/trace_digest.txt) and the references hold.
+template <class Distribution>
+V drawZyx(Distribution& distribution, std::mt19937_64& engine) {
+  const double z = distribution(engine);
+  const double y = distribution(engine);
+  const double x = distribution(engine);
+  return V(x, y, z);
+}
+
 /// The state rates of the short scenes (Hz).
 const std::vector<double> kRates = {10.0, 30.0, 60.0, 100.0, 300.0, 1000.0};
 
@@ -112,7 +124,7 @@ BenchScene gasScene() {
     scene.bodies.push_back(
         ball("gas_" + std::to_string(100 + i), 0.1, 0.05, "elastic",
              V(0.25 + 0.5 * (i % 4), 0.25 + 0.5 * ((i / 4) % 4), 0.25 + 0.5 * (i / 16)),
-             V(speed(engine), speed(engine), speed(engine))));
+             drawZyx(speed, engine)));
   }
   const V normals[] = {V(1, 0, 0), V(-1, 0, 0), V(0, 1, 0), V(0, -1, 0), V(0, 0, 1), V(0, 0, -1)};
   for (int i = 0; i < 6; ++i) {
@@ -312,7 +324,7 @@ BenchScene ballPileScene(int count, double duration) {
     std::snprintf(id, sizeof id, "ball_%04d", i);
     scene.bodies.push_back(ball(
         id, 0.1, 0.05, "pile",
-        V(0.11, 0.11, 0.11) + spacing * cell + V(offset(engine), offset(engine), offset(engine))));
+        V(0.11, 0.11, 0.11) + spacing * cell + drawZyx(offset, engine)));
   }
   const V normals[] = {V(1, 0, 0), V(-1, 0, 0), V(0, 1, 0), V(0, -1, 0), V(0, 0, 1), V(0, 0, -1)};
   for (int i = 0; i < 6; ++i) {
