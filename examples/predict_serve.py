@@ -83,8 +83,16 @@ def main():
                      lambda array: played_impacts.extend(
                          i for i in array.impacts if i.body_a == body))
     markers = rospy.Publisher("predicted_path", MarkerArray, queue_size=1, latch=True)
+    waiting_since = rospy.get_time()
+    said = waiting_since
     while not rospy.is_shutdown() and not first:
         rospy.sleep(0.001)
+        if rospy.get_time() - said >= 3.0:
+            said = rospy.get_time()
+            rospy.logwarn("predict_serve: no state of '%s' on %s for %.0f s: is a scene playing "
+                          "(roslaunch collision_response predict_demo.launch), and is ~body the "
+                          "id of one of its bodies?", body, rospy.resolve_name("body_states"),
+                          said - waiting_since)
     if rospy.is_shutdown():
         return
     start = first[0]
