@@ -38,11 +38,13 @@ install_packages() {
     return 0
   fi
   echo "== installing ${#missing[@]} Debian packages: ${missing[*]}"
+  local started=$SECONDS
   as_root apt-get update -qq
   # Without the packages they only recommend (llvm's development files, rosdep, manual pages):
   # 397 packages rather than 464 on a fresh Debian 12, none of them used here.
   as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
     "${PACKAGES[@]}" >/dev/null
+  echo "== installed in $((SECONDS - started)) s"
 }
 
 # BUILD_TARGET: build only that target (default: all).
@@ -67,7 +69,7 @@ build_workspace() {
 # the log's place, each stage, and the progress every tenth of the way (a first build takes
 # about 5 minutes on 2 cores, a rebuild seconds). On failure, the log's last lines.
 build_package() {
-  local log="$ws/build.log" status=0
+  local log="$ws/build.log" status=0 started=$SECONDS
   # The pipeline's status is build_workspace's, also where the caller has no pipefail.
   local -
   set -o pipefail
@@ -83,7 +85,7 @@ build_package() {
     echo "build failed (log: $log)"
     return 1
   fi
-  echo "== built"
+  echo "== built in $((SECONDS - started)) s"
 }
 
 # The one clang build with AddressSanitizer, UndefinedBehaviorSanitizer and libFuzzer's
