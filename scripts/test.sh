@@ -38,7 +38,8 @@ mkdir -p "$results"
 status=0
 
 if [ "$mode" = quick ]; then
-  echo "== building and running the unit tests without a master (log: $ws/test.log)"
+  echo "== building the unit tests without a master (the first time after the demo's build: about"
+  echo "   3 minutes, the demo does not build test programs; log: $ws/test.log), then running them"
   if ! cmake --build "$ws/build" --target core_tests ros_unit_tests -- -j2 >"$ws/test.log" 2>&1; then
     tail -40 "$ws/test.log"
     echo "0 passed, 1 failed"
