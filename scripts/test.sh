@@ -86,6 +86,23 @@ lane="$ws/second-lane.log"
     printf '<testsuite><testcase classname="catkin_lint" name="package"><failure message="catkin_lint --strict reported problems (printed above)"/></testcase></testsuite>\n' \
       >"$ws/build/test_results/lint/catkin_lint.xml"
   fi
+  # Every launch file's arguments have a doc (roslaunch --ros-args lists them): one counted case.
+  echo "== every launch argument documented"
+  undocumented=""
+  for launch in "$repo"/launch/*.launch; do
+    args=$(roslaunch --ros-args "$launch" 2>&1) || undocumented+="$(basename "$launch"): $args; "
+    if grep -q undocumented <<<"$args"; then
+      undocumented+="$(basename "$launch"): $(grep undocumented <<<"$args" | tr -s ' ' | tr '\n' ' ')"
+    fi
+  done
+  if [ -z "$undocumented" ]; then
+    printf '<testsuite><testcase classname="launch" name="every argument documented"/></testsuite>\n' \
+      >"$ws/build/test_results/lint/launch_arguments.xml"
+  else
+    echo "$undocumented"
+    printf '<testsuite><testcase classname="launch" name="every argument documented"><failure message="%s"/></testcase></testsuite>\n' \
+      "$(sed 's/[<>&"]/_/g' <<<"$undocumented")" >"$ws/build/test_results/lint/launch_arguments.xml"
+  fi
   echo "== second lane done"
 ) >"$lane" 2>&1 &
 second_lane=$!
