@@ -19,19 +19,31 @@ declare -A filters=(
   [core_tests]="-Trace.*:Monitor.BroadphaseGivesTheSameImpactsAsEveryPair"
   [ros_unit_tests]="*"
 )
-status=0
-for test in core_tests ros_unit_tests; do
-  echo "== $test under ASan and UBSan"
+# Each program in two shards side by side (gtest's GTEST_TOTAL_SHARDS): the two cores.
+run_shard() {
+  local test=$1 shard=$2 name="$1-$2"
   # The random throws at the finite shapes (core_tests) 2,000 a shape here rather than 20,000:
   # every path of the code runs, in a tenth of the time the sanitizers make it take.
   (cd "$repo/test" && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
-    FINITE_SHAPE_THROWS="${FINITE_SHAPE_THROWS:-2000}" \
+    FINITE_SHAPE_THROWS="${FINITE_SHAPE_THROWS:-2000}" GTEST_TOTAL_SHARDS=2 GTEST_SHARD_INDEX="$shard" \
     "$sanitized/devel/lib/collision_response/$test" --gtest_filter="${filters[$test]}" \
-    --gtest_output="xml:$results/sanitized-$test.xml") \
-    >"$sanitized/$test.log" 2>&1 || { status=1; tail -30 "$sanitized/$test.log"; }
-  # A sanitizer abort leaves no result file: say so in one the count reads.
-  [ -f "$results/sanitized-$test.xml" ] || printf '<testsuite><testcase classname="sanitized" name="%s"><failure message="no result: the sanitizer stopped it (see %s)"/></testcase></testsuite>\n' \
-    "$test" "$sanitized/$test.log" >"$results/sanitized-$test.xml"
-  grep -E '^\[  (PASSED|FAILED)' "$sanitized/$test.log" | sed "s/^/   /" || true
+    --gtest_output="xml:$results/sanitized-$name.xml") >"$sanitized/$name.log" 2>&1 || {
+    tail -30 "$sanitized/$name.log"
+    return 1
+  }
+}
+status=0
+for test in core_tests ros_unit_tests; do
+  echo "== $test under ASan and UBSan (two shards)"
+  run_shard "$test" 0 &
+  first=$!
+  run_shard "$test" 1 || status=1
+  wait "$first" || status=1
+  for shard in 0 1; do
+    # A sanitizer abort leaves no result file: say so in one the count reads.
+    [ -f "$results/sanitized-$test-$shard.xml" ] || printf '<testsuite><testcase classname="sanitized" name="%s"><failure message="no result: the sanitizer stopped it (see %s)"/></testcase></testsuite>\n' \
+      "$test shard $shard" "$sanitized/$test-$shard.log" >"$results/sanitized-$test-$shard.xml"
+    grep -E '^\[  (PASSED|FAILED)' "$sanitized/$test-$shard.log" | sed "s/^/   shard $shard: /" || true
+  done
 done
 exit $status

@@ -66,7 +66,11 @@ fi
 # fuzzers (replaying their saved inputs; fuzzing with --long) and catkin_lint. Its results join
 # the count.
 lane="$ws/second-lane.log"
+# Each lane writes its end into a file of its own, which the progress below waits for (a process
+# id that ended can be another process's a moment later).
+rm -f "$ws/first-lane.status" "$ws/second-lane.status"
 (
+  trap 'echo "$?" >"$ws/second-lane.status"' EXIT
   renice -n 10 -p "$BASHPID" >/dev/null
   bash "$repo/scripts/sanitize.sh" || true
   if [ "$mode" = long ]; then
@@ -110,11 +114,11 @@ pids+=("$second_lane")
 
 # Each of the two lanes' logs, as it grows: a line for each test program that ends (catkin's
 # "verify result" of its result file) and each stage of the second lane; and a line at least
-# every minute saying what still runs.   usage: show_progress PID  (until PID ends)
+# every minute saying what still runs.   usage: show_progress STATUS_FILE  (until it is written)
+first_shown=0 second_shown=0 tests_done=0 stage="its build"
 show_progress() {
-  local pid=$1 first_shown=0 second_shown=0 lines quiet_since=$SECONDS printed
-  local tests_done=0 name
-  while kill -0 "$pid" 2>/dev/null; do
+  local done_file=$1 lines quiet_since=$SECONDS printed name
+  while [ ! -s "$done_file" ]; do
     sleep 5
     printed=false
     if [ -f "$ws/test.log" ]; then
@@ -132,21 +136,22 @@ show_progress() {
             printed=true
             ;;
         esac
-      done < <(sed -n "$((first_shown + 1)),${lines}p" "$ws/test.log")
+      done < <([ "$lines" -gt "$first_shown" ] && sed -n "$((first_shown + 1)),${lines}p" "$ws/test.log")
       first_shown=$lines
     fi
     if [ -f "$lane" ]; then
       lines=$(wc -l <"$lane")
       while IFS= read -r line; do
         echo "   [$(elapsed)] second lane: ${line#== }"
+        [[ $line != '== '* ]] || stage=${line#== }
         printed=true
-      done < <(sed -n "$((second_shown + 1)),${lines}p" "$lane" | grep -E '^== |^ *\[  (PASSED|FAILED)|^ *fuzz_[a-z_]*: exit' | grep -v 'Debian packages are installed' || true)
+      done < <([ "$lines" -gt "$second_shown" ] && sed -n "$((second_shown + 1)),${lines}p" "$lane" | grep -E '^== |^ *\[  (PASSED|FAILED)|^ *fuzz_[a-z_]*: exit' | grep -v 'Debian packages are installed' || true)
       second_shown=$lines
     fi
     if $printed; then
       quiet_since=$SECONDS
     elif [ $((SECONDS - quiet_since)) -ge 55 ]; then
-      echo "   [$(elapsed)] still running: $tests_done test programs of the first lane ended"
+      echo "   [$(elapsed)] still running: $tests_done test programs of the first lane ended; the second lane: ${stage:0:60}"
       quiet_since=$SECONDS
     fi
   done
@@ -158,10 +163,15 @@ elapsed() {
 
 echo "== building and running the gtest and rostest suites, two at a time (log: $ws/test.log)"
 echo "   beside them: the sanitizer build, its tests, the fuzzers and catkin_lint (log: $lane)"
-cmake --build "$ws/build" --target run_tests -- -j2 >"$ws/test.log" 2>&1 &
+(
+  trap 'echo "$?" >"$ws/first-lane.status"' EXIT
+  cmake --build "$ws/build" --target run_tests -- -j2 >"$ws/test.log" 2>&1
+) &
 first_lane=$!
-show_progress "$first_lane"
-wait "$first_lane" || status=$?
+pids+=("$first_lane")
+show_progress "$ws/first-lane.status"
+wait "$first_lane" || true
+status=$(cat "$ws/first-lane.status")
 grep -E '^\[ *(RUN|OK|FAILED|PASSED) *\]|FAILURE|ERROR|^\[(ROS)?TEST\]' "$ws/test.log" | grep -v -E '^\[ *(RUN|OK) ' || true
 if [ "$status" -ne 0 ]; then
   tail -40 "$ws/test.log"
@@ -179,7 +189,7 @@ descendants() {
 # shellcheck disable=SC2046  # one pid a word
 renice -n 0 -p "$second_lane" $(descendants "$second_lane") >/dev/null 2>&1 || true
 echo "== the first lane is done ($(elapsed)); the second lane goes on"
-show_progress "$second_lane"
+show_progress "$ws/second-lane.status"
 wait "$second_lane" || true
 echo "== the second lane's whole log ($lane):"
 sed 's/^/   /' "$lane"
