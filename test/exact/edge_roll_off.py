@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """A ball rolling or sliding off a box's edge: when it slips, when it leaves, how it flies on.
 
-The numbers test/core/test_lasting_contact.cpp's edge scans (EdgeScan.*) and
-test/ros/test_table.cpp compare the monitor with, derived here from Newton's and Coulomb's laws
-alone (nothing here calls or copies the C++ code under test).
+The numbers test/core/test_lasting_contact.cpp's edge scans (EdgeScan.*), test/ros/test_table.cpp
+and test/ros/test_edge_roll_off.cpp (the flight to the floor, printed last) compare the monitor
+with, derived here from Newton's and Coulomb's laws alone (nothing here calls or copies the C++
+code under test).
 
 The model (doc/model.md, "Lasting contact" and "Finite shapes"): a ball of radius r, mass m and
 moment of inertia I = k m r^2 (k = 2/5, a solid ball) moves at v0 along a box's top face, rolling
@@ -39,6 +40,14 @@ centre's velocity r theta' (cos theta, -sin theta) is its flight's.
 Everything in mpmath at 40 digits from the doubles the tests use (mpf(float)); each slipping
 phase is also integrated as the full ODE in (theta, theta', w) by mpmath's Taylor series
 (odefun, at 20 digits) and the script stops if its angle at the leave disagrees by 1e-15.
+
+Over ROS (test/ros/edge_roll_off.yaml: the table's ball rolling at 0.3 m/s from x0 = 0.3 with
+mu = 1, a floor plane at z = 0; its other balls the same, later by (0.3 - x0) / v0): after the
+leave it flies freely, its centre on the parabola p(t) = p_l + v_l (t - t_l) + g (t - t_l)^2 / 2
+from the leave's point p_l = (0.5 + r sin theta, 0.75 + r cos theta) and velocity v_l, until its
+centre is r above the floor (the later root of that quadratic in closed form). N = 0 there makes
+g cos theta = |v_l|^2 / r, so the flight's horizontal velocity is sqrt(g r) cos^(3/2) theta all
+along: cos theta = (vx^2 / (g r))^(1/3), printed as a check of the leave.
 
 Run: python3 test/exact/edge_roll_off.py
 """
@@ -144,6 +153,29 @@ def main():
     _, _, theta_l, t_l, _, _ = roll_off(r, v0, 1, True)
     print(f"mu = 1 from x0 = 0.3 (crossing at 2/3 s): leaves at "
           f"{mpmath.nstr(mpf(0.2) / mpf(v0) + t_l, 17)} s")
+    floor_flight(r, v0, mpf(0.3))
+
+
+def floor_flight(r, v0, x0):
+    """test/ros/edge_roll_off.yaml: rolling with mu = 1 from x0 on the top (z = 0.75, its edge at
+    x = 0.5), off the edge onto a floor plane at z = 0; times from the scene's start."""
+    _, _, theta_l, t_l, thd, w = roll_off(r, v0, 1, True)
+    r = mpf(r)
+    leaves = (mpf(0.5) - x0) / mpf(v0) + t_l
+    px, pz = mpf(0.5) + r * mpmath.sin(theta_l), mpf(0.75) + r * mpmath.cos(theta_l)
+    vx, vz = r * thd * mpmath.cos(theta_l), -r * thd * mpmath.sin(theta_l)
+    # pz + vz s - g s^2 / 2 = r: the later root.
+    s = (vz + mpmath.sqrt(vz**2 + 2 * G * (pz - r))) / G
+    print("over ROS (test/ros/edge_roll_off.yaml), mu = 1 from x0 = 0.3, floor at z = 0:")
+    print(f"  leaves at {mpmath.nstr(leaves, 17)} s, centre ({mpmath.nstr(px, 17)}, 0, "
+          f"{mpmath.nstr(pz, 17)}), cos theta = {mpmath.nstr(mpmath.cos(theta_l), 17)}")
+    print(f"  velocity ({mpmath.nstr(vx, 17)}, 0, {mpmath.nstr(vz, 17)}) m/s, spin about y "
+          f"{mpmath.nstr(w, 17)} rad/s")
+    print(f"  cos theta from the flight's vx, (vx^2/(g r))^(1/3) = "
+          f"{mpmath.nstr(mpmath.cbrt(vx**2 / (G * r)), 17)}")
+    print(f"  meets the floor at {mpmath.nstr(leaves + s, 17)} s ({mpmath.nstr(s, 17)} s of "
+          f"flight), contact point ({mpmath.nstr(px + vx * s, 17)}, 0, 0), velocity before "
+          f"({mpmath.nstr(vx, 17)}, 0, {mpmath.nstr(vz - G * s, 17)}) m/s")
 
 
 if __name__ == "__main__":
