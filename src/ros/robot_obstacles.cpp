@@ -96,7 +96,12 @@ core::Expected<std::vector<core::ObstacleSpec>> robotObstacles(const std::string
       const auto found = model.links_.find(name);
       const std::string item = indexKey(joinKey(field, "links"), i);
       if (found == model.links_.end()) {
-        return core::Error{item, "the URDF has no link '" + name + "'"};
+        // Its links, in name order, so that a typo is seen at once.
+        std::string known;
+        for (const auto& [link_name, link] : model.links_) {
+          known += (known.empty() ? "" : ", ") + link_name;
+        }
+        return core::Error{item, "the URDF has no link '" + name + "'; its links: " + known};
       }
       if (found->second->collision_array.empty()) {
         return core::Error{item, "link '" + name + "' has no <collision>"};

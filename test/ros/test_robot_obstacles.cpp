@@ -174,6 +174,11 @@ TEST(RobotObstacles, ErrorsNameTheKey) {
   result = robotObstacles(kArm, robot, "~scene/robot", skipped);
   ASSERT_FALSE(result.ok());
   EXPECT_EQ(result.error().field, "~scene/robot/links[1]");  // no such link
+  // ... answered with the URDF's links, in name order.
+  EXPECT_NE(result.error().message().find(
+                "the URDF has no link 'elbow'; its links: base_link, paddle, upper_arm"),
+            std::string::npos)
+      << result.error().message();
   robot.links = {"base_link"};
   result = robotObstacles(kArm, robot, "~scene/robot", skipped);
   ASSERT_FALSE(result.ok());
