@@ -107,6 +107,18 @@ rm -f "$ws/first-lane.status" "$ws/second-lane.status"
     printf '<testsuite><testcase classname="launch" name="every argument documented"><failure message="%s"/></testcase></testsuite>\n' \
       "$(sed 's/[<>&"]/_/g' <<<"$undocumented")" >"$ws/build/test_results/lint/launch_arguments.xml"
   fi
+  # Every link to a Markdown file and its heading resolves (the README's to doc/model.md's
+  # sections among them): one counted case.
+  echo "== every link to a Markdown heading resolves"
+  if links=$(/usr/bin/python3 "$repo/scripts/check_links.py" "$repo" 2>&1); then
+    echo "$links"
+    printf '<testsuite><testcase classname="docs" name="every link resolves"/></testsuite>\n' \
+      >"$ws/build/test_results/lint/links.xml"
+  else
+    echo "$links"
+    printf '<testsuite><testcase classname="docs" name="every link resolves"><failure message="%s"/></testcase></testsuite>\n' \
+      "$(sed 's/[<>&"]/_/g' <<<"$links" | tr '\n' ' ')" >"$ws/build/test_results/lint/links.xml"
+  fi
   echo "== second lane done"
 ) >"$lane" 2>&1 &
 second_lane=$!
