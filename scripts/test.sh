@@ -119,6 +119,18 @@ rm -f "$ws/first-lane.status" "$ws/second-lane.status"
     printf '<testsuite><testcase classname="docs" name="every link resolves"><failure message="%s"/></testcase></testsuite>\n' \
       "$(sed 's/[<>&"]/_/g' <<<"$links" | tr '\n' ' ')" >"$ws/build/test_results/lint/links.xml"
   fi
+  # The API documentation builds, every header and message with its page, without a warning of
+  # Doxygen (scripts/docs.sh): one counted case.
+  echo "== the API documentation (bash scripts/docs.sh)"
+  if docs=$(bash "$repo/scripts/docs.sh" 2>&1) && grep -q '^== 0 Doxygen warnings' <<<"$docs"; then
+    printf '<testsuite><testcase classname="docs" name="API documentation"/></testsuite>\n' \
+      >"$ws/build/test_results/lint/api_docs.xml"
+  else
+    echo "$docs"
+    printf '<testsuite><testcase classname="docs" name="API documentation"><failure message="%s"/></testcase></testsuite>\n' \
+      "$(grep -E 'warning|missing' <<<"$docs" | head -5 | sed 's/[<>&"]/_/g' | tr '\n' ' ')" \
+      >"$ws/build/test_results/lint/api_docs.xml"
+  fi
   echo "== second lane done"
 ) >"$lane" 2>&1 &
 second_lane=$!

@@ -20,15 +20,15 @@ struct RobotLinks {
   double padding = 0.0;  ///< m, >= 0: every shape grown by it (a box by it on each side)
 };
 
-/// The obstacles of `urdf` (the URDF's XML) for `robot`: one per <collision> of each chosen link,
+/// The obstacles of `urdf` (the URDF's XML) for `robot`: one per `<collision>` of each chosen link,
 /// in link-name order, named `<link>/<index>` (`<link>` alone when it has one), in the link's
-/// frame at the collision's <origin>: a URDF box (`size` full lengths), cylinder (along z,
+/// frame at the collision's `<origin>`: a URDF box (`size` full lengths), cylinder (along z,
 /// `length` full) and sphere as the scene's box, cylinder and sphere, grown by `padding`; a
-/// <mesh> as a mesh obstacle, loaded from its filename at its scale (mesh_resource.h), not grown.
-/// `warnings` says what is left out: a <collision> without geometry, a mesh's zero-area
+/// `<mesh>` as a mesh obstacle, loaded from its filename at its scale (mesh_resource.h), not grown.
+/// `warnings` says what is left out: a `<collision>` without geometry, a mesh's zero-area
 /// triangles, a padding a mesh does not take. Errors name `field`'s keys: a URDF that does not
 /// parse (field/description), a mesh that does not load (field/description, with the link, the
-/// filename and the reason), a chosen link the URDF does not have or without a <collision>
+/// filename and the reason), a chosen link the URDF does not have or without a `<collision>`
 /// (field/links[i]).
 core::Expected<std::vector<core::ObstacleSpec>> robotObstacles(const std::string& urdf,
                                                                const RobotLinks& robot,

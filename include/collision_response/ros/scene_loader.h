@@ -21,7 +21,7 @@ namespace collision_response {
 ///
 /// A mesh obstacle's triangles are loaded from its `resource` (mesh_resource.h). With `robot:` the
 /// links of the URDF that `urdf` returns for the parameter it names become obstacles
-/// (robot_obstacles.h). What the scene leaves out (a mesh's zero-area triangles, a <collision>
+/// (robot_obstacles.h). What the scene leaves out (a mesh's zero-area triangles, a `<collision>`
 /// without geometry), a body that starts inside a fixed obstacle (core::bodiesStartingInside) and
 /// an obstacle placed beyond where its contacts resolve (core::obstaclesBeyondResolution) are
 /// added to `warnings`, for the caller to log.
