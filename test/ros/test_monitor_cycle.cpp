@@ -647,6 +647,89 @@ TEST_F(Cycle, AMissingTransformMakesTheInputWaitThenDropsItsStateByName) {
       << update.reports[0].text;
 }
 
+// A tf-attached obstacle: the plane x = 0 of frame "paddle", its normal +x, the frame at
+// x = -1 in the world (a static transform, so at rest). a at x = -t moving -1 m/s touches it
+// (radius 0.1) at x = -0.9, t = 0.9 s; e = 0.5 against the immovable plane: v' = +0.5 m/s,
+// impulse (1 + e) m v = 1.5 N s, energy lost m v^2 (1 - e^2) / 2 = 0.375 J.
+core::Scene twoBallsAndPaddleScene() {
+  core::Scene scene = twoBallScene();
+  core::ObstacleSpec paddle;
+  paddle.id = "paddle";
+  paddle.material = "test_half";
+  paddle.frame = "paddle";
+  paddle.normal = Eigen::Vector3d::UnitX();
+  scene.obstacles.push_back(paddle);
+  return scene;
+}
+
+class CycleWithPaddle : public Cycle {
+ protected:
+  CycleWithPaddle() : Cycle(twoBallsAndPaddleScene()) {}
+};
+
+TEST_F(CycleWithPaddle, AMissingObstacleFrameMakesTheInputWaitThenTheObstacleIsPlacedOnceKnown) {
+  const ros::Time start = clock_;
+  std::vector<BodyState> first = {state("a", start, {0, 0, 0}, {-1, 0, 0})};
+  MonitorCycle::Input input{&first, "/body_states", "/source", ""};
+  const MonitorCycle::Update waited = cycle_.process(input, clock_, true, tf_);
+  EXPECT_TRUE(waited.waiting);
+  EXPECT_TRUE(waited.reports.empty());
+  // Not waiting any more: the step goes on without the obstacle, counted but not warned of
+  // (tf has no history of its frame yet).
+  const MonitorCycle::Update update = send(first);
+  EXPECT_FALSE(update.waiting);
+  EXPECT_TRUE(update.stepped);
+  ASSERT_EQ(update.reports.size(), 1u);
+  EXPECT_EQ(update.reports[0].reason, Reason::kObstacleTransform);
+  EXPECT_FALSE(update.reports[0].warn);
+  EXPECT_NE(update.reports[0].text.find("obstacle 'paddle'"), std::string::npos)
+      << update.reports[0].text;
+
+  geometry_msgs::TransformStamped frame;
+  frame.header.frame_id = "world";
+  frame.child_frame_id = "paddle";
+  frame.transform.translation.x = -1.0;
+  frame.transform.rotation.w = 1.0;
+  tf_.setTransform(frame, "test", /*is_static=*/true);
+  reports_.clear();
+  for (int k = 1; k <= 10; ++k) {
+    const double t = 0.1 * k;
+    send({state("a", start + ros::Duration(0, 100000000 * k), {-t, 0, 0}, {-1, 0, 0})});
+  }
+  // The obstacle is placed at every input from then on; the source ignores the impact, and
+  // its state at t = 1 lacks it (said once).
+  EXPECT_EQ(reportsOf(Reason::kObstacleTransform), 0u);
+  EXPECT_EQ(reportsOf(Reason::kImpactContradicted), 1u);
+  EXPECT_EQ(reports_.size(), 1u);
+  ASSERT_EQ(impacts_.size(), 1u);
+  const Impact& impact = impacts_[0];
+  EXPECT_EQ(impact.body_a, "a");
+  EXPECT_EQ(impact.body_b, "paddle");
+  EXPECT_NEAR((impact.header.stamp - start).toSec(), 0.9, 1e-9);
+  EXPECT_NEAR(impact.contact_point.x, -1.0, 1e-9);
+  EXPECT_NEAR(impact.velocity_a_after.linear.x, 0.5, 1e-9);
+  EXPECT_NEAR(impact.impulse, 1.5, 1e-9);
+  EXPECT_NEAR(impact.energy_lost, 0.375, 1e-9);
+}
+
+// Live tuning (dynamic_reconfigure) reaches the next impact and the scene the node reports:
+// with restitution_threshold 3 m/s above the two balls' approach at 2 m/s, e = 0: equal masses
+// end at the common velocity 0, impulse m v_rel / 2 = 1 N s, energy lost m v^2 = 1 J.
+TEST_F(Cycle, ATunedRestitutionThresholdReachesTheNextImpactAndTheScene) {
+  cycle_.tune(core::Detection::kContinuous, 3.0, core::CombineRule::kMax);
+  EXPECT_EQ(cycle_.scene().restitution_threshold, 3.0);
+  EXPECT_EQ(cycle_.scene().materials.combineRule(), core::CombineRule::kMax);
+  playTwoBalls(ros::Time(1000, 0));
+  ASSERT_EQ(impacts_.size(), 1u);
+  const Impact& impact = impacts_[0];
+  EXPECT_NEAR((impact.header.stamp - ros::Time(1000, 0)).toSec(), 0.43, 1e-9);
+  EXPECT_EQ(impact.restitution, 0.0);
+  EXPECT_NEAR(impact.velocity_a_after.linear.x, 0.0, 1e-9);
+  EXPECT_NEAR(impact.velocity_b_after.linear.x, 0.0, 1e-9);
+  EXPECT_NEAR(impact.impulse, 1.0, 1e-9);
+  EXPECT_NEAR(impact.energy_lost, 1.0, 1e-9);
+}
+
 // Issue 12, item 3: an elastic ball between two walls 1e-5 m wider than it, crossing at 1 m/s,
 // strikes a wall every 1e-5 s: a 1 s message interval asks for 100,000 impacts, beyond the
 // step's budget (10,000 instants). The fallback is counted by name in diagnostics, and every
