@@ -132,7 +132,10 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
       std::max_element(samples_.begin(), samples_.end(), [](const auto& x, const auto& y) {
         return x.stamp < y.stamp;
       })->stamp;
-  if (may_wait && obstacleFrameMissing(newest, tf)) {
+  // The tf-attached obstacles' frames at the newest stamp: looked up once, both to tell
+  // whether the input must wait for them and to place them for the step.
+  lookUpObstacles(newest, tf, obstacle_motions_);
+  if (may_wait && obstacleFrameMissing()) {
     update.waiting = true;
     update.reports.clear();
     return update;
@@ -156,7 +159,7 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
   timeSamples(placed, newest);
   std::vector<core::ImpactRecord> earlier_impacts;
   stepMovingObstacles(placed, newest, tf, earlier_impacts, update);
-  updateObstacles(newest, placed.time, tf, update);
+  placeObstacles(obstacle_motions_, placed.time, update);
   core::StepReport step = monitor_.step(placed.time, timed_);
   step.impacts.insert(step.impacts.begin(), earlier_impacts.begin(), earlier_impacts.end());
   update.stepped = true;
@@ -169,16 +172,10 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
   return update;
 }
 
-bool MonitorCycle::obstacleFrameMissing(const ros::Time& newest, const tf2::BufferCore& tf) const {
+bool MonitorCycle::obstacleFrameMissing() const {
   // The tf-attached obstacles must be known up to the newest stamp as well.
-  for (const core::ObstacleSpec& obstacle : scene_.obstacles) {
-    if (!obstacle.frame.empty() &&
-        !lookupFrameMotion(tf, scene_.fixed_frame, obstacle.frame, newest,
-                           ros::Duration(params_.frame_velocity_interval))) {
-      return true;
-    }
-  }
-  return false;
+  return std::any_of(obstacle_motions_.begin(), obstacle_motions_.end(),
+                     [](const auto& motion) { return motion && !*motion; });
 }
 
 namespace {
@@ -456,25 +453,38 @@ void MonitorCycle::stepMovingObstacles(const TimeLine::Placed& placed, const ros
   for (int k = 1; k < count; ++k) {
     const double time = from + span * k / count;
     const ros::Time stamp = newest - ros::Duration(placed.time - time);
-    updateObstacles(stamp, time, tf, update);
+    lookUpObstacles(stamp, tf, between_motions_);
+    placeObstacles(between_motions_, time, update);
     const core::StepReport step = monitor_.step(time, {});
     reportStep(step, update);
     impacts.insert(impacts.end(), step.impacts.begin(), step.impacts.end());
   }
 }
 
-void MonitorCycle::updateObstacles(const ros::Time& stamp, double time, const tf2::BufferCore& tf,
-                                   Update& update) {
+void MonitorCycle::lookUpObstacles(const ros::Time& stamp, const tf2::BufferCore& tf,
+                                   std::vector<ObstacleMotion>& motions) const {
+  motions.clear();
   for (std::size_t i = 0; i < monitor_.obstacleCount(); ++i) {
     const core::ObstacleSpec& spec = monitor_.obstacle(i);
-    if (spec.frame.empty()) continue;
-    const auto motion = lookupFrameMotion(tf, scene_.fixed_frame, spec.frame, stamp,
-                                          ros::Duration(params_.frame_velocity_interval));
+    if (spec.frame.empty()) {
+      motions.emplace_back();
+      continue;
+    }
+    motions.emplace_back(lookupFrameMotion(tf, scene_.fixed_frame, spec.frame, stamp,
+                                           ros::Duration(params_.frame_velocity_interval)));
+  }
+}
+
+void MonitorCycle::placeObstacles(const std::vector<ObstacleMotion>& motions, double time,
+                                  Update& update) {
+  for (std::size_t i = 0; i < motions.size(); ++i) {
+    if (!motions[i]) continue;  // a fixed obstacle
+    const core::Expected<FrameMotion>& motion = *motions[i];
     if (!motion) {
       // Before its first placement, tf has no history yet for its velocity: counted only.
-      Report item{
-          Reason::kObstacleTransform,
-          "obstacle '" + spec.id + "' keeps its last known motion: " + motion.error().message()};
+      Report item{Reason::kObstacleTransform,
+                  "obstacle '" + monitor_.obstacle(i).id +
+                      "' keeps its last known motion: " + motion.error().message()};
       item.warn = placed_obstacles_.count(i) != 0;
       update.reports.push_back(std::move(item));
       continue;

@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -23,6 +24,7 @@
 #include "collision_response/ImpactArray.h"
 #include "collision_response/core/monitor.h"
 #include "collision_response/core/scene.h"
+#include "collision_response/ros/frame_motion.h"
 #include "collision_response/ros/monitor_params.h"
 #include "collision_response/ros/state_intake.h"
 #include "collision_response/ros/time_line.h"
@@ -82,8 +84,14 @@ class MonitorCycle {
   std::int64_t clockOf(double time, std::size_t body_a, std::size_t other,
                        bool other_is_obstacle) const;
   // The stages of process(), in its order.
-  /// A tf-attached obstacle's frame not yet known at `newest`: the input waits.
-  bool obstacleFrameMissing(const ros::Time& newest, const tf2::BufferCore& tf) const;
+  /// A tf-attached obstacle's frame, looked up at one stamp; empty for a fixed obstacle.
+  using ObstacleMotion = std::optional<core::Expected<FrameMotion>>;
+  /// Looks up each tf-attached obstacle's frame at `stamp`, once: `motions` by obstacle index.
+  void lookUpObstacles(const ros::Time& stamp, const tf2::BufferCore& tf,
+                       std::vector<ObstacleMotion>& motions) const;
+  /// A tf-attached obstacle's frame not known at the input's newest stamp (obstacle_motions_):
+  /// the input waits.
+  bool obstacleFrameMissing() const;
   /// The held states of `source` (one stamp off its clock) are dropped, said.
   void dropHeldStates(const std::string& source, const TimeLine::Placed& placed, Update& update);
   /// The input's states wait for the source's next input (TimeLine::Event::kHeld).
@@ -105,9 +113,9 @@ class MonitorCycle {
   /// the doubles or a ros::Time cannot hold is reported, not published.
   void publishContacts(const core::StepReport& step, const ros::Time& newest, Update& update) const;
   void publishImpacts(const core::StepReport& step, const ros::Time& newest, Update& update) const;
-  /// Places the tf-attached obstacles at `stamp` (line time `time`).
-  void updateObstacles(const ros::Time& stamp, double time, const tf2::BufferCore& tf,
-                       Update& update);
+  /// Places the tf-attached obstacles where `motions` (lookUpObstacles) has them, at line time
+  /// `time`; one whose frame is missing keeps its last known motion (reported).
+  void placeObstacles(const std::vector<ObstacleMotion>& motions, double time, Update& update);
   /// Steps the monitor (no states) through the update's time before its first state, every
   /// ~obstacle_update_period, placing the tf-attached obstacles again from tf at each; the
   /// impacts found are gathered in `impacts`, what the steps report in `update`.
@@ -121,7 +129,11 @@ class MonitorCycle {
   StateIntake intake_;
   TimeLine time_line_;
   std::set<std::size_t> placed_obstacles_;  ///< tf-attached obstacles placed at least once
-  std::vector<StampedSample> samples_;      ///< working memory, kept between inputs
+  /// The tf-attached obstacles' frames at the input's newest stamp, and at an instant before it
+  /// (stepMovingObstacles): working memory, kept between inputs.
+  std::vector<ObstacleMotion> obstacle_motions_;
+  std::vector<ObstacleMotion> between_motions_;
+  std::vector<StampedSample> samples_;  ///< working memory, kept between inputs
   std::vector<core::BodyStateSample> timed_;
   /// By source: the states of an input whose stamp went back on its clock, until its next
   /// input tells a clock jump from a stamp off the clock (TimeLine::Event::kHeld).
