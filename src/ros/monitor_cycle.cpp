@@ -128,10 +128,7 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
     return update;
   }
   if (samples_.empty()) return update;
-  const ros::Time newest =
-      std::max_element(samples_.begin(), samples_.end(), [](const auto& x, const auto& y) {
-        return x.stamp < y.stamp;
-      })->stamp;
+  const ros::Time newest = *std::max_element(samples_.stamps.begin(), samples_.stamps.end());
   // The tf-attached obstacles' frames at the newest stamp: looked up once, both to tell
   // whether the input must wait for them and to place them for the step.
   lookUpObstacles(newest, tf, obstacle_motions_);
@@ -160,7 +157,7 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
   std::vector<core::ImpactRecord> earlier_impacts;
   stepMovingObstacles(placed, newest, tf, earlier_impacts, update);
   placeObstacles(obstacle_motions_, placed.time, update);
-  core::StepReport step = monitor_.step(placed.time, timed_);
+  core::StepReport step = monitor_.step(placed.time, samples_.samples);
   step.impacts.insert(step.impacts.begin(), earlier_impacts.begin(), earlier_impacts.end());
   update.stepped = true;
   ++steps_;
@@ -228,11 +225,15 @@ void MonitorCycle::restartTimeLine(const std::string& source, const TimeLine::Pl
   // one's).
   const auto held = held_.find(source);
   if (held != held_.end()) {
-    for (const StampedSample& item : held->second) {
-      const bool newer = std::any_of(samples_.begin(), samples_.end(), [&](const auto& x) {
-        return x.sample.body == item.sample.body;
-      });
-      if (!newer && item.stamp <= newest) samples_.push_back(item);
+    const StampedSamples& held_samples = held->second;
+    for (std::size_t k = 0; k < held_samples.size(); ++k) {
+      const core::BodyStateSample& sample = held_samples.samples[k];
+      const bool newer =
+          std::any_of(samples_.samples.begin(), samples_.samples.end(),
+                      [&](const core::BodyStateSample& x) { return x.body == sample.body; });
+      if (!newer && held_samples.stamps[k] <= newest) {
+        samples_.push_back(sample, held_samples.stamps[k]);
+      }
     }
   }
   held_.clear();  // the line forgot every other source's held stamp too
@@ -272,14 +273,12 @@ void MonitorCycle::timeSamples(const TimeLine::Placed& placed, const ros::Time& 
     body_clock_.assign(monitor_.bodyCount(), 0);
     body_time_.assign(monitor_.bodyCount(), -std::numeric_limits<double>::infinity());
   }
-  timed_.clear();
-  timed_.reserve(samples_.size());
   clock_before_ = body_clock_;
   const std::int64_t newest_ns = nanoseconds(newest);
-  for (const StampedSample& item : samples_) {
-    core::BodyStateSample sample = item.sample;
-    sample.time = placed.time - static_cast<double>(newest_ns - nanoseconds(item.stamp)) * 1e-9;
-    timed_.push_back(sample);
+  for (std::size_t k = 0; k < samples_.size(); ++k) {
+    core::BodyStateSample& sample = samples_.samples[k];
+    sample.time =
+        placed.time - static_cast<double>(newest_ns - nanoseconds(samples_.stamps[k])) * 1e-9;
     if (sample.body < body_time_.size() && sample.time > body_time_[sample.body]) {
       body_time_[sample.body] = sample.time;
       body_clock_[sample.body] = placed.clock_offset;
@@ -445,7 +444,7 @@ void MonitorCycle::stepMovingObstacles(const TimeLine::Placed& placed, const ros
   // Up to the update's first state (the monitor takes states in time order), at most 1,000
   // placements an update.
   double until = placed.time;
-  for (const core::BodyStateSample& sample : timed_) until = std::min(until, sample.time);
+  for (const core::BodyStateSample& sample : samples_.samples) until = std::min(until, sample.time);
   const double from = monitor_.now();
   const double span = until - from;
   if (!(span > period)) return;

@@ -204,29 +204,28 @@ std::optional<Report> StateIntake::problemOf(const BodyState& state, const ros::
   return std::nullopt;
 }
 
-StampedSample StateIntake::inFixedFrame(const BodyState& state, std::size_t index,
-                                        const FrameMotion& frame_motion) {
-  StampedSample item;
-  item.stamp = state.header.stamp;
-  item.sample.body = index;
+core::BodyStateSample StateIntake::inFixedFrame(const BodyState& state, std::size_t index,
+                                                const FrameMotion& frame_motion) {
+  core::BodyStateSample sample;
+  sample.body = index;
   const Eigen::Vector3d position = toEigen(state.pose.position);
-  item.sample.position = frame_motion.point(position);
-  item.sample.velocity = frame_motion.velocity(position, toEigen(state.twist.linear));
-  item.sample.angular_velocity =
+  sample.position = frame_motion.point(position);
+  sample.velocity = frame_motion.velocity(position, toEigen(state.twist.linear));
+  sample.angular_velocity =
       frame_motion.pose.linear() * toEigen(state.twist.angular) + frame_motion.angular_velocity;
-  return item;
+  return sample;
 }
 
-void StateIntake::keepOncePerInput(const StampedSample& item, const Place& place,
-                                   const std::string& id, std::vector<StampedSample>& samples,
-                                   std::vector<Report>& reports) {
-  const std::size_t index = item.sample.body;
+void StateIntake::keepOncePerInput(const core::BodyStateSample& sample, const ros::Time& stamp,
+                                   const Place& place, const std::string& id,
+                                   StampedSamples& samples, std::vector<Report>& reports) {
+  const std::size_t index = sample.body;
   // A body once per input: of two states of one body, the newer stamp is kept (the first of
   // equal ones), and the other is dropped naming both places.
   if (seen_in_input_[index] == input_serial_) {
     const std::size_t kept_place = seen_at_place_[index];
-    StampedSample& kept = samples[seen_at_sample_[index]];
-    const bool newer = item.stamp > kept.stamp;
+    const std::size_t kept = seen_at_sample_[index];
+    const bool newer = stamp > samples.stamps[kept];
     const std::size_t dropped_place = newer ? kept_place : place.index;
     reports.push_back(
         {Reason::kDuplicateId, "dropped " + Place{place.array, dropped_place}.text(id) +
@@ -235,7 +234,8 @@ void StateIntake::keepOncePerInput(const StampedSample& item, const Place& place
                                    "] of this message (a body once per message; the newer stamp is "
                                    "kept)"});
     if (newer) {
-      kept = item;
+      samples.samples[kept] = sample;
+      samples.stamps[kept] = stamp;
       seen_at_place_[index] = place.index;
     }
     return;
@@ -243,14 +243,13 @@ void StateIntake::keepOncePerInput(const StampedSample& item, const Place& place
   seen_in_input_[index] = input_serial_;
   seen_at_place_[index] = place.index;
   seen_at_sample_[index] = samples.size();
-  samples.push_back(item);
+  samples.push_back(sample, stamp);
 }
 
 StateIntake::Outcome StateIntake::convert(const std::vector<BodyState>& states,
                                           const std::string& own_body, const ros::Time& clock,
                                           bool may_wait, const tf2::BufferCore& tf,
-                                          std::vector<StampedSample>& samples,
-                                          std::vector<Report>& reports) {
+                                          StampedSamples& samples, std::vector<Report>& reports) {
   const std::size_t samples_before = samples.size();
   const std::size_t reports_before = reports.size();
   ++input_serial_;
@@ -289,10 +288,9 @@ StateIntake::Outcome StateIntake::convert(const std::vector<BodyState>& states,
                                           " s: header.frame_id: " + motion->error().message()});
       continue;
     }
-    const StampedSample item = inFixedFrame(state, *index, **motion);
+    const core::BodyStateSample sample = inFixedFrame(state, *index, **motion);
     // A frame far out can carry a resolvable position past the bound (or past the doubles).
-    if (auto status = core::checkResolvablePosition(item.sample.position, "pose.position");
-        !status) {
+    if (auto status = core::checkResolvablePosition(sample.position, "pose.position"); !status) {
       Report report{Reason::kBeyondResolution,
                     "dropped " + place.text(id) + ": " + status.error().field + " (in " +
                         quoted(std::as_const(settings_.fixed_frame)) + ", from " + quoted(frame) +
@@ -301,7 +299,7 @@ StateIntake::Outcome StateIntake::convert(const std::vector<BodyState>& states,
       reports.push_back(std::move(report));
       continue;
     }
-    keepOncePerInput(item, place, id, samples, reports);
+    keepOncePerInput(sample, state.header.stamp, place, id, samples, reports);
   }
   return Outcome::kDone;
 }

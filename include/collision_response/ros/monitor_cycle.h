@@ -103,7 +103,8 @@ class MonitorCycle {
   /// A source (or a stamp) whose clock differs from the line's is said once.
   void reportClockOffset(const std::string& source, const TimeLine::Placed& placed,
                          const ros::Time& newest, Update& update);
-  /// The input's samples on the line (timed_), each body's clock remembered.
+  /// Sets each of the input's samples' time on the line, in place, from its stamp's distance
+  /// to the newest (integer nanoseconds); each body's clock remembered.
   void timeSamples(const TimeLine::Placed& placed, const ros::Time& newest);
   /// What the step dropped or fell back on, as reports.
   void reportStep(const core::StepReport& step, Update& update) const;
@@ -133,11 +134,11 @@ class MonitorCycle {
   /// (stepMovingObstacles): working memory, kept between inputs.
   std::vector<ObstacleMotion> obstacle_motions_;
   std::vector<ObstacleMotion> between_motions_;
-  std::vector<StampedSample> samples_;  ///< working memory, kept between inputs
-  std::vector<core::BodyStateSample> timed_;
+  /// The input's samples, timed in place (timeSamples): working memory, kept between inputs.
+  StampedSamples samples_;
   /// By source: the states of an input whose stamp went back on its clock, until its next
   /// input tells a clock jump from a stamp off the clock (TimeLine::Event::kHeld).
-  std::map<std::string, std::vector<StampedSample>> held_;
+  std::map<std::string, StampedSamples> held_;
   /// By body: the clock offset (ns) of its newest state, and that state's line time.
   std::vector<std::int64_t> body_clock_;
   std::vector<double> body_time_;

@@ -67,10 +67,27 @@ struct Report {
   int variant = 0;
 };
 
-/// A state, in the fixed frame, with its own stamp (the time line places it later).
-struct StampedSample {
-  ros::Time stamp;
-  core::BodyStateSample sample;
+/// The states of an input, in the fixed frame, as the monitor takes them, and each one's own
+/// stamp (samples[k] is stamped stamps[k]). A sample's time is set in place once the time line
+/// has placed the input (MonitorCycle), so the monitor steps with these samples themselves.
+struct StampedSamples {
+  std::vector<core::BodyStateSample> samples;
+  std::vector<ros::Time> stamps;
+
+  std::size_t size() const { return samples.size(); }
+  bool empty() const { return samples.empty(); }
+  void clear() {
+    samples.clear();
+    stamps.clear();
+  }
+  void resize(std::size_t size) {
+    samples.resize(size);
+    stamps.resize(size);
+  }
+  void push_back(const core::BodyStateSample& sample, const ros::Time& stamp) {
+    samples.push_back(sample);
+    stamps.push_back(stamp);
+  }
 };
 
 /// What the intake needs to know; from MonitorParams.
@@ -98,7 +115,7 @@ class StateIntake {
   /// rather than drop its states. Each state is converted or dropped (reported), in order.
   Outcome convert(const std::vector<BodyState>& states, const std::string& own_body,
                   const ros::Time& clock, bool may_wait, const tf2::BufferCore& tf,
-                  std::vector<StampedSample>& samples, std::vector<Report>& reports);
+                  StampedSamples& samples, std::vector<Report>& reports);
 
   const IntakeSettings& settings() const { return settings_; }
 
@@ -117,12 +134,14 @@ class StateIntake {
   /// Why a state's values cannot be used (its stamp, a non-finite number, a position past the
   /// monitor's resolution), or nothing.
   std::optional<Report> problemOf(const BodyState& state, const ros::Time& clock) const;
-  /// The state in the fixed frame (the frame's own motion added).
-  static StampedSample inFixedFrame(const BodyState& state, std::size_t index,
-                                    const FrameMotion& frame_motion);
-  /// Adds `item` unless its body already has a state in this input (the newer stamp is kept).
-  void keepOncePerInput(const StampedSample& item, const Place& place, const std::string& id,
-                        std::vector<StampedSample>& samples, std::vector<Report>& reports);
+  /// The state in the fixed frame (the frame's own motion added); its time is set later.
+  static core::BodyStateSample inFixedFrame(const BodyState& state, std::size_t index,
+                                            const FrameMotion& frame_motion);
+  /// Adds `sample`, stamped `stamp`, unless its body already has a state in this input (the
+  /// newer stamp is kept).
+  void keepOncePerInput(const core::BodyStateSample& sample, const ros::Time& stamp,
+                        const Place& place, const std::string& id, StampedSamples& samples,
+                        std::vector<Report>& reports);
   /// The body's index, or a report of why there is none.
   bool lookUp(const BodyState& state, std::size_t place, std::size_t& index,
               std::vector<Report>& reports);
