@@ -112,8 +112,7 @@ core::Expected<Contact> toContactMessage(const core::ContactRecord& record,
 }
 
 MonitorCycle::MonitorCycle(const core::Scene& scene, const MonitorParams& params)
-    : scene_(scene),
-      params_(params),
+    : params_(params),
       monitor_(scene, core::MonitorSettings{params.contact_tolerance, params.body_timeout}),
       intake_(bodyIds(monitor_), intakeSettings(scene, params)),
       time_line_(params.clock_jump_back) {}
@@ -361,7 +360,7 @@ Report MonitorCycle::overBudgetReport(const core::StepReport& step) const {
   }
   return {Reason::kOverWorkBudget,
           "the exact model's work on " + names + " ran over ~scene/exact_work_budget (" +
-              std::to_string(scene_.exact_work_budget) +
+              std::to_string(monitor_.scene().exact_work_budget) +
               ") in one update (an inelastic collapse, a chattering slip): from there they and "
               "the bodies near them are a stepped cluster until they part (doc/model.md, "
               "\"Lasting contact\")",
@@ -371,7 +370,7 @@ Report MonitorCycle::overBudgetReport(const core::StepReport& step) const {
 void MonitorCycle::publishContacts(const core::StepReport& step, const ros::Time& newest,
                                    Update& update) const {
   update.contacts.header.stamp = newest;
-  update.contacts.header.frame_id = scene_.fixed_frame;
+  update.contacts.header.frame_id = monitor_.scene().fixed_frame;
   update.contacts.contacts.reserve(step.contacts.size());
   for (const core::ContactRecord& record : step.contacts) {
     ros::Time since;
@@ -396,14 +395,14 @@ void MonitorCycle::publishContacts(const core::StepReport& step, const ros::Time
 void MonitorCycle::publishImpacts(const core::StepReport& step, const ros::Time& newest,
                                   Update& update) const {
   update.impacts.header.stamp = newest;
-  update.impacts.header.frame_id = scene_.fixed_frame;
+  update.impacts.header.frame_id = monitor_.scene().fixed_frame;
   update.impacts.impacts.reserve(step.impacts.size());
   for (const core::ImpactRecord& record : step.impacts) {
     ros::Time stamp;
     const bool stamped = time_line_.stampOf(
         record.time, clockOf(record.time, record.body_a, record.other, record.other_is_obstacle),
         stamp);
-    auto impact = toImpactMessage(record, monitor_, stamp, scene_.fixed_frame);
+    auto impact = toImpactMessage(record, monitor_, stamp, monitor_.scene().fixed_frame);
     if (impact && stamped) {
       update.impacts.impacts.push_back(std::move(impact.value()));
       continue;
@@ -438,7 +437,8 @@ void MonitorCycle::stepMovingObstacles(const TimeLine::Placed& placed, const ros
                                        std::vector<core::ImpactRecord>& impacts, Update& update) {
   const double period = params_.obstacle_update_period;
   if (!(period > 0) || !monitor_.started()) return;
-  const bool moving = std::any_of(scene_.obstacles.begin(), scene_.obstacles.end(),
+  const std::vector<core::ObstacleSpec>& obstacles = monitor_.scene().obstacles;
+  const bool moving = std::any_of(obstacles.begin(), obstacles.end(),
                                   [](const core::ObstacleSpec& o) { return !o.frame.empty(); });
   if (!moving) return;
   // Up to the update's first state (the monitor takes states in time order), at most 1,000
@@ -469,7 +469,7 @@ void MonitorCycle::lookUpObstacles(const ros::Time& stamp, const tf2::BufferCore
       motions.emplace_back();
       continue;
     }
-    motions.emplace_back(lookupFrameMotion(tf, scene_.fixed_frame, spec.frame, stamp,
+    motions.emplace_back(lookupFrameMotion(tf, monitor_.scene().fixed_frame, spec.frame, stamp,
                                            ros::Duration(params_.frame_velocity_interval)));
   }
 }
@@ -500,10 +500,11 @@ void MonitorCycle::placeObstacles(const std::vector<ObstacleMotion>& motions, do
 
 void MonitorCycle::tune(core::Detection detection, double restitution_threshold,
                         core::CombineRule rule) {
-  scene_.detection = detection;
-  scene_.restitution_threshold = restitution_threshold;
-  scene_.materials.setCombineRule(rule);
-  monitor_.tune(detection, restitution_threshold, scene_.materials);
+  // The monitor holds the scene: the new rule is set on its materials, and its scene says the
+  // tuned values from then on.
+  core::MaterialTable materials = monitor_.scene().materials;
+  materials.setCombineRule(rule);
+  monitor_.tune(detection, restitution_threshold, materials);
 }
 
 }  // namespace collision_response

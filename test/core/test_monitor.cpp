@@ -386,6 +386,28 @@ TEST(Monitor, OrderOfListingAndOfStatesDoesNotMatter) {
   EXPECT_EQ(permutations, 120);
 }
 
+// The monitor holds the scene it watches (the ROS layer reads it there): as given, its lists in
+// the scene's order, and with what live tuning changed; a copy taken before the tuning keeps
+// what it was given.
+TEST(Monitor, HoldsItsSceneAsGivenAndAsTuned) {
+  Scene scene = sceneWithRestitution(0.5);
+  scene.bodies = {ball("b", 1.0, 0.1), ball("a", 1.0, 0.1)};
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  EXPECT_EQ(monitor.body(0).id, "a");  // indexed by sorted id
+  ASSERT_EQ(monitor.scene().bodies.size(), 2u);
+  EXPECT_EQ(monitor.scene().bodies[0].id, "b");
+  const ImpactMonitor before = monitor;
+  MaterialTable materials = scene.materials;
+  materials.setCombineRule(CombineRule::kMax);
+  monitor.tune(Detection::kDiscrete, 0.25, materials);
+  EXPECT_EQ(monitor.scene().detection, Detection::kDiscrete);
+  EXPECT_EQ(monitor.scene().restitution_threshold, 0.25);
+  EXPECT_EQ(monitor.scene().materials.combineRule(), CombineRule::kMax);
+  EXPECT_EQ(before.scene().detection, Detection::kContinuous);
+  EXPECT_EQ(before.scene().restitution_threshold, 0.0);
+  EXPECT_EQ(before.scene().materials.combineRule(), CombineRule::kMin);
+}
+
 // The broadphase only leaves out pairs that cannot meet: a random gas (with gravity and without,
 // continuous and discrete) gives the very same impacts, to the bit, with it and with every pair.
 TEST(Monitor, BroadphaseGivesTheSameImpactsAsEveryPair) {

@@ -180,6 +180,8 @@ class ImpactMonitor {
   const BodySpec& body(std::size_t index) const;
   const ObstacleSpec& obstacle(std::size_t index) const;
   std::optional<std::size_t> bodyIndex(const std::string& id) const;
+  /// The scene it watches, as given (its lists in the scene's order), with what tune changed.
+  const Scene& scene() const;
 
   /// Where a tf-attached obstacle's frame is (`frame`: the frame's motion, fixed <- frame), from
   /// `frame.time` on: its shape is placed there and moves straight on. Fixed obstacles are set
@@ -195,7 +197,7 @@ class ImpactMonitor {
   /// Live tuning (dynamic_reconfigure): the detection mode, the restitution threshold and the
   /// materials' coefficients (a new combine rule) from the next step on. The tracks are kept;
   /// after a change of detection mode, a pair that overlaps at that instant may be reported
-  /// once more. The caller validates the values (as validateScene does).
+  /// once more. The caller validates the values (as validateScene does). scene() says them.
   void tune(Detection detection, double restitution_threshold, const MaterialTable& materials);
 
   /// Advances the monitor to `time` with the states given (each at its own time <= `time`;

@@ -69,7 +69,8 @@ class MonitorCycle {
   void tune(core::Detection detection, double restitution_threshold, core::CombineRule rule);
 
   const core::ImpactMonitor& monitor() const { return monitor_; }
-  const core::Scene& scene() const { return scene_; }
+  /// The scene, as the monitor holds it (tuned by tune).
+  const core::Scene& scene() const { return monitor_.scene(); }
   const TimeLine& timeLine() const { return time_line_; }
   const MonitorParams& params() const { return params_; }
   /// Steps taken so far: one per input that had a usable state.
@@ -124,7 +125,6 @@ class MonitorCycle {
                            const tf2::BufferCore& tf, std::vector<core::ImpactRecord>& impacts,
                            Update& update);
 
-  core::Scene scene_;
   MonitorParams params_;
   core::ImpactMonitor monitor_;
   StateIntake intake_;

@@ -712,6 +712,7 @@ void start(World& world, double time) {
 ImpactMonitor::ImpactMonitor(const Scene& scene, const MonitorSettings& settings)
     : world_(std::make_unique<World>()) {
   World& world = *world_;
+  world.scene = std::make_shared<const Scene>(scene);
   world.settings = settings;
   world.detection = scene.detection;
   world.restitution_threshold = scene.restitution_threshold;
@@ -787,6 +788,7 @@ const BodySpec& ImpactMonitor::body(std::size_t index) const { return world_->bo
 const ObstacleSpec& ImpactMonitor::obstacle(std::size_t index) const {
   return world_->obstacles[index];
 }
+const Scene& ImpactMonitor::scene() const { return *world_->scene; }
 bool ImpactMonitor::started() const { return world_->started; }
 double ImpactMonitor::now() const { return world_->now; }
 
@@ -798,6 +800,11 @@ void ImpactMonitor::tune(Detection detection, double restitution_threshold,
   world.detection = detection;
   world.restitution_threshold = restitution_threshold;
   computePairCoefficients(world, materials);
+  auto tuned = std::make_shared<Scene>(*world.scene);
+  tuned->detection = detection;
+  tuned->restitution_threshold = restitution_threshold;
+  tuned->materials = materials;
+  world.scene = std::move(tuned);
 }
 
 std::optional<PlacedShape> ImpactMonitor::obstaclePose(std::size_t obstacle) const {

@@ -200,6 +200,9 @@ struct Scratch {
 };
 
 struct World {
+  /// The scene as given, tuned (ImpactMonitor::scene): shared by a monitor's copies (a
+  /// prediction copies its models often), replaced whole when tuned.
+  std::shared_ptr<const Scene> scene;
   MonitorSettings settings;
   Detection detection = Detection::kContinuous;
   double restitution_threshold = 0.0;
