@@ -322,9 +322,8 @@ BenchScene ballPileScene(int count, double duration) {
     const V cell(i % side, (i / side) % side, i / (side * side));
     char id[16];
     std::snprintf(id, sizeof id, "ball_%04d", i);
-    scene.bodies.push_back(ball(
-        id, 0.1, 0.05, "pile",
-        V(0.11, 0.11, 0.11) + spacing * cell + drawZyx(offset, engine)));
+    scene.bodies.push_back(ball(id, 0.1, 0.05, "pile",
+                                V(0.11, 0.11, 0.11) + spacing * cell + drawZyx(offset, engine)));
   }
   const V normals[] = {V(1, 0, 0), V(-1, 0, 0), V(0, 1, 0), V(0, -1, 0), V(0, 0, 1), V(0, 0, -1)};
   for (int i = 0; i < 6; ++i) {
