@@ -67,13 +67,13 @@ build_workspace() {
 
 # build_workspace with its whole output in .ws/build.log, saying on the terminal what it does:
 # the log's place, each stage, and the progress every tenth of the way (a first build takes
-# about 5 minutes on 2 cores, a rebuild seconds). On failure, the log's last lines.
+# about 2 minutes on 2 cores, a rebuild seconds). On failure, the log's last lines.
 build_package() {
   local log="$ws/build.log" status=0 started=$SECONDS
   # The pipeline's status is build_workspace's, also where the caller has no pipefail.
   local -
   set -o pipefail
-  echo "== building collision_response in $ws (first build about 5 minutes; log: $log)"
+  echo "== building collision_response in $ws (first build about 2 minutes on 2 cores; log: $log)"
   build_workspace "$@" 2>&1 | tee "$log" | awk '
     /^== / { print "  " substr($0, 4); fflush(); next }
     match($0, /^\[ *[0-9]+%\]/) {

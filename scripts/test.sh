@@ -5,8 +5,8 @@
 #                                  and UBSan, each fuzzer's saved inputs replayed, catkin_lint.
 #   bash scripts/test.sh --quick   the unit tests that need no master only (core_tests, with the
 #                                  trace, and ros_unit_tests). The first run after the demo's build
-#                                  compiles these two test programs first (about 3 minutes on 2
-#                                  cores); then about 40 s.
+#                                  compiles these two test programs first (about 1.5 minutes on 2
+#                                  cores); then 36 s.
 #   bash scripts/test.sh --long    the full run, with each fuzzer fuzzing for FUZZ_SECONDS
 #                                  (default 600) instead of replaying: a nightly run.
 # The full run keeps its two cores busy with two lanes side by side: the gtests and rostests (two
@@ -39,7 +39,7 @@ status=0
 
 if [ "$mode" = quick ]; then
   echo "== building the unit tests without a master (the first time after the demo's build: about"
-  echo "   3 minutes, the demo does not build test programs; log: $ws/test.log), then running them"
+  echo "   1.5 minutes, the demo builds no test program; log: $ws/test.log), then running them (36 s)"
   if ! cmake --build "$ws/build" --target core_tests ros_unit_tests -- -j2 >"$ws/test.log" 2>&1; then
     tail -40 "$ws/test.log"
     echo "0 passed, 1 failed"
