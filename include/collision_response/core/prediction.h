@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -26,6 +27,9 @@ inline constexpr std::size_t kPredictionMaxSamples = 10000;
 /// Without samples, the first crossing of a plane is looked for at this period, then bisected to
 /// the last bit of its instant: a crossing and a return within one period are not seen.
 inline constexpr double kCrossingSearchPeriod = 0.02;  ///< s
+/// With a budget (PredictionBudget), a request without samples or a plane is advanced in pieces
+/// at most this long, so that the budget is looked at this often along the horizon.
+inline constexpr double kBudgetCheckPeriod = 0.1;  ///< s
 
 struct PredictionRequest {
   BodySpec body;                ///< the body predicted (id, mass, radius, material, coefficients)
@@ -50,13 +54,48 @@ struct Prediction {
   std::vector<ContactRecord> contacts;
   std::vector<BodyStateSample> samples;     ///< from the state's instant, every sample_period
   std::optional<BodyStateSample> crossing;  ///< the first crossing of the request's plane
-  /// A budget cut the prediction short (kPredictionMax*, or the monitor's guards); `message` says
-  /// which.
+  /// A budget cut the prediction short (kPredictionMax*, the monitor's guards, the CPU budget);
+  /// `message` says which.
   bool cut_short = false;
+  /// The CPU budget (PredictionBudget) ran out: the prediction ends where it got to.
+  bool out_of_budget = false;
   std::string message;
   /// The model the prediction ran on: the body (index 0), the obstacles and the held bodies.
   std::shared_ptr<const ImpactMonitor> model;
 };
+
+/// A CPU budget for one prediction: looked at between the pieces the horizon is advanced in (the
+/// sample period, the crossing's search period, or kBudgetCheckPeriod); once spent, the
+/// prediction stops where it got to and answers what it found up to there (its impacts, samples
+/// and the state there), cut short, the message naming the budget.
+struct PredictionBudget {
+  double seconds = 0.0;                              ///< s of `clock`; 0: no budget
+  std::string name = "the prediction's CPU budget";  ///< as the message names it
+  /// s: the clock the budget is spent on; empty: the calling thread's CPU time
+  /// (CLOCK_THREAD_CPUTIME_ID), so that other threads' work does not count.
+  std::function<double()> clock;
+};
+
+/// What a prediction reads of the live monitor, copied at once by startPrediction (the scene, the
+/// other bodies where the monitor has them at the request's instant, the obstacles where it
+/// placed them: O(bodies + obstacles), no motion computed), so that runPrediction needs the
+/// monitor no more and may run on another thread while it steps on.
+struct PredictionStart {
+  Scene ahead;  ///< the body alone among the obstacles and the other bodies, held
+  PredictionRequest request;
+  MonitorSettings settings;
+  /// Per obstacle of `ahead`: where the live monitor placed it (a tf-attached one), its time on
+  /// the prediction's line; empty: where `ahead` puts it.
+  std::vector<std::optional<PlacedShape>> placed;
+};
+
+/// The part of predictImpacts that reads `live`; the request's own numbers are checked here.
+Expected<PredictionStart> startPrediction(const Scene& scene, const ImpactMonitor* live,
+                                          const MonitorSettings& settings,
+                                          const PredictionRequest& request);
+/// The rest of predictImpacts, on `start` alone, within `budget`.
+Expected<Prediction> runPrediction(const PredictionStart& start,
+                                   const PredictionBudget& budget = {});
 
 /// Predicts `request.body` from `request.state` in `scene` (validated), under `request.effects`,
 /// with continuous detection. Obstacles on tf frames are where `live` last placed them, moving
@@ -64,8 +103,10 @@ struct Prediction {
 /// the state's instant (immovable spheres); without `live`, the scene's fixed obstacles only.
 /// Errors name the request's field: a state that is not finite or is inside an obstacle, a
 /// horizon or count not > 0, a body's number out of range, an effect the body cannot have.
+/// Within `budget` (none by default): see PredictionBudget.
 Expected<Prediction> predictImpacts(const Scene& scene, const ImpactMonitor* live,
                                     const MonitorSettings& settings,
-                                    const PredictionRequest& request);
+                                    const PredictionRequest& request,
+                                    const PredictionBudget& budget = {});
 
 }  // namespace collision_response::core

@@ -1,5 +1,6 @@
 #include "collision_response/core/prediction.h"
 
+#include <time.h>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -102,35 +103,52 @@ Scene sceneAhead(const Scene& scene, const ImpactMonitor* live, const Prediction
   return ahead;
 }
 
-/// The obstacles on tf frames where `live` placed them; an error where the state starts inside
-/// an obstacle.
-Status placeObstacles(ImpactMonitor& model, const ImpactMonitor* live,
-                      const PredictionRequest& request, double contact_tolerance) {
+/// Where `live` placed each tf-attached obstacle of `ahead` (by id), its time moved onto the
+/// prediction's line (from 0 at the request's state).
+std::vector<std::optional<PlacedShape>> livePlacements(const Scene& ahead,
+                                                       const ImpactMonitor* live,
+                                                       const PredictionRequest& request) {
+  std::vector<std::optional<PlacedShape>> placed(ahead.obstacles.size());
+  if (live == nullptr) return placed;
   std::map<std::string, std::size_t> live_index;
-  for (std::size_t i = 0; live != nullptr && i < live->obstacleCount(); ++i) {
-    live_index[live->obstacle(i).id] = i;
+  for (std::size_t i = 0; i < live->obstacleCount(); ++i) live_index[live->obstacle(i).id] = i;
+  for (std::size_t i = 0; i < ahead.obstacles.size(); ++i) {
+    if (ahead.obstacles[i].frame.empty()) continue;
+    const auto found = live_index.find(ahead.obstacles[i].id);
+    if (found == live_index.end()) continue;
+    placed[i] = live->obstaclePose(found->second);
+    if (placed[i]) placed[i]->pose.time -= request.state.time;  // onto the prediction's line
   }
+  return placed;
+}
+
+/// The obstacles on tf frames where the live monitor placed them; an error where the state
+/// starts inside an obstacle.
+Status placeObstacles(ImpactMonitor& model, const PredictionStart& start) {
+  const PredictionRequest& request = start.request;
   for (std::size_t i = 0; i < model.obstacleCount(); ++i) {
     const ObstacleSpec& obstacle = model.obstacle(i);
-    if (!obstacle.frame.empty()) {
-      const auto found = live_index.find(obstacle.id);
-      if (found == live_index.end()) continue;
-      if (auto placed = live->obstaclePose(found->second)) {
-        placed->pose.time -= request.state.time;  // onto the prediction's line, from 0
-        model.placeObstacle(i, *placed);
-      }
+    if (!obstacle.frame.empty() && i < start.placed.size() && start.placed[i]) {
+      model.placeObstacle(i, *start.placed[i]);
     }
     const auto placed = model.obstaclePose(i);
     if (!placed) continue;  // on a frame tf has not given yet
-    const ContactGeometry g =
-        contactGeometry(request.state.position, request.body.radius, shapeAt(*placed, 0.0),
-                        contact_tolerance, [] { return Eigen::Vector3d(Eigen::Vector3d::Zero()); });
+    const ContactGeometry g = contactGeometry(
+        request.state.position, request.body.radius, shapeAt(*placed, 0.0),
+        start.settings.contact_tolerance, [] { return Eigen::Vector3d(Eigen::Vector3d::Zero()); });
     if (g.gap < -g.tolerance) {
       return Error{"body.position", "is " + formatNumber(-g.gap) + " m inside obstacle '" +
                                         obstacle.id + "' (a prediction starts in free space)"};
     }
   }
   return Ok{};
+}
+
+/// The calling thread's CPU time, s.
+double threadCpuSeconds() {
+  timespec now{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+  return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
 }
 
 BodyStateSample stateOf(const ImpactMonitor& model, double time) {
@@ -170,14 +188,18 @@ BodyStateSample bisectCrossing(const Plane& plane, double from, double to, State
 /// the same motion to the bit.
 class PredictionRun {
  public:
-  PredictionRun(const Scene& ahead, const MonitorSettings& settings, const ImpactMonitor* live,
-                const PredictionRequest& request)
-      : ahead_(ahead), settings_(settings), live_(live), request_(request) {}
+  PredictionRun(const PredictionStart& start, const PredictionBudget& budget, double began)
+      : start_(start),
+        ahead_(start.ahead),
+        settings_(start.settings),
+        request_(start.request),
+        budget_(budget),
+        began_(began) {}
 
   /// A model at the state's instant, 0.
   std::shared_ptr<ImpactMonitor> fresh() const {
     auto model = std::make_shared<ImpactMonitor>(ahead_, settings_);
-    placeObstacles(*model, live_, request_, settings_.contact_tolerance);  // checked before
+    placeObstacles(*model, start_);  // checked before
     BodyStateSample state = request_.state;
     state.body = 0;
     state.time = 0.0;
@@ -188,12 +210,17 @@ class PredictionRun {
   Prediction run(std::vector<std::string>& cut) {
     budget(cut);
     Prediction prediction;
+    bool spent = false;
     auto model = fresh();
     if (request_.sample_period > 0) prediction.samples.push_back(stateOf(*model, 0.0));
     double now = 0.0;
     bool truncated = false;
     double stalled_at = INFINITY;  // the earliest stall of the body's flight through air
     for (std::size_t piece = 1; piece <= pieces_ && now < horizon_; ++piece) {
+      if (piece > 1 && outOfBudget()) {
+        spent = true;
+        break;
+      }
       const double next = pieceEnd(piece);
       const Eigen::Vector3d from = stateOf(*model, now).position;
       StepReport report = model->advance(next, {});
@@ -234,6 +261,12 @@ class PredictionRun {
                     "too large for it); the body is held where it got to from there, its state "
                     "at the horizon too");
     }
+    if (spent) {
+      prediction.out_of_budget = true;
+      cut.push_back(budget_.name + " (" + formatNumber(budget_.seconds) +
+                    " s of CPU) ran out at +" + formatNumber(now) +
+                    " s: the impacts, samples and state up to there");
+    }
     prediction.final_state = stateOf(*model, now);
     prediction.model = std::move(model);
     return prediction;
@@ -244,6 +277,12 @@ class PredictionRun {
     for (const StalledFlight& flight : report.stalled) {
       stalled_at = std::min(stalled_at, flight.stalled);
     }
+  }
+
+  bool outOfBudget() const {
+    if (!(budget_.seconds > 0)) return false;
+    const double spent = (budget_.clock ? budget_.clock() : threadCpuSeconds()) - began_;
+    return spent >= budget_.seconds;
   }
 
   /// The horizon, impacts and pieces within the budgets (kPredictionMax*); what was cut is said.
@@ -260,6 +299,7 @@ class PredictionRun {
     }
     period_ = request_.sample_period > 0 ? request_.sample_period
               : request_.crossing        ? kCrossingSearchPeriod
+              : budget_.seconds > 0      ? std::min(horizon_, kBudgetCheckPeriod)
                                          : horizon_;
     pieces_ = static_cast<std::size_t>(std::ceil(horizon_ / period_));
     if (request_.sample_period > 0 && pieces_ > kPredictionMaxSamples) {
@@ -305,39 +345,57 @@ class PredictionRun {
     });
   }
 
+  const PredictionStart& start_;
   const Scene& ahead_;
-  MonitorSettings settings_;
-  const ImpactMonitor* live_;
+  const MonitorSettings& settings_;
   const PredictionRequest& request_;
+  const PredictionBudget& budget_;
+  double began_ = 0.0;  ///< budget_'s clock when the prediction began
   double horizon_ = 0.0, period_ = 0.0, next_ = 0.0;
   std::size_t max_impacts_ = 0, pieces_ = 0;
 };
 
 }  // namespace
 
-Expected<Prediction> predictImpacts(const Scene& scene, const ImpactMonitor* live,
-                                    const MonitorSettings& settings,
-                                    const PredictionRequest& request) {
+Expected<PredictionStart> startPrediction(const Scene& scene, const ImpactMonitor* live,
+                                          const MonitorSettings& settings,
+                                          const PredictionRequest& request) {
   if (auto status = checkRequest(scene, request); !status) return status.error();
-  const Scene ahead = sceneAhead(scene, live, request);
-  if (auto status = validateScene(ahead, "request"); !status) return status.error();
-  MonitorSettings model_settings = settings;
-  model_settings.body_timeout = std::numeric_limits<double>::infinity();
-  model_settings.detect_impacts = true;
+  PredictionStart start;
+  start.ahead = sceneAhead(scene, live, request);
+  start.request = request;
+  start.settings = settings;
+  start.settings.body_timeout = std::numeric_limits<double>::infinity();
+  start.settings.detect_impacts = true;
+  start.placed = livePlacements(start.ahead, live, request);
+  return start;
+}
+
+Expected<Prediction> runPrediction(const PredictionStart& start, const PredictionBudget& budget) {
+  const double began =
+      budget.seconds > 0 ? (budget.clock ? budget.clock() : threadCpuSeconds()) : 0.0;
+  if (auto status = validateScene(start.ahead, "request"); !status) return status.error();
   {
-    ImpactMonitor check(ahead, model_settings);
-    if (auto status = placeObstacles(check, live, request, settings.contact_tolerance); !status) {
-      return status.error();
-    }
+    ImpactMonitor check(start.ahead, start.settings);
+    if (auto status = placeObstacles(check, start); !status) return status.error();
   }
   // The prediction's own time line starts at the state (0), where its instants hold every digit.
   std::vector<std::string> cut;
-  Prediction prediction = PredictionRun(ahead, model_settings, live, request).run(cut);
+  Prediction prediction = PredictionRun(start, budget, began).run(cut);
   prediction.cut_short = !cut.empty();
   for (const std::string& reason : cut) {
     prediction.message += (prediction.message.empty() ? "" : "; ") + reason;
   }
   return prediction;
+}
+
+Expected<Prediction> predictImpacts(const Scene& scene, const ImpactMonitor* live,
+                                    const MonitorSettings& settings,
+                                    const PredictionRequest& request,
+                                    const PredictionBudget& budget) {
+  auto start = startPrediction(scene, live, settings, request);
+  if (!start) return start.error();
+  return runPrediction(*start, budget);
 }
 
 }  // namespace collision_response::core
