@@ -648,3 +648,62 @@ TEST(Playback, BodiesBounceBeforeTheImpactIsHeardUnderContinuousDetectionOnly) {
 
 }  // namespace
 }  // namespace collision_response
+
+namespace collision_response {
+namespace {
+// Issue 41, item 10: an impact heard late (the node busy) but within the replay window is played
+// from its instant, through the same instants, as if it had been heard at once; older than the
+// window, it is refused. A ball thrown at v0 = (-1.5, 0, 4.05) m/s under g = 9.81 m/s^2, asked for
+// every 10 ms, meets an obstacle the played motion does not know (a paddle on a tf frame) at
+// tau = 0.255 s, heard 45 ms later (after the instant 0.30 s was played; window 0.1 s): from
+// tau it moves from c = p(tau) at v' = (1.2, 0, 0.5), so at t > tau it is at
+// c + v' (t - tau) + g (t - tau)^2 / 2 (closed form).
+TEST(Playback, AnImpactHeardLateWithinTheReplayWindowIsPlayedFromItsInstant) {
+  using V = Eigen::Vector3d;
+  constexpr double kG = 9.81, kTau = 0.255, kWindow = 0.1;
+  core::Scene scene;
+  scene.effects.gravity = true;
+  scene.gravity = V(0, 0, -kG);
+  core::BodySpec ball;
+  ball.id = "ball";
+  ball.radius = 0.02;
+  ball.material = "tennis_ball";
+  ball.position = V(2.0, 0, 0.6);
+  ball.velocity = V(-1.5, 0, 4.05);
+  scene.bodies = {ball};
+  const auto lob = [&](double t) { return V(2.0 - 1.5 * t, 0, 0.6 + 4.05 * t - 0.5 * kG * t * t); };
+  const V centre = lob(kTau), after(1.2, 0, 0.5);
+  const auto bounced = [&](double t) {
+    const double s = t - kTau;
+    return V(centre + after * s + 0.5 * s * s * V(0, 0, -kG));
+  };
+  const auto grid = [](int k) { return 0.01 * k; };
+
+  core::Playback in_time(scene, 1e-9, 0.0, kWindow);
+  core::Playback late(scene, 1e-9, 0.0, kWindow);
+  core::Playback too_late(scene, 1e-9, 0.0, kWindow);
+  for (int k = 1; k <= 26; ++k) {
+    in_time.position(0, grid(k));
+    late.position(0, grid(k));
+    too_late.position(0, grid(k));
+  }
+  EXPECT_TRUE(in_time.applyImpact(0, kTau, centre, after));  // heard at once
+  for (int k = 27; k <= 30; ++k) {
+    in_time.position(0, grid(k));
+    EXPECT_NEAR((late.position(0, grid(k)) - lob(grid(k))).norm(), 0, 1e-12);  // not heard yet
+  }
+  EXPECT_TRUE(late.applyImpact(0, kTau, centre, after)) << "heard 45 ms late, within 0.1 s";
+  for (int k = 27; k <= 60; ++k) {
+    const double t = grid(k);
+    EXPECT_NEAR((late.position(0, t) - bounced(t)).norm(), 0, 1e-12) << t << " s";
+    EXPECT_NEAR((late.velocity(0, t) - (after + V(0, 0, -kG * (t - kTau)))).norm(), 0, 1e-12);
+    EXPECT_EQ(late.position(0, t), in_time.position(0, t)) << "the same steps, the same motion";
+  }
+  // 0.255 s is more than the window before 0.40 s: what is final is at 0.29 s, after it.
+  for (int k = 27; k <= 40; ++k) too_late.position(0, grid(k));
+  EXPECT_FALSE(too_late.applyImpact(0, kTau, centre, after));
+  EXPECT_NEAR((too_late.position(0, grid(41)) - lob(grid(41))).norm(), 0, 1e-12);
+}
+
+}  // namespace
+}  // namespace collision_response

@@ -32,15 +32,18 @@ struct Apex {
 /// contact solves (a squeezed ball in a settling pile). Under discrete detection it does not:
 /// the watcher finds impacts as overlaps at its samples, which the played bodies must reach.
 ///
-/// Impacts arrive after the states that revealed them were played, so the motion is kept in two
-/// parts: what is final (committed, up to the latest instant asked for before the last one) and
-/// what is played ahead from it with the impacts applied so far. Asking for a later instant makes
-/// the earlier part final; an impact older than what is final is refused (false). Bodies are the
-/// scene's, as listed.
+/// Impacts arrive after the states that revealed them were played, so the motion is kept as the
+/// model at each instant asked for (in increasing order) over the last `replay_window` s, from
+/// what is final: the model at the latest instant asked for that is more than `replay_window` s
+/// before the last one (window 0: the one before the last, so an impact must be heard within a
+/// period). An impact inside the window is applied by playing the motion again from its instant
+/// through the same instants (the same steps, so the same result as heard in time); an impact
+/// older than what is final is refused (false). Bodies are the scene's, as listed.
 class Playback {
  public:
-  /// Starts every body of `scene` at `start` from its `position` and `velocity`.
-  Playback(const Scene& scene, double contact_tolerance, double start);
+  /// Starts every body of `scene` at `start` from its `position` and `velocity`; impacts heard
+  /// up to `replay_window` s (>= 0) after the latest instant asked for are still applied.
+  Playback(const Scene& scene, double contact_tolerance, double start, double replay_window = 0.0);
 
   std::size_t bodyCount() const { return scene_.bodies.size(); }
   Eigen::Vector3d position(std::size_t body, double time) const;
@@ -49,6 +52,7 @@ class Playback {
 
   /// An impact on `body` at `time`: from then on it moves from `centre` with the velocities after
   /// (its lasting contacts formed again there). False when `time` is older than what is final.
+  /// The instants asked for after `time` are played again at the next question.
   bool applyImpact(std::size_t body, double time, const Eigen::Vector3d& centre,
                    const Eigen::Vector3d& velocity_after,
                    const Eigen::Vector3d& angular_velocity_after = Eigen::Vector3d::Zero());
@@ -85,20 +89,36 @@ class Playback {
     int impacts_before = 0;
     Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
   };
-  /// The model at `time`: the final part advanced with the impacts applied up to then.
+  /// The model at one instant asked for; empty while an impact heard since has to be played
+  /// again through it.
+  struct Played {
+    double time = 0.0;
+    std::optional<ImpactMonitor> model;
+    std::vector<ContactRecord> contacts;  ///< the lasting contacts of the step that reached it
+  };
+  /// The model at `time`: the latest instant played at or before it, advanced with the impacts
+  /// applied up to then.
   const ImpactMonitor& at(double time) const;
+  /// Plays again every instant whose model an impact dropped, each from the one before.
+  void replay() const;
+  /// `played_[k]`'s model from `played_[k - 1]`'s, with the impacts in between.
+  void playFromPrevious(std::size_t k) const;
+  /// The impacts applied in (from, to], in time order.
+  std::vector<BodyStateSample> impactsIn(double from, double to) const;
 
   Scene scene_;
   Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();
   std::vector<std::size_t> model_index_;  // scene body -> the model's index
   std::map<std::string, std::size_t> index_;
-  mutable ImpactMonitor committed_;
-  mutable double committed_time_;
-  mutable std::vector<BodyStateSample> pending_;  // impacts after committed_time_, by time
-  mutable std::optional<ImpactMonitor> view_;
+  double replay_window_ = 0.0;
+  /// The instants asked for, in increasing order: the front is final (an impact before it is
+  /// refused), the others within replay_window_ of the back.
+  mutable std::vector<Played> played_;
+  mutable std::vector<BodyStateSample> pending_;  // impacts after played_.front(), by time
+  mutable std::optional<ImpactMonitor> view_;     // between two instants asked for
   mutable double view_time_ = 0.0;
-  mutable double horizon_;  // the latest instant asked for
   mutable std::vector<ContactRecord> view_contacts_;
+  mutable const std::vector<ContactRecord>* at_contacts_ = nullptr;  // those of at()'s model
   std::vector<Flight> flights_;
 };
 

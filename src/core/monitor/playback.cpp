@@ -24,17 +24,15 @@ MonitorSettings playbackSettings(double contact_tolerance, Detection detection) 
 
 }  // namespace
 
-Playback::Playback(const Scene& scene, double contact_tolerance, double start)
-    : scene_(scene),
-      committed_(scene, playbackSettings(contact_tolerance, scene.detection)),
-      committed_time_(start),
-      horizon_(start) {
+Playback::Playback(const Scene& scene, double contact_tolerance, double start, double replay_window)
+    : scene_(scene), replay_window_(replay_window > 0 ? replay_window : 0.0) {
   if (scene_.effects.gravity) gravity_ = scene_.gravity;
+  ImpactMonitor model(scene, playbackSettings(contact_tolerance, scene.detection));
   std::vector<BodyStateSample> states;
   for (std::size_t i = 0; i < scene_.bodies.size(); ++i) {
     const BodySpec& body = scene_.bodies[i];
     index_[body.id] = i;
-    model_index_.push_back(*committed_.bodyIndex(body.id));
+    model_index_.push_back(*model.bodyIndex(body.id));
     BodyStateSample state;
     state.body = model_index_.back();
     state.time = start;
@@ -45,39 +43,64 @@ Playback::Playback(const Scene& scene, double contact_tolerance, double start)
     flights_.push_back(
         Flight{start, body.position, body.velocity, false, 0, body.angular_velocity});
   }
-  committed_.step(start, states);
+  model.step(start, states);
+  played_.push_back(Played{start, std::move(model), {}});
+}
+
+std::vector<BodyStateSample> Playback::impactsIn(double from, double to) const {
+  std::vector<BodyStateSample> impacts;
+  for (const BodyStateSample& state : pending_) {
+    if (state.time > from && state.time <= to) impacts.push_back(state);
+  }
+  return impacts;
+}
+
+void Playback::playFromPrevious(std::size_t k) const {
+  Played& played = played_[k];
+  const Played& before = played_[k - 1];
+  played.model = *before.model;
+  played.contacts =
+      played.model->advance(played.time, impactsIn(before.time, played.time)).contacts;
+}
+
+void Playback::replay() const {
+  for (std::size_t k = 1; k < played_.size(); ++k) {
+    if (!played_[k].model) playFromPrevious(k);
+  }
 }
 
 const ImpactMonitor& Playback::at(double time) const {
   if (view_ && view_time_ == time) return *view_;
-  if (time > horizon_) {
-    // Asking for a later instant makes what was asked for before final.
-    if (horizon_ > committed_time_) {
-      std::vector<BodyStateSample> final_part;
-      while (!pending_.empty() && pending_.front().time <= horizon_) {
-        final_part.push_back(pending_.front());
-        pending_.erase(pending_.begin());
-      }
-      if (view_ && view_time_ == horizon_) {
-        // The view was worked out to that instant with the same impacts (any impact applied
-        // since would have dropped it): it is what advancing would give again.
-        committed_ = std::move(*view_);
-        view_.reset();
-      } else {
-        committed_.advance(horizon_, final_part);
-      }
-      committed_time_ = horizon_;
+  replay();
+  if (time > played_.back().time) {
+    played_.push_back(Played{time, std::nullopt, {}});
+    playFromPrevious(played_.size() - 1);
+    // What is final: the latest instant asked for more than the window before this one (window
+    // 0: the one before it). The impacts up to it are in its model.
+    std::size_t final_index = 0;
+    while (final_index + 2 <= played_.size() - 1 &&
+           played_[final_index + 1].time < time - replay_window_) {
+      ++final_index;
     }
-    horizon_ = time;
+    played_.erase(played_.begin(), played_.begin() + static_cast<std::ptrdiff_t>(final_index));
+    const double final_time = played_.front().time;
+    pending_.erase(std::remove_if(pending_.begin(), pending_.end(),
+                                  [&](const BodyStateSample& s) { return s.time <= final_time; }),
+                   pending_.end());
+    at_contacts_ = &played_.back().contacts;
+    return *played_.back().model;
   }
-  view_ = committed_;
-  std::vector<BodyStateSample> ahead;
-  for (const BodyStateSample& state : pending_) {
-    if (state.time <= time) ahead.push_back(state);
+  // An instant at or before the last one asked for: the latest played at or before it.
+  std::size_t k = played_.size() - 1;
+  while (k > 0 && played_[k].time > time) --k;
+  if (played_[k].time >= time) {
+    at_contacts_ = &played_[k].contacts;
+    return *played_[k].model;
   }
-  view_contacts_.clear();
-  if (time > committed_time_) view_contacts_ = view_->advance(time, ahead).contacts;
+  view_ = *played_[k].model;
+  view_contacts_ = view_->advance(time, impactsIn(played_[k].time, time)).contacts;
   view_time_ = time;
+  at_contacts_ = &view_contacts_;
   return *view_;
 }
 
@@ -95,13 +118,13 @@ Eigen::Vector3d Playback::angularVelocity(std::size_t body, double time) const {
 
 std::vector<ContactRecord> Playback::contacts(double time) const {
   at(time);
-  return view_contacts_;
+  return *at_contacts_;
 }
 
 bool Playback::applyImpact(std::size_t body, double time, const Eigen::Vector3d& centre,
                            const Eigen::Vector3d& velocity_after,
                            const Eigen::Vector3d& angular_velocity_after) {
-  if (time < committed_time_ || time < flights_[body].start) return false;
+  if (time < played_.front().time || time < flights_[body].start) return false;
   BodyStateSample state;
   state.body = model_index_[body];
   state.time = time;
@@ -115,10 +138,14 @@ bool Playback::applyImpact(std::size_t body, double time, const Eigen::Vector3d&
                           false,
                           flights_[body].impacts_before + 1,
                           angular_velocity_after};
-  if (time == committed_time_) {
-    // An impact at the instant the model was committed to (two bodies that touch exactly at a
-    // sample, found by the next step): taken at that instant.
-    committed_.step(time, {state});
+  // Every instant asked for at or after the impact is played again from the one before it.
+  for (std::size_t k = 1; k < played_.size(); ++k) {
+    if (played_[k].time >= time) played_[k].model.reset();
+  }
+  if (time == played_.front().time) {
+    // An impact at the instant that is final (two bodies that touch exactly at a sample, found
+    // by the next step): taken at that instant.
+    played_.front().model->step(time, {state});
     return true;
   }
   const auto later = std::upper_bound(
