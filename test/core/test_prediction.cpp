@@ -280,6 +280,47 @@ TEST(Prediction, Issue39_Item5_AFlightThatStallsIsSaidInTheMessage) {
   EXPECT_EQ(prediction->final_state.position, V(5, 0, 1.0));
 }
 
+// Issue 41, item 8: a sample period of 5e-324 s gave a 0 s prediction with one sample (the
+// horizon over it is infinite, and the count taken from it was none). Any period too small for
+// the samples' budget gives the most samples, 10,000 over the horizon, and says so: the ball,
+// dropped from rest at z = 1 beside the table, is at 1 - g t^2 / 2 at each.
+TEST(Prediction, Issue41_Item8_ASamplePeriodTooSmallForAnyCountGivesTheMostSamples) {
+  const Scene scene = tableScene();
+  for (const double period : {5e-324, std::numeric_limits<double>::min(), 1e-300, 1e-10}) {
+    auto request = requestFor(scene, V(5, 0, 1.0), V::Zero(), 0.1, 5);
+    request.sample_period = period;
+    const auto prediction = predictImpacts(scene, nullptr, MonitorSettings{}, request);
+    ASSERT_TRUE(prediction.ok()) << prediction.error().message();
+    EXPECT_TRUE(prediction->cut_short) << period;
+    EXPECT_NE(prediction->message.find("samples are cut to 10000"), std::string::npos)
+        << period << ": " << prediction->message;
+    EXPECT_EQ(prediction->final_state.time, 0.1) << period;
+    ASSERT_EQ(prediction->samples.size(), 10001u) << period;
+    for (std::size_t k = 0; k <= 10000; k += 1250) {
+      const BodyStateSample& sample = prediction->samples[k];
+      const double t = 1e-5 * static_cast<double>(k);
+      EXPECT_NEAR(sample.time, t, 1e-16) << period << ", sample " << k;
+      EXPECT_NEAR(sample.position.z(), 1.0 - 0.5 * kG * t * t, 1e-14) << period << ", " << k;
+    }
+  }
+}
+
+// Issue 41, item 8: a plane's normal is any nonzero length, as the service's is: 1e-13 was taken
+// for zero ("is zero: a plane needs a direction"; Eigen's isZero is approximate). The ball
+// dropped from rest at z = 1 crosses z = 0.9 at t = sqrt(2 (0.1) / g).
+TEST(Prediction, Issue41_Item8_ACrossingNormalOfAnyNonzeroLengthIsAPlane) {
+  const Scene scene = tableScene();
+  for (const double length : {1e-13, 1e-300, 1.0}) {
+    auto request = requestFor(scene, V(5, 0, 1.0), V::Zero(), 0.5, 5);
+    request.crossing = Plane{V(0, 0, length), 0.9 * length};
+    const auto prediction = predictImpacts(scene, nullptr, MonitorSettings{}, request);
+    ASSERT_TRUE(prediction.ok()) << length << ": " << prediction.error().message();
+    ASSERT_TRUE(prediction->crossing) << length;
+    EXPECT_NEAR(prediction->crossing->time, std::sqrt(2 * 0.1 / kG), 1e-15) << length;
+    EXPECT_NEAR(prediction->crossing->position.z(), 0.9, 1e-15) << length;
+  }
+}
+
 TEST(Prediction, EveryBadRequestIsNamed) {
   const Scene scene = tableScene();
   const auto good = requestFor(scene, V(0, 0, 1.2), V::Zero(), 1.0, 2);

@@ -51,7 +51,8 @@ Status checkRequest(const Scene& scene, const PredictionRequest& request) {
     if (auto status = checkFinite(request.crossing->normal, "crossing_normal"); !status) {
       return status;
     }
-    if (request.crossing->normal.isZero()) {
+    // Exactly zero only: any other length is a direction (Eigen's isZero() is approximate).
+    if ((request.crossing->normal.array() == 0.0).all()) {
       return Error{"crossing_normal", "is zero: a plane needs a direction"};
     }
     if (!std::isfinite(request.crossing->offset)) {
@@ -301,12 +302,16 @@ class PredictionRun {
               : request_.crossing        ? kCrossingSearchPeriod
               : budget_.seconds > 0      ? std::min(horizon_, kBudgetCheckPeriod)
                                          : horizon_;
-    pieces_ = static_cast<std::size_t>(std::ceil(horizon_ / period_));
-    if (request_.sample_period > 0 && pieces_ > kPredictionMaxSamples) {
+    // Compared as a double before it is a count: a sample period of 5e-324 s makes it infinite.
+    // Without samples: at most kPredictionMaxHorizon / kCrossingSearchPeriod = 3,000 pieces.
+    const double pieces = std::ceil(horizon_ / period_);
+    if (request_.sample_period > 0 && !(pieces <= static_cast<double>(kPredictionMaxSamples))) {
       period_ = horizon_ / static_cast<double>(kPredictionMaxSamples);
       pieces_ = kPredictionMaxSamples;
       cut.push_back("samples are cut to " + std::to_string(kPredictionMaxSamples) + ", every " +
                     formatNumber(period_) + " s");
+    } else {
+      pieces_ = static_cast<std::size_t>(pieces);
     }
   }
 
