@@ -16,6 +16,8 @@ CollisionResponseNode::CollisionResponseNode(const ros::NodeHandle& node,
 
 CollisionResponseNode::~CollisionResponseNode() {
   if (service_spinner_) service_spinner_->stop();
+  if (predict_spinner_) predict_spinner_->stop();
+  predict_impacts_server_.shutdown();
   if (diagnostics_spinner_) diagnostics_spinner_->stop();
   diagnostics_timer_.stop();
   compute_collision_server_.shutdown();
@@ -96,8 +98,13 @@ bool CollisionResponseNode::start() {
     reconfigure_->updateConfig(config_);
     reconfigure_->setCallback(
         [this](MonitorConfig& config, std::uint32_t level) { onReconfigure(config, level); });
-    predict_impacts_server_ = private_node_.advertiseService(
+    // Predictions on their own queue and thread: one at a time, never on the monitor's.
+    ros::NodeHandle predict_node(private_node_);
+    predict_node.setCallbackQueue(&predict_queue_);
+    predict_impacts_server_ = predict_node.advertiseService(
         "predict_impacts", &CollisionResponseNode::onPredictImpacts, this);
+    predict_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &predict_queue_);
+    predict_spinner_->start();
   } else {
     ROS_WARN_STREAM("collision_response: no " << joinKey(ns, "scene")
                                               << " parameter: serving the services with the "
@@ -189,7 +196,8 @@ void CollisionResponseNode::logScene(const core::Scene& scene, const MonitorPara
                   << " s, contact_tolerance " << params.contact_tolerance << ", clock_jump_back "
                   << params.clock_jump_back << " s, future_stamp_tolerance "
                   << params.future_stamp_tolerance << " s, queue_size " << params.queue_size
-                  << ", max_states " << params.max_states);
+                  << ", max_states " << params.max_states << ", prediction_cpu_budget "
+                  << params.prediction_cpu_budget << " s");
 }
 
 void CollisionResponseNode::onReconfigure(MonitorConfig& config, std::uint32_t /*level*/) {

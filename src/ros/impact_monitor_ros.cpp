@@ -1,5 +1,7 @@
 #include "collision_response/ros/impact_monitor_ros.h"
 
+#include <algorithm>
+#include <functional>
 #include <map>
 #include <utility>
 
@@ -8,27 +10,68 @@
 
 namespace collision_response {
 
+namespace {
+
+/// A call of `function` on a callback queue (the monitor's wake-up).
+class FunctionCall : public ros::CallbackInterface {
+ public:
+  explicit FunctionCall(std::function<void()> function) : function_(std::move(function)) {}
+  CallResult call() override {
+    function_();
+    return Success;
+  }
+
+ private:
+  std::function<void()> function_;
+};
+
+/// Whether a reason drops input states (the others: outputs, or nothing dropped).
+bool dropsInput(Reason reason) {
+  return isDrop(reason) && reason != Reason::kImpactNotFinite &&
+         reason != Reason::kContactNotFinite;
+}
+
+}  // namespace
+
 ImpactMonitorRos::ImpactMonitorRos(ros::NodeHandle node, const core::Scene& scene,
                                    const MonitorParams& params)
     : node_(node), params_(params), cycle_(scene, params), tf_listener_(tf_buffer_, node) {
-  array_subscriber_ = node_.subscribe("body_states", 100, &ImpactMonitorRos::onStateArray, this);
+  // The subscriptions on the intake's queue. Its callbacks take microseconds and never wait for
+  // an update, so roscpp's queue (as long as ours, ~queue_size) fills only if the intake's thread
+  // cannot run for ~queue_size messages' time; what ours cannot hold is dropped and counted.
+  ros::NodeHandle intake(node_);
+  intake.setCallbackQueue(&intake_queue_);
+  const auto roscpp_queue = static_cast<std::uint32_t>(params_.queue_size);
+  array_subscriber_ =
+      intake.subscribe("body_states", roscpp_queue, &ImpactMonitorRos::onStateArray, this);
   array_topic_ = array_subscriber_.getTopic();
   for (const core::BodySpec& body : scene.bodies) {
     if (body.topic.empty()) continue;
     const std::string topic = node_.resolveName(body.topic);
-    body_subscribers_.push_back(node_.subscribe<BodyState>(
-        topic, 100, [this, topic, id = body.id](const ros::MessageEvent<const BodyState>& event) {
+    body_subscribers_.push_back(intake.subscribe<BodyState>(
+        topic, roscpp_queue,
+        [this, topic, id = body.id](const ros::MessageEvent<const BodyState>& event) {
           onState(event, topic, id);
         }));
   }
   impact_publisher_ = node_.advertise<ImpactArray>("impacts", 100);
   contact_publisher_ = node_.advertise<ContactArray>("contacts", 100);
   marker_publisher_ = node_.advertise<visualization_msgs::MarkerArray>("markers", 10);
-  // Retries inputs that wait for transforms; it runs only while some input waits.
+  // Retries inputs that wait for transforms; it runs only while the head waits.
   queue_timer_ = node_.createWallTimer(
       ros::WallDuration(0.005), [this](const ros::WallTimerEvent&) { processQueue(); },
       /*oneshot=*/false, /*autostart=*/false);
   figures_ = MonitorFigures::of(cycle_);
+  intake_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &intake_queue_);
+  intake_spinner_->start();
+}
+
+ImpactMonitorRos::~ImpactMonitorRos() {
+  intake_spinner_->stop();
+  array_subscriber_.shutdown();
+  for (ros::Subscriber& subscriber : body_subscribers_) subscriber.shutdown();
+  node_.getCallbackQueue()->removeByID(reinterpret_cast<std::uint64_t>(this));
+  queue_timer_.stop();
 }
 
 void ImpactMonitorRos::onStateArray(const ros::MessageEvent<const BodyStateArray>& event) {
@@ -62,54 +105,78 @@ void ImpactMonitorRos::onState(const ros::MessageEvent<const BodyState>& event,
 }
 
 void ImpactMonitorRos::enqueue(Pending pending) {
-  // At most ~queue_size inputs and ~max_states states wait: the oldest make room.
+  // At most ~queue_size inputs and ~max_states states wait (the head the monitor has taken
+  // among them): the oldest waiting make room.
   const std::size_t states = pending.states().size();
-  while (!queue_.empty() &&
-         (queue_.size() >= static_cast<std::size_t>(params_.queue_size) ||
-          queued_states_ + states > static_cast<std::size_t>(params_.max_states))) {
-    tell(queue_.front().topic,
-         {{Reason::kQueueFull,
-           "input queue full (" + std::to_string(queue_.size()) + " messages, " +
-               std::to_string(queued_states_) + " states waiting for transforms; ~queue_size " +
-               std::to_string(params_.queue_size) + ", ~max_states " +
-               std::to_string(params_.max_states) + "): dropped the oldest",
-           queue_.front().states().size()}});
-    queued_states_ -= queue_.front().states().size();
-    queue_.pop_front();
+  std::vector<Pending> dropped;
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    while (
+        !queue_.empty() &&
+        (queue_.size() + taken_inputs_ >= static_cast<std::size_t>(params_.queue_size) ||
+         queued_states_ + taken_states_ + states > static_cast<std::size_t>(params_.max_states))) {
+      dropped.push_back(std::move(queue_.front()));
+      queued_states_ -= dropped.back().states().size();
+      queue_.pop_front();
+    }
+    queued_states_ += states;
+    queue_.push_back(std::move(pending));
   }
-  queued_states_ += states;
-  queue_.push_back(std::move(pending));
-  processQueue();
+  for (const Pending& oldest : dropped) {
+    tell(oldest.topic, {{Reason::kQueueFull,
+                         "input queue full (~queue_size " + std::to_string(params_.queue_size) +
+                             " messages, ~max_states " + std::to_string(params_.max_states) +
+                             " states, waiting for the update in progress or for transforms): "
+                             "dropped the oldest",
+                         oldest.states().size()}});
+  }
+  // One wake-up at a time: the monitor's thread takes every input queued when it runs.
+  if (!wake_posted_.exchange(true)) {
+    node_.getCallbackQueue()->addCallback(boost::make_shared<FunctionCall>([this] {
+                                            wake_posted_ = false;
+                                            processQueue();
+                                          }),
+                                          reinterpret_cast<std::uint64_t>(this));
+  }
 }
 
 void ImpactMonitorRos::processQueue() {
-  while (!queue_.empty()) {
+  bool waits = false;
+  while (!waits) {
+    Pending head;
+    {
+      std::lock_guard<std::mutex> lock(queue_mutex_);
+      if (queue_.empty()) break;
+      head = std::move(queue_.front());
+      queue_.pop_front();
+      taken_inputs_ = 1;
+      taken_states_ = head.states().size();
+      queued_states_ -= taken_states_;
+    }
     bool handled = true;
     try {
-      handled = processHead();
+      handled = processHead(head);
     } catch (const std::exception& error) {
       // Never let an exception out of a callback: drop the message that caused it and go on.
-      tell(queue_.front().topic,
-           {{Reason::kInternalError, std::string("dropped a message: ") + error.what(),
-             queue_.front().states().size()}});
+      tell(head.topic, {{Reason::kInternalError, std::string("dropped a message: ") + error.what(),
+                         head.states().size()}});
     }
-    if (!handled) break;
-    queued_states_ -= queue_.front().states().size();
-    queue_.pop_front();
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    if (!handled) {  // back at the head, to wait for its transforms
+      queued_states_ += taken_states_;
+      queue_.push_front(std::move(head));
+      waits = true;
+    }
+    taken_inputs_ = taken_states_ = 0;
   }
-  {
-    std::lock_guard<std::mutex> lock(diagnostics_mutex_);
-    waiting_ = queue_.size();
-  }
-  if (queue_.empty()) {
-    queue_timer_.stop();
-  } else {
+  if (waits) {
     queue_timer_.start();  // no effect when already running
+  } else {
+    queue_timer_.stop();
   }
 }
 
-bool ImpactMonitorRos::processHead() {
-  const Pending& head = queue_.front();
+bool ImpactMonitorRos::processHead(const Pending& head) {
   const ros::WallTime began = ros::WallTime::now();
   const bool may_wait = (began - head.received).toSec() < params_.transform_timeout;
   const MonitorCycle::Input input{&head.states(), head.topic, head.publisher, head.own_body};
@@ -117,7 +184,11 @@ bool ImpactMonitorRos::processHead() {
     std::lock_guard<std::mutex> lock(diagnostics_mutex_);
     update_began_ = began;
   }
-  const MonitorCycle::Update update = cycle_.process(input, ros::Time::now(), may_wait, tf_buffer_);
+  MonitorCycle::Update update;
+  {
+    std::lock_guard<std::mutex> lock(monitor_mutex_);
+    update = cycle_.process(input, ros::Time::now(), may_wait, tf_buffer_);
+  }
   {
     std::lock_guard<std::mutex> lock(diagnostics_mutex_);
     update_began_ = ros::WallTime();
@@ -125,6 +196,15 @@ bool ImpactMonitorRos::processHead() {
   }
   if (update.waiting) return false;
   tell(head.topic, update.reports);
+  std::size_t dropped = 0;
+  for (const Report& report : update.reports) {
+    if (dropsInput(report.reason)) dropped += report.count;
+  }
+  const std::size_t states = head.states().size();
+  {
+    std::lock_guard<std::mutex> lock(diagnostics_mutex_);
+    diagnostics_.used(states - std::min(states, dropped));
+  }
   if (update.stepped) {
     publish(update);
     const ros::WallTime done = ros::WallTime::now();
@@ -181,7 +261,7 @@ void ImpactMonitorRos::tell(const std::string& topic, const std::vector<Report>&
     group.events += report.count;
     if (report.warn && group.first == nullptr) group.first = &report;
   }
-  lock.unlock();
+  // warnings_ is shared by the intake's thread and the monitor's: kept under the lock.
   for (const auto& [key, group] : groups) {
     if (group.first == nullptr) continue;
     std::string text = group.first->text;
@@ -194,22 +274,47 @@ void ImpactMonitorRos::tell(const std::string& topic, const std::vector<Report>&
 
 void ImpactMonitorRos::tune(core::Detection detection, double restitution_threshold,
                             core::CombineRule rule) {
-  cycle_.tune(detection, restitution_threshold, rule);
+  {
+    std::lock_guard<std::mutex> lock(monitor_mutex_);
+    cycle_.tune(detection, restitution_threshold, rule);
+  }
   std::lock_guard<std::mutex> lock(diagnostics_mutex_);
   figures_ = MonitorFigures::of(cycle_);
 }
 
 void ImpactMonitorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  std::size_t waiting = 0;
+  {
+    std::lock_guard<std::mutex> lock(queue_mutex_);
+    waiting = queue_.size();
+  }
   std::lock_guard<std::mutex> lock(diagnostics_mutex_);
   const double running =
       update_began_.isZero() ? 0.0 : (ros::WallTime::now() - update_began_).toSec();
   // An update that has run for 1 s turns the summary to WARN.
-  diagnostics_.report(status, figures_, waiting_, running, 1.0);
+  diagnostics_.report(status, figures_, waiting, running, 1.0);
 }
 
 void ImpactMonitorRos::predict(const PredictImpacts::Request& request,
-                               PredictImpacts::Response& response) const {
-  answerPredictImpacts(request, cycle_, tf_buffer_, ros::Time::now(), response);
+                               PredictImpacts::Response& response) {
+  // What the prediction needs of the monitor, between two of its updates; then without it.
+  const auto prepared = [&] {
+    std::lock_guard<std::mutex> lock(monitor_mutex_);
+    return preparePredictImpacts(request, cycle_, tf_buffer_, ros::Time::now());
+  }();
+  if (!prepared) {
+    response = PredictImpacts::Response{};
+    response.success = false;
+    response.message = prepared.error().message();
+    return;
+  }
+  core::PredictionBudget budget;
+  budget.seconds = params_.prediction_cpu_budget;
+  budget.name = "~prediction_cpu_budget";
+  if (answerPreparedPrediction(*prepared, budget, response)) {
+    std::lock_guard<std::mutex> lock(diagnostics_mutex_);
+    diagnostics_.count(Reason::kPredictionCutShort);
+  }
 }
 
 }  // namespace collision_response

@@ -80,7 +80,9 @@ void MonitorDiagnostics::report(diagnostic_updater::DiagnosticStatusWrapper& sta
   status.add("arrival to publication, mean (ms)",
              period_.steps ? 1e3 * period_.latency_seconds / steps : 0.0);
   status.add("arrival to publication, max (ms)", 1e3 * period_.latency_seconds_max);
-  status.add("messages waiting for transforms", waiting);
+  status.add("messages waiting", waiting);
+  status.add("states received (total)", states_received_);
+  status.add("states used (total)", states_used_);
   status.add("transforms missing (states dropped, total)", total(Reason::kTransformMissing));
   status.add("obstacle transforms missing (total)", total(Reason::kObstacleTransform));
   // By source (at most TimeLine::kMaxSources): the clocks that are not the node's, and the

@@ -75,6 +75,9 @@ const KeyTable<MonitorParams>& MonitorParams::keys() {
       typeOnly("detection", XmlRpc::XmlRpcValue::TypeString, "a string"),
       typeOnly("restitution_threshold", XmlRpc::XmlRpcValue::TypeDouble, "a number"),
       typeOnly("restitution_combine", XmlRpc::XmlRpcValue::TypeString, "a string"),
+      numberKey<P>(
+          "prediction_cpu_budget", [](P& p) -> double& { return p.prediction_cpu_budget; },
+          checkDurationOrZero),
   };
   return kKeys;
 }

@@ -108,45 +108,67 @@ void refuse(const core::Error& error, PredictImpacts::Response& response) {
 
 }  // namespace
 
-void answerPredictImpacts(const PredictImpacts::Request& request, const MonitorCycle& cycle,
-                          const tf2::BufferCore& tf, const ros::Time& clock,
-                          PredictImpacts::Response& response) {
+core::Expected<PreparedPrediction> preparePredictImpacts(const PredictImpacts::Request& request,
+                                                         const MonitorCycle& cycle,
+                                                         const tf2::BufferCore& tf,
+                                                         const ros::Time& clock) {
   const core::ImpactMonitor& live = cycle.monitor();
   const TimeLine& line = cycle.timeLine();
+  PreparedPrediction prepared;
   // The request's instant: on the monitor's line once it has one; before, its own line from 0.
-  ros::Time stamp = request.header.stamp;
+  prepared.stamp = request.header.stamp;
   double time = 0.0;
-  if (stamp.isZero()) {
-    if (live.started() && line.stampOf(live.now(), stamp)) {
+  if (prepared.stamp.isZero()) {
+    if (live.started() && line.stampOf(live.now(), prepared.stamp)) {
       time = live.now();
     } else {
-      stamp = clock;
+      prepared.stamp = clock;
     }
-  } else if (!line.lineTimeOf(stamp, time)) {
+  } else if (!line.lineTimeOf(prepared.stamp, time)) {
     time = 0.0;
   }
-  auto predict = requestInFixedFrame(request, cycle, tf, stamp, time);
-  if (!predict) return refuse(predict.error(), response);
+  auto predict = requestInFixedFrame(request, cycle, tf, prepared.stamp, time);
+  if (!predict) return predict.error();
   const core::MonitorSettings settings{cycle.params().contact_tolerance,
                                        cycle.params().body_timeout};
-  const auto prediction =
-      core::predictImpacts(cycle.scene(), live.started() ? &live : nullptr, settings, *predict);
-  if (!prediction) return refuse(prediction.error(), response);
+  auto start =
+      core::startPrediction(cycle.scene(), live.started() ? &live : nullptr, settings, *predict);
+  if (!start) return start.error();
+  prepared.start = std::move(*start);
+  prepared.fixed_frame = cycle.scene().fixed_frame;
+  return prepared;
+}
 
-  const std::string& fixed = cycle.scene().fixed_frame;
+bool answerPreparedPrediction(const PreparedPrediction& prepared,
+                              const core::PredictionBudget& budget,
+                              PredictImpacts::Response& response) {
+  const auto prediction = core::runPrediction(prepared.start, budget);
+  if (!prediction) {
+    refuse(prediction.error(), response);
+    return false;
+  }
+
+  const std::string& fixed = prepared.fixed_frame;
+  const ros::Time& stamp = prepared.stamp;
   const auto stampAt = [&](double after) { return stamp + ros::Duration(after); };
   const core::ImpactMonitor& model = *prediction->model;
   for (const core::ImpactRecord& record : prediction->impacts) {
     auto message = toImpactMessage(record, model, stampAt(record.time), fixed);
-    if (!message) return refuse(message.error(), response);
+    if (!message) {
+      refuse(message.error(), response);
+      return false;
+    }
     response.impacts.push_back(*message);
   }
   for (const core::ContactRecord& record : prediction->contacts) {
     auto message = toContactMessage(record, model, stampAt(record.since));
-    if (!message) return refuse(message.error(), response);
+    if (!message) {
+      refuse(message.error(), response);
+      return false;
+    }
     response.final_contacts.push_back(*message);
   }
-  const std::string& id = predict->body.id;
+  const std::string& id = prepared.start.request.body.id;
   response.final_state =
       stateMessage(prediction->final_state, id, fixed, stampAt(prediction->final_state.time));
   if (prediction->crossing) {
@@ -160,8 +182,18 @@ void answerPredictImpacts(const PredictImpacts::Request& request, const MonitorC
   response.success = true;
   response.message = std::to_string(response.impacts.size()) + " impact(s) in " +
                      core::formatNumber(prediction->final_state.time) + " s, effects " +
-                     core::toString(predict->effects);
+                     core::toString(prepared.start.request.effects);
   if (prediction->cut_short) response.message += "; cut short: " + prediction->message;
+  return prediction->out_of_budget;
+}
+
+void answerPredictImpacts(const PredictImpacts::Request& request, const MonitorCycle& cycle,
+                          const tf2::BufferCore& tf, const ros::Time& clock,
+                          PredictImpacts::Response& response,
+                          const core::PredictionBudget& budget) {
+  const auto prepared = preparePredictImpacts(request, cycle, tf, clock);
+  if (!prepared) return refuse(prepared.error(), response);
+  answerPreparedPrediction(*prepared, budget, response);
 }
 
 }  // namespace collision_response

@@ -104,6 +104,8 @@ const char* counterName(Reason reason) {
       return "impacts a later state lacks";
     case Reason::kFlightStalled:
       return "flights through air stalled";
+    case Reason::kPredictionCutShort:
+      return "predictions cut short";
   }
   return "unknown";
 }

@@ -1,11 +1,14 @@
 // The collision_response node: loads the scene and the parameters, serves the collision services
 // and runs the impact monitor on the scene's bodies.
 //
-// Threads: the monitor (its subscriptions, queue, diagnostics and live tuning) runs on the
-// callback queue of `node`; the two services are served from a callback queue of their own by a
-// spinner thread, so that a long step never delays an answer. The services read only the
-// material table, which they take as an immutable snapshot (a shared pointer swapped under a
-// mutex when live tuning changes the combine rule); they never touch the monitor.
+// Threads (doc/model.md, "Threads"): the monitor (its queue, updates and live tuning) runs on the
+// callback queue of `node`, its subscriptions' intake on a thread of its own (ImpactMonitorRos);
+// /diagnostics on a thread of its own; ~predict_impacts on a thread of its own, one request at a
+// time (ImpactMonitorRos::predict: it reads the monitor between two updates, then predicts
+// without it within ~prediction_cpu_budget); and the two collision services on a thread of their
+// own, so that neither a long step nor a prediction delays an answer. The collision services
+// read only the material table, which they take as an immutable snapshot (a shared pointer
+// swapped under a mutex when live tuning changes the combine rule); they never touch the monitor.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -70,8 +73,11 @@ class CollisionResponseNode {
   boost::recursive_mutex reconfigure_mutex_;  ///< the server's, so updateConfig is safe
   std::unique_ptr<dynamic_reconfigure::Server<MonitorConfig>> reconfigure_;
   MonitorConfig config_;  ///< the values in use
-  /// ~predict_impacts, on the monitor's queue: it reads the monitor between its updates.
+  /// ~predict_impacts on a queue and thread of its own (one request at a time): a prediction
+  /// never holds up the monitor's updates, nor an update a prediction for longer than it lasts.
+  ros::CallbackQueue predict_queue_;
   ros::ServiceServer predict_impacts_server_;
+  std::unique_ptr<ros::AsyncSpinner> predict_spinner_;
   // The diagnostics' own queue and thread (their timer), so that /diagnostics is published
   // while an update runs on the node's queue; declared after what it reads, so that its thread
   // stops first.

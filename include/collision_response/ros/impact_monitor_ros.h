@@ -1,22 +1,35 @@
 // The impact monitor on ROS: a thin wrapper that subscribes to the body states, queues the
-// inputs whose transforms are not there yet, hands each input to the update cycle
-// (MonitorCycle) and publishes what it returns: impacts, lasting contacts, markers, warnings and
-// diagnostics.
+// inputs, hands each input to the update cycle (MonitorCycle) and publishes what it returns:
+// impacts, lasting contacts, markers, warnings and diagnostics.
 //
-// Threads: every callback of this class, and every use of the cycle, runs on the callback queue
-// of the node handle it is given (the node's global queue, or a nodelet's single-threaded one),
-// one at a time: the monitor's state is only ever touched from there. The collision services
-// run on a thread of their own (CollisionResponseNode) and never touch the monitor. diagnose()
-// is called from the diagnostics' own thread, so that /diagnostics is published while an update
-// runs: it reads only the counters and the figures copied after each update, under a mutex.
+// Threads (doc/model.md, "Threads"):
+// - intake: the subscriptions' callbacks run on a callback queue and thread of their own. They
+//   only count what arrives, refuse a message past ~max_states, and append it to the node's own
+//   bounded queue (~queue_size inputs, ~max_states states; past them the oldest waiting input is
+//   dropped and counted), under queue_mutex_, then wake the monitor's thread. They never wait for
+//   an update, so roscpp's own subscriber queue never fills: every message received is used or
+//   counted with its reason.
+// - the monitor: the queue is processed, and the cycle used, on the callback queue of the node
+//   handle given (the node's global queue, or a nodelet's), one input at a time: the cycle is
+//   changed only there, under monitor_mutex_ (an update, live tuning).
+// - ~predict_impacts (CollisionResponseNode) runs on a thread of its own: predict() takes what
+//   the prediction needs of the cycle under monitor_mutex_ (between two updates; quick: no motion
+//   is computed), then predicts without it, within ~prediction_cpu_budget.
+// - diagnose() is called from the diagnostics' own thread, so that /diagnostics is published
+//   while an update runs: it reads only the counters and the figures copied after each update,
+//   under diagnostics_mutex_, and the queue's length under queue_mutex_.
 #pragma once
 
 #include <diagnostic_updater/DiagnosticStatusWrapper.h>
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <atomic>
+#include <cstdint>
 #include <deque>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -39,13 +52,18 @@ class ImpactMonitorRos {
   /// Subscribes `body_states` and the bodies' own topics (checked by checkBodyTopics first),
   /// advertises `impacts`, `contacts` and `markers`.
   ImpactMonitorRos(ros::NodeHandle node, const core::Scene& scene, const MonitorParams& params);
+  /// Stops the intake's thread and takes back its wake-ups from the monitor's queue.
+  ~ImpactMonitorRos();
+  ImpactMonitorRos(const ImpactMonitorRos&) = delete;
+  ImpactMonitorRos& operator=(const ImpactMonitorRos&) = delete;
 
   /// Live tuning (dynamic_reconfigure), validated by the caller: see core::ImpactMonitor::tune.
   void tune(core::Detection detection, double restitution_threshold, core::CombineRule rule);
 
-  /// ~predict_impacts (prediction_service.h): reads the monitor, so it is called on the
-  /// monitor's queue, between updates.
-  void predict(const PredictImpacts::Request& request, PredictImpacts::Response& response) const;
+  /// ~predict_impacts (prediction_service.h), from any thread but the monitor's: what it needs
+  /// of the monitor is taken between two updates, the prediction then runs on the caller's
+  /// thread within ~prediction_cpu_budget of its CPU time (one cut short is counted).
+  void predict(const PredictImpacts::Request& request, PredictImpacts::Response& response);
   /// The monitor's status for /diagnostics: rates, bodies tracked, drops by reason, timing.
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
@@ -65,10 +83,13 @@ class ImpactMonitorRos {
   void onStateArray(const ros::MessageEvent<const BodyStateArray>& event);
   void onState(const ros::MessageEvent<const BodyState>& event, const std::string& topic,
                const std::string& id);
+  /// On the intake's thread: appends to the queue (the oldest waiting dropped past its bounds)
+  /// and wakes the monitor's thread.
   void enqueue(Pending pending);
+  /// On the monitor's thread: processes the queue until it is empty or its head must wait.
   void processQueue();
-  /// true when the head of the queue was handled (processed or dropped), false to wait.
-  bool processHead();
+  /// true when `head` was handled (processed or dropped), false to wait.
+  bool processHead(const Pending& head);
   /// Each output of an update, in turn: a new topic is one more publisher and one more line.
   void publish(const MonitorCycle::Update& update);
   void publishMarkers(const MonitorCycle::Update& update);
@@ -77,6 +98,9 @@ class ImpactMonitorRos {
 
   ros::NodeHandle node_;
   MonitorParams params_;
+  /// Held by the monitor's thread while it changes the cycle (an update, live tuning), and by
+  /// predict() while it reads it.
+  std::mutex monitor_mutex_;
   MonitorCycle cycle_;
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
@@ -94,8 +118,15 @@ class ImpactMonitorRos {
   ros::WallTime last_scene_markers_;
   int next_impact_marker_ = 0;
   ros::WallTimer queue_timer_;
+  /// Guards the queue: the intake's thread appends, the monitor's takes the head (and puts it
+  /// back while it waits for transforms). Never held during an update.
+  std::mutex queue_mutex_;
   std::deque<Pending> queue_;
   std::size_t queued_states_ = 0;
+  /// The head the monitor's thread has taken (0 or 1 input, its states): in the bounds too.
+  std::size_t taken_inputs_ = 0, taken_states_ = 0;
+  /// A wake-up is posted to the monitor's queue and has not begun: no second one is posted.
+  std::atomic<bool> wake_posted_{false};
   ThrottledWarning warnings_;
   /// Guards what diagnose() reads from the diagnostics' thread: the counters, the figures of
   /// the monitor after its last update, the update in progress and the inputs waiting.
@@ -103,7 +134,10 @@ class ImpactMonitorRos {
   MonitorDiagnostics diagnostics_;
   MonitorFigures figures_;
   ros::WallTime update_began_;  ///< zero: no update in progress
-  std::size_t waiting_ = 0;
+  // The intake's own queue and thread; its subscriptions are declared above and shut down (the
+  // thread stopped first) in the destructor.
+  ros::CallbackQueue intake_queue_;
+  std::unique_ptr<ros::AsyncSpinner> intake_spinner_;
 };
 
 }  // namespace collision_response

@@ -33,7 +33,10 @@ class MonitorDiagnostics {
   void received(std::size_t states) {
     ++period_.messages;
     period_.states += states;
+    states_received_ += states;
   }
+  /// States of a processed input that the monitor took (those dropped are counted by reason).
+  void used(std::size_t states) { states_used_ += states; }
   void count(Reason reason, std::size_t events = 1) {
     totals_[static_cast<std::size_t>(reason)] += events;
   }
@@ -51,8 +54,9 @@ class MonitorDiagnostics {
 
   /// Fills `status` (the summary: WARN while states or impacts are dropped, with the reasons
   /// and counts of the period; OK otherwise) and starts a new period.
-  /// `running`: how long the update in progress has run (s; 0: none), shown as "update in
-  /// progress (s)", and in the summary (WARN) from `slow` s on.
+  /// `waiting`: the inputs queued for the monitor (for the update in progress, or for their
+  /// transforms). `running`: how long the update in progress has run (s; 0: none), shown as "update
+  /// in progress (s)", and in the summary (WARN) from `slow` s on.
   void report(diagnostic_updater::DiagnosticStatusWrapper& status, const MonitorFigures& figures,
               std::size_t waiting, double running = 0.0, double slow = INFINITY);
   void report(diagnostic_updater::DiagnosticStatusWrapper& status, const MonitorCycle& cycle,
@@ -71,6 +75,8 @@ class MonitorDiagnostics {
   Period period_;
   std::array<std::uint64_t, kReasonCount> totals_{};
   std::uint64_t impacts_published_ = 0;
+  /// In total: every state received is used, dropped (counted by reason) or waiting.
+  std::uint64_t states_received_ = 0, states_used_ = 0;
   std::string last_beyond_resolution_;
   std::string last_over_work_budget_;
 };

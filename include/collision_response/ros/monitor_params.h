@@ -28,6 +28,8 @@ struct MonitorParams {
   int max_states = 100000;         ///< states in one BodyStateArray, and waiting in all, at most
   double diagnostic_period = 1.0;  ///< s: diagnostic_updater's own parameter, checked here
   MarkerParams markers;            ///< ~marker_rate, ~impact_marker_lifetime, ...
+  /// s of the prediction thread's CPU time one ~predict_impacts request may spend (0: no budget)
+  double prediction_cpu_budget = 1.0;
 
   /// Every private parameter the node reads: its own above, `scene` (read by loadScene),
   /// `player` (a scene file's part for the scene player, type-checked only) and

@@ -47,8 +47,9 @@ enum class Reason {
   kObstacleTransform,   ///< a tf-attached obstacle keeps its last known motion
   kImpactContradicted,  ///< a state taken after an impact lacks it (the impact stays published)
   kFlightStalled,       ///< a flight through air the integrator could not carry on: held
+  kPredictionCutShort,  ///< a ~predict_impacts request that spent ~prediction_cpu_budget
 };
-inline constexpr int kReasonCount = static_cast<int>(Reason::kFlightStalled) + 1;
+inline constexpr int kReasonCount = static_cast<int>(Reason::kPredictionCutShort) + 1;
 
 /// The counter's name, as diagnostics shows it: "dropped: unknown id", "clock jumped back", ...
 const char* counterName(Reason reason);
