@@ -47,7 +47,8 @@ core::Expected<bool> toObstacle(const urdf::Collision& collision, const RobotLin
       obstacle.resource = mesh->filename;
       obstacle.scale = Eigen::Vector3d(mesh->scale.x, mesh->scale.y, mesh->scale.z);
       std::vector<std::string> left_out;
-      auto triangles = loadMeshResource(obstacle.resource, obstacle.scale, "mesh", left_out);
+      auto triangles = loadMeshResource(obstacle.resource, obstacle.scale, "mesh", left_out,
+                                        robot.max_mesh_bytes);
       if (!triangles) {
         // Named as the URDF names it: the <mesh>'s filename or scale.
         const bool scale = triangles.error().field.rfind("mesh/scale", 0) == 0;

@@ -324,6 +324,17 @@ const KeyTable<RobotLinks>& robotKeys() {
   return kKeys;
 }
 
+/// The scene's `max_mesh_bytes`: the largest mesh file read (mesh_resource.h), an integer >= 1.
+core::Expected<std::size_t> readMaxMeshBytes(const XmlRpc::XmlRpcValue& value,
+                                             const std::string& field) {
+  const auto count = readInt(value, field);
+  if (!count) return count.error();
+  if (*count < 1) {
+    return core::Error{field, "must be an integer >= 1 (bytes), got " + std::to_string(*count)};
+  }
+  return static_cast<std::size_t>(*count);
+}
+
 const KeyTable<Scene>& sceneTable() {
   // The material keys first: bodies and pairs name materials.
   static const KeyTable<Scene> kKeys = {
@@ -420,6 +431,11 @@ const KeyTable<Scene>& sceneTable() {
        [](const XmlRpc::XmlRpcValue&, const std::string&, Scene&) {
          return core::Status(core::Ok{});  // read by loadScene, with the URDF it names
        }},
+      {"max_mesh_bytes", false,
+       [](const XmlRpc::XmlRpcValue& value, const std::string& field, Scene&) {
+         const auto limit = readMaxMeshBytes(value, field);  // used by loadScene
+         return limit ? core::Status(core::Ok{}) : core::Status(limit.error());
+       }},
   };
   return kKeys;
 }
@@ -442,13 +458,20 @@ core::Expected<core::Scene> loadScene(const XmlRpc::XmlRpcValue& value, const st
                                       const UrdfSource& urdf, std::vector<std::string>* warnings) {
   Scene scene;
   if (auto status = readKeys(value, sceneTable(), field, scene); !status) return status.error();
-  // The meshes' triangles, from their resources.
+  // The meshes' triangles, from their resources, each file within the scene's limit.
+  std::size_t max_mesh_bytes = kDefaultMaxMeshBytes;
+  if (value.hasMember("max_mesh_bytes")) {
+    const auto limit = readMaxMeshBytes(value["max_mesh_bytes"], joinKey(field, "max_mesh_bytes"));
+    if (!limit) return limit.error();
+    max_mesh_bytes = *limit;
+  }
   for (std::size_t i = 0; i < scene.obstacles.size(); ++i) {
     ObstacleSpec& obstacle = scene.obstacles[i];
     if (obstacle.shape != core::ObstacleShape::kMesh) continue;
     std::vector<std::string> left_out;
-    auto triangles = loadMeshResource(obstacle.resource, obstacle.scale,
-                                      indexKey(joinKey(field, "obstacles"), i), left_out);
+    auto triangles =
+        loadMeshResource(obstacle.resource, obstacle.scale,
+                         indexKey(joinKey(field, "obstacles"), i), left_out, max_mesh_bytes);
     if (!triangles) return triangles.error();
     obstacle.mesh = *triangles;
     if (warnings) warnings->insert(warnings->end(), left_out.begin(), left_out.end());
@@ -456,6 +479,7 @@ core::Expected<core::Scene> loadScene(const XmlRpc::XmlRpcValue& value, const st
   if (value.hasMember("robot")) {
     const std::string robot_field = joinKey(field, "robot");
     RobotLinks robot;
+    robot.max_mesh_bytes = max_mesh_bytes;
     if (auto status = readKeys(value["robot"], robotKeys(), robot_field, robot); !status) {
       return status.error();
     }

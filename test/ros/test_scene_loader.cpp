@@ -1,7 +1,12 @@
 // The scene file as the node reads it from the parameter server (XmlRpc values, built here as
 // rosparam would from YAML), and the README's tables of keys against the loader's own. No
 // master needed.
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -873,6 +878,218 @@ TEST(SceneLoader, AMissingCoefficientIsFoundAtTheFirstPairThatNeedsIt) {
   ASSERT_FALSE(loaded.ok());
   EXPECT_EQ(loaded.error().field, "s/bodies[3]/material");
   EXPECT_NE(loaded.error().reason.find("against 'b3'"), std::string::npos);
+}
+
+// --- Issue 41 item 6: mesh resources with limits --------------------------------------------
+
+/// A scene of one mesh obstacle, `grip`, at `resource`.
+XmlRpc::XmlRpcValue meshScene(const std::string& resource) {
+  XmlRpc::XmlRpcValue scene;
+  scene["obstacles"][0]["id"] = "grip";
+  scene["obstacles"][0]["type"] = "mesh";
+  scene["obstacles"][0]["material"] = "concrete";
+  scene["obstacles"][0]["resource"] = resource;
+  return scene;
+}
+
+/// The error loading `scene` gives, as "field: reason" ("" when it loads).
+std::string loadError(const XmlRpc::XmlRpcValue& scene) {
+  const auto loaded = loadScene(scene, "~scene");
+  return loaded.ok() ? "" : loaded.error().message();
+}
+
+/// A directory of its own under /tmp, for the files a test makes.
+std::string scratchDirectory() {
+  std::string pattern = "/tmp/collision_response_mesh_XXXXXX";
+  const char* made = ::mkdtemp(pattern.data());
+  return made ? std::string(made) : std::string();
+}
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+// /dev/zero and /dev/urandom never end: read as meshes they were read until memory ran out
+// (2.1 GB, then std::bad_alloc with no key named). A device is refused before it is opened,
+// however it is addressed (a package:// address that leaves its package too).
+TEST(SceneLoader, Issue41_Item6_ADeviceIsRefusedNotReadUntilMemoryRunsOut) {
+  for (const std::string& device :
+       {std::string("file:///dev/zero"), std::string("file:///dev/urandom"),
+        std::string("package://collision_response/../../../../../../../../../../dev/zero")}) {
+    const std::string error = loadError(meshScene(device));
+    EXPECT_TRUE(contains(error, "~scene/obstacles[0]/resource: '" + device +
+                                    "' is a character "
+                                    "device (/"))
+        << error;
+    EXPECT_TRUE(contains(error, "not a regular file")) << error;
+  }
+  // A directory is no mesh either.
+  const std::string directory = loadError(meshScene("file:///tmp"));
+  EXPECT_TRUE(contains(directory, "~scene/obstacles[0]/resource: 'file:///tmp' is a directory"))
+      << directory;
+}
+
+// A FIFO is refused without being opened: opening it would wait for a writer, for ever.
+TEST(SceneLoader, Issue41_Item6_AFifoIsRefusedWithoutWaitingForAWriter) {
+  const std::string directory = scratchDirectory();
+  ASSERT_FALSE(directory.empty());
+  const std::string fifo = directory + "/grip.stl";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string error = loadError(meshScene("file://" + fifo));
+  ::unlink(fifo.c_str());
+  ::rmdir(directory.c_str());
+  EXPECT_TRUE(contains(error, "~scene/obstacles[0]/resource: 'file://" + fifo + "' is a FIFO"))
+      << error;
+}
+
+// Only the documented package:// and file:// addresses are read. An http:// address on a server
+// that never answers (here a socket that listens and never accepts) held the scene's loading
+// for ever; now it, like any other scheme or a bare path, is refused at once naming the scheme.
+TEST(SceneLoader, Issue41_Item6_OnlyPackageAndFileAddressesAreRead) {
+  const int server = ::socket(AF_INET, SOCK_STREAM, 0);
+  ASSERT_GE(server, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  address.sin_port = 0;  // any free port
+  ASSERT_EQ(::bind(server, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
+  ASSERT_EQ(::listen(server, 8), 0);
+  socklen_t length = sizeof address;
+  ASSERT_EQ(::getsockname(server, reinterpret_cast<sockaddr*>(&address), &length), 0);
+  const std::string silent =
+      "http://127.0.0.1:" + std::to_string(ntohs(address.sin_port)) + "/grip.stl";
+  const std::string error = loadError(meshScene(silent));
+  ::close(server);
+  EXPECT_TRUE(contains(error, "~scene/obstacles[0]/resource: '" + silent +
+                                  "' has the scheme http://, which is not read: a mesh is a "
+                                  "package:// or file:// address"))
+      << error;
+  for (const std::string& other :
+       {std::string("https://example.com/grip.stl"), std::string("ftp://example.com/grip.stl")}) {
+    const std::string refused = loadError(meshScene(other));
+    EXPECT_TRUE(contains(refused, "' has the scheme " + other.substr(0, other.find("://") + 3)))
+        << refused;
+  }
+  // A bare path, and a file:// address of a relative path, are not addresses of a file.
+  const std::string bare = std::string(COLLISION_RESPONSE_TEST_MESHES) + "/grip.stl";
+  EXPECT_TRUE(contains(loadError(meshScene(bare)), "' is not an address")) << bare;
+  EXPECT_TRUE(contains(loadError(meshScene("file://grip.stl")), "absolute path"));
+  EXPECT_EQ(loadError(meshScene(testMesh("grip.stl"))), "");  // the base loads
+}
+
+// A file larger than the scene's max_mesh_bytes is refused before it is read, and one that
+// grows past it as it is read (as /proc's files, whose size stat gives as 0) as soon as it does.
+TEST(SceneLoader, Issue41_Item6_AFileLargerThanMaxMeshBytesIsRefused) {
+  XmlRpc::XmlRpcValue scene = meshScene(testMesh("grip.stl"));  // 2,175 bytes
+  scene["max_mesh_bytes"] = 2175;
+  EXPECT_EQ(loadError(scene), "");
+  scene["max_mesh_bytes"] = 2174;
+  std::string error = loadError(scene);
+  EXPECT_TRUE(contains(
+      error, "~scene/obstacles[0]/resource: '" + testMesh("grip.stl") + "' is 2175 bytes ("))
+      << error;
+  EXPECT_TRUE(contains(error, "more than max_mesh_bytes (2174")) << error;
+  scene = meshScene("file:///proc/self/maps");
+  scene["max_mesh_bytes"] = 100;
+  error = loadError(scene);
+  EXPECT_TRUE(contains(error,
+                       "~scene/obstacles[0]/resource: 'file:///proc/self/maps' grew past "
+                       "100 bytes as it was read"))
+      << error;
+  // The key itself: an integer >= 1.
+  for (const XmlRpc::XmlRpcValue& bad : {XmlRpc::XmlRpcValue(0), XmlRpc::XmlRpcValue(-5),
+                                         XmlRpc::XmlRpcValue(1e9), XmlRpc::XmlRpcValue("large")}) {
+    scene = meshScene(testMesh("grip.stl"));
+    scene["max_mesh_bytes"] = bad;
+    EXPECT_EQ(sceneErrorField(scene), "~scene/max_mesh_bytes");
+  }
+}
+
+// A robot's <mesh filename="file:///dev/zero"> is refused as the scene's mesh is, naming the
+// link and the filename, and the scene's max_mesh_bytes holds for the robot's meshes too.
+TEST(SceneLoader, Issue41_Item6_ARobotsMeshHasTheSameLimits) {
+  const auto robot = [](const std::string& filename, const std::string& scale) {
+    return R"(<?xml version="1.0"?>
+<robot name="arm">
+  <link name="paddle">
+    <collision><geometry><mesh filename=")" +
+           filename + R"(" scale=")" + scale + R"("/></geometry></collision>
+  </link>
+</robot>)";
+  };
+  XmlRpc::XmlRpcValue scene;
+  scene["robot"]["material"] = "concrete";
+  std::string urdf;
+  const UrdfSource source = [&](const std::string&) -> core::Expected<std::string> { return urdf; };
+  const auto error = [&] {
+    const auto loaded = loadScene(scene, "~scene", source);
+    return loaded.ok() ? std::string() : loaded.error().message();
+  };
+  urdf = robot("file:///dev/zero", "1 1 1");
+  EXPECT_TRUE(contains(error(),
+                       "~scene/robot/description: link 'paddle' <collision> 0, <mesh> "
+                       "filename: 'file:///dev/zero' is a character device"))
+      << error();
+  urdf = robot(testMesh("grip.stl"), "1 1 1");
+  EXPECT_EQ(error(), "");
+  scene["max_mesh_bytes"] = 1000;
+  EXPECT_TRUE(contains(error(), "more than max_mesh_bytes (1000")) << error();
+  scene = XmlRpc::XmlRpcValue();
+  scene["robot"]["material"] = "concrete";
+  urdf = robot(testMesh("grip.stl"), "1e300 1e300 1e300");
+  EXPECT_TRUE(contains(error(),
+                       "~scene/robot/description: link 'paddle' <collision> 0, <mesh> "
+                       "scale: "))
+      << error();
+}
+
+// --- Issue 41 item 8: a scale the doubles cannot take is the scale's fault, not the file's ------
+
+// grip.stl (a box 0.0625 x 0.125 x 0.09375 m about its origin) at scale 1e300 was refused as
+// "has no triangle of nonzero area", blaming the file. A triangle's area is the length of its
+// edges' cross product, whose components are products of two edges: at 1e200 and 1e300 (edges
+// of 6e198 m and more) they overflow to infinity; at 1e-100 (cross products of about 1e-202
+// m^2) their squares, about 1e-404, underflow to 0, and so do smaller ones. A scale whose
+// product with a coordinate overflows (4 m at 1e308) is named on its axis.
+TEST(SceneLoader, Issue41_Item8_AScaleBeyondTheDoublesIsNamedNotTheFile) {
+  for (const double factor : {1e300, 1e200, 1e-100, 1e-200, 1e-300}) {
+    XmlRpc::XmlRpcValue scene = meshScene(testMesh("grip.stl"));
+    scene["obstacles"][0]["scale"] = list3(factor, factor, factor);
+    const std::string error = loadError(scene);
+    EXPECT_TRUE(contains(error, "~scene/obstacles[0]/scale: [")) << factor << ": " << error;
+    EXPECT_TRUE(contains(error, "leaves 12 of the 12 triangles of nonzero area of '" +
+                                    testMesh("grip.stl") + "' without area in doubles"))
+        << factor << ": " << error;
+  }
+  // Cross products of about 1e197 m^2 (their components doubles) and 1e-103 m^2 (their squares,
+  // 1e-206, too): these load.
+  for (const double factor : {1e100, 1e-50}) {
+    XmlRpc::XmlRpcValue scene = meshScene(testMesh("grip.stl"));
+    scene["obstacles"][0]["scale"] = list3(factor, factor, factor);
+    EXPECT_EQ(loadError(scene), "") << factor;
+  }
+  // Flattened along z only: the 8 triangles of the box's sides lose their area, the 4 of its top
+  // and bottom keep theirs; it is still the scale's fault.
+  XmlRpc::XmlRpcValue flat = meshScene(testMesh("grip.stl"));
+  flat["obstacles"][0]["scale"] = list3(1, 1, 1e-300);
+  EXPECT_TRUE(contains(loadError(flat),
+                       "~scene/obstacles[0]/scale: [1, 1, 1e-300] leaves 8 of "
+                       "the 12 triangles"))
+      << loadError(flat);
+  // A vertex 4 m out, times 1e308, is beyond the doubles: scale[0] is named.
+  const std::string directory = scratchDirectory();
+  ASSERT_FALSE(directory.empty());
+  const std::string path = directory + "/corner.stl";
+  std::ofstream(path)
+      << "solid corner\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n"
+         "   vertex 4 0 0\n   vertex 0 4 0\n  endloop\n endfacet\nendsolid corner\n";
+  XmlRpc::XmlRpcValue far = meshScene("file://" + path);
+  far["obstacles"][0]["scale"] = list3(1e308, 1, 1);
+  const std::string error = loadError(far);
+  ::unlink(path.c_str());
+  ::rmdir(directory.c_str());
+  EXPECT_TRUE(contains(error, "~scene/obstacles[0]/scale[0]: 1e+308 times the extent of")) << error;
+  EXPECT_TRUE(contains(error, "(4 m at scale 1) overflows the doubles")) << error;
 }
 
 }  // namespace

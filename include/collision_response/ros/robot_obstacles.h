@@ -3,11 +3,13 @@
 // with it (README, "A robot's links").
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
 #include "collision_response/core/expected.h"
 #include "collision_response/core/scene.h"
+#include "collision_response/ros/mesh_resource.h"
 
 namespace collision_response {
 
@@ -18,6 +20,8 @@ struct RobotLinks {
   std::vector<std::string> links;                 ///< otherwise these
   std::string material;                           ///< required: every link's
   double padding = 0.0;  ///< m, >= 0: every shape grown by it (a box by it on each side)
+  /// Not a `robot:` key: the scene's `max_mesh_bytes`, the largest mesh file read.
+  std::size_t max_mesh_bytes = kDefaultMaxMeshBytes;
 };
 
 /// The obstacles of `urdf` (the URDF's XML) for `robot`: one per `<collision>` of each chosen link,
