@@ -1,6 +1,8 @@
 #include "collision_response/ros/prediction_service.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <string>
 
 #include "collision_response/core/prediction.h"
@@ -34,6 +36,25 @@ core::Expected<core::BodySpec> requestedBody(const Body& body, const core::Scene
   return spec;
 }
 
+/// The answer's stamps, `stamp` plus instants up to the horizon (at most
+/// core::kPredictionMaxHorizon), must be ros::Time's: an error names header.stamp when they would
+/// pass its last instant, 4294967295.999999999 (in 2106). A horizon that is not a number > 0 is
+/// the core's to name.
+core::Status checkStampRoom(const ros::Time& stamp, double horizon) {
+  if (!(std::isfinite(horizon) && horizon > 0)) return core::Ok{};
+  constexpr std::uint64_t kLastNanosecond = 4294967295ull * 1000000000ull + 999999999ull;
+  // Rounded up, and a nanosecond more: ros::Duration rounds an instant to its nanosecond.
+  const auto room =
+      static_cast<std::uint64_t>(std::ceil(std::min(horizon, core::kPredictionMaxHorizon) * 1e9)) +
+      1;
+  if (stamp.toNSec() <= kLastNanosecond - room) return core::Ok{};
+  return core::Error{"header.stamp", formatStamp(stamp) + " leaves no room for the horizon (" +
+                                         core::formatNumber(horizon) +
+                                         " s): the answer is stamped up to it after the request's "
+                                         "instant, past the last instant a ROS time holds "
+                                         "(4294967295.999999999, in 2106)"};
+}
+
 /// What the request asks for, in the scene's fixed frame, on the monitor's time line: an error
 /// names the field.
 core::Expected<core::PredictionRequest> requestInFixedFrame(const PredictImpacts::Request& request,
@@ -42,6 +63,7 @@ core::Expected<core::PredictionRequest> requestInFixedFrame(const PredictImpacts
                                                             const ros::Time& stamp, double time) {
   const core::Scene& scene = cycle.scene();
   core::PredictionRequest predict;
+  if (auto status = checkStampRoom(stamp, request.horizon); !status) return status.error();
   auto body = requestedBody(request.body, scene);
   if (!body) return body.error();
   predict.body = *body;
@@ -75,7 +97,8 @@ core::Expected<core::PredictionRequest> requestInFixedFrame(const PredictImpacts
   predict.max_impacts = request.max_impacts;
   predict.sample_period = request.sample_period;
   const Eigen::Vector3d normal = toEigen(request.crossing_normal);
-  if (!normal.isZero()) {
+  // Exactly zero is no plane; any other length (1e-300 too) is a direction (the srv).
+  if (!(normal.array() == 0.0).all()) {
     if (auto status = core::checkFinite(normal, "crossing_normal"); !status) return status.error();
     const Eigen::Vector3d point = toEigen(request.crossing_point);
     if (auto status = core::checkFinite(point, "crossing_point"); !status) return status.error();

@@ -184,6 +184,70 @@ TEST(PredictServe, EveryBadRequestIsNamedAndTheNodeKeepsServing) {
   EXPECT_EQ(refusal(servedBall(ref)), "accepted");
 }
 
+// Issue 41, item 8: absurd numbers answered rightly, each against its closed form.
+//  - crossing_normal (0, 0, 1e-300) was taken for no plane (Eigen's isZero is approximate): any
+//    nonzero length is a direction, as the srv says; the probe falling from z = 1.0 at
+//    vz = -2.25 m/s crosses z = 0.9 when 4.905 t^2 + 2.25 t - 0.1 = 0,
+//    t = 2 (0.1) / (2.25 + sqrt(2.25^2 + 2 (9.81) 0.1));
+//  - sample_period 5e-324 gave a 0 s prediction with one sample (horizon / period is infinite):
+//    as for 1e-10, the most samples, 10,000 over the horizon, and the message says so;
+//  - header.stamp 4294967295.999999999 answered "internal error: Time is out of dual 32-bit
+//    range": the answer's stamps (up to the horizon after it) pass ros::Time's last instant, so
+//    header.stamp is named, and why.
+TEST(PredictServe, Issue41_Item8_AbsurdNumbersAreAnsweredRightly) {
+  ASSERT_TRUE(ros::service::waitForService("/collision_response/predict_impacts", 30000));
+  PredictImpacts probe;
+  probe.request.header.frame_id = "world";
+  probe.request.header.stamp = ros::Time(200.0);
+  probe.request.body.id = "probe";
+  probe.request.body.mass = 0.0027;
+  probe.request.body.radius = 0.02;
+  probe.request.body.material = "celluloid";
+  probe.request.body.position.x = -3.0;  // beyond the table's end: nothing met within 0.1 s
+  probe.request.body.position.z = 1.0;
+  probe.request.body.velocity.z = -2.25;
+  probe.request.effects = {"gravity"};
+  probe.request.horizon = 0.1;
+  probe.request.max_impacts = 1;
+
+  PredictImpacts call = probe;
+  call.request.crossing_normal.z = 1e-300;
+  call.request.crossing_point.z = 0.9;
+  ASSERT_TRUE(callService(call));
+  ASSERT_TRUE(call.response.success) << call.response.message;
+  EXPECT_TRUE(call.response.crossed) << "a normal 1e-300 long was taken for no plane";
+  const double t = 2 * 0.1 / (2.25 + std::sqrt(2.25 * 2.25 + 2 * 9.81 * 0.1));
+  EXPECT_NEAR((call.response.crossing.header.stamp - ros::Time(200.0)).toSec(), t, 1e-9);
+  EXPECT_NEAR(call.response.crossing.pose.position.z, 0.9, 1e-12);
+
+  for (const double period : {5e-324, 1e-10}) {
+    call = probe;
+    call.request.sample_period = period;
+    ASSERT_TRUE(callService(call));
+    ASSERT_TRUE(call.response.success) << call.response.message;
+    EXPECT_EQ(call.response.samples.size(), 10001u) << period;  // the state's instant, then 10,000
+    EXPECT_NE(call.response.message.find("samples are cut to 10000"), std::string::npos)
+        << call.response.message;
+    EXPECT_EQ(call.response.final_state.header.stamp, ros::Time(200.1)) << period;
+  }
+
+  call = probe;
+  call.request.header.stamp = ros::Time(4294967295u, 999999999u);
+  ASSERT_TRUE(callService(call));
+  EXPECT_FALSE(call.response.success);
+  EXPECT_EQ(call.response.message.rfind("header.stamp: 4294967295.999999999 leaves no room for "
+                                        "the horizon (0.1 s)",
+                                        0),
+            0u)
+      << call.response.message;
+  call.request.header.stamp = ros::Time(4294967295u, 900000000u);  // 0.1 s later is past it
+  ASSERT_TRUE(callService(call));
+  EXPECT_FALSE(call.response.success) << call.response.message;
+  call.request.header.stamp = ros::Time(4294967295u, 899999998u);  // within, by a rounding's ns
+  ASSERT_TRUE(callService(call));
+  EXPECT_TRUE(call.response.success) << call.response.message;
+}
+
 /// What the played serve brought on the topics, heard from the test's start (main): the ball's
 /// first state's stamp (the serve's instant 0) and the impacts.
 /// Guarded by played_mutex: written by the spinner's thread.
