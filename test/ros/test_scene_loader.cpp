@@ -975,6 +975,9 @@ TEST(SceneLoader, Issue41_Item6_OnlyPackageAndFileAddressesAreRead) {
   EXPECT_TRUE(contains(loadError(meshScene(bare)), "' is not an address")) << bare;
   EXPECT_TRUE(contains(loadError(meshScene("file://grip.stl")), "absolute path"));
   EXPECT_EQ(loadError(meshScene(testMesh("grip.stl"))), "");  // the base loads
+  EXPECT_EQ(loadError(meshScene("package://collision_response/meshes/table.stl")), "");
+  EXPECT_TRUE(contains(loadError(meshScene("package://collision_response")),
+                       "is not a package://<package>/<path> address"));
 }
 
 // A file larger than the scene's max_mesh_bytes is refused before it is read, and one that
