@@ -53,7 +53,8 @@ std::map<std::string, XmlRpc::XmlRpcValue> nodeExamples() {
           {"diagnostic_period", 0.5},
           {"detection", "discrete"},
           {"restitution_threshold", 0.1},
-          {"restitution_combine", "max"}};
+          {"restitution_combine", "max"},
+          {"prediction_cpu_budget", 0.25}};
 }
 
 std::vector<std::string> documentedNames(const testing::Table& table) {
@@ -73,6 +74,7 @@ TEST(MonitorParams, DefaultsWhenNothingIsSet) {
   EXPECT_EQ(params->queue_size, 1000);
   EXPECT_EQ(params->max_states, 100000);
   EXPECT_EQ(params->future_stamp_tolerance, 300.0);
+  EXPECT_EQ(params->prediction_cpu_budget, 1.0);
 }
 
 // "A test fails if any documented parameter is refused": every `~name` of the README's table
@@ -108,6 +110,7 @@ TEST(MonitorParams, EveryDocumentedParameterLoadsAndEveryReadOneIsDocumented) {
   EXPECT_EQ(params->future_stamp_tolerance, 30.0);
   EXPECT_EQ(params->queue_size, 7);
   EXPECT_EQ(params->max_states, 11);
+  EXPECT_EQ(params->prediction_cpu_budget, 0.25);
   EXPECT_EQ(params->markers.rate, 10.0);
   EXPECT_EQ(params->markers.impact_lifetime, 1.5);
   EXPECT_EQ(params->markers.impulse_scale, 0.3);
@@ -189,7 +192,8 @@ TEST(MonitorParams, ValuesOutOfRangeAreErrors) {
       {"marker_rate", std::numeric_limits<double>::infinity()},
       {"frame_velocity_interval", 0.0},
       {"obstacle_update_period", -0.001},
-      {"diagnostic_period", -1.0}};
+      {"diagnostic_period", -1.0},
+      {"prediction_cpu_budget", -1.0}};
   for (const auto& [key, value] : cases) {
     XmlRpc::XmlRpcValue tree;
     tree[key] = value;
