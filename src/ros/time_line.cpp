@@ -24,7 +24,8 @@ ros::Time fromNanoseconds(std::int64_t at) {
 
 }  // namespace
 
-TimeLine::TimeLine(double clock_jump_back) : jump_ns_(toNanoseconds(clock_jump_back)) {}
+TimeLine::TimeLine(double clock_jump_back)
+    : jump_ns_(toNanoseconds(clock_jump_back)), ahead_ns_(jump_ns_ / kAheadFraction) {}
 
 TimeLine::Placed TimeLine::start(const std::string& source, std::int64_t first, std::int64_t at,
                                  std::int64_t clock, Event event) {
@@ -32,8 +33,7 @@ TimeLine::Placed TimeLine::start(const std::string& source, std::int64_t first, 
   started_ = true;
   // Line zero is `first` in the node's clock: a stamp far from the node's clock (one
   // arriving first, say) starts the line at the node's present, not at the stamp.
-  const std::int64_t offset =
-      clock != 0 && std::abs(clock - at) > jump_ns_ ? clock - at : std::int64_t{0};
+  const std::int64_t offset = clock != 0 && !agrees(at, clock, true) ? clock - at : std::int64_t{0};
   epoch_ = first + offset;
   last_clock_ = clock;
   first_source_ = source;
@@ -48,8 +48,15 @@ TimeLine::Placed TimeLine::start(const std::string& source, std::int64_t first, 
   return placed;
 }
 
-std::int64_t TimeLine::newOffset(std::int64_t at, std::int64_t clock, std::int64_t present) const {
-  if (clock == 0 || std::abs(clock - at) <= jump_ns_) return 0;
+bool TimeLine::agrees(std::int64_t at, std::int64_t clock, bool clock_runs) const {
+  // Behind it by its messages' latency, which load can make long; ahead of it only by the
+  // difference of two clocks that agree (another machine's, a /clock heard a tick late).
+  return clock - at <= jump_ns_ && at - clock <= (clock_runs ? ahead_ns_ : jump_ns_);
+}
+
+std::int64_t TimeLine::newOffset(std::int64_t at, std::int64_t clock,
+                                 const Present& present) const {
+  if (clock == 0 || agrees(at, clock, present.clock_runs)) return 0;
   // A clock off the node's that another source keeps, which this stamp continues: on it, the
   // stamp is no more than ~clock_jump_back before that source's last one, nor ahead of where
   // that source is now (its last instant plus the node's time since). The two share it (two
@@ -71,15 +78,17 @@ std::int64_t TimeLine::newOffset(std::int64_t at, std::int64_t clock, std::int64
       }
     }
   }
-  return shared != nullptr ? shared->offset : present - (at - epoch_);
+  return shared != nullptr ? shared->offset : present.line - (at - epoch_);
 }
 
-bool TimeLine::continues(const Clock& clock, std::int64_t at, std::int64_t node_clock,
-                         std::int64_t present) const {
+bool TimeLine::continues(const Clock& clock, std::int64_t at, const Present& present) const {
   if (at < clock.last_stamp - jump_ns_) return false;  // went back
-  // Leapt ahead of the line's present (judged only with the node's clock: `present` moves
-  // with it; without it, a source's stamps going forward are its own business).
-  return node_clock == 0 || at + clock.offset - epoch_ <= present + jump_ns_;
+  // Leapt ahead of the line's present (judged only with a running node's clock; without it, a
+  // source's stamps going forward are its own business): the node's clock, by more than two
+  // clocks that agree differ; a clock of its own (placed at the present), by more than
+  // ~clock_jump_back, a stamp off it.
+  return !present.clock_runs ||
+         at + clock.offset - epoch_ <= present.line + (clock.offset == 0 ? ahead_ns_ : jump_ns_);
 }
 
 bool TimeLine::continues(const Held& held, std::int64_t at, std::int64_t node_clock) const {
@@ -104,18 +113,26 @@ TimeLine::Source& TimeLine::sourceOf(const std::string& source, bool& is_new) {
 }
 
 TimeLine::Placed TimeLine::on(Clock& clock, std::int64_t at, std::int64_t node_clock,
-                              std::int64_t now, std::int64_t present) {
+                              std::int64_t now, const Present& present) {
   Placed placed;
   clock.heard = heard_;
   ++clock.messages;
   if (at > clock.last_stamp) clock.last_stamp = at;
   std::int64_t line = at + clock.offset - epoch_;
-  if (line < now - jump_ns_) {
-    // Behind the line although its own clock did not go back: another clock. Shifted onto
-    // the line's present.
-    clock.offset += present - line;
-    line = present;
-    placed.event = Event::kOffsetChanged;
+  if (present.clock_runs && clock.offset != 0 && line > present.line) {
+    // A clock of its own running ahead of the node's (a bag played faster than it was recorded,
+    // without sim time): placed at the line's present, never past it, its offset following, so
+    // that it moves no instant of another source (the monitor cannot step back to a state of
+    // the past). Said when it got its clock, not again.
+    clock.offset -= line - present.line;
+    line = present.line;
+  } else if (line < (present.clock_runs ? std::min(now, present.line) : now) - jump_ns_) {
+    // Behind the line although its own clock did not go back: another clock (a source that
+    // joins after another one moved the line ahead, a bag played slower than it was recorded).
+    // Shifted onto the line's present; said when it leaves the node's clock, not again.
+    if (clock.offset == 0) placed.event = Event::kOffsetChanged;
+    clock.offset += present.line - line;
+    line = present.line;
   }
   if (node_clock != 0) last_clock_ = node_clock;
   clock.last_line = line;
@@ -135,12 +152,12 @@ TimeLine::Clock& TimeLine::addClock(Source& known, const Clock& added) {
   return known.clocks.back();
 }
 
-TimeLine::Clock* TimeLine::continuedClock(Source& known, std::int64_t at, std::int64_t node_clock,
-                                          std::int64_t present) const {
+TimeLine::Clock* TimeLine::continuedClock(Source& known, std::int64_t at,
+                                          const Present& present) const {
   // The one heard last first.
   Clock* continued = nullptr;
   for (Clock& candidate : known.clocks) {
-    if (continues(candidate, at, node_clock, present) &&
+    if (continues(candidate, at, present) &&
         (continued == nullptr || candidate.heard > continued->heard)) {
       continued = &candidate;
     }
@@ -150,7 +167,7 @@ TimeLine::Clock* TimeLine::continuedClock(Source& known, std::int64_t at, std::i
 
 TimeLine::Placed TimeLine::continueHeld(const std::string& source, Source& known, std::int64_t at,
                                         std::int64_t node_clock, std::int64_t now_ns,
-                                        std::int64_t present) {
+                                        const Present& present) {
   const Held held = known.held;
   known.held = Held{};
   if (!held.interrupted) {
@@ -173,13 +190,16 @@ TimeLine::Placed TimeLine::place(const std::string& source, const ros::Time& sta
   const std::int64_t node_clock = clock.isZero() ? 0 : nanoseconds(clock);
   if (!started_) return start(source, at, at, node_clock, Event::kStarted);
   const std::int64_t now_ns = toNanoseconds(now);
-  const std::int64_t present = now_ns + (node_clock != 0 && last_clock_ != 0
-                                             ? std::max<std::int64_t>(0, node_clock - last_clock_)
-                                             : std::int64_t{0});
+  // The line's present is the node's clock (epoch_ is line zero in it): no stamp, however far
+  // ahead its source's clock runs, moves it. Without a node's clock that ran since the last
+  // placement (none yet, or sim time standing still), the line's last instant.
+  const Present present = node_clock != 0 && node_clock > last_clock_
+                              ? Present{node_clock - epoch_, true}
+                              : Present{now_ns, false};
   bool is_new = false;
   Source& known = sourceOf(source, is_new);
   known.heard = ++heard_;
-  if (Clock* continued = continuedClock(known, at, node_clock, present)) {
+  if (Clock* continued = continuedClock(known, at, present)) {
     Placed placed = on(*continued, at, node_clock, now_ns, present);
     if (known.held.active && !known.held.interrupted) {
       // The stamp held before this one was off the source's clock: its states are dropped.

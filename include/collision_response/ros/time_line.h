@@ -26,10 +26,22 @@
 //    new line); if the next one continues the clock before, the held states are dropped,
 //    naming the source, and should the held clock go on, interleaved with the other one, it
 //    becomes the source's second clock, placed at the line's present;
+//  - no state is placed ahead of the line's present (judged only with a node's clock that ran
+//    since the line's last placement): the monitor cannot step back, so a state placed there
+//    would put every other source's next states in its past. A stamp of the node's clock a
+//    little ahead of it (another machine's, within ~clock_jump_back) is placed at the present;
+//    a clock of its own that runs ahead (a bag played faster than it was recorded without
+//    use_sim_time, past ~clock_jump_back ahead and on a clock of its own from then on) is
+//    placed at the present, its offset following, said only when it got that clock;
 //  - a clock that lags the line's last instant by more than ~clock_jump_back while its stamps
-//    go forward (a source that joins after another one moved the line ahead) is shifted onto
-//    the line's present, said once.
-// The line's present is its last instant plus the node's clock's time since it was placed.
+//    go forward (a source that joins after another one moved the line ahead, a bag played
+//    slower than it was recorded) is shifted onto the line's present, said when it leaves the
+//    node's clock; "the line's last instant" is never past the present, whatever a source ahead
+//    of the node's clock sent, so a source that keeps the node's clock (its messages' latency
+//    below ~clock_jump_back) keeps its stamps.
+// The line's present is the node's clock, on the line (epoch_ is line zero in it): no source
+// moves it, however fast its clock runs; without a running node's clock, the line's last
+// instant.
 // An instant of the line has a stamp in each clock (stampOf): an impact is stamped in the clock
 // of the states that produced it. Differences are taken in integer nanoseconds: no stamp can
 // make the arithmetic throw (as ros::Duration does beyond 2^31 s) or lose its nanoseconds.
@@ -107,6 +119,12 @@ class TimeLine {
   static constexpr std::size_t kMaxSources = 64;
   /// Clocks of one source, at most: the one heard from least recently is forgotten.
   static constexpr std::size_t kMaxClocks = 2;
+  /// A stamp of the node's clock may be ahead of the running node's clock by ~clock_jump_back
+  /// divided by this (0.1 s by default): well above the difference of clocks that agree (a
+  /// /clock heard one 100 Hz tick late, another machine's clock kept by NTP), and a bound on
+  /// how far a source whose clock runs fast can carry the line past the present before it is
+  /// on a clock of its own.
+  static constexpr std::int64_t kAheadFraction = 10;
 
  private:
   struct Clock {
@@ -133,26 +151,36 @@ class TimeLine {
 
   Placed start(const std::string& source, std::int64_t first, std::int64_t at, std::int64_t clock,
                Event event);
+  /// The line's present: the node's clock on the line, when it ran since the last placement
+  /// (`clock_runs`); else the line's last instant.
+  struct Present {
+    std::int64_t line = 0;  ///< ns on the line
+    bool clock_runs = false;
+  };
+  /// Whether a stamp `at` agrees with the node's clock `clock`: no more than ~clock_jump_back
+  /// behind it, nor more than ahead_ns_ ahead of a running one (~clock_jump_back of one that
+  /// stood still since the last placement, or at the line's start).
+  bool agrees(std::int64_t at, std::int64_t clock, bool clock_runs) const;
   /// The offset of a new clock whose stamp is `at`: zero when it agrees with the node's clock,
-  /// else the one that places it at `present`.
-  std::int64_t newOffset(std::int64_t at, std::int64_t clock, std::int64_t present) const;
+  /// else the one that places it at the present.
+  std::int64_t newOffset(std::int64_t at, std::int64_t clock, const Present& present) const;
   Placed on(Clock& clock, std::int64_t at, std::int64_t node_clock, std::int64_t now,
-            std::int64_t present);
-  bool continues(const Clock& clock, std::int64_t at, std::int64_t node_clock,
-                 std::int64_t present) const;
+            const Present& present);
+  bool continues(const Clock& clock, std::int64_t at, const Present& present) const;
   bool continues(const Held& held, std::int64_t at, std::int64_t node_clock) const;
   Source& sourceOf(const std::string& source, bool& is_new);
   /// Adds a clock to the source, forgetting its least recently heard one past kMaxClocks.
   static Clock& addClock(Source& known, const Clock& added);
   /// The source's clock that the stamp `at` continues (the one heard last first), if any.
-  Clock* continuedClock(Source& known, std::int64_t at, std::int64_t node_clock,
-                        std::int64_t present) const;
+  Clock* continuedClock(Source& known, std::int64_t at, const Present& present) const;
   /// The source's next stamp after a held one continues the held stamp: a real jump back (every
   /// track reset), or, after an interruption, the source's second clock.
   Placed continueHeld(const std::string& source, Source& known, std::int64_t at,
-                      std::int64_t node_clock, std::int64_t now_ns, std::int64_t present);
+                      std::int64_t node_clock, std::int64_t now_ns, const Present& present);
 
   std::int64_t jump_ns_;
+  /// ns: how far a stamp of the node's clock may be ahead of it, a tenth of ~clock_jump_back.
+  std::int64_t ahead_ns_;
   bool started_ = false;
   std::int64_t epoch_ = 0;       ///< ns: line zero, in the node's clock (offset-zero stamps)
   std::int64_t last_clock_ = 0;  ///< ns: the node's clock at the last placement (0: unknown)
