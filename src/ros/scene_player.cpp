@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
+#include <limits>
+#include <sstream>
 
 #include "collision_response/BodyStateArray.h"
 #include "collision_response/core/restitution.h"
@@ -16,6 +19,18 @@ namespace collision_response {
 namespace {
 
 using P = ScenePlayerParams;
+
+/// Periods a late timer callback still publishes (the node's bound on an update, doc/model.md
+/// "Lasting contact": about ten periods); further behind, the player skips to the newest.
+constexpr std::int64_t kMaxCatchUp = 10;
+/// The replay window holds one model of the scene per period: at most this many.
+constexpr double kMaxReplayPeriods = 1000.0;
+
+double threadCpuSeconds() {
+  timespec now{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+  return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
+}
 
 const KeyTable<MovingFrame>& frameKeys() {
   static const KeyTable<MovingFrame> kKeys = {
@@ -93,6 +108,8 @@ const KeyTable<ScenePlayerParams>& ScenePlayerParams::keys() {
           "contact_tolerance", [](P& p) -> double& { return p.contact_tolerance; },
           core::checkContactTolerance),
       boolKey<P>("report_restitution", [](P& p) -> bool& { return p.report_restitution; }),
+      numberKey<P>(
+          "replay_window", [](P& p) -> double& { return p.replay_window; }, checkDurationOrZero),
   };
   return kKeys;
 }
@@ -104,6 +121,19 @@ core::Expected<ScenePlayerParams> ScenePlayerParams::load(const XmlRpc::XmlRpcVa
     return core::Error{joinKey(ns, "scene"), "is required (load a scene file)"};
   }
   if (auto status = readKeys(tree, keys(), ns, params); !status) return status.error();
+  if (params.replay_window * params.rate > kMaxReplayPeriods) {
+    // One model of the scene is kept per period of the window: the default shrinks to 1,000
+    // periods at a rate above 4 kHz (README, "Parameters"); a value given is refused.
+    if (!tree.hasMember("replay_window")) {
+      params.replay_window = kMaxReplayPeriods / params.rate;
+      return params;
+    }
+    return core::Error{joinKey(ns, "replay_window"),
+                       core::formatNumber(params.replay_window) + " s at ~rate " +
+                           core::formatNumber(params.rate) + " Hz is " +
+                           core::formatNumber(params.replay_window * params.rate) +
+                           " periods: at most " + core::formatNumber(kMaxReplayPeriods)};
+  }
   return params;
 }
 
@@ -147,6 +177,7 @@ bool ScenePlayer::initialize() {
 }
 
 void ScenePlayer::onTimer(const ros::TimerEvent& event) {
+  if (stopping_) return;
   const ros::Time now = event.current_real;
   if (!playback_) {
     // Start once the monitor listens and the start delay is over (so a printer can connect).
@@ -155,15 +186,66 @@ void ScenePlayer::onTimer(const ros::TimerEvent& event) {
       return;
     }
     start_ = now;
-    playback_ = std::make_unique<core::Playback>(scene_, params_.contact_tolerance, 0.0);
+    playback_ = std::make_unique<core::Playback>(scene_, params_.contact_tolerance, 0.0,
+                                                 params_.replay_window);
   }
-  if (params_.duration > 0 && (now - start_).toSec() > params_.duration) {
-    ROS_INFO_STREAM("scene_player: " << params_.duration << " s played; stopping");
-    ros::shutdown();
-    return;
+  playPeriodsDue(now);
+}
+
+void ScenePlayer::playPeriodsDue(const ros::Time& now) {
+  const double rate = params_.rate;
+  // Period k is the instant k / rate s after the start; the last one is at or before `duration`.
+  const double last = params_.duration > 0 ? std::floor(params_.duration * rate + 1e-9)
+                                           : std::numeric_limits<double>::infinity();
+  const double due = std::min(std::floor(sinceStart(now) * rate + 1e-9), last);
+  if (due >= static_cast<double>(next_period_)) {
+    const auto newest = static_cast<std::int64_t>(due);
+    if (newest - next_period_ >= kMaxCatchUp) {
+      // Too far behind to publish every period without falling further behind: the newest
+      // alone, the others counted and said.
+      const std::int64_t skipped = newest - next_period_;
+      const double from = static_cast<double>(next_period_) / rate;
+      skipped_ += skipped;
+      next_period_ = newest;
+      ROS_WARN_STREAM_THROTTLE(
+          5.0, "scene_player: fell behind: the "
+                   << skipped << " periods from " << from << " s to "
+                   << static_cast<double>(newest - 1) / rate
+                   << " s of the scene were not published (more than " << kMaxCatchUp
+                   << " periods late), the newest, at " << static_cast<double>(newest) / rate
+                   << " s, is; so far " << playedSummary() << ". Playing one period took "
+                   << 1000.0 * last_period_cpu_ << " ms of CPU against a period of "
+                   << 1000.0 / rate
+                   << " ms: the machine is busy, or the scene costs more than ~rate allows");
+    }
+    const double began = threadCpuSeconds();
+    const std::int64_t first = next_period_;
+    for (; next_period_ <= newest; ++next_period_) {
+      const ros::Time stamp =
+          start_ + ros::Duration(static_cast<double>(next_period_) / params_.rate);
+      publishStates(stamp);
+      publishApexes(stamp);
+      ++published_;
+    }
+    last_period_cpu_ = (threadCpuSeconds() - began) / static_cast<double>(next_period_ - first);
   }
-  publishStates(now);
-  publishApexes(now);
+  if (static_cast<double>(next_period_) > last) {
+    stopping_ = true;
+    ROS_INFO_STREAM("scene_player: " << params_.duration << " s played: " << playedSummary()
+                                     << "; stopping");
+    // A moment for the line to reach rosout before the node goes.
+    stop_timer_ = node_.createWallTimer(
+        ros::WallDuration(0.5), [](const ros::WallTimerEvent&) { ros::shutdown(); }, true);
+  }
+}
+
+std::string ScenePlayer::playedSummary() const {
+  std::ostringstream line;
+  line << next_period_ << " periods of " << 1.0 / params_.rate << " s, " << published_
+       << " states published, " << skipped_
+       << " periods skipped; impacts not applied: " << late_impacts_ << " heard too late, "
+       << stale_impacts_ << " found from states sent before an earlier impact was heard";
+  return line.str();
 }
 
 void ScenePlayer::publishStates(const ros::Time& time) {
@@ -200,25 +282,76 @@ void ScenePlayer::onImpacts(const ImpactArray::ConstPtr& message) {
   // restarts one radius back along the normal from it; in discrete detection the bodies overlap
   // at the sample, and each restarts where the player had it (Playback::applyImpacts).
   const bool exact_contact = scene_.detection == core::Detection::kContinuous;
+  // The state that revealed these impacts (the message's stamp), from the start.
+  const double revealed = sinceStart(message->header.stamp);
+  const auto bodyIds = [&](const core::ImpactRecord& record) {
+    std::vector<std::string> ids{indexing_->body(record.body_a).id};
+    if (!record.other_is_obstacle) ids.push_back(indexing_->body(record.other).id);
+    return ids;
+  };
   std::vector<core::ImpactRecord> records;
   std::vector<const Impact*> heard;
   for (const Impact& impact : message->impacts) {
     auto record = toImpactRecord(impact, *indexing_, sinceStart(impact.header.stamp));
     if (!record) continue;
+    // Found from states the player sent before it heard of an earlier impact of one of these
+    // bodies that it could not play itself (below): the node's motion there was not the scene's.
+    bool stale = false;
+    for (const std::string& id : bodyIds(*record)) {
+      const auto found = unheard_.find(id);
+      if (found == unheard_.end()) continue;
+      // (The stamps are the periods': half a period apart from a period is past it.)
+      if (revealed > found->second.second + 0.5 / params_.rate) {
+        unheard_.erase(found);  // states sent since carry that impact
+      } else if (record->time > found->second.first) {
+        stale = true;
+      }
+    }
+    if (stale) {
+      ++stale_impacts_;
+      ROS_WARN_STREAM_THROTTLE(
+          5.0, "scene_player: the impact of '"
+                   << impact.body_a << "' and '" << impact.body_b << "' at "
+                   << sinceStart(impact.header.stamp)
+                   << " s was found from states sent before the player heard of an earlier impact "
+                      "of theirs (on a tf-attached obstacle, which the player cannot resolve "
+                      "itself): not applied ("
+                   << stale_impacts_ << " so far)");
+      continue;
+    }
     records.push_back(std::move(*record));
     heard.push_back(&impact);
   }
-  for (const std::size_t k : playback_->applyImpacts(*indexing_, records, exact_contact)) {
-    // Heard after its instant was played and made final: the bodies go on without it (under
-    // continuous detection by the player's own resolution of it; under discrete, inside each
-    // other). Never silent.
+  const std::vector<std::size_t> refused =
+      playback_->applyImpacts(*indexing_, records, exact_contact);
+  // An impact on a tf-attached obstacle under continuous detection: the player did not resolve
+  // it in what it played (it does not place those obstacles), so the states it sent from its
+  // instant up to the newest lack it, and the node's impacts along those states' motion (up to
+  // the next state's, found along the tracks of the one before) are not the scene's.
+  const double newest = static_cast<double>(next_period_ - 1) / params_.rate;
+  for (std::size_t k = 0; k < records.size(); ++k) {
+    const core::ImpactRecord& record = records[k];
+    if (!exact_contact || !record.other_is_obstacle ||
+        indexing_->obstacle(record.other).frame.empty() ||
+        std::find(refused.begin(), refused.end(), k) != refused.end() || !(newest > record.time)) {
+      continue;
+    }
+    for (const std::string& id : bodyIds(record)) {
+      unheard_[id] = {record.time, newest + 1.0 / params_.rate};
+    }
+  }
+  late_impacts_ += static_cast<std::int64_t>(refused.size());
+  for (const std::size_t k : refused) {
+    // Heard more than ~replay_window after its instant was played: the bodies go on without it
+    // (under continuous detection by the player's own resolution of it where the player knows
+    // the other side; otherwise into it). Never silent.
     ROS_WARN_STREAM_THROTTLE(
         5.0, "scene_player: the impact of '"
                  << heard[k]->body_a << "' and '" << heard[k]->body_b << "' at "
-                 << sinceStart(heard[k]->header.stamp)
-                 << " s came after that instant was played (the node answered more than a period "
-                    "of ~rate late): not applied, so those bodies go on without the node's answer "
-                    "(by the player's own, or under discrete detection inside each other)");
+                 << sinceStart(heard[k]->header.stamp) << " s came more than ~replay_window ("
+                 << params_.replay_window
+                 << " s) after that instant was played: not applied, so those bodies go on "
+                    "without the node's answer (by the player's own, or into what they met)");
   }
 }
 

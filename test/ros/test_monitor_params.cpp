@@ -127,7 +127,8 @@ TEST(ScenePlayerParams, EveryDocumentedParameterLoadsAndEveryReadOneIsDocumented
   const std::map<std::string, XmlRpc::XmlRpcValue> examples = {
       {"scene", minimalScene()},   {"rate", 50},
       {"duration", 2.5},           {"start_delay", 0.0},
-      {"contact_tolerance", 1e-7}, {"report_restitution", true}};
+      {"contact_tolerance", 1e-7}, {"report_restitution", true},
+      {"replay_window", 0.5}};
   XmlRpc::XmlRpcValue tree;
   for (const std::string& name : documented) {
     EXPECT_NE(std::find(read.begin(), read.end(), name), read.end())
@@ -311,6 +312,23 @@ TEST(ScenePlayerParams, ItsRateDurationAndStartDelayAreBoundedAsDurations) {
                                           ": 1e+10 s is longer than a ros::Duration can hold "
                                           "(2147483647 s)");
   }
+}
+
+// Issue 41, item 10: ~replay_window keeps one model of the scene per period: a duration >= 0 of
+// at most 1,000 periods of ~rate (the default, 0.25 s, shrinks to 1,000 periods above 4 kHz).
+TEST(ScenePlayerParams, ItsReplayWindowIsADurationOfAtMostAThousandPeriods) {
+  EXPECT_EQ(playerError("replay_window", 0.0), "");
+  EXPECT_EQ(playerError("replay_window", 10.0), "");  // 1,000 periods at the default 100 Hz
+  EXPECT_EQ(playerError("replay_window", 10.5),
+            "/scene_player/replay_window: 10.5 s at ~rate 100 Hz is 1050 periods: at most 1000");
+  EXPECT_EQ(playerError("replay_window", -1.0),
+            "/scene_player/replay_window: must be a finite number of seconds >= 0, got -1");
+  XmlRpc::XmlRpcValue tree;
+  tree["scene"] = minimalScene();
+  tree["rate"] = 1e6;
+  const auto fast = ScenePlayerParams::load(tree, "/scene_player");
+  ASSERT_TRUE(fast.ok());
+  EXPECT_EQ(fast->replay_window, 1e-3);
 }
 
 // The re-read of one key while the node runs (~diagnostic_period) is the start-up's reader:

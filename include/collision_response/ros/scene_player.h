@@ -8,6 +8,8 @@
 #include <tf2_ros/transform_broadcaster.h>
 
 #include <Eigen/Core>
+#include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -36,6 +38,9 @@ struct ScenePlayerParams {
   double start_delay = 1.0;         ///< s waited before the first state
   double contact_tolerance = 1e-9;  ///< as the node's: resting on a plane
   bool report_restitution = false;  ///< print e = sqrt(h'/h) of each first bounce
+  /// s: an impact heard up to this long after the newest period played is still applied, by
+  /// playing the scene again from its instant (core::Playback's replay window)
+  double replay_window = 0.25;
   std::vector<MovingFrame> frames;  ///< `~player/frames`
 
   /// Every private parameter the player reads (`scene` is loadScene's).
@@ -55,6 +60,12 @@ class ScenePlayer {
 
  private:
   void onTimer(const ros::TimerEvent& event);
+  /// Publishes the periods due by `now` (k / rate s after the start, each once, in order): up to
+  /// kMaxCatchUp late ones; further behind, the newest alone, the others counted as skipped and
+  /// said (a throttled warning with the figures).
+  void playPeriodsDue(const ros::Time& now);
+  /// The line that says what was played: periods, states published, periods skipped.
+  std::string playedSummary() const;
   void onImpacts(const ImpactArray::ConstPtr& message);
   void publishStates(const ros::Time& time);
   /// Publishes on `apexes` each flight's highest point once it is past; with
@@ -77,6 +88,19 @@ class ScenePlayer {
   ros::Subscriber impact_subscriber_;
   tf2_ros::TransformBroadcaster broadcaster_;
   ros::Timer timer_;
+  ros::WallTimer stop_timer_;     ///< the summary line goes out before the player stops
+  std::int64_t next_period_ = 0;  ///< the next period to publish: k / rate s from the start
+  std::int64_t published_ = 0;    ///< states published (one per period played)
+  std::int64_t skipped_ = 0;      ///< periods not published: the player fell behind
+  double last_period_cpu_ = 0.0;  ///< s of CPU the last period played took
+  bool stopping_ = false;
+  /// Bodies whose states were sent lacking an impact the player could not resolve itself (on a
+  /// tf-attached obstacle): id -> (the impact's instant, the last state's instant, from the
+  /// start, whose impacts came along those states). The node's later impacts of the body
+  /// revealed up to then are not applied.
+  std::map<std::string, std::pair<double, double>> unheard_;
+  std::int64_t stale_impacts_ = 0;  ///< impacts not applied for that reason
+  std::int64_t late_impacts_ = 0;   ///< impacts heard more than ~replay_window late
 };
 
 }  // namespace collision_response
