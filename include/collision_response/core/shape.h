@@ -76,4 +76,8 @@ struct PlacedShape {
   RigidPose pose;
 };
 
+/// m: the radius about a placed shape's pose origin of a sphere that holds the shape (a sphere's
+/// own radius, a box's half diagonal, ...); infinite for a plane.
+double boundingRadiusOf(const Shape& shape);
+
 }  // namespace collision_response::core

@@ -1,5 +1,7 @@
 #include "geometry/narrow_phase.h"
 
+#include <limits>
+
 #include "collision_response/core/time_of_impact.h"
 #include "collision_response/core/validation.h"
 #include "geometry/finite_shapes.h"
@@ -443,6 +445,25 @@ bool mayReach(const PlacedShape& placed, const Box& box) {
                                return bound.overlaps(box);
                              }},
                     placed.shape);
+}
+
+double boundingRadiusOf(const Shape& shape) {
+  return std::visit(Dispatch{[](const Plane&) { return std::numeric_limits<double>::infinity(); },
+                             [](const Sphere& sphere) { return sphere.radius; },
+                             [](const auto& finite) { return boundingRadius(finite); }},
+                    shape);
+}
+
+bool mayReachMoving(const PlacedShape& placed, const Box& box, double from, double to) {
+  const RigidPose& pose = placed.pose;
+  if (pose.velocity.isZero() && pose.angular_velocity.isZero()) return mayReach(placed, box);
+  if (std::holds_alternative<Plane>(placed.shape)) return true;
+  // The pose's origin is the shape's centre (a sphere's too) and moves at |v| (shapeAt).
+  const double reach =
+      boundingRadiusOf(placed.shape) +
+      pose.velocity.norm() * std::max(std::abs(from - pose.time), std::abs(to - pose.time));
+  const Eigen::Vector3d& centre = pose.transform.translation();
+  return Box{centre.array() - reach, centre.array() + reach}.overlaps(box);
 }
 
 double contactRadius(const Shape& shape) {

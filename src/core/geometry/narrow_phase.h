@@ -8,7 +8,8 @@
 //    surface's velocity at the point);
 //  - firstContact: the first contact along a ball's motion (time_of_impact.h's closed forms, and
 //    finite_shapes.h's certified roots for boxes, cylinders and capsules);
-//  - mayReach: whether a box may reach a fixed shape (the broad phase's test).
+//  - mayReach, mayReachMoving: whether a box may reach a fixed or a moving shape (the broad
+//    phase's test).
 #pragma once
 
 #include <Eigen/Core>
@@ -208,6 +209,12 @@ std::optional<double> firstContact(const BallMotion& ball, const PlacedShape& sh
 
 /// Whether a box may reach a fixed shape placed at `placed` (the broad phase's test).
 bool mayReach(const PlacedShape& placed, const Box& box);
+
+/// Whether a box may reach a shape moving straight on from `placed` (shapeAt) at some instant of
+/// [from, to]: at rest, mayReach; a sphere's or a finite shape's centre moves at the constant
+/// speed |v| of its pose's origin (a screw keeps it), so its bounding sphere grown by |v| times
+/// the longest time from the placement bounds it; a moving plane always may.
+bool mayReachMoving(const PlacedShape& placed, const Box& box, double from, double to);
 
 /// m: the size of a shape about its pose's origin that a ball's contact distance counts (a
 /// sphere's radius; 0 for a plane, whose distance is along its normal, and for a finite shape,

@@ -27,7 +27,9 @@ std::vector<std::size_t> addReachablePairs(World& world, std::size_t body, doubl
                                            std::vector<Pair>& pairs,
                                            const std::vector<std::vector<std::size_t>>& pairs_of);
 
-/// Whether a body's swept box may reach a (fixed) obstacle; moving obstacles always may.
-bool mayReachObstacle(const World& world, const Box& box, std::size_t obstacle);
+/// Whether a body's box swept over [from, to] may reach an obstacle: a fixed one where it is, a
+/// tf-attached one moving on from its placement (mayReachMoving).
+bool mayReachObstacle(const World& world, const Box& box, std::size_t obstacle, double from,
+                      double to);
 
 }  // namespace collision_response::core::monitor
