@@ -1,10 +1,15 @@
 #include "collision_response/ros/robot_obstacles.h"
 
+#include <tinyxml2.h>
 #include <urdf/model.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
 #include <map>
+#include <sstream>
 
 #include "collision_response/ros/mesh_resource.h"
 #include "collision_response/ros/parameters.h"
@@ -75,6 +80,62 @@ core::Expected<bool> toObstacle(const urdf::Collision& collision, const RobotLin
   return true;
 }
 
+/// The first word of `value` that is not a finite number, as urdfdom reads numbers (a `nan`, an
+/// `inf`, a `1e400` past the doubles, a `0.1x`); empty when there is none.
+std::string firstNonFinite(const char* value) {
+  std::istringstream words(value);
+  std::string word;
+  while (words >> word) {
+    errno = 0;
+    char* end = nullptr;
+    const double number = std::strtod(word.c_str(), &end);
+    if (end == word.c_str() || *end != '\0' || errno == ERANGE || !std::isfinite(number)) {
+      return word;
+    }
+  }
+  return "";
+}
+
+/// Why urdfdom left out a <collision> of link `name` (issue 41, item 7: it drops every
+/// <collision> of a link for one value it cannot read, with a log line only): the raw XML's
+/// <collision> elements of the link (`link`, read with tinyxml2 as urdf reads the XML) are held
+/// against `parsed`, urdfdom's; the first number it could not read is named. Empty when they agree.
+std::string droppedCollisions(const tinyxml2::XMLElement* link, const std::string& name,
+                              std::size_t parsed) {
+  if (link == nullptr) return "";
+  // The numbers of a <collision>: its origin's, its geometry's.
+  static const std::vector<std::pair<const char*, std::vector<const char*>>> kNumbers = {
+      {"origin", {"xyz", "rpy"}},         {"box", {"size"}},   {"sphere", {"radius"}},
+      {"cylinder", {"radius", "length"}}, {"mesh", {"scale"}},
+  };
+  std::size_t raw = 0;
+  for (const tinyxml2::XMLElement* collision = link->FirstChildElement("collision");
+       collision != nullptr; collision = collision->NextSiblingElement("collision"), ++raw) {
+    const tinyxml2::XMLElement* geometry = collision->FirstChildElement("geometry");
+    for (const auto& [tag, attributes] : kNumbers) {
+      const tinyxml2::XMLElement* element =
+          std::string(tag) == "origin"
+              ? collision->FirstChildElement(tag)
+              : (geometry != nullptr ? geometry->FirstChildElement(tag) : nullptr);
+      if (element == nullptr) continue;
+      for (const char* attribute : attributes) {
+        const char* value = element->Attribute(attribute);
+        if (value == nullptr) continue;
+        const std::string bad = firstNonFinite(value);
+        if (bad.empty()) continue;
+        return "link '" + name + "' <collision> " + std::to_string(raw) + ", <" + tag + "> " +
+               attribute + "=\"" + value + "\": '" + bad +
+               "' is not a finite number (urdfdom drops every <collision> of the link for it)";
+      }
+    }
+  }
+  if (raw != parsed) {
+    return "link '" + name + "' has " + std::to_string(raw) + " <collision> element(s), of which " +
+           "urdfdom read " + std::to_string(parsed) + " (its message is in the log above)";
+  }
+  return "";
+}
+
 }  // namespace
 
 core::Expected<std::vector<core::ObstacleSpec>> robotObstacles(const std::string& urdf,
@@ -87,6 +148,22 @@ core::Expected<std::vector<core::ObstacleSpec>> robotObstacles(const std::string
                        "the URDF in '" + robot.description +
                            "' does not parse (urdfdom's message is in the log above)"};
   }
+  // The raw XML, for what urdfdom dropped (droppedCollisions): urdfdom parsed it, so does
+  // tinyxml2.
+  tinyxml2::XMLDocument xml;
+  xml.Parse(urdf.c_str());
+  std::map<std::string, const tinyxml2::XMLElement*> links_xml;
+  const tinyxml2::XMLElement* robot_xml = xml.FirstChildElement("robot");
+  for (const tinyxml2::XMLElement* link = robot_xml ? robot_xml->FirstChildElement("link")
+                                                    : nullptr;
+       link != nullptr; link = link->NextSiblingElement("link")) {
+    if (const char* name = link->Attribute("name")) links_xml.emplace(name, link);
+  }
+  const auto dropped = [&](const std::string& name) {
+    const auto link = links_xml.find(name);
+    return droppedCollisions(link == links_xml.end() ? nullptr : link->second, name,
+                             model.links_.at(name)->collision_array.size());
+  };
   // In name order (the model's map), or as listed.
   std::vector<std::string> names;
   if (robot.all_links) {
@@ -104,6 +181,9 @@ core::Expected<std::vector<core::ObstacleSpec>> robotObstacles(const std::string
         }
         return core::Error{item, "the URDF has no link '" + name + "'; its links: " + known};
       }
+      if (const std::string why = dropped(name); !why.empty()) {
+        return core::Error{joinKey(field, "description"), why};
+      }
       if (found->second->collision_array.empty()) {
         return core::Error{item, "link '" + name + "' has no <collision>"};
       }
@@ -112,6 +192,9 @@ core::Expected<std::vector<core::ObstacleSpec>> robotObstacles(const std::string
   }
   std::vector<core::ObstacleSpec> obstacles;
   for (const std::string& name : names) {
+    if (const std::string why = dropped(name); !why.empty()) {
+      return core::Error{joinKey(field, "description"), why};
+    }
     const auto& collisions = model.links_.at(name)->collision_array;
     for (std::size_t i = 0; i < collisions.size(); ++i) {
       core::ObstacleSpec obstacle;

@@ -224,5 +224,55 @@ TEST(RobotObstacles, TheSceneKeyReadsTheUrdfItNames) {
   EXPECT_NE(clashed.error().message().find("upper_arm"), std::string::npos);
 }
 
+// Issue 41, item 7: urdfdom drops every <collision> of a link for one number it cannot read (a
+// `nan`, or `1e400` past the doubles: size, radius, origin, scale), with a log line only; the
+// link would be missing as an obstacle. Each is refused at start-up, naming the link, the
+// <collision>, the attribute and the word, whether the link is chosen by `all` or by name.
+TEST(RobotObstacles, Issue41_Item7_ACollisionUrdfdomCannotReadIsRefusedNamingTheLink) {
+  const std::vector<std::tuple<std::string, std::string, std::string>> cases = {
+      {"<box size=\"nan 0.1 0.1\"/>", "", "<box> size=\"nan 0.1 0.1\": 'nan'"},
+      {"<sphere radius=\"1e400\"/>", "", "<sphere> radius=\"1e400\": '1e400'"},
+      {"<cylinder radius=\"0.1\" length=\"inf\"/>", "", "<cylinder> length=\"inf\": 'inf'"},
+      {"<box size=\"0.1 0.1 0.1\"/>", "<origin xyz=\"0 nan 0\"/>",
+       "<origin> xyz=\"0 nan 0\": 'nan'"},
+      {"<box size=\"0.1 0.1 0.1\"/>", "<origin rpy=\"1e400 0 0\"/>",
+       "<origin> rpy=\"1e400 0 0\": '1e400'"},
+      {"<mesh filename=\"" + meshFile("grip.stl") + "\" scale=\"nan 1 1\"/>", "",
+       "<mesh> scale=\"nan 1 1\": 'nan'"},
+  };
+  for (const auto& [geometry, origin, named] : cases) {
+    const std::string urdf =
+        "<robot name=\"r\"><link name=\"base\"/><link name=\"paddle\">"
+        "<collision><geometry><sphere radius=\"0.1\"/></geometry></collision><collision>" +
+        origin + "<geometry>" + geometry +
+        "</geometry></collision></link><joint name=\"j\" type=\"fixed\"><parent "
+        "link=\"base\"/><child link=\"paddle\"/></joint></robot>";
+    for (const bool all : {true, false}) {
+      RobotLinks robot;
+      robot.material = "concrete";
+      robot.all_links = all;
+      if (!all) robot.links = {"paddle"};
+      std::vector<std::string> warnings;
+      const auto result = robotObstacles(urdf, robot, "~scene/robot", warnings);
+      ASSERT_FALSE(result.ok()) << geometry << origin;
+      EXPECT_EQ(result.error().field, "~scene/robot/description");
+      EXPECT_EQ(result.error().reason, "link 'paddle' <collision> 1, " + named +
+                                           " is not a finite number (urdfdom drops every "
+                                           "<collision> of the link for it)");
+    }
+  }
+  // A <collision> urdfdom drops for another reason (no <geometry>): the count tells.
+  RobotLinks robot;
+  robot.material = "concrete";
+  std::vector<std::string> warnings;
+  const auto result = robotObstacles(
+      "<robot name=\"r\"><link name=\"paddle\"><collision><geometry><sphere radius=\"0.1\"/>"
+      "</geometry></collision><collision/></link></robot>",
+      robot, "~scene/robot", warnings);
+  ASSERT_FALSE(result.ok());
+  EXPECT_EQ(result.error().reason,
+            "link 'paddle' has 2 <collision> element(s), of which urdfdom read 1 (its message is "
+            "in the log above)");
+}
 }  // namespace
 }  // namespace collision_response
