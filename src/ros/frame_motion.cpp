@@ -3,12 +3,23 @@
 #include <tf2/exceptions.h>
 #include <tf2_eigen/tf2_eigen.h>
 
+#include <algorithm>
+
 namespace collision_response {
 
 Eigen::Vector3d FrameMotion::velocity(const Eigen::Vector3d& in_frame,
                                       const Eigen::Vector3d& velocity_in_frame) const {
   const Eigen::Vector3d offset = pose.linear() * in_frame;
   return pose.linear() * velocity_in_frame + linear_velocity + angular_velocity.cross(offset);
+}
+
+std::string tfErrorText(const std::string& what) {
+  constexpr std::size_t kMaxLength = 300;
+  const std::size_t end = what.find_last_not_of(" \n");
+  const std::string whole = end == std::string::npos ? "" : what.substr(0, end + 1);
+  std::string text = whole.substr(0, std::min(whole.find('\n'), kMaxLength));
+  if (text.size() < whole.size()) text += " ... (tf's text cut here)";
+  return text;
 }
 
 namespace {
@@ -59,7 +70,7 @@ core::Expected<FrameMotion> lookupFrameMotion(const tf2::BufferCore& buffer,
     return motion;
   } catch (const tf2::TransformException& error) {
     return core::Error{frame, "no transform to '" + fixed_frame + "' at " +
-                                  std::to_string(stamp.toSec()) + ": " + error.what()};
+                                  std::to_string(stamp.toSec()) + ": " + tfErrorText(error.what())};
   }
 }
 

@@ -1,5 +1,7 @@
 #include "collision_response/ros/monitor_cycle.h"
 
+#include <tf2/exceptions.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -115,12 +117,20 @@ MonitorCycle::MonitorCycle(const core::Scene& scene, const MonitorParams& params
     : params_(params),
       monitor_(scene, core::MonitorSettings{params.contact_tolerance, params.body_timeout}),
       intake_(bodyIds(monitor_), intakeSettings(scene, params)),
-      time_line_(params.clock_jump_back) {}
+      time_line_(params.clock_jump_back) {
+  frame_jumped_.assign(monitor_.obstacleCount(), 0);
+  frame_kind_.reserve(monitor_.obstacleCount());
+  for (std::size_t i = 0; i < monitor_.obstacleCount(); ++i) {
+    frame_kind_.push_back(monitor_.obstacle(i).frame.empty() ? FrameKind::kFixed
+                                                             : FrameKind::kUnknown);
+  }
+}
 
 MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& clock,
                                            bool may_wait, const tf2::BufferCore& tf) {
   Update update;
   samples_.clear();
+  obstacle_work_ = {};
   if (intake_.convert(*input.states, input.own_body, clock, may_wait, tf, samples_,
                       update.reports) == StateIntake::Outcome::kWait) {
     update.waiting = true;
@@ -170,8 +180,11 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
 
 bool MonitorCycle::obstacleFrameMissing() const {
   // The tf-attached obstacles must be known up to the newest stamp as well.
-  return std::any_of(obstacle_motions_.begin(), obstacle_motions_.end(),
-                     [](const auto& motion) { return motion && !*motion; });
+  for (std::size_t i = 0; i < obstacle_motions_.size(); ++i) {
+    const ObstacleMotion& motion = obstacle_motions_[i];
+    if (motion && !*motion && !frame_jumped_[i]) return true;
+  }
+  return false;
 }
 
 namespace {
@@ -437,64 +450,257 @@ void MonitorCycle::stepMovingObstacles(const TimeLine::Placed& placed, const ros
                                        std::vector<core::ImpactRecord>& impacts, Update& update) {
   const double period = params_.obstacle_update_period;
   if (!(period > 0) || !monitor_.started()) return;
-  const std::vector<core::ObstacleSpec>& obstacles = monitor_.scene().obstacles;
-  const bool moving = std::any_of(obstacles.begin(), obstacles.end(),
-                                  [](const core::ObstacleSpec& o) { return !o.frame.empty(); });
-  if (!moving) return;
-  // Up to the update's first state (the monitor takes states in time order), at most 1,000
-  // placements an update.
+  // Up to the update's first state (the monitor takes states in time order).
   double until = placed.time;
   for (const core::BodyStateSample& sample : samples_.samples) until = std::min(until, sample.time);
   const double from = monitor_.now();
   const double span = until - from;
   if (!(span > period)) return;
-  const int count = static_cast<int>(std::min(std::ceil(span / period), 1000.0));
+  // Only the obstacles that may reach a body are placed again within the update: a robot's far
+  // links cost nothing here, and the placements are bounded (kMaxPlacements).
+  findNearObstacles(from, until, placed.time);
+  if (near_obstacles_.empty()) return;
+  // Sub-steps, the last at `until` (10 ms of 1 ms periods are 10, whatever the rounding).
+  const double wanted = std::ceil(span / period - 1e-9);
+  const std::size_t near = near_obstacles_.size();
+  const double affordable =
+      std::floor(static_cast<double>(kMaxPlacements) / static_cast<double>(near)) + 1;
+  const int count = static_cast<int>(std::max(1.0, std::min(wanted, affordable)));
+  obstacle_work_.near = near;
+  if (count < wanted) {
+    const auto left_out = static_cast<std::size_t>(wanted - count) * near;
+    std::string names;
+    for (std::size_t k = 0; k < near && k < 4; ++k) {
+      names += (k ? ", '" : "'") + monitor_.obstacle(near_obstacles_[k]).id + "'";
+    }
+    if (near > 4) names += " and " + std::to_string(near - 4) + " more";
+    update.reports.push_back(
+        {Reason::kObstaclePlacementsLeftOut,
+         "placed the " + std::to_string(near) + " tf-attached obstacle(s) that may reach a body (" +
+             names + ") every " + core::formatNumber(span / count) + " s over this update's " +
+             core::formatNumber(span) + " s instead of every ~obstacle_update_period (" +
+             core::formatNumber(period) + " s): at most " + std::to_string(kMaxPlacements) +
+             " placements an update; " + std::to_string(left_out) +
+             " left out (the obstacles moved straight on between the placements made)",
+         left_out});
+  }
   for (int k = 1; k < count; ++k) {
     const double time = from + span * k / count;
     const ros::Time stamp = newest - ros::Duration(placed.time - time);
-    lookUpObstacles(stamp, tf, between_motions_);
-    placeObstacles(between_motions_, time, update);
+    between_motions_.resize(monitor_.obstacleCount());
+    explain_missing_ = true;
+    for (const std::size_t i : near_obstacles_) lookUpObstacle(i, stamp, tf, between_motions_[i]);
+    placeObstacles(between_motions_, time, update, &near_obstacles_);
     const core::StepReport step = monitor_.step(time, {});
     reportStep(step, update);
     impacts.insert(impacts.end(), step.impacts.begin(), step.impacts.end());
   }
 }
 
-void MonitorCycle::lookUpObstacles(const ros::Time& stamp, const tf2::BufferCore& tf,
-                                   std::vector<ObstacleMotion>& motions) const {
-  motions.clear();
-  for (std::size_t i = 0; i < monitor_.obstacleCount(); ++i) {
-    const core::ObstacleSpec& spec = monitor_.obstacle(i);
-    if (spec.frame.empty()) {
-      motions.emplace_back();
+void MonitorCycle::findNearObstacles(double from, double until, double end) {
+  // Bounding spheres, swept. An obstacle's centre goes from c0 (its last placement, at t0,
+  // moving at v0) to c1 (its frame's lookup at the update's end, moving at v1): along a path
+  // no faster than max(|v0|, |v1|) it stays within that speed times (end - t0) of c1, and along
+  // an arc no longer than a half circle within |c1 - c0| of c1 (a half circle's points are
+  // nearer either end than its chord); the larger of the two, plus the shape's bounding radius.
+  // A tracked body moves from p (its predicted position at `from`) at no more than its speed,
+  // what gravity adds (|g| span^2 / 2) and what a moving obstacle's strike can add (twice the
+  // fastest obstacle surface's speed): within that distance of p, plus its radius.
+  near_obstacles_.clear();
+  struct Sphere {
+    Eigen::Vector3d centre;
+    double radius;
+  };
+  std::vector<Sphere> links;
+  std::vector<std::size_t> indices;
+  double fastest = 0.0;  // m/s: the fastest surface point of a moving obstacle
+  for (std::size_t i = 0; i < frame_kind_.size(); ++i) {
+    if (frame_kind_[i] != FrameKind::kMoving) continue;
+    const ObstacleMotion& end_motion = obstacle_motions_[i];
+    if (!end_motion || !*end_motion) continue;  // its frame is missing: not looked up again
+    const std::optional<core::PlacedShape> last = monitor_.obstaclePose(i);
+    if (!last) {  // not placed yet: where it is within the update is not known
+      near_obstacles_.push_back(i);
       continue;
     }
-    motions.emplace_back(lookupFrameMotion(tf, monitor_.scene().fixed_frame, spec.frame, stamp,
-                                           ros::Duration(params_.frame_velocity_interval)));
+    const double reach = core::boundingRadiusOf(last->shape);
+    const FrameMotion& motion = end_motion->value();
+    const Eigen::Vector3d& offset = monitor_.obstacle(i).position;  // its centre in its frame
+    const Eigen::Vector3d c1 = motion.point(offset);
+    const double v1 = motion.velocity(offset, Eigen::Vector3d::Zero()).norm();
+    const Eigen::Vector3d& c0 = last->pose.transform.translation();
+    const double v0 = last->pose.velocity.norm();
+    const double speed = std::max(v0, v1);
+    const double turning =
+        std::max(last->pose.angular_velocity.norm(), motion.angular_velocity.norm());
+    if (!std::isfinite(reach)) {  // a plane on a frame: always near
+      near_obstacles_.push_back(i);
+      continue;
+    }
+    fastest = std::max(fastest, speed + turning * reach);
+    links.push_back({c1, std::max((c1 - c0).norm(), speed * (end - last->pose.time)) + reach});
+    indices.push_back(i);
+  }
+  if (links.empty()) return;
+  const double span = until - from;
+  const double gravity = monitor_.scene().effects.gravity ? monitor_.scene().gravity.norm() : 0.0;
+  std::vector<Sphere> bodies;
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d high = -low;
+  for (std::size_t b = 0; b < monitor_.bodyCount(); ++b) {
+    const auto state = monitor_.predictedState(b, from);
+    if (!state) continue;
+    const double reach = monitor_.body(b).radius + (state->second.norm() + 2 * fastest) * span +
+                         0.5 * gravity * span * span;
+    bodies.push_back({state->first, reach});
+    low = low.cwiseMin((state->first.array() - reach).matrix());
+    high = high.cwiseMax((state->first.array() + reach).matrix());
+  }
+  for (std::size_t k = 0; k < links.size(); ++k) {
+    const Sphere& link = links[k];
+    // The bodies' common box first: a robot's links far from every body cost one test each.
+    if ((link.centre.array() + link.radius < low.array()).any() ||
+        (link.centre.array() - link.radius > high.array()).any()) {
+      continue;
+    }
+    for (const Sphere& body : bodies) {
+      if ((link.centre - body.centre).norm() <= link.radius + body.radius) {
+        near_obstacles_.push_back(indices[k]);
+        break;
+      }
+    }
+  }
+  std::sort(near_obstacles_.begin(), near_obstacles_.end());
+}
+
+void MonitorCycle::lookUpObstacle(std::size_t i, const ros::Time& stamp, const tf2::BufferCore& tf,
+                                  ObstacleMotion& motion) {
+  const std::string& fixed = monitor_.scene().fixed_frame;
+  const std::string& frame = monitor_.obstacle(i).frame;
+  ++obstacle_work_.lookups;
+  // A frame tf does not have is told without an exception and, but for the first of a pass (the
+  // one a report names), without tf's text (2,000 missing links an update; a chain deeper than
+  // tf walks lists every frame in it).
+  if (frame != fixed && !tf.canTransform(fixed, frame, stamp)) {
+    std::string why = "not available";
+    if (explain_missing_) {
+      tf.canTransform(fixed, frame, stamp, &why);
+      explain_missing_ = false;
+    }
+    motion = core::Expected<FrameMotion>(core::Error{frame, "no transform to '" + fixed + "' at " +
+                                                                std::to_string(stamp.toSec()) +
+                                                                ": " + tfErrorText(why)});
+    return;
+  }
+  motion =
+      lookupFrameMotion(tf, fixed, frame, stamp, ros::Duration(params_.frame_velocity_interval));
+  frame_jumped_[i] = 0;
+  if (*motion) {
+    // Its surface's speed: its centre's, and its turning's at its bounding radius (once placed).
+    const FrameMotion& found = motion->value();
+    const std::optional<core::PlacedShape> last = monitor_.obstaclePose(i);
+    const double reach = last ? core::boundingRadiusOf(last->shape) : 0.0;
+    const double turning = found.angular_velocity.norm();
+    const double speed =
+        found.velocity(monitor_.obstacle(i).position, Eigen::Vector3d::Zero()).norm() +
+        (turning > 0 ? turning * reach : 0.0);
+    if (!(speed <= kMaxFrameSpeed)) {
+      frame_jumped_[i] = 1;
+      motion = core::Expected<FrameMotion>(core::Error{
+          frame, "moves at " + core::formatNumber(speed) + " m/s at " +
+                     std::to_string(stamp.toSec()) + " (tf's backward difference over " +
+                     core::formatNumber(params_.frame_velocity_interval) + " s), faster than " +
+                     core::formatNumber(kMaxFrameSpeed) +
+                     " m/s: a jump between its tf samples, which no body could follow"});
+      return;
+    }
+  }
+  if (frame_kind_[i] != FrameKind::kUnknown || !*motion) return;
+  // Wholly on /tf_static: tf stamps its latest transform zero (no time in the chain).
+  try {
+    frame_kind_[i] = tf.lookupTransform(fixed, frame, ros::Time(0)).header.stamp.isZero()
+                         ? FrameKind::kStatic
+                         : FrameKind::kMoving;
+  } catch (const tf2::TransformException&) {
+    frame_kind_[i] = FrameKind::kMoving;
+  }
+}
+
+void MonitorCycle::lookUpObstacles(const ros::Time& stamp, const tf2::BufferCore& tf,
+                                   std::vector<ObstacleMotion>& motions) {
+  motions.resize(monitor_.obstacleCount());
+  explain_missing_ = true;
+  std::size_t rechecks = 0;
+  for (std::size_t i = 0; i < monitor_.obstacleCount(); ++i) {
+    if (frame_kind_[i] == FrameKind::kFixed) {
+      motions[i].reset();
+      continue;
+    }
+    // A static frame known and placed stays where it is; a few are looked up again in turn
+    // (a static transform published anew), below.
+    if (frame_kind_[i] == FrameKind::kStatic && motions[i] && *motions[i] &&
+        placed_obstacles_.count(i) != 0) {
+      continue;
+    }
+    lookUpObstacle(i, stamp, tf, motions[i]);
+  }
+  for (std::size_t n = 0; n < frame_kind_.size() && rechecks < kStaticRechecks; ++n) {
+    const std::size_t i = next_recheck_++ % frame_kind_.size();
+    if (frame_kind_[i] != FrameKind::kStatic || placed_obstacles_.count(i) == 0 || !motions[i] ||
+        !*motions[i]) {
+      continue;
+    }
+    ++rechecks;
+    const Eigen::Isometry3d was = (*motions[i])->pose;
+    lookUpObstacle(i, stamp, tf, motions[i]);
+    if (!*motions[i] || !(*motions[i])->pose.isApprox(was, 0.0)) placed_obstacles_.erase(i);
   }
 }
 
 void MonitorCycle::placeObstacles(const std::vector<ObstacleMotion>& motions, double time,
-                                  Update& update) {
-  for (std::size_t i = 0; i < motions.size(); ++i) {
+                                  Update& update, const std::vector<std::size_t>* which) {
+  // The frames missing, said in one report each for those placed before (warned) and those
+  // never placed (counted only: tf has no history yet for their velocity).
+  constexpr std::size_t kNamed = 4;
+  struct Missing {
+    std::size_t count = 0;
+    std::string names, first_error;
+  } missing[3];  // never placed, placed before, jumped
+  const std::size_t n = which ? which->size() : motions.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t i = which ? (*which)[k] : k;
     if (!motions[i]) continue;  // a fixed obstacle
     const core::Expected<FrameMotion>& motion = *motions[i];
     if (!motion) {
-      // Before its first placement, tf has no history yet for its velocity: counted only.
-      Report item{Reason::kObstacleTransform,
-                  "obstacle '" + monitor_.obstacle(i).id +
-                      "' keeps its last known motion: " + motion.error().message()};
-      item.warn = placed_obstacles_.count(i) != 0;
-      update.reports.push_back(std::move(item));
+      Missing& m = missing[frame_jumped_[i] ? 2 : placed_obstacles_.count(i) != 0 ? 1 : 0];
+      if (m.count < kNamed) m.names += (m.count ? ", '" : "'") + monitor_.obstacle(i).id + "'";
+      if (m.count == 0) m.first_error = motion.error().message();
+      ++m.count;
       continue;
     }
+    if (frame_kind_[i] == FrameKind::kStatic && !placed_obstacles_.insert(i).second) continue;
     placed_obstacles_.insert(i);
+    ++obstacle_work_.placements;
     core::RigidPose frame;  // the core places the obstacle's shape on it
     frame.time = time;
     frame.transform = motion->pose;
     frame.velocity = motion->linear_velocity;
     frame.angular_velocity = motion->angular_velocity;
     monitor_.setObstaclePose(i, frame);
+  }
+  for (int kind = 0; kind < 3; ++kind) {
+    const Missing& m = missing[kind];
+    if (m.count == 0) continue;
+    const std::string more =
+        m.count > kNamed ? " and " + std::to_string(m.count - kNamed) + " more" : "";
+    Report item{kind == 2 ? Reason::kFrameJumped : Reason::kObstacleTransform,
+                (m.count == 1 ? "obstacle " + m.names + " keeps its last known motion: "
+                              : "obstacles " + m.names + more + " keep their last known motion; " +
+                                    "the first's: ") +
+                    m.first_error,
+                m.count};
+    item.warn = kind != 0;
+    update.reports.push_back(std::move(item));
   }
 }
 

@@ -26,6 +26,7 @@ MonitorFigures MonitorFigures::of(const MonitorCycle& cycle) {
   figures.bodies = cycle.monitor().bodyCount();
   figures.tracked = cycle.monitor().trackedBodies();
   figures.stepped = cycle.steppedBodies();
+  figures.obstacle_work = cycle.obstacleWork();
   figures.sources = cycle.timeLine().sources();
   return figures;
 }
@@ -85,6 +86,9 @@ void MonitorDiagnostics::report(diagnostic_updater::DiagnosticStatusWrapper& sta
   status.add("states used (total)", states_used_);
   status.add("transforms missing (states dropped, total)", total(Reason::kTransformMissing));
   status.add("obstacle transforms missing (total)", total(Reason::kObstacleTransform));
+  status.add("obstacle frames looked up, last update", figures.obstacle_work.lookups);
+  status.add("obstacle placements, last update", figures.obstacle_work.placements);
+  status.add("obstacles placed again within the last update", figures.obstacle_work.near);
   // By source (at most TimeLine::kMaxSources): the clocks that are not the node's, and the
   // stamps dropped off its clock.
   for (const auto& [source, clocks] : figures.sources) {

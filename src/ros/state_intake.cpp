@@ -106,6 +106,10 @@ const char* counterName(Reason reason) {
       return "flights through air stalled";
     case Reason::kPredictionCutShort:
       return "predictions cut short";
+    case Reason::kObstaclePlacementsLeftOut:
+      return "obstacle placements left out";
+    case Reason::kFrameJumped:
+      return "frames jumped";
   }
   return "unknown";
 }

@@ -1196,5 +1196,314 @@ TEST_F(Cycle, EveryReasonHasItsOwnCounter) {
   EXPECT_FALSE(isDrop(Reason::kClockJumpedBack));
 }
 
+// Issue 41, item 3: a robot of any size. Ball 'a' (radius 0.1 m, e = 0.5) at x = t moving
+// +1 m/s towards the fixed wall x = 1 (normal -x): it touches at x = 0.9, t = 0.9 s, and leaves
+// at -e v = -0.5 m/s (impulse (1 + e) m v = 1.5 N s); its source applies the bounce, so it sends
+// x = 0.9 - 0.5 (t - 0.9) after. Beside it a robot of `links` spheres of radius 0.05 m on frames
+// link_0000, ..., 9 m and more away: on /tf_static each at its place, or as a chain (each frame
+// 0.2 m along x from its parent), or not on tf at all.
+core::Scene ballWallAndRobotScene(int links) {
+  core::Scene scene = twoBallScene();
+  core::ObstacleSpec wall;
+  wall.id = "wall";
+  wall.material = "test_half";
+  wall.normal = -Eigen::Vector3d::UnitX();
+  wall.offset = -1.0;
+  scene.obstacles.push_back(wall);
+  for (int i = 0; i < links; ++i) {
+    core::ObstacleSpec link;
+    link.shape = core::ObstacleShape::kSphere;
+    link.radius = 0.05;
+    link.material = "test_half";
+    link.frame = "link_" + std::to_string(10000 + i).substr(1);
+    link.id = link.frame;
+    scene.obstacles.push_back(link);
+  }
+  return scene;
+}
+
+class RobotCycle : public Cycle {
+ protected:
+  static constexpr int kLinks = 2000;
+  RobotCycle() : Cycle(ballWallAndRobotScene(kLinks)) {}
+
+  enum class Links { kStatic, kChain, kMissing };
+  void publishLinks(Links links) {
+    for (int i = 0; i < kLinks && links != Links::kMissing; ++i) {
+      geometry_msgs::TransformStamped frame;
+      const bool chain = links == Links::kChain && i > 0;
+      frame.header.frame_id = chain ? "link_" + std::to_string(10000 + i - 1).substr(1) : "world";
+      frame.child_frame_id = "link_" + std::to_string(10000 + i).substr(1);
+      frame.transform.translation.x = chain ? 0.2 : 10.0 + 0.2 * (i % 50);
+      frame.transform.translation.y = links == Links::kChain ? 0.0 : 0.2 * (i / 50);
+      frame.transform.rotation.w = 1.0;
+      tf_.setTransform(frame, "test", /*is_static=*/true);
+    }
+  }
+
+  /// The ball's 1.5 s at 100 Hz; each update's obstacle work into work_.
+  void playBallOnWall() {
+    for (int k = 0; k <= 150; ++k) {
+      const double t = 0.01 * k;
+      const bool after = t > 0.9;
+      const double x = after ? 0.9 - 0.5 * (t - 0.9) : t;
+      send({state("a", at(clock_, t), {x, 0, 0}, {after ? -0.5 : 1.0, 0, 0})});
+      work_.push_back(cycle_.obstacleWork());
+    }
+  }
+
+  void expectTheBounceOnce() const {
+    ASSERT_EQ(impacts_.size(), 1u);
+    const Impact& impact = impacts_[0];
+    EXPECT_EQ(impact.body_b, "wall");
+    EXPECT_NEAR((impact.header.stamp - clock_).toSec(), 0.9, 1e-9);
+    EXPECT_NEAR(impact.contact_point.x, 1.0, 1e-9);
+    EXPECT_NEAR(impact.velocity_a_after.linear.x, -0.5, 1e-9);
+    EXPECT_NEAR(impact.impulse, 1.5, 1e-9);
+  }
+
+  std::vector<MonitorCycle::ObstacleWork> work_;
+};
+
+TEST_F(RobotCycle, Issue41_Item3_TwoThousandStaticLinksAreLookedUpOnceAndCostNothingAfter) {
+  publishLinks(Links::kStatic);
+  playBallOnWall();
+  expectTheBounceOnce();
+  EXPECT_EQ(reportsOf(Reason::kObstacleTransform), 0u);
+  // The first update looks every link up and places it; from then on a static link is where it
+  // was: a few are looked up again in turn, none placed again.
+  ASSERT_EQ(work_.size(), 151u);
+  EXPECT_EQ(work_[0].lookups, static_cast<std::size_t>(kLinks));
+  EXPECT_EQ(work_[0].placements, static_cast<std::size_t>(kLinks));
+  for (std::size_t k = 1; k < work_.size(); ++k) {
+    EXPECT_LE(work_[k].lookups, MonitorCycle::kStaticRechecks) << "update " << k;
+    EXPECT_EQ(work_[k].placements, 0u) << "update " << k;
+  }
+}
+
+// As a chain 2,000 deep: tf2 walks at most tf2::BufferCore::MAX_GRAPH_DEPTH (1,000) frames and
+// takes a deeper chain for a loop, its text listing every frame (2,000 of them, in each of the
+// 1,000 failures of each lookup pass: the 1.1 GB of issue 41). The links within 1,000 frames are
+// looked up once; the rest are said once an update, tf's text cut to its first line.
+TEST_F(RobotCycle, Issue41_Item3_AChainTwoThousandDeepIsLookedUpOnceAsFarAsTfWalks) {
+  publishLinks(Links::kChain);
+  playBallOnWall();
+  expectTheBounceOnce();
+  std::size_t reports = 0;
+  for (const Report& report : reports_) {
+    if (report.reason != Reason::kObstacleTransform) continue;
+    ++reports;
+    EXPECT_EQ(report.count, 1000u);
+    EXPECT_LT(report.text.size(), 600u) << report.text;
+    EXPECT_NE(report.text.find("(tf's text cut here)"), std::string::npos) << report.text;
+  }
+  EXPECT_EQ(reports, work_.size());
+  EXPECT_EQ(work_[0].placements, 1000u);
+  for (std::size_t k = 1; k < work_.size(); ++k) {
+    EXPECT_LE(work_[k].lookups, 1000u + MonitorCycle::kStaticRechecks) << "update " << k;
+    EXPECT_EQ(work_[k].placements, 0u) << "update " << k;
+  }
+}
+
+TEST_F(RobotCycle, Issue41_Item3_TwoThousandMissingLinksAreOneReportAnUpdate) {
+  publishLinks(Links::kMissing);
+  playBallOnWall();
+  expectTheBounceOnce();
+  // Each update says once that the links keep their last known motion (never placed: counted,
+  // not warned), counting every link, and looks each up once.
+  std::size_t reports = 0;
+  for (const Report& report : reports_) {
+    if (report.reason != Reason::kObstacleTransform) continue;
+    ++reports;
+    EXPECT_EQ(report.count, static_cast<std::size_t>(kLinks));
+    EXPECT_FALSE(report.warn);
+    EXPECT_EQ(report.text.find("obstacles 'link_0000', 'link_0001', 'link_0002', 'link_0003' and "
+                               "1996 more keep their last known motion; the first's: "
+                               "link_0000: no transform to 'world'"),
+              0u)
+        << report.text;
+  }
+  EXPECT_EQ(reports, work_.size());
+  for (std::size_t k = 0; k < work_.size(); ++k) {
+    EXPECT_EQ(work_[k].lookups, static_cast<std::size_t>(kLinks)) << "update " << k;
+    EXPECT_EQ(work_[k].placements, 0u) << "update " << k;
+  }
+}
+
+// Moving links on /tf: `far` spheres (radius 0.05 m) at x >= 10 m moving +1 m/s along y, and a
+// `paddle` sphere (radius 0.1 m) at x = 2.06 - t moving -1 m/s towards ball 'a' at x = t: they
+// touch when 2.06 - 2 t = 0.2, t = 0.93 s; against the immovable paddle the ball leaves at
+// v_p - e (v_a - v_p) = -1 - 0.5 (1 + 1) = -2 m/s, impulse m (1 + 2) = 3 N s.
+core::Scene ballAndMovingRobotScene(int far) {
+  core::Scene scene = twoBallScene();
+  for (int i = 0; i <= far; ++i) {
+    core::ObstacleSpec link;
+    link.shape = core::ObstacleShape::kSphere;
+    link.radius = i == far ? 0.1 : 0.05;
+    link.material = "test_half";
+    link.frame = i == far ? "paddle" : "link_" + std::to_string(10000 + i).substr(1);
+    link.id = link.frame;
+    scene.obstacles.push_back(link);
+  }
+  return scene;
+}
+
+class MovingRobotCycle : public Cycle {
+ protected:
+  static constexpr int kFar = 200;
+  MovingRobotCycle() : Cycle(ballAndMovingRobotScene(kFar)) {
+    // tf from 0.1 s before the clock (the frames' velocities look 0.02 s back) to 1.5 s after.
+    for (int k = -10; k <= 150; ++k) {
+      const double t = 0.01 * k;
+      for (int i = 0; i <= kFar; ++i) {
+        geometry_msgs::TransformStamped frame;
+        frame.header.stamp = at(clock_, t);
+        frame.header.frame_id = "world";
+        frame.child_frame_id = i == kFar ? "paddle" : "link_" + std::to_string(10000 + i).substr(1);
+        frame.transform.translation.x = i == kFar ? 2.06 - t : 10.0 + 0.2 * i;
+        frame.transform.translation.y = i == kFar ? 0.0 : t;
+        frame.transform.rotation.w = 1.0;
+        tf_.setTransform(frame, "test", /*is_static=*/false);
+      }
+    }
+  }
+};
+
+TEST_F(MovingRobotCycle, Issue41_Item3_FarMovingLinksArePlacedOnceAnUpdateTheNearOneEveryPeriod) {
+  for (int k = 0; k <= 100; ++k) {
+    const double t = 0.01 * k;
+    const bool after = t > 0.93;
+    const double x = after ? 0.93 - 2.0 * (t - 0.93) : t;
+    send({state("a", at(clock_, t), {x, 0, 0}, {after ? -2.0 : 1.0, 0, 0})});
+    const MonitorCycle::ObstacleWork& work = cycle_.obstacleWork();
+    // Every link once at the update's end; the paddle, once near the ball, at each of the
+    // update's 10 periods of 1 ms.
+    EXPECT_LE(work.near, 1u) << "update " << k;
+    EXPECT_EQ(work.lookups, kFar + 1 + 9 * work.near) << "update " << k;
+    EXPECT_EQ(work.placements, work.lookups) << "update " << k;
+    if (k == 93) {
+      EXPECT_EQ(work.near, 1u) << "the update of the impact";
+    }
+    if (k < 50) {
+      EXPECT_EQ(work.near, 0u) << "update " << k << ": the paddle is 1 m away";
+    }
+  }
+  EXPECT_EQ(reportsOf(Reason::kObstacleTransform), 0u);
+  ASSERT_EQ(impacts_.size(), 1u);
+  const Impact& impact = impacts_[0];
+  EXPECT_EQ(impact.body_b, "paddle");
+  EXPECT_NEAR((impact.header.stamp - clock_).toSec(), 0.93, 1e-9);
+  EXPECT_NEAR(impact.velocity_a_after.linear.x, -2.0, 1e-9);
+  EXPECT_NEAR(impact.impulse, 3.0, 1e-9);
+}
+
+// Two spheres (radius 0.1 m) on frames near ball 'a' at rest at the origin, and an update 1 s
+// long (the ball's states 1 s apart): the spheres pass it at y = +-0.25 m moving +0.1 m/s along
+// x (never touching: 0.25 > 0.2), so both may reach it. 1,000 periods of 1 ms, two obstacles to
+// place again at each of the 999 within: 1,998 placements; the bound allows 1,000, so 500
+// instants 1/501 s apart (1,000 placements, and 2 at the end), and counts the 998 left out.
+core::Scene ballBetweenTwoMovingSpheresScene() {
+  core::Scene scene = twoBallScene();
+  for (const char* id : {"left", "right"}) {
+    core::ObstacleSpec sphere;
+    sphere.shape = core::ObstacleShape::kSphere;
+    sphere.radius = 0.1;
+    sphere.material = "test_half";
+    sphere.frame = id;
+    sphere.id = id;
+    scene.obstacles.push_back(sphere);
+  }
+  return scene;
+}
+
+class LateUpdateCycle : public Cycle {
+ protected:
+  LateUpdateCycle() : Cycle(ballBetweenTwoMovingSpheresScene()) {}
+};
+
+TEST_F(LateUpdateCycle, Issue41_Item3_ALateUpdatesPlacementsAreBoundedAndWhatIsLeftOutCounted) {
+  for (int k = -10; k <= 110; ++k) {
+    for (const char* id : {"left", "right"}) {
+      geometry_msgs::TransformStamped frame;
+      frame.header.stamp = at(clock_, 0.01 * k);
+      frame.header.frame_id = "world";
+      frame.child_frame_id = id;
+      frame.transform.translation.x = 0.001 * k;
+      frame.transform.translation.y = id[0] == 'l' ? 0.25 : -0.25;
+      frame.transform.rotation.w = 1.0;
+      tf_.setTransform(frame, "test", /*is_static=*/false);
+    }
+  }
+  send({state("a", clock_, {0, 0, 0}, {0, 0, 0})});
+  send({state("a", at(clock_, 1.0), {0, 0, 0}, {0, 0, 0})});
+  const MonitorCycle::ObstacleWork& work = cycle_.obstacleWork();
+  EXPECT_EQ(work.near, 2u);
+  EXPECT_EQ(work.placements, 2u + 2u * 500u);
+  EXPECT_LE(work.placements, MonitorCycle::kMaxPlacements + 2u);
+  EXPECT_EQ(reportsOf(Reason::kObstaclePlacementsLeftOut), 998u);
+  const Report* report = firstReport(Reason::kObstaclePlacementsLeftOut);
+  ASSERT_NE(report, nullptr);
+  EXPECT_EQ(
+      report->text.find("placed the 2 tf-attached obstacle(s) that may reach a body "
+                        "('left', 'right') every 0.001996007984031936 s over this update's 1 s "
+                        "instead of "
+                        "every ~obstacle_update_period (0.001 s): at most 1000 placements "
+                        "an update; 998 left out"),
+      0u)
+      << report->text;
+  EXPECT_TRUE(impacts_.empty());
+}
+
+// Issue 41, item 8: a frame that jumps. Sphere 'paddle' (radius 0.1 m) on frame "paddle", whose
+// tf samples (every 10 ms) put it at x = 2 m until t = 0.49 s and at x = 5 m from t = 0.5 s:
+// tf interpolates the 3 m over 10 ms, so its backward difference of second order (frame_motion.h)
+// at t = 0.5 s is 300 + (300 - 0) / 2 = 450 m/s and at t = 0.51 s 0 + (0 - 300) / 2 = -150 m/s,
+// both above MonitorCycle::kMaxFrameSpeed (100 m/s); from t = 0.52 s it is 0 again. Ball 'a'
+// rests at the origin, its states every 10 ms.
+TEST_F(MovingRobotCycle, Issue41_Item8_AFrameThatJumpsKeepsItsLastGoodMotionAndIsNamed) {
+  tf2::BufferCore tf;
+  for (int k = -10; k <= 100; ++k) {
+    geometry_msgs::TransformStamped frame;
+    frame.header.stamp = at(clock_, 0.01 * k);
+    frame.header.frame_id = "world";
+    frame.child_frame_id = "paddle";
+    frame.transform.translation.x = k < 50 ? 2.0 : 5.0;
+    frame.transform.rotation.w = 1.0;
+    tf.setTransform(frame, "test", /*is_static=*/false);
+  }
+  core::Scene scene = twoBallScene();
+  scene.obstacles.push_back(ballAndMovingRobotScene(0).obstacles[0]);  // 'paddle'
+  MonitorCycle cycle(scene, MonitorParams{});
+  std::deque<std::vector<BodyState>> inputs;
+  for (int k = 0; k <= 60; ++k) {
+    inputs.push_back({state("a", at(clock_, 0.01 * k), {0, 0, 0}, {0, 0, 0})});
+    const MonitorCycle::Update update =
+        cycle.process({&inputs.back(), "/body_states", "/source", ""}, clock_, false, tf);
+    const auto pose = cycle.monitor().obstaclePose(0);
+    ASSERT_TRUE(pose.has_value());
+    // Never faster than a body could follow; where it was until its frame moves slower again.
+    EXPECT_LE(pose->pose.velocity.norm(), MonitorCycle::kMaxFrameSpeed) << "update " << k;
+    EXPECT_EQ(pose->pose.velocity.norm(), 0.0) << "update " << k;
+    EXPECT_EQ(pose->pose.transform.translation().x(), k < 52 ? 2.0 : 5.0) << "update " << k;
+    std::size_t jumped = 0;
+    for (const Report& report : update.reports) {
+      if (report.reason != Reason::kFrameJumped) continue;
+      ++jumped;
+      EXPECT_TRUE(report.warn);
+      const std::string speed = k == 50 ? "450" : "150";
+      EXPECT_EQ(
+          report.text.find("obstacle 'paddle' keeps its last known motion: paddle: moves at " +
+                           speed + " m/s at "),
+          0u)
+          << report.text;
+      EXPECT_NE(report.text.find("faster than 100 m/s: a jump between its tf samples, which no "
+                                 "body could follow"),
+                std::string::npos)
+          << report.text;
+    }
+    EXPECT_EQ(jumped, k == 50 || k == 51 ? 1u : 0u) << "update " << k;
+    EXPECT_TRUE(update.impacts.impacts.empty());
+  }
+}
 }  // namespace
 }  // namespace collision_response

@@ -25,6 +25,10 @@ struct FrameMotion {
                            const Eigen::Vector3d& velocity_in_frame) const;
 };
 
+/// tf's error text, bounded: its first line, at most 300 characters (tf's text for a tree it
+/// takes for a loop, a chain deeper than tf2::BufferCore::MAX_GRAPH_DEPTH, lists every frame).
+std::string tfErrorText(const std::string& what);
+
 /// Looks up `frame` in `fixed_frame` at `stamp`, `stamp - interval` and `stamp - 2 interval`:
 /// the velocity is the backward finite difference of second order (exact for a frame moving at
 /// constant velocity, as tf interpolates linearly between its samples; first order where tf has

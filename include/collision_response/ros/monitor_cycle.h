@@ -78,6 +78,29 @@ class MonitorCycle {
   /// Bodies in stepped clusters at the end of the last step (0 before the first).
   std::size_t steppedBodies() const { return stepped_bodies_; }
 
+  /// What one update did for the tf-attached obstacles (README, "Finite obstacles"): every
+  /// moving obstacle's frame is looked up once, at the input's newest stamp, and placed there; a
+  /// frame wholly on /tf_static is looked up once (a few a update looked up again, in turn:
+  /// kStaticRechecks); within the update, only the obstacles whose motion may reach some body
+  /// are looked up and placed again every ~obstacle_update_period, at most kMaxPlacements
+  /// placements in all (what that left out is counted: Reason::kObstaclePlacementsLeftOut).
+  struct ObstacleWork {
+    std::size_t lookups = 0;     ///< frames looked up in tf
+    std::size_t placements = 0;  ///< obstacles placed in the monitor
+    std::size_t near = 0;        ///< obstacles placed again within the update
+  };
+  static constexpr std::size_t kStaticRechecks = 8;
+  /// m/s: a tf-attached obstacle whose surface tf moves faster (its centre's speed, and its
+  /// turning times its bounding radius) jumped between tf's samples (a frame published anew
+  /// elsewhere, a driver's glitch): no robot link or tracked thing moves so (a golf club's
+  /// head, about the fastest thing a body swings, reaches about 55 m/s), and a ball it met would
+  /// be sent off at up to twice that. The obstacle keeps its last good motion
+  /// (Reason::kFrameJumped) until its frame moves slower again.
+  static constexpr double kMaxFrameSpeed = 100.0;
+  static constexpr std::size_t kMaxPlacements = 1000;
+  /// The last input's obstacle work (its waiting attempts included).
+  const ObstacleWork& obstacleWork() const { return obstacle_work_; }
+
  private:
   /// The offset (ns, TimeLine::stampOf) of the clock to stamp an instant `time` of the two
   /// sides in: the clock of the states it was predicted from when they share one; else the
@@ -87,9 +110,10 @@ class MonitorCycle {
   // The stages of process(), in its order.
   /// A tf-attached obstacle's frame, looked up at one stamp; empty for a fixed obstacle.
   using ObstacleMotion = std::optional<core::Expected<FrameMotion>>;
-  /// Looks up each tf-attached obstacle's frame at `stamp`, once: `motions` by obstacle index.
+  /// Looks up each tf-attached obstacle's frame at `stamp`, once (a static one placed already:
+  /// not, but kStaticRechecks of them in turn): `motions` by obstacle index.
   void lookUpObstacles(const ros::Time& stamp, const tf2::BufferCore& tf,
-                       std::vector<ObstacleMotion>& motions) const;
+                       std::vector<ObstacleMotion>& motions);
   /// A tf-attached obstacle's frame not known at the input's newest stamp (obstacle_motions_):
   /// the input waits.
   bool obstacleFrameMissing() const;
@@ -115,12 +139,22 @@ class MonitorCycle {
   /// the doubles or a ros::Time cannot hold is reported, not published.
   void publishContacts(const core::StepReport& step, const ros::Time& newest, Update& update) const;
   void publishImpacts(const core::StepReport& step, const ros::Time& newest, Update& update) const;
-  /// Places the tf-attached obstacles where `motions` (lookUpObstacles) has them, at line time
-  /// `time`; one whose frame is missing keeps its last known motion (reported).
-  void placeObstacles(const std::vector<ObstacleMotion>& motions, double time, Update& update);
+  /// Looks up obstacle `i`'s frame at `stamp` into `motion` (a missing frame without an
+  /// exception: canTransform first).
+  void lookUpObstacle(std::size_t i, const ros::Time& stamp, const tf2::BufferCore& tf,
+                      ObstacleMotion& motion);
+  /// Places the tf-attached obstacles `which` (all when null) where `motions` has them, at line
+  /// time `time`; one whose frame is missing keeps its last known motion (reported once for all
+  /// of them); a static one already placed is left where it is.
+  void placeObstacles(const std::vector<ObstacleMotion>& motions, double time, Update& update,
+                      const std::vector<std::size_t>* which = nullptr);
+  /// The moving obstacles whose motion over [from, until] may reach some tracked body's (their
+  /// bounding spheres swept: see the definition), into near_obstacles_.
+  void findNearObstacles(double from, double until, double end);
   /// Steps the monitor (no states) through the update's time before its first state, every
-  /// ~obstacle_update_period, placing the tf-attached obstacles again from tf at each; the
-  /// impacts found are gathered in `impacts`, what the steps report in `update`.
+  /// ~obstacle_update_period, placing the near obstacles again from tf at each (at most
+  /// kMaxPlacements in all, what is left out counted); the impacts found are gathered in
+  /// `impacts`, what the steps report in `update`.
   void stepMovingObstacles(const TimeLine::Placed& placed, const ros::Time& newest,
                            const tf2::BufferCore& tf, std::vector<core::ImpactRecord>& impacts,
                            Update& update);
@@ -134,6 +168,17 @@ class MonitorCycle {
   /// (stepMovingObstacles): working memory, kept between inputs.
   std::vector<ObstacleMotion> obstacle_motions_;
   std::vector<ObstacleMotion> between_motions_;
+  /// By obstacle: whether its frame's chain is wholly static (on /tf_static: a lookup at time
+  /// zero stamped zero), found at its first lookup.
+  enum class FrameKind : std::uint8_t { kFixed, kUnknown, kStatic, kMoving };
+  std::vector<FrameKind> frame_kind_;
+  /// By obstacle: its frame's last lookup moved faster than kMaxFrameSpeed (its motion is an
+  /// error then, but not a missing frame: the input does not wait for it).
+  std::vector<char> frame_jumped_;
+  std::size_t next_recheck_ = 0;  ///< the static obstacle to look up again next (in turn)
+  bool explain_missing_ = true;   ///< the next missing frame of a pass gets tf's text
+  std::vector<std::size_t> near_obstacles_;
+  ObstacleWork obstacle_work_;
   /// The input's samples, timed in place (timeSamples): working memory, kept between inputs.
   StampedSamples samples_;
   /// By source: the states of an input whose stamp went back on its clock, until its next

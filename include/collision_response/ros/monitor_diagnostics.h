@@ -24,6 +24,7 @@ struct MonitorFigures {
   std::string detection, combine_rule;
   double restitution_threshold = 0.0;
   std::size_t bodies = 0, tracked = 0, stepped = 0;
+  MonitorCycle::ObstacleWork obstacle_work;  ///< the last update's (tf-attached obstacles)
   std::map<std::string, TimeLine::SourceClocks> sources;
   static MonitorFigures of(const MonitorCycle& cycle);
 };

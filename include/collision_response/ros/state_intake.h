@@ -48,8 +48,10 @@ enum class Reason {
   kImpactContradicted,  ///< a state taken after an impact lacks it (the impact stays published)
   kFlightStalled,       ///< a flight through air the integrator could not carry on: held
   kPredictionCutShort,  ///< a ~predict_impacts request that spent ~prediction_cpu_budget
+  kObstaclePlacementsLeftOut,  ///< an update's bound left out placements of near obstacles
+  kFrameJumped,                ///< a tf frame moved faster than any body could follow
 };
-inline constexpr int kReasonCount = static_cast<int>(Reason::kPredictionCutShort) + 1;
+inline constexpr int kReasonCount = static_cast<int>(Reason::kFrameJumped) + 1;
 
 /// The counter's name, as diagnostics shows it: "dropped: unknown id", "clock jumped back", ...
 const char* counterName(Reason reason);
