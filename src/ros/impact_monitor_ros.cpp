@@ -37,11 +37,12 @@ ImpactMonitorRos::ImpactMonitorRos(ros::NodeHandle node, const core::Scene& scen
                                    const MonitorParams& params)
     : node_(node), params_(params), cycle_(scene, params), tf_listener_(tf_buffer_, node) {
   // The subscriptions on the intake's queue. Its callbacks take microseconds and never wait for
-  // an update, so roscpp's queue (as long as ours, ~queue_size) fills only if the intake's thread
-  // cannot run for ~queue_size messages' time; what ours cannot hold is dropped and counted.
+  // an update, so roscpp's queue (as long as ours, ~queue_size, and at least the 100 it had)
+  // fills only if the intake's thread cannot run for that many messages' time (10 s at 100 Hz
+  // by default); what ours cannot hold is dropped and counted.
   ros::NodeHandle intake(node_);
   intake.setCallbackQueue(&intake_queue_);
-  const auto roscpp_queue = static_cast<std::uint32_t>(params_.queue_size);
+  const auto roscpp_queue = static_cast<std::uint32_t>(std::max(params_.queue_size, 100));
   array_subscriber_ =
       intake.subscribe("body_states", roscpp_queue, &ImpactMonitorRos::onStateArray, this);
   array_topic_ = array_subscriber_.getTopic();
@@ -84,7 +85,8 @@ void ImpactMonitorRos::onStateArray(const ros::MessageEvent<const BodyStateArray
     tell(array_topic_,
          {{Reason::kTooManyStates,
            "dropped a message: states: " + std::to_string(message->states.size()) +
-               " states exceed ~max_states (" + std::to_string(params_.max_states) + ")"}});
+               " states exceed ~max_states (" + std::to_string(params_.max_states) + ")",
+           message->states.size()}});
     return;
   }
   enqueue(Pending{ros::WallTime::now(), array_topic_, event.getPublisherName(), "", message, {}});
