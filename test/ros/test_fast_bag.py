@@ -1,0 +1,130 @@
+#!/usr/bin/python3
+"""A bag played at twice its speed without use_sim_time moves no other source (issue 41, item 5;
+README, ~clock_jump_back).
+
+The node's scene (fast_bag.test): a concrete floor (z = 0), a probe ball (r = 0.05 m, e = 1 on
+concrete) and a second ball on its own topic. The probe bounces on the floor from H = 0.2 m above
+contact: dropped from rest at its top at t0, it meets the floor at t0 + tf + k T, tf = sqrt(2 H /
+g), T = 2 tf (e = 1: every flight the same). The test publishes its closed-form state at 100 Hz
+for 6 s, each stamped with the node's clock at the instant it describes. Beside it, as a bag
+played at twice its speed would, the second ball at rest on the floor 50 m away, at 100 Hz,
+stamped t0 + 2 (now - t0): 6 s ahead of the node's clock by the end. Checked:
+
+- every impact of the probe in the run is on /impacts, at its closed form (1e-6 s): before the
+  fix the probe was shifted by seconds onto a present the fast source dragged ahead, and half of
+  its impacts were lost;
+- /diagnostics, once drained: a clock offset for the fast source only (none for the probe's),
+  no "clock jumped back", no state set aside (before the fix the probe's source was shifted by
+  5.07 s and 465 of its 600 states were set aside: behind the monitor's motion). The fast
+  source's own first states, up to a tenth of ~clock_jump_back ahead, then placed at the
+  present, may be stale (counted).
+"""
+import math
+import threading
+import time
+import unittest
+
+import rospy
+import rostest
+from diagnostic_msgs.msg import DiagnosticArray
+from collision_response.msg import BodyState, BodyStateArray, ImpactArray
+
+G, R, H = 9.81, 0.05, 0.2
+TF = math.sqrt(2 * H / G)
+T = 2 * TF
+RUN = 6.0
+NODE = "fast_bag_monitor"
+
+
+def probe_state(t0, t):
+    """The probe at t (s after t0 on the same clock): height and vertical speed in closed form."""
+    tau = math.fmod(t - t0 + TF, T) - TF  # time since the top of its current flight
+    return R + H - 0.5 * G * tau * tau, -G * tau
+
+
+def state(body, stamp, x, z, vz):
+    message = BodyState()
+    message.header.stamp = stamp
+    message.header.frame_id = "world"
+    message.id = body
+    message.pose.position.x, message.pose.position.z = x, z
+    message.pose.orientation.w = 1.0
+    message.twist.linear.z = vz
+    return message
+
+
+class FastBag(unittest.TestCase):
+    def test_a_bag_at_twice_its_speed_moves_no_other_source(self):
+        impacts, lock = [], threading.Lock()
+
+        def on_impacts(message):
+            with lock:
+                impacts.extend(message.impacts)
+
+        rospy.Subscriber("/fast_bag/impacts", ImpactArray, on_impacts, queue_size=1000)
+        diagnostics = []
+        rospy.Subscriber("/diagnostics", DiagnosticArray,
+                         lambda message: diagnostics.extend(
+                             s for s in message.status if s.name.startswith(NODE)))
+        probe = rospy.Publisher("/fast_bag/body_states", BodyStateArray, queue_size=1000)
+        bag = rospy.Publisher("/fast_bag/bag_ball", BodyState, queue_size=1000)
+        deadline = time.monotonic() + 30
+        while ((probe.get_num_connections() == 0 or bag.get_num_connections() == 0)
+               and time.monotonic() < deadline):
+            time.sleep(0.05)
+        time.sleep(0.5)
+
+        t0 = rospy.Time.now().to_sec()
+        published = 0
+        rate = rospy.Rate(100)
+        while rospy.Time.now().to_sec() - t0 < RUN:
+            now = rospy.Time.now()
+            z, vz = probe_state(t0, now.to_sec())
+            array = BodyStateArray()
+            array.header.stamp = now
+            array.states.append(state("probe", now, -2.0, z, vz))
+            probe.publish(array)
+            published += 1
+            last = now.to_sec()
+            # The bag's clock: twice the node's since t0.
+            ahead = rospy.Time.from_sec(t0 + 2.0 * (rospy.Time.now().to_sec() - t0))
+            bag.publish(state("bag_ball", ahead, 50.0, R, 0.0))
+            rate.sleep()
+
+        deadline = time.monotonic() + 20
+        values = {}
+        while time.monotonic() < deadline:
+            time.sleep(0.5)
+            if diagnostics:
+                values = {v.key: v.value for v in diagnostics[-1].values}
+                if (values.get("messages waiting") == "0"
+                        and int(values.get("states received (total)", "0")) >= 2 * published):
+                    break
+
+        expected = []
+        k = 0
+        while t0 + TF + k * T < last - 0.02:
+            expected.append(t0 + TF + k * T)
+            k += 1
+        with lock:
+            found = sorted(i.header.stamp.to_sec() for i in impacts
+                           if "probe" in (i.body_a, i.body_b))
+        self.assertGreaterEqual(len(expected), 13)
+        missing = [t for t in expected if not any(abs(f - t) < 1e-6 for f in found)]
+        self.assertEqual(missing, [], "probe impacts not found (%d of %d found; found: %s)"
+                         % (len(expected) - len(missing), len(expected), found))
+
+        offsets = {k: v for k, v in values.items() if k.startswith("clock offset of ")}
+        self.assertTrue(any("/fast_bag/bag_ball" in k for k in offsets), values)
+        self.assertFalse(any("/fast_bag/body_states" in k for k in offsets), offsets)
+        dropped = {k: v for k, v in values.items()
+                   if k.startswith("dropped:")}
+        self.assertEqual(values.get("clock jumped back (total)", "0"), "0", values)
+        # Before the fix: the probe's source 5.07 s off, 465 of its 600 states set aside.
+        self.assertNotIn("dropped: state older than its body's motion (total)", values)
+        print("diagnostics: %s; dropped: %s" % (offsets, dropped))
+
+
+if __name__ == "__main__":
+    rospy.init_node("fast_bag_test")
+    rostest.rosrun("collision_response", "fast_bag_test", FastBag)
