@@ -36,6 +36,14 @@ struct MonitorSettings {
   /// impacts; impacts come in as states imposed at their instants (advance()). What Playback
   /// moves a scene with.
   bool detect_impacts = true;
+  /// What the joint solves of the impact clusters (their normal impulses, then their friction)
+  /// may spend in one step, in contact iterations (WorkBound: an iteration over n contacts
+  /// counts n, a dense factorisation of n contacts 1 + n^2 / 4 + n^3 / 400). A friction solve
+  /// that would pass it stops where it got to (within mu J, no energy added); a cluster whose
+  /// normal solve would pass it, and every later one of the step, is locked together with what
+  /// touches it (one velocity: its centre of mass's, or its fixed obstacles'), and the bodies are
+  /// named in StepReport::over_impact_work (doc/model.md, "Simultaneous contacts"). 0: no bound.
+  std::size_t max_impact_work_per_step = 100000;
 };
 
 /// A body's state at one instant, in the fixed frame.
@@ -137,6 +145,14 @@ struct StepReport {
   /// What the exact model spent in this step, in all (World::work's units: an instant a body's
   /// motion changed, a solve of its curved lasting contact); with the gravity effect.
   std::size_t exact_work = 0;
+  /// What the impact clusters' joint solves spent in this step, in contact iterations: at most
+  /// MonitorSettings::max_impact_work_per_step.
+  std::size_t impact_work = 0;
+  /// Bodies of the impact clusters the step's impact work bound cut short (sorted, each once):
+  /// a joint friction solve stopped where it got to, or the cluster and what touches it locked
+  /// together (MonitorSettings::max_impact_work_per_step). No energy gained, momentum kept (where
+  /// no obstacle takes part), no contact among them left approaching.
+  std::vector<std::size_t> over_impact_work;
 };
 
 /// Watches the scene's bodies and obstacles and finds their impacts.

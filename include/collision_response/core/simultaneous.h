@@ -52,6 +52,20 @@ struct ContactOutcome {
   double energy_lost = 0.0;     ///< J, this contact's share: J (1 - e)(-d) / 2
 };
 
+/// What a joint solve of an impact cluster may spend, and spent, in contact iterations
+/// (MonitorSettings::max_impact_work_per_step): a block of n contacts solved iteratively counts
+/// n an iteration, one solved densely 1 + n^2 / 4 + n^3 / 400 a factorisation (what such a
+/// factorisation takes in the time of an iteration's contact: doc/performance.md).
+struct WorkBound {
+  std::size_t limit = 0;  ///< at most this much; 0: no limit
+  std::size_t spent = 0;  ///< added to by each solve
+  bool cut = false;       ///< a solve stopped at the limit
+  /// What is left of the limit (the largest size_t without one).
+  std::size_t left() const;
+  /// The cost of a dense factorisation of n contacts.
+  static std::size_t denseStep(std::size_t n) { return 1 + n * n / 4 + n * n * n / 400; }
+};
+
 /// Resolves contacts that all strike at one instant, updating the bodies' velocities.
 ///
 /// Model (Newton's restitution on every contact at once): find impulses J >= 0 such that every
@@ -65,7 +79,12 @@ struct ContactOutcome {
 /// Two balls striking a third from both sides at once receive equal impulses; a chain struck at
 /// one end (a cradle) is not solved here at once: the caller resolves, in rounds, only the
 /// contacts that approach, so the impact travels down the chain ball by ball.
+///
+/// `work` (optional) bounds and counts the solve's work: where its next iteration would pass the
+/// limit, the solve stops, `work->cut` is set, the bodies are left as they were and the answer
+/// is empty (the caller resolves the cluster otherwise).
 std::vector<ContactOutcome> resolveSimultaneous(std::vector<ClusterBody>& bodies,
-                                                const std::vector<ClusterContact>& contacts);
+                                                const std::vector<ClusterContact>& contacts,
+                                                WorkBound* work = nullptr);
 
 }  // namespace collision_response::core

@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <set>
 #include <utility>
@@ -672,13 +673,33 @@ void switchSides(const DiscProblem& problem, const Vector& x, std::vector<char>&
   }
 }
 
+/// The dense solve's steps (a factorisation of the block's matrix: the sticking solve, a round of
+/// polishing, a Newton step) that a bound on the impact's work leaves it (WorkBound), and how
+/// many it took.
+struct DenseSteps {
+  std::size_t left = std::numeric_limits<std::size_t>::max();
+  std::size_t taken = 0;
+  bool cut = false;  ///< a step was wanted with none left
+  /// One more step: false (and cut) where none is left.
+  bool take() {
+    if (taken >= left) {
+      cut = true;
+      return false;
+    }
+    ++taken;
+    return true;
+  }
+};
+
 /// Coulomb's conditions for a given set of contacts at their disc's edge: those take the bound
 /// exactly, against the slip they leave; the others stop their slip exactly (a linear solve);
 /// repeated while the edge directions move. True (and `x` set) when they then hold; else `x` is
 /// the last attempt and `edge` switched where a condition failed.
-bool polishCoulomb(const DiscProblem& problem, Vector& x, std::vector<char>& edge) {
+bool polishCoulomb(const DiscProblem& problem, Vector& x, std::vector<char>& edge,
+                   DenseSteps& steps) {
   Vector polished = x;
   for (int round = 0; round < 8; ++round) {
+    if (!steps.take()) return false;
     pressEdgesToBound(problem, edge, polished);
     stopInnerSlips(problem, edge, polished);
     const CoulombVerdict verdict = coulombVerdict(problem, edge, polished);
@@ -736,13 +757,18 @@ bool newtonStep(const DiscProblem& problem, Real t, Vector& x) {
 /// until the duality gap discs / t is below 1e-14 of the energies (nearer the discs' edges
 /// b^2 - |x|^2 loses its digits). Where A is singular the barrier tends to the centre of the
 /// optimal set, so the answer depends on no order.
-Vector barrierMinimum(const DiscProblem& problem) {
+///
+/// Stopped short (no `steps` left), x is still inside every disc and E(x) <= 0: each Newton step
+/// lowers t E - sum log(b^2 - |x|^2), whose log part is least at x = 0, so t E(x) stays below
+/// what the log part gained, and a larger t keeps it so.
+Vector barrierMinimum(const DiscProblem& problem, DenseSteps& steps) {
   const Real scale = energyScale(problem);
   Vector x = Vector::Zero(problem.size());
   Real t = 1 / std::max(scale, Real(1e-300));
   const Real gap_wanted = 1e-14L * std::max(scale, Real(1e-300));
   for (int outer = 0; outer < 40; ++outer) {
     for (int newton = 0; newton < 50; ++newton) {
+      if (!steps.take()) return x;
       if (!newtonStep(problem, t, x)) break;
     }
     if (Real(problem.discs()) / t < gap_wanted) break;
@@ -757,26 +783,34 @@ Vector barrierMinimum(const DiscProblem& problem) {
 /// from the sticking answer (fast, and usually right at once); where they do not settle, a
 /// primal barrier method (barrierMinimum, in long double), then the same exact conditions from
 /// its answer.
-Vector frictionByBarrier(const Matrix& coupling, const Vector& slip,
-                         const std::vector<Real>& bound) {
+///
+/// `steps`: what a bound on the impact's work leaves (DenseSteps). Stopped short before the
+/// barrier method, no friction (x = 0); within it, its last iterate, inside every disc, where
+/// its energy is at most E(0) = 0 (else x = 0); in the last polish, the barrier's answer;
+/// `steps.cut` says so.
+Vector frictionByBarrier(const Matrix& coupling, const Vector& slip, const std::vector<Real>& bound,
+                         DenseSteps& steps) {
   const DiscProblem problem{coupling, slip, bound};
   const Eigen::Index disc = problem.discs();
+  if (!steps.take()) return Vector::Zero(slip.size());
   Vector x = coupling.completeOrthogonalDecomposition().solve(-slip);  // sticking everywhere
   std::vector<char> edge(static_cast<std::size_t>(disc), 0);
   for (Eigen::Index k = 0; k < disc; ++k) {
     edge[static_cast<std::size_t>(k)] = x.segment<2>(2 * k).norm() > problem.b(k);
   }
   bool settled = false;
-  for (int attempt = 0; attempt < 8 && !settled; ++attempt) {
-    settled = polishCoulomb(problem, x, edge);
+  for (int attempt = 0; attempt < 8 && !settled && !steps.cut; ++attempt) {
+    settled = polishCoulomb(problem, x, edge, steps);
   }
   if (settled) return x;
-  x = barrierMinimum(problem);
+  if (steps.cut) return Vector::Zero(slip.size());
+  x = barrierMinimum(problem, steps);
+  if (steps.cut) return problem.energy(x) <= 0 ? x : Vector::Zero(slip.size());
   for (Eigen::Index k = 0; k < disc; ++k) {
     edge[static_cast<std::size_t>(k)] = x.segment<2>(2 * k).norm() >= problem.b(k) * (1 - 1e-8L);
   }
   Vector polished = x;
-  if (polishCoulomb(problem, polished, edge)) x = polished;
+  if (polishCoulomb(problem, polished, edge, steps)) x = polished;
   return x;
 }
 
@@ -804,12 +838,13 @@ constexpr int kFrictionIterations = 10000;
 /// L |x - P(x - (A x + s) / L)| (per contact; 0 exactly where x is the minimum: Coulomb's law,
 /// the slip stopped inside the disc, at the bound against the slip left on its edge) is at most
 /// kFrictionResidual of the largest slip, returning true; else at a fixed point of the rounded
-/// step or after kFrictionIterations, returning false. The last iterate is returned where its
-/// energy is at most E(0) = 0 (friction adds no energy), else the iterate of the lowest energy
-/// (x = 0 at worst), returning false. Every sum (rows of A x, the energy, dot products, the
-/// bound) is order-free and sign-symmetric (orderFreeSum), so renaming the bodies or mirroring
-/// the cluster changes no bit.
-/// A block's friction problem by A's nonzeros (CouplingRows), every sum order-free.
+/// step or after `max_iterations` (kFrictionIterations, or fewer where the impact's work is
+/// bounded: WorkBound), returning false; `iterations` says how many it took. The last iterate is
+/// returned where its energy is at most E(0) = 0 (friction adds no energy), else the iterate of the
+/// lowest energy (x = 0 at worst), returning false. Every sum (rows of A x, the energy, dot
+/// products, the bound) is order-free and sign-symmetric (orderFreeSum), so renaming the bodies or
+/// mirroring the cluster changes no bit. A block's friction problem by A's nonzeros (CouplingRows),
+/// every sum order-free.
 class SparseDiscProblem {
  public:
   SparseDiscProblem(const CouplingRows& rows, const Vector& slip, const std::vector<Real>& bound)
@@ -916,7 +951,8 @@ void advance(SparseDiscProblem& problem, Vector z, const Vector& coupled_z,
 }
 
 bool frictionByProjectedGradient(const CouplingRows& rows, const Vector& slip,
-                                 const std::vector<Real>& bound, Vector& solution) {
+                                 const std::vector<Real>& bound, int max_iterations,
+                                 Vector& solution, int& iterations) {
   SparseDiscProblem problem(rows, slip, bound);
   const Eigen::Index size = problem.size();
   const Real lipschitz = problem.lipschitz();
@@ -929,7 +965,8 @@ bool frictionByProjectedGradient(const CouplingRows& rows, const Vector& slip,
   Vector lowest = it.x;  // the iterate of the lowest energy so far
   Real lowest_energy = 0, energy_x = 0;
   bool settled = false;
-  for (int iteration = 0; iteration < kFrictionIterations && !settled; ++iteration) {
+  iterations = 0;
+  for (int iteration = 0; iteration < max_iterations && !settled; ++iteration) {
     Vector z = problem.projectedStep(it.y, it.coupled_y, lipschitz);
     const Vector coupled_z = problem.apply(z);
     energy_x = problem.energy(z, coupled_z);
@@ -940,6 +977,7 @@ bool frictionByProjectedGradient(const CouplingRows& rows, const Vector& slip,
     // Or a fixed point of the rounding.
     settled = problem.residual(z, coupled_z, lipschitz) <= tolerance || z == it.x;
     advance(problem, std::move(z), coupled_z, it);
+    ++iterations;
   }
   if (energy_x <= 0) {
     solution = it.x;
@@ -1090,21 +1128,48 @@ void addBlockImpulses(const Group& group, const FrictionContacts& friction,
 /// A block's friction impulses x (in its numbering), by dense algebra up to kDenseBlockContacts
 /// contacts (frictionByBarrier), above by the accelerated projected gradient
 /// (frictionByProjectedGradient; false where it stops short of its residual).
+///
+/// `work` (optional): what the block may spend and spent (solveFrictionImpulses; WorkBound's
+/// units: an iteration of the projected gradient costs the block's contacts, a step of the dense
+/// solve, frictionByBarrier's factorisation and its line search, WorkBound::denseStep). A block
+/// reached with too little left for a step gets no friction (x = 0); one that runs out stops
+/// where its solve got to.
 bool frictionOfBlock(const TangentialCoupling& coupling, const std::vector<std::size_t>& block,
                      const std::vector<Eigen::Index>& place, const Vector& slip,
-                     const std::vector<Real>& bound, Vector& x) {
+                     const std::vector<Real>& bound, WorkBound* work, Vector& x) {
+  const std::size_t left = work == nullptr ? std::numeric_limits<std::size_t>::max() : work->left();
   if (block.size() <= kDenseBlockContacts) {
+    const std::size_t step_cost = WorkBound::denseStep(block.size());
+    DenseSteps steps;
+    if (left != std::numeric_limits<std::size_t>::max()) steps.left = left / step_cost;
     Matrix dense = Matrix::Zero(slip.size(), slip.size());
     forEachCouplingEntry(coupling, block, place,
                          [&](Eigen::Index i, Eigen::Index j, Real value) { dense(i, j) = value; });
-    x = frictionByBarrier(dense, slip, bound);
-    return true;
+    x = frictionByBarrier(dense, slip, bound, steps);
+    if (work != nullptr) {
+      work->spent += steps.taken * step_cost;
+      work->cut = work->cut || steps.cut;
+    }
+    return !steps.cut;
+  }
+  const int allowed = static_cast<int>(
+      std::min<std::size_t>(left / block.size(), static_cast<std::size_t>(kFrictionIterations)));
+  if (allowed == 0) {
+    work->cut = true;
+    x = Vector::Zero(slip.size());
+    return false;
   }
   CouplingRows rows(static_cast<std::size_t>(slip.size()));
   forEachCouplingEntry(coupling, block, place, [&](Eigen::Index i, Eigen::Index j, Real value) {
     if (value != 0) rows[static_cast<std::size_t>(i)].emplace_back(j, value);
   });
-  return frictionByProjectedGradient(rows, slip, bound, x);
+  int iterations = 0;
+  const bool converged = frictionByProjectedGradient(rows, slip, bound, allowed, x, iterations);
+  if (work != nullptr) {
+    work->spent += static_cast<std::size_t>(iterations) * block.size();
+    if (!converged && allowed < kFrictionIterations && iterations == allowed) work->cut = true;
+  }
+  return converged;
 }
 
 /// The answer in doubles: each contact's impulse (in `tangential`), slip, slip change and mode
@@ -1143,7 +1208,8 @@ ContactForceSolution storeFrictionImpulses(const Group& group, const FrictionCon
 
 ContactForceSolution solveFrictionImpulses(const std::vector<ForceBody>& bodies,
                                            const std::vector<ForceContact>& contacts,
-                                           const std::vector<double>& normal_impulses) {
+                                           const std::vector<double>& normal_impulses,
+                                           WorkBound* work) {
   // Maximal dissipation: the tangential impulses x (on each contact's b, in its tangent basis)
   // minimise the kinetic energy they leave, E(x) = x'A x / 2 + s'x (A the tangential coupling,
   // s the slips; E is exactly the change of kinetic energy), over the discs |x_k| <= mu_k J_k.
@@ -1165,7 +1231,7 @@ ContactForceSolution solveFrictionImpulses(const std::vector<ForceBody>& bodies,
     const BlockProblem problem = setUpBlock(group, friction, block, place);
     Vector x;
     converged =
-        frictionOfBlock(coupling, block, place, problem.slip, problem.bound, x) && converged;
+        frictionOfBlock(coupling, block, place, problem.slip, problem.bound, work, x) && converged;
     addBlockImpulses(group, friction, block, x, impulses);
   }
   return storeFrictionImpulses(group, friction, impulses, bodies.size(), converged);

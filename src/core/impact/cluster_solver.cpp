@@ -25,7 +25,7 @@ template <bool kSpin>
 void applyFrictionJointly(std::vector<ClusterBody>& bodies,
                           const std::vector<ClusterContact>& contacts,
                           const std::vector<FrictionContact>& frictions,
-                          std::vector<FrictionOutcome>& outcomes) {
+                          std::vector<FrictionOutcome>& outcomes, WorkBound* work) {
   std::vector<ForceBody> force_bodies;
   for (const ClusterBody& body : bodies) {
     ForceBody force_body;
@@ -50,7 +50,7 @@ void applyFrictionJointly(std::vector<ClusterBody>& bodies,
     normal_impulses.push_back(frictions[k].normal_impulse);
   }
   const ContactForceSolution solution =
-      solveFrictionImpulses(force_bodies, force_contacts, normal_impulses);
+      solveFrictionImpulses(force_bodies, force_contacts, normal_impulses, work);
   outcomes.assign(contacts.size(), FrictionOutcome{});
   for (std::size_t k = 0; k < contacts.size(); ++k) {
     const ContactForce& friction = solution.contacts[k];
@@ -87,16 +87,16 @@ void applyFrictionJointly(std::vector<ClusterBody>& bodies,
 template void applyFrictionJointly<true>(std::vector<ClusterBody>&,
                                          const std::vector<ClusterContact>&,
                                          const std::vector<FrictionContact>&,
-                                         std::vector<FrictionOutcome>&);
+                                         std::vector<FrictionOutcome>&, WorkBound*);
 template void applyFrictionJointly<false>(std::vector<ClusterBody>&,
                                           const std::vector<ClusterContact>&,
                                           const std::vector<FrictionContact>&,
-                                          std::vector<FrictionOutcome>&);
+                                          std::vector<FrictionOutcome>&, WorkBound*);
 
 ClusterOutcome solveCluster(std::vector<ClusterBody>& bodies,
                             const std::vector<ClusterContact>& contacts,
                             const std::vector<double>& friction_coefficients,
-                            const FrictionModel& friction_model) {
+                            const FrictionModel& friction_model, WorkBound* work) {
   ClusterOutcome outcome;
   if (contacts.size() == 1) {
     const ClusterContact& contact = contacts.front();
@@ -107,14 +107,15 @@ ClusterOutcome solveCluster(std::vector<ClusterBody>& bodies,
     outcome.friction.assign(1, resolution.friction);
     return outcome;
   }
-  outcome.normal = resolveSimultaneous(bodies, contacts);
+  outcome.normal = resolveSimultaneous(bodies, contacts, work);
+  if (outcome.normal.empty()) return outcome;  // its work ran out: the bodies as they were
   outcome.friction.assign(contacts.size(), FrictionOutcome{});
   if (friction_model) {
     std::vector<FrictionContact> frictions(contacts.size());
     for (std::size_t c = 0; c < contacts.size(); ++c) {
       frictions[c] = FrictionContact{friction_coefficients[c], outcome.normal[c].impulse};
     }
-    friction_model.cluster(bodies, contacts, frictions, outcome.friction);
+    friction_model.cluster(bodies, contacts, frictions, outcome.friction, work);
   }
   return outcome;
 }

@@ -8,6 +8,7 @@
 #include "collision_response/core/friction.h"
 #include "collision_response/core/scene.h"
 #include "collision_response/core/simultaneous.h"
+#include "contact/contact_forces.h"
 #include "contact/stepped_friction.h"
 
 namespace collision_response::core {
@@ -22,7 +23,9 @@ Effects runnableEffects(const Effects& requested);
 struct FrictionModel {
   FrictionOutcome (*contact)(ClusterBody& a, ClusterBody& b, const Eigen::Vector3d& normal,
                              double friction, double normal_impulse) = nullptr;
-  ClusterFrictionStep cluster = nullptr;
+  void (*cluster)(std::vector<ClusterBody>&, const std::vector<ClusterContact>&,
+                  const std::vector<FrictionContact>&, std::vector<FrictionOutcome>&,
+                  WorkBound*) = nullptr;
   /// A stepped cluster's sub-step: warm-started sweeps (applyFrictionBySweeps).
   SweptFrictionStep swept = nullptr;
   explicit operator bool() const { return contact != nullptr; }
@@ -32,12 +35,13 @@ struct FrictionModel {
 /// impulses applied already: the tangential impulses come from one joint solve, as the normal
 /// ones do, so mirror images get mirror answers and no order of the contacts matters. kSpin:
 /// angular velocities enter the slip and receive the moments. The energy each contact removes
-/// is the work of its impulse, -T.(u + u') / 2 (u, u' its slip before and after).
+/// is the work of its impulse, -T.(u + u') / 2 (u, u' its slip before and after). `work`
+/// (optional) bounds and counts the solve's work (solveFrictionImpulses).
 template <bool kSpin>
 void applyFrictionJointly(std::vector<ClusterBody>& bodies,
                           const std::vector<ClusterContact>& contacts,
                           const std::vector<FrictionContact>& frictions,
-                          std::vector<FrictionOutcome>& outcomes);
+                          std::vector<FrictionOutcome>& outcomes, WorkBound* work = nullptr);
 
 /// The friction `effects` call for: none (no friction effect), Coulomb friction on spheres that
 /// do not turn, or (spin) on turning ones.
@@ -62,10 +66,13 @@ struct ClusterOutcome {
 /// Resolves a cluster: the normal impulses of resolveSimultaneous, then the model's friction
 /// with each contact's coefficient in `friction_coefficients` (read only with a model). The
 /// bodies' velocities (and with spin their angular velocities) are updated. A cluster of one
-/// contact is solveContact.
+/// contact is solveContact. `work` (optional) bounds and counts the joint solves' work
+/// (resolveSimultaneous, then solveFrictionImpulses): where the normal solve runs out, the
+/// bodies are left as they were and the outcome's `normal` is empty; where the friction's does,
+/// its impulses are where it got to (within mu J, no energy added).
 ClusterOutcome solveCluster(std::vector<ClusterBody>& bodies,
                             const std::vector<ClusterContact>& contacts,
                             const std::vector<double>& friction_coefficients,
-                            const FrictionModel& friction_model);
+                            const FrictionModel& friction_model, WorkBound* work = nullptr);
 
 }  // namespace collision_response::core

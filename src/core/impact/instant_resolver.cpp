@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <map>
 #include <numeric>
+#include <unordered_map>
 #include <utility>
 
 #include "collision_response/core/impact.h"
@@ -151,11 +152,13 @@ PreparedCluster prepareCluster(World& world, double time,
   PreparedCluster prepared;
   std::vector<std::size_t>& members = prepared.members;
   std::vector<std::pair<std::size_t, Eigen::Vector3d>> finite_members;  // member, its velocity
-  const auto local = [&members](std::size_t participant) {
-    const auto found = std::find(members.begin(), members.end(), participant);
-    if (found != members.end()) return static_cast<std::size_t>(found - members.begin());
-    members.push_back(participant);
-    return members.size() - 1;
+  // Each participant's local index (a finite shape's per-contact members are not looked up): a
+  // map, as a cluster of a lattice has thousands of members.
+  std::unordered_map<std::size_t, std::size_t> local_of;
+  const auto local = [&members, &local_of](std::size_t participant) {
+    const auto [found, inserted] = local_of.emplace(participant, members.size());
+    if (inserted) members.push_back(participant);
+    return found->second;
   };
   for (const std::size_t k : cluster) {
     const InstantContact& instant_contact = contacts[k];
@@ -195,6 +198,109 @@ PreparedCluster prepareCluster(World& world, double time,
   // Its own angular velocity stays (as reported), acting on nothing: its radius is 0.
   for (const auto& [member, velocity] : finite_members) prepared.bodies[member].velocity = velocity;
   return prepared;
+}
+
+/// The cluster's contacts one after the other, in their canonical order, each that approaches
+/// by the closed form of a single contact (solveContact: Newton's restitution, then its own
+/// friction): the fallback of a joint solve past the step's impact work. Each such impact removes
+/// energy (or none) and keeps momentum; what still approaches strikes again in the next round.
+/// Not counted in World::impact_work: like a round's own bookkeeping, it costs O(the contacts).
+ClusterOutcome solveContactByContact(const World& world, PreparedCluster& prepared) {
+  ClusterOutcome outcome;
+  outcome.normal.assign(prepared.contacts.size(), ContactOutcome{});
+  outcome.friction.assign(prepared.contacts.size(), FrictionOutcome{});
+  for (std::size_t c = 0; c < prepared.contacts.size(); ++c) {
+    const ClusterContact& contact = prepared.contacts[c];
+    ClusterBody& a = prepared.bodies[contact.a];
+    ClusterBody& b = prepared.bodies[contact.b];
+    if (!((b.velocity - a.velocity).dot(contact.normal) < 0)) continue;
+    const ContactResolution resolution = solveContact(
+        a, b, contact, world.friction_model ? prepared.friction[c] : 0.0, world.friction_model);
+    outcome.normal[c] = resolution.normal;
+    outcome.friction[c] = resolution.friction;
+  }
+  return outcome;
+}
+
+/// The cluster locked together (a perfectly plastic impact of the whole cluster), the fallback of
+/// a joint solve past the step's impact work: every movable body takes one velocity, after which
+/// no contact of the cluster approaches. Without an immovable participant, the cluster's centre
+/// of mass velocity: momentum kept, and of all velocities that keep it, the least kinetic energy,
+/// so none is gained. With immovable ones that all move alike (a fixed wall: at rest), theirs.
+/// Angular velocities are kept (a sphere's turning does not move its surface along a normal).
+/// Each contact's impulse and energy are those of its two bodies alone, J = -d / (w_a + w_b) and
+/// J (-d) / 2 (d its normal relative velocity before, < 0 where it approaches): the lock's
+/// forces between its contacts are indeterminate. False, nothing changed, where immovable
+/// participants move differently (no velocity keeps every contact from approaching).
+bool lockCluster(PreparedCluster& prepared, ClusterOutcome& outcome) {
+  std::vector<ClusterBody>& bodies = prepared.bodies;
+  const ClusterBody* immovable = nullptr;
+  long double mass = 0;
+  Eigen::Matrix<long double, 3, 1> momentum = Eigen::Matrix<long double, 3, 1>::Zero();
+  for (const ClusterBody& body : bodies) {
+    if (body.inverse_mass == 0.0) {
+      if (immovable != nullptr && body.velocity != immovable->velocity) return false;
+      immovable = &body;
+    } else {
+      mass += 1.0L / body.inverse_mass;
+      momentum += body.velocity.cast<long double>() / static_cast<long double>(body.inverse_mass);
+    }
+  }
+  const Eigen::Vector3d locked = immovable != nullptr
+                                     ? immovable->velocity
+                                     : Eigen::Vector3d((momentum / mass).cast<double>());
+  outcome.normal.assign(prepared.contacts.size(), ContactOutcome{});
+  outcome.friction.assign(prepared.contacts.size(), FrictionOutcome{});
+  for (std::size_t c = 0; c < prepared.contacts.size(); ++c) {
+    const ClusterContact& contact = prepared.contacts[c];
+    const ClusterBody& a = bodies[contact.a];
+    const ClusterBody& b = bodies[contact.b];
+    const double approach = -(b.velocity - a.velocity).dot(contact.normal);
+    ContactOutcome& normal = outcome.normal[c];
+    normal.approach_speed = approach;
+    if (approach > 0) {
+      normal.impulse = approach / (a.inverse_mass + b.inverse_mass);
+      normal.energy_lost = 0.5 * normal.impulse * approach;
+    }
+  }
+  for (ClusterBody& body : bodies) {
+    if (body.inverse_mass > 0.0) body.velocity = locked;
+  }
+  return true;
+}
+
+/// The cluster solved (solveCluster), its joint solves' work counted in World::impact_work
+/// against MonitorSettings::max_impact_work_per_step, each stopped where it would pass what the
+/// step has left. Where the normal solve is stopped, or the step's work is spent already,
+/// `stopped` is set and the bodies are as they were (the caller locks the cluster with what
+/// touches it: lockTouching); where the friction solve is stopped, its impulses are where it got
+/// to (within mu J, no energy added) and the cluster's movable bodies are named in
+/// report.over_impact_work. A single contact is its closed form, never bounded.
+ClusterOutcome solveWithinBudget(World& world, PreparedCluster& prepared, StepReport& report,
+                                 bool& stopped) {
+  const std::size_t budget = world.settings.max_impact_work_per_step;
+  const bool joint = prepared.contacts.size() > 1;
+  WorkBound work;
+  if (budget > 0) work.limit = budget - std::min(budget, world.impact_work);
+  const bool spent = budget > 0 && joint && world.impact_work >= budget;
+  ClusterOutcome outcome;
+  if (!spent) {
+    const std::vector<ClusterBody> before = prepared.bodies;
+    outcome = solveCluster(prepared.bodies, prepared.contacts, prepared.friction,
+                           world.friction_model, &work);
+    world.impact_work += work.spent;
+    if (outcome.normal.empty()) prepared.bodies = before;  // stopped: as they were
+  }
+  stopped = spent || outcome.normal.empty();
+  if (stopped) return outcome;
+  if (work.cut) {
+    for (const std::size_t member : prepared.members) {
+      if (!world.isObstacle(member) && world.inverseMassOf(member) > 0) {
+        report.over_impact_work.push_back(member);
+      }
+    }
+  }
+  return outcome;
 }
 
 /// The cluster's movable bodies continue from `time` with their new velocities.
@@ -276,6 +382,39 @@ void recordImpacts(const World& world, double time, const std::vector<InstantCon
     record.energy_lost = outcome.normal[c].energy_lost + outcome.friction[c].energy_lost;
     report.impacts.push_back(record);
   }
+}
+
+/// The instant's contacts (indices into `contacts`) connected to those of `cluster` through
+/// movable bodies, in order: the cluster and everything that touches it, transitively.
+std::vector<std::size_t> touchingComponent(const World& world,
+                                           const std::vector<InstantContact>& contacts,
+                                           const std::vector<std::size_t>& cluster) {
+  std::vector<std::size_t> parent(world.bodyCount());
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto find = [&parent](std::size_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  const auto movable = [&world](std::size_t participant) {
+    return !world.isObstacle(participant) && world.inverseMassOf(participant) > 0;
+  };
+  const auto root_of = [&](const Pair& pair) {
+    return movable(pair.first) ? find(pair.first) : find(pair.second);
+  };
+  for (const InstantContact& contact : contacts) {
+    const auto [a, other] = contact.pair;
+    if (movable(a) && movable(other)) parent[find(a)] = find(other);
+  }
+  std::vector<char> reached(world.bodyCount(), 0);
+  for (const std::size_t k : cluster) reached[root_of(contacts[k].pair)] = 1;
+  std::vector<std::size_t> component;
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    const Pair& pair = contacts[k].pair;
+    if ((movable(pair.first) || movable(pair.second)) && reached[root_of(pair)]) {
+      component.push_back(k);
+    }
+  }
+  return component;
 }
 
 /// The movable bodies among the contacts' participants, sorted.
@@ -611,6 +750,31 @@ void storeInelasticVelocities(World& world, double time,
   }
 }
 
+/// Past the step's impact work (solveWithinBudget stopped), the cluster and every body that
+/// touches it at the instant, transitively, are locked together (lockCluster; contact by contact
+/// where immovable participants move differently: solveContactByContact): no contact among them
+/// approaches after it, so the instant's rounds end there for them. Their impacts are recorded
+/// (those that took an impulse), their bodies named in report.over_impact_work.
+template <class Motion>
+void lockTouching(World& world, double time, const std::vector<InstantContact>& contacts,
+                  const std::vector<std::size_t>& cluster, StepReport& report,
+                  std::vector<std::size_t>& changed) {
+  const std::vector<std::size_t> component = touchingComponent(world, contacts, cluster);
+  std::vector<char> joined(contacts.size(), 2);  // recorded only where it takes an impulse
+  PreparedCluster prepared = prepareCluster<Motion>(world, time, contacts, component, joined);
+  const std::vector<ClusterBody> before = prepared.bodies;
+  ClusterOutcome outcome;
+  if (!lockCluster(prepared, outcome)) outcome = solveContactByContact(world, prepared);
+  storeVelocities<Motion>(world, time, prepared, changed);
+  recordImpacts<Motion>(world, time, contacts, component, prepared, before, outcome, joined,
+                        report);
+  for (const std::size_t member : prepared.members) {
+    if (!world.isObstacle(member) && world.inverseMassOf(member) > 0) {
+      report.over_impact_work.push_back(member);
+    }
+  }
+}
+
 }  // namespace
 
 template <class Motion>
@@ -650,8 +814,12 @@ void resolveInstant(World& world, double time, const std::vector<Pair>& touching
     for (const std::vector<std::size_t>& cluster : formClusters(world, contacts, striking)) {
       PreparedCluster prepared = prepareCluster<Motion>(world, time, contacts, cluster, joined);
       const std::vector<ClusterBody> before = prepared.bodies;
-      const ClusterOutcome outcome =
-          solveCluster(prepared.bodies, prepared.contacts, prepared.friction, world.friction_model);
+      bool stopped = false;
+      const ClusterOutcome outcome = solveWithinBudget(world, prepared, report, stopped);
+      if (stopped) {
+        lockTouching<Motion>(world, time, contacts, cluster, report, changed);
+        continue;
+      }
       progress.solved(cluster, prepared.contacts, before, prepared.bodies, outcome);
       storeVelocities<Motion>(world, time, prepared, changed);
       recordImpacts<Motion>(world, time, contacts, cluster, prepared, before, outcome, joined,

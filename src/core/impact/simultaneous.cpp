@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <limits>
 
 #include "collision_response/core/impact.h"
 #include "impact/order_free.h"
@@ -42,7 +43,7 @@ using SparseRows = std::vector<std::vector<std::pair<std::size_t, double>>>;
 /// double), or after 10 n iterations. Every sum is order-free, so the answer is the same for any
 /// numbering of the contacts.
 VectorL conjugateGradients(const SparseRows& rows, const std::vector<std::size_t>& active,
-                           const VectorL& b) {
+                           const VectorL& b, WorkBound* work) {
   const std::size_t n = active.size();
   std::vector<long> slot(rows.size(), -1);
   for (std::size_t i = 0; i < n; ++i) slot[active[i]] = static_cast<long>(i);
@@ -70,6 +71,13 @@ VectorL conjugateGradients(const SparseRows& rows, const std::vector<std::size_t
   RealL rs = dot(r, r);
   const RealL goal = RealL(1e-15) * RealL(1e-15) * rs;
   for (std::size_t iteration = 0; iteration < 10 * n && rs > goal; ++iteration) {
+    if (work != nullptr) {
+      if (work->left() < n) {
+        work->cut = true;
+        break;
+      }
+      work->spent += n;
+    }
     const VectorL ap = apply(p);
     const RealL curvature = dot(p, ap);
     if (!(curvature > 0)) break;
@@ -86,7 +94,10 @@ VectorL conjugateGradients(const SparseRows& rows, const std::vector<std::size_t
 /// A block's impulses by the active set: solve for the contacts still active, drop the one that
 /// would pull hardest, until none pulls. `rows` and `target` ((1 + e) (-d)) in the block's
 /// numbering.
-std::vector<double> solveBlock(const SparseRows& rows, const std::vector<RealL>& target) {
+///
+/// `work` (optional): where it runs out (work->cut), the answer is to be discarded.
+std::vector<double> solveBlock(const SparseRows& rows, const std::vector<RealL>& target,
+                               WorkBound* work) {
   const std::size_t count = rows.size();
   std::vector<bool> active(count, true);
   std::vector<double> impulses(count, 0.0);
@@ -100,6 +111,14 @@ std::vector<double> solveBlock(const SparseRows& rows, const std::vector<RealL>&
     for (Eigen::Index i = 0; i < size; ++i) right[i] = target[kept[static_cast<std::size_t>(i)]];
     Eigen::VectorXd solution;
     if (count <= kDenseBlockContacts) {
+      if (work != nullptr) {
+        const std::size_t cost = WorkBound::denseStep(kept.size());
+        if (work->left() < cost) {
+          work->cut = true;
+          break;
+        }
+        work->spent += cost;
+      }
       // Solved in long double (11 more bits) and rounded once: the impulses are the doubles
       // nearest the exact solution, so contacts that are mirror images of each other receive the
       // same impulse to the bit, whatever order the solver visits them in.
@@ -114,7 +133,8 @@ std::vector<double> solveBlock(const SparseRows& rows, const std::vector<RealL>&
       // Minimum-norm least squares: also right when two contacts are redundant (A singular).
       solution = system.completeOrthogonalDecomposition().solve(right).cast<double>();
     } else {
-      solution = conjugateGradients(rows, kept, right).cast<double>();
+      solution = conjugateGradients(rows, kept, right, work).cast<double>();
+      if (work != nullptr && work->cut) break;
     }
     std::fill(impulses.begin(), impulses.end(), 0.0);
     Eigen::Index most_negative = -1;
@@ -138,8 +158,13 @@ std::vector<double> solveBlock(const SparseRows& rows, const std::vector<RealL>&
 
 }  // namespace
 
+std::size_t WorkBound::left() const {
+  return limit == 0 ? std::numeric_limits<std::size_t>::max() : limit - std::min(limit, spent);
+}
+
 std::vector<ContactOutcome> resolveSimultaneous(std::vector<ClusterBody>& bodies,
-                                                const std::vector<ClusterContact>& contacts) {
+                                                const std::vector<ClusterContact>& contacts,
+                                                WorkBound* work) {
   if (contacts.size() == 1) return resolveOne(bodies, contacts.front());
 
   const std::size_t count = contacts.size();
@@ -194,7 +219,8 @@ std::vector<ContactOutcome> resolveSimultaneous(std::vector<ClusterBody>& bodies
       target[i] = (1.0L + contacts[k].restitution) * approach[static_cast<Eigen::Index>(k)];
       for (const std::size_t l : neighbours[k]) rows[i].emplace_back(place[l], coupling(k, l));
     }
-    const std::vector<double> solved = solveBlock(rows, target);
+    const std::vector<double> solved = solveBlock(rows, target, work);
+    if (work != nullptr && work->cut) return {};  // the bodies untouched
     for (std::size_t i = 0; i < block.size(); ++i) {
       impulses[static_cast<Eigen::Index>(block[i])] = solved[i];
     }

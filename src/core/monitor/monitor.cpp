@@ -390,9 +390,19 @@ void stepOverBudget(World& world, const monitor::PairIndex& index, std::vector<s
 /// The first contacts of the pairs of the bodies whose motion changed scheduled again (at the
 /// start: of every pair).
 template <class Motion>
-void scheduleChanged(ContactSchedule<Motion>& schedule, bool first, const StepProgress& at) {
+void scheduleChanged(const World& world, ContactSchedule<Motion>& schedule, bool first,
+                     const StepProgress& at) {
   if (first) {
-    schedule.scheduleAll(at.instant, at.changed);
+    // Each body once, in the order first changed (without gravity `changed` holds a body once a
+    // round it took part in: a lattice's thousands, each round); a body's pairs are added at its
+    // first mention, so the later ones added nothing.
+    std::vector<std::size_t> once;
+    std::vector<char> seen(world.bodyCount(), 0);
+    for (const std::size_t body : at.changed) {
+      if (!seen[body]) once.push_back(body);
+      seen[body] = 1;
+    }
+    schedule.scheduleAll(at.instant, once);
   } else {
     for (const std::size_t body : at.changed) schedule.reschedule(body, at.instant);
     for (const std::size_t body : at.extended) schedule.reschedule(body, at.instant);
@@ -444,6 +454,15 @@ void reportLastingContact(World& world, double time, StepReport& report) {
   report.stepped_bodies = monitor::steppedBodies(world);
 }
 
+/// What the step's impact clusters' joint solves spent (MonitorSettings::max_impact_work_per_step),
+/// and the bodies of the clusters its bound cut short, each once.
+void reportImpactWork(const World& world, StepReport& report) {
+  report.impact_work = world.impact_work;
+  std::vector<std::size_t>& cut = report.over_impact_work;
+  std::sort(cut.begin(), cut.end());
+  cut.erase(std::unique(cut.begin(), cut.end()), cut.end());
+}
+
 /// Continuous detection: from the last states, the first contact of every candidate pair,
 /// earliest first, and (gravity) the events of the groups of lasting contact; at each instant of
 /// contact the touching contacts are resolved, the groups of the bodies whose motion changed
@@ -462,6 +481,7 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
   world.work.assign(world.bodies.size(), 0);
   world.work_total = 0;
   world.work_all_spent = false;
+  world.impact_work = 0;
   monitor::candidatePairs<Motion>(world, world.now, time, world.scratch.pairs);
   ContactSchedule<Motion> schedule(world, time);
   const monitor::PairIndex index{world.scratch.pairs, world.scratch.pairs_of};
@@ -482,7 +502,7 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
       stepOverBudget<Motion>(world, index, charged, at.instant, at.changed, report);
     }
     at.event_bodies.clear();
-    scheduleChanged<Motion>(schedule, first, at);
+    scheduleChanged<Motion>(world, schedule, first, at);
     at.extended.clear();
     if (!nextEvent<Motion>(world, schedule, imposed, time, at)) break;
   }
@@ -494,6 +514,7 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
     reportLastingContact(world, time, report);
     report.exact_work = world.work_total;
   }
+  reportImpactWork(world, report);
   return report;
 }
 
@@ -666,6 +687,7 @@ template <class Motion>
 StepReport discreteStep(World& world, double time, const std::vector<BodyStateSample>& states) {
   StepReport report;
   world.sample_period = time - world.now;
+  world.impact_work = 0;
   if constexpr (Motion::kAccelerates) advanceLastingContact<Motion>(world, time, report);
   applyStates(world, states, report, true);
   world.now = time;
@@ -689,6 +711,7 @@ StepReport discreteStep(World& world, double time, const std::vector<BodyStateSa
     reportLastingContact(world, time, report);
     report.exact_work = world.work_total;
   }
+  reportImpactWork(world, report);
   return report;
 }
 

@@ -238,6 +238,9 @@ struct World {
   std::size_t work_total = 0;   // the sum of `work`
   bool work_all_spent = false;  // work_total ran over the step's budget in all (monitor.cpp)
   std::size_t work_budget = 0;  // Scene::exact_work_budget; 0: none
+  /// What the impact clusters' joint solves spent in the step being taken (contact iterations:
+  /// MonitorSettings::max_impact_work_per_step).
+  std::size_t impact_work = 0;
   Scratch scratch;
   bool started = false;
   double now = 0.0;
