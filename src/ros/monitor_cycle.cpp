@@ -189,6 +189,26 @@ bool MonitorCycle::obstacleFrameMissing() const {
 
 namespace {
 
+/// The bodies of impacts the update's impact work bound cut short (core::StepReport::
+/// over_impact_work), named, at most a few: the count says how many.
+Report overImpactWorkReport(const core::ImpactMonitor& monitor, const core::StepReport& step) {
+  constexpr std::size_t kNamed = 8;
+  std::string names;
+  for (std::size_t i = 0; i < step.over_impact_work.size() && i < kNamed; ++i) {
+    names += (i ? ", '" : "'") + monitor.body(step.over_impact_work[i]).id + "'";
+  }
+  if (step.over_impact_work.size() > kNamed) {
+    names += " and " + std::to_string(step.over_impact_work.size() - kNamed) + " more";
+  }
+  return {Reason::kOverImpactWork,
+          "the impacts of " + names + " at one instant ran over the update's impact work (" +
+              std::to_string(core::MonitorSettings{}.max_impact_work_per_step) +
+              " contact iterations): their friction was cut short, or they were locked together "
+              "with what touches them (no energy gained, none left approaching another; "
+              "doc/model.md, \"Simultaneous contacts\")",
+          step.over_impact_work.size()};
+}
+
 /// "N s behind" or "N s ahead of" for a clock offset (ns) from the time line.
 std::string offsetText(std::int64_t offset) {
   return core::formatNumber(std::abs(static_cast<double>(offset)) * 1e-9) + " s " +
@@ -269,10 +289,12 @@ void MonitorCycle::reportClockOffset(const std::string& source, const TimeLine::
     Report report{
         Reason::kClockOffset,
         source + " sent header.stamp " + formatStamp(newest) + ", off its clock by more than " +
-            "~clock_jump_back (" + core::formatNumber(params_.clock_jump_back) + " s): " +
-            (second ? "it interleaves two clocks; this one is placed on the line on its own, "
-                    : "one odd stamp, a publisher interleaving two clocks, or its clock leapt "
-                      "ahead? Placed on a clock of its own, ") +
+            "~clock_jump_back (" + core::formatNumber(params_.clock_jump_back) + " s)" +
+            (second ? ": it interleaves two clocks; this one is placed on the line on its own, "
+                    : ", or ahead of this node's clock by more than a tenth of it: one odd "
+                      "stamp, a publisher interleaving two clocks, or its clock leapt ahead or "
+                      "runs fast (a bag played faster than it was recorded, without "
+                      "use_sim_time)? Placed on a clock of its own, ") +
             offsetText(placed.clock_offset) +
             " the time line; its other clock and every other source keep theirs"};
     report.variant = second ? 1 : 2;
@@ -359,6 +381,9 @@ void MonitorCycle::reportStep(const core::StepReport& step, Update& update) cons
          held});
   }
   if (!step.over_budget.empty()) update.reports.push_back(overBudgetReport(step));
+  if (!step.over_impact_work.empty()) {
+    update.reports.push_back(overImpactWorkReport(monitor_, step));
+  }
 }
 
 Report MonitorCycle::overBudgetReport(const core::StepReport& step) const {
