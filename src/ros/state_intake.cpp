@@ -110,6 +110,8 @@ const char* counterName(Reason reason) {
       return "obstacle placements left out";
     case Reason::kFrameJumped:
       return "frames jumped";
+    case Reason::kOverImpactWork:
+      return "bodies of impacts over the impact work bound";
   }
   return "unknown";
 }
