@@ -187,14 +187,16 @@ bool ImpactMonitorRos::processHead(const Pending& head) {
     update_began_ = began;
   }
   MonitorCycle::Update update;
+  MonitorFigures figures;
   {
     std::lock_guard<std::mutex> lock(monitor_mutex_);
     update = cycle_.process(input, ros::Time::now(), may_wait, tf_buffer_);
+    figures = MonitorFigures::of(cycle_);
   }
   {
     std::lock_guard<std::mutex> lock(diagnostics_mutex_);
     update_began_ = ros::WallTime();
-    figures_ = MonitorFigures::of(cycle_);
+    figures_ = std::move(figures);
   }
   if (update.waiting) return false;
   tell(head.topic, update.reports);
@@ -235,8 +237,13 @@ void ImpactMonitorRos::publishMarkers(const MonitorCycle::Update& update) {
   const ros::WallTime now = ros::WallTime::now();
   if ((now - last_scene_markers_).toSec() >= 1.0 / params_.markers.rate) {
     last_scene_markers_ = now;
-    appendSceneMarkers(cycle_.monitor(), update.time, cycle_.scene().fixed_frame, update.stamp,
-                       params_.markers, markers);
+    {
+      // A const query of the monitor may integrate a curved contact's motion on (its caches):
+      // not at once with a prediction's reading of it.
+      std::lock_guard<std::mutex> lock(monitor_mutex_);
+      appendSceneMarkers(cycle_.monitor(), update.time, cycle_.scene().fixed_frame, update.stamp,
+                         params_.markers, markers);
+    }
     appendContactMarkers(update.contacts, contact_markers_, params_.markers, markers);
     contact_markers_ = update.contacts.contacts.size();
   } else if (update.contacts.contacts.size() < contact_markers_) {
@@ -276,12 +283,14 @@ void ImpactMonitorRos::tell(const std::string& topic, const std::vector<Report>&
 
 void ImpactMonitorRos::tune(core::Detection detection, double restitution_threshold,
                             core::CombineRule rule) {
+  MonitorFigures figures;
   {
     std::lock_guard<std::mutex> lock(monitor_mutex_);
     cycle_.tune(detection, restitution_threshold, rule);
+    figures = MonitorFigures::of(cycle_);
   }
   std::lock_guard<std::mutex> lock(diagnostics_mutex_);
-  figures_ = MonitorFigures::of(cycle_);
+  figures_ = std::move(figures);
 }
 
 void ImpactMonitorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {

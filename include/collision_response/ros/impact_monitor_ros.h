@@ -98,8 +98,9 @@ class ImpactMonitorRos {
 
   ros::NodeHandle node_;
   MonitorParams params_;
-  /// Held by the monitor's thread while it changes the cycle (an update, live tuning), and by
-  /// predict() while it reads it.
+  /// Held by the monitor's thread while it changes the cycle (an update, live tuning) or queries
+  /// its motion (markers: a const query may integrate a curved contact's motion on, in caches),
+  /// and by predict() while it reads it.
   std::mutex monitor_mutex_;
   MonitorCycle cycle_;
   tf2_ros::Buffer tf_buffer_;
