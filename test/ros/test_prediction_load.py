@@ -22,6 +22,7 @@ in roscpp's subscriber queue (100), lost there uncounted, and impacts were misse
 """
 import math
 import os
+import shutil
 import struct
 import subprocess
 import tempfile
@@ -112,6 +113,7 @@ class PredictionLoad(unittest.TestCase):
                     node.wait(timeout=10)
                 except subprocess.TimeoutExpired:
                     node.kill()
+            shutil.rmtree(folder, ignore_errors=True)
 
     def run_probe(self, node):
         service = "/%s/predict_impacts" % NODE
