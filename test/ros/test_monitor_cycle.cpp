@@ -10,6 +10,7 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <random>
 #include <set>
 #include <string>
 #include <vector>
@@ -1504,6 +1505,79 @@ TEST_F(MovingRobotCycle, Issue41_Item8_AFrameThatJumpsKeepsItsLastGoodMotionAndI
     EXPECT_EQ(jumped, k == 50 || k == 51 ? 1u : 0u) << "update " << k;
     EXPECT_TRUE(update.impacts.impacts.empty());
   }
+}
+
+// Issue 41, item 4: a touching 6 x 6 x 6 lattice of balls with friction and spin closing on its
+// centre in one message: its joint solves would spend about 490,000 contact iterations in one
+// update (0.5 s); past the monitor's impact work bound (100,000) its impacts are cut short, and
+// the cycle says so: counted with the bodies' number, warned naming the first of them.
+core::Scene closingLatticeScene() {
+  core::Scene scene;
+  scene.effects.friction = true;
+  scene.effects.spin = true;
+  scene.materials.addMaterial("clay", core::Material{0.5, 0.3}, "materials");
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 6; ++j) {
+      for (int k = 0; k < 6; ++k) {
+        core::BodySpec body;
+        body.id = "ball_" + std::to_string(i) + std::to_string(j) + std::to_string(k);
+        body.mass = 0.1;
+        body.radius = 0.05;
+        body.material = "clay";
+        body.position = Eigen::Vector3d(0.1 * i, 0.1 * j, 0.1 * k);
+        scene.bodies.push_back(body);
+      }
+    }
+  }
+  core::BodySpec clock;  // far from the lattice: the later messages' only state
+  clock.id = "clock";
+  clock.mass = 0.1;
+  clock.radius = 0.05;
+  clock.material = "clay";
+  clock.position = Eigen::Vector3d(10, 0, 0);
+  scene.bodies.push_back(clock);
+  return scene;
+}
+
+class ClosingLatticeCycle : public Cycle {
+ protected:
+  ClosingLatticeCycle() : Cycle(closingLatticeScene()) {}
+};
+
+TEST_F(ClosingLatticeCycle, AnImpactPastTheImpactWorkBoundIsNamedAndCounted) {
+  const ros::Time start(1000, 0);
+  std::vector<BodyState> first;
+  const Eigen::Vector3d centre = Eigen::Vector3d::Constant(0.25);
+  std::mt19937_64 engine(3);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  for (const core::BodySpec& body : cycle_.scene().bodies) {
+    const bool ball = body.id != "clock";
+    const Eigen::Vector3d offset = body.position - centre;
+    BodyState s = state(body.id, start, body.position,
+                        ball ? Eigen::Vector3d(-offset + Eigen::Vector3d::UnitZ().cross(offset))
+                             : Eigen::Vector3d::Zero());
+    if (ball) {  // each spinning at up to 10 rad/s about an axis of its own (seeded)
+      s.twist.angular.x = 10 * unit(engine);
+      s.twist.angular.y = 10 * unit(engine);
+      s.twist.angular.z = 10 * unit(engine);
+    }
+    first.push_back(s);
+  }
+  send(first);
+  const MonitorCycle::Update update =
+      send({state("clock", at(start, 0.01), {10, 0, 0}, {0, 0, 0})});
+  EXPECT_FALSE(update.impacts.impacts.empty());
+  EXPECT_EQ(reportsOf(Reason::kOverImpactWork), 216u) << "every ball of the lattice, not the clock";
+  ASSERT_NE(firstReport(Reason::kOverImpactWork), nullptr);
+  const Report& report = *firstReport(Reason::kOverImpactWork);
+  EXPECT_EQ(report.text.find("the impacts of 'ball_000', 'ball_001'"), 0u) << report.text;
+  EXPECT_NE(report.text.find("and 208 more at one instant ran over the update's impact work "
+                             "(100000 contact iterations)"),
+            std::string::npos)
+      << report.text;
+  EXPECT_FALSE(isDrop(Reason::kOverImpactWork));
+  EXPECT_STREQ(counterName(Reason::kOverImpactWork),
+               "bodies of impacts over the impact work bound");
 }
 }  // namespace
 }  // namespace collision_response
