@@ -532,9 +532,10 @@ def main():
             f"From the first sample to the last: {samples[-1][1] - samples[0][1]:+.1f} MB; over "
             f"the second half of the run: {samples[-1][1] - samples[len(samples) // 2][1]:+.1f} MB "
             f"(largest sample {max(mb for _, mb in samples):.1f} MB). What the node holds is "
-            "bounded: `body_states`' subscriber queue (100 arrays of about 1.3 MB each, full "
-            "only while the node falls behind), `~queue_size` inputs waiting for transforms, "
-            "`~max_states` states per array, and a body without states for `~body_timeout` is "
+            "bounded: `~queue_size` inputs and `~max_states` states waiting (behind the "
+            "update in progress or for transforms; roscpp's subscriber queue, as long, is "
+            "emptied at once by the intake's own thread), `~max_states` states per array, and "
+            "a body without states for `~body_timeout` is "
             "forgotten. Memory freed after a backlog stays with the process (glibc's heap), "
             "so the resident size steps up while the node falls behind and stays flat after.",
             "",
