@@ -179,6 +179,7 @@ def predict_section(out):
 
 
 DROPPED_PILE_TITLE = "## A pile dropped into a box, with friction and spin (profile)"
+IMPACT_TITLE = "## One impact of many bodies"
 DROPPED_TITLE = "## Piles dropped into a box: what keeping up costs"
 
 # Issue 26's targets: the monitor's CPU per simulated second of the pile with friction and spin
@@ -540,13 +541,16 @@ def main():
             "so the resident size steps up while the node falls behind and stays flat after.",
             "",
         ]
-    # The profile of a pile dropped into a box is measured by hand (bench/pile_run.cpp, the
-    # command in its section): kept as it is.
+    # The profile of a pile dropped into a box and the impact of many bodies are measured by hand
+    # (bench/pile_run.cpp, bench/lattice_impact.cpp, the commands in their sections): kept as
+    # they are.
     kept = ""
-    if target.exists() and DROPPED_PILE_TITLE in target.read_text():
-        rest = target.read_text().split(DROPPED_PILE_TITLE, 1)[1]
-        kept = DROPPED_PILE_TITLE + (rest[:rest.index("\n## ")] if "\n## " in rest else rest)
-    target.write_text("\n".join(lines) + "\n" + ("\n" + kept.rstrip("\n") + "\n" if kept else ""))
+    for title in (DROPPED_PILE_TITLE, IMPACT_TITLE):
+        if target.exists() and title in target.read_text():
+            rest = target.read_text().split(title, 1)[1]
+            section = title + (rest[:rest.index("\n## ")] if "\n## " in rest else rest)
+            kept += "\n" + section.rstrip("\n") + "\n"
+    target.write_text("\n".join(lines) + "\n" + kept)
 
 
 if __name__ == "__main__":
