@@ -514,6 +514,7 @@ void MonitorCycle::stepMovingObstacles(const TimeLine::Placed& placed, const ros
     const ros::Time stamp = newest - ros::Duration(placed.time - time);
     between_motions_.resize(monitor_.obstacleCount());
     explain_missing_ = true;
+    chains_.reset();
     for (const std::size_t i : near_obstacles_) lookUpObstacle(i, stamp, tf, between_motions_[i]);
     placeObstacles(between_motions_, time, update, &near_obstacles_);
     const core::StepReport step = monitor_.step(time, {});
@@ -606,19 +607,30 @@ void MonitorCycle::lookUpObstacle(std::size_t i, const ros::Time& stamp, const t
   // A frame tf does not have is told without an exception and, but for the first of a pass (the
   // one a report names), without tf's text (2,000 missing links an update; a chain deeper than
   // tf walks lists every frame in it).
+  const ros::Duration interval(params_.frame_velocity_interval);
   if (frame != fixed && !tf.canTransform(fixed, frame, stamp)) {
-    std::string why = "not available";
-    if (explain_missing_) {
-      tf.canTransform(fixed, frame, stamp, &why);
-      explain_missing_ = false;
+    // A chain deeper than tf2 walks (1,000 frames) is followed hop by hop.
+    if (tf._frameExists(frame)) {
+      if (!chains_) chains_.emplace(tf, fixed);
+      motion = chains_->motion(frame, stamp, interval);
     }
-    motion = core::Expected<FrameMotion>(core::Error{frame, "no transform to '" + fixed + "' at " +
-                                                                std::to_string(stamp.toSec()) +
-                                                                ": " + tfErrorText(why)});
-    return;
+    if (!tf._frameExists(frame) || !*motion) {
+      std::string why = "not available";
+      if (explain_missing_) {
+        tf.canTransform(fixed, frame, stamp, &why);
+        explain_missing_ = false;
+      }
+      motion = core::Expected<FrameMotion>(
+          core::Error{frame, "no transform to '" + fixed + "' at " + std::to_string(stamp.toSec()) +
+                                 ": " + tfErrorText(why)});
+      return;
+    }
+    if (frame_kind_[i] == FrameKind::kUnknown) {
+      frame_kind_[i] = chains_->wholeStatic(frame) ? FrameKind::kStatic : FrameKind::kMoving;
+    }
+  } else {
+    motion = lookupFrameMotion(tf, fixed, frame, stamp, interval);
   }
-  motion =
-      lookupFrameMotion(tf, fixed, frame, stamp, ros::Duration(params_.frame_velocity_interval));
   frame_jumped_[i] = 0;
   if (*motion) {
     // Its surface's speed: its centre's, and its turning's at its bounding radius (once placed).
@@ -655,6 +667,7 @@ void MonitorCycle::lookUpObstacles(const ros::Time& stamp, const tf2::BufferCore
                                    std::vector<ObstacleMotion>& motions) {
   motions.resize(monitor_.obstacleCount());
   explain_missing_ = true;
+  chains_.reset();
   std::size_t rechecks = 0;
   for (std::size_t i = 0; i < monitor_.obstacleCount(); ++i) {
     if (frame_kind_[i] == FrameKind::kFixed) {

@@ -5,7 +5,9 @@
 #include <tf2/buffer_core.h>
 
 #include <Eigen/Geometry>
+#include <cstdint>
 #include <string>
+#include <unordered_map>
 
 #include "collision_response/core/expected.h"
 
@@ -38,5 +40,36 @@ core::Expected<FrameMotion> lookupFrameMotion(const tf2::BufferCore& buffer,
                                               const std::string& fixed_frame,
                                               const std::string& frame, const ros::Time& stamp,
                                               const ros::Duration& interval);
+
+/// Frames' motions relative to the fixed frame composed hop by hop, each frame's transform to
+/// its parent looked up once a stamp and kept (clear() forgets them): a robot's chain of links
+/// costs one hop a link, and a chain deeper than tf2 walks (tf2::BufferCore::MAX_GRAPH_DEPTH,
+/// 1,000 frames, beyond which tf2 takes it for a loop) is followed to its end. Each hop is
+/// interpolated at the stamp as tf2 interpolates it, so a pose is tf2's lookup, composed in
+/// another order.
+class FrameChains {
+ public:
+  FrameChains(const tf2::BufferCore& buffer, std::string fixed_frame);
+  /// As lookupFrameMotion.
+  core::Expected<FrameMotion> motion(const std::string& frame, const ros::Time& stamp,
+                                     const ros::Duration& interval);
+  /// Whether every hop from `frame` up to its root is static (on /tf_static: tf stamps its
+  /// latest transform zero).
+  bool wholeStatic(const std::string& frame);
+
+ private:
+  static constexpr std::size_t kMaxDepth = 1000000;  ///< hops: past it, a loop
+  struct Rooted {
+    std::string root;  ///< the chain's root frame; empty: not connected at that stamp
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  ///< root <- frame
+  };
+  using Poses = std::unordered_map<std::string, Rooted>;
+  const Rooted& rooted(const std::string& frame, const ros::Time& stamp);
+
+  const tf2::BufferCore& buffer_;
+  std::string fixed_frame_;
+  std::unordered_map<std::uint64_t, Poses> poses_;  ///< by stamp (ns)
+  std::unordered_map<std::string, bool> static_;    ///< wholeStatic, by frame
+};
 
 }  // namespace collision_response

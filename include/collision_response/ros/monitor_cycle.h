@@ -177,6 +177,9 @@ class MonitorCycle {
   std::vector<char> frame_jumped_;
   std::size_t next_recheck_ = 0;  ///< the static obstacle to look up again next (in turn)
   bool explain_missing_ = true;   ///< the next missing frame of a pass gets tf's text
+  /// The frames tf2 does not walk to, composed hop by hop: for one pass of lookups (one
+  /// stamp), made when first needed (it holds the pass's tf buffer).
+  std::optional<FrameChains> chains_;
   std::vector<std::size_t> near_obstacles_;
   ObstacleWork obstacle_work_;
   /// The input's samples, timed in place (timeSamples): working memory, kept between inputs.
