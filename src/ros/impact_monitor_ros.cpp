@@ -49,11 +49,15 @@ ImpactMonitorRos::ImpactMonitorRos(ros::NodeHandle node, const core::Scene& scen
   for (const core::BodySpec& body : scene.bodies) {
     if (body.topic.empty()) continue;
     const std::string topic = node_.resolveName(body.topic);
-    body_subscribers_.push_back(intake.subscribe<BodyState>(
-        topic, roscpp_queue,
+    // Typed as taking the event, so that roscpp hands over the connection's header (the
+    // publisher's name, the state's source on the time line); a lambda converted to a
+    // callback of the message alone gets an event of "unknown_publisher".
+    const boost::function<void(const ros::MessageEvent<const BodyState>&)> callback =
         [this, topic, id = body.id](const ros::MessageEvent<const BodyState>& event) {
           onState(event, topic, id);
-        }));
+        };
+    body_subscribers_.push_back(
+        intake.subscribe<const ros::MessageEvent<const BodyState>&>(topic, roscpp_queue, callback));
   }
   impact_publisher_ = node_.advertise<ImpactArray>("impacts", 100);
   contact_publisher_ = node_.advertise<ContactArray>("contacts", 100);
@@ -89,7 +93,13 @@ void ImpactMonitorRos::onStateArray(const ros::MessageEvent<const BodyStateArray
            message->states.size()}});
     return;
   }
-  enqueue(Pending{ros::WallTime::now(), array_topic_, event.getPublisherName(), "", message, {}});
+  enqueue(Pending{ros::WallTime::now(),
+                  ros::Time::now(),
+                  array_topic_,
+                  event.getPublisherName(),
+                  "",
+                  message,
+                  {}});
 }
 
 void ImpactMonitorRos::onState(const ros::MessageEvent<const BodyState>& event,
@@ -99,6 +109,7 @@ void ImpactMonitorRos::onState(const ros::MessageEvent<const BodyState>& event,
     diagnostics_.received(1);
   }
   enqueue(Pending{ros::WallTime::now(),
+                  ros::Time::now(),
                   topic,
                   event.getPublisherName(),
                   id,
@@ -190,7 +201,7 @@ bool ImpactMonitorRos::processHead(const Pending& head) {
   MonitorFigures figures;
   {
     std::lock_guard<std::mutex> lock(monitor_mutex_);
-    update = cycle_.process(input, ros::Time::now(), may_wait, tf_buffer_);
+    update = cycle_.process(input, head.clock, may_wait, tf_buffer_);
     figures = MonitorFigures::of(cycle_);
   }
   {

@@ -116,6 +116,10 @@ class FastBag(unittest.TestCase):
 
         offsets = {k: v for k, v in values.items() if k.startswith("clock offset of ")}
         self.assertTrue(any("/fast_bag/bag_ball" in k for k in offsets), values)
+        # A body's own topic names its publisher, as body_states does: it was
+        # "unknown_publisher" (a callback typed on the message alone has no connection header).
+        self.assertTrue(any("/fast_bag/bag_ball from /fast_bag_test" in k for k in offsets),
+                        offsets)
         self.assertFalse(any("/fast_bag/body_states" in k for k in offsets), offsets)
         dropped = {k: v for k, v in values.items()
                    if k.startswith("dropped:")}

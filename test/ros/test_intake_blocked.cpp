@@ -62,6 +62,10 @@ TEST(IntakeBlocked, WhileTheMonitorIsHeldEveryStateIsReceivedThenUsedOrCounted) 
   MonitorParams params;
   params.queue_size = kQueueSize;
   params.max_states = kMaxStates;
+  // The states keep the node's clock (stamped as published): their time line is the node's
+  // clock at their arrival, however long they wait. Taken when processed, the hold below put
+  // them further behind it than ~clock_jump_back and shifted their source onto a clock of its own.
+  params.clock_jump_back = 0.25;
   ImpactMonitorRos monitor(node, oneBallScene(), params);
 
   ros::NodeHandle publisher_node;
@@ -74,16 +78,16 @@ TEST(IntakeBlocked, WhileTheMonitorIsHeldEveryStateIsReceivedThenUsedOrCounted) 
   ASSERT_GT(publisher.getNumSubscribers(), 0u);
   ros::WallDuration(0.3).sleep();
 
-  // A ball in free flight, 300 states 5 ms apart, its stamps 5 ms apart.
+  // A ball in free flight at 1 m/s, 300 states about 5 ms apart, each stamped as published.
   const ros::Time start = ros::Time::now();
   for (int k = 0; k < kPublished; ++k) {
     BodyStateArray array;
-    array.header.stamp = start + ros::Duration(0.005 * k);
+    array.header.stamp = ros::Time::now();
     BodyState state;
     state.header = array.header;
     state.header.frame_id = "world";
     state.id = "probe";
-    state.pose.position.x = 0.005 * k;
+    state.pose.position.x = (array.header.stamp - start).toSec();
     state.pose.orientation.w = 1.0;
     state.twist.linear.x = 1.0;
     array.states.push_back(state);
@@ -112,7 +116,9 @@ TEST(IntakeBlocked, WhileTheMonitorIsHeldEveryStateIsReceivedThenUsedOrCounted) 
   EXPECT_EQ(valueOf(held, "states used (total)"), 0);
   EXPECT_EQ(valueOf(held, "dropped: input queue full (total)"), kPublished - kQueueSize);
 
-  // Released: the 20 are used, nothing else is dropped.
+  // Held four times ~clock_jump_back longer, then released: the 20 are used, nothing else is
+  // dropped, and their source keeps the node's clock.
+  ros::WallDuration(1.0).sleep();
   const ros::WallTime releasing = ros::WallTime::now();
   std::map<std::string, std::string> done;
   do {
@@ -130,6 +136,10 @@ TEST(IntakeBlocked, WhileTheMonitorIsHeldEveryStateIsReceivedThenUsedOrCounted) 
   EXPECT_EQ(dropped, kPublished - kQueueSize + kOversize);
   EXPECT_EQ(valueOf(done, "states used (total)") + dropped,
             valueOf(done, "states received (total)"));
+  for (const auto& [key, value] : done) {
+    EXPECT_NE(key.rfind("clock offset of ", 0), 0u)
+        << "a source that keeps the node's clock was shifted for waiting: " << key << " " << value;
+  }
 }
 
 }  // namespace

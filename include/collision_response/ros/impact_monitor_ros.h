@@ -72,6 +72,9 @@ class ImpactMonitorRos {
   /// a nodelet's publisher's message itself), or one state.
   struct Pending {
     ros::WallTime received;
+    /// The node's clock at its arrival: the time line's present for it (a long queue
+    /// ahead of it does not make its stamps look late).
+    ros::Time clock;
     std::string topic;
     std::string publisher;
     std::string own_body;  ///< a body's own topic: its id
