@@ -1,5 +1,11 @@
 #include "monitor/candidate_pairs.h"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+#include <variant>
+
 #include "monitor/motion_model.h"
 
 namespace collision_response::core::monitor {
@@ -28,6 +34,62 @@ bool mayReachObstacle(const World& world, const Box& box, std::size_t obstacle, 
   return spec.frame.empty() ? mayReach(placed, box) : mayReachMoving(placed, box, from, to);
 }
 
+Box obstacleReachBound(const World& world, std::size_t obstacle, double from, double to) {
+  const ObstacleSpec& spec = world.obstacles[obstacle];
+  const PlacedShape& placed = world.obstacle_tracks[obstacle].placed;
+  const RigidPose& pose = placed.pose;
+  if (std::holds_alternative<Plane>(placed.shape)) {
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    return Box{Eigen::Vector3d::Constant(-kInf), Eigen::Vector3d::Constant(kInf)};
+  }
+  // mayReach's box (a sphere's about its centre, a finite shape's bounding sphere's about its
+  // pose's origin), or mayReachMoving's (that of the origin's bounding sphere grown by |v| times
+  // the longest time from the placement).
+  const bool moves =
+      !spec.frame.empty() && !(pose.velocity.isZero() && pose.angular_velocity.isZero());
+  Eigen::Vector3d centre = pose.transform.translation();
+  double reach = boundingRadiusOf(placed.shape);
+  if (moves) {
+    reach += pose.velocity.norm() * std::max(std::abs(from - pose.time), std::abs(to - pose.time));
+  } else if (const Sphere* sphere = std::get_if<Sphere>(&placed.shape)) {
+    centre = sphere->centre;
+  }
+  reach += 1e-9 * (centre.lpNorm<Eigen::Infinity>() + reach);
+  return Box{centre.array() - reach, centre.array() + reach};
+}
+
+void ObstacleIndex::build(std::vector<Box> bounds, const std::vector<char>& entered) {
+  bounds_ = std::move(bounds);
+  gridded_.assign(bounds_.size(), 0);
+  entered_.clear();
+  always_.clear();
+  any_gridded_ = false;
+  for (std::size_t o = 0; o < bounds_.size(); ++o) {
+    if (!entered[o]) continue;
+    entered_.push_back(o);
+    if (bounds_[o].low.allFinite() && bounds_[o].high.allFinite()) {
+      gridded_[o] = 1;
+      any_gridded_ = true;
+    } else {
+      always_.push_back(o);
+    }
+  }
+  if (any_gridded_) grid_.build(bounds_, gridded_);
+}
+
+void ObstacleIndex::query(const Box& box, std::vector<std::size_t>& found) const {
+  found.clear();
+  if (!(box.low.allFinite() && box.high.allFinite())) {
+    found = entered_;  // a box the grid cannot place: every obstacle is asked
+    return;
+  }
+  if (any_gridded_) grid_.query(box, found);
+  const std::size_t gridded = found.size();
+  found.insert(found.end(), always_.begin(), always_.end());
+  std::inplace_merge(found.begin(), found.begin() + static_cast<std::ptrdiff_t>(gridded),
+                     found.end());
+}
+
 namespace {
 
 template <class Motion>
@@ -43,6 +105,18 @@ void broadphasePairs(World& world, double from, double to, std::vector<Pair>& pa
   }
   world.scratch.hash.build(boxes, active);
   world.scratch.hash.overlappingPairs(world.scratch.body_pairs);
+  // Each body asks the obstacles its box may reach through their grid, not each of them (a
+  // robot's 2,000 links beside a cluster of 1,728 balls: 3.5 million tests a step otherwise).
+  std::vector<Box> bounds(world.obstacles.size());
+  std::vector<char> entered(world.obstacles.size(), 0);
+  for (std::size_t o = 0; o < world.obstacles.size(); ++o) {
+    if (!world.obstacle_tracks[o].known) continue;
+    entered[o] = 1;
+    bounds[o] = obstacleReachBound(world, o, from, to);
+  }
+  ObstacleIndex obstacles;
+  obstacles.build(std::move(bounds), entered);
+  std::vector<std::size_t> near;
   pairs.clear();
   std::size_t next = 0;
   const std::vector<std::pair<std::size_t, std::size_t>>& body_pairs = world.scratch.body_pairs;
@@ -53,8 +127,9 @@ void broadphasePairs(World& world, double from, double to, std::vector<Pair>& pa
       }
     }
     if (!active[a] || world.inverse_mass[a] == 0.0) continue;
-    for (std::size_t o = 0; o < world.obstacles.size(); ++o) {
-      if (world.obstacle_tracks[o].known && mayReachObstacle(world, boxes[a], o, from, to)) {
+    obstacles.query(boxes[a], near);
+    for (const std::size_t o : near) {
+      if (mayReachObstacle(world, boxes[a], o, from, to)) {
         pairs.emplace_back(a, world.bodies.size() + o);
       }
     }
