@@ -32,33 +32,6 @@ std::vector<std::size_t> addReachablePairs(World& world, std::size_t body, doubl
 bool mayReachObstacle(const World& world, const Box& box, std::size_t obstacle, double from,
                       double to);
 
-/// The obstacles a box may reach, through a grid of their bounds (SpatialHash), so that a body
-/// asks only the near ones of a robot's thousands of links: a filter only, each caller still
-/// tests what it finds exactly, so the pairs are those of a test against every obstacle. An
-/// obstacle without a finite bound (a plane) is found by every query.
-class ObstacleIndex {
- public:
-  ObstacleIndex() = default;
-  ObstacleIndex(const ObstacleIndex&) = delete;  // the grid points into bounds_
-  ObstacleIndex& operator=(const ObstacleIndex&) = delete;
-
-  /// Enters each obstacle `o` with `entered[o]`: its bound `bounds[o]`, or, where that is not
-  /// finite, as one every query finds.
-  void build(std::vector<Box> bounds, const std::vector<char>& entered);
-
-  /// The entered obstacles whose bound overlaps `box` (all of them for a box that is not
-  /// finite), and those found by every query: sorted, each once.
-  void query(const Box& box, std::vector<std::size_t>& found) const;
-
- private:
-  std::vector<Box> bounds_;
-  std::vector<char> gridded_;
-  std::vector<std::size_t> entered_;  ///< every entered obstacle, sorted
-  std::vector<std::size_t> always_;   ///< those without a finite bound, sorted
-  SpatialHash grid_;
-  bool any_gridded_ = false;
-};
-
 /// A bound on where a body's box swept over [from, to] may reach `obstacle` (mayReachObstacle
 /// is false for a box that does not overlap it), grown by a relative 1e-9 against rounding;
 /// not finite where there is none (a plane).

@@ -27,6 +27,7 @@
 #include "geometry/motion.h"
 #include "geometry/narrow_phase.h"
 #include "impact/cluster_solver.h"
+#include "monitor/obstacle_index.h"
 
 namespace collision_response::core::monitor {
 
@@ -197,6 +198,7 @@ struct Scratch {
   std::vector<std::pair<double, std::size_t>> events;
   std::vector<std::pair<std::size_t, Box>> changed_boxes;
   std::vector<std::size_t> found;
+  ObstacleIndex obstacles;  ///< candidatePairs' (the obstacles' reach over its span)
 };
 
 struct World {
