@@ -5,6 +5,8 @@
 
 #include <limits>
 #include <random>
+#include <utility>
+#include <variant>
 #include <vector>
 
 #include "monitor/candidate_pairs.h"
@@ -87,6 +89,70 @@ TEST(ObstacleIndex, OnlyPlanesOrNothing) {
   index.build({plane, plane, plane}, {1, 0, 1});
   index.query(around(Eigen::Vector3d::Zero(), 1.0), found);
   EXPECT_EQ(found, (std::vector<std::size_t>{0, 2}));
+}
+
+// The bound candidatePairs enters an obstacle with holds every box its exact test accepts
+// (mayReachObstacle), over the span it was built for and any span within it (addReachablePairs
+// asks it for a body changed within the step): spheres, boxes, cylinders and capsules, fixed or
+// on a tf frame, at rest, moving, turning, placed before, within or after the span; planes have
+// none (found always).
+TEST(ObstacleIndex, BoundHoldsWhatTheExactTestAccepts) {
+  std::mt19937 random(8);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), size(0.01, 0.5);
+  World world;
+  for (int i = 0; i < 400; ++i) {
+    ObstacleSpec spec;
+    spec.frame = i % 3 == 0 ? "" : "link";
+    PlacedShape placed;
+    switch (i % 5) {
+      case 0:
+        placed.shape = Plane{Eigen::Vector3d(unit(random), unit(random), 1).normalized(), 0.1};
+        break;
+      case 1:
+        placed.shape = Cuboid{Eigen::Vector3d(size(random), size(random), size(random))};
+        break;
+      case 2:
+        placed.shape = Cylinder{size(random), size(random)};
+        break;
+      case 3:
+        placed.shape = Capsule{size(random), size(random)};
+        break;
+      default:
+        break;
+    }
+    placed.pose.time = 0.1 * unit(random);
+    placed.pose.transform.translation() = Eigen::Vector3d(unit(random), unit(random), unit(random));
+    placed.pose.transform.linear() =
+        Eigen::AngleAxisd(3 * unit(random),
+                          Eigen::Vector3d(unit(random), unit(random), 1).normalized())
+            .toRotationMatrix();
+    if (i % 4 == 0) placed.shape = Sphere{placed.pose.transform.translation(), size(random)};
+    if (i % 7 != 0)
+      placed.pose.velocity = 3 * Eigen::Vector3d(unit(random), unit(random), unit(random));
+    if (i % 2 == 0)
+      placed.pose.angular_velocity = 5 * Eigen::Vector3d(unit(random), 0, unit(random));
+    world.obstacles.push_back(spec);
+    world.obstacle_tracks.push_back(ObstacleTrack{true, placed});
+  }
+  const double from = 0.0, to = 0.05;
+  std::size_t accepted = 0;
+  for (std::size_t o = 0; o < world.obstacles.size(); ++o) {
+    const Box bound = obstacleReachBound(world, o, from, to);
+    const bool plane = std::holds_alternative<Plane>(world.obstacle_tracks[o].placed.shape);
+    EXPECT_EQ(finite(bound), !plane) << o;
+    for (int q = 0; q < 200; ++q) {
+      const Box box = around(1.5 * Eigen::Vector3d(unit(random), unit(random), unit(random)),
+                             0.1 * size(random));
+      const double start = from + (to - from) * 0.5 * (1 + unit(random));
+      const double end = start + (to - start) * 0.5 * (1 + unit(random));
+      for (const auto& [a, b] : {std::pair(from, to), std::pair(start, end)}) {
+        if (!mayReachObstacle(world, box, o, a, b)) continue;
+        ++accepted;
+        EXPECT_TRUE(!finite(bound) || bound.overlaps(box)) << o << " " << a << " " << b;
+      }
+    }
+  }
+  EXPECT_GT(accepted, 1000u);  // the boxes reach some obstacles
 }
 
 }  // namespace
