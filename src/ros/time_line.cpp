@@ -33,7 +33,9 @@ TimeLine::Placed TimeLine::start(const std::string& source, std::int64_t first, 
   started_ = true;
   // Line zero is `first` in the node's clock: a stamp far from the node's clock (one
   // arriving first, say) starts the line at the node's present, not at the stamp.
-  const std::int64_t offset = clock != 0 && !agrees(at, clock, true) ? clock - at : std::int64_t{0};
+  // Alone on the line at its start: ~clock_jump_back either way.
+  const std::int64_t offset =
+      clock != 0 && !agrees(at, clock, false) ? clock - at : std::int64_t{0};
   epoch_ = first + offset;
   last_clock_ = clock;
   first_source_ = source;
@@ -56,7 +58,7 @@ bool TimeLine::agrees(std::int64_t at, std::int64_t clock, bool clock_runs) cons
 
 std::int64_t TimeLine::newOffset(std::int64_t at, std::int64_t clock,
                                  const Present& present) const {
-  if (clock == 0 || agrees(at, clock, present.clock_runs)) return 0;
+  if (clock == 0 || agrees(at, clock, present.clock_runs && present.shared)) return 0;
   // A clock off the node's that another source keeps, which this stamp continues: on it, the
   // stamp is no more than ~clock_jump_back before that source's last one, nor ahead of where
   // that source is now (its last instant plus the node's time since). The two share it (two
@@ -81,8 +83,32 @@ std::int64_t TimeLine::newOffset(std::int64_t at, std::int64_t clock,
   return shared != nullptr ? shared->offset : present.line - (at - epoch_);
 }
 
+bool TimeLine::sharedWith(const std::string& source, std::int64_t node_clock) const {
+  if (node_clock == 0) return false;
+  for (const auto& [name, known] : sources_) {
+    if (name == source) continue;
+    for (const Clock& clock : known.clocks) {
+      // Heard lately, on the node's clock and not ahead of it when last placed: a source whose
+      // states a lead of this one's would put in the monitor's past. Sources that run ahead
+      // alike, or on clocks of their own (two topics of one burst of hand-made stamps), are
+      // not held back for each other.
+      if (clock.offset == 0 && clock.last_clock != 0 && node_clock - clock.last_clock <= jump_ns_ &&
+          clock.last_line <= clock.last_clock - epoch_ + ahead_ns_) {
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
 bool TimeLine::continues(const Clock& clock, std::int64_t at, const Present& present) const {
   if (at < clock.last_stamp - jump_ns_) return false;  // went back
+  if (present.clock_runs && !present.shared && clock.last_clock != 0) {
+    // Alone on the line: leapt ahead of where its own clock is now (its last instant plus the
+    // node's time since) by more than ~clock_jump_back, a stamp off it.
+    return at + clock.offset - epoch_ <=
+           clock.last_line + (present.node_clock - clock.last_clock) + jump_ns_;
+  }
   // Leapt ahead of the line's present (judged only with a running node's clock; without it, a
   // source's stamps going forward are its own business): the node's clock, by more than two
   // clocks that agree differ; a clock of its own (placed at the present), by more than
@@ -119,7 +145,7 @@ TimeLine::Placed TimeLine::on(Clock& clock, std::int64_t at, std::int64_t node_c
   ++clock.messages;
   if (at > clock.last_stamp) clock.last_stamp = at;
   std::int64_t line = at + clock.offset - epoch_;
-  if (present.clock_runs && clock.offset != 0 && line > present.line) {
+  if (present.clock_runs && present.shared && clock.offset != 0 && line > present.line) {
     // A clock of its own running ahead of the node's (a bag played faster than it was recorded,
     // without sim time): placed at the line's present, never past it, its offset following, so
     // that it moves no instant of another source (the monitor cannot step back to a state of
@@ -193,9 +219,14 @@ TimeLine::Placed TimeLine::place(const std::string& source, const ros::Time& sta
   // The line's present is the node's clock (epoch_ is line zero in it): no stamp, however far
   // ahead its source's clock runs, moves it. Without a node's clock that ran since the last
   // placement (none yet, or sim time standing still), the line's last instant.
-  const Present present = node_clock != 0 && node_clock > last_clock_
-                              ? Present{node_clock - epoch_, true}
-                              : Present{now_ns, false};
+  Present present{now_ns, false, false, node_clock};
+  if (node_clock != 0 && node_clock > last_clock_) {
+    present.clock_runs = true;
+    present.shared = sharedWith(source, node_clock);
+    // Shared, the node's clock; alone, a source that ran ahead of it carried the monitor
+    // there, and what comes next is placed no earlier than the line's last instant.
+    present.line = present.shared ? node_clock - epoch_ : std::max(node_clock - epoch_, now_ns);
+  }
   bool is_new = false;
   Source& known = sourceOf(source, is_new);
   known.heard = ++heard_;

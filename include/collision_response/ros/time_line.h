@@ -156,6 +156,13 @@ class TimeLine {
   struct Present {
     std::int64_t line = 0;  ///< ns on the line
     bool clock_runs = false;
+    /// Another source that keeps the node's clock (on it, and not ahead of it when last
+    /// placed) was heard within ~clock_jump_back of it: the line is shared, and no clock may carry
+    /// it past the present (it would put that source's next states in the monitor's past). A source
+    /// alone on it keeps its stamps as they are, however they run against the node's clock (a
+    /// test's or a simulator's burst of states stamped ahead): there is no one its lead could move.
+    bool shared = false;
+    std::int64_t node_clock = 0;  ///< ns (0: unknown)
   };
   /// Whether a stamp `at` agrees with the node's clock `clock`: no more than ~clock_jump_back
   /// behind it, nor more than ahead_ns_ ahead of a running one (~clock_jump_back of one that
@@ -164,6 +171,9 @@ class TimeLine {
   /// The offset of a new clock whose stamp is `at`: zero when it agrees with the node's clock,
   /// else the one that places it at the present.
   std::int64_t newOffset(std::int64_t at, std::int64_t clock, const Present& present) const;
+  /// Whether a source other than `source` that keeps the node's clock was heard within
+  /// ~clock_jump_back of `node_clock`.
+  bool sharedWith(const std::string& source, std::int64_t node_clock) const;
   Placed on(Clock& clock, std::int64_t at, std::int64_t node_clock, std::int64_t now,
             const Present& present);
   bool continues(const Clock& clock, std::int64_t at, const Present& present) const;
