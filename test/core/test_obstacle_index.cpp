@@ -9,6 +9,8 @@
 #include <variant>
 #include <vector>
 
+#include "contact/stepped_clusters.h"
+#include "geometry/narrow_phase.h"
 #include "monitor/candidate_pairs.h"
 
 namespace collision_response::core::monitor {
@@ -91,13 +93,9 @@ TEST(ObstacleIndex, OnlyPlanesOrNothing) {
   EXPECT_EQ(found, (std::vector<std::size_t>{0, 2}));
 }
 
-// The bound candidatePairs enters an obstacle with holds every box its exact test accepts
-// (mayReachObstacle), over the span it was built for and any span within it (addReachablePairs
-// asks it for a body changed within the step): spheres, boxes, cylinders and capsules, fixed or
-// on a tf frame, at rest, moving, turning, placed before, within or after the span; planes have
-// none (found always).
-TEST(ObstacleIndex, BoundHoldsWhatTheExactTestAccepts) {
-  std::mt19937 random(8);
+/// 400 obstacles: spheres, boxes, cylinders, capsules and planes, fixed or on a frame, at rest,
+/// moving and turning, placed at times about 0.
+World obstacles(std::mt19937& random) {
   std::uniform_real_distribution<double> unit(-1.0, 1.0), size(0.01, 0.5);
   World world;
   for (int i = 0; i < 400; ++i) {
@@ -134,6 +132,18 @@ TEST(ObstacleIndex, BoundHoldsWhatTheExactTestAccepts) {
     world.obstacles.push_back(spec);
     world.obstacle_tracks.push_back(ObstacleTrack{true, placed});
   }
+  return world;
+}
+
+// The bound candidatePairs enters an obstacle with holds every box its exact test accepts
+// (mayReachObstacle), over the span it was built for and any span within it (addReachablePairs
+// asks it for a body changed within the step): spheres, boxes, cylinders and capsules, fixed or
+// on a tf frame, at rest, moving, turning, placed before, within or after the span; planes have
+// none (found always).
+TEST(ObstacleIndex, BoundHoldsWhatTheExactTestAccepts) {
+  std::mt19937 random(8);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), size(0.01, 0.5);
+  const World world = obstacles(random);
   const double from = 0.0, to = 0.05;
   std::size_t accepted = 0;
   for (std::size_t o = 0; o < world.obstacles.size(); ++o) {
@@ -153,6 +163,53 @@ TEST(ObstacleIndex, BoundHoldsWhatTheExactTestAccepts) {
     }
   }
   EXPECT_GT(accepted, 1000u);  // the boxes reach some obstacles
+}
+
+// nearPairs' filter (a stepped cluster's bodies with the obstacles) holds every pair its exact
+// test accepts: a ball whose surface is within its reach, the obstacle's motion over the span
+// and the touching band of the obstacle's (contactGeometry of the obstacle moved on to the
+// instant: shapeAt) has its box overlap the obstacle's, at instants before and after the
+// obstacle's placement, with touching bands of 0 and of a tenth.
+TEST(ObstacleIndex, SteppedNearBoxesHoldWhatTheGeometryAccepts) {
+  std::mt19937 random(9);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), size(0.01, 0.2);
+  World world = obstacles(random);
+  const double span = 0.01;
+  std::size_t accepted = 0;
+  for (const double tolerance : {0.0, 0.1}) {
+    world.settings.contact_tolerance = tolerance;
+    for (std::size_t o = 0; o < world.obstacles.size(); ++o) {
+      const PlacedShape& placed = world.obstacle_tracks[o].placed;
+      const double moving = placed.pose.velocity.norm() * span;
+      for (int q = 0; q < 200; ++q) {
+        const double time = 0.2 * unit(random);
+        const Eigen::Vector3d centre =
+            1.5 * Eigen::Vector3d(unit(random), unit(random), unit(random));
+        const double radius = size(random), reach = 0.5 * size(random);
+        const ContactGeometry g =
+            contactGeometry(centre, radius, shapeAt(placed, time), tolerance,
+                            [] { return Eigen::Vector3d(Eigen::Vector3d::UnitX()); });
+        if (!g.valid || !(g.gap <= reach + moving + g.tolerance)) continue;
+        ++accepted;
+        const Box bound = nearObstacleBox(world, o, time, moving);
+        EXPECT_TRUE(!finite(bound) || bound.overlaps(nearBodyBox(world, radius, centre, reach)))
+            << o << " at " << time << ", gap " << g.gap;
+      }
+    }
+  }
+  EXPECT_GT(accepted, 1000u);
+  // At the edge: a ball of 0.1 m beside a sphere of 0.3 m along x, its gap its reach (0.05 m)
+  // plus the whole touching band of a tenth (0.04 m): near, so the boxes meet.
+  world.settings.contact_tolerance = 0.1;
+  world.obstacles.assign(1, ObstacleSpec{});
+  PlacedShape sphere;
+  sphere.shape = Sphere{Eigen::Vector3d::Zero(), 0.3};
+  world.obstacle_tracks.assign(1, ObstacleTrack{true, sphere});
+  const Eigen::Vector3d centre(0.1 + 0.3 + 0.05 + 0.04, 0, 0);
+  const ContactGeometry g = contactGeometry(
+      centre, 0.1, sphere, 0.1, [] { return Eigen::Vector3d(Eigen::Vector3d::UnitX()); });
+  ASSERT_LE(g.gap, 0.05 + g.tolerance);
+  EXPECT_TRUE(nearObstacleBox(world, 0, 0.0, 0.0).overlaps(nearBodyBox(world, 0.1, centre, 0.05)));
 }
 
 }  // namespace

@@ -42,32 +42,6 @@ double reachBefore(const World& world, std::size_t body, double time, double spa
   return (speed + world.gravity.norm() * span) * span + 0.5 * acceleration * span * span;
 }
 
-/// A box about obstacle `o`'s origin at its placement that a ball's box of half-width
-/// r (1 + contact_tolerance) + reach about its centre (nearBodyBox) must overlap for the
-/// ball's surface to be within reach + moving + the touching band of the obstacle's at `time`:
-/// the shape lies within its bounding radius R of its origin, which moves at most |v| |time -
-/// placement| (straight on, or on the screw of its twist: shapeAt), so the gap is at least the
-/// centres' distance less r, R and that; the band (contactGeometry's) is at most
-/// contact_tolerance (r + R) and a few roundings, the relative 1e-9 in each box. Not finite for a
-/// plane (every body asks it).
-Box nearObstacleBox(const World& world, std::size_t o, double time, double moving) {
-  const PlacedShape& placed = world.obstacle_tracks[o].placed;
-  const double bounding = boundingRadiusOf(placed.shape);
-  const Eigen::Vector3d& origin = placed.pose.transform.translation();
-  const double travel = placed.pose.velocity.norm() * std::abs(time - placed.pose.time);
-  double half = bounding * (1 + world.settings.contact_tolerance) + travel + moving;
-  half += 1e-9 * (origin.lpNorm<Eigen::Infinity>() + bounding + travel + moving);
-  return Box{origin.array() - half, origin.array() + half};
-}
-
-/// The ball's side of nearObstacleBox.
-Box nearBodyBox(const World& world, std::size_t body, const Eigen::Vector3d& centre, double reach) {
-  const double radius = world.radius[body];
-  double half = radius * (1 + world.settings.contact_tolerance) + reach;
-  half += 1e-9 * (centre.lpNorm<Eigen::Infinity>() + radius + reach);
-  return Box{centre.array() - half, centre.array() + half};
-}
-
 /// Every pair of tracked participants whose surfaces are within their reaches of each other at
 /// `time` (body pairs through a grid of their boxes; each movable body with the obstacles a
 /// grid of their bounds finds near it, nearObstacleBox), in the canonical order.
@@ -112,7 +86,7 @@ std::vector<Pair> nearPairs(const World& world, double time, double span,
   std::vector<std::size_t> near;
   for (std::size_t a = 0; a < n; ++a) {
     if (!active[a] || world.inverse_mass[a] == 0.0) continue;
-    obstacles.query(nearBodyBox(world, a, centres[a], reach[a]), near);
+    obstacles.query(nearBodyBox(world, world.radius[a], centres[a], reach[a]), near);
     for (const std::size_t o : near) {
       const Pair pair(a, n + o);
       const Geometry g = geometry<Motion>(world, pair, time);
@@ -572,6 +546,31 @@ ContactState clusterContactState(const World& world, double time,
 }
 
 }  // namespace
+
+// A box about obstacle `o`'s origin at its placement that a ball's box of half-width
+// r (1 + contact_tolerance) + reach about its centre (nearBodyBox) must overlap for the
+// ball's surface to be within reach + moving + the touching band of the obstacle's at `time`:
+// the shape lies within its bounding radius R of its origin, which moves at most |v| |time -
+// placement| (straight on, or on the screw of its twist: shapeAt), so the gap is at least the
+// centres' distance less r, R and that; the band (contactGeometry's) is at most
+// contact_tolerance (r + R) and a few roundings, the relative 1e-9 in each box. Not finite for a
+// plane (every body asks it).
+Box nearObstacleBox(const World& world, std::size_t o, double time, double moving) {
+  const PlacedShape& placed = world.obstacle_tracks[o].placed;
+  const double bounding = boundingRadiusOf(placed.shape);
+  const Eigen::Vector3d& origin = placed.pose.transform.translation();
+  const double travel = placed.pose.velocity.norm() * std::abs(time - placed.pose.time);
+  double half = bounding * (1 + world.settings.contact_tolerance) + travel + moving;
+  half += 1e-9 * (origin.lpNorm<Eigen::Infinity>() + bounding + travel + moving);
+  return Box{origin.array() - half, origin.array() + half};
+}
+
+// The ball's side of nearObstacleBox.
+Box nearBodyBox(const World& world, double radius, const Eigen::Vector3d& centre, double reach) {
+  double half = radius * (1 + world.settings.contact_tolerance) + reach;
+  half += 1e-9 * (centre.lpNorm<Eigen::Infinity>() + radius + reach);
+  return Box{centre.array() - half, centre.array() + half};
+}
 
 double nextSteppedEvent(const World& world, double time) {
   const Stepping& stepping = world.stepping;

@@ -61,4 +61,12 @@ void clearStepped(World& world, double time);
 /// How many bodies are in clusters.
 std::size_t steppedBodies(const World& world);
 
+/// A box about obstacle `o`'s origin at its placement that a ball's box nearBodyBox must overlap
+/// for the ball's surface to be within `reach` + `moving` + the touching band of the obstacle's
+/// at `time` (nearPairs' filter before the contact geometry; not finite for a plane).
+Box nearObstacleBox(const World& world, std::size_t o, double time, double moving);
+
+/// The ball's side of nearObstacleBox: a ball of `radius` at `centre` that may move `reach`.
+Box nearBodyBox(const World& world, double radius, const Eigen::Vector3d& centre, double reach);
+
 }  // namespace collision_response::core::monitor
