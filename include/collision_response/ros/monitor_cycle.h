@@ -60,8 +60,9 @@ class MonitorCycle {
     std::vector<Report> reports;
   };
 
-  /// `clock`: the node's clock now (ros::Time::now(); zero when unknown); `may_wait`: a missing
-  /// transform makes the input wait rather than drop. Never throws on any message content.
+  /// `clock`: the node's clock at the input's arrival (ros::Time::now() then; zero when
+  /// unknown); `may_wait`: a missing transform makes the input wait rather than drop. Never
+  /// throws on any message content.
   Update process(const Input& input, const ros::Time& clock, bool may_wait,
                  const tf2::BufferCore& tf);
 
