@@ -514,6 +514,7 @@ std::map<std::string, std::map<std::string, XmlRpc::XmlRpcValue>> examples() {
                      {"stepped_cluster_min_bodies", 40},
                      {"stepped_cluster_time_step", 0.005},
                      {"exact_work_budget", 300},
+                     {"max_mesh_bytes", 16777216},
                      {"restitution_combine", "max"}};
   values["materials.<name>"] = {{"restitution", 0.85}, {"friction", 0.9}};
   XmlRpc::XmlRpcValue pair;

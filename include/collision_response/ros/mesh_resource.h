@@ -20,9 +20,9 @@ namespace collision_response {
 /// for a binary STL of a million, 50 MB).
 inline constexpr std::size_t kDefaultMaxMeshBytes = std::size_t{128} << 20;
 
-/// The file a package:// or file:// address names: package://<package>/<path> is <path> in the
-/// package's directory (as resource_retriever resolves it), file://<path> an absolute path. Any
-/// other address (http://, a bare path, ...) is an error naming the scheme.
+/// The file a package:// or file:// address names: `package://<package>/<path>` is `<path>` in
+/// the package's directory (as resource_retriever resolves it), `file://<path>` an absolute
+/// path. Any other address (http://, a bare path, ...) is an error naming the scheme.
 core::Expected<std::string> meshResourcePath(const std::string& resource);
 
 /// The bytes of `path`: a regular file (not a device, a FIFO, a directory) of at most `max_bytes`,
