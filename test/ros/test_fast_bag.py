@@ -124,8 +124,12 @@ class FastBag(unittest.TestCase):
         dropped = {k: v for k, v in values.items()
                    if k.startswith("dropped:")}
         self.assertEqual(values.get("clock jumped back (total)", "0"), "0", values)
-        # Before the fix: the probe's source 5.07 s off, 465 of its 600 states set aside.
-        self.assertNotIn("dropped: state older than its body's motion (total)", values)
+        # Before the fix: the probe's source 5.07 s off, 465 of its 600 states set aside. Now at
+        # most the states of the bag's first tenth of ~clock_jump_back (0.1 s at 100 Hz: 10), while
+        # it may still carry the line past the present (README, ~clock_jump_back); one was, once,
+        # on a machine running two suites at once.
+        self.assertLessEqual(
+            int(values.get("dropped: state older than its body's motion (total)", "0")), 10, values)
         print("diagnostics: %s; dropped: %s" % (offsets, dropped))
 
 

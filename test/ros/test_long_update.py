@@ -148,8 +148,9 @@ class LongUpdate(unittest.TestCase):
             self.assertTrue(alive(player.pid), "the scene player stopped by itself")
             before = cpu_seconds(player.pid)
             time.sleep(1.0)
-            # Busy (inside the update), not waiting for its next tick.
-            self.assertGreater(cpu_seconds(player.pid) - before, 0.5, "the player is not busy")
+            # Busy (inside the update), not waiting for its next tick: a fifth of a core at
+            # least, whatever else the machine runs (0.35 s in 1 s beside two suites at once).
+            self.assertGreater(cpu_seconds(player.pid) - before, 0.2, "the player is not busy")
             self.assertLess(seconds_to_end(player), 1.0, "the scene player outlived SIGINT by 1 s")
         finally:
             listener.unregister()
