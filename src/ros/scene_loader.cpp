@@ -335,70 +335,99 @@ core::Expected<std::size_t> readMaxMeshBytes(const XmlRpc::XmlRpcValue& value,
   return static_cast<std::size_t>(*count);
 }
 
+// The scene's keys that are more than a number, a text or a vector: each read into the scene.
+
+core::Status readCombineRule(const XmlRpc::XmlRpcValue& value, const std::string& field,
+                             Scene& scene) {
+  const auto name = readString(value, field);
+  if (!name) return core::Status(name.error());
+  const auto rule = core::parseCombineRule(*name, field);
+  if (!rule) return core::Status(rule.error());
+  scene.materials.setCombineRule(*rule);
+  return core::Status(core::Ok{});
+}
+
+core::Status readMaterials(const XmlRpc::XmlRpcValue& value, const std::string& field,
+                           Scene& scene) {
+  if (auto status = checkStruct(value, field); !status) return status;
+  for (auto it = value.begin(); it != value.end(); ++it) {
+    const std::string entry_field = joinKey(field, it->first);
+    core::Material material;
+    if (auto status = readKeys(it->second, materialKeys(), entry_field, material); !status) {
+      return status;
+    }
+    if (auto status = scene.materials.addMaterial(it->first, material, entry_field); !status) {
+      return status;
+    }
+  }
+  return core::Status(core::Ok{});
+}
+
+core::Status readPairs(const XmlRpc::XmlRpcValue& value, const std::string& field, Scene& scene) {
+  std::vector<PairEntry> pairs;
+  return readList(
+      value, field, pairs,
+      [&scene](const XmlRpc::XmlRpcValue& entry, const std::string& entry_field, PairEntry& pair) {
+        pair.materials = &scene.materials;
+        if (auto status = readKeys(entry, pairKeys(), entry_field, pair); !status) {
+          return status;
+        }
+        return scene.materials.addPair(pair.first, pair.second, pair.coefficients, entry_field);
+      });
+}
+
+core::Status readDetection(const XmlRpc::XmlRpcValue& value, const std::string& field,
+                           Scene& scene) {
+  const auto name = readString(value, field);
+  if (!name) return core::Status(name.error());
+  const auto detection = core::parseDetection(*name, field);
+  if (!detection) return core::Status(detection.error());
+  scene.detection = *detection;
+  return core::Status(core::Ok{});
+}
+
+core::Status readEffects(const XmlRpc::XmlRpcValue& value, const std::string& field, Scene& scene) {
+  if (auto status = checkArray(value, field); !status) return status;
+  for (int i = 0; i < value.size(); ++i) {
+    const std::string item = indexKey(field, static_cast<std::size_t>(i));
+    const auto name = readString(value[i], item);
+    if (!name) return core::Status(name.error());
+    if (auto status = core::addEffect(*name, item, scene.effects); !status) return status;
+  }
+  return core::Status(core::Ok{});
+}
+
+core::Status readBodies(const XmlRpc::XmlRpcValue& value, const std::string& field, Scene& scene) {
+  return readList(value, field, scene.bodies,
+                  [](const XmlRpc::XmlRpcValue& entry, const std::string& entry_field,
+                     BodySpec& body) { return readKeys(entry, bodyKeys(), entry_field, body); });
+}
+
+core::Status readObstacles(const XmlRpc::XmlRpcValue& value, const std::string& field,
+                           Scene& scene) {
+  return readList(value, field, scene.obstacles, readObstacle);
+}
+
+/// Only checked here: loadScene reads it again for the meshes it loads.
+core::Status checkMaxMeshBytes(const XmlRpc::XmlRpcValue& value, const std::string& field, Scene&) {
+  const auto limit = readMaxMeshBytes(value, field);
+  return limit ? core::Status(core::Ok{}) : core::Status(limit.error());
+}
+
+/// Read by loadScene, with the URDF it names.
+core::Status skipRobot(const XmlRpc::XmlRpcValue&, const std::string&, Scene&) {
+  return core::Status(core::Ok{});
+}
+
 const KeyTable<Scene>& sceneTable() {
   // The material keys first: bodies and pairs name materials.
   static const KeyTable<Scene> kKeys = {
-      {"restitution_combine", false,
-       [](const XmlRpc::XmlRpcValue& value, const std::string& field, Scene& scene) {
-         const auto name = readString(value, field);
-         if (!name) return core::Status(name.error());
-         const auto rule = core::parseCombineRule(*name, field);
-         if (!rule) return core::Status(rule.error());
-         scene.materials.setCombineRule(*rule);
-         return core::Status(core::Ok{});
-       }},
-      {"materials", false,
-       [](const XmlRpc::XmlRpcValue& value, const std::string& field, Scene& scene) {
-         if (auto status = checkStruct(value, field); !status) return status;
-         for (auto it = value.begin(); it != value.end(); ++it) {
-           const std::string entry_field = joinKey(field, it->first);
-           core::Material material;
-           if (auto status = readKeys(it->second, materialKeys(), entry_field, material); !status) {
-             return status;
-           }
-           if (auto status = scene.materials.addMaterial(it->first, material, entry_field);
-               !status) {
-             return status;
-           }
-         }
-         return core::Status(core::Ok{});
-       }},
-      {"pairs", false,
-       [](const XmlRpc::XmlRpcValue& value, const std::string& field, Scene& scene) {
-         std::vector<PairEntry> pairs;
-         return readList(value, field, pairs,
-                         [&scene](const XmlRpc::XmlRpcValue& entry, const std::string& entry_field,
-                                  PairEntry& pair) {
-                           pair.materials = &scene.materials;
-                           if (auto status = readKeys(entry, pairKeys(), entry_field, pair);
-                               !status) {
-                             return status;
-                           }
-                           return scene.materials.addPair(pair.first, pair.second,
-                                                          pair.coefficients, entry_field);
-                         });
-       }},
+      {"restitution_combine", false, readCombineRule},
+      {"materials", false, readMaterials},
+      {"pairs", false, readPairs},
       textKey<Scene>("fixed_frame", [](Scene& s) -> std::string& { return s.fixed_frame; }),
-      {"detection", false,
-       [](const XmlRpc::XmlRpcValue& value, const std::string& field, Scene& scene) {
-         const auto name = readString(value, field);
-         if (!name) return core::Status(name.error());
-         const auto detection = core::parseDetection(*name, field);
-         if (!detection) return core::Status(detection.error());
-         scene.detection = *detection;
-         return core::Status(core::Ok{});
-       }},
-      {"effects", false,
-       [](const XmlRpc::XmlRpcValue& value, const std::string& field, Scene& scene) {
-         if (auto status = checkArray(value, field); !status) return status;
-         for (int i = 0; i < value.size(); ++i) {
-           const std::string item = indexKey(field, static_cast<std::size_t>(i));
-           const auto name = readString(value[i], item);
-           if (!name) return core::Status(name.error());
-           if (auto status = core::addEffect(*name, item, scene.effects); !status) return status;
-         }
-         return core::Status(core::Ok{});
-       }},
+      {"detection", false, readDetection},
+      {"effects", false, readEffects},
       vectorKey<Scene>("gravity", [](Scene& s) -> Eigen::Vector3d& { return s.gravity; }),
       numberKey<Scene>("restitution_threshold",
                        [](Scene& s) -> double& { return s.restitution_threshold; }),
@@ -415,27 +444,10 @@ const KeyTable<Scene>& sceneTable() {
                        [](Scene& s) -> double& { return s.stepped_cluster_time_step; }),
       countKey<Scene>(
           "exact_work_budget", [](Scene& s) -> int& { return s.exact_work_budget; }, 0),
-      {"bodies", false,
-       [](const XmlRpc::XmlRpcValue& value, const std::string& field, Scene& scene) {
-         return readList(
-             value, field, scene.bodies,
-             [](const XmlRpc::XmlRpcValue& entry, const std::string& entry_field, BodySpec& body) {
-               return readKeys(entry, bodyKeys(), entry_field, body);
-             });
-       }},
-      {"obstacles", false,
-       [](const XmlRpc::XmlRpcValue& value, const std::string& field, Scene& scene) {
-         return readList(value, field, scene.obstacles, readObstacle);
-       }},
-      {"robot", false,
-       [](const XmlRpc::XmlRpcValue&, const std::string&, Scene&) {
-         return core::Status(core::Ok{});  // read by loadScene, with the URDF it names
-       }},
-      {"max_mesh_bytes", false,
-       [](const XmlRpc::XmlRpcValue& value, const std::string& field, Scene&) {
-         const auto limit = readMaxMeshBytes(value, field);  // used by loadScene
-         return limit ? core::Status(core::Ok{}) : core::Status(limit.error());
-       }},
+      {"bodies", false, readBodies},
+      {"obstacles", false, readObstacles},
+      {"robot", false, skipRobot},
+      {"max_mesh_bytes", false, checkMaxMeshBytes},
   };
   return kKeys;
 }
