@@ -19,98 +19,40 @@ stamped t0 + 2 (now - t0): 6 s ahead of the node's clock by the end. Checked:
   source's own first states, up to a tenth of ~clock_jump_back ahead, then placed at the
   present, may be stale (counted).
 """
-import math
-import threading
-import time
 import unittest
 
 import rospy
 import rostest
-from diagnostic_msgs.msg import DiagnosticArray
-from collision_response.msg import BodyState, BodyStateArray, ImpactArray
+from collision_response.msg import BodyState, BodyStateArray
 
-G, R, H = 9.81, 0.05, 0.2
-TF = math.sqrt(2 * H / G)
-T = 2 * TF
+from probe_ball import (R, NodeListener, ball_state, bounce_instants, missing_instants,
+                        play_probe, wait_for_subscribers)
+
 RUN = 6.0
 NODE = "fast_bag_monitor"
 
 
-def probe_state(t0, t):
-    """The probe at t (s after t0 on the same clock): height and vertical speed in closed form."""
-    tau = math.fmod(t - t0 + TF, T) - TF  # time since the top of its current flight
-    return R + H - 0.5 * G * tau * tau, -G * tau
-
-
-def state(body, stamp, x, z, vz):
-    message = BodyState()
-    message.header.stamp = stamp
-    message.header.frame_id = "world"
-    message.id = body
-    message.pose.position.x, message.pose.position.z = x, z
-    message.pose.orientation.w = 1.0
-    message.twist.linear.z = vz
-    return message
-
-
 class FastBag(unittest.TestCase):
     def test_a_bag_at_twice_its_speed_moves_no_other_source(self):
-        impacts, lock = [], threading.Lock()
-
-        def on_impacts(message):
-            with lock:
-                impacts.extend(message.impacts)
-
-        rospy.Subscriber("/fast_bag/impacts", ImpactArray, on_impacts, queue_size=1000)
-        diagnostics = []
-        rospy.Subscriber("/diagnostics", DiagnosticArray,
-                         lambda message: diagnostics.extend(
-                             s for s in message.status if s.name.startswith(NODE)))
+        listener = NodeListener("/fast_bag/impacts", NODE)
         probe = rospy.Publisher("/fast_bag/body_states", BodyStateArray, queue_size=1000)
         bag = rospy.Publisher("/fast_bag/bag_ball", BodyState, queue_size=1000)
-        deadline = time.monotonic() + 30
-        while ((probe.get_num_connections() == 0 or bag.get_num_connections() == 0)
-               and time.monotonic() < deadline):
-            time.sleep(0.05)
-        time.sleep(0.5)
+        wait_for_subscribers([probe, bag])
+        rospy.sleep(0.5)
 
-        t0 = rospy.Time.now().to_sec()
-        published = 0
-        rate = rospy.Rate(100)
-        while rospy.Time.now().to_sec() - t0 < RUN:
-            now = rospy.Time.now()
-            z, vz = probe_state(t0, now.to_sec())
-            array = BodyStateArray()
-            array.header.stamp = now
-            array.states.append(state("probe", now, -2.0, z, vz))
-            probe.publish(array)
-            published += 1
-            last = now.to_sec()
+        def bag_state(now, t0):
             # The bag's clock: twice the node's since t0.
             ahead = rospy.Time.from_sec(t0 + 2.0 * (rospy.Time.now().to_sec() - t0))
-            bag.publish(state("bag_ball", ahead, 50.0, R, 0.0))
-            rate.sleep()
+            bag.publish(ball_state("bag_ball", ahead, 50.0, R, 0.0))
+            return 1
 
-        deadline = time.monotonic() + 20
-        values = {}
-        while time.monotonic() < deadline:
-            time.sleep(0.5)
-            if diagnostics:
-                values = {v.key: v.value for v in diagnostics[-1].values}
-                if (values.get("messages waiting") == "0"
-                        and int(values.get("states received (total)", "0")) >= 2 * published):
-                    break
+        t0, last, published = play_probe(probe, RUN, each=bag_state)
+        values = listener.drained(published, idle=False)
 
-        expected = []
-        k = 0
-        while t0 + TF + k * T < last - 0.02:
-            expected.append(t0 + TF + k * T)
-            k += 1
-        with lock:
-            found = sorted(i.header.stamp.to_sec() for i in impacts
-                           if "probe" in (i.body_a, i.body_b))
+        expected = bounce_instants(t0, last)
+        found = listener.impact_instants("probe")
         self.assertGreaterEqual(len(expected), 13)
-        missing = [t for t in expected if not any(abs(f - t) < 1e-6 for f in found)]
+        missing = missing_instants(expected, found)
         self.assertEqual(missing, [], "probe impacts not found (%d of %d found; found: %s)"
                          % (len(expected) - len(missing), len(expected), found))
 

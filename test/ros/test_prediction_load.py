@@ -20,25 +20,21 @@ second of CPU without a budget; ~prediction_cpu_budget is 0.5 s here). Checked:
 Before the fix, the predictions ran on the monitor's queue: the probe's states waited behind them
 in roscpp's subscriber queue (100), lost there uncounted, and impacts were missed.
 """
-import math
 import os
 import shutil
 import struct
-import subprocess
 import tempfile
-import threading
 import time
 import unittest
 
 import rospy
 import rostest
-from diagnostic_msgs.msg import DiagnosticArray
-from collision_response.msg import BodyState, BodyStateArray, ImpactArray
-from collision_response.srv import PredictImpacts, PredictImpactsRequest
+from collision_response.msg import BodyStateArray
+from collision_response.srv import PredictImpactsRequest
 
-G, R, H = 9.81, 0.05, 0.2
-TF = math.sqrt(2 * H / G)
-T = 2 * TF
+from probe_ball import (R, NodeListener, PredictionClients, bounce_instants, missing_instants,
+                        play_probe, start_node, stop_node, wait_for_subscribers)
+
 RUN = 8.0
 NODE = "prediction_load"
 
@@ -60,12 +56,6 @@ def write_grid_stl(path, cells, size):
                     for vertex in triangle:
                         stream.write(struct.pack("<3f", *vertex))
                     stream.write(b"\0\0")
-
-
-def probe_state(t0, t):
-    """The probe at t (s after t0 on the same clock): height and vertical speed in closed form."""
-    tau = math.fmod(t - t0 + TF, T) - TF  # time since the top of its current flight
-    return R + H - 0.5 * G * tau * tau, -G * tau
 
 
 def expensive_request():
@@ -100,104 +90,35 @@ class PredictionLoad(unittest.TestCase):
                  "position": [100, 0, 0], "material": "concrete"}]})
         rospy.set_param("/%s/diagnostic_period" % NODE, 0.2)
         rospy.set_param("/%s/prediction_cpu_budget" % NODE, 0.5)
-        node = subprocess.Popen(["rosrun", "collision_response", "collision_response_node",
-                                 "__name:=" + NODE, "body_states:=/load/body_states",
-                                 "impacts:=/load/impacts"],
-                                stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT)
+        node = start_node(NODE, ["body_states:=/load/body_states", "impacts:=/load/impacts"])
         try:
             self.run_probe(node)
         finally:
-            if node.poll() is None:
-                node.send_signal(2)
-                try:
-                    node.wait(timeout=10)
-                except subprocess.TimeoutExpired:
-                    node.kill()
+            stop_node(node)
             shutil.rmtree(folder, ignore_errors=True)
 
     def run_probe(self, node):
         service = "/%s/predict_impacts" % NODE
         rospy.wait_for_service(service, timeout=60.0)
-        impacts, lock = [], threading.Lock()
-
-        def on_impacts(message):
-            with lock:
-                impacts.extend(message.impacts)
-
-        rospy.Subscriber("/load/impacts", ImpactArray, on_impacts, queue_size=1000)
-        diagnostics = []
-        rospy.Subscriber("/diagnostics", DiagnosticArray,
-                         lambda message: diagnostics.extend(
-                             s for s in message.status if s.name.startswith(NODE)))
+        listener = NodeListener("/load/impacts", NODE)
         publisher = rospy.Publisher("/load/body_states", BodyStateArray, queue_size=1000)
-        deadline = time.monotonic() + 30
-        while publisher.get_num_connections() == 0 and time.monotonic() < deadline:
-            time.sleep(0.05)
+        wait_for_subscribers([publisher])
         time.sleep(0.5)
 
         # The clients: one request after another until the probe has run.
-        stop = threading.Event()
-        answers = []
-
-        def client():
-            call = rospy.ServiceProxy(service, PredictImpacts)
-            while not stop.is_set():
-                answer = call(expensive_request())
-                with lock:
-                    answers.append((answer.success, answer.message))
-
-        clients = [threading.Thread(target=client) for _ in range(3)]
-        for thread in clients:
-            thread.start()
+        clients = PredictionClients(service, expensive_request, 3)
         time.sleep(1.0)  # the predictions are under way
-
-        t0 = rospy.Time.now().to_sec()
-        published = 0
-        rate = rospy.Rate(100)
-        while rospy.Time.now().to_sec() - t0 < RUN:
-            now = rospy.Time.now()
-            z, vz = probe_state(t0, now.to_sec())
-            array = BodyStateArray()
-            array.header.stamp = now
-            state = BodyState()
-            state.header.stamp = now
-            state.header.frame_id = "world"
-            state.id = "probe"
-            state.pose.position.x, state.pose.position.z = -2.0, z
-            state.pose.orientation.w = 1.0
-            state.twist.linear.z = vz
-            array.states.append(state)
-            publisher.publish(array)
-            published += 1
-            last = now.to_sec()
-            rate.sleep()
-        stop.set()
-        for thread in clients:
-            thread.join(timeout=30)
-
-        # Drained: nothing waits, and a report after the last state.
-        deadline = time.monotonic() + 20
-        values = {}
-        while time.monotonic() < deadline:
-            time.sleep(0.5)
-            if diagnostics:
-                values = {v.key: v.value for v in diagnostics[-1].values}
-                if (values.get("messages waiting") == "0"
-                        and float(values.get("update in progress (s)", "1")) == 0
-                        and int(values.get("states received (total)", "0")) >= published):
-                    break
+        t0, last, published = play_probe(publisher, RUN)
+        clients.stop()
+        clients.join()
+        values = listener.drained(published)
         self.assertTrue(node.poll() is None, "the node died")
 
         # Every impact of the probe within the run, at its closed form.
-        expected = []
-        k = 0
-        while t0 + TF + k * T < last - 0.02:
-            expected.append(t0 + TF + k * T)
-            k += 1
-        with lock:
-            found = sorted(i.header.stamp.to_sec() for i in impacts if "probe" in (i.body_a, i.body_b))
+        expected = bounce_instants(t0, last)
+        found = listener.impact_instants("probe")
         self.assertGreaterEqual(len(expected), 15)
-        missing = [t for t in expected if not any(abs(f - t) < 1e-6 for f in found)]
+        missing = missing_instants(expected, found)
         self.assertEqual(missing, [], "probe impacts not found (%d of %d found; found: %s)"
                          % (len(expected) - len(missing), len(expected), found))
 
@@ -208,10 +129,10 @@ class PredictionLoad(unittest.TestCase):
         self.assertEqual(drops, {}, "states dropped")
 
         # The predictions were answered; a cut one names the budget's key and is counted.
-        with lock:
-            self.assertGreater(len(answers), 0)
-            self.assertTrue(all(success for success, _ in answers), answers[:3])
-            cut = [message for _, message in answers if "~prediction_cpu_budget" in message]
+        answers = clients.answered()
+        self.assertGreater(len(answers), 0)
+        self.assertTrue(all(success for success, _ in answers), answers[:3])
+        cut = [message for _, message in answers if "~prediction_cpu_budget" in message]
         self.assertGreater(len(cut), 0, "no prediction was cut at its budget: %s" % answers[:3])
         self.assertIn("cut short:", cut[0])
         self.assertIn("~prediction_cpu_budget (0.5 s of CPU) ran out at", cut[0])

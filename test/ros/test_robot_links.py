@@ -15,16 +15,11 @@ at 100 Hz for RUN s, stamped with the node's clock. Checked:
 - /diagnostics, from 1 s into the run: each update looked up at most 8 link frames (static ones
   are looked up once, and 8 an update again in turn) and placed none again.
 """
-import math
 import sys
-import threading
 import time
 import unittest
 
 LINKS = 2000
-G, R, H = 9.81, 0.05, 0.2
-TF = math.sqrt(2 * H / G)
-T = 2 * TF
 RUN = 5.0
 NODE = "robot_links_monitor"
 
@@ -52,103 +47,34 @@ if __name__ == "__main__" and "--urdf" in sys.argv:
 import rospy  # noqa: E402
 import rostest  # noqa: E402
 import tf2_ros  # noqa: E402
-from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402
-from geometry_msgs.msg import TransformStamped  # noqa: E402
-from collision_response.msg import BodyState, BodyStateArray, ImpactArray  # noqa: E402
+from collision_response.msg import BodyStateArray  # noqa: E402
 
-
-def probe_state(t0, t):
-    """The probe at t (s after t0 on the same clock): height and vertical speed in closed form."""
-    tau = math.fmod(t - t0 + TF, T) - TF  # time since the top of its current flight
-    return R + H - 0.5 * G * tau * tau, -G * tau
+from probe_ball import (NodeListener, bounce_instants, missing_instants,  # noqa: E402
+                        play_probe, static_link_frames, wait_for_subscribers)
 
 
 class RobotLinks(unittest.TestCase):
     def test_two_thousand_links_cost_what_can_reach_the_probe(self):
-        impacts, lock = [], threading.Lock()
-
-        def on_impacts(message):
-            with lock:
-                impacts.extend(message.impacts)
-
-        rospy.Subscriber("/robot_links/impacts", ImpactArray, on_impacts, queue_size=1000)
-        diagnostics, diagnostics_lock = [], threading.Lock()
-
-        def on_diagnostics(message):
-            with diagnostics_lock:
-                diagnostics.extend((time.monotonic(), s) for s in message.status
-                                   if s.name.startswith(NODE))
-
-        rospy.Subscriber("/diagnostics", DiagnosticArray, on_diagnostics)
+        listener = NodeListener("/robot_links/impacts", NODE)
         broadcaster = tf2_ros.StaticTransformBroadcaster()
-        frames = []
-        for i in range(LINKS):
-            frame = TransformStamped()
-            frame.header.stamp = rospy.Time.now()
-            frame.header.frame_id = "world"
-            frame.child_frame_id = link_name(i)
-            frame.transform.translation.x = 10.0 + 0.2 * (i % 50)
-            frame.transform.translation.y = 0.2 * (i // 50)
-            frame.transform.translation.z = 0.5
-            frame.transform.rotation.w = 1.0
-            frames.append(frame)
-        broadcaster.sendTransform(frames)
+        broadcaster.sendTransform(static_link_frames(LINKS, link_name))
         probe = rospy.Publisher("/robot_links/body_states", BodyStateArray, queue_size=1000)
-        deadline = time.monotonic() + 30
-        while probe.get_num_connections() == 0 and time.monotonic() < deadline:
-            time.sleep(0.05)
+        wait_for_subscribers([probe])
         time.sleep(1.0)
 
-        t0 = rospy.Time.now().to_sec()
         began = time.monotonic()
-        published = 0
-        rate = rospy.Rate(100)
-        while rospy.Time.now().to_sec() - t0 < RUN:
-            now = rospy.Time.now()
-            z, vz = probe_state(t0, now.to_sec())
-            array = BodyStateArray()
-            array.header.stamp = now
-            message = BodyState()
-            message.header.stamp = now
-            message.header.frame_id = "world"
-            message.id = "probe"
-            message.pose.position.z = z
-            message.pose.orientation.w = 1.0
-            message.twist.linear.z = vz
-            array.states.append(message)
-            probe.publish(array)
-            published += 1
-            last = now.to_sec()
-            rate.sleep()
+        t0, last, published = play_probe(probe, RUN, x=0.0)
+        values = listener.drained(published, idle=False)
 
-        deadline = time.monotonic() + 20
-        values = {}
-        while time.monotonic() < deadline:
-            time.sleep(0.5)
-            with diagnostics_lock:
-                if diagnostics:
-                    values = {v.key: v.value for v in diagnostics[-1][1].values}
-            if (values.get("messages waiting") == "0"
-                    and int(values.get("states received (total)", "0")) >= published):
-                break
-
-        expected = []
-        k = 0
-        while t0 + TF + k * T < last - 0.02:
-            expected.append(t0 + TF + k * T)
-            k += 1
-        with lock:
-            found = sorted(i.header.stamp.to_sec() for i in impacts
-                           if "probe" in (i.body_a, i.body_b))
+        expected = bounce_instants(t0, last)
+        found = listener.impact_instants("probe")
         self.assertGreaterEqual(len(expected), 12)
-        missing = [t for t in expected if not any(abs(f - t) < 1e-6 for f in found)]
+        missing = missing_instants(expected, found)
         self.assertEqual(missing, [], "probe impacts not found (%d of %d found; found: %s)"
                          % (len(expected) - len(missing), len(expected), found))
 
         # Each update's obstacle work, as /diagnostics showed it from 1 s into the run.
-        with diagnostics_lock:
-            samples = [{v.key: v.value for v in s.values} for at, s in diagnostics
-                       if at > began + 1.0]
+        samples = listener.values_since(began + 1.0)
         self.assertGreater(len(samples), 5)
         slowest = 0.0
         for sample in samples:

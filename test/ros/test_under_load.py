@@ -39,21 +39,19 @@ to drain its queue after the run (wall time, not asserted).
 import os
 import random
 import shutil
-import subprocess
 import tempfile
-import threading
 import time
 import unittest
 
 import rospy
 import rostest
 import tf2_ros
-from diagnostic_msgs.msg import DiagnosticArray
-from geometry_msgs.msg import TransformStamped
-from collision_response.msg import BodyState, BodyStateArray, ImpactArray
-from collision_response.srv import PredictImpacts
+from collision_response.msg import BodyState, BodyStateArray
 
-from test_prediction_load import expensive_request, probe_state, write_grid_stl, H, R, TF, T
+from probe_ball import (H, R, NodeListener, PredictionClients, bounce_instants, missing_instants,
+                        play_probe, start_node, static_link_frames, stop_node,
+                        wait_for_subscribers)
+from test_prediction_load import expensive_request, write_grid_stl
 from test_robot_links import LINKS, link_name, urdf
 
 LATTICE = 12  # balls along each edge of the lattice
@@ -120,122 +118,48 @@ class UnderLoad(unittest.TestCase):
             "robot": {"material": "concrete"}})
         rospy.set_param("/%s/diagnostic_period" % NODE, 0.2)
         rospy.set_param("/%s/prediction_cpu_budget" % NODE, 0.5)
-        node = subprocess.Popen(["rosrun", "collision_response", "collision_response_node",
-                                 "__name:=" + NODE, "body_states:=/under_load/body_states",
+        node = start_node(NODE, ["body_states:=/under_load/body_states",
                                  "impacts:=/under_load/impacts"])
         try:
             self.run_loads(node)
         finally:
-            if node.poll() is None:
-                node.send_signal(2)
-                try:
-                    node.wait(timeout=10)
-                except subprocess.TimeoutExpired:
-                    node.kill()
+            stop_node(node)
             shutil.rmtree(folder, ignore_errors=True)
 
     def run_loads(self, node):
         service = "/%s/predict_impacts" % NODE
         rospy.wait_for_service(service, timeout=60.0)
-        impacts, lock = [], threading.Lock()
-
-        def on_impacts(message):
-            with lock:
-                impacts.extend(message.impacts)
-
-        rospy.Subscriber("/under_load/impacts", ImpactArray, on_impacts, queue_size=1000)
-        diagnostics = []
-
-        def on_diagnostics(message):
-            with lock:
-                diagnostics.extend((time.monotonic(), s) for s in message.status
-                                   if s.name.startswith(NODE))
-
-        rospy.Subscriber("/diagnostics", DiagnosticArray, on_diagnostics)
-
+        listener = NodeListener("/under_load/impacts", NODE)
         # The robot's 2,000 link frames, once, on /tf_static, far from every body.
         broadcaster = tf2_ros.StaticTransformBroadcaster()
-        frames = []
-        for i in range(LINKS):
-            frame = TransformStamped()
-            frame.header.stamp = rospy.Time.now()
-            frame.header.frame_id = "world"
-            frame.child_frame_id = link_name(i)
-            frame.transform.translation.x = 10.0 + 0.2 * (i % 50)
-            frame.transform.translation.y = 0.2 * (i // 50)
-            frame.transform.translation.z = 0.5
-            frame.transform.rotation.w = 1.0
-            frames.append(frame)
-        broadcaster.sendTransform(frames)
-
+        broadcaster.sendTransform(static_link_frames(LINKS, link_name))
         publisher = rospy.Publisher("/under_load/body_states", BodyStateArray, queue_size=1000)
-        deadline = time.monotonic() + 30
-        while publisher.get_num_connections() == 0 and time.monotonic() < deadline:
-            time.sleep(0.05)
+        wait_for_subscribers([publisher])
         time.sleep(1.0)
 
         # The clients: one request after another until the probe has run.
-        stop = threading.Event()
-        answers = []
-
-        def client():
-            call = rospy.ServiceProxy(service, PredictImpacts)
-            while not stop.is_set():
-                answer = call(expensive_request())
-                with lock:
-                    answers.append((answer.success, answer.message))
-
-        clients = [threading.Thread(target=client, daemon=True) for _ in range(CLIENTS)]
-        for thread in clients:
-            thread.start()
+        clients = PredictionClients(service, expensive_request, CLIENTS)
         time.sleep(1.0)  # the predictions are under way
+        lattice_sent = []
 
-        t0 = rospy.Time.now().to_sec()
+        def lattice_once(now, t0):
+            if lattice_sent or now.to_sec() - t0 < LATTICE_AT:
+                return 0
+            lattice = lattice_states(rospy.Time.now())
+            publisher.publish(lattice)
+            lattice_sent.append(True)
+            return len(lattice.states)
+
         began = time.monotonic()
-        published = 0
-        lattice_sent = False
-        rate = rospy.Rate(100)
-        while rospy.Time.now().to_sec() - t0 < RUN:
-            now = rospy.Time.now()
-            z, vz = probe_state(t0, now.to_sec())
-            array = BodyStateArray()
-            array.header.stamp = now
-            state = BodyState()
-            state.header.stamp = now
-            state.header.frame_id = "world"
-            state.id = "probe"
-            state.pose.position.x, state.pose.position.z = -2.0, z
-            state.pose.orientation.w = 1.0
-            state.twist.linear.z = vz
-            array.states.append(state)
-            publisher.publish(array)
-            published += 1
-            last = now.to_sec()
-            if not lattice_sent and now.to_sec() - t0 >= LATTICE_AT:
-                lattice = lattice_states(rospy.Time.now())
-                publisher.publish(lattice)
-                published += len(lattice.states)
-                lattice_sent = True
-            rate.sleep()
-        stop.set()
+        t0, last, published = play_probe(publisher, RUN, each=lattice_once)
+        clients.stop()
         ran = time.monotonic() - began
 
         # Drained: nothing waits, no update runs, every state published received (a prediction
         # waits for the update in progress, so the clients end after it).
-        deadline = time.monotonic() + 120
-        values = {}
-        while time.monotonic() < deadline:
-            time.sleep(0.5)
-            with lock:
-                if diagnostics:
-                    values = {v.key: v.value for v in diagnostics[-1][1].values}
-            if (values.get("messages waiting") == "0"
-                    and float(values.get("update in progress (s)", "1")) == 0
-                    and int(values.get("states received (total)", "0")) >= published):
-                break
+        values = listener.drained(published, timeout=120.0)
         drained = time.monotonic() - began - ran
-        for thread in clients:
-            thread.join(timeout=30)
+        clients.join()
         self.assertTrue(node.poll() is None, "the node died")
 
         # Every state received, and each used or dropped under a counted reason.
@@ -245,25 +169,19 @@ class UnderLoad(unittest.TestCase):
         counters = {key: value for key, value in values.items()
                     if key.endswith("(total)") and not key.startswith("dropped: ")}
         dropped = sum(drops.values())
-        with lock:
-            samples = [(at, {v.key: v.value for v in s.values}) for at, s in diagnostics]
-        slowest = max(float(v.get("processing time per update, max (ms)", "0"))
-                      for _, v in samples)
-        longest_running = max(float(v.get("update in progress (s)", "0")) for _, v in samples)
+        samples = listener.values_since(0.0)
+        slowest = max(float(v.get("processing time per update, max (ms)", "0")) for v in samples)
+        longest_running = max(float(v.get("update in progress (s)", "0")) for v in samples)
 
         # Every impact of the probe within the run, at its closed form.
-        expected = []
-        k = 0
-        while t0 + TF + k * T < last - 0.02:
-            expected.append(t0 + TF + k * T)
-            k += 1
-        with lock:
-            found = sorted(i.header.stamp.to_sec() for i in impacts
-                           if "probe" in (i.body_a, i.body_b))
-            lattice_impacts = sum(1 for i in impacts if "probe" not in (i.body_a, i.body_b))
-            cut = [message for _, message in answers if "~prediction_cpu_budget" in message]
-            answered = list(answers)
-        missing = [t for t in expected if not any(abs(f - t) < 1e-6 for f in found)]
+        expected = bounce_instants(t0, last)
+        found = listener.impact_instants("probe")
+        with listener.lock:
+            lattice_impacts = sum(1 for i in listener.impacts
+                                  if "probe" not in (i.body_a, i.body_b))
+        answered = clients.answered()
+        cut = [message for _, message in answered if "~prediction_cpu_budget" in message]
+        missing = missing_instants(expected, found)
         print("under load (%d links, %d^3-ball lattice, %d prediction clients): probe impacts "
               "found %d of %d; states published %d, received %d, used %d, dropped %d %s; "
               "slowest update %.1f ms (wall; longest seen running %.2f s); lattice impacts "
@@ -282,7 +200,7 @@ class UnderLoad(unittest.TestCase):
                              % (len(expected) - len(missing), len(expected), found))
 
         # Each update's obstacle work, from 1 s into the run.
-        later = [v for at, v in samples if at > began + 1.0]
+        later = listener.values_since(began + 1.0)
         self.assertGreater(len(later), 5)
         for sample in later:
             self.assertLessEqual(int(sample["obstacle frames looked up, last update"]), 8, sample)
