@@ -53,6 +53,29 @@ def missing_instants(expected, found, tolerance=1e-6):
     return [t for t in expected if not any(abs(f - t) < tolerance for f in found)]
 
 
+def check_bounces(test, listener, t0, last, at_least, dropped=0):
+    """Each of the probe's impacts from t0 to its last state is on the node's impacts at its
+    closed form (1e-6 s), and there are at least `at_least` of them; with `dropped` states
+    counted as dropped, at most that many may be missing. Returns (expected, missing)."""
+    expected = bounce_instants(t0, last)
+    found = listener.impact_instants("probe")
+    test.assertGreaterEqual(len(expected), at_least)
+    missing = missing_instants(expected, found)
+    test.assertLessEqual(len(missing), dropped,
+                         "probe impacts not found (%d of %d found, %d states dropped; found: %s)"
+                         % (len(expected) - len(missing), len(expected), dropped, found))
+    return expected, missing
+
+
+def check_links_untouched(test, samples):
+    """Each update, as /diagnostics showed it: at most 8 link frames looked up (static ones once,
+    then 8 an update in turn) and none placed again (no link is near a body)."""
+    test.assertGreater(len(samples), 5)
+    for sample in samples:
+        test.assertLessEqual(int(sample["obstacle frames looked up, last update"]), 8, sample)
+        test.assertEqual(int(sample["obstacle placements, last update"]), 0, sample)
+
+
 def static_link_frames(count, name):
     """`count` frames on a grid 10 m and more from the probe (50 along x, 0.2 m apart), for
     /tf_static: the links of a robot that no body reaches."""

@@ -32,8 +32,8 @@ import rostest
 from collision_response.msg import BodyStateArray
 from collision_response.srv import PredictImpactsRequest
 
-from probe_ball import (R, NodeListener, PredictionClients, bounce_instants, missing_instants,
-                        play_probe, start_node, stop_node, wait_for_subscribers)
+from probe_ball import (R, NodeListener, PredictionClients, check_bounces, play_probe,
+                        start_node, stop_node, wait_for_subscribers)
 
 RUN = 8.0
 NODE = "prediction_load"
@@ -115,12 +115,7 @@ class PredictionLoad(unittest.TestCase):
         self.assertTrue(node.poll() is None, "the node died")
 
         # Every impact of the probe within the run, at its closed form.
-        expected = bounce_instants(t0, last)
-        found = listener.impact_instants("probe")
-        self.assertGreaterEqual(len(expected), 15)
-        missing = missing_instants(expected, found)
-        self.assertEqual(missing, [], "probe impacts not found (%d of %d found; found: %s)"
-                         % (len(expected) - len(missing), len(expected), found))
+        check_bounces(self, listener, t0, last, 15)
 
         # Every state received, and every one used.
         self.assertEqual(int(values.get("states received (total)", "-1")), published, values)
