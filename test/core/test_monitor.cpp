@@ -562,6 +562,41 @@ TEST(Playback, ABallSetDownSpinningIsPulledAlongUntilItRolls) {
   }
 }
 
+// The contacts asked for at an instant between two played ones are that instant's, also when
+// the instant was asked for before (it is kept as the view): a clay ball (e = 0) dropped from
+// h = 0.2 m above contact meets the floor at sqrt(2 h / g) = 0.2019 s and rests on it from then.
+// Asked at 0.1 s and 0.3 s (played), then at 0.15 s, 0.3 s and 0.15 s again: no contact at
+// 0.15 s, one at 0.3 s. The view's early return left the contacts of the instant asked before.
+TEST(Playback, TheContactsOfAnInstantAskedAgainAreItsOwn) {
+  using V = Eigen::Vector3d;
+  constexpr double kG = 9.81, kRadius = 0.05, kDrop = 0.2;
+  core::Scene scene;
+  scene.effects.gravity = true;
+  scene.gravity = V(0, 0, -kG);
+  ASSERT_TRUE(
+      static_cast<bool>(scene.materials.addMaterial("clay", core::Material{0.0, 0.0}, "m")));
+  core::BodySpec ball;
+  ball.id = "ball";
+  ball.mass = 0.1;
+  ball.radius = kRadius;
+  ball.material = "clay";
+  ball.position = V(0, 0, kRadius + kDrop);
+  scene.bodies = {ball};
+  core::ObstacleSpec floor;
+  floor.id = "floor";
+  floor.normal = V(0, 0, 1);
+  floor.material = "clay";
+  scene.obstacles = {floor};
+  core::Playback playback(scene, 1e-9, 0.0);
+  ASSERT_LT(0.15, std::sqrt(2 * kDrop / kG));
+  ASSERT_GT(0.3, std::sqrt(2 * kDrop / kG));
+  EXPECT_TRUE(playback.contacts(0.1).empty());
+  EXPECT_EQ(playback.contacts(0.3).size(), 1u);
+  EXPECT_TRUE(playback.contacts(0.15).empty());
+  EXPECT_EQ(playback.contacts(0.3).size(), 1u);
+  EXPECT_TRUE(playback.contacts(0.15).empty()) << "the contacts of 0.3 s, asked for before";
+}
+
 // An impact heard after its instant was made final (a node answering more than a period late)
 // cannot be played: the body goes on without it. The caller is told (false), so that the scene
 // player can say so instead of showing bodies inside each other without a word.

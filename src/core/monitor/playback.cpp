@@ -70,7 +70,10 @@ void Playback::replay() const {
 }
 
 const ImpactMonitor& Playback::at(double time) const {
-  if (view_ && view_time_ == time) return *view_;
+  if (view_ && view_time_ == time) {
+    at_contacts_ = &view_contacts_;
+    return *view_;
+  }
   replay();
   if (time > played_.back().time) {
     played_.push_back(Played{time, std::nullopt, {}});
