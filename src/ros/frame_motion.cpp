@@ -4,6 +4,7 @@
 #include <tf2_eigen/tf2_eigen.h>
 
 #include <algorithm>
+#include <unordered_set>
 
 namespace collision_response {
 
@@ -96,11 +97,16 @@ const FrameChains::Rooted& FrameChains::rooted(const std::string& frame, const r
   Poses& poses = poses_[stamp.toNSec()];
   // Up to a frame known at this stamp, or the root; then down again, one hop each.
   std::vector<std::pair<std::string, std::string>> path;  // (frame, its parent)
+  std::unordered_set<std::string> walked{frame};
   std::string at = frame;
   while (poses.count(at) == 0) {
     std::string parent;
-    if (path.size() > kMaxDepth || !buffer_._getParent(at, stamp, parent) || parent.empty()) {
-      poses[at] = Rooted{path.size() > kMaxDepth ? "" : at, Eigen::Isometry3d::Identity()};
+    if (!buffer_._getParent(at, stamp, parent) || parent.empty()) {
+      poses[at] = Rooted{at, Eigen::Isometry3d::Identity()};  // a root
+      break;
+    }
+    if (!walked.insert(parent).second) {
+      poses[at] = Rooted{"", Eigen::Isometry3d::Identity()};  // a loop: rooted nowhere
       break;
     }
     path.emplace_back(at, parent);
@@ -123,6 +129,7 @@ const FrameChains::Rooted& FrameChains::rooted(const std::string& frame, const r
 
 bool FrameChains::wholeStatic(const std::string& frame) {
   std::vector<std::string> path;
+  std::unordered_set<std::string> walked;
   std::string at = frame;
   bool whole = true;
   while (true) {
@@ -131,9 +138,12 @@ bool FrameChains::wholeStatic(const std::string& frame) {
       whole = known->second;
       break;
     }
+    if (!walked.insert(at).second) {
+      whole = false;  // a loop: no chain to a root, static or not
+      break;
+    }
     std::string parent;
-    if (path.size() > kMaxDepth || !buffer_._getParent(at, ros::Time(0), parent) ||
-        parent.empty()) {
+    if (!buffer_._getParent(at, ros::Time(0), parent) || parent.empty()) {
       static_[at] = true;  // a root
       break;
     }
@@ -150,7 +160,7 @@ bool FrameChains::wholeStatic(const std::string& frame) {
     at = parent;
   }
   // Every frame walked has the hop found moving, or the known frame's chain, above it.
-  for (const std::string& walked : path) static_[walked] = whole;
+  for (const std::string& below : path) static_[below] = whole;
   return static_.at(frame);
 }
 

@@ -626,7 +626,11 @@ void MonitorCycle::lookUpObstacle(std::size_t i, const ros::Time& stamp, const t
       return;
     }
     if (frame_kind_[i] == FrameKind::kUnknown) {
-      frame_kind_[i] = chains_->wholeStatic(frame) ? FrameKind::kStatic : FrameKind::kMoving;
+      // Static when the chains of both the frame and the fixed frame are (the one tf2 path
+      // beside, a lookup at time zero, asks the same of both).
+      frame_kind_[i] = chains_->wholeStatic(frame) && chains_->wholeStatic(fixed)
+                           ? FrameKind::kStatic
+                           : FrameKind::kMoving;
     }
   } else {
     motion = lookupFrameMotion(tf, fixed, frame, stamp, interval);

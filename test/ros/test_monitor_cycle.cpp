@@ -1583,5 +1583,27 @@ TEST_F(ClosingLatticeCycle, AnImpactPastTheImpactWorkBoundIsNamedAndCounted) {
   EXPECT_STREQ(counterName(Reason::kOverImpactWork),
                "bodies of impacts over the impact work bound");
 }
+
+// A loop in tf (a's parent b, b's parent a, both static) is no chain to a root: FrameChains says
+// so at once. It walked a million hops an update, each under tf's lock, and then took the loop
+// for a static root.
+TEST(FrameChainsLoop, ALoopIsNeitherRootedNorStatic) {
+  tf2::BufferCore tf;
+  geometry_msgs::TransformStamped hop;
+  hop.transform.rotation.w = 1.0;
+  hop.header.frame_id = "world";
+  hop.child_frame_id = "base";
+  ASSERT_TRUE(tf.setTransform(hop, "test", /*is_static=*/true));
+  hop.header.frame_id = "b";
+  hop.child_frame_id = "a";
+  ASSERT_TRUE(tf.setTransform(hop, "test", /*is_static=*/true));
+  hop.header.frame_id = "a";
+  hop.child_frame_id = "b";
+  tf.setTransform(hop, "test", /*is_static=*/true);
+  FrameChains chains(tf, "world");
+  EXPECT_FALSE(chains.wholeStatic("a"));
+  EXPECT_FALSE(static_cast<bool>(chains.motion("a", ros::Time(100), ros::Duration(0.01))));
+  EXPECT_TRUE(chains.wholeStatic("base"));
+}
 }  // namespace
 }  // namespace collision_response

@@ -58,7 +58,6 @@ class FrameChains {
   bool wholeStatic(const std::string& frame);
 
  private:
-  static constexpr std::size_t kMaxDepth = 1000000;  ///< hops: past it, a loop
   struct Rooted {
     std::string root;  ///< the chain's root frame; empty: not connected at that stamp
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  ///< root <- frame
