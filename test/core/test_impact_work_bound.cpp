@@ -192,6 +192,44 @@ TEST(ImpactWorkBound, ALatticeClosingInOneMessageIsCutAtTheBoundNamedKeptApartAn
       << momentum_after.transpose();
 }
 
+// Once a cluster's normal solve would pass the bound, every later cluster of the step is locked
+// too (MonitorSettings::max_impact_work_per_step): the step's work is spent. Beside the 6 x 6 x 6
+// lattice under 5,000, 10 m away, three balls in a row: the outer two close on the middle one at
+// 1 m/s each, at the same instant. Solved (Newton, e = 0.5), by symmetry the middle one keeps
+// still and each outer one leaves at e 1 m/s = 0.5 m/s: A J = (1 + e) 1 m/s with A = 2w - w
+// (w = 1/m), so J = 1.5 m/s times m and dv = w J = 1.5 m/s. Locked, all three take their centre
+// of mass's velocity, zero. Before, a cut left the step's count under the bound and the row was
+// solved as if nothing had run out.
+TEST(ImpactWorkBound, AfterACutTheStepsLaterClustersAreLockedToo) {
+  const int n = 6;
+  Scene scene = latticeScene(n, false);
+  const char* row[] = {"zrow_a", "zrow_b", "zrow_c"};
+  for (int k = 0; k < 3; ++k) {
+    scene.bodies.push_back(
+        scene_builders::ball(row[k], kMass, kRadius, "clay", V(10 + 2 * kRadius * k, 0, 0)));
+  }
+  MonitorSettings settings;
+  settings.max_impact_work_per_step = 5000;
+  ImpactMonitor monitor(scene, settings);
+  std::vector<BodyStateSample> states = closingStates(monitor, n);
+  const std::size_t first = states.size() - 3;
+  for (int k = 0; k < 3; ++k) {
+    states[first + k].velocity = V(k == 0 ? 1.0 : (k == 2 ? -1.0 : 0.0), 0, 0);
+    states[first + k].angular_velocity = V::Zero();
+  }
+  monitor.step(0.0, states);
+  const StepReport report = monitor.step(kStep, {});
+  ASSERT_FALSE(report.over_impact_work.empty());
+  EXPECT_LE(report.impact_work, 5000u);
+  for (int k = 0; k < 3; ++k) {
+    const V velocity = monitor.predictedState(first + k, kStep)->second;
+    EXPECT_NEAR(velocity.x(), 0.0, 1e-15) << row[k] << " (solved: -0.5, 0, 0.5 m/s)";
+    EXPECT_NE(std::find(report.over_impact_work.begin(), report.over_impact_work.end(), first + k),
+              report.over_impact_work.end())
+        << row[k] << " is not named";
+  }
+}
+
 // The same lattice met inside a box whose walls touch its outer balls: balls sent outwards by
 // the impact strike the walls in later rounds of the same instant, with friction cut short.
 TEST(ImpactWorkBound, ALatticeClosingInABoxStaysOutOfItsWallsPastTheBound) {

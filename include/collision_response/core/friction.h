@@ -90,9 +90,4 @@ struct FrictionContact {
   double normal_impulse = 0.0;  ///< N s, already applied
 };
 
-/// A cluster's friction step: every contact's tangential impulse, given its normal one.
-using ClusterFrictionStep = void (*)(std::vector<ClusterBody>&, const std::vector<ClusterContact>&,
-                                     const std::vector<FrictionContact>&,
-                                     std::vector<FrictionOutcome>&);
-
 }  // namespace collision_response::core

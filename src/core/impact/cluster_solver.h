@@ -8,7 +8,6 @@
 #include "collision_response/core/friction.h"
 #include "collision_response/core/scene.h"
 #include "collision_response/core/simultaneous.h"
-#include "contact/contact_forces.h"
 #include "contact/stepped_friction.h"
 
 namespace collision_response::core {
@@ -20,12 +19,16 @@ Effects runnableEffects(const Effects& requested);
 
 /// Coulomb friction as the effects call for it, for one contact and for a cluster. Empty (no
 /// friction effect): bodies slide freely. Chosen once, by frictionModelFor.
+/// A cluster's friction step: every contact's tangential impulse, given its normal one, within
+/// `work` (optional: solveFrictionImpulses).
+using ClusterFrictionStep = void (*)(std::vector<ClusterBody>&, const std::vector<ClusterContact>&,
+                                     const std::vector<FrictionContact>&,
+                                     std::vector<FrictionOutcome>&, WorkBound* work);
+
 struct FrictionModel {
   FrictionOutcome (*contact)(ClusterBody& a, ClusterBody& b, const Eigen::Vector3d& normal,
                              double friction, double normal_impulse) = nullptr;
-  void (*cluster)(std::vector<ClusterBody>&, const std::vector<ClusterContact>&,
-                  const std::vector<FrictionContact>&, std::vector<FrictionOutcome>&,
-                  WorkBound*) = nullptr;
+  ClusterFrictionStep cluster = nullptr;
   /// A stepped cluster's sub-step: warm-started sweeps (applyFrictionBySweeps).
   SweptFrictionStep swept = nullptr;
   explicit operator bool() const { return contact != nullptr; }

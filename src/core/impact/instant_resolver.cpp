@@ -285,11 +285,12 @@ ClusterOutcome solveWithinBudget(World& world, PreparedCluster& prepared, StepRe
   const bool spent = budget > 0 && joint && world.impact_work >= budget;
   ClusterOutcome outcome;
   if (!spent) {
-    const std::vector<ClusterBody> before = prepared.bodies;
+    // Stopped (no normal impulses), solveCluster leaves the bodies as they were.
     outcome = solveCluster(prepared.bodies, prepared.contacts, prepared.friction,
                            world.friction_model, &work);
     world.impact_work += work.spent;
-    if (outcome.normal.empty()) prepared.bodies = before;  // stopped: as they were
+    // Cut, the step's impact work is spent: its later clusters are locked (monitor.h).
+    if (work.cut) world.impact_work = std::max(world.impact_work, budget);
   }
   stopped = spent || outcome.normal.empty();
   if (stopped) return outcome;
