@@ -53,11 +53,6 @@ struct FileDescriptor {
   }
 };
 
-std::string formatVector(const Eigen::Vector3d& v) {
-  return "[" + core::formatNumber(v.x()) + ", " + core::formatNumber(v.y()) + ", " +
-         core::formatNumber(v.z()) + "]";
-}
-
 /// How many of `scaled`'s zero-area triangles had an area unscaled (`unscaled`): both ascending.
 std::size_t vanished(const std::vector<std::size_t>& scaled,
                      const std::vector<std::size_t>& unscaled) {
@@ -226,13 +221,13 @@ core::Expected<std::shared_ptr<const core::TriangleMesh>> loadWithinMemory(
     if (lost > 0) {
       return core::Error{
           scale_field,
-          formatVector(scale) + " leaves " + std::to_string(lost) + " of the " +
+          core::formatVector(scale) + " leaves " + std::to_string(lost) + " of the " +
               std::to_string(triangles.size() - zero_area_unscaled.size()) +
               " triangles of nonzero area of '" + resource +
               "' without area in doubles (their edges' squared lengths and cross products "
               "overflow or underflow): the mesh spans " +
-              formatVector(extent) + " m at scale 1, " + formatVector(extent.cwiseProduct(scale)) +
-              " m scaled"};
+              core::formatVector(extent) + " m at scale 1, " +
+              core::formatVector(extent.cwiseProduct(scale)) + " m scaled"};
     }
     if (!mesh) return mesh.error();
   }

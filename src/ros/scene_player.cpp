@@ -5,11 +5,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <ctime>
 #include <limits>
 #include <sstream>
 
 #include "collision_response/BodyStateArray.h"
+#include "collision_response/core/prediction.h"
 #include "collision_response/core/restitution.h"
 #include "collision_response/core/validation.h"
 #include "collision_response/ros/conversions.h"
@@ -25,12 +25,6 @@ using P = ScenePlayerParams;
 constexpr std::int64_t kMaxCatchUp = 10;
 /// The replay window holds one model of the scene per period: at most this many.
 constexpr double kMaxReplayPeriods = 1000.0;
-
-double threadCpuSeconds() {
-  timespec now{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-  return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
-}
 
 const KeyTable<MovingFrame>& frameKeys() {
   static const KeyTable<MovingFrame> kKeys = {
@@ -218,7 +212,7 @@ void ScenePlayer::playPeriodsDue(const ros::Time& now) {
                    << 1000.0 / rate
                    << " ms: the machine is busy, or the scene costs more than ~rate allows");
     }
-    const double began = threadCpuSeconds();
+    const double began = core::threadCpuSeconds();
     const std::int64_t first = next_period_;
     for (; next_period_ <= newest; ++next_period_) {
       const ros::Time stamp =
@@ -227,7 +221,8 @@ void ScenePlayer::playPeriodsDue(const ros::Time& now) {
       publishApexes(stamp);
       ++published_;
     }
-    last_period_cpu_ = (threadCpuSeconds() - began) / static_cast<double>(next_period_ - first);
+    last_period_cpu_ =
+        (core::threadCpuSeconds() - began) / static_cast<double>(next_period_ - first);
   }
   if (static_cast<double>(next_period_) > last) {
     stopping_ = true;

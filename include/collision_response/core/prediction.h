@@ -68,11 +68,15 @@ struct Prediction {
 /// sample period, the crossing's search period, or kBudgetCheckPeriod); once spent, the
 /// prediction stops where it got to and answers what it found up to there (its impacts, samples
 /// and the state there), cut short, the message naming the budget.
+/// The calling thread's CPU time, s (CLOCK_THREAD_CPUTIME_ID): a prediction's default budget
+/// clock, and the scene player's measure of what a period costs.
+double threadCpuSeconds();
+
 struct PredictionBudget {
   double seconds = 0.0;                              ///< s of `clock`; 0: no budget
   std::string name = "the prediction's CPU budget";  ///< as the message names it
-  /// s: the clock the budget is spent on; empty: the calling thread's CPU time
-  /// (CLOCK_THREAD_CPUTIME_ID), so that other threads' work does not count.
+  /// s: the clock the budget is spent on, called on the thread that runs the prediction; empty:
+  /// that thread's CPU time (threadCpuSeconds), so that other threads' work does not count.
   std::function<double()> clock;
 };
 

@@ -10,6 +10,13 @@
 #include "geometry/narrow_phase.h"
 
 namespace collision_response::core {
+
+double threadCpuSeconds() {
+  timespec now{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+  return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
+}
+
 namespace {
 
 Status checkPositive(double value, const std::string& field, const char* unit) {
@@ -143,13 +150,6 @@ Status placeObstacles(ImpactMonitor& model, const PredictionStart& start) {
     }
   }
   return Ok{};
-}
-
-/// The calling thread's CPU time, s.
-double threadCpuSeconds() {
-  timespec now{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-  return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
 }
 
 BodyStateSample stateOf(const ImpactMonitor& model, double time) {
