@@ -281,7 +281,10 @@ void ImpactMonitorRos::tell(const std::string& topic, const std::vector<Report>&
     group.events += report.count;
     if (report.warn && group.first == nullptr) group.first = &report;
   }
-  // warnings_ is shared by the intake's thread and the monitor's: kept under the lock.
+  lock.unlock();
+  // warnings_ is shared by the intake's thread and the monitor's: under a lock of its own, so
+  // that /diagnostics and the counting never wait for a log line.
+  const std::lock_guard<std::mutex> warning(warnings_mutex_);
   for (const auto& [key, group] : groups) {
     if (group.first == nullptr) continue;
     std::string text = group.first->text;

@@ -132,6 +132,7 @@ class ImpactMonitorRos {
   /// A wake-up is posted to the monitor's queue and has not begun: no second one is posted.
   std::atomic<bool> wake_posted_{false};
   ThrottledWarning warnings_;
+  std::mutex warnings_mutex_;  ///< warnings_'s: tell runs on the intake's thread and the monitor's
   /// Guards what diagnose() reads from the diagnostics' thread: the counters, the figures of
   /// the monitor after its last update, the update in progress and the inputs waiting.
   std::mutex diagnostics_mutex_;
