@@ -151,7 +151,12 @@ core::Expected<std::vector<core::ObstacleSpec>> robotObstacles(const std::string
   // The raw XML, for what urdfdom dropped (droppedCollisions): urdfdom parsed it, so does
   // tinyxml2.
   tinyxml2::XMLDocument xml;
-  xml.Parse(urdf.c_str());
+  if (xml.Parse(urdf.c_str()) != tinyxml2::XML_SUCCESS) {
+    return core::Error{joinKey(field, "description"),
+                       "the URDF in '" + robot.description +
+                           "' does not parse as XML, although urdfdom read it: " +
+                           (xml.ErrorStr() != nullptr ? xml.ErrorStr() : "")};
+  }
   std::map<std::string, const tinyxml2::XMLElement*> links_xml;
   const tinyxml2::XMLElement* robot_xml = xml.FirstChildElement("robot");
   for (const tinyxml2::XMLElement* link = robot_xml ? robot_xml->FirstChildElement("link")
@@ -192,7 +197,8 @@ core::Expected<std::vector<core::ObstacleSpec>> robotObstacles(const std::string
   }
   std::vector<core::ObstacleSpec> obstacles;
   for (const std::string& name : names) {
-    if (const std::string why = dropped(name); !why.empty()) {
+    // (A listed link was checked above, before its missing <collision> was.)
+    if (const std::string why = robot.all_links ? dropped(name) : std::string(); !why.empty()) {
       return core::Error{joinKey(field, "description"), why};
     }
     const auto& collisions = model.links_.at(name)->collision_array;
