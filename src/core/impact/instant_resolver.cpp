@@ -755,11 +755,12 @@ void storeInelasticVelocities(World& world, double time,
 /// touches it at the instant, transitively, are locked together (lockCluster; contact by contact
 /// where immovable participants move differently: solveContactByContact): no contact among them
 /// approaches after it, so the instant's rounds end there for them. Their impacts are recorded
-/// (those that took an impulse), their bodies named in report.over_impact_work.
+/// (those that took an impulse), their bodies named in report.over_impact_work and marked in
+/// `locked` (per body: the round's later clusters among them wait for the next round).
 template <class Motion>
 void lockTouching(World& world, double time, const std::vector<InstantContact>& contacts,
                   const std::vector<std::size_t>& cluster, StepReport& report,
-                  std::vector<std::size_t>& changed) {
+                  std::vector<std::size_t>& changed, std::vector<char>& locked) {
   const std::vector<std::size_t> component = touchingComponent(world, contacts, cluster);
   std::vector<char> joined(contacts.size(), 2);  // recorded only where it takes an impulse
   PreparedCluster prepared = prepareCluster<Motion>(world, time, contacts, component, joined);
@@ -772,8 +773,20 @@ void lockTouching(World& world, double time, const std::vector<InstantContact>& 
   for (const std::size_t member : prepared.members) {
     if (!world.isObstacle(member) && world.inverseMassOf(member) > 0) {
       report.over_impact_work.push_back(member);
+      locked[member] = 1;
     }
   }
+}
+
+/// Whether a movable body of `cluster` was locked earlier in the round (lockTouching).
+bool touchesLocked(const World& world, const std::vector<InstantContact>& contacts,
+                   const std::vector<std::size_t>& cluster, const std::vector<char>& locked) {
+  for (const std::size_t k : cluster) {
+    for (const std::size_t participant : {contacts[k].pair.first, contacts[k].pair.second}) {
+      if (!world.isObstacle(participant) && locked[participant]) return true;
+    }
+  }
+  return false;
 }
 
 }  // namespace
@@ -812,13 +825,20 @@ void resolveInstant(World& world, double time, const std::vector<Pair>& touching
     }
     std::sort(striking.begin(), striking.end());
     progress.beginRound(striking);
+    // Bodies locked in this round (past the step's impact work): a later cluster among them is
+    // part of a component already locked; what of it still approaches strikes in the next
+    // round. Without this every such cluster locked its whole component again: a lattice of
+    // 1,728 balls cut in its first round spent 0.1 s locking its 4,752 contacts 197 times.
+    std::vector<char> locked;
     for (const std::vector<std::size_t>& cluster : formClusters(world, contacts, striking)) {
+      if (!locked.empty() && touchesLocked(world, contacts, cluster, locked)) continue;
       PreparedCluster prepared = prepareCluster<Motion>(world, time, contacts, cluster, joined);
       const std::vector<ClusterBody> before = prepared.bodies;
       bool stopped = false;
       const ClusterOutcome outcome = solveWithinBudget(world, prepared, report, stopped);
       if (stopped) {
-        lockTouching<Motion>(world, time, contacts, cluster, report, changed);
+        if (locked.empty()) locked.assign(world.bodyCount(), 0);
+        lockTouching<Motion>(world, time, contacts, cluster, report, changed, locked);
         continue;
       }
       progress.solved(cluster, prepared.contacts, before, prepared.bodies, outcome);
