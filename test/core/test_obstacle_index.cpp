@@ -11,7 +11,7 @@
 
 #include "contact/stepped_clusters.h"
 #include "geometry/narrow_phase.h"
-#include "monitor/candidate_pairs.h"
+#include "model/candidate_pairs.h"
 
 namespace collision_response::core::monitor {
 namespace {

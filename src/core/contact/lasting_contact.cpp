@@ -7,8 +7,8 @@
 
 #include "contact/solve_participants.h"
 #include "contact/stepped_clusters.h"
-#include "monitor/candidate_pairs.h"
-#include "monitor/motion_model.h"
+#include "model/candidate_pairs.h"
+#include "model/motion_model.h"
 
 namespace collision_response::core {
 

@@ -7,7 +7,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "monitor/monitor_world.h"
+#include "model/monitor_world.h"
 
 namespace collision_response::core::monitor {
 

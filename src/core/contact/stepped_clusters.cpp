@@ -9,8 +9,8 @@
 #include "contact/stepped_contact.h"
 #include "geometry/broadphase.h"
 #include "impact/order_free.h"
-#include "monitor/candidate_pairs.h"
-#include "monitor/motion_model.h"
+#include "model/candidate_pairs.h"
+#include "model/motion_model.h"
 
 namespace collision_response::core::monitor {
 namespace {

@@ -10,7 +10,7 @@
 
 #include "collision_response/core/monitor.h"
 #include "contact/lasting_contact.h"
-#include "monitor/monitor_world.h"
+#include "model/monitor_world.h"
 
 namespace collision_response::core::monitor {
 

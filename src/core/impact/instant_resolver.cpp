@@ -9,7 +9,7 @@
 #include "collision_response/core/impact.h"
 #include "contact/contact_forces.h"
 #include "impact/cluster_solver.h"
-#include "monitor/motion_model.h"
+#include "model/motion_model.h"
 
 namespace collision_response::core::monitor {
 namespace {

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "collision_response/core/monitor.h"
-#include "monitor/monitor_world.h"
+#include "model/monitor_world.h"
 
 namespace collision_response::core::monitor {
 

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "monitor/candidate_pairs.h"
-#include "monitor/motion_model.h"
+#include "model/candidate_pairs.h"
+#include "model/motion_model.h"
 
 namespace collision_response::core::monitor {
 namespace {

@@ -6,7 +6,7 @@
 #include <utility>
 #include <vector>
 
-#include "monitor/monitor_world.h"
+#include "model/monitor_world.h"
 
 namespace collision_response::core::monitor {
 

@@ -13,10 +13,10 @@
 #include "contact/stepped_clusters.h"
 #include "impact/cluster_solver.h"
 #include "impact/instant_resolver.h"
-#include "monitor/candidate_pairs.h"
+#include "model/candidate_pairs.h"
+#include "model/monitor_world.h"
+#include "model/motion_model.h"
 #include "monitor/contact_schedule.h"
-#include "monitor/monitor_world.h"
-#include "monitor/motion_model.h"
 
 namespace collision_response::core {
 

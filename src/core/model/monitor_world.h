@@ -27,7 +27,7 @@
 #include "geometry/motion.h"
 #include "geometry/narrow_phase.h"
 #include "impact/cluster_solver.h"
-#include "monitor/obstacle_index.h"
+#include "model/obstacle_index.h"
 
 namespace collision_response::core::monitor {
 

@@ -12,7 +12,7 @@
 #include "collision_response/core/time_of_impact.h"
 #include "geometry/broadphase.h"
 #include "geometry/motion.h"
-#include "monitor/monitor_world.h"
+#include "model/monitor_world.h"
 
 namespace collision_response::core::monitor {
 

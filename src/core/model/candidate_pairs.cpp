@@ -1,4 +1,4 @@
-#include "monitor/candidate_pairs.h"
+#include "model/candidate_pairs.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <utility>
 #include <variant>
 
-#include "monitor/motion_model.h"
+#include "model/motion_model.h"
 
 namespace collision_response::core::monitor {
 
