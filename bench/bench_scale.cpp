@@ -31,7 +31,7 @@
 #include "collision_response/core/triangle_mesh.h"
 #include "dropped_pile.h"
 #include "geometry/narrow_phase.h"
-#include "impact/cluster_solver.h"
+#include "solver/cluster_solver.h"
 #ifdef COLLISION_RESPONSE_WITH_BULLET
 #include <BulletCollision/NarrowPhaseCollision/btContinuousConvexCollision.h>
 #include <BulletCollision/NarrowPhaseCollision/btGjkEpaPenetrationDepthSolver.h>

@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "collision_response/core/monitor.h"
-#include "impact/cluster_solver.h"
 #include "scene_builders.h"
+#include "solver/cluster_solver.h"
 
 namespace collision_response::core {
 namespace {

@@ -7,7 +7,7 @@
 #include <memory>
 #include <vector>
 
-#include "contact/constrained_motion.h"
+#include "model/constrained_motion.h"
 
 namespace collision_response::core::monitor {
 namespace {

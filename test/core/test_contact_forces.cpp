@@ -6,7 +6,7 @@
 #include <cmath>
 #include <vector>
 
-#include "contact/contact_forces.h"
+#include "solver/contact_forces.h"
 
 namespace collision_response::core {
 namespace {

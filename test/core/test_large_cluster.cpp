@@ -17,8 +17,8 @@
 #include <vector>
 
 #include "collision_response/core/simultaneous.h"
-#include "contact/contact_forces.h"
-#include "impact/cluster_solver.h"
+#include "solver/cluster_solver.h"
+#include "solver/friction_impulses.h"
 
 namespace collision_response::core {
 namespace {

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "collision_response/core/monitor.h"
-#include "contact/stepped_contact.h"
 #include "scene_builders.h"
+#include "solver/stepped_contact.h"
 
 namespace collision_response::core {
 namespace {

@@ -9,7 +9,7 @@
 #include <random>
 #include <vector>
 
-#include "contact/stepped_friction.h"
+#include "solver/stepped_friction.h"
 
 namespace collision_response::core {
 namespace {

@@ -9,6 +9,8 @@
 #include "contact/stepped_clusters.h"
 #include "model/candidate_pairs.h"
 #include "model/motion_model.h"
+#include "solver/contact_forces.h"
+#include "solver/contact_projection.h"
 
 namespace collision_response::core {
 

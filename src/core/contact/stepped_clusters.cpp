@@ -6,11 +6,11 @@
 #include <set>
 
 #include "contact/solve_participants.h"
-#include "contact/stepped_contact.h"
 #include "geometry/broadphase.h"
-#include "impact/order_free.h"
 #include "model/candidate_pairs.h"
 #include "model/motion_model.h"
+#include "solver/order_free.h"
+#include "solver/stepped_contact.h"
 
 namespace collision_response::core::monitor {
 namespace {

@@ -5,7 +5,7 @@
 #include "collision_response/core/friction.h"
 #include "collision_response/core/scene.h"
 #include "collision_response/core/validation.h"
-#include "impact/cluster_solver.h"
+#include "solver/cluster_solver.h"
 
 namespace collision_response::core {
 namespace {

@@ -1,5 +1,5 @@
 // The effects of the product build: every effect a scene or a request names runs.
-#include "impact/cluster_solver.h"
+#include "solver/cluster_solver.h"
 
 namespace collision_response::core {
 

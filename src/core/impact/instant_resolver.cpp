@@ -7,9 +7,9 @@
 #include <utility>
 
 #include "collision_response/core/impact.h"
-#include "contact/contact_forces.h"
-#include "impact/cluster_solver.h"
 #include "model/motion_model.h"
+#include "solver/cluster_solver.h"
+#include "solver/contact_forces.h"
 
 namespace collision_response::core::monitor {
 namespace {

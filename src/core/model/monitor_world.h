@@ -20,14 +20,14 @@
 #include "collision_response/core/friction.h"
 #include "collision_response/core/monitor.h"
 #include "collision_response/core/scene.h"
-#include "contact/constrained_motion.h"
-#include "contact/contact_forces.h"
 #include "geometry/air_flight.h"
 #include "geometry/broadphase.h"
 #include "geometry/motion.h"
 #include "geometry/narrow_phase.h"
-#include "impact/cluster_solver.h"
+#include "model/constrained_motion.h"
 #include "model/obstacle_index.h"
+#include "solver/cluster_solver.h"
+#include "solver/contact_forces.h"
 
 namespace collision_response::core::monitor {
 

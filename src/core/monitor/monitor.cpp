@@ -11,12 +11,12 @@
 #include "collision_response/core/body.h"
 #include "contact/lasting_contact.h"
 #include "contact/stepped_clusters.h"
-#include "impact/cluster_solver.h"
 #include "impact/instant_resolver.h"
 #include "model/candidate_pairs.h"
 #include "model/monitor_world.h"
 #include "model/motion_model.h"
 #include "monitor/contact_schedule.h"
+#include "solver/cluster_solver.h"
 
 namespace collision_response::core {
 

@@ -1,4 +1,4 @@
-#include "contact/stepped_friction.h"
+#include "solver/stepped_friction.h"
 
 #include <Eigen/Geometry>
 #include <algorithm>

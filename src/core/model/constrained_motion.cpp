@@ -1,4 +1,4 @@
-#include "contact/constrained_motion.h"
+#include "model/constrained_motion.h"
 
 #include <Eigen/Geometry>
 #include <algorithm>

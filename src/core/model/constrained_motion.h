@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "collision_response/core/shape.h"
-#include "contact/contact_forces.h"
 #include "geometry/integrated_motion.h"
+#include "solver/contact_forces.h"
 
 namespace collision_response::core::monitor {
 

@@ -5,7 +5,7 @@
 #include <limits>
 
 #include "collision_response/core/impact.h"
-#include "impact/order_free.h"
+#include "solver/order_free.h"
 
 namespace collision_response::core {
 namespace {

@@ -8,7 +8,7 @@
 #include "collision_response/core/friction.h"
 #include "collision_response/core/scene.h"
 #include "collision_response/core/simultaneous.h"
-#include "contact/stepped_friction.h"
+#include "solver/stepped_friction.h"
 
 namespace collision_response::core {
 

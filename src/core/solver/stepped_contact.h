@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "collision_response/core/friction.h"
-#include "contact/stepped_friction.h"
+#include "solver/stepped_friction.h"
 
 namespace collision_response::core {
 

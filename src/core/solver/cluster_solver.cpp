@@ -1,7 +1,7 @@
-#include "impact/cluster_solver.h"
+#include "solver/cluster_solver.h"
 
 #include "collision_response/core/impact.h"
-#include "contact/contact_forces.h"
+#include "solver/friction_impulses.h"
 
 namespace collision_response::core {
 

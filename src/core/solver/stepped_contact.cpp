@@ -1,4 +1,4 @@
-#include "contact/stepped_contact.h"
+#include "solver/stepped_contact.h"
 
 #include <Eigen/Dense>
 #include <algorithm>
