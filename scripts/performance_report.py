@@ -485,7 +485,7 @@ def main():
             "",
             "Before issue 13 the array of distinct stamps cost one full step per stamp (23 s for "
             "10,000) and blocked the service for as long (22.9 s); it is one step now. The "
-            "cluster's figure is the cost of the joint solve of `src/core/impact/simultaneous.cpp` as "
+            "cluster's figure is the cost of the joint solve of `src/core/solver/simultaneous.cpp` as "
             "main had it when this ran (issue 12 rewrites it and bounds it): the service no "
             "longer waits for it either way.",
             "",

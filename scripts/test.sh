@@ -119,6 +119,18 @@ rm -f "$ws/first-lane.status" "$ws/second-lane.status"
     printf '<testsuite><testcase classname="docs" name="every link resolves"><failure message="%s"/></testcase></testsuite>\n' \
       "$(sed 's/[<>&"]/_/g' <<<"$links" | tr '\n' ' ')" >"$ws/build/test_results/lint/links.xml"
   fi
+  # No include of the core runs up a floor (src/core's rooms: scripts/check_floors.py): one
+  # counted case.
+  echo "== no include of the core runs up a floor"
+  if floors=$(/usr/bin/python3 "$repo/scripts/check_floors.py" "$repo" 2>&1); then
+    echo "$floors"
+    printf '<testsuite><testcase classname="core" name="no include runs up a floor"/></testsuite>\n' \
+      >"$ws/build/test_results/lint/floors.xml"
+  else
+    echo "$floors"
+    printf '<testsuite><testcase classname="core" name="no include runs up a floor"><failure message="%s"/></testcase></testsuite>\n' \
+      "$(sed 's/[<>&"]/_/g' <<<"$floors" | tr '\n' ' ')" >"$ws/build/test_results/lint/floors.xml"
+  fi
   # The API documentation builds, every header and message with its page, without a warning of
   # Doxygen (scripts/docs.sh): one counted case.
   echo "== the API documentation (bash scripts/docs.sh)"
