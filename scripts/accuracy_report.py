@@ -633,7 +633,7 @@ def stepped_table(results):
     return lines + ["", text, ""]
 
 
-STEPPED_TEXT = """How a sub-step moves a body (`include/collision_response/core/stepped_contact.h`): the
+STEPPED_TEXT = """How a sub-step moves a body (`src/core/solver/stepped_contact.h`): the
 touching contacts that strike bounce (Newton's law, at e times the larger of their approach
 and the speed they arrived at in the sub-step before), gravity's kick g h is added, and the velocities
 nearest those that keep every gap open at the sub-step's end are taken; the body moves in a
