@@ -1,6 +1,8 @@
 #include "geometry/narrow_phase.h"
 
+#include <array>
 #include <limits>
+#include <utility>
 
 #include "collision_response/core/time_of_impact.h"
 #include "collision_response/core/validation.h"
@@ -323,15 +325,36 @@ std::optional<double> firstContactTurning(const BallMotion& ball, const Finite& 
   return std::nullopt;  // a graze too slow to pass in kMaxSteps (doc/model.md, "Finite obstacles")
 }
 
-}  // namespace
-
-std::optional<double> firstContact(const BallMotion& ball, const PlacedShape& placed,
-                                   const Eigen::Vector3d& shape_velocity,
-                                   const Eigen::Vector3d& shape_acceleration, bool accelerates,
-                                   double horizon) {
+/// The sphere's row of the first-contact table: `ball` against `shape`, the alternative
+/// `placed` holds.
+template <class Kind>
+std::optional<double> ballFirstContact(const BallMotion& ball, const Kind& shape,
+                                       const PlacedShape& placed,
+                                       const Eigen::Vector3d& shape_velocity,
+                                       const Eigen::Vector3d& shape_acceleration, bool accelerates,
+                                       double horizon) {
   const Eigen::Vector3d relative_velocity = shape_velocity - ball.velocity;
-  // A finite shape: the ball's motion in the shape's frame (the shape moves straight on).
-  const auto finite = [&](const auto& shape) {
+  if constexpr (std::is_same_v<Kind, Plane>) {
+    const Plane& plane = shape;
+    const double gap = plane.normal.dot(ball.centre) - plane.offset - ball.radius;
+    const double rate = -plane.normal.dot(relative_velocity);
+    if (accelerates) {
+      return timeOfImpactPlaneBallistic(gap, rate, plane.normal.dot(ball.acceleration), horizon);
+    }
+    return timeOfImpactPlane(gap, rate, horizon);
+  } else if constexpr (std::is_same_v<Kind, Sphere>) {
+    const Sphere& sphere = shape;
+    const Eigen::Vector3d separation = sphere.centre - ball.centre;
+    const double contact_distance = ball.radius + sphere.radius;
+    if (accelerates) {
+      // Two bodies under the same gravity keep the straight-line relative problem.
+      return timeOfImpactSpheresAccelerated(separation, relative_velocity,
+                                            shape_acceleration - ball.acceleration,
+                                            contact_distance, horizon);
+    }
+    return timeOfImpactSpheres<double>(separation, relative_velocity, contact_distance, horizon);
+  } else {
+    // A finite shape: the ball's motion in the shape's frame (the shape moves straight on).
     // A shape that turns by more than the rounding of its placement within the horizon.
     if (placed.pose.angular_velocity.norm() * horizon > 2.220446049250313e-16) {
       return firstContactTurning(ball, shape, placed, shape_velocity, accelerates, horizon);
@@ -343,33 +366,135 @@ std::optional<double> firstContact(const BallMotion& ball, const PlacedShape& pl
     if (accelerates) motion.acceleration = to_shape * (ball.acceleration - shape_acceleration);
     motion.radius = ball.radius;
     return firstContactFinite(motion, shape, horizon);
-  };
+  }
+}
+
+/// The table's entries. The sphere's row: a ball (side a, a Sphere) against each kind.
+template <class Kind>
+ContactGeometry sphereContact(const PlacedShape& a, const PlacedShape& b, double contact_tolerance,
+                              ApproachDirection approach) {
+  const Sphere& ball = std::get<Sphere>(a.shape);
+  return ballGeometry(ball.centre, ball.radius, std::get<Kind>(b.shape), b, contact_tolerance,
+                      approach);
+}
+
+template <class Kind>
+std::optional<double> sphereFirstContact(const MovingShape& a, const MovingShape& b,
+                                         bool accelerates, double horizon) {
+  const Sphere& sphere = std::get<Sphere>(a.placed.shape);
+  BallMotion ball;
+  ball.centre = sphere.centre;
+  ball.radius = sphere.radius;
+  ball.velocity = a.velocity;
+  ball.acceleration = a.acceleration;
+  return ballFirstContact(ball, std::get<Kind>(b.placed.shape), b.placed, b.velocity,
+                          b.acceleration, accelerates, horizon);
+}
+
+/// A reversed entry: the entry of the kinds in the other order, the sides swapped (and the
+/// approach with them); the normal then points from b into a and is reversed, the surface
+/// velocity at the point is a's and becomes b's (its pose's v + w x r, as every entry gives it).
+ContactGeometry reversedContact(const PlacedShape& a, const PlacedShape& b,
+                                double contact_tolerance, ApproachDirection approach);
+std::optional<double> reversedFirstContact(const MovingShape& a, const MovingShape& b,
+                                           bool accelerates, double horizon);
+
+using Table = std::array<std::array<NarrowPhaseEntry, kShapeKinds>, kShapeKinds>;
+constexpr std::size_t kSphereKind = static_cast<std::size_t>(ShapeKind::kSphere);
+
+template <std::size_t kKind>
+constexpr void addSphereEntries(Table& table) {
+  using Kind = std::variant_alternative_t<kKind, Shape>;
+  table[kSphereKind][kKind] = {&sphereContact<Kind>, &sphereFirstContact<Kind>, false};
+  if constexpr (kKind != kSphereKind) {
+    table[kKind][kSphereKind] = {&reversedContact, &reversedFirstContact, true};
+  }
+}
+
+template <std::size_t... kKinds>
+constexpr Table makeTable(std::index_sequence<kKinds...>) {
+  Table table{};
+  (addSphereEntries<kKinds>(table), ...);
+  return table;
+}
+
+/// Rows: side a's kind; columns: side b's. Entries left empty are not yet answered.
+constexpr Table kTable = makeTable(std::make_index_sequence<kShapeKinds>());
+
+const NarrowPhaseEntry& entryOf(const Shape& a, const Shape& b) {
+  return kTable[a.index()][b.index()];
+}
+
+ContactGeometry reversedContact(const PlacedShape& a, const PlacedShape& b,
+                                double contact_tolerance, ApproachDirection approach) {
+  const auto back = [&] { return Eigen::Vector3d(-approach()); };
+  ContactGeometry result = entryOf(b.shape, a.shape).contact(b, a, contact_tolerance, back);
+  if (result.valid) {
+    result.normal = -result.normal;
+    result.surface_velocity = b.pose.velocityAt(result.point - b.pose.transform.translation());
+  }
+  return result;
+}
+
+std::optional<double> reversedFirstContact(const MovingShape& a, const MovingShape& b,
+                                           bool accelerates, double horizon) {
+  return entryOf(b.placed.shape, a.placed.shape).first_contact(b, a, accelerates, horizon);
+}
+
+}  // namespace
+
+const char* kindName(ShapeKind kind) {
+  switch (kind) {
+    case ShapeKind::kPlane:
+      return "plane";
+    case ShapeKind::kSphere:
+      return "sphere";
+    case ShapeKind::kBox:
+      return "box";
+    case ShapeKind::kCylinder:
+      return "cylinder";
+    case ShapeKind::kCapsule:
+      return "capsule";
+    case ShapeKind::kMesh:
+      return "mesh";
+  }
+  return "unknown";
+}
+
+const NarrowPhaseEntry& narrowPhaseEntry(ShapeKind a, ShapeKind b) {
+  return kTable[static_cast<std::size_t>(a)][static_cast<std::size_t>(b)];
+}
+
+Status narrowPhaseCovers(ShapeKind a, ShapeKind b, const std::string& field) {
+  const NarrowPhaseEntry& entry = narrowPhaseEntry(a, b);
+  if (entry.contact != nullptr && entry.first_contact != nullptr) return Ok{};
+  return Error{field, std::string("not yet: the contact of a ") + kindName(a) + " with a " +
+                          kindName(b) + " (only a ball's contacts are answered yet)"};
+}
+
+ContactGeometry contactGeometry(const PlacedShape& a, const PlacedShape& b,
+                                double contact_tolerance, ApproachDirection approach) {
+  const NarrowPhaseEntry& entry = entryOf(a.shape, b.shape);
+  if (entry.contact == nullptr) return ContactGeometry{};  // not yet (narrowPhaseCovers)
+  return entry.contact(a, b, contact_tolerance, approach);
+}
+
+std::optional<double> firstContact(const MovingShape& a, const MovingShape& b, bool accelerates,
+                                   double horizon) {
+  const NarrowPhaseEntry& entry = entryOf(a.placed.shape, b.placed.shape);
+  if (entry.first_contact == nullptr) return std::nullopt;  // not yet (narrowPhaseCovers)
+  return entry.first_contact(a, b, accelerates, horizon);
+}
+
+std::optional<double> firstContact(const BallMotion& ball, const PlacedShape& placed,
+                                   const Eigen::Vector3d& shape_velocity,
+                                   const Eigen::Vector3d& shape_acceleration, bool accelerates,
+                                   double horizon) {
   return std::visit(
-      Dispatch{[&](const Plane& plane) -> std::optional<double> {
-                 const double gap = plane.normal.dot(ball.centre) - plane.offset - ball.radius;
-                 const double rate = -plane.normal.dot(relative_velocity);
-                 if (accelerates) {
-                   return timeOfImpactPlaneBallistic(gap, rate, plane.normal.dot(ball.acceleration),
-                                                     horizon);
-                 }
-                 return timeOfImpactPlane(gap, rate, horizon);
-               },
-               [&](const Sphere& sphere) -> std::optional<double> {
-                 const Eigen::Vector3d separation = sphere.centre - ball.centre;
-                 const double contact_distance = ball.radius + sphere.radius;
-                 if (accelerates) {
-                   // Two bodies under the same gravity keep the straight-line relative problem.
-                   return timeOfImpactSpheresAccelerated(separation, relative_velocity,
-                                                         shape_acceleration - ball.acceleration,
-                                                         contact_distance, horizon);
-                 }
-                 return timeOfImpactSpheres<double>(separation, relative_velocity, contact_distance,
-                                                    horizon);
-               },
-               [&](const Cuboid& box) { return finite(box); },
-               [&](const Cylinder& cylinder) { return finite(cylinder); },
-               [&](const Capsule& capsule) { return finite(capsule); },
-               [&](const Mesh& mesh) { return finite(mesh); }},
+      [&](const auto& shape) {
+        return ballFirstContact(ball, shape, placed, shape_velocity, shape_acceleration,
+                                accelerates, horizon);
+      },
       placed.shape);
 }
 

@@ -4,17 +4,24 @@
 // layer, its scene keys and its marker).
 //  - placement: an obstacle's shape from its scene entry, placed fixed or on a moving frame;
 //  - shapeAt: a placed shape moved on (straight on) to an instant;
-//  - contactGeometry: a ball and a shape at one instant (normal, gap, point, curvature, the
-//    surface's velocity at the point);
-//  - firstContact: the first contact along a ball's motion (time_of_impact.h's closed forms, and
-//    finite_shapes.h's certified roots for boxes, cylinders and capsules);
+//  - contactGeometry: two shapes at one instant (normal, gap, point, curvature, the surface's
+//    velocity at the point);
+//  - firstContact: the first contact along both shapes' motions (time_of_impact.h's closed
+//    forms, and finite_shapes.h's certified roots for boxes, cylinders and capsules);
 //  - mayReach, mayReachMoving: whether a box may reach a fixed or a moving shape (the broad
 //    phase's test).
+// contactGeometry and firstContact are tables over the kinds of both sides (as MuJoCo's
+// mjCOLLISIONFUNC, Box2D v3's s_registers and Jolt's CollisionDispatch): an entry answers a pair
+// of kinds in one order, the entry of the reversed order calls it with the sides swapped and
+// reverses the contact. Every moving body is a ball today: the sphere's row (a ball against
+// every kind) is filled, and its column by reversal; the other entries are not yet
+// (narrowPhaseCovers says so, naming the kinds).
 #pragma once
 
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <functional>
 #include <optional>
 #include <string>
@@ -73,6 +80,68 @@ struct ContactGeometry {
   /// held where it is, or an impact that discrete detection found by overlap).
   double band() const { return std::max(tolerance, -gap); }
 };
+
+/// The kinds of shape, Shape's alternatives in its order: the rows and columns of the narrow
+/// phase's tables.
+enum class ShapeKind : std::size_t { kPlane, kSphere, kBox, kCylinder, kCapsule, kMesh };
+constexpr std::size_t kShapeKinds = std::variant_size_v<Shape>;
+static_assert(kShapeKinds == static_cast<std::size_t>(ShapeKind::kMesh) + 1,
+              "a kind per alternative of Shape");
+inline ShapeKind kindOf(const Shape& shape) { return static_cast<ShapeKind>(shape.index()); }
+/// The kind's scene name: "plane", "sphere", "box", "cylinder", "capsule", "mesh".
+const char* kindName(ShapeKind kind);
+
+/// The direction side a approaches side b in (a's velocity less b's), which contactGeometry asks
+/// for only where the shapes give no line of contact (coincident sphere centres): a reference to
+/// the caller's callable, which outlives the call (no copy, no allocation).
+class ApproachDirection {
+ public:
+  template <class Callable,
+            class = std::enable_if_t<!std::is_same_v<std::decay_t<Callable>, ApproachDirection>>>
+  ApproachDirection(const Callable& callable)  // NOLINT: implicit, as a lambda is passed
+      : callable_(&callable),
+        call_([](const void* c) { return Eigen::Vector3d((*static_cast<const Callable*>(c))()); }) {
+  }
+  Eigen::Vector3d operator()() const { return call_(callable_); }
+
+ private:
+  const void* callable_;
+  Eigen::Vector3d (*call_)(const void*);
+};
+
+/// A shape in motion from its placement's instant on: its origin moving at `velocity`,
+/// accelerating at `acceleration` (read where the question accelerates), a finite shape turning
+/// at its pose's angular velocity.
+struct MovingShape {
+  PlacedShape placed;
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d acceleration = Eigen::Vector3d::Zero();
+};
+
+/// An entry of the narrow phase's table for side a of one kind and side b of another.
+struct NarrowPhaseEntry {
+  /// Where a and b are relative to each other at their placements' (common) instant: the normal
+  /// from a into b, the surface velocity b's at the point. `contact_tolerance`: the touching
+  /// band's share of the contact distance.
+  ContactGeometry (*contact)(const PlacedShape& a, const PlacedShape& b, double contact_tolerance,
+                             ApproachDirection approach) = nullptr;
+  /// The first contact of a and b (placed at the same instant) within `horizon` of it, along
+  /// straight lines or, `accelerates`, parabolas.
+  std::optional<double> (*first_contact)(const MovingShape& a, const MovingShape& b,
+                                         bool accelerates, double horizon) = nullptr;
+  /// The entry calls the one of the kinds in the other order, the sides swapped: the same gap,
+  /// point, curvature and instant, the normal reversed, the surface velocity the other side's.
+  bool reversed = false;
+};
+
+/// The table's entry for a side of kind `a` against one of kind `b`; its functions are null
+/// where the pair is not yet answered (narrowPhaseCovers).
+const NarrowPhaseEntry& narrowPhaseEntry(ShapeKind a, ShapeKind b);
+
+/// Ok where the narrow phase answers a body of kind `a` against one of kind `b`; otherwise an
+/// error naming `field` and both kinds ("not yet: ..."). A body of a kind it does not answer
+/// against every kind it may meet is refused with this before it reaches the tables.
+Status narrowPhaseCovers(ShapeKind a, ShapeKind b, const std::string& field);
 
 /// An obstacle's shape as its scene entry gives it, in its frame.
 Shape shapeOf(const ObstacleSpec& spec);
@@ -151,42 +220,57 @@ ContactGeometry finiteGeometry(const Eigen::Vector3d& centre, double radius, con
 ContactGeometry finiteGeometry(const Eigen::Vector3d& centre, double radius, const Mesh& mesh,
                                const RigidPose& pose, double contact_tolerance);
 
-/// A ball at `centre` of `radius` and `placed` (at the same instant). `contact_tolerance`: the
-/// touching band's share of the contact distance. Centres that coincide have no line of centres:
-/// the normal is then `approach()` normalised (the direction the ball approaches in), and none
-/// (valid false) if that is zero.
+/// contactGeometry against a plane.
+inline ContactGeometry planeGeometry(const Eigen::Vector3d& centre, double radius,
+                                     const Plane& plane, const PlacedShape& placed,
+                                     double contact_tolerance) {
+  ContactGeometry result;
+  result.normal = -plane.normal;  // from the ball into the plane
+  result.gap = plane.normal.dot(centre) - plane.offset - radius;
+  result.tolerance = touchingBand(radius, contact_tolerance, centre, plane.offset);
+  result.valid = true;
+  const Eigen::Vector3d on_shape = centre + (result.gap + radius) * result.normal;
+  result.point = 0.5 * (Eigen::Vector3d(centre + radius * result.normal) + on_shape);
+  result.surface_velocity =
+      placed.pose.velocityAt(result.point - placed.pose.transform.translation());
+  return result;
+}
+
+/// The sphere's row of the contact table: a ball at `centre` of `radius` against `shape`, the
+/// alternative `placed` holds.
+template <class Kind, class Approach>
+ContactGeometry ballGeometry(const Eigen::Vector3d& centre, double radius, const Kind& shape,
+                             const PlacedShape& placed, double contact_tolerance,
+                             Approach&& approach) {
+  if constexpr (std::is_same_v<Kind, Plane>) {
+    return planeGeometry(centre, radius, shape, placed, contact_tolerance);
+  } else if constexpr (std::is_same_v<Kind, Sphere>) {
+    return sphereGeometry(centre, radius, shape, placed, contact_tolerance, approach);
+  } else {
+    return finiteGeometry(centre, radius, shape, placed.pose, contact_tolerance);
+  }
+}
+
+/// A ball at `centre` of `radius` and `placed` (at the same instant): the sphere's row of the
+/// table, entered directly. `contact_tolerance`: the touching band's share of the contact
+/// distance. Centres that coincide have no line of centres: the normal is then `approach()`
+/// normalised (the direction the ball approaches in), and none (valid false) if that is zero.
 template <class Approach>
 ContactGeometry contactGeometry(const Eigen::Vector3d& centre, double radius,
                                 const PlacedShape& placed, double contact_tolerance,
                                 Approach&& approach) {
-  ContactGeometry result;
-  const auto surfaceVelocity = [&](const Eigen::Vector3d& on_shape) {
-    result.point = 0.5 * (Eigen::Vector3d(centre + radius * result.normal) + on_shape);
-    result.surface_velocity =
-        placed.pose.velocityAt(result.point - placed.pose.transform.translation());
-  };
-  if (const Plane* plane = std::get_if<Plane>(&placed.shape)) {
-    result.normal = -plane->normal;  // from the ball into the plane
-    result.gap = plane->normal.dot(centre) - plane->offset - radius;
-    result.tolerance = touchingBand(radius, contact_tolerance, centre, plane->offset);
-    result.valid = true;
-    surfaceVelocity(centre + (result.gap + radius) * result.normal);
-    return result;
-  }
-  if (const Sphere* sphere = std::get_if<Sphere>(&placed.shape)) {
-    return sphereGeometry(centre, radius, *sphere, placed, contact_tolerance, approach);
-  }
   return std::visit(
-      [&](const auto& shape) -> ContactGeometry {
-        using Kind = std::decay_t<decltype(shape)>;
-        if constexpr (std::is_same_v<Kind, Plane> || std::is_same_v<Kind, Sphere>) {
-          return result;  // answered above
-        } else {
-          return finiteGeometry(centre, radius, shape, placed.pose, contact_tolerance);
-        }
+      [&](const auto& shape) {
+        return ballGeometry(centre, radius, shape, placed, contact_tolerance, approach);
       },
       placed.shape);
 }
+
+/// Two placed shapes at one instant, by the table (narrowPhaseEntry): the normal from a into b,
+/// the surface velocity b's at the point; `approach()` is a's velocity less b's. A pair the
+/// table does not yet answer (narrowPhaseCovers) has no contact geometry: valid false.
+ContactGeometry contactGeometry(const PlacedShape& a, const PlacedShape& b,
+                                double contact_tolerance, ApproachDirection approach);
 
 /// How a ball moves from an instant on: along a straight line, or (accelerates) a parabola.
 struct BallMotion {
@@ -201,10 +285,16 @@ struct BallMotion {
 /// (timeOfImpactPlane, timeOfImpactSpheres), or with `accelerates` parabolas
 /// (timeOfImpactPlaneBallistic, timeOfImpactSpheresAccelerated; a plane does not accelerate);
 /// a finite shape by its features' polynomials (finite_shapes.h, firstContactFinite), or, where
-/// it turns (its pose's angular velocity), by conservative advancement on the distance.
+/// it turns (its pose's angular velocity), by conservative advancement on the distance. The
+/// sphere's row of the table, entered directly.
 std::optional<double> firstContact(const BallMotion& ball, const PlacedShape& shape,
                                    const Eigen::Vector3d& shape_velocity,
                                    const Eigen::Vector3d& shape_acceleration, bool accelerates,
+                                   double horizon);
+
+/// The first contact of two moving shapes (placed at the same instant) within `horizon`, by the
+/// table (narrowPhaseEntry). A pair the table does not yet answer (narrowPhaseCovers) has none.
+std::optional<double> firstContact(const MovingShape& a, const MovingShape& b, bool accelerates,
                                    double horizon);
 
 /// Whether a box may reach a fixed shape placed at `placed` (the broad phase's test).
