@@ -7,6 +7,8 @@
 #include <numeric>
 #include <tuple>
 
+#include "solver/effective_mass.h"
+
 namespace collision_response::core {
 namespace {
 
@@ -349,6 +351,13 @@ struct Strikes {
   double owed = 0.0;
 };
 
+/// A sphere's side of a contact whose point is along `outward` from its centre: its lever arm
+/// R outward, for the effective mass (solver/effective_mass.h).
+ContactSide sphereSide(const SteppedBody& body, const Eigen::Vector3d& outward) {
+  return {body.inverse_mass, sphereInverseInertia(body.inverse_mass, body.spin_factor, body.radius),
+          body.radius * outward};
+}
+
 /// The strikes of stage 1 (header), each contact's approach speed and whether it struck recorded
 /// in `outcome`.
 Strikes findStrikes(const std::vector<SteppedBody>& bodies,
@@ -376,8 +385,10 @@ Strikes findStrikes(const std::vector<SteppedBody>& bodies,
     if (out.struck) {
       strikes.bounce_speed[k] = c.restitution * speed;
       const double closing = std::max(out.approach_speed, 0.0);
+      // (1/2) m_eff (speed^2 - closing^2), m_eff = 1 / n.K.n (w_a + w_b to the bit for spheres).
       strikes.owed += 0.5 * (speed * speed - closing * closing) /
-                      (bodies[c.a].inverse_mass + bodies[c.b].inverse_mass);
+                      inverseEffectiveMassAlong(sphereSide(bodies[c.a], c.normal),
+                                                sphereSide(bodies[c.b], -c.normal), c.normal);
     }
     strikes.any = strikes.any || out.struck;
   }
