@@ -1,0 +1,847 @@
+// Coefficients from a tracked body's recorded states: see calibration.h.
+#include "collision_response/core/calibration.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <sstream>
+#include <tuple>
+
+#include "geometry/air_flight.h"
+#include "geometry/motion.h"
+
+namespace collision_response::core {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+/// Samples on each side of a bounce's sample in the lines that find it.
+constexpr std::size_t kWindow = 4;
+/// The fewest samples a flight's fit may have, and a recording.
+constexpr std::size_t kMinFlightSamples = 3;
+constexpr std::size_t kMinSamples = 8;
+constexpr int kMaxIterations = 200;
+
+std::string number(double value) {
+  std::ostringstream out;
+  out.precision(9);
+  out << value;
+  return out.str();
+}
+
+RecordingError problem(RecordingProblem kind, std::string field, std::string reason) {
+  return RecordingError{kind, std::move(field), std::move(reason)};
+}
+
+/// Where the parameters are: the state at the first sample (position, velocity), each bounce's
+/// velocity after, then gravity and the drag factor when they are fitted.
+struct Layout {
+  std::size_t bounces = 0;
+  bool gravity = false;
+  bool drag = false;
+  std::size_t gravityAt() const { return 6 + 3 * bounces; }
+  std::size_t dragAt() const { return gravityAt() + (gravity ? 3 : 0); }
+  std::size_t size() const { return dragAt() + (drag ? 1 : 0); }
+};
+
+/// One flight of a candidate motion: its start and state there, and with drag its integration.
+struct Piece {
+  double start = 0.0;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  std::shared_ptr<AirFlight> air;
+};
+
+double height(const Plane& plane, double radius, const Eigen::Vector3d& position) {
+  return plane.normal.dot(position) - plane.offset - radius;
+}
+
+/// The motion the parameters give: the flights, each from the instant the one before met its
+/// bounce's plane (calibration.h).
+class Motion {
+ public:
+  Motion(const CalibrationOptions& options, const Layout& layout,
+         const std::vector<std::size_t>& bounce_planes, double start, double horizon)
+      : options_(options),
+        layout_(layout),
+        bounce_planes_(bounce_planes),
+        start_(start),
+        horizon_(horizon) {}
+
+  /// False when a flight does not meet its bounce's plane before the horizon.
+  bool build(const Eigen::VectorXd& parameters) {
+    pieces_.clear();
+    gravity_ = layout_.gravity ? Eigen::Vector3d(parameters.segment<3>(layout_.gravityAt()))
+                               : options_.gravity;
+    if (options_.drag) {
+      const double coefficient = layout_.drag
+                                     ? parameters[static_cast<Eigen::Index>(layout_.dragAt())]
+                                     : options_.drag_coefficient;
+      if (!(coefficient >= 0.0)) return false;
+      air_ =
+          airFactors(options_.air_density, options_.radius, 1.0 / options_.mass, coefficient, 0.0);
+    }
+    pieces_.push_back(makePiece(start_, parameters.segment<3>(0), parameters.segment<3>(3)));
+    for (std::size_t j = 0; j < layout_.bounces; ++j) {
+      const Plane& plane = options_.planes[bounce_planes_[j]];
+      const auto meeting = nextMeeting(pieces_.back(), plane);
+      if (!meeting) return false;
+      const Eigen::Vector3d point = position(pieces_.back(), *meeting);
+      pieces_.push_back(
+          makePiece(*meeting, point, parameters.segment<3>(static_cast<Eigen::Index>(6 + 3 * j))));
+    }
+    return true;
+  }
+
+  std::size_t pieceAt(double time) const {
+    std::size_t j = 0;
+    while (j + 1 < pieces_.size() && time >= pieces_[j + 1].start) ++j;
+    return j;
+  }
+  Eigen::Vector3d positionAt(double time) const { return position(pieces_[pieceAt(time)], time); }
+  const std::vector<Piece>& pieces() const { return pieces_; }
+  Eigen::Vector3d velocityBefore(std::size_t bounce) const {
+    return velocity(pieces_[bounce], pieces_[bounce + 1].start);
+  }
+  const Eigen::Vector3d& gravity() const { return gravity_; }
+
+ private:
+  Piece makePiece(double start, const Eigen::Vector3d& position, const Eigen::Vector3d& velocity) {
+    Piece piece{start, position, velocity, nullptr};
+    if (options_.drag) {
+      piece.air =
+          std::make_shared<AirFlight>(start, position, velocity, Eigen::Vector3d::Zero(), gravity_,
+                                      air_, options_.flight_integration_tolerance);
+    }
+    return piece;
+  }
+  Eigen::Vector3d position(const Piece& piece, double time) const {
+    if (piece.air) return piece.air->position(0, time);
+    return positionAfter(piece.position, piece.velocity, gravity_, time - piece.start);
+  }
+  Eigen::Vector3d velocity(const Piece& piece, double time) const {
+    if (piece.air) return piece.air->velocity(0, time);
+    return velocityAfter(piece.velocity, gravity_, time - piece.start);
+  }
+
+  /// The first instant after the piece's start at which it crosses `plane` inwards (the height
+  /// over it falling through 0).
+  std::optional<double> nextMeeting(const Piece& piece, const Plane& plane) const {
+    if (piece.air) return nextMeetingInAir(piece, plane);
+    // h(s) = h0 + vn s + gn s^2 / 2, s after the start: the least positive root where h falls.
+    const double h0 = height(plane, options_.radius, piece.position);
+    const double vn = plane.normal.dot(piece.velocity);
+    const double gn = plane.normal.dot(gravity_);
+    std::optional<double> best;
+    const auto consider = [&](double s) {
+      if (std::isfinite(s) && s > 0.0 && vn + gn * s < 0.0 && (!best || s < *best)) best = s;
+    };
+    if (gn == 0.0) {
+      if (vn != 0.0) consider(-h0 / vn);
+    } else {
+      const double discriminant = vn * vn - 2.0 * gn * h0;
+      if (discriminant < 0.0) return std::nullopt;
+      // Both roots without cancellation: q = -(vn + sign(vn) sqrt(D)), roots q / gn and 2 h0 / q.
+      const double q = -(vn + std::copysign(std::sqrt(discriminant), vn));
+      consider(q / gn);
+      if (q != 0.0) consider(2.0 * h0 / q);
+    }
+    if (!best || piece.start + *best > horizon_) return std::nullopt;
+    return piece.start + *best;
+  }
+
+  std::optional<double> nextMeetingInAir(const Piece& piece, const Plane& plane) const {
+    const double step = 1e-3;
+    double before = piece.start;
+    double h_before = height(plane, options_.radius, piece.position);
+    for (double t = piece.start + step; t <= horizon_ + step; t += step) {
+      const double h = height(plane, options_.radius, position(piece, t));
+      if (h < 0.0 && h_before >= 0.0 && t > piece.start + step / 2) {
+        double low = before;
+        double high = t;
+        for (int i = 0; i < 80 && high - low > 0.0; ++i) {
+          const double middle = 0.5 * (low + high);
+          if (middle <= low || middle >= high) break;
+          (height(plane, options_.radius, position(piece, middle)) >= 0.0 ? low : high) = middle;
+        }
+        return 0.5 * (low + high);
+      }
+      if (piece.air->stalledAt() < kInf) return std::nullopt;
+      before = t;
+      h_before = h;
+    }
+    return std::nullopt;
+  }
+
+  const CalibrationOptions& options_;
+  Layout layout_;
+  std::vector<std::size_t> bounce_planes_;
+  double start_;
+  double horizon_;
+  Eigen::Vector3d gravity_ = Eigen::Vector3d::Zero();
+  AirFactors air_;
+  std::vector<Piece> pieces_;
+};
+
+/// The residuals of the samples against the motion of `parameters` (3 a sample); false when the
+/// motion cannot be built.
+bool residuals(Motion& motion, const std::vector<TrackedSample>& samples,
+               const Eigen::VectorXd& parameters, Eigen::VectorXd& out) {
+  if (!motion.build(parameters)) return false;
+  out.resize(static_cast<Eigen::Index>(3 * samples.size()));
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    out.segment<3>(static_cast<Eigen::Index>(3 * k)) =
+        motion.positionAt(samples[k].time) - samples[k].position;
+  }
+  return out.allFinite();
+}
+
+double stepFor(double value) { return 1e-6 * std::max(1.0, std::abs(value)); }
+
+/// d f / d parameters by central differences; false where f cannot be evaluated.
+template <typename F>
+bool jacobian(const F& f, const Eigen::VectorXd& parameters, Eigen::Index rows,
+              Eigen::MatrixXd& out) {
+  out.resize(rows, parameters.size());
+  Eigen::VectorXd plus;
+  Eigen::VectorXd minus;
+  for (Eigen::Index i = 0; i < parameters.size(); ++i) {
+    const double step = stepFor(parameters[i]);
+    Eigen::VectorXd shifted = parameters;
+    shifted[i] = parameters[i] + step;
+    if (!f(shifted, plus)) return false;
+    shifted[i] = parameters[i] - step;
+    if (!f(shifted, minus)) return false;
+    out.col(i) = (plus - minus) / (2.0 * step);
+  }
+  return out.allFinite();
+}
+
+struct Fit {
+  Eigen::VectorXd parameters;
+  Eigen::MatrixXd covariance;
+  double noise = 0.0;
+  int iterations = 0;
+};
+
+/// Levenberg-Marquardt from `start`; the covariance sigma^2 (J^T J)^-1 at the end.
+std::optional<Fit> leastSquares(Motion& motion, const std::vector<TrackedSample>& samples,
+                                Eigen::VectorXd parameters) {
+  const auto f = [&](const Eigen::VectorXd& p, Eigen::VectorXd& r) {
+    return residuals(motion, samples, p, r);
+  };
+  Eigen::VectorXd r;
+  if (!f(parameters, r)) return std::nullopt;
+  double cost = r.squaredNorm();
+  Eigen::MatrixXd j;
+  double lambda = 1e-3;
+  int iteration = 0;
+  for (; iteration < kMaxIterations; ++iteration) {
+    if (!jacobian(f, parameters, r.size(), j)) return std::nullopt;
+    const Eigen::MatrixXd normal = j.transpose() * j;
+    const Eigen::VectorXd gradient = j.transpose() * r;
+    bool improved = false;
+    bool converged = false;
+    while (lambda < 1e16) {
+      Eigen::MatrixXd damped = normal;
+      damped.diagonal() += lambda * normal.diagonal().cwiseMax(1e-300);
+      const Eigen::VectorXd step = damped.ldlt().solve(-gradient);
+      const Eigen::VectorXd tried = parameters + step;
+      Eigen::VectorXd tried_r;
+      if (step.allFinite() && f(tried, tried_r) && tried_r.squaredNorm() <= cost) {
+        const double decrease = cost - tried_r.squaredNorm();
+        converged = decrease <= 1e-14 * cost || step.norm() <= 1e-13 * (1.0 + parameters.norm());
+        parameters = tried;
+        r = tried_r;
+        cost = r.squaredNorm();
+        lambda = std::max(lambda / 10.0, 1e-12);
+        improved = true;
+        break;
+      }
+      lambda *= 10.0;
+    }
+    if (!improved || converged) break;
+  }
+  if (!f(parameters, r) || !jacobian(f, parameters, r.size(), j)) return std::nullopt;
+  const auto dof = static_cast<double>(r.size() - parameters.size());
+  if (!(dof > 0)) return std::nullopt;
+  Fit fit;
+  fit.parameters = parameters;
+  fit.noise = std::sqrt(r.squaredNorm() / dof);
+  const Eigen::MatrixXd normal = j.transpose() * j;
+  const Eigen::MatrixXd identity = Eigen::MatrixXd::Identity(normal.rows(), normal.cols());
+  fit.covariance = fit.noise * fit.noise * normal.ldlt().solve(identity);
+  fit.iterations = iteration + 1;
+  if (!fit.covariance.allFinite()) return std::nullopt;
+  return fit;
+}
+
+/// The slope of h over t on samples [first, last] (least squares), or 0 with fewer than 2.
+double slope(const std::vector<double>& t, const std::vector<double>& h, std::size_t first,
+             std::size_t last) {
+  double mean_t = 0.0;
+  double mean_h = 0.0;
+  const auto count = static_cast<double>(last - first + 1);
+  for (std::size_t k = first; k <= last; ++k) {
+    mean_t += t[k];
+    mean_h += h[k];
+  }
+  mean_t /= count;
+  mean_h /= count;
+  double sxy = 0.0;
+  double sxx = 0.0;
+  for (std::size_t k = first; k <= last; ++k) {
+    sxy += (t[k] - mean_t) * (h[k] - mean_h);
+    sxx += (t[k] - mean_t) * (t[k] - mean_t);
+  }
+  return sxx > 0.0 ? sxy / sxx : 0.0;
+}
+
+struct FoundBounce {
+  std::size_t sample = 0;  ///< the sample nearest the plane
+  std::size_t plane = 0;
+  double height = 0.0;
+};
+
+/// Bounces: the speed towards a plane reversing (calibration.h), one per window.
+std::vector<FoundBounce> findBounces(const std::vector<TrackedSample>& samples,
+                                     const CalibrationOptions& options) {
+  std::vector<FoundBounce> found;
+  const std::size_t n = samples.size();
+  std::vector<double> t(n);
+  for (std::size_t k = 0; k < n; ++k) t[k] = samples[k].time;
+  for (std::size_t i = 0; i < options.planes.size(); ++i) {
+    std::vector<double> h(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      h[k] = height(options.planes[i], options.radius, samples[k].position);
+    }
+    for (std::size_t k = kWindow; k + kWindow < n; ++k) {
+      const double lowest =
+          *std::min_element(h.begin() + static_cast<std::ptrdiff_t>(k - kWindow),
+                            h.begin() + static_cast<std::ptrdiff_t>(k + kWindow + 1));
+      if (h[k] != lowest) continue;
+      const double before = slope(t, h, k - kWindow, k);
+      const double after = slope(t, h, k, k + kWindow);
+      if (before < -options.min_bounce_speed && after > 0.0 &&
+          after - before > 2.0 * options.min_bounce_speed) {
+        found.push_back(FoundBounce{k, i, h[k]});
+      }
+    }
+  }
+  std::sort(found.begin(), found.end(),
+            [](const FoundBounce& a, const FoundBounce& b) { return a.sample < b.sample; });
+  std::vector<FoundBounce> merged;
+  for (const auto& bounce : found) {
+    if (!merged.empty() && bounce.sample <= merged.back().sample + kWindow) {
+      if (bounce.height < merged.back().height) merged.back() = bounce;
+    } else {
+      merged.push_back(bounce);
+    }
+  }
+  return merged;
+}
+
+std::optional<RecordingError> checkSamples(const std::vector<TrackedSample>& samples) {
+  if (samples.size() < kMinSamples) {
+    return problem(RecordingProblem::kTooFewSamples, "samples",
+                   std::to_string(samples.size()) + " samples; a fit needs at least " +
+                       std::to_string(kMinSamples));
+  }
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    const std::string field = "samples[" + std::to_string(k) + "]";
+    if (!std::isfinite(samples[k].time)) {
+      return problem(RecordingProblem::kBadValue, field + ".time",
+                     "must be finite, got " + number(samples[k].time));
+    }
+    if (!samples[k].position.allFinite()) {
+      return problem(RecordingProblem::kBadValue, field + ".position", "must be finite");
+    }
+    if (samples[k].angular_velocity && !samples[k].angular_velocity->allFinite()) {
+      return problem(RecordingProblem::kBadValue, field + ".angular_velocity", "must be finite");
+    }
+    if (k > 0 && !(samples[k].time > samples[k - 1].time)) {
+      return problem(RecordingProblem::kStampsGoBack, field + ".time",
+                     number(samples[k].time) + " s is not after the sample before it (" +
+                         number(samples[k - 1].time) + " s)");
+    }
+  }
+  return std::nullopt;
+}
+
+std::optional<RecordingError> checkOptions(const CalibrationOptions& options, bool planes) {
+  if (planes && options.planes.empty()) {
+    return problem(RecordingProblem::kBadValue, "planes", "no plane to bounce off");
+  }
+  for (std::size_t i = 0; i < options.planes.size(); ++i) {
+    const auto& plane = options.planes[i];
+    const std::string field = "planes[" + std::to_string(i) + "]";
+    if (!plane.normal.allFinite() || std::abs(plane.normal.norm() - 1.0) > 1e-9) {
+      return problem(RecordingProblem::kBadValue, field + ".normal", "must be a unit vector");
+    }
+    if (!std::isfinite(plane.offset)) {
+      return problem(RecordingProblem::kBadValue, field + ".offset", "must be finite");
+    }
+  }
+  if (!(options.radius >= 0.0) || !std::isfinite(options.radius)) {
+    return problem(RecordingProblem::kBadValue, "radius",
+                   "must be finite and >= 0, got " + number(options.radius));
+  }
+  if (!options.gravity.allFinite()) {
+    return problem(RecordingProblem::kBadValue, "gravity", "must be finite");
+  }
+  if (options.drag) {
+    if (!(options.air_density > 0.0) || !std::isfinite(options.air_density)) {
+      return problem(RecordingProblem::kBadValue, "air_density", "must be finite and > 0");
+    }
+    if (!(options.mass > 0.0) || !std::isfinite(options.mass)) {
+      return problem(RecordingProblem::kBadValue, "mass", "must be finite and > 0");
+    }
+    if (!(options.radius > 0.0)) {
+      return problem(RecordingProblem::kBadValue, "radius", "must be > 0 with drag");
+    }
+    if (!(options.drag_coefficient >= 0.0) || !std::isfinite(options.drag_coefficient)) {
+      return problem(RecordingProblem::kBadValue, "drag_coefficient", "must be finite and >= 0");
+    }
+  }
+  if (!(options.min_bounce_speed > 0.0) || !std::isfinite(options.min_bounce_speed)) {
+    return problem(RecordingProblem::kBadValue, "min_bounce_speed", "must be finite and > 0");
+  }
+  if (!(options.max_gap_periods >= 1.0)) {
+    return problem(RecordingProblem::kBadValue, "max_gap_periods", "must be >= 1");
+  }
+  if (options.spin_before && !options.spin_before->allFinite()) {
+    return problem(RecordingProblem::kBadValue, "spin_before", "must be finite");
+  }
+  return std::nullopt;
+}
+
+double medianSpacing(const std::vector<TrackedSample>& samples) {
+  std::vector<double> spacing;
+  for (std::size_t k = 1; k < samples.size(); ++k) {
+    spacing.push_back(samples[k].time - samples[k - 1].time);
+  }
+  std::nth_element(spacing.begin(),
+                   spacing.begin() + static_cast<std::ptrdiff_t>(spacing.size() / 2),
+                   spacing.end());
+  return spacing[spacing.size() / 2];
+}
+
+/// A line fitted to one flight's samples with gravity taken out, p - g s^2 / 2 = a + b s (s
+/// after `origin`): its start `a` and velocity `b`, the start of the fit.
+std::pair<Eigen::Vector3d, Eigen::Vector3d> lineThrough(const std::vector<TrackedSample>& samples,
+                                                        std::size_t first, std::size_t last,
+                                                        double origin,
+                                                        const Eigen::Vector3d& gravity) {
+  Eigen::Matrix2d normal = Eigen::Matrix2d::Zero();
+  Eigen::Matrix<double, 2, 3> right = Eigen::Matrix<double, 2, 3>::Zero();
+  for (std::size_t k = first; k <= last; ++k) {
+    const double s = samples[k].time - origin;
+    const Eigen::Vector3d y = samples[k].position - 0.5 * s * s * gravity;
+    const Eigen::Vector2d row(1.0, s);
+    normal += row * row.transpose();
+    right += row * y.transpose();
+  }
+  const Eigen::Matrix<double, 2, 3> solution = normal.ldlt().solve(right);
+  return {solution.row(0).transpose(), solution.row(1).transpose()};
+}
+
+Estimate estimate(double value, double variance) {
+  return Estimate{value, std::sqrt(std::max(variance, 0.0))};
+}
+
+/// The generalised least-squares mean of `values` under `covariance`, and the chi-square of the
+/// values about it over its degrees of freedom.
+std::pair<Estimate, double> commonMean(const Eigen::VectorXd& values,
+                                       const Eigen::MatrixXd& covariance) {
+  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(values.size());
+  const auto solver = covariance.ldlt();
+  const Eigen::VectorXd weights = solver.solve(ones);
+  const double information = ones.dot(weights);
+  const double mean = weights.dot(values) / information;
+  const Eigen::VectorXd deviation = values - mean * ones;
+  const double chi_square = deviation.dot(solver.solve(deviation));
+  const double spread =
+      values.size() > 1 ? chi_square / static_cast<double>(values.size() - 1) : 0.0;
+  return {estimate(mean, 1.0 / information), spread};
+}
+
+/// What each bounce gives, from a motion built of the parameters: per bounce its instant, the
+/// approach speed, e, the friction ratio, the slip before and after (along the slip before).
+constexpr Eigen::Index kPerBounce = 6;
+
+RecordingResult<Calibration> run(const std::vector<TrackedSample>& all_samples,
+                                 const CalibrationOptions& given, bool with_bounces) {
+  if (auto error = checkSamples(all_samples)) return *error;
+  if (auto error = checkOptions(given, with_bounces)) return *error;
+  CalibrationOptions options = given;
+
+  std::vector<FoundBounce> found;
+  std::vector<TrackedSample> samples = all_samples;
+  const double spacing = medianSpacing(all_samples);
+  if (with_bounces) {
+    found = findBounces(all_samples, options);
+    if (found.empty()) {
+      return problem(RecordingProblem::kNoBounce, "samples",
+                     "no bounce off a plane: no reversal of the speed towards one from at least " +
+                         number(options.min_bounce_speed) + " m/s (min_bounce_speed)");
+    }
+    for (std::size_t j = 0; j < found.size(); ++j) {
+      const std::size_t k = found[j].sample;
+      const double gap = std::max(all_samples[k].time - all_samples[k - 1].time,
+                                  all_samples[k + 1].time - all_samples[k].time);
+      if (gap > options.max_gap_periods * spacing) {
+        return problem(RecordingProblem::kGapAcrossBounce, "bounce " + std::to_string(j + 1),
+                       "near " + number(all_samples[k].time) + " s the samples are " + number(gap) +
+                           " s apart, more than " + number(options.max_gap_periods) +
+                           " sample periods (" + number(spacing) + " s)");
+      }
+    }
+    std::size_t used = found.size();
+    if (options.max_bounces > 0 && used > options.max_bounces) used = options.max_bounces;
+    // The last flight: up to the next bounce found, else until past its top it has fallen
+    // halfway back (a body settling afterwards is no flight).
+    std::size_t end = all_samples.size();
+    if (used < found.size()) {
+      end = found[used].sample - 1;
+    } else {
+      const Plane& plane = options.planes[found[used - 1].plane];
+      double top = -kInf;
+      for (std::size_t k = found[used - 1].sample + 1; k < all_samples.size(); ++k) {
+        const double h = height(plane, options.radius, all_samples[k].position);
+        top = std::max(top, h);
+        if (h < 0.5 * top && plane.normal.dot(options.gravity) < 0.0) {
+          end = k;
+          break;
+        }
+      }
+    }
+    found.resize(used);
+    samples.assign(all_samples.begin(), all_samples.begin() + static_cast<std::ptrdiff_t>(end));
+  }
+  const std::size_t bounces = found.size();
+
+  // Flights by the samples found nearest each bounce (which side of it that sample is on is
+  // left to the fit).
+  std::vector<std::pair<std::size_t, std::size_t>> flights;
+  {
+    std::size_t first = 0;
+    for (std::size_t j = 0; j <= bounces; ++j) {
+      const std::size_t last = j < bounces ? found[j].sample - 1 : samples.size() - 1;
+      if (last < first || last - first + 1 < kMinFlightSamples) {
+        return problem(RecordingProblem::kTooFewSamples, "flight " + std::to_string(j),
+                       std::to_string(last >= first ? last - first + 1 : 0) + " samples between " +
+                           (j == 0 ? "the start" : "bounce " + std::to_string(j)) + " and " +
+                           (j < bounces ? "bounce " + std::to_string(j + 1) : "the end") +
+                           "; a flight's fit needs " + std::to_string(kMinFlightSamples));
+      }
+      flights.emplace_back(first, last);
+      if (j < bounces) first = found[j].sample + 1;
+    }
+  }
+
+  Layout layout{bounces, options.fit_gravity, options.drag && options.fit_drag};
+  Eigen::VectorXd start = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(layout.size()));
+  const double origin = samples.front().time;
+  {
+    const auto [position, velocity] =
+        lineThrough(samples, flights[0].first, flights[0].second, origin, options.gravity);
+    start.segment<3>(0) = position;
+    start.segment<3>(3) = velocity;
+  }
+  for (std::size_t j = 0; j < bounces; ++j) {
+    const double bounce_time = samples[found[j].sample].time;
+    const auto line = lineThrough(samples, flights[j + 1].first, flights[j + 1].second, bounce_time,
+                                  options.gravity);
+    start.segment<3>(static_cast<Eigen::Index>(6 + 3 * j)) = line.second;
+  }
+  if (layout.gravity)
+    start.segment<3>(static_cast<Eigen::Index>(layout.gravityAt())) = options.gravity;
+  if (layout.drag) start[static_cast<Eigen::Index>(layout.dragAt())] = options.drag_coefficient;
+
+  std::vector<std::size_t> planes;
+  for (const auto& bounce : found) planes.push_back(bounce.plane);
+  const double horizon = samples.back().time + 1.0;
+  Motion motion(options, layout, planes, origin, horizon);
+  const auto fit = leastSquares(motion, samples, start);
+  if (!fit) {
+    return problem(RecordingProblem::kFitFailed, "samples",
+                   "the flights could not be fitted (a flight that does not meet its bounce's "
+                   "plane, or a motion past the doubles)");
+  }
+
+  // The spin before each bounce: the tracker's (its mean over the flight before), else carried
+  // from spin_before through the earlier bounces' friction impulses, else unknown.
+  const double spin_factor = spinFactor(1.0, options.radius, options.inertia);
+  std::vector<std::optional<Eigen::Vector3d>> measured_spin(bounces);
+  for (std::size_t j = 0; j < bounces; ++j) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    int count = 0;
+    for (std::size_t k = flights[j].first; k <= flights[j].second; ++k) {
+      if (samples[k].angular_velocity) {
+        sum += *samples[k].angular_velocity;
+        ++count;
+      }
+    }
+    if (count > 0) measured_spin[j] = sum / count;
+  }
+  const auto derived = [&](const Eigen::VectorXd& p, Eigen::VectorXd& out) {
+    if (!motion.build(p)) return false;
+    out.resize(static_cast<Eigen::Index>(kPerBounce * bounces + (layout.drag ? 1 : 0)));
+    // A flag beside a vector, not an optional: GCC takes the optional's vector for uninitialised.
+    bool spin_known = options.spin_before.has_value();
+    Eigen::Vector3d spin = options.spin_before.value_or(Eigen::Vector3d::Zero());
+    for (std::size_t j = 0; j < bounces; ++j) {
+      const Eigen::Vector3d& n = options.planes[planes[j]].normal;
+      const Eigen::Vector3d before = motion.velocityBefore(j);
+      const Eigen::Vector3d after = motion.pieces()[j + 1].velocity;
+      const Eigen::Vector3d change = after - before;
+      const Eigen::Vector3d tangential_change = change - change.dot(n) * n;
+      if (measured_spin[j]) {
+        spin = *measured_spin[j];
+        spin_known = true;
+      }
+      double slip_before = 0.0;
+      double slip_after = 0.0;
+      if (spin_known) {
+        // The contact point (at -r n from the centre) slips at u = v + w x (-r n), tangentially;
+        // the tangential impulse changes u by (1 + 1/k) dv_t and w by -(1 / (k r)) n x dv_t
+        // (I = k m r^2): friction.h's tangential inverse mass.
+        const Eigen::Vector3d u = before + spin.cross(-options.radius * n);
+        const Eigen::Vector3d u_t = u - u.dot(n) * n;
+        slip_before = u_t.norm();
+        const Eigen::Vector3d u_after = u_t + (1.0 + spin_factor) * tangential_change;
+        slip_after = slip_before > 0.0 ? u_after.dot(u_t) / slip_before : u_after.norm();
+        if (options.radius > 0.0) {
+          spin -= (spin_factor / options.radius) * n.cross(tangential_change);
+        }
+      }
+      const auto row = static_cast<Eigen::Index>(kPerBounce * j);
+      out[row] = motion.pieces()[j + 1].start;
+      out[row + 1] = -before.dot(n);
+      out[row + 2] = -after.dot(n) / before.dot(n);
+      out[row + 3] = tangential_change.norm() / change.dot(n);
+      out[row + 4] = slip_before;
+      out[row + 5] = slip_after;
+    }
+    if (layout.drag) out[out.size() - 1] = p[static_cast<Eigen::Index>(layout.dragAt())];
+    return out.allFinite();
+  };
+  Eigen::VectorXd values;
+  Eigen::MatrixXd gradient;
+  if (!derived(fit->parameters, values) ||
+      !jacobian(derived, fit->parameters, values.size(), gradient)) {
+    return problem(RecordingProblem::kFitFailed, "samples",
+                   "the fitted flights give no coefficients (a bounce without an approach)");
+  }
+  const Eigen::MatrixXd covariance = gradient * fit->covariance * gradient.transpose();
+  motion.build(fit->parameters);
+
+  Calibration result;
+  result.noise = fit->noise;
+  result.samples_used = samples.size();
+  result.parameters = layout.size();
+  result.iterations = fit->iterations;
+  result.fitted_parameters.assign(fit->parameters.data(),
+                                  fit->parameters.data() + fit->parameters.size());
+  result.start_time = origin;
+  result.end_time = samples.back().time;
+  for (int i = 0; i < 3; ++i) {
+    if (layout.gravity) {
+      const auto at = static_cast<Eigen::Index>(layout.gravityAt()) + i;
+      result.gravity[i] = estimate(fit->parameters[at], fit->covariance(at, at));
+    } else {
+      result.gravity[i] = Estimate{options.gravity[i], 0.0};
+    }
+  }
+  if (layout.drag) {
+    const Eigen::Index at = values.size() - 1;
+    result.drag_coefficient = estimate(values[at], covariance(at, at));
+  }
+  const auto variance = [&](Eigen::Index i) { return covariance(i, i); };
+  for (std::size_t j = 0; j < bounces; ++j) {
+    const auto row = static_cast<Eigen::Index>(kPerBounce * j);
+    BounceEstimate bounce;
+    bounce.plane = planes[j];
+    bounce.time = estimate(values[row], variance(row));
+    bounce.point = motion.pieces()[j + 1].position;
+    bounce.velocity_before = motion.velocityBefore(j);
+    bounce.velocity_after = motion.pieces()[j + 1].velocity;
+    bounce.approach_speed = estimate(values[row + 1], variance(row + 1));
+    bounce.restitution = estimate(values[row + 2], variance(row + 2));
+    bounce.friction_ratio = estimate(values[row + 3], variance(row + 3));
+    bounce.slip_after = estimate(values[row + 5], variance(row + 5));
+    const bool spin_known = measured_spin[j] || options.spin_before;
+    const Estimate slip_before = estimate(values[row + 4], variance(row + 4));
+    if (!spin_known) {
+      bounce.friction = FrictionReading::kSpinUnknown;
+    } else if (slip_before.low() <= 0.0) {
+      bounce.friction = FrictionReading::kNoSlip;
+    } else if (bounce.slip_after.low() > 0.0) {
+      bounce.friction = FrictionReading::kSliding;
+    } else {
+      bounce.friction = FrictionReading::kStoppedSlipping;
+    }
+    bounce.samples_before = 0;
+    bounce.samples_after = 0;
+    for (const auto& sample : samples) {
+      const std::size_t piece = motion.pieceAt(sample.time);
+      if (piece == j) ++bounce.samples_before;
+      if (piece == j + 1) ++bounce.samples_after;
+    }
+    // The samples either side of the fitted instant.
+    double last_before = -kInf;
+    double first_after = kInf;
+    for (const auto& sample : samples) {
+      if (sample.time <= bounce.time.value) last_before = std::max(last_before, sample.time);
+      if (sample.time > bounce.time.value) first_after = std::min(first_after, sample.time);
+    }
+    if (!(first_after - last_before <= options.max_gap_periods * spacing)) {
+      return problem(RecordingProblem::kGapAcrossBounce, "bounce " + std::to_string(j + 1),
+                     "at " + number(bounce.time.value) + " s the samples either side are " +
+                         number(first_after - last_before) + " s apart, more than " +
+                         number(options.max_gap_periods) + " sample periods (" + number(spacing) +
+                         " s)");
+    }
+    if (bounce.samples_before < kMinFlightSamples || bounce.samples_after < kMinFlightSamples) {
+      return problem(RecordingProblem::kTooFewSamples, "bounce " + std::to_string(j + 1),
+                     "the fitted flights on either side have " +
+                         std::to_string(bounce.samples_before) + " and " +
+                         std::to_string(bounce.samples_after) + " samples; each needs " +
+                         std::to_string(kMinFlightSamples));
+    }
+    result.bounces.push_back(bounce);
+  }
+  // The joint covariance of the bounces' e and friction ratios, for combine().
+  result.restitution_covariance.resize(static_cast<Eigen::Index>(bounces),
+                                       static_cast<Eigen::Index>(bounces));
+  result.friction_ratio_covariance.resizeLike(result.restitution_covariance);
+  for (std::size_t a = 0; a < bounces; ++a) {
+    for (std::size_t b = 0; b < bounces; ++b) {
+      const auto row = static_cast<Eigen::Index>(kPerBounce * a);
+      const auto column = static_cast<Eigen::Index>(kPerBounce * b);
+      result.restitution_covariance(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) =
+          covariance(row + 2, column + 2);
+      result.friction_ratio_covariance(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) =
+          covariance(row + 3, column + 3);
+    }
+  }
+  std::vector<std::size_t> every(bounces);
+  for (std::size_t j = 0; j < bounces; ++j) every[j] = j;
+  result.all = combine(result, every);
+  for (std::size_t i = 0; i < options.planes.size(); ++i) {
+    std::vector<std::size_t> on_plane;
+    for (std::size_t j = 0; j < bounces; ++j) {
+      if (planes[j] == i) on_plane.push_back(j);
+    }
+    result.per_plane.push_back(combine(result, on_plane));
+  }
+  return result;
+}
+
+}  // namespace
+
+const char* toString(FrictionReading reading) {
+  switch (reading) {
+    case FrictionReading::kSliding:
+      return "sliding";
+    case FrictionReading::kStoppedSlipping:
+      return "stopped slipping";
+    case FrictionReading::kSpinUnknown:
+      return "spin unknown";
+    case FrictionReading::kNoSlip:
+      return "no slip";
+  }
+  return "?";
+}
+
+const char* toString(RecordingProblem problem) {
+  switch (problem) {
+    case RecordingProblem::kTooFewSamples:
+      return "too few samples";
+    case RecordingProblem::kStampsGoBack:
+      return "stamps going back";
+    case RecordingProblem::kBadValue:
+      return "bad value";
+    case RecordingProblem::kNoBounce:
+      return "no bounce";
+    case RecordingProblem::kGapAcrossBounce:
+      return "gap across the bounce";
+    case RecordingProblem::kFitFailed:
+      return "fit failed";
+  }
+  return "?";
+}
+
+std::string RecordingError::message() const {
+  return std::string(toString(problem)) + ": " + field + ": " + reason;
+}
+
+Coefficients combine(const Calibration& calibration, const std::vector<std::size_t>& which) {
+  Coefficients summary;
+  summary.bounces = which.size();
+  if (which.empty()) return summary;
+  const auto pick = [&](const std::vector<std::size_t>& at, const Eigen::MatrixXd& covariance,
+                        bool restitution, Eigen::VectorXd& v, Eigen::MatrixXd& c) {
+    const auto m = static_cast<Eigen::Index>(at.size());
+    v.resize(m);
+    c.resize(m, m);
+    for (Eigen::Index a = 0; a < m; ++a) {
+      const auto& bounce = calibration.bounces[at[static_cast<std::size_t>(a)]];
+      v[a] = restitution ? bounce.restitution.value : bounce.friction_ratio.value;
+      for (Eigen::Index b = 0; b < m; ++b) {
+        c(a, b) = covariance(static_cast<Eigen::Index>(at[static_cast<std::size_t>(a)]),
+                             static_cast<Eigen::Index>(at[static_cast<std::size_t>(b)]));
+      }
+    }
+  };
+  Eigen::VectorXd v;
+  Eigen::MatrixXd c;
+  pick(which, calibration.restitution_covariance, true, v, c);
+  std::tie(summary.restitution, summary.restitution_spread) = commonMean(v, c);
+  summary.slowest_approach = kInf;
+  summary.fastest_approach = 0.0;
+  std::vector<std::size_t> sliding;
+  for (const std::size_t j : which) {
+    const auto& bounce = calibration.bounces[j];
+    summary.slowest_approach = std::min(summary.slowest_approach, bounce.approach_speed.value);
+    summary.fastest_approach = std::max(summary.fastest_approach, bounce.approach_speed.value);
+    if (bounce.friction == FrictionReading::kSliding) {
+      sliding.push_back(j);
+    } else if (bounce.friction != FrictionReading::kNoSlip) {
+      const double bound = std::max(0.0, bounce.friction_ratio.low());
+      summary.friction_lower_bound = std::max(summary.friction_lower_bound.value_or(0.0), bound);
+    }
+  }
+  if (!sliding.empty()) {
+    pick(sliding, calibration.friction_ratio_covariance, false, v, c);
+    summary.friction = commonMean(v, c).first;
+  }
+  return summary;
+}
+
+RecordingResult<Calibration> calibrate(const std::vector<TrackedSample>& samples,
+                                       const CalibrationOptions& options) {
+  return run(samples, options, true);
+}
+
+RecordingResult<Calibration> fitFlight(const std::vector<TrackedSample>& samples,
+                                       const CalibrationOptions& options) {
+  return run(samples, options, false);
+}
+
+Eigen::Vector3d fittedPosition(const Calibration& calibration, const CalibrationOptions& options,
+                               double time) {
+  Layout layout{calibration.bounces.size(), options.fit_gravity, options.drag && options.fit_drag};
+  std::vector<std::size_t> planes;
+  for (const auto& bounce : calibration.bounces) planes.push_back(bounce.plane);
+  Motion motion(options, layout, planes, calibration.start_time, calibration.end_time + 1.0);
+  const Eigen::VectorXd parameters = Eigen::Map<const Eigen::VectorXd>(
+      calibration.fitted_parameters.data(),
+      static_cast<Eigen::Index>(calibration.fitted_parameters.size()));
+  if (!motion.build(parameters)) return Eigen::Vector3d::Constant(std::nan(""));
+  return motion.positionAt(time);
+}
+
+}  // namespace collision_response::core

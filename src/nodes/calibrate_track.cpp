@@ -1,0 +1,243 @@
+// calibrate_track: the core's calibration (collision_response/core/calibration.h) of one body's
+// recorded states, for `rosrun collision_response calibrate` (scripts/calibrate), which reads the
+// bag and the scene and calls this program so that the fit is the core's alone.
+//
+// usage: calibrate_track INPUT   (INPUT "-": standard input)
+//
+// INPUT has one item a line, words separated by spaces ('#' starts a comment):
+//   radius R | inertia solid|hollow | gravity X Y Z | fit_gravity 0|1 | flight_only 0|1
+//   drag AIR_DENSITY MASS DRAG_COEFFICIENT FIT_DRAG(0|1) | plane NX NY NZ OFFSET (one a plane)
+//   spin_before X Y Z | max_bounces N | min_bounce_speed V | max_gap_periods P
+//   group I J ...   (plane indices whose bounces are summed up together: one obstacle pair)
+//   sample T X Y Z [WX WY WZ]   (one a sample, in time order; W: the tracker's spin)
+// Prints the result as one JSON object on standard output; exit status 0, or 1 with
+// {"error": {"problem": ..., "field": ..., "reason": ..., "message": ...}} when the recording gives
+// no coefficients, or 2 with a message on standard error when INPUT cannot be read.
+#include <cmath>
+#include <cstddef>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "collision_response/core/calibration.h"
+
+namespace {
+
+using collision_response::core::Calibration;
+using collision_response::core::CalibrationOptions;
+using collision_response::core::Coefficients;
+using collision_response::core::Estimate;
+using collision_response::core::TrackedSample;
+
+std::string quoted(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (c == '\n') {
+      out += "\\n";
+      continue;
+    }
+    out += c;
+  }
+  return out + "\"";
+}
+
+std::string number(double value) {
+  if (!std::isfinite(value)) return "null";
+  std::ostringstream out;
+  out.precision(std::numeric_limits<double>::max_digits10);
+  out << value;
+  return out.str();
+}
+
+std::string estimate(const Estimate& e) {
+  return "{\"value\": " + number(e.value) + ", \"standard_error\": " + number(e.standard_error) +
+         ", \"low\": " + number(e.low()) + ", \"high\": " + number(e.high()) + "}";
+}
+
+std::string vector(const Eigen::Vector3d& v) {
+  return "[" + number(v.x()) + ", " + number(v.y()) + ", " + number(v.z()) + "]";
+}
+
+std::string coefficients(const Coefficients& c) {
+  std::string out = "{\"bounces\": " + std::to_string(c.bounces);
+  if (c.bounces > 0) {
+    out += ", \"restitution\": " + estimate(c.restitution) +
+           ", \"restitution_spread\": " + number(c.restitution_spread) +
+           ", \"slowest_approach\": " + number(c.slowest_approach) +
+           ", \"fastest_approach\": " + number(c.fastest_approach);
+    out += ", \"friction\": " + (c.friction ? estimate(*c.friction) : std::string("null"));
+    out += ", \"friction_lower_bound\": " +
+           (c.friction_lower_bound ? number(*c.friction_lower_bound) : std::string("null"));
+  }
+  return out + "}";
+}
+
+std::string json(const Calibration& c, const std::vector<std::vector<std::size_t>>& groups) {
+  std::ostringstream out;
+  out << "{\"noise\": " << number(c.noise) << ", \"samples_used\": " << c.samples_used
+      << ", \"parameters\": " << c.parameters << ", \"iterations\": " << c.iterations
+      << ", \"start_time\": " << number(c.start_time) << ", \"end_time\": " << number(c.end_time)
+      << ",\n \"gravity\": [" << estimate(c.gravity[0]) << ", " << estimate(c.gravity[1]) << ", "
+      << estimate(c.gravity[2]) << "],\n \"drag_coefficient\": "
+      << (c.drag_coefficient ? estimate(*c.drag_coefficient) : std::string("null"))
+      << ",\n \"all\": " << coefficients(c.all) << ",\n \"per_plane\": [";
+  for (std::size_t i = 0; i < c.per_plane.size(); ++i) {
+    out << (i ? ",\n  " : "\n  ") << coefficients(c.per_plane[i]);
+  }
+  out << "],\n \"groups\": [";
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    std::vector<std::size_t> which;
+    for (std::size_t j = 0; j < c.bounces.size(); ++j) {
+      for (const std::size_t plane : groups[g]) {
+        if (c.bounces[j].plane == plane) which.push_back(j);
+      }
+    }
+    out << (g ? ",\n  " : "\n  ") << coefficients(collision_response::core::combine(c, which));
+  }
+  out << "],\n \"bounces\": [";
+  for (std::size_t j = 0; j < c.bounces.size(); ++j) {
+    const auto& b = c.bounces[j];
+    out << (j ? ",\n  " : "\n  ") << "{\"plane\": " << b.plane << ", \"time\": " << estimate(b.time)
+        << ", \"point\": " << vector(b.point)
+        << ", \"velocity_before\": " << vector(b.velocity_before)
+        << ", \"velocity_after\": " << vector(b.velocity_after)
+        << ", \"approach_speed\": " << estimate(b.approach_speed)
+        << ", \"restitution\": " << estimate(b.restitution)
+        << ", \"friction_ratio\": " << estimate(b.friction_ratio)
+        << ", \"friction\": " << quoted(collision_response::core::toString(b.friction))
+        << ", \"slip_after\": " << estimate(b.slip_after)
+        << ", \"samples_before\": " << b.samples_before
+        << ", \"samples_after\": " << b.samples_after << "}";
+  }
+  out << "]}";
+  return out.str();
+}
+
+/// Reads INPUT into the options and samples; false with a message naming the line.
+bool read(std::istream& in, CalibrationOptions& options, std::vector<TrackedSample>& samples,
+          bool& flight_only, std::vector<std::vector<std::size_t>>& groups, std::string& error) {
+  std::string line;
+  int number_of_line = 0;
+  while (std::getline(in, line)) {
+    ++number_of_line;
+    const auto hash = line.find('#');
+    if (hash != std::string::npos) line.erase(hash);
+    std::istringstream words(line);
+    std::string key;
+    if (!(words >> key)) continue;
+    const auto fail = [&](const std::string& why) {
+      error = "line " + std::to_string(number_of_line) + " (" + key + "): " + why;
+      return false;
+    };
+    std::vector<double> values;
+    std::string word;
+    std::string text;
+    while (words >> word) {
+      if (key == "inertia") {
+        text = word;
+        continue;
+      }
+      try {
+        std::size_t used = 0;
+        values.push_back(std::stod(word, &used));
+        if (used != word.size()) return fail("not a number: '" + word + "'");
+      } catch (const std::exception&) {
+        return fail("not a number: '" + word + "'");
+      }
+    }
+    const auto count = [&](std::size_t n) { return values.size() == n; };
+    if (key == "sample") {
+      if (!count(4) && !count(7)) return fail("takes T X Y Z [WX WY WZ]");
+      TrackedSample sample{values[0], Eigen::Vector3d(values[1], values[2], values[3]),
+                           std::nullopt};
+      if (count(7)) sample.angular_velocity = Eigen::Vector3d(values[4], values[5], values[6]);
+      samples.push_back(sample);
+    } else if (key == "radius" && count(1)) {
+      options.radius = values[0];
+    } else if (key == "inertia") {
+      auto inertia = collision_response::core::parseInertia(text, "inertia");
+      if (!inertia) return fail(inertia.error().reason);
+      options.inertia = *inertia;
+    } else if (key == "gravity" && count(3)) {
+      options.gravity = Eigen::Vector3d(values[0], values[1], values[2]);
+    } else if (key == "fit_gravity" && count(1)) {
+      options.fit_gravity = values[0] != 0.0;
+    } else if (key == "flight_only" && count(1)) {
+      flight_only = values[0] != 0.0;
+    } else if (key == "drag" && count(4)) {
+      options.drag = true;
+      options.air_density = values[0];
+      options.mass = values[1];
+      options.drag_coefficient = values[2];
+      options.fit_drag = values[3] != 0.0;
+    } else if (key == "plane" && count(4)) {
+      const Eigen::Vector3d normal(values[0], values[1], values[2]);
+      if (!(normal.norm() > 0.0) || !normal.allFinite()) return fail("a nonzero finite normal");
+      options.planes.push_back(
+          collision_response::core::Plane{normal.normalized(), values[3] / normal.norm()});
+    } else if (key == "group" && !values.empty()) {
+      std::vector<std::size_t> planes;
+      for (const double value : values) {
+        if (!(value >= 0.0) || value != std::floor(value)) return fail("plane indices");
+        planes.push_back(static_cast<std::size_t>(value));
+      }
+      groups.push_back(planes);
+    } else if (key == "spin_before" && count(3)) {
+      options.spin_before = Eigen::Vector3d(values[0], values[1], values[2]);
+    } else if (key == "max_bounces" && count(1) && values[0] >= 0) {
+      options.max_bounces = static_cast<std::size_t>(values[0]);
+    } else if (key == "min_bounce_speed" && count(1)) {
+      options.min_bounce_speed = values[0];
+    } else if (key == "max_gap_periods" && count(1)) {
+      options.max_gap_periods = values[0];
+    } else {
+      return fail("unknown item, or the wrong number of values");
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    std::cerr << "usage: calibrate_track INPUT   (INPUT '-': standard input)\n";
+    return 2;
+  }
+  CalibrationOptions options;
+  std::vector<TrackedSample> samples;
+  bool flight_only = false;
+  std::vector<std::vector<std::size_t>> groups;
+  std::string error;
+  bool good = false;
+  if (std::string(argv[1]) == "-") {
+    good = read(std::cin, options, samples, flight_only, groups, error);
+  } else {
+    std::ifstream file(argv[1]);
+    if (!file) {
+      std::cerr << "calibrate_track: cannot read " << argv[1] << "\n";
+      return 2;
+    }
+    good = read(file, options, samples, flight_only, groups, error);
+  }
+  if (!good) {
+    std::cerr << "calibrate_track: " << error << "\n";
+    return 2;
+  }
+  const auto result = flight_only ? collision_response::core::fitFlight(samples, options)
+                                  : collision_response::core::calibrate(samples, options);
+  if (!result.ok()) {
+    const auto& e = result.error();
+    std::cout << "{\"error\": {\"problem\": "
+              << quoted(collision_response::core::toString(e.problem))
+              << ", \"field\": " << quoted(e.field) << ", \"reason\": " << quoted(e.reason)
+              << ", \"message\": " << quoted(e.message()) << "}}\n";
+    return 1;
+  }
+  std::cout << json(*result, groups) << "\n";
+  return 0;
+}

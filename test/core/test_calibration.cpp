@@ -1,0 +1,374 @@
+// e and mu from tracked bounces (issue 44): synthetic tracks of a ball bouncing on a floor with
+// known e, mu and g, flown in closed form here (parabolas; each bounce instant the root of the
+// flight's quadratic; Coulomb friction with sticking as friction.h states it, derived below),
+// sampled at a tracker's rate with Gaussian noise, and the fit's estimates held to the truth
+// within the 95 % intervals it states.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "collision_response/core/calibration.h"
+
+namespace collision_response::core {
+namespace {
+
+using V = Eigen::Vector3d;
+
+constexpr double kG = 9.81;
+
+struct TrueBounce {
+  double time = 0.0;
+  V before = V::Zero();
+  V after = V::Zero();
+  bool stuck = false;
+};
+
+struct Track {
+  std::vector<TrackedSample> samples;
+  std::vector<TrueBounce> bounces;
+};
+
+struct Throw {
+  double e = 0.9;
+  double mu = 0.03;
+  double radius = 0.02;
+  V position = V(0.0, 0.0, 0.5);
+  V velocity = V(3.0, 0.5, -1.0);
+  V spin = V::Zero();
+  int bounces = 5;
+  double rate = 200.0;  ///< Hz
+  double noise = 1e-3;  ///< m, each coordinate
+  double drop = 0.0;    ///< the chance of a sample being dropped
+  unsigned seed = 1;
+};
+
+/// The ball's flight on the floor z = 0 (its centre at z = r when it touches): between bounces a
+/// parabola under g = (0, 0, -9.81); a bounce at the root of r = z + vz s - g s^2 / 2, s =
+/// (vz + sqrt(vz^2 + 2 g (z - r))) / g. At a bounce vz' = -e vz, and the contact point's slip
+/// u = v_t + w x (-r n) (n = +z) is stopped by a tangential impulse J_stick = m |u| / (1 + 5/2)
+/// (a solid ball, I = 2/5 m r^2) when mu J_n (J_n = m (1 + e) |vz|) allows it, otherwise the
+/// impulse is mu J_n against the slip; the spin changes by -(5/2) / r n x dv_t.
+Track throwBall(const Throw& t) {
+  Track track;
+  std::vector<std::pair<double, std::pair<V, V>>> pieces;  // start, (position, velocity)
+  V p = t.position;
+  V v = t.velocity;
+  V w = t.spin;
+  double start = 0.0;
+  const V n(0, 0, 1);
+  for (int j = 0; j < t.bounces; ++j) {
+    pieces.push_back({start, {p, v}});
+    const double h = p.z() - t.radius;
+    const double s = (v.z() + std::sqrt(v.z() * v.z() + 2.0 * kG * h)) / kG;
+    TrueBounce bounce;
+    bounce.time = start + s;
+    V at = p + s * v;
+    at.z() -= 0.5 * kG * s * s;
+    at.z() = t.radius;
+    bounce.before = v;
+    bounce.before.z() -= kG * s;
+    V after = bounce.before;
+    after.z() = -t.e * bounce.before.z();
+    const V u = bounce.before + w.cross(-t.radius * n);
+    const V u_t(u.x(), u.y(), 0.0);
+    const double normal_change = (1.0 + t.e) * std::abs(bounce.before.z());
+    V tangential_change = V::Zero();
+    if (u_t.norm() > 0) {
+      const double stick = u_t.norm() / (1.0 + 2.5);
+      bounce.stuck = stick <= t.mu * normal_change;
+      tangential_change = -std::min(stick, t.mu * normal_change) * u_t.normalized();
+    }
+    after += tangential_change;
+    w -= (2.5 / t.radius) * n.cross(tangential_change);
+    bounce.after = after;
+    track.bounces.push_back(bounce);
+    p = at;
+    v = after;
+    start = bounce.time;
+  }
+  pieces.push_back({start, {p, v}});
+  // Samples to the top of the last flight and a little past it.
+  const double end = start + 1.1 * v.z() / kG;
+  std::mt19937_64 random(t.seed);
+  std::normal_distribution<double> noise(0.0, t.noise);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  for (int k = 0;; ++k) {
+    const double time = k / t.rate;
+    if (time > end) break;
+    std::size_t piece = 0;
+    while (piece + 1 < pieces.size() && time >= pieces[piece + 1].first) ++piece;
+    const double s = time - pieces[piece].first;
+    V position = pieces[piece].second.first + s * pieces[piece].second.second;
+    position.z() -= 0.5 * kG * s * s;
+    const V error(noise(random), noise(random), noise(random));
+    if (t.drop > 0 && uniform(random) < t.drop) continue;
+    track.samples.push_back(TrackedSample{time, position + error, std::nullopt});
+  }
+  return track;
+}
+
+CalibrationOptions floorOptions(const Throw& t) {
+  CalibrationOptions options;
+  options.planes = {Plane{V(0, 0, 1), 0.0}};
+  options.radius = t.radius;
+  options.gravity = V(0, 0, -kG);
+  options.spin_before = t.spin;
+  return options;
+}
+
+bool covers(const Estimate& estimate, double truth) {
+  return estimate.low() <= truth && truth <= estimate.high();
+}
+
+/// Within 4 standard errors: what one track's many quantities are held to (each misses by chance
+/// 6e-5 of the time, 25 of them 0.2 %), where the 95 % interval would miss one of 25 most of the
+/// time; the 95 % intervals themselves are held to their coverage over 1,000 seeds below.
+bool within4(const Estimate& estimate, double truth) {
+  return std::abs(estimate.value - truth) <= 4.0 * estimate.standard_error;
+}
+
+void expectRecovered(const Throw& t, const Track& track, const Calibration& fit) {
+  ASSERT_EQ(fit.bounces.size(), track.bounces.size());
+  for (std::size_t j = 0; j < fit.bounces.size(); ++j) {
+    const auto& bounce = fit.bounces[j];
+    const auto& truth = track.bounces[j];
+    SCOPED_TRACE("bounce " + std::to_string(j + 1));
+    EXPECT_TRUE(within4(bounce.restitution, t.e))
+        << bounce.restitution.value << " +- " << bounce.restitution.standard_error;
+    EXPECT_TRUE(within4(bounce.time, truth.time))
+        << bounce.time.value << " +- " << bounce.time.standard_error << " vs " << truth.time;
+    EXPECT_TRUE(within4(bounce.approach_speed, -truth.before.z()));
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_NEAR(bounce.velocity_before[i], truth.before[i], 0.05);
+      EXPECT_NEAR(bounce.velocity_after[i], truth.after[i], 0.05);
+    }
+    const V change = truth.after - truth.before;
+    const double ratio = std::hypot(change.x(), change.y()) / change.z();
+    EXPECT_TRUE(within4(bounce.friction_ratio, ratio))
+        << bounce.friction_ratio.value << " +- " << bounce.friction_ratio.standard_error << " vs "
+        << ratio;
+  }
+  EXPECT_TRUE(within4(fit.all.restitution, t.e))
+      << fit.all.restitution.value << " +- " << fit.all.restitution.standard_error;
+}
+
+// The issue's bar: 5 bounces at 200 Hz with 1 mm of noise give e within +-0.005 (the ITTF's
+// legal ball, e from 0.887 to 0.923, told from an illegal one), every bounce sliding (mu = 0.03
+// against a slip of 3 m/s: it takes 3.5 mu (1 + e) |vz| = 0.2 |vz| < 0.6 m/s of the slip a bounce).
+TEST(Calibration, FiveBouncesAt200HzGiveEWithinFiveThousandths) {
+  Throw t;
+  const Track track = throwBall(t);
+  const auto fit = calibrate(track.samples, floorOptions(t));
+  ASSERT_TRUE(fit.ok()) << fit.error().message();
+  expectRecovered(t, track, *fit);
+  EXPECT_NEAR(fit->all.restitution.value, t.e, 0.005);
+  EXPECT_LT(1.96 * fit->all.restitution.standard_error, 0.005);
+  for (const auto& bounce : fit->bounces) {
+    EXPECT_EQ(bounce.friction, FrictionReading::kSliding) << toString(bounce.friction);
+    EXPECT_FALSE(track.bounces[&bounce - &fit->bounces[0]].stuck);
+  }
+  ASSERT_TRUE(fit->all.friction.has_value());
+  EXPECT_TRUE(within4(*fit->all.friction, t.mu)) << fit->all.friction->value;
+  EXPECT_NEAR(fit->noise, t.noise, 0.1 * t.noise);
+}
+
+TEST(Calibration, ThreeMillimetresAt60HzRecoveredWithinTheIntervals) {
+  Throw t;
+  t.rate = 60.0;
+  t.noise = 3e-3;
+  t.seed = 7;
+  const Track track = throwBall(t);
+  const auto fit = calibrate(track.samples, floorOptions(t));
+  ASSERT_TRUE(fit.ok()) << fit.error().message();
+  expectRecovered(t, track, *fit);
+  ASSERT_TRUE(fit->all.friction.has_value());
+  EXPECT_TRUE(within4(*fit->all.friction, t.mu)) << fit->all.friction->value;
+}
+
+TEST(Calibration, DroppedSamplesRecoveredWithinTheIntervals) {
+  Throw t;
+  t.drop = 0.1;
+  t.seed = 3;
+  const Track track = throwBall(t);
+  Throw whole = t;
+  whole.drop = 0.0;
+  ASSERT_LT(static_cast<double>(track.samples.size()),
+            0.95 * static_cast<double>(throwBall(whole).samples.size()));
+  const auto fit = calibrate(track.samples, floorOptions(t));
+  ASSERT_TRUE(fit.ok()) << fit.error().message();
+  expectRecovered(t, track, *fit);
+}
+
+// The 95 % interval of e from 5 bounces at 200 Hz with 1 mm of noise covers the truth in 93 to
+// 97 % of the seeds (issue 44). 1,000 seeds (3 ms each): the fraction's binomial standard
+// deviation is sqrt(0.95 * 0.05 / 1000) = 0.0069, so 93..97 % is the truth's +-2.9 standard
+// deviations (a correct interval fails this test 0.4 % of the time; the seeds are fixed, so the
+// test is deterministic). Both the common e and the first bounce's alone.
+TEST(Calibration, NinetyFivePercentIntervalsCoverTheTruthInNinetyThreeToNinetySevenPercent) {
+  constexpr int kSeeds = 1000;
+  int common = 0;
+  int first = 0;
+  int friction = 0;
+  int instant = 0;
+  int fitted = 0;
+  for (int seed = 0; seed < kSeeds; ++seed) {
+    Throw t;
+    t.seed = 1000u + static_cast<unsigned>(seed);
+    const Track track = throwBall(t);
+    const auto fit = calibrate(track.samples, floorOptions(t));
+    if (!fit.ok() || fit->bounces.size() != 5 || !fit->all.friction) continue;
+    ++fitted;
+    common += covers(fit->all.restitution, t.e);
+    first += covers(fit->bounces[0].restitution, t.e);
+    friction += covers(*fit->all.friction, t.mu);
+    instant += covers(fit->bounces[0].time, track.bounces[0].time);
+  }
+  EXPECT_EQ(fitted, kSeeds);
+  EXPECT_GE(common, 930);
+  EXPECT_LE(common, 970);
+  EXPECT_GE(first, 930);
+  EXPECT_LE(first, 970);
+  EXPECT_GE(friction, 930);
+  EXPECT_LE(friction, 970);
+  EXPECT_GE(instant, 930);
+  EXPECT_LE(instant, 970);
+  std::printf(
+      "95 %% intervals covering the truth in %d seeds: e %d, the first bounce's e %d, mu %d, the "
+      "first bounce's instant %d\n",
+      kSeeds, common, first, friction, instant);
+}
+
+// A ball dropped without spin, moving 1 m/s along the floor, on a floor of mu = 0.5: the slip
+// stops within the first bounce (J_stick = m |u| / 3.5 = 0.29 m N s per kg against mu J_n =
+// 0.5 (1 + e) |vz| m), so v_t after = 5/7 of before and the ratio 2/7 / ((1 + e) |vz|) is only a
+// lower bound of mu: the fit says so, gives no mu, and its bound is below the truth.
+TEST(Calibration, AStickingBounceGivesALowerBoundOnly) {
+  Throw t;
+  t.mu = 0.5;
+  t.velocity = V(1.0, 0.0, -1.0);
+  t.bounces = 3;
+  const Track track = throwBall(t);
+  ASSERT_TRUE(track.bounces[0].stuck);
+  const auto fit = calibrate(track.samples, floorOptions(t));
+  ASSERT_TRUE(fit.ok()) << fit.error().message();
+  expectRecovered(t, track, *fit);
+  for (const auto& bounce : fit->bounces) {
+    EXPECT_NE(bounce.friction, FrictionReading::kSliding) << toString(bounce.friction);
+  }
+  EXPECT_EQ(fit->bounces[0].friction, FrictionReading::kStoppedSlipping);
+  EXPECT_FALSE(fit->all.friction.has_value());
+  ASSERT_TRUE(fit->all.friction_lower_bound.has_value());
+  EXPECT_LT(*fit->all.friction_lower_bound, t.mu);
+  EXPECT_GT(*fit->all.friction_lower_bound, 0.0);
+}
+
+// Without the spin before the first bounce (no tracked spin, no spin_before) whether the contact
+// slid cannot be told: the sliding throw of the first test gives a lower bound only.
+TEST(Calibration, AnUnknownSpinGivesALowerBoundOnly) {
+  Throw t;
+  const Track track = throwBall(t);
+  CalibrationOptions options = floorOptions(t);
+  options.spin_before.reset();
+  const auto fit = calibrate(track.samples, options);
+  ASSERT_TRUE(fit.ok()) << fit.error().message();
+  for (const auto& bounce : fit->bounces) {
+    EXPECT_EQ(bounce.friction, FrictionReading::kSpinUnknown);
+  }
+  EXPECT_FALSE(fit->all.friction.has_value());
+  ASSERT_TRUE(fit->all.friction_lower_bound.has_value());
+  EXPECT_LT(*fit->all.friction_lower_bound, t.mu);
+  // The tracker's spin, when the samples carry it, is used instead: zero before the first bounce.
+  std::vector<TrackedSample> spun = track.samples;
+  for (auto& sample : spun) {
+    if (sample.time < track.bounces[0].time) sample.angular_velocity = V::Zero();
+  }
+  const auto tracked = calibrate(spun, options);
+  ASSERT_TRUE(tracked.ok()) << tracked.error().message();
+  EXPECT_EQ(tracked->bounces[0].friction, FrictionReading::kSliding);
+}
+
+TEST(Calibration, BadRecordingsAreNamed) {
+  Throw t;
+  t.bounces = 3;
+  const Track track = throwBall(t);
+  const CalibrationOptions options = floorOptions(t);
+  {
+    const std::vector<TrackedSample> few(track.samples.begin(), track.samples.begin() + 5);
+    const auto fit = calibrate(few, options);
+    ASSERT_FALSE(fit.ok());
+    EXPECT_EQ(fit.error().problem, RecordingProblem::kTooFewSamples) << fit.error().message();
+    EXPECT_EQ(fit.error().message(), "too few samples: samples: 5 samples; a fit needs at least 8");
+  }
+  {
+    std::vector<TrackedSample> back = track.samples;
+    std::swap(back[20].time, back[21].time);
+    const auto fit = calibrate(back, options);
+    ASSERT_FALSE(fit.ok());
+    EXPECT_EQ(fit.error().problem, RecordingProblem::kStampsGoBack) << fit.error().message();
+    EXPECT_EQ(fit.error().field, "samples[21].time");
+  }
+  {
+    // The flight before the first bounce alone.
+    std::vector<TrackedSample> flight;
+    for (const auto& sample : track.samples) {
+      if (sample.time < track.bounces[0].time - 0.01) flight.push_back(sample);
+    }
+    const auto fit = calibrate(flight, options);
+    ASSERT_FALSE(fit.ok());
+    EXPECT_EQ(fit.error().problem, RecordingProblem::kNoBounce) << fit.error().message();
+  }
+  {
+    // 30 ms of samples missing around the second bounce (6 sample periods).
+    std::vector<TrackedSample> gap;
+    for (const auto& sample : track.samples) {
+      if (std::abs(sample.time - track.bounces[1].time) > 0.015) gap.push_back(sample);
+    }
+    const auto fit = calibrate(gap, options);
+    ASSERT_FALSE(fit.ok());
+    EXPECT_EQ(fit.error().problem, RecordingProblem::kGapAcrossBounce) << fit.error().message();
+    EXPECT_EQ(fit.error().field, "bounce 2");
+  }
+  {
+    std::vector<TrackedSample> nan = track.samples;
+    nan[3].position.y() = std::nan("");
+    const auto fit = calibrate(nan, options);
+    ASSERT_FALSE(fit.ok());
+    EXPECT_EQ(fit.error().problem, RecordingProblem::kBadValue);
+    EXPECT_EQ(fit.error().field, "samples[3].position");
+  }
+  {
+    CalibrationOptions no_plane = options;
+    no_plane.planes.clear();
+    const auto fit = calibrate(track.samples, no_plane);
+    ASSERT_FALSE(fit.ok());
+    EXPECT_EQ(fit.error().problem, RecordingProblem::kBadValue);
+    EXPECT_EQ(fit.error().field, "planes");
+  }
+}
+
+// A flight alone gives g and the tracker's noise: a throw's first 0.2 s at 200 Hz with 1 mm of
+// noise, gravity fitted.
+TEST(Calibration, AFlightGivesGravityAndTheNoise) {
+  Throw t;
+  t.bounces = 1;
+  const Track track = throwBall(t);
+  std::vector<TrackedSample> flight;
+  for (const auto& sample : track.samples) {
+    if (sample.time < track.bounces[0].time) flight.push_back(sample);
+  }
+  CalibrationOptions options = floorOptions(t);
+  options.fit_gravity = true;
+  options.gravity = V(0.1, -0.1, -9.0);  // where the fit starts
+  const auto fit = fitFlight(flight, options);
+  ASSERT_TRUE(fit.ok()) << fit.error().message();
+  EXPECT_TRUE(within4(fit->gravity[0], 0.0)) << fit->gravity[0].value;
+  EXPECT_TRUE(within4(fit->gravity[1], 0.0)) << fit->gravity[1].value;
+  EXPECT_TRUE(within4(fit->gravity[2], -kG)) << fit->gravity[2].value;
+  EXPECT_LT(fit->gravity[2].standard_error, 0.5);
+  EXPECT_NEAR(fit->noise, t.noise, 0.2 * t.noise);
+}
+
+}  // namespace
+}  // namespace collision_response::core
