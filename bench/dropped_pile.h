@@ -104,8 +104,8 @@ inline double cpuSeconds() {
 /// Plays `scene` (a droppedPile) for `seconds` at `rate` Hz; `each` (optional) sees every step.
 inline PileFigures playPile(
     const core::Scene& scene, double seconds, double rate,
-    const std::function<void(double, const core::StepReport&, double)>& each = {}) {
-  core::MonitorSettings settings;
+    const std::function<void(double, const core::StepReport&, double)>& each = {},
+    const core::MonitorSettings& settings = {}) {
   core::ImpactMonitor monitor(scene, settings);
   core::Playback source(scene, settings.contact_tolerance, 0.0);
   std::vector<core::BodyStateSample> states(scene.bodies.size());

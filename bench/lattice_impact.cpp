@@ -73,10 +73,11 @@ int main(int argc, char** argv) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::printf(
         "{\"balls\": %d, \"gravity\": %d, \"bound\": %zu, \"update\": %d, \"seconds\": %.4f, "
-        "\"impacts\": %zu, \"impact_work\": %zu, \"over_impact_work\": %zu, \"stepped\": %zu}\n",
+        "\"impacts\": %zu, \"impact_work\": %zu, \"over_impact_work\": %zu, \"stepped\": %zu, "
+        "\"stepped_work\": %zu}\n",
         n * n * n, gravity ? 1 : 0, settings.max_impact_work_per_step, update, seconds,
         report.impacts.size(), report.impact_work, report.over_impact_work.size(),
-        report.stepped_bodies);
+        report.stepped_bodies, report.stepped_work);
   }
   return 0;
 }

@@ -2,7 +2,8 @@
 // moving the bodies by the monitor's model, the monitor's impacts applied from their instants),
 // for profiling and for the cost per simulated second: the monitor's CPU and its worst update.
 //   pile_run [balls=8] [seconds=1] [friction=0.5, 0: none] [rate=100] [seed=11]
-// PILE_RUN_VERBOSE=1: a line per update; PILE_RUN_IMPACTS=1: every impact record.
+// PILE_RUN_VERBOSE=1: a line per update; PILE_RUN_IMPACTS=1: every impact record;
+// PILE_RUN_STEPPED_WORK=n: MonitorSettings::max_stepped_work_per_step (0: no bound).
 // The pile: bench/dropped_pile.h (a pile is chaotic: compare settings over several seeds).
 #include <cstdio>
 #include <cstdlib>
@@ -24,6 +25,10 @@ int main(int argc, char** argv) {
   }
   const bool verbose = std::getenv("PILE_RUN_VERBOSE") != nullptr;
   const bool impacts = std::getenv("PILE_RUN_IMPACTS") != nullptr;
+  core::MonitorSettings settings;
+  if (const char* work = std::getenv("PILE_RUN_STEPPED_WORK")) {
+    settings.max_stepped_work_per_step = std::strtoull(work, nullptr, 10);
+  }
   const bench::PileFigures figures = bench::playPile(
       bench::droppedPile(count, mu, seed), seconds, rate,
       [&](double time, const core::StepReport& report, double cpu) {
@@ -36,10 +41,14 @@ int main(int argc, char** argv) {
           }
         }
         if (verbose) {
-          std::printf("t %.2f impacts %zu contacts %zu stepped %zu monitor %.4f s\n", time,
-                      report.impacts.size(), report.contacts.size(), report.stepped_bodies, cpu);
+          std::printf(
+              "t %.2f impacts %zu contacts %zu stepped %zu stepped work %zu held over it %zu "
+              "monitor %.4f s\n",
+              time, report.impacts.size(), report.contacts.size(), report.stepped_bodies,
+              report.stepped_work, report.over_stepped_work.size(), cpu);
         }
-      });
+      },
+      settings);
   std::printf(
       "balls %d mu %g rate %g: %g s simulated, monitor %.3f s CPU (%.3f s per simulated s), "
       "worst update %.3f s at %.2f s, source %.3f s CPU, impacts %zu, fallbacks %zu, deepest "

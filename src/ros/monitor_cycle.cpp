@@ -47,6 +47,23 @@ std::string sides(const core::ImpactMonitor& monitor, std::size_t body_a, std::s
          (other_is_obstacle ? monitor.obstacle(other).id : monitor.body(other).id) + "'";
 }
 
+/// "'a', 'b' and 3 more": the first `named` of `count` things (name_of(k) the k-th's), quoted,
+/// and how many more, for a report whose count says how many in all.
+template <class NameOf>
+std::string namedList(std::size_t count, std::size_t named, const NameOf& name_of) {
+  std::string names;
+  for (std::size_t k = 0; k < count && k < named; ++k)
+    names += (k ? ", '" : "'") + name_of(k) + "'";
+  if (count > named) names += " and " + std::to_string(count - named) + " more";
+  return names;
+}
+
+/// The bodies `bodies` named, at most eight of them.
+std::string namedBodies(const core::ImpactMonitor& monitor,
+                        const std::vector<std::size_t>& bodies) {
+  return namedList(bodies.size(), 8, [&](std::size_t k) { return monitor.body(bodies[k]).id; });
+}
+
 }  // namespace
 
 core::Expected<Impact> toImpactMessage(const core::ImpactRecord& record,
@@ -192,16 +209,9 @@ namespace {
 /// The bodies of impacts the update's impact work bound cut short (core::StepReport::
 /// over_impact_work), named, at most a few: the count says how many.
 Report overImpactWorkReport(const core::ImpactMonitor& monitor, const core::StepReport& step) {
-  constexpr std::size_t kNamed = 8;
-  std::string names;
-  for (std::size_t i = 0; i < step.over_impact_work.size() && i < kNamed; ++i) {
-    names += (i ? ", '" : "'") + monitor.body(step.over_impact_work[i]).id + "'";
-  }
-  if (step.over_impact_work.size() > kNamed) {
-    names += " and " + std::to_string(step.over_impact_work.size() - kNamed) + " more";
-  }
   return {Reason::kOverImpactWork,
-          "the impacts of " + names + " at one instant ran over the update's impact work (" +
+          "the impacts of " + namedBodies(monitor, step.over_impact_work) +
+              " at one instant ran over the update's impact work (" +
               std::to_string(core::MonitorSettings{}.max_impact_work_per_step) +
               " contact iterations): their friction was cut short, or they were locked together "
               "with what touches them (no energy gained, none left approaching another; "
@@ -384,20 +394,22 @@ void MonitorCycle::reportStep(const core::StepReport& step, Update& update) cons
   if (!step.over_impact_work.empty()) {
     update.reports.push_back(overImpactWorkReport(monitor_, step));
   }
+  if (!step.over_stepped_work.empty()) {
+    update.reports.push_back(
+        {Reason::kOverSteppedWork,
+         "the stepped clusters of " + namedBodies(monitor_, step.over_stepped_work) +
+             " ran over the update's stepped work (" +
+             std::to_string(core::MonitorSettings{}.max_stepped_work_per_step) +
+             " contact iterations): they were held still over the rest of a sub-step (none "
+             "goes into another, no energy gained; doc/model.md, \"Lasting contact\")",
+         step.over_stepped_work.size()});
+  }
 }
 
 Report MonitorCycle::overBudgetReport(const core::StepReport& step) const {
-  // Named, at most a few: the count says how many.
-  constexpr std::size_t kNamed = 8;
-  std::string names;
-  for (std::size_t i = 0; i < step.over_budget.size() && i < kNamed; ++i) {
-    names += (i ? ", '" : "'") + monitor_.body(step.over_budget[i]).id + "'";
-  }
-  if (step.over_budget.size() > kNamed) {
-    names += " and " + std::to_string(step.over_budget.size() - kNamed) + " more";
-  }
   return {Reason::kOverWorkBudget,
-          "the exact model's work on " + names + " ran over ~scene/exact_work_budget (" +
+          "the exact model's work on " + namedBodies(monitor_, step.over_budget) +
+              " ran over ~scene/exact_work_budget (" +
               std::to_string(monitor_.scene().exact_work_budget) +
               ") in one update (an inelastic collapse, a chattering slip): from there they and "
               "the bodies near them are a stepped cluster until they part (doc/model.md, "
@@ -494,11 +506,8 @@ void MonitorCycle::stepMovingObstacles(const TimeLine::Placed& placed, const ros
   obstacle_work_.near = near;
   if (count < wanted) {
     const auto left_out = static_cast<std::size_t>(wanted - count) * near;
-    std::string names;
-    for (std::size_t k = 0; k < near && k < 4; ++k) {
-      names += (k ? ", '" : "'") + monitor_.obstacle(near_obstacles_[k]).id + "'";
-    }
-    if (near > 4) names += " and " + std::to_string(near - 4) + " more";
+    const std::string names =
+        namedList(near, 4, [&](std::size_t k) { return monitor_.obstacle(near_obstacles_[k]).id; });
     update.reports.push_back(
         {Reason::kObstaclePlacementsLeftOut,
          "placed the " + std::to_string(near) + " tf-attached obstacle(s) that may reach a body (" +

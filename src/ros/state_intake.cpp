@@ -112,6 +112,8 @@ const char* counterName(Reason reason) {
       return "frames jumped";
     case Reason::kOverImpactWork:
       return "bodies of impacts over the impact work bound";
+    case Reason::kOverSteppedWork:
+      return "bodies held over the stepped work bound";
   }
   return "unknown";
 }

@@ -334,13 +334,16 @@ struct PileRun {
   std::vector<V> final_positions;  // by the order the balls were listed
   double deepest_into_ball = 0, deepest_into_wall = 0, gain = 0, kinetic_end = 0, released = 0;
   std::size_t most_stepped = 0, fallbacks = 0;
+  std::size_t most_stepped_work = 0;  // of a step (MonitorSettings::max_stepped_work_per_step)
+  std::size_t held_over_work = 0;     // bodies held over the stepped work, summed over the steps
 };
 
 /// 64 balls (r 0.05 m, 0.1 kg) on a loose 4 x 4 x 4 lattice (0.12 m apart, offsets up to 5 mm)
 /// dropped into a box of 0.58 m, the monitor moving them itself at 100 Hz for `duration` s.
 /// `name(i)`: ball i's id. At every step: the deepest overlap of any pair or wall, the energy.
 PileRun dropPile(double duration, const std::function<std::string(int)>& name,
-                 bool box_floor = false) {
+                 bool box_floor = false,
+                 std::size_t stepped_work_bound = MonitorSettings{}.max_stepped_work_per_step) {
   const int side = 4, count = side * side * side;
   const double r = 0.05, m = 0.1, spacing = 0.12, size = spacing * side + 0.1;
   Scene scene = boxScene(size, box_floor);
@@ -355,6 +358,7 @@ PileRun dropPile(double duration, const std::function<std::string(int)>& name,
   }
   MonitorSettings settings;
   settings.body_timeout = 1e9;  // the monitor moves the bodies itself: no states after the first
+  settings.max_stepped_work_per_step = stepped_work_bound;
   ImpactMonitor monitor(scene, settings);
   std::vector<std::size_t> index;
   std::vector<BodyStateSample> states;
@@ -375,6 +379,8 @@ PileRun dropPile(double duration, const std::function<std::string(int)>& name,
     const StepReport report = monitor.step(t, {});
     out.most_stepped = std::max(out.most_stepped, report.stepped_bodies);
     out.fallbacks += report.fallbacks;
+    out.most_stepped_work = std::max(out.most_stepped_work, report.stepped_work);
+    out.held_over_work += report.over_stepped_work.size();
     double energy = 0, kinetic_energy = 0;
     std::vector<V> p(static_cast<std::size_t>(count));
     for (int i = 0; i < count; ++i) {
@@ -428,6 +434,22 @@ TEST(SteppedClusters, APileSettlesInABoxNeverInsideAnything) {
 TEST(SteppedClusters, APileOnABoxFloorNeverInsideIt) {
   const PileRun run = dropPile(2.0, plainName, true);
   EXPECT_GE(run.most_stepped, 32u);
+  EXPECT_EQ(run.fallbacks, 0u);
+  EXPECT_LE(run.deepest_into_ball, 0.25 * 1e-9 * 0.1);
+  EXPECT_LE(run.deepest_into_wall, 0.25 * 1e-9 * 0.05 + 1e-16);
+  EXPECT_LE(run.gain, 1e-12 * run.released);
+}
+
+// Issue 41: a stepped update has a work bound of its own. The same pile with a stepped work
+// bound of 20,000 contact iterations a step (the default is 6,000,000): no step spends more, the
+// sub-steps it cannot pay for hold their bodies still (named, and not counted as a wedge's
+// fallback), and still no ball goes into another or a wall, no energy is gained.
+TEST(SteppedClusters, PastTheStepsSteppedWorkItsBodiesAreHeldNeverInsideAnything) {
+  const std::size_t bound = 20000;
+  const PileRun run = dropPile(2.0, plainName, false, bound);
+  EXPECT_GE(run.most_stepped, 32u);
+  EXPECT_LE(run.most_stepped_work, bound);
+  EXPECT_GT(run.held_over_work, 0u);
   EXPECT_EQ(run.fallbacks, 0u);
   EXPECT_LE(run.deepest_into_ball, 0.25 * 1e-9 * 0.1);
   EXPECT_LE(run.deepest_into_wall, 0.25 * 1e-9 * 0.05 + 1e-16);

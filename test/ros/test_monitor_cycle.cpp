@@ -1584,6 +1584,15 @@ TEST_F(ClosingLatticeCycle, AnImpactPastTheImpactWorkBoundIsNamedAndCounted) {
                "bodies of impacts over the impact work bound");
 }
 
+// Issue 41: bodies of stepped clusters held past an update's stepped work are counted on their
+// own line of /diagnostics, not as lost states and not as a wedge's hold (the core's test
+// SteppedClusters.PastTheStepsSteppedWorkItsBodiesAreHeldNeverInsideAnything holds the bound).
+TEST(OverSteppedWork, IsCountedOnItsOwnLineNotAsALoss) {
+  EXPECT_FALSE(isDrop(Reason::kOverSteppedWork));
+  EXPECT_STREQ(counterName(Reason::kOverSteppedWork), "bodies held over the stepped work bound");
+  EXPECT_STRNE(counterName(Reason::kOverSteppedWork), counterName(Reason::kSteppedHeld));
+}
+
 // A loop in tf (a's parent b, b's parent a, both static) is no chain to a root: FrameChains says
 // so at once. It walked a million hops an update, each under tf's lock, and then took the loop
 // for a static root.

@@ -44,6 +44,15 @@ struct MonitorSettings {
   /// touches it (one velocity: its centre of mass's, or its fixed obstacles'), and the bodies are
   /// named in StepReport::over_impact_work (doc/model.md, "Simultaneous contacts"). 0: no bound.
   std::size_t max_impact_work_per_step = 100000;
+  /// What the stepped clusters' sub-step solves may spend in one step, in contact iterations
+  /// (each iteration of a complementarity solve, and each friction sweep, counts the contacts
+  /// of its cluster): a sub-step's solves together get what the step has left, so the step's
+  /// total never passes it. A solve stopped there ends its sub-step early, before any contact
+  /// closes past its band, or where that is too soon (or nothing is left) holds the cluster's
+  /// movable bodies still over it (the stepped clusters' fallback: no body goes into another, no
+  /// energy gained), and they are named in StepReport::over_stepped_work (doc/model.md,
+  /// "Lasting contact"). 0: no bound.
+  std::size_t max_stepped_work_per_step = 6000000;
 };
 
 /// A body's state at one instant, in the fixed frame.
@@ -153,6 +162,13 @@ struct StepReport {
   /// together (MonitorSettings::max_impact_work_per_step). No energy gained, momentum kept (where
   /// no obstacle takes part), no contact among them left approaching.
   std::vector<std::size_t> over_impact_work;
+  /// What the stepped clusters' solves spent in this step, in contact iterations: at most
+  /// MonitorSettings::max_stepped_work_per_step.
+  std::size_t stepped_work = 0;
+  /// Bodies of stepped clusters held still over a sub-step (or what was left of it) because the
+  /// step's stepped work was spent (sorted, each once; MonitorSettings::
+  /// max_stepped_work_per_step). Not counted in `fallbacks`.
+  std::vector<std::size_t> over_stepped_work;
 };
 
 /// Watches the scene's bodies and obstacles and finds their impacts.

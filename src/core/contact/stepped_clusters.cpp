@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <set>
 
@@ -102,7 +103,27 @@ struct Component {
   std::vector<std::size_t> members;
   std::vector<Pair> pairs;  ///< its contacts, canonical order
   SteppedOutcome outcome;
+  /// Held still because the step's stepped work ran out (MonitorSettings::
+  /// max_stepped_work_per_step), not because no velocities keep its gaps.
+  bool over_work = false;
 };
+
+/// Every movable body of the sub-step held still over it, the others moving as they do: the
+/// stepped clusters' fallback (SteppedOutcome::held), here where the step's stepped work is spent.
+SteppedOutcome heldSubstep(const std::vector<SteppedBody>& bodies, std::size_t contacts,
+                           double duration) {
+  SteppedOutcome outcome;
+  outcome.duration = duration;
+  outcome.contacts.resize(contacts);
+  outcome.converged = false;
+  outcome.held = true;
+  for (const SteppedBody& body : bodies) {
+    const bool movable = body.inverse_mass > 0;
+    outcome.velocity.push_back(movable ? Eigen::Vector3d::Zero() : body.velocity);
+    outcome.angular_velocity.push_back(movable ? Eigen::Vector3d::Zero() : body.angular_velocity);
+  }
+  return outcome;
+}
 
 /// The sub-step's bodies: each movable participant from its start, each fixed one as it moves.
 std::vector<SteppedBody> steppedBodiesOf(const World& world, double time,
@@ -182,8 +203,10 @@ SteppedContacts steppedContactsOf(const World& world, double time, double span, 
   return stepped;
 }
 
-/// The solve of one component from `starts` over `span`.
-void solveComponent(const World& world, double time, double span, const std::vector<Start>& starts,
+/// The solve of one component from `starts` over `span`, its work counted in World::stepped_work
+/// and cut to what the step has left of MonitorSettings::max_stepped_work_per_step: with less
+/// than one iteration over its contacts left, its movable bodies are held still.
+void solveComponent(World& world, double time, double span, const std::vector<Start>& starts,
                     bool warm_start, const RoundImpulses& before, Component& component) {
   const SolveParticipants participants =
       solveParticipants(world, component.members, component.pairs);
@@ -195,7 +218,24 @@ void solveComponent(const World& world, double time, double span, const std::vec
   settings.duration = span;
   settings.restitution_threshold = world.restitution_threshold;
   if (world.friction_model) settings.friction = world.friction_model.swept;
+  // An iteration of a solve, or a sweep, goes over every contact of the component.
+  const std::size_t per_iteration = std::max<std::size_t>(1, stepped.contacts.size());
+  const std::size_t bound = world.settings.max_stepped_work_per_step;
+  if (bound > 0) {
+    const std::size_t left = (bound - std::min(bound, world.stepped_work)) / per_iteration;
+    if (left == 0) {
+      component.outcome = heldSubstep(bodies, stepped.contacts.size(), span);
+      component.over_work = true;
+      return;
+    }
+    settings.max_total_iterations =
+        static_cast<int>(std::min<std::size_t>(left, std::numeric_limits<int>::max()));
+  }
   component.outcome = solveSteppedSubstep(bodies, stepped.contacts, settings, stepped.warm);
+  const int spent = component.outcome.iterations + component.outcome.friction_sweeps;
+  world.stepped_work += static_cast<std::size_t>(spent) * per_iteration;
+  // Held where its work ran out: the bound's, not a wedge's.
+  component.over_work = component.outcome.held && spent >= settings.max_total_iterations;
 }
 
 /// Takes a lasting group apart: its bodies leave it (to be formed again by the caller).
@@ -482,7 +522,11 @@ void storeCluster(World& world, const Region& region, const Component& component
   cluster.bodies = component.members;
   cluster.start = region.time;
   cluster.end = region.time + component.outcome.duration;
-  if (component.outcome.held) {
+  if (component.over_work) {
+    for (const std::size_t body : component.members) {
+      if (movable(world, body)) report.over_stepped_work.push_back(body);
+    }
+  } else if (component.outcome.held) {
     ++world.stepping.held;
     ++report.fallbacks;
   }

@@ -243,6 +243,9 @@ struct World {
   /// What the impact clusters' joint solves spent in the step being taken (contact iterations:
   /// MonitorSettings::max_impact_work_per_step).
   std::size_t impact_work = 0;
+  /// What the stepped clusters' solves spent in the step being taken (contact iterations:
+  /// MonitorSettings::max_stepped_work_per_step).
+  std::size_t stepped_work = 0;
   Scratch scratch;
   bool started = false;
   double now = 0.0;

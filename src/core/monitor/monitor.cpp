@@ -454,13 +454,16 @@ void reportLastingContact(World& world, double time, StepReport& report) {
   report.stepped_bodies = monitor::steppedBodies(world);
 }
 
-/// What the step's impact clusters' joint solves spent (MonitorSettings::max_impact_work_per_step),
-/// and the bodies of the clusters its bound cut short, each once.
+/// What the step's impact clusters' joint solves and stepped clusters' solves spent
+/// (MonitorSettings::max_impact_work_per_step, max_stepped_work_per_step), and the bodies their
+/// bounds cut short or held, each once.
 void reportImpactWork(const World& world, StepReport& report) {
   report.impact_work = world.impact_work;
-  std::vector<std::size_t>& cut = report.over_impact_work;
-  std::sort(cut.begin(), cut.end());
-  cut.erase(std::unique(cut.begin(), cut.end()), cut.end());
+  report.stepped_work = world.stepped_work;
+  for (std::vector<std::size_t>* bodies : {&report.over_impact_work, &report.over_stepped_work}) {
+    std::sort(bodies->begin(), bodies->end());
+    bodies->erase(std::unique(bodies->begin(), bodies->end()), bodies->end());
+  }
 }
 
 /// Continuous detection: from the last states, the first contact of every candidate pair,
@@ -482,6 +485,7 @@ StepReport continuousStep(World& world, double time, const std::vector<BodyState
   world.work_total = 0;
   world.work_all_spent = false;
   world.impact_work = 0;
+  world.stepped_work = 0;
   monitor::candidatePairs<Motion>(world, world.now, time, world.scratch.pairs);
   ContactSchedule<Motion> schedule(world, time);
   const monitor::PairIndex index{world.scratch.pairs, world.scratch.pairs_of};
@@ -688,6 +692,7 @@ StepReport discreteStep(World& world, double time, const std::vector<BodyStateSa
   StepReport report;
   world.sample_period = time - world.now;
   world.impact_work = 0;
+  world.stepped_work = 0;
   if constexpr (Motion::kAccelerates) advanceLastingContact<Motion>(world, time, report);
   applyStates(world, states, report, true);
   world.now = time;

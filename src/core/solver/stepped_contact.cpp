@@ -287,7 +287,7 @@ std::vector<std::size_t> contactOrder(const std::vector<SteppedContact>& contact
 BoundedSolution keepGaps(const std::vector<SteppedBody>& bodies,
                          const std::vector<SteppedContact>& contacts,
                          const std::vector<std::size_t>& order, const Eigen::VectorXd& warm,
-                         double duration, double tolerance, int max_iterations,
+                         double duration, double tolerance, int max_iterations, int total_left,
                          std::vector<Eigen::Vector3d>& v) {
   const ContactSpace space(bodies, contacts, order);
   const Eigen::VectorXd d = space.normalVelocities(v);
@@ -308,12 +308,13 @@ BoundedSolution keepGaps(const std::vector<SteppedBody>& bodies,
     if (body.inverse_mass > 0) lightest = std::min(lightest, 1.0 / body.inverse_mass);
   }
   const double runaway = 1e3 * (momentum + lightest * opening.cwiseAbs().sum());
-  BoundedSolution solution =
-      solveBounded(space, d - opening, warm, tolerance, max_iterations, runaway);
+  BoundedSolution solution = solveBounded(space, d - opening, warm, tolerance,
+                                          std::min(max_iterations, total_left), runaway);
   if (!solution.converged) {
     const int spent = solution.iterations;
     solution = solveBounded(space, d - opening.cwiseMin(0.0), warm.cwiseMin(runaway), tolerance,
-                            max_iterations, std::numeric_limits<double>::infinity());
+                            std::max(0, std::min(max_iterations, total_left - spent)),
+                            std::numeric_limits<double>::infinity());
     solution.iterations += spent;
   }
   space.addVelocityChanges(solution.impulses, v);
@@ -418,6 +419,18 @@ double restitutionScale(const std::vector<SteppedBody>& bodies, const ContactSpa
   return scale;
 }
 
+/// What the sub-step's solves and sweeps may still iterate (SteppedSettings::max_total_iterations)
+/// after those of `outcome` so far.
+int totalLeft(const SteppedSettings& settings, const SteppedOutcome& outcome) {
+  return std::max(0, settings.max_total_iterations - outcome.iterations - outcome.friction_sweeps);
+}
+
+/// A solve's iterations at most: its own bound, and what the sub-step has left after `outcome`'s
+/// and `pending` more not yet added to it.
+int solveIterations(const SteppedSettings& settings, const SteppedOutcome& outcome, int pending) {
+  return std::max(0, std::min(settings.max_iterations, totalLeft(settings, outcome) - pending));
+}
+
 /// Stage 1, the bounce (header): the touching contacts compressed jointly (d' >= 0), then the
 /// struck ones leave at their bounce speed and the others do not approach (d' >= e u where
 /// struck, else >= 0), the restitution scaled down where it would add kinetic energy.
@@ -431,14 +444,15 @@ void bounce(const std::vector<SteppedBody>& bodies, const std::vector<SteppedCon
   const double before = kineticEnergy(bodies, v);
   const BoundedSolution compression =
       solveBounded(space, space.normalVelocities(v), Eigen::VectorXd::Zero(space.size()), tolerance,
-                   settings.max_iterations, infinity);
+                   solveIterations(settings, outcome, 0), infinity);
   space.addVelocityChanges(compression.impulses, v);
   Eigen::VectorXd q = space.normalVelocities(v);
   for (Eigen::Index i = 0; i < space.size(); ++i) {
     q[i] -= strikes.bounce_speed[order[static_cast<std::size_t>(i)]];
   }
-  const BoundedSolution restitution = solveBounded(space, q, Eigen::VectorXd::Zero(space.size()),
-                                                   tolerance, settings.max_iterations, infinity);
+  const BoundedSolution restitution =
+      solveBounded(space, q, Eigen::VectorXd::Zero(space.size()), tolerance,
+                   solveIterations(settings, outcome, compression.iterations), infinity);
   outcome.iterations += compression.iterations + restitution.iterations;
   outcome.converged = outcome.converged && compression.converged && restitution.converged;
   const double scale =
@@ -477,7 +491,7 @@ BoundedSolution keepGapsFrom(const std::vector<SteppedBody>& bodies,
     closing_before[k] = contacts[k].normal.dot(v[contacts[k].a] - v[contacts[k].b]);
   }
   BoundedSolution kept = keepGaps(bodies, contacts, order, start, settings.duration, tolerance,
-                                  settings.max_iterations, v);
+                                  settings.max_iterations, totalLeft(settings, outcome), v);
   outcome.iterations += kept.iterations;
   for (std::size_t i = 0; i < order.size(); ++i) {
     const std::size_t k = order[i];
@@ -533,9 +547,9 @@ void frictionThenGaps(const std::vector<SteppedBody>& bodies,
   const PressedContacts pressed = pressedContacts(contacts, order, kept.impulses, outcome);
   if (pressed.contacts.empty()) return;
   std::vector<SweptFrictionOutcome> friction_outcomes;
-  const SweptFrictionReport swept =
-      settings.friction(cluster_bodies, pressed.contacts, pressed.frictions, tolerance,
-                        settings.max_friction_sweeps, friction_outcomes);
+  const SweptFrictionReport swept = settings.friction(
+      cluster_bodies, pressed.contacts, pressed.frictions, tolerance,
+      std::min(settings.max_friction_sweeps, totalLeft(settings, outcome)), friction_outcomes);
   outcome.friction_sweeps += swept.sweeps;
   outcome.friction_converged = outcome.friction_converged && swept.converged;
   for (std::size_t i = 0; i < bodies.size(); ++i) {
@@ -553,7 +567,7 @@ void frictionThenGaps(const std::vector<SteppedBody>& bodies,
   }
   const BoundedSolution again = keepGaps(
       bodies, contacts, order, Eigen::VectorXd::Zero(static_cast<Eigen::Index>(order.size())),
-      settings.duration, tolerance, settings.max_iterations, v);
+      settings.duration, tolerance, settings.max_iterations, totalLeft(settings, outcome), v);
   outcome.iterations += again.iterations;
   kept.impulses += again.impulses;
   kept.converged = again.converged;

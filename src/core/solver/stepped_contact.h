@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 #include "collision_response/core/friction.h"
@@ -61,6 +62,10 @@ struct SteppedSettings {
   int max_friction_sweeps = 64;
   /// Iterations of each complementarity solve, at most.
   int max_iterations = 20000;
+  /// Iterations of all the sub-step's complementarity solves and friction sweeps together, at
+  /// most (a caller's work bound): past it a solve stops where it got to, not converged, and the
+  /// sub-step ends early or is held (SteppedOutcome::duration, held).
+  int max_total_iterations = std::numeric_limits<int>::max();
 };
 
 /// What a contact received over the sub-step.
