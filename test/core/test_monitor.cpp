@@ -462,6 +462,48 @@ TEST(Monitor, BroadphaseGivesTheSameImpactsAsEveryPair) {
   }
 }
 
+// A state's orientation (world from body) is carried into its body's track, and read by nothing
+// yet: a ball's does not matter, so the same states turned any way give the same impacts to the
+// bit (issue 42 gives bodies shapes, whose orientation will matter).
+TEST(Monitor, AStatesOrientationIsCarriedAndChangesNothing) {
+  ImpactMonitor plain(ballOnFloorScene(0.8), MonitorSettings{});
+  ImpactMonitor turned(ballOnFloorScene(0.8), MonitorSettings{});
+  const std::size_t ball = *turned.bodyIndex("ball");
+  EXPECT_EQ(turned.lastOrientation(ball).coeffs(), Eigen::Quaterniond::Identity().coeffs());
+  const Eigen::Quaterniond first(Eigen::AngleAxisd(0.7, V(1, 2, 3).normalized()));
+  const Eigen::Quaterniond second(Eigen::AngleAxisd(-2.5, V(0, 1, 0)));
+  // Falling 0.2 m at 1 m/s onto the floor (contact at t = 0.2), then a state after the bounce.
+  const auto states = [&](const ImpactMonitor& monitor, double time, const V& position,
+                          const V& velocity, const Eigen::Quaterniond& orientation) {
+    BodyStateSample sample = state(monitor, "ball", time, position, velocity);
+    sample.orientation = orientation;
+    return std::vector<BodyStateSample>{sample};
+  };
+  const Eigen::Quaterniond identity = Eigen::Quaterniond::Identity();
+  std::vector<StepReport> reports[2];
+  reports[0].push_back(plain.step(0.0, states(plain, 0.0, V(0, 0, 0.25), V(0, 0, -1), identity)));
+  reports[1].push_back(turned.step(0.0, states(turned, 0.0, V(0, 0, 0.25), V(0, 0, -1), first)));
+  EXPECT_EQ(turned.lastOrientation(ball).coeffs(), first.coeffs());
+  reports[0].push_back(plain.step(0.5, {}));
+  reports[1].push_back(turned.step(0.5, {}));
+  reports[0].push_back(plain.step(0.6, states(plain, 0.6, V(0, 0, 0.3), V(0, 0, 0.2), identity)));
+  reports[1].push_back(turned.step(0.6, states(turned, 0.6, V(0, 0, 0.3), V(0, 0, 0.2), second)));
+  EXPECT_EQ(turned.lastOrientation(ball).coeffs(), second.coeffs());
+  ASSERT_EQ(reports[0][1].impacts.size(), 1u);
+  for (std::size_t i = 0; i < reports[0].size(); ++i) {
+    ASSERT_EQ(reports[0][i].impacts.size(), reports[1][i].impacts.size()) << i;
+    for (std::size_t k = 0; k < reports[0][i].impacts.size(); ++k) {
+      const ImpactRecord& a = reports[0][i].impacts[k];
+      const ImpactRecord& b = reports[1][i].impacts[k];
+      EXPECT_EQ(a.time, b.time);
+      EXPECT_EQ(a.contact_point, b.contact_point);
+      EXPECT_EQ(a.velocity_a_after, b.velocity_a_after);
+      EXPECT_EQ(a.angular_velocity_a_after, b.angular_velocity_a_after);
+      EXPECT_EQ(a.impulse, b.impulse);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace collision_response::core
 

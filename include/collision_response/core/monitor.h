@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstddef>
 #include <memory>
 #include <optional>
@@ -62,6 +63,9 @@ struct BodyStateSample {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
+  /// World from body, a unit quaternion: carried into the body's track, not yet read (a ball's
+  /// does not matter; issue 42 gives bodies shapes).
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
 };
 
 /// One impact found and resolved.
@@ -257,6 +261,9 @@ class ImpactMonitor {
   double motionSince(std::size_t body) const;
   /// A body's predicted angular velocity at `time` (zero when it is not tracked).
   Eigen::Vector3d predictedAngularVelocity(std::size_t body, double time) const;
+  /// The orientation of a body's last state (identity when it is not tracked): carried, not yet
+  /// followed between states nor read by the model (a ball's does not matter).
+  Eigen::Quaterniond lastOrientation(std::size_t body) const;
 
  private:
   std::unique_ptr<monitor::World> world_;  // the scene, the tracks and a step's working memory

@@ -64,6 +64,9 @@ struct BodySpec {
   /// rad/s, initial, in the fixed frame; nonzero only with the spin effect (without it the
   /// model has no spin to give it)
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
+  /// Initial, world from body, a unit quaternion: carried into the body's first state, not yet
+  /// read (a ball's does not matter; issue 42 gives bodies shapes).
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
 };
 
 enum class ObstacleShape { kPlane, kSphere, kBox, kCylinder, kCapsule, kMesh };

@@ -45,6 +45,9 @@ struct Track {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
+  /// World from body, its last state's: carried, not yet followed nor read (a ball's does not
+  /// matter; issue 42 gives bodies shapes).
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
   /// Gravity, or (in lasting contact) what gravity and the contact forces leave.
   Eigen::Vector3d acceleration = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_acceleration = Eigen::Vector3d::Zero();  ///< rolling: from friction

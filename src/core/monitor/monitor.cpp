@@ -64,6 +64,7 @@ Track& restartTrack(World& world, const BodyStateSample& state) {
   track.position = state.position;
   track.velocity = state.velocity;
   track.angular_velocity = state.angular_velocity;
+  track.orientation = state.orientation;
   track.constrained = nullptr;
   monitor::startFlight(world, state.body);  // drag or magnus: its flight through air
   return track;
@@ -916,6 +917,11 @@ Eigen::Vector3d ImpactMonitor::predictedAngularVelocity(std::size_t body, double
   return withMotionModel(world, [&](auto motion) {
     return monitor::angularVelocityAt<decltype(motion)>(world, body, time);
   });
+}
+
+Eigen::Quaterniond ImpactMonitor::lastOrientation(std::size_t body) const {
+  const monitor::Track& track = world_->tracks[body];
+  return track.known ? track.orientation : Eigen::Quaterniond::Identity();
 }
 
 StepReport ImpactMonitor::advance(double time, const std::vector<BodyStateSample>& imposed) {

@@ -39,6 +39,7 @@ Playback::Playback(const Scene& scene, double contact_tolerance, double start, d
     state.position = body.position;
     state.velocity = body.velocity;
     state.angular_velocity = body.angular_velocity;
+    state.orientation = body.orientation;
     states.push_back(state);
     flights_.push_back(
         Flight{start, body.position, body.velocity, false, 0, body.angular_velocity});
