@@ -201,6 +201,29 @@ TEST(Calibration, DroppedSamplesRecoveredWithinTheIntervals) {
   expectRecovered(t, track, *fit);
 }
 
+// Stamps of a ROS clock (1.7e9 s, resolved to 2e-7 s) fit as stamps from 0 do: the fit counts
+// time from the first sample. The fitted motion replays the track (fittedPosition) at its stamps.
+TEST(Calibration, StampsOfARosClockFitAsStampsFromZero) {
+  Throw t;
+  t.rate = 250.0;  // periods of 4 ms: exact in binary, so the shifted stamps are the same instants
+  const Track track = throwBall(t);
+  const double epoch = 1.7e9;
+  std::vector<TrackedSample> shifted = track.samples;
+  for (auto& sample : shifted) sample.time += epoch;
+  const CalibrationOptions options = floorOptions(t);
+  const auto fit = calibrate(track.samples, options);
+  const auto late = calibrate(shifted, options);
+  ASSERT_TRUE(fit.ok() && late.ok());
+  ASSERT_EQ(fit->bounces.size(), late->bounces.size());
+  EXPECT_NEAR(late->all.restitution.value, fit->all.restitution.value, 1e-9);
+  for (std::size_t j = 0; j < fit->bounces.size(); ++j) {
+    EXPECT_NEAR(late->bounces[j].time.value - epoch, fit->bounces[j].time.value, 1e-6);
+  }
+  for (const auto& sample : shifted) {
+    EXPECT_LT((fittedPosition(*late, options, sample.time) - sample.position).norm(), 5 * t.noise);
+  }
+}
+
 // The 95 % interval of e from 5 bounces at 200 Hz with 1 mm of noise covers the truth in 93 to
 // 97 % of the seeds (issue 44). 1,000 seeds (3 ms each): the fraction's binomial standard
 // deviation is sqrt(0.95 * 0.05 / 1000) = 0.0069, so 93..97 % is the truth's +-2.9 standard

@@ -471,13 +471,17 @@ std::pair<Estimate, double> commonMean(const Eigen::VectorXd& values,
 /// approach speed, e, the friction ratio, the slip before and after (along the slip before).
 constexpr Eigen::Index kPerBounce = 6;
 
-RecordingResult<Calibration> run(const std::vector<TrackedSample>& all_samples,
+RecordingResult<Calibration> run(const std::vector<TrackedSample>& recorded,
                                  const CalibrationOptions& given, bool with_bounces) {
-  if (auto error = checkSamples(all_samples)) return *error;
+  if (auto error = checkSamples(recorded)) return *error;
   if (auto error = checkOptions(given, with_bounces)) return *error;
   CalibrationOptions options = given;
 
   std::vector<FoundBounce> found;
+  // Times from the first sample's: a stamp of 1.7e9 s (a ROS clock's) has a resolution of 2e-7 s.
+  const double epoch = recorded.front().time;
+  std::vector<TrackedSample> all_samples = recorded;
+  for (auto& sample : all_samples) sample.time -= epoch;
   std::vector<TrackedSample> samples = all_samples;
   const double spacing = medianSpacing(all_samples);
   if (with_bounces) {
@@ -493,7 +497,7 @@ RecordingResult<Calibration> run(const std::vector<TrackedSample>& all_samples,
                                   all_samples[k + 1].time - all_samples[k].time);
       if (gap > options.max_gap_periods * spacing) {
         return problem(RecordingProblem::kGapAcrossBounce, "bounce " + std::to_string(j + 1),
-                       "near " + number(all_samples[k].time) + " s the samples are " + number(gap) +
+                       "near " + number(recorded[k].time) + " s the samples are " + number(gap) +
                            " s apart, more than " + number(options.max_gap_periods) +
                            " sample periods (" + number(spacing) + " s)");
       }
@@ -645,8 +649,8 @@ RecordingResult<Calibration> run(const std::vector<TrackedSample>& all_samples,
   result.iterations = fit->iterations;
   result.fitted_parameters.assign(fit->parameters.data(),
                                   fit->parameters.data() + fit->parameters.size());
-  result.start_time = origin;
-  result.end_time = samples.back().time;
+  result.start_time = origin + epoch;
+  result.end_time = samples.back().time + epoch;
   for (int i = 0; i < 3; ++i) {
     if (layout.gravity) {
       const auto at = static_cast<Eigen::Index>(layout.gravityAt()) + i;
@@ -699,7 +703,7 @@ RecordingResult<Calibration> run(const std::vector<TrackedSample>& all_samples,
     }
     if (!(first_after - last_before <= options.max_gap_periods * spacing)) {
       return problem(RecordingProblem::kGapAcrossBounce, "bounce " + std::to_string(j + 1),
-                     "at " + number(bounce.time.value) + " s the samples either side are " +
+                     "at " + number(bounce.time.value + epoch) + " s the samples either side are " +
                          number(first_after - last_before) + " s apart, more than " +
                          number(options.max_gap_periods) + " sample periods (" + number(spacing) +
                          " s)");
@@ -711,6 +715,7 @@ RecordingResult<Calibration> run(const std::vector<TrackedSample>& all_samples,
                          std::to_string(bounce.samples_after) + " samples; each needs " +
                          std::to_string(kMinFlightSamples));
     }
+    bounce.time.value += epoch;
     result.bounces.push_back(bounce);
   }
   // The joint covariance of the bounces' e and friction ratios, for combine().
@@ -836,12 +841,13 @@ Eigen::Vector3d fittedPosition(const Calibration& calibration, const Calibration
   Layout layout{calibration.bounces.size(), options.fit_gravity, options.drag && options.fit_drag};
   std::vector<std::size_t> planes;
   for (const auto& bounce : calibration.bounces) planes.push_back(bounce.plane);
-  Motion motion(options, layout, planes, calibration.start_time, calibration.end_time + 1.0);
+  // The fit's times are from its first sample's (run()).
+  Motion motion(options, layout, planes, 0.0, calibration.end_time - calibration.start_time + 1.0);
   const Eigen::VectorXd parameters = Eigen::Map<const Eigen::VectorXd>(
       calibration.fitted_parameters.data(),
       static_cast<Eigen::Index>(calibration.fitted_parameters.size()));
   if (!motion.build(parameters)) return Eigen::Vector3d::Constant(std::nan(""));
-  return motion.positionAt(time);
+  return motion.positionAt(time - calibration.start_time);
 }
 
 }  // namespace collision_response::core
