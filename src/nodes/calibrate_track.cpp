@@ -9,6 +9,7 @@
 //   drag AIR_DENSITY MASS DRAG_COEFFICIENT FIT_DRAG(0|1) | plane NX NY NZ OFFSET (one a plane)
 //   spin_before X Y Z | max_bounces N | min_bounce_speed V | max_gap_periods P
 //   group I J ...   (plane indices whose bounces are summed up together: one obstacle pair)
+//   fitted_step DT  (also print the fitted motion's centre every DT s over the fit's span)
 //   sample T X Y Z [WX WY WZ]   (one a sample, in time order; W: the tracker's spin)
 // Prints the result as one JSON object on standard output; exit status 0, or 1 with
 // {"error": {"problem": ..., "field": ..., "reason": ..., "message": ...}} when the recording gives
@@ -76,7 +77,8 @@ std::string coefficients(const Coefficients& c) {
   return out + "}";
 }
 
-std::string json(const Calibration& c, const std::vector<std::vector<std::size_t>>& groups) {
+std::string json(const Calibration& c, const std::vector<std::vector<std::size_t>>& groups,
+                 const CalibrationOptions& options, double fitted_step) {
   std::ostringstream out;
   out << "{\"noise\": " << number(c.noise) << ", \"samples_used\": " << c.samples_used
       << ", \"parameters\": " << c.parameters << ", \"iterations\": " << c.iterations
@@ -97,6 +99,16 @@ std::string json(const Calibration& c, const std::vector<std::vector<std::size_t
       }
     }
     out << (g ? ",\n  " : "\n  ") << coefficients(collision_response::core::combine(c, which));
+  }
+  out << "],\n \"fitted\": [";
+  if (fitted_step > 0.0) {
+    const auto steps = static_cast<long>(std::floor((c.end_time - c.start_time) / fitted_step));
+    for (long k = 0; k <= steps; ++k) {
+      const double t = c.start_time + static_cast<double>(k) * fitted_step;
+      const Eigen::Vector3d p = collision_response::core::fittedPosition(c, options, t);
+      out << (k ? ", " : "") << "[" << number(t) << ", " << number(p.x()) << ", " << number(p.y())
+          << ", " << number(p.z()) << "]";
+    }
   }
   out << "],\n \"bounces\": [";
   for (std::size_t j = 0; j < c.bounces.size(); ++j) {
@@ -119,7 +131,8 @@ std::string json(const Calibration& c, const std::vector<std::vector<std::size_t
 
 /// Reads INPUT into the options and samples; false with a message naming the line.
 bool read(std::istream& in, CalibrationOptions& options, std::vector<TrackedSample>& samples,
-          bool& flight_only, std::vector<std::vector<std::size_t>>& groups, std::string& error) {
+          bool& flight_only, std::vector<std::vector<std::size_t>>& groups, double& fitted_step,
+          std::string& error) {
   std::string line;
   int number_of_line = 0;
   while (std::getline(in, line)) {
@@ -186,6 +199,8 @@ bool read(std::istream& in, CalibrationOptions& options, std::vector<TrackedSamp
         planes.push_back(static_cast<std::size_t>(value));
       }
       groups.push_back(planes);
+    } else if (key == "fitted_step" && count(1) && values[0] > 0.0) {
+      fitted_step = values[0];
     } else if (key == "spin_before" && count(3)) {
       options.spin_before = Eigen::Vector3d(values[0], values[1], values[2]);
     } else if (key == "max_bounces" && count(1) && values[0] >= 0) {
@@ -212,17 +227,18 @@ int main(int argc, char** argv) {
   std::vector<TrackedSample> samples;
   bool flight_only = false;
   std::vector<std::vector<std::size_t>> groups;
+  double fitted_step = 0.0;
   std::string error;
   bool good = false;
   if (std::string(argv[1]) == "-") {
-    good = read(std::cin, options, samples, flight_only, groups, error);
+    good = read(std::cin, options, samples, flight_only, groups, fitted_step, error);
   } else {
     std::ifstream file(argv[1]);
     if (!file) {
       std::cerr << "calibrate_track: cannot read " << argv[1] << "\n";
       return 2;
     }
-    good = read(file, options, samples, flight_only, groups, error);
+    good = read(file, options, samples, flight_only, groups, fitted_step, error);
   }
   if (!good) {
     std::cerr << "calibrate_track: " << error << "\n";
@@ -238,6 +254,6 @@ int main(int argc, char** argv) {
               << ", \"message\": " << quoted(e.message()) << "}}\n";
     return 1;
   }
-  std::cout << json(*result, groups) << "\n";
+  std::cout << json(*result, groups, options, fitted_step) << "\n";
   return 0;
 }
