@@ -229,7 +229,11 @@ TEST(Calibration, StampsOfARosClockFitAsStampsFromZero) {
 // deviation is sqrt(0.95 * 0.05 / 1000) = 0.0069, so 93..97 % is the truth's +-2.9 standard
 // deviations (a correct interval fails this test 0.4 % of the time; the seeds are fixed, so the
 // test is deterministic). Both the common e and the first bounce's alone.
-TEST(Calibration, NinetyFivePercentIntervalsCoverTheTruthInNinetyThreeToNinetySevenPercent) {
+/// Over 1,000 seeds of `base`: how often the 95 % intervals of the common e, the first bounce's
+/// e, the common mu and the first bounce's instant cover the truth, each held to 93..97 % of the
+/// tracks fitted; a track refused must be refused for a gap across a bounce (three samples or
+/// more dropped in a row there), at most 3 % of them.
+void expectCoverage(const Throw& base, const char* what) {
   constexpr int kSeeds = 1000;
   int common = 0;
   int first = 0;
@@ -237,30 +241,45 @@ TEST(Calibration, NinetyFivePercentIntervalsCoverTheTruthInNinetyThreeToNinetySe
   int instant = 0;
   int fitted = 0;
   for (int seed = 0; seed < kSeeds; ++seed) {
-    Throw t;
+    Throw t = base;
     t.seed = 1000u + static_cast<unsigned>(seed);
     const Track track = throwBall(t);
     const auto fit = calibrate(track.samples, floorOptions(t));
-    if (!fit.ok() || fit->bounces.size() != 5 || !fit->all.friction) continue;
+    if (!fit.ok()) {
+      EXPECT_EQ(fit.error().problem, RecordingProblem::kGapAcrossBounce) << fit.error().message();
+      continue;
+    }
+    EXPECT_EQ(fit->bounces.size(), 5u);
+    if (fit->bounces.size() != 5 || !fit->all.friction) continue;
     ++fitted;
     common += covers(fit->all.restitution, t.e);
     first += covers(fit->bounces[0].restitution, t.e);
     friction += covers(*fit->all.friction, t.mu);
     instant += covers(fit->bounces[0].time, track.bounces[0].time);
   }
-  EXPECT_EQ(fitted, kSeeds);
-  EXPECT_GE(common, 930);
-  EXPECT_LE(common, 970);
-  EXPECT_GE(first, 930);
-  EXPECT_LE(first, 970);
-  EXPECT_GE(friction, 930);
-  EXPECT_LE(friction, 970);
-  EXPECT_GE(instant, 930);
-  EXPECT_LE(instant, 970);
+  EXPECT_GE(fitted, kSeeds * 97 / 100);
+  for (const int count : {common, first, friction, instant}) {
+    EXPECT_GE(count, 0.93 * fitted);
+    EXPECT_LE(count, 0.97 * fitted);
+  }
   std::printf(
-      "95 %% intervals covering the truth in %d seeds: e %d, the first bounce's e %d, mu %d, the "
-      "first bounce's instant %d\n",
-      kSeeds, common, first, friction, instant);
+      "%s: 95 %% intervals covering the truth in %d seeds (%d fitted): e %d, the first bounce's e "
+      "%d, mu %d, the first bounce's instant %d\n",
+      what, kSeeds, fitted, common, first, friction, instant);
+}
+
+TEST(Calibration, NinetyFivePercentIntervalsCoverTheTruthInNinetyThreeToNinetySevenPercent) {
+  expectCoverage(Throw{}, "200 Hz, 1 mm");
+}
+
+// The same at 60 Hz with 3 mm of noise and a tenth of the samples dropped (a camera's track): 15
+// of the 1,000 tracks have three samples or more missing in a row at a bounce, refused.
+TEST(Calibration, NinetyFivePercentIntervalsCoverTheTruthAt60HzWithDroppedSamples) {
+  Throw t;
+  t.rate = 60.0;
+  t.noise = 3e-3;
+  t.drop = 0.1;
+  expectCoverage(t, "60 Hz, 3 mm, 10 % dropped");
 }
 
 // A ball dropped without spin, moving 1 m/s along the floor, on a floor of mu = 0.5: the slip

@@ -52,7 +52,8 @@ struct CalibrationOptions {
   /// or a body settling, are not bounces).
   double min_bounce_speed = 0.2;
   /// A bounce whose neighbouring samples are further apart than this many sample periods (the
-  /// median spacing) lies in a gap of the recording and is refused.
+  /// median spacing; and half a period for jitter) lies in a gap of the recording and is refused:
+  /// 3, two samples missing in a row are taken, three are not.
   double max_gap_periods = 3.0;
 };
 

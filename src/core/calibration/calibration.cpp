@@ -417,6 +417,12 @@ std::optional<RecordingError> checkOptions(const CalibrationOptions& options, bo
   return std::nullopt;
 }
 
+/// The longest spacing of samples a bounce may lie in: max_gap_periods periods, and half a period
+/// for the jitter of stamps (and their rounding: 3 periods of 1/60 s are 0.05 s, or just above).
+double longestSpacing(const CalibrationOptions& options, double period) {
+  return (options.max_gap_periods + 0.5) * period;
+}
+
 double medianSpacing(const std::vector<TrackedSample>& samples) {
   std::vector<double> spacing;
   for (std::size_t k = 1; k < samples.size(); ++k) {
@@ -495,7 +501,7 @@ RecordingResult<Calibration> run(const std::vector<TrackedSample>& recorded,
       const std::size_t k = found[j].sample;
       const double gap = std::max(all_samples[k].time - all_samples[k - 1].time,
                                   all_samples[k + 1].time - all_samples[k].time);
-      if (gap > options.max_gap_periods * spacing) {
+      if (gap > longestSpacing(options, spacing)) {
         return problem(RecordingProblem::kGapAcrossBounce, "bounce " + std::to_string(j + 1),
                        "near " + number(recorded[k].time) + " s the samples are " + number(gap) +
                            " s apart, more than " + number(options.max_gap_periods) +
@@ -701,7 +707,7 @@ RecordingResult<Calibration> run(const std::vector<TrackedSample>& recorded,
       if (sample.time <= bounce.time.value) last_before = std::max(last_before, sample.time);
       if (sample.time > bounce.time.value) first_after = std::min(first_after, sample.time);
     }
-    if (!(first_after - last_before <= options.max_gap_periods * spacing)) {
+    if (!(first_after - last_before <= longestSpacing(options, spacing))) {
       return problem(RecordingProblem::kGapAcrossBounce, "bounce " + std::to_string(j + 1),
                      "at " + number(bounce.time.value + epoch) + " s the samples either side are " +
                          number(first_after - last_before) + " s apart, more than " +
