@@ -5,6 +5,7 @@
 // within the 95 % intervals it states.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -280,6 +281,73 @@ TEST(Calibration, NinetyFivePercentIntervalsCoverTheTruthAt60HzWithDroppedSample
   t.noise = 3e-3;
   t.drop = 0.1;
   expectCoverage(t, "60 Hz, 3 mm, 10 % dropped");
+}
+
+// Two obstacle pairs in one recording: a ball (r = 0.02 m, no friction) thrown at a wall (x = 1,
+// its normal -x, e = 0.6) above a floor (z = 0, e = 0.9). Flown here: each flight a parabola up to
+// the earlier of the floor's root (as throwBall) and the wall's, s = (1 - r - x) / vx (linear:
+// gravity is along the wall). Each bounce is put on its plane and each plane's e recovered.
+TEST(Calibration, AWallAndAFloorGiveEachTheirOwnE) {
+  const double r = 0.02, e_floor = 0.9, e_wall = 0.6, rate = 200.0;
+  V p(0.0, 0.0, 0.4);
+  V v(2.0, 0.0, 0.5);
+  double start = 0.0;
+  std::vector<std::pair<double, std::pair<V, V>>> pieces;
+  std::vector<std::size_t> truth_planes;  // 0 floor, 1 wall
+  for (int j = 0; j < 5; ++j) {
+    pieces.push_back({start, {p, v}});
+    const double floor_s = (v.z() + std::sqrt(v.z() * v.z() + 2.0 * kG * (p.z() - r))) / kG;
+    const double wall_s = v.x() > 0 ? (1.0 - r - p.x()) / v.x() : 1e9;
+    const double s = std::min(floor_s, wall_s);
+    p += s * v;
+    p.z() -= 0.5 * kG * s * s;
+    v.z() -= kG * s;
+    if (wall_s < floor_s) {
+      p.x() = 1.0 - r;
+      v.x() = -e_wall * v.x();
+      truth_planes.push_back(1);
+    } else {
+      p.z() = r;
+      v.z() = -e_floor * v.z();
+      truth_planes.push_back(0);
+    }
+    start += s;
+  }
+  pieces.push_back({start, {p, v}});
+  std::mt19937_64 random(11);
+  std::normal_distribution<double> noise(0.0, 1e-3);
+  std::vector<TrackedSample> samples;
+  const double end = start + 1.1 * v.z() / kG;
+  for (int k = 0; k / rate <= end; ++k) {
+    const double time = k / rate;
+    std::size_t piece = 0;
+    while (piece + 1 < pieces.size() && time >= pieces[piece + 1].first) ++piece;
+    const double s = time - pieces[piece].first;
+    V at = pieces[piece].second.first + s * pieces[piece].second.second;
+    at.z() -= 0.5 * kG * s * s;
+    samples.push_back({time, at + V(noise(random), noise(random), noise(random)), std::nullopt});
+  }
+  ASSERT_EQ(std::count(truth_planes.begin(), truth_planes.end(), 1u), 1);  // one wall bounce
+  CalibrationOptions options;
+  options.planes = {Plane{V(0, 0, 1), 0.0}, Plane{V(-1, 0, 0), -1.0}};
+  options.radius = r;
+  options.spin_before = V::Zero();
+  const auto fit = calibrate(samples, options);
+  ASSERT_TRUE(fit.ok()) << fit.error().message();
+  ASSERT_EQ(fit->bounces.size(), truth_planes.size());
+  for (std::size_t j = 0; j < truth_planes.size(); ++j) {
+    EXPECT_EQ(fit->bounces[j].plane, truth_planes[j]) << "bounce " << j + 1;
+  }
+  ASSERT_EQ(fit->per_plane.size(), 2u);
+  EXPECT_EQ(fit->per_plane[0].bounces, 4u);
+  EXPECT_EQ(fit->per_plane[1].bounces, 1u);
+  EXPECT_TRUE(within4(fit->per_plane[0].restitution, e_floor))
+      << fit->per_plane[0].restitution.value;
+  EXPECT_TRUE(within4(fit->per_plane[1].restitution, e_wall))
+      << fit->per_plane[1].restitution.value;
+  EXPECT_EQ(fit->per_plane[1].restitution_spread, 0.0);  // one bounce: no spread
+  // Without friction the floor's bounces leave v_t as it was: no slip is stopped, the ratio is 0.
+  for (const auto& bounce : fit->bounces) EXPECT_TRUE(within4(bounce.friction_ratio, 0.0));
 }
 
 // A ball dropped without spin, moving 1 m/s along the floor, on a floor of mu = 0.5: the slip
