@@ -45,9 +45,10 @@ double reachBefore(const World& world, std::size_t body, double time, double spa
 
 /// Every pair of tracked participants whose surfaces are within their reaches of each other at
 /// `time` (body pairs through a grid of their boxes; each movable body with the obstacles a
-/// grid of their bounds finds near it, nearObstacleBox), in the canonical order.
+/// grid of their bounds finds near it, nearObstacleBox), in the canonical order. `looked_at`: the
+/// bodies placed and the pairs whose contact geometry was computed.
 std::vector<Pair> nearPairs(const World& world, double time, double span,
-                            const std::vector<double>& reach) {
+                            const std::vector<double>& reach, std::size_t& looked_at) {
   const std::size_t n = world.bodies.size();
   std::vector<Box> boxes(n);
   std::vector<Eigen::Vector3d> centres(n, Eigen::Vector3d::Zero());
@@ -65,6 +66,7 @@ std::vector<Pair> nearPairs(const World& world, double time, double span,
   hash.build(boxes, active);
   std::vector<std::pair<std::size_t, std::size_t>> overlapping;
   hash.overlappingPairs(overlapping);
+  looked_at = n + overlapping.size();
   std::vector<Pair> pairs;
   for (const auto& [a, b] : overlapping) {
     if (world.inverse_mass[a] + world.inverse_mass[b] == 0.0) continue;
@@ -88,6 +90,7 @@ std::vector<Pair> nearPairs(const World& world, double time, double span,
   for (std::size_t a = 0; a < n; ++a) {
     if (!active[a] || world.inverse_mass[a] == 0.0) continue;
     obstacles.query(nearBodyBox(world, world.radius[a], centres[a], reach[a]), near);
+    looked_at += near.size();
     for (const std::size_t o : near) {
       const Pair pair(a, n + o);
       const Geometry g = geometry<Motion>(world, pair, time);
@@ -535,6 +538,70 @@ void storeCluster(World& world, const Region& region, const Component& component
   world.stepping.clusters.push_back(std::move(cluster));
 }
 
+/// Whether the step's stepped work is spent (MonitorSettings::max_stepped_work_per_step).
+bool steppedWorkSpent(const World& world) {
+  const std::size_t bound = world.settings.max_stepped_work_per_step;
+  return bound > 0 && world.stepped_work >= bound;
+}
+
+/// The pairs near each other over `span` from `time` (nearPairs), the search counted in the step's
+/// stepped work: one unit for each body it placed and each pair whose contact geometry it
+/// computed.
+std::vector<Pair> countedNearPairs(World& world, double time, double span,
+                                   const std::vector<double>& reach) {
+  std::size_t looked_at = 0;
+  std::vector<Pair> near = nearPairs(world, time, span, reach, looked_at);
+  world.stepped_work += looked_at;
+  return near;
+}
+
+/// The step's stepped work spent: the clusters with a body of `member` (at the grid: every
+/// cluster), and the members in none, are held still from `time` to `end` as they are, without
+/// looking for near pairs (their contacts kept, no impulse): the stepped clusters' fallback,
+/// their bodies named in report.over_stepped_work. A body in no cluster at the grid stays with the
+/// exact model.
+void holdRegion(World& world, double time, double end, std::vector<char> member, bool grid,
+                std::vector<std::size_t>& changed, std::vector<std::size_t>& released,
+                StepReport& report) {
+  const std::size_t n = world.bodies.size();
+  if (grid) {
+    member.assign(n, 0);
+    for (std::size_t i = 0; i < n; ++i) member[i] = world.stepped(i) ? 1 : 0;
+  }
+  Region region = setUpRegion(world, time, end, grid, std::move(member), {});
+  startMembers(world, region);
+  std::vector<Component> components;
+  std::vector<char> placed(n, 0);
+  for (const SteppedCluster& cluster : world.stepping.clusters) {
+    bool in_region = false;
+    for (const std::size_t body : cluster.bodies) in_region = in_region || region.member[body];
+    if (!in_region) continue;
+    Component component;
+    component.members = cluster.bodies;
+    for (const SteppedClusterContact& contact : cluster.contacts) {
+      component.pairs.push_back(contact.pair);
+    }
+    components.push_back(std::move(component));
+    for (const std::size_t body : cluster.bodies) placed[body] = 1;
+  }
+  for (std::size_t body = 0; body < n; ++body) {
+    if (region.member[body] && !placed[body] && movable(world, body)) {
+      components.push_back(Component{{body}, {}, {}, false});
+    }
+  }
+  for (Component& component : components) {
+    std::vector<SteppedBody> bodies(component.members.size());
+    for (std::size_t i = 0; i < bodies.size(); ++i) bodies[i].inverse_mass = 1.0;  // all held
+    component.outcome = heldSubstep(bodies, component.pairs.size(), end - time);
+    component.over_work = true;
+  }
+  replaceClusters(world, region, changed, released);
+  for (const Component& component : components) {
+    storeCluster(world, region, component, changed, report);
+  }
+  indexClusters(world);
+}
+
 /// Solves the bodies of `member` (and every body their sub-steps bring near them) from `time`
 /// to `end`, in connected components of near pairs, and makes them the clusters in place of
 /// those they were in. `grid`: every tracked body is looked at and only components of at least
@@ -543,13 +610,17 @@ void storeCluster(World& world, const Region& region, const Component& component
 void solveRegion(World& world, double time, double end, std::vector<char> member, bool grid,
                  std::vector<std::size_t>& changed, std::vector<std::size_t>& released,
                  StepReport& report) {
+  if (steppedWorkSpent(world)) {
+    holdRegion(world, time, end, std::move(member), grid, changed, released, report);
+    return;
+  }
   const double span = end - time;
   // Near is judged over a whole sub-step at least (stepped_cluster_time_step), whatever this one
   // is: a sub-step shortened to the rest of an update, or an update a little early, would
   // otherwise part a cluster for one sub-step and hand its bodies to the exact model.
   const double horizon = std::max(span, world.stepping.time_step);
   std::vector<double> reach = reachesOver(world, time, horizon);
-  const std::vector<Pair> near = nearPairs(world, time, horizon, reach);
+  const std::vector<Pair> near = countedNearPairs(world, time, horizon, reach);
   Region region = setUpRegion(world, time, end, grid,
                               grid ? gridMembers(world, near) : std::move(member), near);
   // The closure: the components solved, then near pairs again with the solved velocities. At
@@ -573,7 +644,7 @@ void solveRegion(World& world, double time, double end, std::vector<char> member
     }
     if (closure + 1 >= kMaxClosures) break;
     widenReaches(components, reach);
-    if (!takeNear(world, nearPairs(world, time, horizon, reach), region)) break;
+    if (!takeNear(world, countedNearPairs(world, time, horizon, reach), region)) break;
   }
   replaceClusters(world, region, changed, released);
   for (const Component& component : components) {
