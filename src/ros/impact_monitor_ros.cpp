@@ -5,6 +5,7 @@
 #include <map>
 #include <utility>
 
+#include "collision_response/core/prediction.h"
 #include "collision_response/core/validation.h"
 #include "collision_response/ros/prediction_service.h"
 
@@ -191,6 +192,7 @@ void ImpactMonitorRos::processQueue() {
 
 bool ImpactMonitorRos::processHead(const Pending& head) {
   const ros::WallTime began = ros::WallTime::now();
+  const double cpu_began = core::threadCpuSeconds();
   const bool may_wait = (began - head.received).toSec() < params_.transform_timeout;
   const MonitorCycle::Input input{&head.states(), head.topic, head.publisher, head.own_body};
   {
@@ -224,8 +226,8 @@ bool ImpactMonitorRos::processHead(const Pending& head) {
     publish(update);
     const ros::WallTime done = ros::WallTime::now();
     std::lock_guard<std::mutex> lock(diagnostics_mutex_);
-    diagnostics_.stepped((done - began).toSec(), (done - head.received).toSec(),
-                         update.impacts.impacts.size());
+    diagnostics_.stepped((done - began).toSec(), core::threadCpuSeconds() - cpu_began,
+                         (done - head.received).toSec(), update.impacts.impacts.size());
   }
   return true;
 }

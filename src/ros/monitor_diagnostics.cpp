@@ -6,11 +6,12 @@
 
 namespace collision_response {
 
-void MonitorDiagnostics::stepped(double step_seconds, double latency_seconds,
-                                 std::size_t impacts_published) {
+void MonitorDiagnostics::stepped(double step_seconds, double step_cpu_seconds,
+                                 double latency_seconds, std::size_t impacts_published) {
   ++period_.steps;
   period_.step_seconds += step_seconds;
   period_.step_seconds_max = std::max(period_.step_seconds_max, step_seconds);
+  period_.step_cpu_seconds_max = std::max(period_.step_cpu_seconds_max, step_cpu_seconds);
   period_.latency_seconds += latency_seconds;
   period_.latency_seconds_max = std::max(period_.latency_seconds_max, latency_seconds);
   period_.impacts += impacts_published;
@@ -78,6 +79,7 @@ void MonitorDiagnostics::report(diagnostic_updater::DiagnosticStatusWrapper& sta
   status.add("processing time per update, mean (ms)",
              period_.steps ? 1e3 * period_.step_seconds / steps : 0.0);
   status.add("processing time per update, max (ms)", 1e3 * period_.step_seconds_max);
+  status.add("processing CPU per update, max (ms)", 1e3 * period_.step_cpu_seconds_max);
   status.add("arrival to publication, mean (ms)",
              period_.steps ? 1e3 * period_.latency_seconds / steps : 0.0);
   status.add("arrival to publication, max (ms)", 1e3 * period_.latency_seconds_max);

@@ -171,6 +171,7 @@ class UnderLoad(unittest.TestCase):
         dropped = sum(drops.values())
         samples = listener.values_since(0.0)
         slowest = max(float(v.get("processing time per update, max (ms)", "0")) for v in samples)
+        costliest = max(float(v.get("processing CPU per update, max (ms)", "0")) for v in samples)
         longest_running = max(float(v.get("update in progress (s)", "0")) for v in samples)
 
         with listener.lock:
@@ -185,11 +186,12 @@ class UnderLoad(unittest.TestCase):
         expected, missing = check_bounces(self, listener, t0, last, 10, dropped)
         print("under load (%d links, %d^3-ball lattice, %d prediction clients): probe impacts "
               "found %d of %d; states published %d, received %d, used %d, dropped %d %s; "
-              "slowest update %.1f ms (wall; longest seen running %.2f s); lattice impacts "
+              "slowest update %.1f ms (wall; longest seen running %.2f s), costliest %.1f ms "
+              "(the monitor thread's CPU); lattice impacts "
               "published %d; predictions answered %d, cut at the budget %d; %.1f s of run, "
               "%.1f s more to drain; counters %s"
               % (LINKS, LATTICE, CLIENTS, len(expected) - len(missing), len(expected),
-                 published, received, used, dropped, drops, slowest, longest_running,
+                 published, received, used, dropped, drops, slowest, longest_running, costliest,
                  lattice_impacts, len(answered), len(cut), ran, drained, counters))
 
 

@@ -47,8 +47,11 @@ class MonitorDiagnostics {
   /// The warning of the last update whose exact work ran over the scene's budget: it names the
   /// bodies stepped from there (a few, and how many more), and /diagnostics shows it.
   void noteOverWorkBudget(const std::string& text) { last_over_work_budget_ = text; }
-  /// A processed input: the step's processing time and the arrival-to-publication latency (s).
-  void stepped(double step_seconds, double latency_seconds, std::size_t impacts_published);
+  /// A processed input: the step's processing time (wall, and the CPU of the monitor's thread:
+  /// what the update cost, whatever else shares the cores) and the arrival-to-publication
+  /// latency (s).
+  void stepped(double step_seconds, double step_cpu_seconds, double latency_seconds,
+               std::size_t impacts_published);
 
   std::uint64_t total(Reason reason) const { return totals_[static_cast<std::size_t>(reason)]; }
   std::uint64_t impactsPublished() const { return impacts_published_; }
@@ -69,7 +72,7 @@ class MonitorDiagnostics {
   struct Period {
     ros::WallTime start = ros::WallTime::now();
     std::uint64_t messages = 0, states = 0, steps = 0, impacts = 0;
-    double step_seconds = 0.0, step_seconds_max = 0.0;
+    double step_seconds = 0.0, step_seconds_max = 0.0, step_cpu_seconds_max = 0.0;
     double latency_seconds = 0.0, latency_seconds_max = 0.0;  ///< arrival to publication
     std::array<std::uint64_t, kReasonCount> totals{};         ///< totals_ at its start
   };
