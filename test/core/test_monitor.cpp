@@ -504,6 +504,21 @@ TEST(Monitor, AStatesOrientationIsCarriedAndChangesNothing) {
   }
 }
 
+// An imposed state (an impact a scene player was told of, ImpactMonitor::advance) is the motion
+// just after an impact, which turns no body at its instant: the track keeps the orientation it
+// carries rather than taking the imposed state's default.
+TEST(Monitor, AnImposedImpactKeepsTheOrientation) {
+  ImpactMonitor monitor(ballOnFloorScene(0.8), MonitorSettings{});
+  const std::size_t ball = *monitor.bodyIndex("ball");
+  const Eigen::Quaterniond turned(Eigen::AngleAxisd(0.7, V(1, 2, 3).normalized()));
+  BodyStateSample start = state(monitor, "ball", 0.0, V(0, 0, 1), V(0, 0, 0));
+  start.orientation = turned;
+  monitor.step(0.0, {start});
+  monitor.advance(0.2, {state(monitor, "ball", 0.1, V(0, 0, 0.95), V(1, 0, 0))});
+  EXPECT_EQ(monitor.lastOrientation(ball).coeffs(), turned.coeffs());
+  EXPECT_EQ(monitor.predictedState(ball, 0.1)->second.x(), 1.0);  // the imposed state was taken
+}
+
 }  // namespace
 }  // namespace collision_response::core
 

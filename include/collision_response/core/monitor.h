@@ -243,6 +243,7 @@ class ImpactMonitor {
   /// Advances the monitor to `time` by its own motion, without states, imposing each of
   /// `imposed` (a body's position and velocities at an instant in (now, time], in time order)
   /// at its instant: the body continues from there, and its lasting contacts are formed again.
+  /// An imposed state is the motion just after an impact: the body keeps its orientation.
   StepReport advance(double time, const std::vector<BodyStateSample>& imposed);
 
   /// Forgets every track and the time line (after a clock jump back).

@@ -265,7 +265,11 @@ void imposeStates(World& world, const std::vector<BodyStateSample>& imposed, Ste
   for (; at.next_imposed < imposed.size() && imposed[at.next_imposed].time <= at.instant;
        ++at.next_imposed) {
     const BodyStateSample& state = imposed[at.next_imposed];
+    // The motion just after an impact, which turns no body at its instant: the orientation the
+    // track carries is kept.
+    const Eigen::Quaterniond orientation = world.tracks[state.body].orientation;
     Track& track = restartTrack(world, state);
+    track.orientation = orientation;
     const bool stepped = releaseFromState(world, state.body);
     at.stepped_due = at.stepped_due || stepped;
     track.last_impact_time = state.time;
