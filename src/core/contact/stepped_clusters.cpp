@@ -557,9 +557,10 @@ std::vector<Pair> countedNearPairs(World& world, double time, double span,
 
 /// The step's stepped work spent: the clusters with a body of `member` (at the grid: every
 /// cluster), and the members in none, are held still from `time` to `end` as they are, without
-/// looking for near pairs (their contacts kept, no impulse): the stepped clusters' fallback,
-/// their bodies named in report.over_stepped_work. A body in no cluster at the grid stays with the
-/// exact model.
+/// looking for near pairs: the stepped clusters' fallback, their bodies named in
+/// report.over_stepped_work. Their contacts carry no impulse over it (none is published; the next
+/// sub-step's search finds them again). A body in no cluster at the grid stays with the exact
+/// model.
 void holdRegion(World& world, double time, double end, std::vector<char> member, bool grid,
                 std::vector<std::size_t>& changed, std::vector<std::size_t>& released,
                 StepReport& report) {
@@ -591,7 +592,9 @@ void holdRegion(World& world, double time, double end, std::vector<char> member,
   }
   for (Component& component : components) {
     std::vector<SteppedBody> bodies(component.members.size());
-    for (std::size_t i = 0; i < bodies.size(); ++i) bodies[i].inverse_mass = 1.0;  // all held
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      bodies[i].inverse_mass = world.inverseMassOf(component.members[i]);  // movable: held
+    }
     component.outcome = heldSubstep(bodies, component.pairs.size(), end - time);
     component.over_work = true;
   }
