@@ -519,6 +519,21 @@ TEST(Monitor, AnImposedImpactKeepsTheOrientation) {
   EXPECT_EQ(monitor.predictedState(ball, 0.1)->second.x(), 1.0);  // the imposed state was taken
 }
 
+// The scene's initial orientation of a body is carried by the scene player's model, through an
+// impact applied to it (an impact turns no body at its instant).
+TEST(Playback, TheScenesOrientationIsCarriedThroughAnImpact) {
+  Scene scene = ballOnFloorScene(0.8);
+  const Eigen::Quaterniond turned(Eigen::AngleAxisd(1.1, V(0, 0, 1)));
+  scene.bodies[0].orientation = turned;
+  scene.bodies[0].position = V(0, 0, 0.25);
+  scene.bodies[0].velocity = V(0, 0, -1);
+  Playback playback(scene, 1e-9, 0.0);
+  EXPECT_EQ(playback.orientation(0, 0.1).coeffs(), turned.coeffs());
+  ASSERT_TRUE(playback.applyImpact(0, 0.2, V(0, 0, 0.05), V(0, 0, 0.8)));
+  EXPECT_EQ(playback.orientation(0, 0.3).coeffs(), turned.coeffs());
+  EXPECT_EQ(playback.velocity(0, 0.3).z(), 0.8);  // the impact was applied
+}
+
 }  // namespace
 }  // namespace collision_response::core
 

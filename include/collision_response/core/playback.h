@@ -49,6 +49,9 @@ class Playback {
   Eigen::Vector3d position(std::size_t body, double time) const;
   Eigen::Vector3d velocity(std::size_t body, double time) const;
   Eigen::Vector3d angularVelocity(std::size_t body, double time) const;
+  /// World from body: the scene's initial orientation, carried through the impacts applied, not
+  /// yet followed in flight (a ball's does not matter; issue 42 gives bodies shapes).
+  Eigen::Quaterniond orientation(std::size_t body, double time) const;
 
   /// An impact on `body` at `time`: from then on it moves from `centre` with the velocities after
   /// (its lasting contacts formed again there). False when `time` is older than what is final.

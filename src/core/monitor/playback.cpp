@@ -120,6 +120,10 @@ Eigen::Vector3d Playback::angularVelocity(std::size_t body, double time) const {
   return at(time).predictedAngularVelocity(model_index_[body], time);
 }
 
+Eigen::Quaterniond Playback::orientation(std::size_t body, double time) const {
+  return at(time).lastOrientation(model_index_[body]);
+}
+
 std::vector<ContactRecord> Playback::contacts(double time) const {
   at(time);
   return *at_contacts_;
