@@ -93,7 +93,7 @@ Track throwBall(const Throw& t) {
   // Samples to the top of the last flight and a little past it.
   const double end = start + 1.1 * v.z() / kG;
   std::mt19937_64 random(t.seed);
-  std::normal_distribution<double> noise(0.0, t.noise);
+  std::normal_distribution<double> noise(0.0, 1.0);  // scaled by t.noise (which may be 0)
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   for (int k = 0;; ++k) {
     const double time = k / t.rate;
@@ -103,7 +103,7 @@ Track throwBall(const Throw& t) {
     const double s = time - pieces[piece].first;
     V position = pieces[piece].second.first + s * pieces[piece].second.second;
     position.z() -= 0.5 * kG * s * s;
-    const V error(noise(random), noise(random), noise(random));
+    const V error = t.noise * V(noise(random), noise(random), noise(random));
     if (t.drop > 0 && uniform(random) < t.drop) continue;
     track.samples.push_back(TrackedSample{time, position + error, std::nullopt});
   }
@@ -397,6 +397,27 @@ TEST(Calibration, AnUnknownSpinGivesALowerBoundOnly) {
   const auto tracked = calibrate(spun, options);
   ASSERT_TRUE(tracked.ok()) << tracked.error().message();
   EXPECT_EQ(tracked->bounces[0].friction, FrictionReading::kSliding);
+}
+
+// A ball dropped straight down, tracked without noise (as the scene player plays it): e to 1e-9,
+// and no slip before any bounce, so nothing about mu (the rounding's slip of 1e-17 m/s was read
+// as a slip that stopped, and gave "mu >= 0").
+TEST(Calibration, ADropWithoutNoiseGivesENoSlipAndNothingAboutMu) {
+  Throw t;
+  t.position = V(0.3, 0.0, 1.0335);  // the drop test's tennis ball: its x rounds in the fit
+  t.velocity = V(0.0, 0.0, 0.0);
+  t.noise = 0.0;
+  t.bounces = 3;
+  const Track track = throwBall(t);
+  const auto fit = calibrate(track.samples, floorOptions(t));
+  ASSERT_TRUE(fit.ok()) << fit.error().message();
+  ASSERT_EQ(fit->bounces.size(), 3u);
+  EXPECT_NEAR(fit->all.restitution.value, t.e, 1e-9);
+  for (const auto& bounce : fit->bounces) {
+    EXPECT_EQ(bounce.friction, FrictionReading::kNoSlip) << toString(bounce.friction);
+  }
+  EXPECT_FALSE(fit->all.friction.has_value());
+  EXPECT_FALSE(fit->all.friction_lower_bound.has_value());
 }
 
 TEST(Calibration, BadRecordingsAreNamed) {

@@ -686,7 +686,9 @@ RecordingResult<Calibration> run(const std::vector<TrackedSample>& recorded,
     const Estimate slip_before = estimate(values[row + 4], variance(row + 4));
     if (!spin_known) {
       bounce.friction = FrictionReading::kSpinUnknown;
-    } else if (slip_before.low() <= 0.0) {
+    } else if (slip_before.low() <= 0.0 ||
+               slip_before.value <= 1e-9 * (1.0 + bounce.approach_speed.value)) {
+      // No slip, or one within the rounding of a track without noise (a vertical drop played).
       bounce.friction = FrictionReading::kNoSlip;
     } else if (bounce.slip_after.low() > 0.0) {
       bounce.friction = FrictionReading::kSliding;
