@@ -6,20 +6,13 @@
 #include <cstddef>
 #include <vector>
 
+#include "collision_response/core/solver_body.h"
+
 namespace collision_response::core {
 
 /// A body of the cluster: inverse mass (0: immovable, an obstacle), velocity (updated) and, for
-/// friction and spin, angular velocity, radius and 1/k of its moment of inertia I = k m r^2.
-struct ClusterBody {
-  double inverse_mass = 0.0;
-  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
-  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
-  /// 1/k (5/2 solid, 3/2 hollow); 0: does not turn (immovable, a point, no spin effect). Kept as
-  /// a factor, not as 1/I = w / (k r^2): that underflows for large bodies (r = 1e145 m) while
-  /// every quantity friction needs, w/k and (w/k)/r, does not.
-  double spin_factor = 0.0;
-  double radius = 0.0;  ///< m
-};
+/// friction and spin, angular velocity and inverse inertia (solver_body.h).
+using ClusterBody = SolverBody;
 
 /// Sums each body's velocity changes from several contacts in an order that does not depend on
 /// the order of the contacts: each component's positive terms are added smallest first, its

@@ -557,12 +557,7 @@ class RoundProgress {
 };
 
 /// A body of an inelastic impact: what its impulses act on, and its velocities just before.
-struct ImpactBody {
-  double inverse_mass = 0.0;  ///< 1/kg; 0: immovable
-  double spin_factor = 0.0;   ///< 1/k of I = k m r^2; 0: it does not turn
-  double radius = 0.0;        ///< m; 0 for a plane
-  BodyVelocities before;
-};
+using ImpactBody = SolverBody;
 
 /// A pair of an inelastic impact (indices into its bodies), along its line of impact.
 struct ImpactContact {
@@ -593,12 +588,11 @@ InelasticImpact solveInelasticImpact(const std::vector<ImpactBody>& bodies,
                                      const std::vector<ImpactContact>& contacts) {
   std::vector<ForceBody> velocity_level;
   for (const ImpactBody& body : bodies) {
-    ForceBody force_body;
-    force_body.inverse_mass = body.inverse_mass;
-    force_body.spin_factor = body.spin_factor;
-    force_body.radius = body.radius;
-    force_body.acceleration = body.before.linear;
-    force_body.angular_acceleration = body.before.angular;
+    ForceBody force_body{body};
+    force_body.acceleration = body.velocity;
+    force_body.angular_acceleration = body.angular_velocity;
+    force_body.velocity = Eigen::Vector3d::Zero();
+    force_body.angular_velocity = Eigen::Vector3d::Zero();
     velocity_level.push_back(force_body);
   }
   std::vector<ForceContact> force_contacts;
@@ -644,7 +638,8 @@ std::vector<ImpactBody> impactBodies(const World& world, double time,
     ImpactBody body;
     body.inverse_mass = world.inverseMassOf(p);
     body.radius = world.radius[p];
-    body.before = {velocityAt<Motion>(world, p, time), angularVelocityAt<Motion>(world, p, time)};
+    body.velocity = velocityAt<Motion>(world, p, time);
+    body.angular_velocity = angularVelocityAt<Motion>(world, p, time);
     if (!world.isObstacle(p)) body.spin_factor = world.spin_factor[p];
     bodies.push_back(body);
   }
@@ -701,8 +696,8 @@ void recordInelasticImpacts(const World& world, double time, const InelasticPair
     const Pair& pair = inelastic.pairs[k];
     const Geometry& g = inelastic.geometries[k];
     const ImpactContact& contact = inelastic.contacts[k];
-    const BodyVelocities& a_before = bodies[contact.a].before;
-    const BodyVelocities& b_before = bodies[contact.b].before;
+    const BodyVelocities a_before = velocitiesOf(bodies[contact.a]);
+    const BodyVelocities b_before = velocitiesOf(bodies[contact.b]);
     const BodyVelocities a_after{world.isObstacle(pair.first) || bodies[contact.a].inverse_mass == 0
                                      ? a_before.linear
                                      : impact.after[contact.a].linear,

@@ -28,13 +28,10 @@ void applyFrictionJointly(std::vector<ClusterBody>& bodies,
                           std::vector<FrictionOutcome>& outcomes, WorkBound* work) {
   std::vector<ForceBody> force_bodies;
   for (const ClusterBody& body : bodies) {
-    ForceBody force_body;
-    force_body.inverse_mass = body.inverse_mass;
-    force_body.radius = body.radius;
-    force_body.velocity = body.velocity;
-    if constexpr (kSpin) {
-      force_body.spin_factor = body.spin_factor;
-      force_body.angular_velocity = body.angular_velocity;
+    ForceBody force_body{body};  // no free accelerations
+    if constexpr (!kSpin) {      // bodies that do not turn: no rotational terms
+      force_body.spin_factor = 0.0;
+      force_body.angular_velocity = Eigen::Vector3d::Zero();
     }
     force_bodies.push_back(force_body);
   }

@@ -6,18 +6,13 @@
 #include <cstddef>
 #include <vector>
 
+#include "collision_response/core/solver_body.h"
+
 namespace collision_response::core {
 
-/// A body of a contact group. An obstacle or an immovable body has inverse_mass 0 (and moves
-/// with constant velocity, acceleration 0).
-struct ForceBody {
-  double inverse_mass = 0.0;  ///< 1/kg; 0: immovable
-  /// 1/k of the moment of inertia I = k m r^2 (5/2 a solid sphere, 3/2 a hollow one); 0: the
-  /// body does not turn (no spin effect, an obstacle, a point).
-  double spin_factor = 0.0;
-  double radius = 0.0;  ///< m; 0 for a plane
-  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
-  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
+/// A body of a contact group: a solver body (an obstacle or an immovable body has inverse mass 0,
+/// and moves with constant velocity, acceleration 0) and its free accelerations.
+struct ForceBody : SolverBody {
   /// m/s^2 without contact forces: gravity for a movable body, 0 for an immovable one.
   Eigen::Vector3d acceleration = Eigen::Vector3d::Zero();
   /// rad/s^2 without contact forces (0; see solveContactForces for its use with impulses).

@@ -536,13 +536,10 @@ void frictionThenGaps(const std::vector<SteppedBody>& bodies,
                       double tolerance, BoundedSolution& kept, SteppedOutcome& outcome) {
   std::vector<Eigen::Vector3d>& v = outcome.velocity;
   std::vector<Eigen::Vector3d>& w = outcome.angular_velocity;
-  std::vector<ClusterBody> cluster_bodies(bodies.size());
+  std::vector<ClusterBody> cluster_bodies(bodies.begin(), bodies.end());  // without the kick
   for (std::size_t i = 0; i < bodies.size(); ++i) {
-    cluster_bodies[i].inverse_mass = bodies[i].inverse_mass;
     cluster_bodies[i].velocity = v[i];
     cluster_bodies[i].angular_velocity = w[i];
-    cluster_bodies[i].spin_factor = bodies[i].spin_factor;
-    cluster_bodies[i].radius = bodies[i].radius;
   }
   const PressedContacts pressed = pressedContacts(contacts, order, kept.impulses, outcome);
   if (pressed.contacts.empty()) return;

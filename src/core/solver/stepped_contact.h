@@ -12,21 +12,17 @@
 #include <vector>
 
 #include "collision_response/core/friction.h"
+#include "collision_response/core/solver_body.h"
 #include "solver/stepped_friction.h"
 
 namespace collision_response::core {
 
 /// A participant of a sub-step: a movable body, or (inverse mass 0) an obstacle or an immovable
-/// body, which moves on at its velocity.
-struct SteppedBody {
-  double inverse_mass = 0.0;
-  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< m/s at the start, before `kick`
-  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
+/// body, which moves on at its velocity; its velocity is the one at the start, before `kick`.
+struct SteppedBody : SolverBody {
   /// m/s: what gravity adds over the sub-step, g h (0 for an obstacle, or for a body given its
   /// gravity for this sub-step already).
   Eigen::Vector3d kick = Eigen::Vector3d::Zero();
-  double spin_factor = 0.0;  ///< 1/k of I = k m r^2 (friction with spin), as ClusterBody
-  double radius = 0.0;       ///< m
 };
 
 /// A pair that may touch within the sub-step: two spheres, or a sphere and a plane.
