@@ -264,6 +264,7 @@ std::optional<Fit> leastSquares(Motion& motion, const std::vector<TrackedSample>
     }
     if (!improved || converged) break;
   }
+  if (iteration == kMaxIterations) return std::nullopt;  // never settled: no fit to answer
   if (!f(parameters, r) || !jacobian(f, parameters, r.size(), j)) return std::nullopt;
   const auto dof = static_cast<double>(r.size() - parameters.size());
   if (!(dof > 0)) return std::nullopt;
@@ -578,7 +579,8 @@ RecordingResult<Calibration> run(const std::vector<TrackedSample>& recorded,
   if (!fit) {
     return problem(RecordingProblem::kFitFailed, "samples",
                    "the flights could not be fitted (a flight that does not meet its bounce's "
-                   "plane, or a motion past the doubles)");
+                   "plane, a motion past the doubles, or no settling in " +
+                       std::to_string(kMaxIterations) + " iterations)");
   }
 
   // The spin before each bounce: the tracker's (its mean over the flight before), else carried
