@@ -244,6 +244,29 @@ TEST(NarrowPhaseTable, AReversedEntryGivesTheSameContactWithTheNormalReversed) {
   }
 }
 
+// The lever arms (ContactPoint's r_a, r_b) of the same ball against each kind: the ball's is
+// R n = -R m (from its centre to its surface point), the obstacle's p - its pose origin (for the
+// sphere, -R_s n: the point (2, 0, 0) of the sphere about (3, 0, 0) of radius 1); in the other
+// order the two swap, to the bit.
+TEST(NarrowPhaseTable, TheLeverArmsGoFromEachCentreToItsOwnSurfacePoint) {
+  const double radius = 0.125, gap = 0.0625;
+  for (const KnownSurface& known : oneOfEachKind()) {
+    const std::size_t kind = known.placed.shape.index();
+    const V centre = known.point + (radius + gap) * known.outward;
+    const PlacedShape ball = atRest(Sphere{centre, radius}, centre);
+    const ContactGeometry forward = contactGeometry(ball, known.placed, 1e-9, kNoApproach);
+    const ContactGeometry reversed = contactGeometry(known.placed, ball, 1e-9, kNoApproach);
+    ASSERT_TRUE(forward.valid) << kind;
+    ASSERT_TRUE(reversed.valid) << kind;
+    EXPECT_LT((forward.lever_a + radius * known.outward).norm(), 1e-15) << kind;
+    EXPECT_LT((forward.lever_b - (known.point - known.placed.pose.transform.translation())).norm(),
+              1e-15)
+        << kind;
+    EXPECT_EQ(reversed.lever_a, forward.lever_b) << kind;
+    EXPECT_EQ(reversed.lever_b, forward.lever_a) << kind;
+  }
+}
+
 // The same ball moving at 2 m/s along -m towards each (still) obstacle, in both orders: it
 // touches when it has crossed the gap d, at d / 2 = 0.03125 s; the sphere's row is the ball
 // code's instant to the bit.

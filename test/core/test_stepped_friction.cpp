@@ -61,7 +61,7 @@ TEST(SteppedFriction, OneContactSticksOrSlidesAsItsClosedFormSays) {
   const V v(0.3, -0.4, 0.0), spin(2.0, 1.0, 0.0);  // the floor's normal +z: contact at -r z
   for (const double bound : {1.0, 0.01}) {
     std::vector<ClusterBody> bodies{floorBody(), ballBody(m, r, v, spin)};
-    const std::vector<ClusterContact> contacts{ClusterContact{0, 1, V::UnitZ(), 0.0}};
+    const std::vector<ClusterContact> contacts{ClusterContact{{0, 1, V::UnitZ()}, 0.0}};
     const V u = v + spin.cross(-r * V::UnitZ());  // (0.25, -0.3, 0): independent of the code
     std::vector<SweptFrictionOutcome> outcomes;
     const SweptFrictionReport report = applyFrictionBySweeps<true>(
@@ -96,13 +96,13 @@ Cluster randomCluster(std::mt19937_64& engine, int balls) {
         ballBody(0.1 * (1 + speed(engine) * 0.5), r, V(speed(engine), speed(engine), 0.0),
                  V(10 * speed(engine), 10 * speed(engine), 10 * speed(engine))));
     const std::size_t body = cluster.bodies.size() - 1;
-    cluster.contacts.push_back(ClusterContact{0, body, V::UnitZ(), 0.0});
+    cluster.contacts.push_back(ClusterContact{{0, body, V::UnitZ()}, 0.0});
     cluster.frictions.push_back(SweptFrictionContact{bound(engine), V::Zero()});
     if (i > 0) {
       const double turn = angle(engine);
       centre = previous_centre + 2 * r * V(std::cos(turn), std::sin(turn), 0.0);
       cluster.contacts.push_back(
-          ClusterContact{body - 1, body, (centre - previous_centre).normalized(), 0.0});
+          ClusterContact{{body - 1, body, (centre - previous_centre).normalized()}, 0.0});
       cluster.frictions.push_back(SweptFrictionContact{bound(engine), V::Zero()});
     }
     previous_centre = centre;
@@ -152,7 +152,7 @@ TEST(SteppedFriction, AWarmStartThatWouldAddEnergyIsDropped) {
   std::vector<ClusterBody> bodies{floorBody(), ballBody(0.1, 0.05, V::Zero(), V::Zero())};
   std::vector<SweptFrictionOutcome> outcomes;
   const SweptFrictionReport report = applyFrictionBySweeps<true>(
-      bodies, {ClusterContact{0, 1, V::UnitZ(), 0.0}},
+      bodies, {ClusterContact{{0, 1, V::UnitZ()}, 0.0}},
       {SweptFrictionContact{0.1, V(0.05, 0.0, 0.0)}}, 1e-15, 64, outcomes);
   EXPECT_TRUE(report.cold);
   EXPECT_TRUE(report.converged);
@@ -200,7 +200,7 @@ TEST(SteppedFriction, WithoutSpinTheBodiesDoNotTurn) {
   for (const double bound : {1.0, 0.02}) {
     std::vector<ClusterBody> bodies{floorBody(), ballBody(m, 0.05, v, spin)};
     std::vector<SweptFrictionOutcome> outcomes;
-    applyFrictionBySweeps<false>(bodies, {ClusterContact{0, 1, V::UnitZ(), 0.0}},
+    applyFrictionBySweeps<false>(bodies, {ClusterContact{{0, 1, V::UnitZ()}, 0.0}},
                                  {SweptFrictionContact{bound, V::Zero()}}, 1e-15, 64, outcomes);
     const V expected = v.norm() / w <= bound ? V(-v / w) : V(-bound * v.normalized());
     EXPECT_LE((outcomes[0].impulse - expected).norm(), 1e-15) << bound;

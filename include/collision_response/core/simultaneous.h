@@ -31,11 +31,8 @@ class OrderFreeSum {
 };
 
 /// A contact of the cluster between bodies `a` and `b` (indices into the cluster's bodies).
-struct ClusterContact {
-  std::size_t a = 0;
-  std::size_t b = 0;
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();  ///< unit, a -> b
-  double restitution = 0.0;                           ///< the coefficient this contact uses
+struct ClusterContact : ContactPoint {
+  double restitution = 0.0;  ///< the coefficient this contact uses
 };
 
 /// What one contact of the cluster received.

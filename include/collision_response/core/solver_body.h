@@ -1,10 +1,11 @@
-// The body every solver works on (issue 42, build step 1): one struct for the joint impulse
-// solve (simultaneous.h), friction at an impact (friction.h), the contact forces and inelastic
-// impacts (solver/contact_forces.h) and the stepped sub-step (solver/stepped_contact.h), each of
-// which adds only what is its own.
+// The body and the contact point every solver works on (issue 42, build step 1): one struct
+// each for the joint impulse solve (simultaneous.h), friction at an impact (friction.h), the
+// contact forces and inelastic impacts (solver/contact_forces.h) and the stepped sub-step
+// (solver/stepped_contact.h), each of which adds only what is its own.
 #pragma once
 
 #include <Eigen/Core>
+#include <cstddef>
 
 namespace collision_response::core {
 
@@ -33,6 +34,21 @@ struct SolverBody {
   double radius = 0.0;  ///< m, kIsotropic; 0 for a plane
   /// kTensor: I^-1 about the centre of mass, 1/(kg m^2), in the common frame (R I_body^-1 R^T).
   Eigen::Matrix3d inverse_inertia = Eigen::Matrix3d::Zero();
+};
+
+/// A contact between bodies `a` and `b` (indices into the solve's bodies), as the narrow phase
+/// gives it (ContactGeometry: normal, point, lever arms).
+struct ContactPoint {
+  std::size_t a = 0;
+  std::size_t b = 0;
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();  ///< unit, a -> b
+  /// A point of the contact: the middle of the gap along the normal (ContactGeometry::point).
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  /// r_a, r_b, m: from each body's centre of mass (a shape's pose origin) to its own surface
+  /// point at the contact; a ball's is R n (its b side -R n). Carried for the shaped bodies to
+  /// come: the ball formulas compute with the radius and the normal, as before.
+  Eigen::Vector3d lever_a = Eigen::Vector3d::Zero();
+  Eigen::Vector3d lever_b = Eigen::Vector3d::Zero();
 };
 
 }  // namespace collision_response::core

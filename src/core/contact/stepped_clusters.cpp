@@ -178,6 +178,8 @@ SteppedContacts steppedContactsOf(const World& world, double time, double span, 
     contact.b = participants.slot(pair.second);
     contact.normal = g.normal;
     contact.point = g.point;
+    contact.lever_a = g.lever_a;
+    contact.lever_b = g.lever_b;
     contact.gap = g.gap;
     contact.band = g.tolerance;
     contact.restitution = world.restitutionOf(pair);

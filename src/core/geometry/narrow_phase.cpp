@@ -431,6 +431,7 @@ ContactGeometry reversedContact(const PlacedShape& a, const PlacedShape& b,
   ContactGeometry result = entryOf(b.shape, a.shape).contact(b, a, contact_tolerance, back);
   if (result.valid) {
     result.normal = -result.normal;
+    std::swap(result.lever_a, result.lever_b);
     result.surface_velocity = b.pose.velocityAt(result.point - b.pose.transform.translation());
   }
   return result;
@@ -525,6 +526,8 @@ ContactGeometry finiteGeometryOf(const Eigen::Vector3d& centre, double radius, c
   const Eigen::Vector3d on_shape = origin + axes * nearest.point;
   result.point = 0.5 * (Eigen::Vector3d(centre + radius * result.normal) + on_shape);
   result.surface_velocity = pose.velocityAt(result.point - origin);
+  result.lever_a = radius * result.normal;
+  result.lever_b = axes * nearest.point;
   return result;
 }
 

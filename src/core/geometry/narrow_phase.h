@@ -63,6 +63,11 @@ struct ContactGeometry {
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   /// m/s: the shape's surface at `point`, v + w x r (r from the shape's pose origin).
   Eigen::Vector3d surface_velocity = Eigen::Vector3d::Zero();
+  /// m: the lever arms r_a, r_b of the solvers' contact point (ContactPoint, solver_body.h): from
+  /// each side's centre (a ball's, a sphere's; a plane's or finite shape's pose origin) to its
+  /// own surface point at the contact. A ball's is R n; a sphere's on the other side -R n.
+  Eigen::Vector3d lever_a = Eigen::Vector3d::Zero();
+  Eigen::Vector3d lever_b = Eigen::Vector3d::Zero();
 
   /// The shape is flat here: the normal does not turn as the ball moves along it.
   bool flat() const { return curvature == 0; }
@@ -202,6 +207,8 @@ ContactGeometry sphereGeometry(const Eigen::Vector3d& centre, double radius, con
   result.curvature = 1.0 / result.turning_radius;
   result.point = 0.5 * (Eigen::Vector3d(centre + radius * result.normal) +
                         Eigen::Vector3d(sphere.centre - sphere.radius * result.normal));
+  result.lever_a = radius * result.normal;
+  result.lever_b = -sphere.radius * result.normal;
   result.surface_velocity =
       placed.pose.velocityAt(result.point - placed.pose.transform.translation());
   return result;
@@ -231,6 +238,8 @@ inline ContactGeometry planeGeometry(const Eigen::Vector3d& centre, double radiu
   result.valid = true;
   const Eigen::Vector3d on_shape = centre + (result.gap + radius) * result.normal;
   result.point = 0.5 * (Eigen::Vector3d(centre + radius * result.normal) + on_shape);
+  result.lever_a = radius * result.normal;
+  result.lever_b = on_shape - placed.pose.transform.translation();
   result.surface_velocity =
       placed.pose.velocityAt(result.point - placed.pose.transform.translation());
   return result;

@@ -116,6 +116,8 @@ Expected<CollisionOutcome> computeCollision(const CollisionRequest& request,
   contact.a = 0;
   contact.b = 1;
   contact.normal = *line_of_impact;
+  contact.lever_a = request.a.radius * contact.normal;  // the balls' lever arms
+  contact.lever_b = -request.b.radius * contact.normal;
   contact.restitution = *restitution;
   const ContactResolution solved =
       solveContact(a, b, contact, *friction, frictionModelFor(runnable));

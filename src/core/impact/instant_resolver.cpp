@@ -177,6 +177,9 @@ PreparedCluster prepareCluster(World& world, double time,
       contact.b = local(pair.second);
     }
     contact.normal = g.normal;
+    contact.point = g.point;
+    contact.lever_a = g.lever_a;
+    contact.lever_b = g.lever_b;
     const double approach_speed = (velocityAt<Motion>(world, pair.first, time) -
                                    touchingVelocity<Motion>(world, pair, g, time))
                                       .dot(contact.normal);
@@ -560,11 +563,8 @@ class RoundProgress {
 using ImpactBody = SolverBody;
 
 /// A pair of an inelastic impact (indices into its bodies), along its line of impact.
-struct ImpactContact {
-  std::size_t a = 0;
-  std::size_t b = 0;
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();  ///< unit, from a towards b
-  double friction = 0.0;                              ///< Coulomb mu; 0 frictionless
+struct ImpactContact : ContactPoint {
+  double friction = 0.0;  ///< Coulomb mu; 0 frictionless
 };
 
 /// The impulse on b at a contact (on a the opposite).
@@ -597,10 +597,7 @@ InelasticImpact solveInelasticImpact(const std::vector<ImpactBody>& bodies,
   }
   std::vector<ForceContact> force_contacts;
   for (const ImpactContact& contact : contacts) {
-    ForceContact force_contact;
-    force_contact.a = contact.a;
-    force_contact.b = contact.b;
-    force_contact.normal = contact.normal;
+    ForceContact force_contact{contact};
     force_contact.friction = contact.friction;
     force_contacts.push_back(force_contact);
   }
@@ -670,6 +667,9 @@ InelasticPairs inelasticPairs(const World& world, double time, const std::vector
     contact.a = slot(pair.first);
     contact.b = slot(pair.second);
     contact.normal = g.normal;
+    contact.point = g.point;
+    contact.lever_a = g.lever_a;
+    contact.lever_b = g.lever_b;
     if (world.friction_model) contact.friction = world.frictionOf(pair);
     inelastic.pairs.push_back(pair);
     inelastic.geometries.push_back(g);

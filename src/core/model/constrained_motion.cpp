@@ -123,13 +123,18 @@ ContactForceSolution ConstrainedStep::forces(const State& state, double time) co
     contact.b = c.b;
     contact.friction = c.friction;
     contact.slide_direction = c.slide_direction;
+    const double radius_a = bodies[c.a].radius;
     if (c.plane) {
       contact.normal = -c.plane_normal;
+      contact.lever_a = radius_a * contact.normal;  // the plane's side: immovable, not read
     } else if (c.shape) {
       const ContactGeometry g =
           contactGeometry(positions[c.a], bodies[c.a].radius, shapeAt(*c.shape, time), 0.0,
                           [] { return Eigen::Vector3d(Eigen::Vector3d::Zero()); });
       contact.normal = g.normal;
+      contact.point = g.point;
+      contact.lever_a = g.lever_a;
+      contact.lever_b = g.lever_b;
       contact.curvature = g.curvature;
       contact.turning_axis = g.turning_axis;
       contact.axial_share = g.axial_share;
@@ -138,6 +143,8 @@ ContactForceSolution ConstrainedStep::forces(const State& state, double time) co
       const double distance = centres.norm();
       contact.normal = centres / distance;
       contact.curvature = 1.0 / distance;
+      contact.lever_a = radius_a * contact.normal;
+      contact.lever_b = -bodies[c.b].radius * contact.normal;
     }
     modes[k] = c.mode;
   }

@@ -38,10 +38,7 @@ void applyFrictionJointly(std::vector<ClusterBody>& bodies,
   std::vector<ForceContact> force_contacts;
   std::vector<double> normal_impulses;
   for (std::size_t k = 0; k < contacts.size(); ++k) {
-    ForceContact contact;
-    contact.a = contacts[k].a;
-    contact.b = contacts[k].b;
-    contact.normal = contacts[k].normal;
+    ForceContact contact{contacts[k]};
     contact.friction = frictions[k].friction;
     force_contacts.push_back(contact);
     normal_impulses.push_back(frictions[k].normal_impulse);

@@ -20,10 +20,7 @@ struct ForceBody : SolverBody {
 };
 
 /// A touching pair of the group: b rests on a, or a on b (indices into the bodies).
-struct ForceContact {
-  std::size_t a = 0;
-  std::size_t b = 0;
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();  ///< unit, from a towards b
+struct ForceContact : ContactPoint {
   /// 1 / (distance between the centres) for two spheres, whose line of centres turns as they
   /// move; 0 against a plane; against a finite shape, 1 / (the centre's distance from the
   /// feature's core: an edge's line, a corner, a rim's circle; narrow_phase.h).

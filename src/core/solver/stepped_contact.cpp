@@ -521,7 +521,7 @@ PressedContacts pressedContacts(const std::vector<SteppedContact>& contacts,
         outcome.contacts[k].bounce_impulse + keeping[static_cast<Eigen::Index>(i)];
     if (!(normal > 0) || !(contacts[k].friction > 0)) continue;
     const SteppedContact& c = contacts[k];
-    pressed.contacts.push_back(ClusterContact{c.a, c.b, c.normal, 0.0});
+    pressed.contacts.push_back(ClusterContact{c, 0.0});
     pressed.frictions.push_back(SweptFrictionContact{c.friction * normal, c.friction_warm});
     pressed.index.push_back(k);
   }

@@ -26,14 +26,9 @@ struct SteppedBody : SolverBody {
 };
 
 /// A pair that may touch within the sub-step: two spheres, or a sphere and a plane.
-struct SteppedContact {
-  std::size_t a = 0;
-  std::size_t b = 0;
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();  ///< unit, a -> b, at the start
-  /// A point of the contact at the start (a's centre plus its radius along the normal). The
-  /// solve visits contacts in the order of these points, so that no name or listing order of the
-  /// bodies enters the answer.
-  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+/// Its normal and point are those at the start; the solve visits contacts in the order of their
+/// points, so that no name or listing order of the bodies enters the answer.
+struct SteppedContact : ContactPoint {
   double gap = 0.0;   ///< m at the start, surface to surface; < 0 overlapping (held, not pushed)
   double band = 0.0;  ///< m: within it the pair touches (it may strike); the overlap allowed
   double restitution = 0.0;
