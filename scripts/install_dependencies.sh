@@ -39,6 +39,7 @@ declare -A DEBIAN_PACKAGES=(
   [urdf]="liburdf-dev"
   [roslib]="libroslib-dev"
   [geometric_shapes]="libgeometric-shapes-dev"
+  [libqhull]="libqhull-dev"
   [robot_state_publisher]="ros-robot-state-publisher"
   [sensor_msgs]="libsensor-msgs-dev ros-sensor-msgs python3-sensor-msgs"
   [boost]="libboost-dev"
