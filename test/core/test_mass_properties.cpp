@@ -421,5 +421,21 @@ TEST(InertiaTensorCheck, EachBadValueIsNamed) {
   expectRefused(checkInertiaTensor(bad, "b.inertia"), "b.inertia", "too small");
 }
 
+TEST(OrientationCheck, EachBadQuaternionIsNamed) {
+  EXPECT_TRUE(checkOrientation(Eigen::Quaterniond::Identity(), "q").ok());
+  EXPECT_TRUE(checkOrientation(Eigen::Quaterniond(0.5, 0.5, 0.5, 0.5), "q").ok());
+  // Within tf2's tolerance of unit length (x^2 + ... within 0.01 of 1).
+  EXPECT_TRUE(checkOrientation(Eigen::Quaterniond(1.004, 0, 0, 0), "q").ok());
+  expectRefused(checkOrientation(Eigen::Quaterniond(0, 0, 0, 0), "bodies[0]/orientation"),
+                "bodies[0]/orientation", "is zero");
+  expectRefused(checkOrientation(Eigen::Quaterniond(2, 0, 0, 0), "state.orientation"),
+                "state.orientation", "length 1");
+  expectRefused(checkOrientation(Eigen::Quaterniond(0, 1e-200, 0, 0), "q"), "q", "length 1");
+  // Eigen's (w, x, y, z) constructor; the field names the component.
+  expectRefused(checkOrientation(Eigen::Quaterniond(1, 0, kNan, 0), "state.orientation"),
+                "state.orientation.y", "finite");
+  expectRefused(checkOrientation(Eigen::Quaterniond(kInf, 0, 0, 0), "q"), "q.w", "finite");
+}
+
 }  // namespace
 }  // namespace collision_response::core

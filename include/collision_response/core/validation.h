@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cmath>
 #include <initializer_list>
 #include <string>
@@ -112,5 +113,13 @@ Expected<Eigen::Vector3d> lineOfImpact(const Eigen::Vector3d& normal,
                                        const Eigen::Vector3d& position_a,
                                        const Eigen::Vector3d& position_b,
                                        const std::string& field = "normal");
+
+/// How far a unit quaternion's squared length may be from 1: tf2's tolerance for a transform's
+/// rotation (its buffer refuses a quaternion whose x^2 + y^2 + z^2 + w^2 is 0.01 or more away).
+inline constexpr double kQuaternionNormTolerance = 0.01;
+/// An orientation (world from body): every component finite (`field`.x, .y, .z, .w named), not
+/// zero (no rotation has it), and of unit length to kQuaternionNormTolerance in its square (a
+/// quaternion of another length is a mistake, not a rotation: the caller then normalises it).
+Status checkOrientation(const Eigen::Quaterniond& orientation, const std::string& field);
 
 }  // namespace collision_response::core

@@ -200,4 +200,28 @@ Eigen::Vector3d unitVector(const Eigen::Vector3d& v) {
   return scaled / scaled.norm();
 }
 
+Status checkOrientation(const Eigen::Quaterniond& orientation, const std::string& field) {
+  static const std::array<const char*, 4> kComponents = {"x", "y", "z", "w"};
+  const Eigen::Vector4d& q = orientation.coeffs();  // x, y, z, w
+  for (int k = 0; k < 4; ++k) {
+    if (!std::isfinite(q[k])) {
+      return Error{field + "." + kComponents[k],
+                   "must be a finite number, got " + formatNumber(q[k])};
+    }
+  }
+  if (q.isZero(0.0)) {
+    return Error{field,
+                 "is zero: no rotation has it (a rotation's quaternion has length 1; the "
+                 "identity is [0, 0, 0, 1] as [x, y, z, w])"};
+  }
+  const double length = q.stableNorm();
+  if (!(std::abs(length * length - 1.0) < kQuaternionNormTolerance)) {
+    return Error{field,
+                 "must have length 1 (a rotation's quaternion: x^2 + y^2 + z^2 + w^2 within " +
+                     formatNumber(kQuaternionNormTolerance) + " of 1), got length " +
+                     formatNumber(length)};
+  }
+  return Ok{};
+}
+
 }  // namespace collision_response::core
