@@ -5,11 +5,13 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "collision_response/core/expected.h"
 #include "collision_response/core/friction.h"
+#include "collision_response/core/mass_properties.h"
 #include "collision_response/core/materials.h"
 #include "collision_response/core/shape.h"
 
@@ -46,6 +48,10 @@ inline constexpr double kDefaultDragCoefficient = 0.47;
 inline constexpr double kDefaultLiftCoefficient = 0.2;
 inline constexpr double kDefaultAirDensity = 1.204;
 
+/// A body's shape (issue 42): a sphere, a box, a cylinder or a capsule about its origin (the
+/// latter two along its z), or the convex hull of a mesh in its own frame.
+enum class BodyShape { kSphere, kBox, kCylinder, kCapsule, kMesh };
+
 /// A body the monitor tracks. `position` and `velocity` are its initial state for the scene
 /// player; the monitor takes states from topics.
 struct BodySpec {
@@ -67,6 +73,19 @@ struct BodySpec {
   /// Initial, world from body, a unit quaternion: carried into the body's first state, not yet
   /// read (a ball's does not matter; issue 42 gives bodies shapes).
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+  /// Its shape: a sphere of `radius` by default; a box of edges `size`, a cylinder or a capsule
+  /// of `radius` and `length` (between the caps; of the capsule's segment), or the convex hull of
+  /// `mesh` (loaded from `resource`, scaled by `scale`, as an obstacle's). Checked and carried,
+  /// not yet moved: validateScene refuses a body that is not a sphere ("not yet", body_shape.h).
+  BodyShape shape = BodyShape::kSphere;
+  Eigen::Vector3d size = Eigen::Vector3d::Zero();  ///< box: edge lengths, m
+  double length = 0.0;                             ///< cylinder, capsule: m
+  std::shared_ptr<const TriangleMesh> mesh;
+  std::string resource;
+  Eigen::Vector3d scale = Eigen::Vector3d::Ones();
+  /// Given: the tensor about the centre of mass in the body's frame (`inertia: {ixx, ...}`),
+  /// instead of the uniform solid of its shape (`inertia: solid`, or `hollow` for a sphere).
+  std::optional<InertiaTensor> inertia_tensor;
 };
 
 enum class ObstacleShape { kPlane, kSphere, kBox, kCylinder, kCapsule, kMesh };
@@ -127,8 +146,9 @@ struct Scene {
 };
 
 /// Every value and cross-reference of a scene: ids unique among bodies and obstacles, masses,
-/// radii, known materials, finite vectors, nonzero plane normals. Fields are named as scene file
-/// keys under `prefix` ("~scene/bodies[2]/mass").
+/// radii, known materials, finite vectors, nonzero plane normals, each body's shape and inertia
+/// (checkBodyShape), and last, for now, that every body is a sphere (checkOnlySpheresMove: "not
+/// yet"). Fields are named as scene file keys under `prefix` ("~scene/bodies[2]/mass").
 /// Start-up cost: O(n log n) in the bodies, plus one check per pair of distinct materials.
 Status validateScene(const Scene& scene, const std::string& prefix);
 

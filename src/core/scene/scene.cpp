@@ -10,6 +10,7 @@
 #include <utility>
 #include <variant>
 
+#include "collision_response/core/body_shape.h"
 #include "collision_response/core/validation.h"
 #include "geometry/air_flight.h"
 #include "geometry/finite_shapes.h"
@@ -173,6 +174,8 @@ Status checkBodies(const Scene& scene, const std::string& prefix, std::set<std::
     if (auto status = checkRadius(body.radius, item(prefix, "bodies", i, "radius")); !status) {
       return status;
     }
+    const auto key = [&](const char* name) { return item(prefix, "bodies", i, name); };
+    if (auto status = checkBodyShape(body, key); !status) return status;
     if (auto status =
             checkMaterial(scene.materials, body.material, item(prefix, "bodies", i, "material"));
         !status) {
@@ -324,7 +327,8 @@ Status validateScene(const Scene& scene, const std::string& prefix) {
   std::set<std::string> ids;  // shared by bodies and obstacles
   if (auto status = checkBodies(scene, prefix, ids); !status) return status;
   if (auto status = checkObstacles(scene, prefix, ids); !status) return status;
-  return checkEveryPairHasRestitution(scene, prefix);
+  if (auto status = checkEveryPairHasRestitution(scene, prefix); !status) return status;
+  return checkOnlySpheresMove(scene, prefix);
 }
 
 std::vector<std::string> bodiesStartingInside(const Scene& scene) {

@@ -1,0 +1,44 @@
+// A scene body's shape and mass (issue 42, build step 2): its shape in its own frame, the checks
+// of its shape and inertia keys, and its mass properties. Only spheres move yet: a scene with any
+// other body is refused by name (checkOnlySpheresMove, the last check of validateScene), so that
+// nothing silently becomes a ball.
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include "collision_response/core/expected.h"
+#include "collision_response/core/mass_properties.h"
+#include "collision_response/core/scene.h"
+#include "collision_response/core/shape.h"
+
+namespace collision_response::core {
+
+/// The body's shape in its own frame: a sphere about the origin, a box, a cylinder or a capsule
+/// (half its `size` or `length`), or its mesh (whose convex hull the body is).
+Shape shapeOf(const BodySpec& body);
+
+/// `sphere` | `box` | `cylinder` | `capsule` | `mesh`; anything else an error naming `field`.
+Expected<BodyShape> parseBodyShape(const std::string& name, const std::string& field);
+const char* toString(BodyShape shape);
+
+/// A body's shape and inertia, named as its scene keys (`field("size")`, `field("inertia")`
+/// ...): the shape's numbers as an obstacle's (a box's edges, a cylinder's radius and length
+/// > 0, a capsule's length >= 0, a mesh loaded); `hollow` only for a sphere (a thin shell); a
+/// given tensor (checkInertiaTensor, its entries `inertia.ixx` ...); and for a movable body
+/// without a tensor, the uniform solid's mass properties (a mesh whose hull has no volume, a
+/// body whose moments are beyond the range of double).
+Status checkBodyShape(const BodySpec& body, const std::function<std::string(const char*)>& field);
+
+/// The body's mass properties in its own frame: the uniform solid of its shape
+/// (uniformMassProperties; a mesh's centre of mass is its hull's centroid), or with a given
+/// tensor, the shape's volume, the tensor, and the centre of mass at the body's origin. For a
+/// movable body (finite mass) of nonzero size that checkBodyShape accepted.
+Expected<MassProperties> bodyMassProperties(const BodySpec& body, const std::string& field);
+
+/// For now (issue 42: the model moves spheres only), the first body that is not a sphere, or a
+/// sphere given a tensor, is refused, naming its `shape` (or `inertia`) key under `prefix` and
+/// the body: "not yet: only spheres move".
+Status checkOnlySpheresMove(const Scene& scene, const std::string& prefix);
+
+}  // namespace collision_response::core
