@@ -176,7 +176,9 @@ class RecordingResult {
 /// The bounces of one body's recording off `options.planes`, and the coefficients they give.
 ///
 /// Bounces are found where the speed towards a plane reverses (a line fitted to the height over
-/// the plane on 4 samples each side falls faster than min_bounce_speed before, rises after). The
+/// the plane on 4 samples each side falls faster than min_bounce_speed before, rises after) near
+/// the plane (the lowest sample within 1.5 samples' travel and 4 times the noise, estimated from
+/// the positions' second differences, of it: not the noise at a flight's top). The
 /// whole recording is then one least-squares fit (Levenberg-Marquardt, Jacobian by central
 /// differences) of a piecewise motion: the state at the first sample, flown with the scene's
 /// model (parabolas, motion.h; with drag the core's AirFlight) to where it meets the first

@@ -307,10 +307,32 @@ struct FoundBounce {
 };
 
 /// Bounces: the speed towards a plane reversing (calibration.h), one per window.
+/// The tracker's noise (m, each coordinate) before any fit: the median absolute second
+/// difference of the positions over evenly spaced triples, gravity's g dt^2 taken out, as a
+/// normal distribution's standard deviation (1.4826 median |d|; d = p+ - 2 p + p- has 6 sigma^2).
+/// A few bounces among the triples do not move a median.
+double noiseBeforeTheFit(const std::vector<TrackedSample>& samples,
+                         const Eigen::Vector3d& gravity) {
+  std::vector<double> second;
+  for (std::size_t k = 1; k + 1 < samples.size(); ++k) {
+    const double before = samples[k].time - samples[k - 1].time;
+    const double after = samples[k + 1].time - samples[k].time;
+    if (std::abs(before - after) > 0.01 * std::max(before, after)) continue;
+    const Eigen::Vector3d d = samples[k + 1].position - 2.0 * samples[k].position +
+                              samples[k - 1].position - (before * after) * gravity;
+    for (int i = 0; i < 3; ++i) second.push_back(std::abs(d[i]));
+  }
+  if (second.empty()) return 0.0;
+  std::nth_element(second.begin(), second.begin() + static_cast<std::ptrdiff_t>(second.size() / 2),
+                   second.end());
+  return 1.4826 * second[second.size() / 2] / std::sqrt(6.0);
+}
+
 std::vector<FoundBounce> findBounces(const std::vector<TrackedSample>& samples,
                                      const CalibrationOptions& options) {
   std::vector<FoundBounce> found;
   const std::size_t n = samples.size();
+  const double noise = noiseBeforeTheFit(samples, options.gravity);
   std::vector<double> t(n);
   for (std::size_t k = 0; k < n; ++k) t[k] = samples[k].time;
   for (std::size_t i = 0; i < options.planes.size(); ++i) {
@@ -325,8 +347,12 @@ std::vector<FoundBounce> findBounces(const std::vector<TrackedSample>& samples,
       if (h[k] != lowest) continue;
       const double before = slope(t, h, k - kWindow, k);
       const double after = slope(t, h, k, k + kWindow);
+      // At a bounce the sample nearest the plane is within a sample's travel of it (and the
+      // noise): a reversal far from the plane is the noise at a flight's top.
+      const double spacing = std::max(t[k] - t[k - 1], t[k + 1] - t[k]);
+      const double near = 1.5 * std::max(-before, after) * spacing + 4.0 * noise + 1e-3;
       if (before < -options.min_bounce_speed && after > 0.0 &&
-          after - before > 2.0 * options.min_bounce_speed) {
+          after - before > 2.0 * options.min_bounce_speed && h[k] <= near) {
         found.push_back(FoundBounce{k, i, h[k]});
       }
     }
@@ -517,12 +543,14 @@ RecordingResult<Calibration> run(const std::vector<TrackedSample>& recorded,
     if (used < found.size()) {
       end = found[used].sample - 1;
     } else {
+      // A top is one well above the noise (a noisy sample just after the bounce is none).
       const Plane& plane = options.planes[found[used - 1].plane];
+      const double noise = noiseBeforeTheFit(all_samples, options.gravity);
       double top = -kInf;
       for (std::size_t k = found[used - 1].sample + 1; k < all_samples.size(); ++k) {
         const double h = height(plane, options.radius, all_samples[k].position);
         top = std::max(top, h);
-        if (h < 0.5 * top && plane.normal.dot(options.gravity) < 0.0) {
+        if (top > 10.0 * noise && h < 0.5 * top && plane.normal.dot(options.gravity) < 0.0) {
           end = k;
           break;
         }
