@@ -1,6 +1,8 @@
 // The effective mass of a contact (solver/effective_mass.h): K against closed forms for a box
 // struck at a corner and for spheres, K J as the velocity change it stands for, and its normal
-// entry for spheres the normal inverse mass w_a + w_b of the ball solvers to the bit.
+// entry for spheres the normal inverse mass w_a + w_b of the ball solvers to the bit; the turn,
+// the slip and the tangential inverse mass of solver bodies (solver/impulse_response.h): a
+// ball's as its formulas, a body with a tensor as the closed form of a box.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,6 +11,7 @@
 
 #include "collision_response/core/friction.h"
 #include "solver/effective_mass.h"
+#include "solver/impulse_response.h"
 
 namespace collision_response::core {
 namespace {
@@ -122,6 +125,94 @@ TEST(EffectiveMass, SpheresNormalEntryIsTheSumOfInverseMassesToTheBit) {
     ++tested;
   }
   EXPECT_GT(tested, 90000);
+}
+
+// A ball's turn, slip and tangential inverse mass (impulse_response.h) are the formulas the ball
+// solvers wrote out before they shared them, to the bit (written out here again): random balls,
+// solid and hollow, immovable and points, with spin and without, in double and long double.
+TEST(ImpulseResponse, ABallsTurnSlipAndTangentialInverseMassAreItsFormulasToTheBit) {
+  std::mt19937_64 random(11);
+  std::uniform_real_distribution<double> exponent(-6.0, 6.0), radius_exponent(-4.0, 1.0),
+      unit(-1.0, 1.0);
+  std::uniform_int_distribution<int> choice(0, 7);
+  const auto vector = [&] { return V(unit(random), unit(random), unit(random)); };
+  const auto ball = [&] {
+    const int kind = choice(random);
+    SolverBody s;
+    s.inverse_mass = kind == 0 ? 0.0 : 1.0 / std::pow(10.0, exponent(random));
+    s.radius = kind == 1 ? 0.0 : std::pow(10.0, radius_exponent(random));
+    const Inertia inertia = kind % 2 ? Inertia::kSolid : Inertia::kHollow;
+    s.spin_factor = kind == 2 ? 0.0 : spinFactor(s.inverse_mass, s.radius, inertia);
+    s.velocity = vector();
+    s.angular_velocity = 10 * vector();
+    return s;
+  };
+  for (int trial = 0; trial < 10000; ++trial) {
+    const SolverBody a = ball(), b = ball();
+    ContactPoint contact;
+    contact.normal = vector().normalized();
+    const V& n = contact.normal;
+    contact.lever_a = a.radius * n;
+    contact.lever_b = -b.radius * n;
+    V slip = b.velocity - a.velocity;
+    slip += b.angular_velocity.cross(-b.radius * n) - a.angular_velocity.cross(a.radius * n);
+    ASSERT_EQ(slipAt<true>(a, b, contact), V(slip - slip.dot(n) * n)) << trial;
+    const V still = b.velocity - a.velocity;
+    ASSERT_EQ(slipAt<false>(a, b, contact), V(still - still.dot(n) * n)) << trial;
+    const auto unused = [] { return V(V::Constant(NAN)); };  // a ball's needs no direction
+    ASSERT_EQ(tangentialInverseMass<true>(a, b, contact, unused),
+              (a.inverse_mass + b.inverse_mass) +
+                  (a.inverse_mass * a.spin_factor + b.inverse_mass * b.spin_factor))
+        << trial;
+    ASSERT_EQ(tangentialInverseMass<false>(a, b, contact, unused), a.inverse_mass + b.inverse_mass);
+    const V impulse = vector();
+    for (const SolverBody& body : {a, b}) {
+      ASSERT_EQ(turns(body), body.spin_factor != 0.0 && body.radius > 0.0);
+      if (!turns(body)) continue;
+      const double factor = body.inverse_mass * body.spin_factor / body.radius;
+      ASSERT_EQ(turnOf<double>(body, n, V::Zero(), impulse), V(factor * n.cross(impulse)));
+      using W = Eigen::Matrix<long double, 3, 1>;
+      const W wide_n = n.cast<long double>(), wide_impulse = impulse.cast<long double>();
+      const long double wide_factor = static_cast<long double>(body.inverse_mass) *
+                                      static_cast<long double>(body.spin_factor) /
+                                      static_cast<long double>(body.radius);
+      ASSERT_EQ(turnOf<long double>(body, W(-wide_n), V::Zero(), wide_impulse),
+                W(wide_factor * (-wide_n).cross(wide_impulse)));
+    }
+  }
+}
+
+// A box given by its tensor (kTensor): the box of BoxStruckAtACornerAsItsClosedForm, w = 1/3,
+// I^-1 = diag(64/17, 16/5, 64/5), its corner r = (0.25, -0.125, 0.5) on an immovable floor
+// (side a, normal +z into the box). An impulse J = (0, 0, 1) there turns it by I^-1 (r x J) =
+// I^-1 (-1/8, -1/4, 0) = (-8/17, -4/5, 0); moving at v = (1, 0, 0), w = (0, 0, 2), its corner
+// slips at v + w x r = (1 + 1/4, 1/2, 0); along x its tangential inverse mass is K_xx = 4/3, along
+// y 529/255 (the closed form's entries).
+TEST(ImpulseResponse, ABoxGivenByItsTensorTurnsAndSlipsAsItsClosedForm) {
+  SolverBody floor;
+  SolverBody box;
+  box.inverse_mass = 1.0 / 3.0;
+  box.inertia_kind = InverseInertiaKind::kTensor;
+  box.inverse_inertia = V(64.0 / 17.0, 16.0 / 5.0, 64.0 / 5.0).asDiagonal();
+  box.velocity = V(1, 0, 0);
+  box.angular_velocity = V(0, 0, 2);
+  ContactPoint contact;
+  contact.normal = V::UnitZ();
+  contact.lever_b = V(0.25, -0.125, 0.5);
+  ASSERT_TRUE(turns(box));
+  ASSERT_FALSE(turns(floor));
+  const V turn = turnOf<double>(box, V(-contact.normal), contact.lever_b, V::UnitZ());
+  EXPECT_NEAR(turn.x(), -8.0 / 17.0, 2 * kEps);
+  EXPECT_NEAR(turn.y(), -4.0 / 5.0, 2 * kEps);
+  EXPECT_EQ(turn.z(), 0.0);
+  EXPECT_EQ(slipAt<true>(floor, box, contact), V(1.25, 0.5, 0));
+  EXPECT_EQ(slipAt<false>(floor, box, contact), V(1, 0, 0));
+  EXPECT_NEAR(tangentialInverseMass<true>(floor, box, contact, [] { return V(V::UnitX()); }),
+              4.0 / 3.0, 4 * kEps);
+  EXPECT_NEAR(tangentialInverseMass<true>(floor, box, contact, [] { return V(V::UnitY()); }),
+              529.0 / 255.0, 8 * kEps);
+  EXPECT_EQ(tangentialInverseMass<false>(floor, box, contact, [] { return V(V::UnitY()); }),
+            1.0 / 3.0);
 }
 
 }  // namespace

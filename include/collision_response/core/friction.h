@@ -36,7 +36,8 @@ struct FrictionOutcome {
 /// The slip is the tangential velocity of b's surface relative to a's at the contact point
 /// (p_a + r_a n = p_b - r_b n): u = (v_b + w_b x (-r_b n)) - (v_a + w_a x (r_a n)),
 /// u_t = u - (u.n) n. Stopping it takes J_stick = |u_t| / W_t, with the tangential inverse mass
-/// W_t = w_a + w_b + r_a^2 / I_a + r_b^2 / I_b, where r^2 / I = w / k for a sphere. The impulse
+/// W_t = w_a + w_b + r_a^2 / I_a + r_b^2 / I_b, where r^2 / I = w / k for a sphere (for a body
+/// with an inertia tensor, t.K.t of its effective mass along the slip's direction t). The impulse
 /// is J_t = min(J_stick, mu J_n): the contact sticks when the bound allows, slides otherwise. It
 /// never exceeds mu J_n and never reverses the slip (J_t <= J_stick), so the work it does,
 /// J_t (2 |u_t| - J_t W_t) / 2, is >= 0: friction never adds energy.
@@ -45,44 +46,8 @@ struct FrictionOutcome {
 /// moment (a ball with topspin kicks forward); without it bodies do not turn (no rotational
 /// terms, angular velocities untouched).
 template <bool kSpin>
-FrictionOutcome applyFriction(ClusterBody& a, ClusterBody& b, const Eigen::Vector3d& normal,
-                              double friction, double normal_impulse) {
-  FrictionOutcome outcome;
-  Eigen::Vector3d slip = b.velocity - a.velocity;
-  double tangential_inverse_mass = a.inverse_mass + b.inverse_mass;
-  if constexpr (kSpin) {
-    slip +=
-        b.angular_velocity.cross(-b.radius * normal) - a.angular_velocity.cross(a.radius * normal);
-    tangential_inverse_mass += a.inverse_mass * a.spin_factor + b.inverse_mass * b.spin_factor;
-  }
-  const Eigen::Vector3d tangential = slip - slip.dot(normal) * normal;
-  const double slip_speed = tangential.norm();
-  if (!(slip_speed > 0) || !(tangential_inverse_mass > 0) || !(normal_impulse > 0)) {
-    return outcome;
-  }
-  const Eigen::Vector3d direction = tangential / slip_speed;
-  const double sticking_impulse = slip_speed / tangential_inverse_mass;
-  const double bound = friction * normal_impulse;
-  outcome.sticking = sticking_impulse <= bound;
-  outcome.impulse = std::min(sticking_impulse, bound);
-  const Eigen::Vector3d impulse_on_a = outcome.impulse * direction;  // b gets -impulse_on_a
-  a.velocity += a.inverse_mass * impulse_on_a;
-  b.velocity -= b.inverse_mass * impulse_on_a;
-  if constexpr (kSpin) {
-    // dw = (1/I) (r n x J) = ((w/k) J / r) (n x t): the velocity change w J first, then / r.
-    if (a.spin_factor != 0.0) {
-      a.angular_velocity +=
-          (a.inverse_mass * outcome.impulse) * a.spin_factor / a.radius * normal.cross(direction);
-    }
-    if (b.spin_factor != 0.0) {
-      b.angular_velocity +=
-          (b.inverse_mass * outcome.impulse) * b.spin_factor / b.radius * normal.cross(direction);
-    }
-  }
-  outcome.energy_lost =
-      0.5 * outcome.impulse * (2 * slip_speed - outcome.impulse * tangential_inverse_mass);
-  return outcome;
-}
+FrictionOutcome applyFriction(ClusterBody& a, ClusterBody& b, const ContactPoint& contact,
+                              double friction, double normal_impulse);
 
 /// What applyFriction needs of one contact of a cluster besides the bodies.
 struct FrictionContact {

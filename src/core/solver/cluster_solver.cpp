@@ -2,8 +2,54 @@
 
 #include "collision_response/core/impact.h"
 #include "solver/friction_impulses.h"
+#include "solver/impulse_response.h"
 
 namespace collision_response::core {
+
+template <bool kSpin>
+FrictionOutcome applyFriction(ClusterBody& a, ClusterBody& b, const ContactPoint& contact,
+                              double friction, double normal_impulse) {
+  FrictionOutcome outcome;
+  const Eigen::Vector3d& normal = contact.normal;
+  const Eigen::Vector3d tangential = slipAt<kSpin>(a, b, contact);
+  const double slip_speed = tangential.norm();
+  if (!(slip_speed > 0) || !(normal_impulse > 0)) return outcome;
+  const Eigen::Vector3d direction = tangential / slip_speed;
+  const double tangential_inverse_mass =
+      tangentialInverseMass<kSpin>(a, b, contact, [&] { return direction; });
+  if (!(tangential_inverse_mass > 0)) return outcome;
+  const double sticking_impulse = slip_speed / tangential_inverse_mass;
+  const double bound = friction * normal_impulse;
+  outcome.sticking = sticking_impulse <= bound;
+  outcome.impulse = std::min(sticking_impulse, bound);
+  const Eigen::Vector3d impulse_on_a = outcome.impulse * direction;  // b gets -impulse_on_a
+  a.velocity += a.inverse_mass * impulse_on_a;
+  b.velocity -= b.inverse_mass * impulse_on_a;
+  if constexpr (kSpin) {
+    // A ball: dw = (1/I) (r n x J) = ((w/k) J / r) (n x t), the velocity change w J first, then
+    // / r (on both sides: b's -J t acts at -r_b n); a body with a tensor: turnOf.
+    const auto turn = [&](ClusterBody& body, const Eigen::Vector3d& outward,
+                          const Eigen::Vector3d& lever, const Eigen::Vector3d& impulse) {
+      if (!turns(body)) return;
+      if (body.inertia_kind == InverseInertiaKind::kIsotropic) {
+        body.angular_velocity += (body.inverse_mass * outcome.impulse) * body.spin_factor /
+                                 body.radius * normal.cross(direction);
+      } else {
+        body.angular_velocity += turnOf<double>(body, outward, lever, impulse);
+      }
+    };
+    turn(a, normal, contact.lever_a, impulse_on_a);
+    turn(b, -normal, contact.lever_b, -impulse_on_a);
+  }
+  outcome.energy_lost =
+      0.5 * outcome.impulse * (2 * slip_speed - outcome.impulse * tangential_inverse_mass);
+  return outcome;
+}
+
+template FrictionOutcome applyFriction<true>(ClusterBody&, ClusterBody&, const ContactPoint&,
+                                             double, double);
+template FrictionOutcome applyFriction<false>(ClusterBody&, ClusterBody&, const ContactPoint&,
+                                              double, double);
 
 ContactResolution solveContact(ClusterBody& a, ClusterBody& b, const ClusterContact& contact,
                                double friction, const FrictionModel& friction_model) {
@@ -15,8 +61,7 @@ ContactResolution solveContact(ClusterBody& a, ClusterBody& b, const ClusterCont
   resolution.normal =
       ContactOutcome{response.normal_impulse, response.approach_speed, response.energy_lost};
   if (friction_model) {
-    resolution.friction =
-        friction_model.contact(a, b, contact.normal, friction, response.normal_impulse);
+    resolution.friction = friction_model.contact(a, b, contact, friction, response.normal_impulse);
   }
   return resolution;
 }
@@ -66,9 +111,11 @@ void applyFrictionJointly(std::vector<ClusterBody>& bodies,
       const ClusterBody& body = bodies[index];
       if (body.inverse_mass == 0.0) continue;
       velocity.add(index, sign * (body.inverse_mass * impulse));
-      if (kSpin && body.spin_factor != 0.0) {
-        angular.add(
-            index, -((body.inverse_mass * body.spin_factor / body.radius) * normal.cross(impulse)));
+      if (kSpin && turns(body)) {
+        // T on b at r_b, -T on a at r_a: -(I^-1 (r' x T)), r' = r_a and -r_b along n.
+        const Eigen::Vector3d lever =
+            sign < 0 ? contacts[k].lever_a : Eigen::Vector3d(-contacts[k].lever_b);
+        angular.add(index, -turnOf<double>(body, normal, lever, impulse));
       }
     }
   }

@@ -26,7 +26,7 @@ using ClusterFrictionStep = void (*)(std::vector<ClusterBody>&, const std::vecto
                                      std::vector<FrictionOutcome>&, WorkBound* work);
 
 struct FrictionModel {
-  FrictionOutcome (*contact)(ClusterBody& a, ClusterBody& b, const Eigen::Vector3d& normal,
+  FrictionOutcome (*contact)(ClusterBody& a, ClusterBody& b, const ContactPoint& contact,
                              double friction, double normal_impulse) = nullptr;
   ClusterFrictionStep cluster = nullptr;
   /// A stepped cluster's sub-step: warm-started sweeps (applyFrictionBySweeps).

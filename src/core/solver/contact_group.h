@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "solver/contact_forces.h"
+#include "solver/impulse_response.h"
 
 namespace collision_response::core::contact_group {
 
@@ -87,8 +88,10 @@ class Group {
     V3 acceleration[2] = {V3::Zero(), V3::Zero()};
     V3 angular_acceleration[2] = {V3::Zero(), V3::Zero()};
     const std::size_t moved[2] = {source.a, source.b};
-    accelerate(source.b, force, -normal_[j], acceleration[1], angular_acceleration[1]);
-    accelerate(source.a, -force, normal_[j], acceleration[0], angular_acceleration[0]);
+    accelerate(source.b, force, -normal_[j], source.lever_b, acceleration[1],
+               angular_acceleration[1]);
+    accelerate(source.a, -force, normal_[j], source.lever_a, acceleration[0],
+               angular_acceleration[0]);
     const auto local = [&](std::size_t body, const V3* values) -> V3 {
       if (body == moved[0]) return values[0];
       if (body == moved[1]) return values[1];
@@ -131,8 +134,9 @@ class Group {
     }
     for (std::size_t k = 0; k < contacts_.size(); ++k) {
       const ForceContact& contact = contacts_[k];
-      push(r, contact.b, forces[k], -normal_[k]);  // b's contact point: -r_b n from its centre
-      push(r, contact.a, -forces[k], normal_[k]);  // a's: +r_a n
+      // b's contact point: -r_b n from its centre (a ball's), a's: +r_a n.
+      push(r, contact.b, forces[k], -normal_[k], contact.lever_b);
+      push(r, contact.a, -forces[k], normal_[k], contact.lever_a);
     }
     r.gap_acceleration.resize(contacts_.size());
     r.slip_acceleration.resize(contacts_.size());
@@ -154,28 +158,26 @@ class Group {
   }
 
  private:
-  /// Force `force` on body `i` at its contact point, r `lever` from its centre (lever +n for a,
-  /// -n for b).
-  void push(Response& r, std::size_t i, const V3& force, const V3& lever) const {
-    pushAt(r, i, i, force, lever);
+  /// Force `force` on body `i` at its contact point, `arm` from its centre (its lever arm; a
+  /// ball's is r `outward`, outward +n for a, -n for b).
+  void push(Response& r, std::size_t i, const V3& force, const V3& outward,
+            const Eigen::Vector3d& arm) const {
+    pushAt(r, i, i, force, outward, arm);
   }
   /// push() into slot `slot` of `r` for body `i`.
-  void pushAt(Response& r, std::size_t slot, std::size_t i, const V3& force,
-              const V3& lever) const {
-    accelerate(i, force, lever, r.acceleration[slot], r.angular_acceleration[slot]);
+  void pushAt(Response& r, std::size_t slot, std::size_t i, const V3& force, const V3& outward,
+              const Eigen::Vector3d& arm) const {
+    accelerate(i, force, outward, arm, r.acceleration[slot], r.angular_acceleration[slot]);
   }
-  /// What `force` at `lever` adds to body `i`'s accelerations.
-  void accelerate(std::size_t i, const V3& force, const V3& lever, V3& acceleration,
-                  V3& angular_acceleration) const {
+  /// What `force` at its contact point (`outward`, `arm`: push()) adds to body `i`'s
+  /// accelerations: w F, and the moment arm x F over I (turnOf; for a ball r outward x F times
+  /// 1/I = w / (k r^2)).
+  void accelerate(std::size_t i, const V3& force, const V3& outward, const Eigen::Vector3d& arm,
+                  V3& acceleration, V3& angular_acceleration) const {
     const ForceBody& body = bodies_[i];
     if (body.inverse_mass == 0.0) return;
     acceleration += Real(body.inverse_mass) * force;
-    if (body.spin_factor != 0.0 && body.radius > 0.0) {
-      // Moment r lever x F about the centre; angular acceleration moment / I, 1/I = w / (k r^2).
-      angular_acceleration +=
-          (Real(body.inverse_mass) * Real(body.spin_factor) / Real(body.radius)) *
-          lever.cross(force);
-    }
+    if (turns(body)) angular_acceleration += turnOf<Real>(body, outward, arm, force);
   }
 
   const std::vector<ForceBody>& bodies_;

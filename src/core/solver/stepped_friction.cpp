@@ -4,24 +4,21 @@
 #include <algorithm>
 #include <cmath>
 
+#include "solver/impulse_response.h"
+
 namespace collision_response::core {
 namespace {
 
-/// b's surface relative to a's at the contact, perpendicular to the normal: the slip (friction.h).
+/// b's surface relative to a's at the contact, perpendicular to the normal: the slip
+/// (impulse_response.h).
 template <bool kSpin>
 Eigen::Vector3d slipOf(const std::vector<ClusterBody>& bodies, const ClusterContact& contact) {
-  const ClusterBody& a = bodies[contact.a];
-  const ClusterBody& b = bodies[contact.b];
-  Eigen::Vector3d slip = b.velocity - a.velocity;
-  if constexpr (kSpin) {
-    slip += b.angular_velocity.cross(-b.radius * contact.normal) -
-            a.angular_velocity.cross(a.radius * contact.normal);
-  }
-  return slip - slip.dot(contact.normal) * contact.normal;
+  return slipAt<kSpin>(bodies[contact.a], bodies[contact.b], contact);
 }
 
 /// A tangential impulse `impulse` on b (-impulse on a) applied to the bodies: b's velocity by
-/// w_b T, a's by -w_a T, and (kSpin) each turned by -(w / (k r)) n x T (friction.h).
+/// w_b T, a's by -w_a T, and (kSpin) each turned by I^-1 (r_b x T), I^-1 (r_a x -T), which is
+/// -(I^-1 (r' x T)) with r' = r_a and -r_b along n: for a ball -(w / (k r)) n x T (turnOf).
 template <bool kSpin>
 void applyImpulse(std::vector<ClusterBody>& bodies, const ClusterContact& contact,
                   const Eigen::Vector3d& impulse) {
@@ -30,9 +27,10 @@ void applyImpulse(std::vector<ClusterBody>& bodies, const ClusterContact& contac
     if (body.inverse_mass == 0.0) continue;
     body.velocity += sign * (body.inverse_mass * impulse);
     if constexpr (kSpin) {
-      if (body.spin_factor != 0.0) {
-        body.angular_velocity -=
-            (body.inverse_mass * body.spin_factor / body.radius) * contact.normal.cross(impulse);
+      if (turns(body)) {
+        const Eigen::Vector3d lever =
+            sign < 0 ? contact.lever_a : Eigen::Vector3d(-contact.lever_b);
+        body.angular_velocity -= turnOf<double>(body, contact.normal, lever, impulse);
       }
     }
   }
@@ -58,10 +56,11 @@ SweptFrictionReport applyFrictionBySweeps(std::vector<ClusterBody>& bodies,
   // Each contact's D_k (0: it takes no friction).
   std::vector<double> coupling(count, 0.0);
   for (std::size_t k = 0; k < count; ++k) {
-    const ClusterBody& a = bodies[contacts[k].a];
-    const ClusterBody& b = bodies[contacts[k].b];
-    double d = a.inverse_mass + b.inverse_mass;
-    if constexpr (kSpin) d += a.inverse_mass * a.spin_factor + b.inverse_mass * b.spin_factor;
+    // A ball's coupling is the same along every tangent; a shaped body's is not (a 2 x 2 block:
+    // not yet, every stepped body is a ball), here along one of them.
+    const double d =
+        tangentialInverseMass<kSpin>(bodies[contacts[k].a], bodies[contacts[k].b], contacts[k],
+                                     [&] { return contacts[k].normal.unitOrthogonal(); });
     if (frictions[k].bound > 0 && d > 0) coupling[k] = d;
   }
   // The warm start, kept where it removes energy: E(T) = T.(s + s') / 2, s and s' the slips

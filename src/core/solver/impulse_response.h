@@ -1,0 +1,104 @@
+// How a solver body answers an impulse at a contact point, in one place for the solvers of
+// friction at an impact (cluster_solver.cpp), of a cluster's friction (cluster_solver.cpp) and
+// of a stepped sub-step's (stepped_friction.cpp), issue 42's build step 1: the turn an impulse
+// gives a body, the slip at a contact and the tangential inverse mass. A ball (kIsotropic) keeps
+// its formulas word for word, with its radius and the normal, so that its bits do not move; a
+// body with an inertia tensor (kTensor) takes the general ones, with the contact's lever arms.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "collision_response/core/solver_body.h"
+#include "solver/effective_mass.h"
+
+namespace collision_response::core {
+
+/// An impulse turns `body`: a ball with a spin factor (the spin effect, a movable ball of
+/// nonzero radius), a body with a nonzero inverse inertia tensor.
+inline bool turns(const SolverBody& body) {
+  if (body.inertia_kind == InverseInertiaKind::kIsotropic) {
+    return body.spin_factor != 0.0 && body.radius > 0.0;
+  }
+  return !body.inverse_inertia.isZero(0.0);
+}
+
+/// The change of `body`'s angular velocity from `impulse` on it at its contact point:
+/// I^-1 (r x J), r the lever arm `lever`. A ball's r is R `outward` (the unit normal n on side
+/// a, -n on side b) and I^-1 = w / (k R^2) (1/k its spin factor): (w (1/k) / R) (outward x J),
+/// divided by R once, as the solvers of balls always have (`Scalar`: their precision, double or
+/// the contact group's long double). Only for a body that turns (turns()).
+template <class Scalar>
+Eigen::Matrix<Scalar, 3, 1> turnOf(const SolverBody& body,
+                                   const Eigen::Matrix<Scalar, 3, 1>& outward,
+                                   const Eigen::Vector3d& lever,
+                                   const Eigen::Matrix<Scalar, 3, 1>& impulse) {
+  if (body.inertia_kind == InverseInertiaKind::kIsotropic) {
+    return (Scalar(body.inverse_mass) * Scalar(body.spin_factor) / Scalar(body.radius)) *
+           outward.cross(impulse);
+  }
+  return body.inverse_inertia.cast<Scalar>() * lever.cast<Scalar>().cross(impulse);
+}
+
+/// w x r of `body` at its contact point: its surface's velocity there from its turning. A
+/// ball's r is R `outward` (n on side a, -n on side b), the others' their lever arm `lever`.
+inline Eigen::Vector3d turningVelocity(const SolverBody& body, const Eigen::Vector3d& outward,
+                                       const Eigen::Vector3d& lever) {
+  if (body.inertia_kind == InverseInertiaKind::kIsotropic) {
+    return body.angular_velocity.cross(body.radius * outward);
+  }
+  return body.angular_velocity.cross(lever);
+}
+
+/// The slip at `contact`: the velocity of b's surface point relative to a's,
+/// u = (v_b + w_b x r_b) - (v_a + w_a x r_a), less its part along the normal, u - (u.n) n
+/// (friction.h). kSpin false: bodies do not turn (no rotational terms).
+template <bool kSpin>
+Eigen::Vector3d slipAt(const SolverBody& a, const SolverBody& b, const ContactPoint& contact) {
+  const Eigen::Vector3d& normal = contact.normal;
+  Eigen::Vector3d slip = b.velocity - a.velocity;
+  if constexpr (kSpin) {
+    slip +=
+        turningVelocity(b, -normal, contact.lever_b) - turningVelocity(a, normal, contact.lever_a);
+  }
+  return slip - slip.dot(normal) * normal;
+}
+
+/// One side of `contact` as the effective mass sees it (effective_mass.h): a ball's inverse
+/// inertia from its spin factor (sphereInverseInertia), 0 where it does not turn.
+inline ContactSide contactSideOf(const SolverBody& body, const Eigen::Vector3d& lever) {
+  ContactSide side;
+  side.inverse_mass = body.inverse_mass;
+  if (turns(body)) {
+    side.inverse_inertia =
+        body.inertia_kind == InverseInertiaKind::kIsotropic
+            ? sphereInverseInertia(body.inverse_mass, body.spin_factor, body.radius)
+            : body.inverse_inertia;
+  }
+  side.lever_arm = lever;
+  return side;
+}
+
+/// The tangential inverse mass of `contact` along the unit tangent `direction()` (called only
+/// where it is needed): how fast the slip along it answers an impulse along it, t.K.t
+/// (inverseEffectiveMassAlong, effective_mass.h). Two balls: W_t = w_a + w_b + r_a^2 / I_a +
+/// r_b^2 / I_b, where r^2 / I = w / k for a ball, the same along every tangent, summed as
+/// (w_a + w_b) + (w_a / k_a + w_b / k_b) as the ball solvers always have. kSpin false: bodies do
+/// not turn, w_a + w_b.
+template <bool kSpin, class Direction>
+double tangentialInverseMass(const SolverBody& a, const SolverBody& b, const ContactPoint& contact,
+                             Direction&& direction) {
+  double inverse_mass = a.inverse_mass + b.inverse_mass;
+  if constexpr (kSpin) {
+    if (a.inertia_kind == InverseInertiaKind::kIsotropic &&
+        b.inertia_kind == InverseInertiaKind::kIsotropic) {
+      inverse_mass += a.inverse_mass * a.spin_factor + b.inverse_mass * b.spin_factor;
+    } else {
+      inverse_mass = inverseEffectiveMassAlong(contactSideOf(a, contact.lever_a),
+                                               contactSideOf(b, contact.lever_b), direction());
+    }
+  }
+  return inverse_mass;
+}
+
+}  // namespace collision_response::core
