@@ -335,6 +335,49 @@ TEST(MassProperties, PolyhedraOpenOrWoundInwardsAreNamed) {
   expectRefused(polyhedronMassProperties(Polyhedron{}, 1.0, "p"), "p", "no triangles");
 }
 
+// A rigid motion moves the mass, not its distribution: the hull of points on an ellipsoid (an
+// irregular polyhedron of about 300 faces) turned by R keeps its volume, its centre of mass goes
+// to R c and its tensor becomes R I R^T; moved by t, its centre goes to c + t and the rest stays.
+// The points are on a grid of 2^-20 m, so that the shift (1000.5, -250.25, 30) moves them
+// exactly (a rounded shift of 1e-14 m would change a 5 cm body's volume by about 1e-12 of
+// itself); each to 64 ulps of its scale (qhull triangulates the turned points' faces its own
+// way, and the sums run in another order).
+TEST(MassProperties, AHullTurnedOrMovedTurnsOrMovesItsTensor) {
+  std::mt19937 random(5);
+  std::normal_distribution<double> normal;
+  std::vector<V> points;
+  for (int k = 0; k < 300; ++k) {
+    const V direction = V(normal(random), normal(random), normal(random)).normalized();
+    const V point = direction.cwiseProduct(V(0.3, 0.1, 0.05)) + V(0.02, -0.01, 0.03);
+    points.push_back((point * 0x1p20).array().round() * 0x1p-20);
+  }
+  const auto hull = convexHull(points, "points");
+  ASSERT_TRUE(hull.ok()) << hull.error().message();
+  const auto properties = polyhedronMassProperties(*hull, 0.8, "hull");
+  ASSERT_TRUE(properties.ok()) << properties.error().message();
+
+  const M turn = Eigen::AngleAxisd(2.1, V(-1, 3, 0.5).normalized()).toRotationMatrix();
+  const V shift(1000.5, -250.25, 30.0);
+  for (const bool turned : {true, false}) {
+    SCOPED_TRACE(turned ? "turned" : "moved");
+    std::vector<V> moved;
+    for (const V& point : points) moved.push_back(turned ? V(turn * point) : V(point + shift));
+    const auto moved_hull = convexHull(moved, "moved");
+    ASSERT_TRUE(moved_hull.ok()) << moved_hull.error().message();
+    EXPECT_EQ(moved_hull->vertices.size(), hull->vertices.size());
+    const auto moved_properties = polyhedronMassProperties(*moved_hull, 0.8, "hull");
+    ASSERT_TRUE(moved_properties.ok());
+    EXPECT_NEAR(moved_properties->volume, properties->volume, 64 * kEps * properties->volume);
+    const V centre =
+        turned ? V(turn * properties->centre_of_mass) : V(properties->centre_of_mass + shift);
+    EXPECT_NEAR((moved_properties->centre_of_mass - centre).lpNorm<Eigen::Infinity>(), 0.0,
+                64 * kEps * centre.lpNorm<Eigen::Infinity>());
+    expectTensorNear(
+        moved_properties->inertia,
+        turned ? M(turn * properties->inertia * turn.transpose()) : properties->inertia, 64);
+  }
+}
+
 // URDF's convention: the off-diagonal entries are the tensor's, symmetric.
 TEST(InertiaTensorCheck, EntriesAreTheTensorsOwn) {
   InertiaTensor tensor;
