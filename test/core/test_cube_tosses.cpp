@@ -1,7 +1,8 @@
-// Real tracked flights (issue 44): the cube tosses of ../shared/data/cube_tosses (its README: 285
-// tosses of a 10.48 cm acrylic cube onto a table, motion capture at 148 Hz, the ContactNets data
-// set) read where they are, never copied: each toss's flight before its first contact (its lowest
-// corner more than 5 mm above the table's top, z = -0.001 m) fitted with gravity free
+// Real tracked flights (issue 44): 285 tosses of a 10.48 cm acrylic cube onto a table, motion
+// capture at 148 Hz, from the real-world data set of ContactNets (Pfrommer, Halm and Posa, CoRL
+// 2020; DAIRLab/contact-nets, BSD 3-Clause), kept outside the repository and read where they are,
+// never copied (doc/model.md, "Calibration"): each toss's flight before its first contact (its
+// lowest corner more than 5 mm above the table's top, z = -0.001 m) fitted with gravity free
 // (core/calibration.h's fitFlight: the centre of a body in free flight follows a parabola whatever
 // it turns). The folder is COLLISION_RESPONSE_CUBE_TOSSES (environment) or the one beside the
 // project's root; missing, the test is skipped, saying so.
@@ -24,7 +25,7 @@ namespace collision_response::core {
 namespace {
 
 constexpr double kHalfWidth = 0.0524;  // m, the data set's half width of the cube
-constexpr double kTableTop = -0.001;   // m, its README
+constexpr double kTableTop = -0.001;   // m, the table's top in the data set's frame
 constexpr double kClearance = 0.005;   // m: a flight's samples are this far above the table
 
 std::filesystem::path tossFolder() {
