@@ -8,6 +8,7 @@
 #include <optional>
 #include <utility>
 
+#include "collision_response/core/body_shape.h"
 #include "collision_response/core/validation.h"
 #include "collision_response/ros/mesh_resource.h"
 #include "collision_response/ros/parameters.h"
@@ -90,14 +91,55 @@ const KeyTable<PairEntry>& pairKeys() {
   return kKeys;
 }
 
-const KeyTable<BodySpec>& bodyKeys() {
-  static const KeyTable<BodySpec> kKeys = {
+/// `inertia`: `solid` | `hollow`, or the tensor {ixx, iyy, izz, ixy, ixz, iyz} about the centre
+/// of mass in the body's frame (kg m^2, URDF's names; the moments required, the products 0 by
+/// default), checked by validateScene (core::checkBodyShape).
+const KeyTable<core::InertiaTensor>& inertiaTensorKeys() {
+  using core::InertiaTensor;
+  static const KeyTable<InertiaTensor> kKeys = {
+      numberKey<InertiaTensor>(
+          "ixx", [](InertiaTensor& t) -> double& { return t.ixx; }, nullptr, true),
+      numberKey<InertiaTensor>(
+          "iyy", [](InertiaTensor& t) -> double& { return t.iyy; }, nullptr, true),
+      numberKey<InertiaTensor>(
+          "izz", [](InertiaTensor& t) -> double& { return t.izz; }, nullptr, true),
+      numberKey<InertiaTensor>("ixy", [](InertiaTensor& t) -> double& { return t.ixy; }),
+      numberKey<InertiaTensor>("ixz", [](InertiaTensor& t) -> double& { return t.ixz; }),
+      numberKey<InertiaTensor>("iyz", [](InertiaTensor& t) -> double& { return t.iyz; }),
+  };
+  return kKeys;
+}
+
+core::Status readBodyInertia(const XmlRpc::XmlRpcValue& value, const std::string& field,
+                             BodySpec& body) {
+  if (value.getType() == XmlRpc::XmlRpcValue::TypeStruct) {
+    core::InertiaTensor tensor;
+    if (auto status = readKeys(value, inertiaTensorKeys(), field, tensor); !status) return status;
+    body.inertia_tensor = tensor;
+    return core::Ok{};
+  }
+  const auto name = readString(value, field);
+  if (!name) {
+    return core::Error{field,
+                       "must be `solid`, `hollow` or a tensor {ixx, iyy, izz, ixy, ixz, iyz}"};
+  }
+  const auto inertia = core::parseInertia(*name, field);
+  if (!inertia) return inertia.error();
+  body.inertia = *inertia;
+  return core::Ok{};
+}
+
+/// The keys every body has; `shape` was read first, to choose the table.
+KeyTable<BodySpec> commonBodyKeys() {
+  return {
       textKey<BodySpec>(
           "id", [](BodySpec& b) -> std::string& { return b.id; }, nullptr, true),
+      {"shape", false,
+       [](const XmlRpc::XmlRpcValue&, const std::string&, BodySpec&) {
+         return core::Status(core::Ok{});  // read to choose this table
+       }},
       numberKey<BodySpec>(
           "mass", [](BodySpec& b) -> double& { return b.mass; }, core::checkMass, true),
-      numberKey<BodySpec>(
-          "radius", [](BodySpec& b) -> double& { return b.radius; }, core::checkRadius, true),
       textKey<BodySpec>(
           "material", [](BodySpec& b) -> std::string& { return b.material; }, nullptr, true),
       textKey<BodySpec>("topic", [](BodySpec& b) -> std::string& { return b.topic; }),
@@ -109,17 +151,65 @@ const KeyTable<BodySpec>& bodyKeys() {
                           [](BodySpec& b) -> double& { return b.drag_coefficient; }),
       numberKey<BodySpec>("lift_coefficient",
                           [](BodySpec& b) -> double& { return b.lift_coefficient; }),
-      {"inertia", false,
-       [](const XmlRpc::XmlRpcValue& value, const std::string& field, BodySpec& body) {
-         const auto name = readString(value, field);
-         if (!name) return core::Status(name.error());
-         const auto inertia = core::parseInertia(*name, field);
-         if (!inertia) return core::Status(inertia.error());
-         body.inertia = *inertia;
-         return core::Status(core::Ok{});
-       }},
+      {"inertia", false, readBodyInertia},
   };
+}
+
+KeyTable<BodySpec> bodyKeysWith(const KeyTable<BodySpec>& shape_keys) {
+  KeyTable<BodySpec> keys = commonBodyKeys();
+  keys.insert(keys.end(), shape_keys.begin(), shape_keys.end());
+  return keys;
+}
+
+const KeyTable<BodySpec>& sphereBodyKeys() {
+  static const KeyTable<BodySpec> kKeys = bodyKeysWith({numberKey<BodySpec>(
+      "radius", [](BodySpec& b) -> double& { return b.radius; }, core::checkRadius, true)});
   return kKeys;
+}
+
+const KeyTable<BodySpec>& boxBodyKeys() {
+  static const KeyTable<BodySpec> kKeys = bodyKeysWith({vectorKey<BodySpec>(
+      "size", [](BodySpec& b) -> Eigen::Vector3d& { return b.size; }, true)});
+  return kKeys;
+}
+
+/// A cylinder's and a capsule's: radius and length along the body's z.
+const KeyTable<BodySpec>& roundBodyKeys() {
+  static const KeyTable<BodySpec> kKeys =
+      bodyKeysWith({numberKey<BodySpec>(
+                        "radius", [](BodySpec& b) -> double& { return b.radius; }, nullptr, true),
+                    numberKey<BodySpec>(
+                        "length", [](BodySpec& b) -> double& { return b.length; }, nullptr, true)});
+  return kKeys;
+}
+
+/// A mesh body's (the convex hull of its vertices): its resource and scale, as an obstacle's.
+const KeyTable<BodySpec>& meshBodyKeys() {
+  static const KeyTable<BodySpec> kKeys = bodyKeysWith(
+      {{"resource", true,
+        [](const XmlRpc::XmlRpcValue& value, const std::string& field, BodySpec& body) {
+          const auto text = readString(value, field);
+          if (!text) return core::Status(text.error());
+          body.resource = *text;
+          return core::Status(core::Ok{});
+        }},
+       vectorKey<BodySpec>("scale", [](BodySpec& b) -> Eigen::Vector3d& { return b.scale; })});
+  return kKeys;
+}
+
+const KeyTable<BodySpec>& bodyKeysOf(core::BodyShape shape) {
+  switch (shape) {
+    case core::BodyShape::kBox:
+      return boxBodyKeys();
+    case core::BodyShape::kCylinder:
+    case core::BodyShape::kCapsule:
+      return roundBodyKeys();
+    case core::BodyShape::kMesh:
+      return meshBodyKeys();
+    case core::BodyShape::kSphere:
+      break;
+  }
+  return sphereBodyKeys();
 }
 
 /// The keys every obstacle has; `type` was read first, to choose the table.
@@ -398,9 +488,7 @@ core::Status readEffects(const XmlRpc::XmlRpcValue& value, const std::string& fi
 }
 
 core::Status readBodies(const XmlRpc::XmlRpcValue& value, const std::string& field, Scene& scene) {
-  return readList(value, field, scene.bodies,
-                  [](const XmlRpc::XmlRpcValue& entry, const std::string& entry_field,
-                     BodySpec& body) { return readKeys(entry, bodyKeys(), entry_field, body); });
+  return readList(value, field, scene.bodies, readBody);
 }
 
 core::Status readObstacles(const XmlRpc::XmlRpcValue& value, const std::string& field,
@@ -454,6 +542,20 @@ const KeyTable<Scene>& sceneTable() {
 
 }  // namespace
 
+core::Status readBody(const XmlRpc::XmlRpcValue& entry, const std::string& field,
+                      core::BodySpec& body) {
+  if (auto status = checkStruct(entry, field); !status) return status;
+  if (entry.hasMember("shape")) {
+    const std::string shape_field = joinKey(field, "shape");
+    const auto name = readString(entry["shape"], shape_field);
+    if (!name) return name.error();
+    const auto shape = core::parseBodyShape(*name, shape_field);
+    if (!shape) return shape.error();
+    body.shape = *shape;
+  }
+  return readKeys(entry, bodyKeysOf(body.shape), field, body);
+}
+
 UrdfSource parameterServerUrdf(const std::string& field) {
   return [field](const std::string& parameter) -> core::Expected<std::string> {
     std::string xml;
@@ -488,6 +590,17 @@ core::Expected<core::Scene> loadScene(const XmlRpc::XmlRpcValue& value, const st
     obstacle.mesh = *triangles;
     if (warnings) warnings->insert(warnings->end(), left_out.begin(), left_out.end());
   }
+  // A mesh body's triangles, the same way: the body is their convex hull.
+  for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
+    BodySpec& body = scene.bodies[i];
+    if (body.shape != core::BodyShape::kMesh) continue;
+    std::vector<std::string> left_out;
+    auto triangles = loadMeshResource(
+        body.resource, body.scale, indexKey(joinKey(field, "bodies"), i), left_out, max_mesh_bytes);
+    if (!triangles) return triangles.error();
+    body.mesh = *triangles;
+    if (warnings) warnings->insert(warnings->end(), left_out.begin(), left_out.end());
+  }
   if (value.hasMember("robot")) {
     const std::string robot_field = joinKey(field, "robot");
     RobotLinks robot;
@@ -519,7 +632,10 @@ core::Expected<core::Scene> loadScene(const XmlRpc::XmlRpcValue& value, const st
 
 std::map<std::string, std::vector<std::string>> sceneKeys() {
   return {{"scene", keyNames(sceneTable())},
-          {"bodies[]", keyNames(bodyKeys())},
+          {"bodies[] sphere", keyNames(sphereBodyKeys())},
+          {"bodies[] box", keyNames(boxBodyKeys())},
+          {"bodies[] cylinder, capsule", keyNames(roundBodyKeys())},
+          {"bodies[] mesh", keyNames(meshBodyKeys())},
           {"obstacles[] plane", keyNames(planeKeys())},
           {"obstacles[] sphere", keyNames(sphereKeys())},
           {"obstacles[] box", keyNames(boxKeys())},

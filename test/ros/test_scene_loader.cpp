@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <map>
 #include <regex>
@@ -531,7 +532,28 @@ std::map<std::string, std::map<std::string, XmlRpc::XmlRpcValue>> examples() {
                         {"angular_velocity", list3(7, 8, 9)},
                         {"inertia", "hollow"},
                         {"drag_coefficient", 0.5},
-                        {"lift_coefficient", 0.25}};
+                        {"lift_coefficient", 0.25},
+                        {"shape", "sphere"}};
+  XmlRpc::XmlRpcValue tensor;
+  tensor["ixx"] = 1e-3;
+  tensor["iyy"] = 2e-3;
+  tensor["izz"] = 2.5e-3;
+  tensor["ixy"] = 1e-4;
+  for (const char* table : {"bodies[] box", "bodies[] cylinder, capsule", "bodies[] mesh"}) {
+    values[table] = values["bodies[]"];
+    values[table].erase("radius");
+    values[table]["inertia"] = "solid";
+  }
+  values["bodies[] box"]["shape"] = "box";
+  values["bodies[] box"]["size"] = list3(0.1048, 0.1048, 0.1048);
+  values["bodies[] box"]["inertia"] = tensor;
+  values["bodies[] cylinder, capsule"]["shape"] = "cylinder";
+  values["bodies[] cylinder, capsule"]["radius"] = 0.033;
+  values["bodies[] cylinder, capsule"]["length"] = 0.12;
+  values["bodies[] mesh"]["shape"] = "mesh";
+  values["bodies[] mesh"]["resource"] = testMesh("grip.stl");
+  values["bodies[] mesh"]["scale"] = list3(2, 1, 1);
+  values["bodies[] sphere"] = values["bodies[]"];
   values["obstacles[] plane"] = {
       {"id", "floor"},         {"type", "plane"},          {"material", "concrete"},
       {"frame", "floor_link"}, {"normal", list3(0, 0, 2)}, {"offset", 0.5}};
@@ -589,11 +611,11 @@ TEST(SceneKeys, EveryDocumentedKeyIsReadAndEveryReadKeyDocumented) {
   for (const auto& row : tables.front()) {
     ASSERT_FALSE(row.empty()) << "a row of the scene key table names no key";
     auto [entity, key] = entityAndKey(row.front());
-    if (entity == "obstacles[]") {
-      // One row for a key of every obstacle type that has it.
+    if (entity == "obstacles[]" || entity == "bodies[]") {
+      // One row for a key of every obstacle type (body shape) that has it.
       bool in_any = false;
       for (const auto& [table, keys] : read) {
-        if (table.rfind("obstacles[] ", 0) != 0) continue;
+        if (table.rfind(entity + " ", 0) != 0) continue;
         if (std::find(keys.begin(), keys.end(), key) != keys.end()) {
           documented.emplace(table, key);
           in_any = true;
@@ -623,7 +645,8 @@ TEST(SceneKeys, EveryDocumentedKeyLoadsWithItsValue) {
   const auto values = examples();
   const auto read = sceneKeys();
   XmlRpc::XmlRpcValue scene, body, material, pair, frame;
-  std::map<std::string, XmlRpc::XmlRpcValue> obstacles;  // by the loader's table
+  std::map<std::string, XmlRpc::XmlRpcValue> obstacles;      // by the loader's table
+  std::map<std::string, XmlRpc::XmlRpcValue> shaped_bodies;  // by the loader's table
   const auto put = [&](XmlRpc::XmlRpcValue& target, const std::string& entity,
                        const std::string& key) {
     const auto found = values.find(entity);
@@ -635,7 +658,14 @@ TEST(SceneKeys, EveryDocumentedKeyLoadsWithItsValue) {
     const auto [entity, key] = entityAndKey(row.front());
     if (entity == "scene" && kContainers.count(key)) continue;
     if (entity == "scene") put(scene, entity, key);
-    if (entity == "bodies[]") put(body, entity, key);
+    if (entity == "bodies[]") {
+      // The ball takes the sphere's keys; each other shape's table is read on its own below.
+      for (const auto& [table, keys] : read) {
+        if (table.rfind("bodies[] ", 0) != 0) continue;
+        if (std::find(keys.begin(), keys.end(), key) == keys.end()) continue;
+        put(table == "bodies[] sphere" ? body : shaped_bodies[table], table, key);
+      }
+    }
     if (entity == "materials.<name>") put(material, entity, key);
     if (entity == "pairs[]") put(pair, entity, key);
     if (entity == "player.frames[]") put(frame, entity, key);
@@ -694,6 +724,26 @@ TEST(SceneKeys, EveryDocumentedKeyLoadsWithItsValue) {
   EXPECT_EQ(ball.inertia, core::Inertia::kHollow);  // once refused as an unknown key
   EXPECT_EQ(ball.drag_coefficient, 0.5);
   EXPECT_EQ(ball.lift_coefficient, 0.25);
+  EXPECT_EQ(ball.shape, core::BodyShape::kSphere);
+  // The other shapes' keys, each read into its body (a scene with one is refused, "not yet").
+  core::BodySpec block, can, grip_body;
+  ASSERT_TRUE(readBody(shaped_bodies["bodies[] box"], "b", block).ok());
+  EXPECT_EQ(block.shape, core::BodyShape::kBox);
+  EXPECT_EQ(block.size, Eigen::Vector3d(0.1048, 0.1048, 0.1048));
+  ASSERT_TRUE(block.inertia_tensor.has_value());
+  EXPECT_EQ(block.inertia_tensor->ixx, 1e-3);
+  EXPECT_EQ(block.inertia_tensor->iyy, 2e-3);
+  EXPECT_EQ(block.inertia_tensor->izz, 2.5e-3);
+  EXPECT_EQ(block.inertia_tensor->ixy, 1e-4);
+  EXPECT_EQ(block.inertia_tensor->ixz, 0.0);
+  ASSERT_TRUE(readBody(shaped_bodies["bodies[] cylinder, capsule"], "b", can).ok());
+  EXPECT_EQ(can.shape, core::BodyShape::kCylinder);
+  EXPECT_EQ(can.radius, 0.033);
+  EXPECT_EQ(can.length, 0.12);
+  ASSERT_TRUE(readBody(shaped_bodies["bodies[] mesh"], "b", grip_body).ok());
+  EXPECT_EQ(grip_body.shape, core::BodyShape::kMesh);
+  EXPECT_EQ(grip_body.resource, testMesh("grip.stl"));
+  EXPECT_EQ(grip_body.scale, Eigen::Vector3d(2, 1, 1));
   ASSERT_EQ(loaded->obstacles.size(), 5u);
   EXPECT_EQ(loaded->obstacles[0].frame, "floor_link");
   EXPECT_EQ(loaded->obstacles[0].normal, Eigen::Vector3d(0, 0, 1));  // scaled to unit length
@@ -737,6 +787,130 @@ TEST(SceneKeys, EveryDocumentedKeyLoadsWithItsValue) {
   EXPECT_EQ(player->frames[0].parent, "world");
   EXPECT_EQ(player->frames[0].position, Eigen::Vector3d(1, 0, 0));
   EXPECT_EQ(player->frames[0].velocity, Eigen::Vector3d(-0.5, 0, 0));
+}
+
+// Issue 42, build step 2: a body's shape keys. Each bad value is named at its key; a good box,
+// cylinder, capsule or mesh body is read, checked and then refused at load, naming the body, as
+// only spheres move yet (nothing silently becomes a ball).
+TEST(SceneLoader, Issue42_ShapedBodiesAreReadCheckedAndNotYetMoved) {
+  const auto withBody = [](const std::function<void(XmlRpc::XmlRpcValue&)>& shape_it) {
+    XmlRpc::XmlRpcValue scene = fullScene();
+    XmlRpc::XmlRpcValue body;
+    body["id"] = "block";
+    body["mass"] = 0.37;
+    body["material"] = "tennis_ball";
+    shape_it(body);
+    scene["bodies"][2] = body;
+    return scene;
+  };
+  const auto refused = [](const XmlRpc::XmlRpcValue& scene, const std::string& field,
+                          const std::string& words) {
+    const auto loaded = loadScene(scene, "~scene");
+    ASSERT_FALSE(loaded.ok()) << "expected a refusal naming " << field;
+    EXPECT_EQ(loaded.error().field, field) << loaded.error().message();
+    EXPECT_NE(loaded.error().reason.find(words), std::string::npos) << loaded.error().message();
+  };
+  const std::string at = "~scene/bodies[2]/";
+  // Good shapes: read and checked, then "not yet".
+  refused(withBody([](XmlRpc::XmlRpcValue& b) {
+            b["shape"] = "box";
+            b["size"] = list3(0.1, 0.2, 0.3);
+          }),
+          at + "shape", "not yet: only spheres move (body 'block' is a box");
+  refused(withBody([](XmlRpc::XmlRpcValue& b) {
+            b["shape"] = "capsule";
+            b["radius"] = 0.05;
+            b["length"] = 0.0;
+          }),
+          at + "shape", "is a capsule");
+  refused(withBody([](XmlRpc::XmlRpcValue& b) {
+            b["shape"] = "mesh";
+            b["resource"] = testMesh("grip.stl");
+          }),
+          at + "shape", "is a mesh");
+  // A ball given a tensor.
+  refused(withBody([](XmlRpc::XmlRpcValue& b) {
+            b["radius"] = 0.05;
+            b["inertia"]["ixx"] = 1e-3;
+            b["inertia"]["iyy"] = 1e-3;
+            b["inertia"]["izz"] = 1e-3;
+          }),
+          at + "inertia", "not yet");
+  // Bad values, each at its key.
+  refused(withBody([](XmlRpc::XmlRpcValue& b) { b["shape"] = "plane"; }), at + "shape",
+          "unknown body shape 'plane'");
+  refused(withBody([](XmlRpc::XmlRpcValue& b) { b["shape"] = "box"; }), at + "size", "is required");
+  refused(withBody([](XmlRpc::XmlRpcValue& b) {
+            b["shape"] = "box";
+            b["size"] = list3(0.1, 0.0, 0.3);
+          }),
+          at + "size", "> 0");
+  refused(withBody([](XmlRpc::XmlRpcValue& b) {
+            b["shape"] = "box";
+            b["size"] = list3(0.1, 0.1, 0.1);
+            b["radius"] = 0.05;
+          }),
+          at + "radius", "");  // not a box's key
+  refused(withBody([](XmlRpc::XmlRpcValue& b) {
+            b["shape"] = "cylinder";
+            b["radius"] = 0.05;
+          }),
+          at + "length", "is required");
+  refused(withBody([](XmlRpc::XmlRpcValue& b) {
+            b["shape"] = "cylinder";
+            b["radius"] = -0.05;
+            b["length"] = 0.1;
+          }),
+          at + "radius", "");
+  refused(withBody([](XmlRpc::XmlRpcValue& b) {
+            b["shape"] = "mesh";
+            b["resource"] = testMesh("no_such_file.stl");
+          }),
+          at + "resource", "no_such_file.stl");
+  refused(withBody([](XmlRpc::XmlRpcValue& b) {
+            b["shape"] = "box";
+            b["size"] = list3(0.1, 0.1, 0.1);
+            b["inertia"] = "hollow";
+          }),
+          at + "inertia", "`hollow` is a sphere's");
+  refused(withBody([](XmlRpc::XmlRpcValue& b) {
+            b["shape"] = "box";
+            b["size"] = list3(0.1, 0.1, 0.1);
+            b["inertia"]["ixx"] = 1.0;
+            b["inertia"]["iyy"] = 1.0;
+          }),
+          at + "inertia/izz", "is required");
+  refused(withBody([](XmlRpc::XmlRpcValue& b) {
+            b["shape"] = "box";
+            b["size"] = list3(0.1, 0.1, 0.1);
+            b["inertia"]["ixx"] = 1.0;
+            b["inertia"]["iyy"] = 1.0;
+            b["inertia"]["izz"] = 3.0;
+          }),
+          at + "inertia", "triangle inequality");
+  refused(withBody([](XmlRpc::XmlRpcValue& b) {
+            b["shape"] = "box";
+            b["size"] = list3(0.1, 0.1, 0.1);
+            b["inertia"]["ixx"] = 1.0;
+            b["inertia"]["iyy"] = 1.0;
+            b["inertia"]["izz"] = 1.0;
+            b["inertia"]["ixy"] = 1.5;
+          }),
+          at + "inertia.ixy", "not positive definite");
+  refused(withBody([](XmlRpc::XmlRpcValue& b) {
+            b["shape"] = "box";
+            b["size"] = list3(0.1, 0.1, 0.1);
+            b["inertia"]["ixx"] = 1.0;
+            b["inertia"]["iyy"] = 1.0;
+            b["inertia"]["izz"] = 1.0;
+            b["inertia"]["density"] = 3.0;
+          }),
+          at + "inertia/density", "");
+  refused(withBody([](XmlRpc::XmlRpcValue& b) {
+            b["radius"] = 0.05;
+            b["inertia"] = 7.0;
+          }),
+          at + "inertia", "a tensor");
 }
 
 // Issue 13, item 7: a plane normal "of any length" is one, also 1e-200 and 1e200 long (where

@@ -30,11 +30,18 @@ core::Expected<core::Scene> loadScene(const XmlRpc::XmlRpcValue& scene, const st
                                       const UrdfSource& urdf = nullptr,
                                       std::vector<std::string>* warnings = nullptr);
 
+/// One entry of `bodies` (`field`: ".../bodies[2]"), its keys read into `body` by its `shape`'s
+/// table (sphere by default), before any check across keys or of its mesh (loadScene loads a
+/// mesh body's triangles from its `resource` and validates the scene).
+core::Status readBody(const XmlRpc::XmlRpcValue& entry, const std::string& field,
+                      core::BodySpec& body);
+
 /// The URDF from the parameter server (a name relative to the node's namespace); an error names
 /// `field`/robot/description.
 UrdfSource parameterServerUrdf(const std::string& field);
 
-/// The keys loadScene reads, by entity, as the README's tables name them: "scene", "bodies[]",
+/// The keys loadScene reads, by entity, as the README's tables name them: "scene", "bodies[]
+/// sphere", "bodies[] box", "bodies[] cylinder, capsule", "bodies[] mesh",
 /// "obstacles[] plane", "obstacles[] sphere", "obstacles[] box", "obstacles[] cylinder, capsule",
 /// "obstacles[] mesh", "materials.<name>", "pairs[]", "robot". These are the key tables the loader
 /// reads and checks with: a key is accepted exactly when it is listed here.
