@@ -21,7 +21,7 @@
 namespace collision_response::core {
 
 /// A symmetric inertia tensor by its six entries, kg m^2, about the centre of mass in the body's
-/// frame, named as URDF's <inertia> names them (the off-diagonal entries are the tensor's).
+/// frame, named as URDF's `inertia` element names them (the off-diagonal entries are the tensor's).
 struct InertiaTensor {
   double ixx = 0.0, iyy = 0.0, izz = 0.0;
   double ixy = 0.0, ixz = 0.0, iyz = 0.0;
