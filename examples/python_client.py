@@ -39,7 +39,8 @@ def estimate_restitution(drop_height, bounce_height, node=NODE, timeout=10.0):
     """Calls ~estimate_restitution: e = sqrt(bounce / drop) and the nearest seed material."""
     name = node + "/estimate_restitution"
     rospy.wait_for_service(name, timeout)
-    return rospy.ServiceProxy(name, EstimateRestitution)(drop_height, bounce_height)
+    return rospy.ServiceProxy(name, EstimateRestitution)(drop_height=drop_height,
+                                                           bounce_height=bounce_height)
 
 
 def listen_to_impacts(seconds, topic="impacts"):

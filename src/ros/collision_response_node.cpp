@@ -197,7 +197,8 @@ void CollisionResponseNode::logScene(const core::Scene& scene, const MonitorPara
                   << params.clock_jump_back << " s, future_stamp_tolerance "
                   << params.future_stamp_tolerance << " s, queue_size " << params.queue_size
                   << ", max_states " << params.max_states << ", prediction_cpu_budget "
-                  << params.prediction_cpu_budget << " s");
+                  << params.prediction_cpu_budget << " s, calibration_window "
+                  << params.calibration_window << " s");
 }
 
 void CollisionResponseNode::onReconfigure(MonitorConfig& config, std::uint32_t /*level*/) {
@@ -258,7 +259,16 @@ bool CollisionResponseNode::onComputeCollision(ComputeCollision::Request& reques
 bool CollisionResponseNode::onEstimateRestitution(EstimateRestitution::Request& request,
                                                   EstimateRestitution::Response& response) {
   try {
-    answerEstimateRestitution(request, *materials(), response);
+    if (request.body.empty()) {
+      answerEstimateRestitution(request, *materials(), response);
+    } else if (!monitor_) {
+      response = EstimateRestitution::Response();
+      response.message = "body: '" + request.body +
+                         "': no ~scene loaded, so the node tracks no body (the drop test, body "
+                         "empty, needs none)";
+    } else {
+      monitor_->estimateRestitution(request, response);  // live, from the tracked states
+    }
   } catch (const std::exception& error) {
     response = EstimateRestitution::Response();
     response.message = std::string("internal error: ") + error.what();

@@ -320,6 +320,20 @@ void ImpactMonitorRos::diagnose(diagnostic_updater::DiagnosticStatusWrapper& sta
       update_began_.isZero() ? 0.0 : (ros::WallTime::now() - update_began_).toSec();
   // An update that has run for 1 s turns the summary to WARN.
   diagnostics_.report(status, figures_, waiting, running, 1.0);
+  for (const auto& [pair, text] : restitution_estimates_) {
+    status.add("restitution estimate " + pair, text);
+  }
+}
+
+void ImpactMonitorRos::estimateRestitution(const EstimateRestitution::Request& request,
+                                           EstimateRestitution::Response& response) {
+  std::vector<PairEstimate> pairs;
+  cycle_.liveCalibration().answer(request, response, pairs);
+  if (pairs.empty()) return;
+  std::lock_guard<std::mutex> lock(diagnostics_mutex_);
+  for (const PairEstimate& estimate : pairs) {
+    restitution_estimates_[estimate.pair] = estimate.summary;
+  }
 }
 
 void ImpactMonitorRos::predict(const PredictImpacts::Request& request,

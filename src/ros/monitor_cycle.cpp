@@ -134,7 +134,8 @@ MonitorCycle::MonitorCycle(const core::Scene& scene, const MonitorParams& params
     : params_(params),
       monitor_(scene, core::MonitorSettings{params.contact_tolerance, params.body_timeout}),
       intake_(bodyIds(monitor_), intakeSettings(scene, params)),
-      time_line_(params.clock_jump_back) {
+      time_line_(params.clock_jump_back),
+      live_calibration_(scene, params.calibration_window) {
   frame_jumped_.assign(monitor_.obstacleCount(), 0);
   frame_kind_.reserve(monitor_.obstacleCount());
   for (std::size_t i = 0; i < monitor_.obstacleCount(); ++i) {
@@ -180,6 +181,8 @@ MonitorCycle::Update MonitorCycle::process(const Input& input, const ros::Time& 
   update.stamp = newest;
   update.time = placed.time;
   timeSamples(placed, newest);
+  // The states as received (in the fixed frame, on the line), before the monitor takes them.
+  live_calibration_.window().record(samples_.samples);
   std::vector<core::ImpactRecord> earlier_impacts;
   stepMovingObstacles(placed, newest, tf, earlier_impacts, update);
   placeObstacles(obstacle_motions_, placed.time, update);
@@ -260,6 +263,7 @@ void MonitorCycle::restartTimeLine(const std::string& source, const TimeLine::Pl
            "with --loop? a simulator restarted?): every track is reset and the time line "
            "starts again there"});
   monitor_.reset();
+  live_calibration_.window().clear();
   placed_obstacles_.clear();
   body_clock_.assign(monitor_.bodyCount(), 0);
   body_time_.assign(monitor_.bodyCount(), -std::numeric_limits<double>::infinity());

@@ -78,6 +78,9 @@ const KeyTable<MonitorParams>& MonitorParams::keys() {
       numberKey<P>(
           "prediction_cpu_budget", [](P& p) -> double& { return p.prediction_cpu_budget; },
           checkDurationOrZero),
+      numberKey<P>(
+          "calibration_window", [](P& p) -> double& { return p.calibration_window; },
+          checkDurationOrZero),
   };
   return kKeys;
 }

@@ -54,7 +54,8 @@ std::map<std::string, XmlRpc::XmlRpcValue> nodeExamples() {
           {"detection", "discrete"},
           {"restitution_threshold", 0.1},
           {"restitution_combine", "max"},
-          {"prediction_cpu_budget", 0.25}};
+          {"prediction_cpu_budget", 0.25},
+          {"calibration_window", 2.5}};
 }
 
 std::vector<std::string> documentedNames(const testing::Table& table) {
@@ -75,6 +76,7 @@ TEST(MonitorParams, DefaultsWhenNothingIsSet) {
   EXPECT_EQ(params->max_states, 100000);
   EXPECT_EQ(params->future_stamp_tolerance, 300.0);
   EXPECT_EQ(params->prediction_cpu_budget, 1.0);
+  EXPECT_EQ(params->calibration_window, 10.0);
 }
 
 // "A test fails if any documented parameter is refused": every `~name` of the README's table
@@ -117,6 +119,7 @@ TEST(MonitorParams, EveryDocumentedParameterLoadsAndEveryReadOneIsDocumented) {
   EXPECT_EQ(params->markers.plane_size, 2.0);
   EXPECT_EQ(params->markers.contact_diameter, 0.05);
   EXPECT_EQ(params->diagnostic_period, 0.5);
+  EXPECT_EQ(params->calibration_window, 2.5);
 }
 
 TEST(ScenePlayerParams, EveryDocumentedParameterLoadsAndEveryReadOneIsDocumented) {
@@ -194,7 +197,9 @@ TEST(MonitorParams, ValuesOutOfRangeAreErrors) {
       {"frame_velocity_interval", 0.0},
       {"obstacle_update_period", -0.001},
       {"diagnostic_period", -1.0},
-      {"prediction_cpu_budget", -1.0}};
+      {"prediction_cpu_budget", -1.0},
+      {"calibration_window", -1.0},
+      {"calibration_window", std::numeric_limits<double>::quiet_NaN()}};
   for (const auto& [key, value] : cases) {
     XmlRpc::XmlRpcValue tree;
     tree[key] = value;

@@ -7,8 +7,10 @@
 // time (ImpactMonitorRos::predict: it reads the monitor between two updates, then predicts
 // without it within ~prediction_cpu_budget); and the two collision services on a thread of their
 // own, so that neither a long step nor a prediction delays an answer. The collision services
-// read only the material table, which they take as an immutable snapshot (a shared pointer
-// swapped under a mutex when live tuning changes the combine rule); they never touch the monitor.
+// read the material table, which they take as an immutable snapshot (a shared pointer swapped
+// under a mutex when live tuning changes the combine rule); ~estimate_restitution given a
+// tracked body copies that body's kept states under the window's own mutex and fits them
+// without any (live_calibration.h): it never takes the monitor's.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>

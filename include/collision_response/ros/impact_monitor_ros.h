@@ -15,6 +15,9 @@
 // - ~predict_impacts (CollisionResponseNode) runs on a thread of its own: predict() takes what
 //   the prediction needs of the cycle under monitor_mutex_ (between two updates; quick: no motion
 //   is computed), then predicts without it, within ~prediction_cpu_budget.
+// - estimateRestitution() (~estimate_restitution given a tracked body, on the services' thread)
+//   copies the body's states under the calibration window's own mutex, which an update holds
+//   only to append its input's states (live_calibration.h), and fits them without any lock.
 // - diagnose() is called from the diagnostics' own thread, so that /diagnostics is published
 //   while an update runs: it reads only the counters and the figures copied after each update,
 //   under diagnostics_mutex_, and the queue's length under queue_mutex_.
@@ -29,6 +32,7 @@
 #include <atomic>
 #include <cstdint>
 #include <deque>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -36,6 +40,7 @@
 
 #include "collision_response/BodyState.h"
 #include "collision_response/BodyStateArray.h"
+#include "collision_response/EstimateRestitution.h"
 #include "collision_response/ImpactArray.h"
 #include "collision_response/PredictImpacts.h"
 #include "collision_response/core/scene.h"
@@ -64,6 +69,11 @@ class ImpactMonitorRos {
   /// of the monitor is taken between two updates, the prediction then runs on the caller's
   /// thread within ~prediction_cpu_budget of its CPU time (one cut short is counted).
   void predict(const PredictImpacts::Request& request, PredictImpacts::Response& response);
+  /// ~estimate_restitution for a tracked body (request.body set), from any thread but the
+  /// monitor's: the body's window copied under its own lock, fitted without any
+  /// (LiveCalibration::answer); each pair's estimate kept for /diagnostics.
+  void estimateRestitution(const EstimateRestitution::Request& request,
+                           EstimateRestitution::Response& response);
   /// The monitor's status for /diagnostics: rates, bodies tracked, drops by reason, timing.
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
@@ -139,6 +149,9 @@ class ImpactMonitorRos {
   MonitorDiagnostics diagnostics_;
   MonitorFigures figures_;
   ros::WallTime update_began_;  ///< zero: no update in progress
+  /// The last live estimate of each obstacle pair ("[a, b]" -> its /diagnostics line), from
+  /// ~estimate_restitution's answers (no periodic fit); one a pair of materials: bounded.
+  std::map<std::string, std::string> restitution_estimates_;
   // The intake's own queue and thread; its subscriptions are declared above and shut down (the
   // thread stopped first) in the destructor.
   ros::CallbackQueue intake_queue_;

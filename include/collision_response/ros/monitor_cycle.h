@@ -25,6 +25,7 @@
 #include "collision_response/core/monitor.h"
 #include "collision_response/core/scene.h"
 #include "collision_response/ros/frame_motion.h"
+#include "collision_response/ros/live_calibration.h"
 #include "collision_response/ros/monitor_params.h"
 #include "collision_response/ros/state_intake.h"
 #include "collision_response/ros/time_line.h"
@@ -74,6 +75,9 @@ class MonitorCycle {
   const core::Scene& scene() const { return monitor_.scene(); }
   const TimeLine& timeLine() const { return time_line_; }
   const MonitorParams& params() const { return params_; }
+  /// The tracked bodies' recent states (~calibration_window) and the live fit of them: safe to
+  /// use from any thread without the monitor's lock (live_calibration.h).
+  const LiveCalibration& liveCalibration() const { return live_calibration_; }
   /// Steps taken so far: one per input that had a usable state.
   std::uint64_t steps() const { return steps_; }
   /// Bodies in stepped clusters at the end of the last step (0 before the first).
@@ -194,6 +198,8 @@ class MonitorCycle {
   std::vector<std::int64_t> clock_before_;  ///< body_clock_ before the input's states
   std::uint64_t steps_ = 0;
   std::size_t stepped_bodies_ = 0;
+  /// Each input's timed states are recorded into its window (off: nothing, at no cost).
+  LiveCalibration live_calibration_;
 };
 
 /// The impact message of a monitor's record, its stamp `stamp`; or the error naming the first

@@ -30,6 +30,9 @@ struct MonitorParams {
   MarkerParams markers;            ///< ~marker_rate, ~impact_marker_lifetime, ...
   /// s of the prediction thread's CPU time one ~predict_impacts request may spend (0: no budget)
   double prediction_cpu_budget = 1.0;
+  /// s of stamps of each tracked body's states kept for ~estimate_restitution's live fit
+  /// (live_calibration.h; 0: off, none kept)
+  double calibration_window = 10.0;
 
   /// Every private parameter the node reads: its own above, `scene` (read by loadScene),
   /// `player` (a scene file's part for the scene player, type-checked only) and
