@@ -1,0 +1,332 @@
+#include "geometry/free_rotation.h"
+
+#include <algorithm>
+#include <array>
+#include <boost/math/quadrature/gauss.hpp>
+#include <boost/math/special_functions/ellint_rf.hpp>
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+#include <string>
+
+#include "collision_response/core/validation.h"
+
+namespace collision_response::core {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr int kMaxAgmSteps = 40;
+constexpr double kPieceLength = 0.5;
+
+const char* axisName(int i) { return i == 0 ? "x" : (i == 1 ? "y" : "z"); }
+
+/// The rotation by `angle` about the unit `axis`.
+Eigen::Quaterniond turn(const Eigen::Vector3d& axis, double angle) {
+  return Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis));
+}
+
+/// The least rotation taking e_3 to the unit l, l_3 > -1: (1 + l_3, e_3 x l) normalised.
+Eigen::Quaterniond leastRotationFromZ(const Eigen::Vector3d& l) {
+  Eigen::Quaterniond q(1.0 + l.z(), -l.y(), l.x(), 0.0);
+  q.normalize();
+  return q;
+}
+
+double sign(double x) { return x < 0.0 ? -1.0 : 1.0; }
+
+/// A number to 17 significant digits (it reads back as the same double).
+std::string exact(double x) {
+  std::ostringstream text;
+  text << std::setprecision(17) << x;
+  return text.str();
+}
+
+}  // namespace
+
+JacobiElliptic jacobiElliptic(double u, double m, double m1) {
+  // Abramowitz and Stegun 16.4: a_0 = 1, b_0 = sqrt(m1), c_0 = sqrt(m); a_n, b_n, c_n the
+  // arithmetic and geometric means and half the difference, to c_N = 0; phi_N = 2^N a_N u and
+  // sin(2 phi_{n-1} - phi_n) = (c_n / a_n) sin phi_n; sn = sin phi_0, cn = cos phi_0.
+  std::array<double, kMaxAgmSteps + 1> a{};
+  std::array<double, kMaxAgmSteps + 1> c{};
+  a[0] = 1.0;
+  double b = std::sqrt(m1);
+  c[0] = std::sqrt(m);
+  int n = 0;
+  while (n < kMaxAgmSteps &&
+         c[static_cast<std::size_t>(n)] >
+             std::numeric_limits<double>::epsilon() * a[static_cast<std::size_t>(n)]) {
+    const auto i = static_cast<std::size_t>(n);
+    a[i + 1] = 0.5 * (a[i] + b);
+    c[i + 1] = 0.5 * (a[i] - b);
+    b = std::sqrt(a[i] * b);
+    ++n;
+  }
+  const double quarter = kPi / (2.0 * a[static_cast<std::size_t>(n)]);  // K(m)
+  const double reduced = u - 4.0 * quarter * std::nearbyint(u / (4.0 * quarter));
+  double phi = std::ldexp(a[static_cast<std::size_t>(n)] * reduced, n);
+  for (int k = n; k >= 1; --k) {
+    const auto i = static_cast<std::size_t>(k);
+    phi = 0.5 * (phi + std::asin(c[i] / a[i] * std::sin(phi)));
+  }
+  const double cn = std::cos(phi);
+  return {std::sin(phi), cn, std::sqrt(m1 + m * cn * cn)};
+}
+
+double completeEllipticK(double m1) { return boost::math::ellint_rf(0.0, m1, 1.0); }
+
+double ellipticF(double sine, double cosine, double m1) {
+  if (sine < 0.0) return -ellipticF(-sine, cosine, m1);
+  const double c2 = cosine * cosine;
+  const double first = sine * boost::math::ellint_rf(c2, c2 + m1 * sine * sine, 1.0);
+  return cosine < 0.0 ? 2.0 * completeEllipticK(m1) - first : first;
+}
+
+Expected<FreeRotation> FreeRotation::create(const Eigen::Vector3d& principal_moments,
+                                            const Eigen::Quaterniond& orientation,
+                                            const Eigen::Vector3d& angular_velocity) {
+  for (int i = 0; i < 3; ++i) {
+    const double j = principal_moments[i];
+    if (!std::isfinite(j) || j <= 0.0) {
+      return Error{std::string("principal_moments.") + axisName(i),
+                   "must be finite and > 0, got " + exact(j)};
+    }
+    if (!std::isfinite(angular_velocity[i])) {
+      return Error{std::string("angular_velocity.") + axisName(i),
+                   "must be finite, got " + exact(angular_velocity[i])};
+    }
+  }
+  // The triangle inequality J_i <= J_j + J_k, to checkInertiaTensor's rounding (16 eps of the
+  // sum): a flat body meets it with equality.
+  const double sum = principal_moments.sum();
+  for (int i = 0; i < 3; ++i) {
+    const double others = principal_moments[(i + 1) % 3] + principal_moments[(i + 2) % 3];
+    if (principal_moments[i] > others + 16.0 * std::numeric_limits<double>::epsilon() * sum) {
+      return Error{std::string("principal_moments.") + axisName(i),
+                   "breaks the triangle inequality: " + exact(principal_moments[i]) + " > " +
+                       exact(others) + ", the sum of the other two"};
+    }
+  }
+  const Status orientation_ok = checkOrientation(orientation, "orientation");
+  if (!orientation_ok) return orientation_ok.error();
+
+  FreeRotation r;
+  r.orientation0_ = orientation.normalized();
+  r.omega0_world_ = angular_velocity;
+  const Eigen::Matrix3d rotation0 = r.orientation0_.toRotationMatrix();
+  const Eigen::Vector3d w = rotation0.transpose() * angular_velocity;
+  r.omega0_body_ = w;
+  const Eigen::Vector3d& j = principal_moments;
+  r.momentum_world_ = rotation0 * j.cwiseProduct(w);
+  if (!r.momentum_world_.allFinite()) {
+    return Error{"angular_velocity",
+                 "its angular momentum about the principal moments is beyond the doubles"};
+  }
+  if (w.isZero(0.0)) {
+    r.kind_ = Kind::kResting;
+    return r;
+  }
+  r.momentum_axis_ = r.momentum_world_.stableNormalized();
+  // The moments in ascending order: lo, mid, hi (body axes).
+  std::array<int, 3> order{0, 1, 2};
+  std::sort(order.begin(), order.end(), [&](int x, int y) { return j[x] < j[y]; });
+  const int lo = order[0], mid = order[1], hi = order[2];
+  const bool low_pair = j[lo] == j[mid];
+  const bool high_pair = j[mid] == j[hi];
+  if (low_pair && high_pair) {
+    r.kind_ = Kind::kIsotropic;
+    return r;
+  }
+  if (low_pair || high_pair) {
+    r.kind_ = Kind::kAxisymmetric;
+    const int s = low_pair ? hi : lo;
+    const double js = j[s];
+    const double jt = j[mid];
+    r.symmetry_axis_ = Eigen::Vector3d::Unit(s);
+    r.body_rate_ = (js - jt) / jt * w[s];
+    r.precession_rate_ = r.momentum_world_.stableNorm() / jt;
+    return r;
+  }
+  // The asymmetric body's parameters are homogeneous in w (the amplitudes and the rates of
+  // degree 1, the rest of degree 0): computed for w scaled by a power of two to |w|_max in
+  // [1, 2), exactly, so that no square underflows or overflows, and scaled back.
+  const int exponent = std::ilogb(w.cwiseAbs().maxCoeff());
+  const Eigen::Vector3d ws = w.unaryExpr([&](double x) { return std::ldexp(x, -exponent); });
+  // M^2 - 2 E J_mid, written so that nothing cancels but the separatrix's own difference.
+  const double separation =
+      j[lo] * (j[lo] - j[mid]) * ws[lo] * ws[lo] + j[hi] * (j[hi] - j[mid]) * ws[hi] * ws[hi];
+  if ((w.array() != 0.0).count() == 1) {
+    r.kind_ = Kind::kIsotropic;  // a steady turn about a principal axis
+    return r;
+  }
+  // The working frame: axis 3 the one the polhode goes round, axis 2 the middle one.
+  const std::array<int, 3> p =
+      separation < 0.0 ? std::array<int, 3>{hi, mid, lo} : std::array<int, 3>{lo, mid, hi};
+  r.kind_ = separation == 0.0 ? Kind::kSeparatrix : Kind::kAsymmetric;
+  const double s3 = sign(w[p[2]]);
+  const double s1 = r.kind_ == Kind::kSeparatrix ? sign(w[p[0]]) : 1.0;
+  Eigen::Matrix3d frame = Eigen::Matrix3d::Zero();
+  frame(0, p[0]) = s1;
+  frame(2, p[2]) = s3;
+  frame(1, p[1]) = 1.0;
+  if (frame.determinant() < 0.0) frame(1, p[1]) = -1.0;
+  r.working_ = frame;
+  const Eigen::Vector3d jw(j[p[0]], j[p[1]], j[p[2]]);
+  r.moments_ = jw;
+  const Eigen::Vector3d ww = frame * ws;
+  const double w1 = ww.x(), w2 = ww.y(), w3 = ww.z();
+  const double j1 = jw.x(), j2 = jw.y(), j3 = jw.z();
+  // 2 E J_3 - M^2, M^2 - 2 E J_1, M^2 - 2 E J_2 (signed: in the frame of the smallest axis
+  // the first two are negative and their ratios as in Landau's).
+  const double top = j1 * (j3 - j1) * w1 * w1 + j2 * (j3 - j2) * w2 * w2;
+  const double bottom = j2 * (j2 - j1) * w2 * w2 + j3 * (j3 - j1) * w3 * w3;
+  const double middle = j1 * (j1 - j2) * w1 * w1 + j3 * (j3 - j2) * w3 * w3;
+  const double m2 = ww.cwiseProduct(jw).squaredNorm();
+  const double momentum = std::sqrt(m2);
+  const double two_energy = ww.dot(jw.cwiseProduct(ww));
+  r.amplitude_ = Eigen::Vector3d(std::sqrt(w1 * w1 + j2 * (j3 - j2) / (j1 * (j3 - j1)) * w2 * w2),
+                                 std::sqrt(j1 * (j3 - j1) / (j2 * (j3 - j2)) * w1 * w1 + w2 * w2),
+                                 std::sqrt(j2 * (j2 - j1) / (j3 * (j3 - j1)) * w2 * w2 + w3 * w3));
+  r.rate_ = sign(j3 - j2) * std::sqrt((j3 - j2) * bottom / (j1 * j2 * j3));
+  r.m_ = (j2 - j1) * top / ((j3 - j2) * bottom);
+  r.m1_ = (j3 - j1) * middle / ((j3 - j2) * bottom);
+  // sn u0 and cn u0: (w_2 / A_2, w_1 / A_1), scaled alike (A_1 / A_2 is sqrt(J_2 |J_3 - J_2|) /
+  // sqrt(J_1 |J_3 - J_1|)) and made a unit vector; no angle in between, whose rounding near
+  // pi / 2 the near-separatrix F would magnify.
+  const Eigen::Vector2d phase = Eigen::Vector2d(w2 * std::sqrt(j2 * std::abs(j3 - j2)),
+                                                w1 * std::sqrt(j1 * std::abs(j3 - j1)))
+                                    .normalized();
+  r.a_ = j3 * r.amplitude_.z() / momentum;
+  r.psi_factor_ = j1 * j2 * r.amplitude_.x() * r.amplitude_.y() / m2;
+  r.energy_rate_ = std::ldexp(two_energy / momentum, exponent);
+  r.amplitude_ = r.amplitude_.unaryExpr([&](double x) { return std::ldexp(x, exponent); });
+  r.rate_ = std::ldexp(r.rate_, exponent);
+  if (r.kind_ == Kind::kSeparatrix) {
+    r.m_ = 1.0;
+    r.m1_ = 0.0;
+    r.u0_ = std::asinh(phase.x() / phase.y());  // F(phi | 1) = asinh(tan phi); cn u0 > 0
+    r.quarter_period_ = std::numeric_limits<double>::infinity();
+  } else {
+    r.u0_ = ellipticF(phase.x(), phase.y(), r.m1_);
+    r.quarter_period_ = completeEllipticK(r.m1_);
+    // G at the pieces' ends over one period, once: an evaluation integrates one piece.
+    const double pieces = std::max(1.0, std::ceil(2.0 * r.quarter_period_ / kPieceLength));
+    r.piece_ = 2.0 * r.quarter_period_ / pieces;
+    r.piece_ends_.assign(static_cast<std::size_t>(pieces) + 1, 0.0);
+    for (std::size_t k = 1; k < r.piece_ends_.size(); ++k) {
+      r.piece_ends_[k] =
+          r.piece_ends_[k - 1] + r.integrateThirdKind(r.piece_ * static_cast<double>(k - 1),
+                                                      r.piece_ * static_cast<double>(k));
+    }
+    r.period_integral_ = r.piece_ends_.back();
+  }
+  r.start_integral_ = r.thirdKindIntegral(r.u0_);
+  const Eigen::Vector3d l0 = jw.cwiseProduct(ww) / momentum;
+  r.frame0_ = r.orientation0_ * Eigen::Quaterniond(frame.transpose()) * leastRotationFromZ(l0);
+  return r;
+}
+
+double FreeRotation::thirdKindIntegral(double u) const {
+  if (kind_ == Kind::kSeparatrix) {
+    // integral_0^u sech / (1 + a sech) = integral_0^u 1 / (cosh s + a) ds
+    // = 2 / sqrt(1 - a^2) atan(sqrt((1 - a) / (1 + a)) tanh(u / 2)), 0 <= a < 1 (with
+    // tau = tanh(s / 2): cosh s + a = ((1 + a) + (1 - a) tau^2) / (1 - tau^2), ds = 2 dtau /
+    // (1 - tau^2)).
+    const double root = std::sqrt((1.0 - a_) * (1.0 + a_));
+    return 2.0 / root * std::atan((1.0 - a_) / root * std::tanh(0.5 * u));
+  }
+  const double period = 2.0 * quarter_period_;
+  const double whole = std::floor(u / period);
+  const double rest = u - whole * period;
+  return (whole == 0.0 ? 0.0 : whole * period_integral_) + thirdKindIntegralWithin(rest);
+}
+
+double FreeRotation::thirdKindIntegralWithin(double u) const {
+  const std::size_t last = piece_ends_.size() - 2;
+  const std::size_t k = std::min(last, static_cast<std::size_t>(std::max(0.0, u / piece_)));
+  return piece_ends_[k] + integrateThirdKind(piece_ * static_cast<double>(k), u);
+}
+
+double FreeRotation::integrateThirdKind(double from, double to) const {
+  // The integrand is analytic near the real axis (dn's nearest poles are K(m1) >= pi / 2 off
+  // it; 1 + a dn >= 1 on it), so a 20-point Gauss-Legendre rule on a piece of at most
+  // kPieceLength leaves an error far below the doubles' rounding (of the order rho^-40, rho
+  // the ellipse of analyticity's sum of half-axes over the half-length, > 6 here).
+  const auto integrand = [this](double s) {
+    const double dn = jacobiElliptic(s, m_, m1_).dn;
+    return dn / (1.0 + a_ * dn);
+  };
+  return boost::math::quadrature::gauss<double, 20>::integrate(integrand, from, to);
+}
+
+Eigen::Vector3d FreeRotation::workingAngularVelocity(double time) const {
+  const double u = rate_ * time + u0_;
+  if (kind_ == Kind::kSeparatrix) {
+    const double sech = 1.0 / std::cosh(u);
+    return amplitude_.cwiseProduct(Eigen::Vector3d(sech, std::tanh(u), sech));
+  }
+  const JacobiElliptic f = jacobiElliptic(u, m_, m1_);
+  return amplitude_.cwiseProduct(Eigen::Vector3d(f.cn, f.sn, f.dn));
+}
+
+Eigen::Vector3d FreeRotation::bodyAngularVelocity(double time) const {
+  switch (kind_) {
+    case Kind::kResting:
+    case Kind::kIsotropic:
+      return omega0_body_;
+    case Kind::kAxisymmetric:
+      return turn(symmetry_axis_, body_rate_ * time) * omega0_body_;
+    case Kind::kAsymmetric:
+    case Kind::kSeparatrix:
+      break;
+  }
+  return working_.transpose() * workingAngularVelocity(time);
+}
+
+Eigen::Vector3d FreeRotation::angularVelocity(double time) const {
+  if (kind_ == Kind::kResting || kind_ == Kind::kIsotropic) return omega0_world_;
+  return orientation(time) * bodyAngularVelocity(time);
+}
+
+double FreeRotation::psi(double time) const {
+  return energy_rate_ * time -
+         psi_factor_ * (thirdKindIntegral(rate_ * time + u0_) - start_integral_);
+}
+
+Eigen::Quaterniond FreeRotation::orientation(double time) const {
+  switch (kind_) {
+    case Kind::kResting:
+      return orientation0_;
+    case Kind::kIsotropic: {
+      const double speed = omega0_world_.stableNorm();
+      return turn(omega0_world_.stableNormalized(), speed * time) * orientation0_;
+    }
+    case Kind::kAxisymmetric: {
+      return turn(momentum_axis_, precession_rate_ * time) * orientation0_ *
+             turn(symmetry_axis_, -body_rate_ * time);
+    }
+    case Kind::kAsymmetric:
+    case Kind::kSeparatrix:
+      break;
+  }
+  const Eigen::Vector3d l = moments_.cwiseProduct(workingAngularVelocity(time)).stableNormalized();
+  const Eigen::Quaterniond working =
+      turn(momentum_axis_, psi(time)) * frame0_ * leastRotationFromZ(l).conjugate();
+  return (working * Eigen::Quaterniond(working_)).normalized();
+}
+
+double FreeRotation::period() const {
+  switch (kind_) {
+    case Kind::kAxisymmetric:
+      return body_rate_ == 0.0 ? std::numeric_limits<double>::infinity()
+                               : 2.0 * kPi / std::abs(body_rate_);
+    case Kind::kAsymmetric:
+      return 4.0 * quarter_period_ / std::abs(rate_);
+    default:
+      return std::numeric_limits<double>::infinity();
+  }
+}
+
+}  // namespace collision_response::core
