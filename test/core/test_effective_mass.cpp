@@ -170,13 +170,14 @@ TEST(ImpulseResponse, ABallsTurnSlipAndTangentialInverseMassAreItsFormulasToTheB
       ASSERT_EQ(turns(body), body.spin_factor != 0.0 && body.radius > 0.0);
       if (!turns(body)) continue;
       const double factor = body.inverse_mass * body.spin_factor / body.radius;
-      ASSERT_EQ(turnOf<double>(body, n, V::Zero(), impulse), V(factor * n.cross(impulse)));
+      const auto unused_lever = [] { return V(V::Constant(NAN)); };  // a ball's is R n
+      ASSERT_EQ(turnOf<double>(body, n, unused_lever, impulse), V(factor * n.cross(impulse)));
       using W = Eigen::Matrix<long double, 3, 1>;
       const W wide_n = n.cast<long double>(), wide_impulse = impulse.cast<long double>();
       const long double wide_factor = static_cast<long double>(body.inverse_mass) *
                                       static_cast<long double>(body.spin_factor) /
                                       static_cast<long double>(body.radius);
-      ASSERT_EQ(turnOf<long double>(body, W(-wide_n), V::Zero(), wide_impulse),
+      ASSERT_EQ(turnOf<long double>(body, W(-wide_n), unused_lever, wide_impulse),
                 W(wide_factor * (-wide_n).cross(wide_impulse)));
     }
   }
@@ -201,7 +202,8 @@ TEST(ImpulseResponse, ABoxGivenByItsTensorTurnsAndSlipsAsItsClosedForm) {
   contact.lever_b = V(0.25, -0.125, 0.5);
   ASSERT_TRUE(turns(box));
   ASSERT_FALSE(turns(floor));
-  const V turn = turnOf<double>(box, V(-contact.normal), contact.lever_b, V::UnitZ());
+  const V turn = turnOf<double>(
+      box, V(-contact.normal), [&] { return contact.lever_b; }, V::UnitZ());
   EXPECT_NEAR(turn.x(), -8.0 / 17.0, 2 * kEps);
   EXPECT_NEAR(turn.y(), -4.0 / 5.0, 2 * kEps);
   EXPECT_EQ(turn.z(), 0.0);

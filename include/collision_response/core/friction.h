@@ -44,7 +44,9 @@ struct FrictionOutcome {
 ///
 /// kSpin: with the spin effect the angular velocities enter the slip and receive the impulse's
 /// moment (a ball with topspin kicks forward); without it bodies do not turn (no rotational
-/// terms, angular velocities untouched).
+/// terms, angular velocities untouched). Defined, for both, in the solver room
+/// (src/core/solver/cluster_solver.cpp), whose shared turn, slip and tangential inverse mass it
+/// uses.
 template <bool kSpin>
 FrictionOutcome applyFriction(ClusterBody& a, ClusterBody& b, const ContactPoint& contact,
                               double friction, double normal_impulse);

@@ -14,8 +14,9 @@ enum class InverseInertiaKind {
   /// I^-1 = 1 / (k m r^2) times the identity (a sphere): read from spin_factor 1/k and radius,
   /// from which every ball formula of the solvers takes it.
   kIsotropic,
-  /// I^-1 in the common frame (inverse_inertia), for the shaped bodies to come; not yet read by
-  /// any solver.
+  /// I^-1 in the common frame (inverse_inertia), for the shaped bodies to come: read by the
+  /// turn, the slip and the tangential inverse mass (src/core/solver/impulse_response.h); no
+  /// body has one yet.
   kTensor,
 };
 

@@ -35,7 +35,8 @@ FrictionOutcome applyFriction(ClusterBody& a, ClusterBody& b, const ContactPoint
         body.angular_velocity += (body.inverse_mass * outcome.impulse) * body.spin_factor /
                                  body.radius * normal.cross(direction);
       } else {
-        body.angular_velocity += turnOf<double>(body, outward, lever, impulse);
+        body.angular_velocity += turnOf<double>(
+            body, outward, [&] { return lever; }, impulse);
       }
     };
     turn(a, normal, contact.lever_a, impulse_on_a);
@@ -113,8 +114,9 @@ void applyFrictionJointly(std::vector<ClusterBody>& bodies,
       velocity.add(index, sign * (body.inverse_mass * impulse));
       if (kSpin && turns(body)) {
         // T on b at r_b, -T on a at r_a: -(I^-1 (r' x T)), r' = r_a and -r_b along n.
-        const Eigen::Vector3d lever =
-            sign < 0 ? contacts[k].lever_a : Eigen::Vector3d(-contacts[k].lever_b);
+        const auto lever = [&, sign = sign] {
+          return sign < 0 ? contacts[k].lever_a : Eigen::Vector3d(-contacts[k].lever_b);
+        };
         angular.add(index, -turnOf<double>(body, normal, lever, impulse));
       }
     }

@@ -177,7 +177,10 @@ class Group {
     const ForceBody& body = bodies_[i];
     if (body.inverse_mass == 0.0) return;
     acceleration += Real(body.inverse_mass) * force;
-    if (turns(body)) angular_acceleration += turnOf<Real>(body, outward, arm, force);
+    if (turns(body)) {
+      angular_acceleration += turnOf<Real>(
+          body, outward, [&] { return arm; }, force);
+    }
   }
 
   const std::vector<ForceBody>& bodies_;

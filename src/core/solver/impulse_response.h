@@ -23,21 +23,28 @@ inline bool turns(const SolverBody& body) {
   return !body.inverse_inertia.isZero(0.0);
 }
 
-/// The change of `body`'s angular velocity from `impulse` on it at its contact point:
-/// I^-1 (r x J), r the lever arm `lever`. A ball's r is R `outward` (the unit normal n on side
-/// a, -n on side b) and I^-1 = w / (k R^2) (1/k its spin factor): (w (1/k) / R) (outward x J),
-/// divided by R once, as the solvers of balls always have (`Scalar`: their precision, double or
-/// the contact group's long double). Only for a body that turns (turns()).
+/// I^-1 (r x J) of a body given by its tensor (turnOf's general branch, out of the balls' way).
 template <class Scalar>
-Eigen::Matrix<Scalar, 3, 1> turnOf(const SolverBody& body,
-                                   const Eigen::Matrix<Scalar, 3, 1>& outward,
-                                   const Eigen::Vector3d& lever,
-                                   const Eigen::Matrix<Scalar, 3, 1>& impulse) {
-  if (body.inertia_kind == InverseInertiaKind::kIsotropic) {
-    return (Scalar(body.inverse_mass) * Scalar(body.spin_factor) / Scalar(body.radius)) *
-           outward.cross(impulse);
-  }
+Eigen::Matrix<Scalar, 3, 1> tensorTurnOf(const SolverBody& body, const Eigen::Vector3d& lever,
+                                         const Eigen::Matrix<Scalar, 3, 1>& impulse) {
   return body.inverse_inertia.cast<Scalar>() * lever.cast<Scalar>().cross(impulse);
+}
+
+/// The change of `body`'s angular velocity from `impulse` on it at its contact point:
+/// I^-1 (r x J), r its lever arm `lever()` (called only for a body given by its tensor). A
+/// ball's r is R `outward` (the unit normal n on side a, -n on side b) and I^-1 = w / (k R^2)
+/// (1/k its spin factor): (w (1/k) / R) (outward x J), divided by R once, as the solvers of
+/// balls always have (`Scalar`: their precision, double or the contact group's long double).
+/// Only for a body that turns (turns()).
+template <class Scalar, class Lever>
+inline Eigen::Matrix<Scalar, 3, 1> turnOf(const SolverBody& body,
+                                          const Eigen::Matrix<Scalar, 3, 1>& outward, Lever&& lever,
+                                          const Eigen::Matrix<Scalar, 3, 1>& impulse) {
+  if (body.inertia_kind != InverseInertiaKind::kIsotropic) {
+    return tensorTurnOf<Scalar>(body, lever(), impulse);
+  }
+  return (Scalar(body.inverse_mass) * Scalar(body.spin_factor) / Scalar(body.radius)) *
+         outward.cross(impulse);
 }
 
 /// w x r of `body` at its contact point: its surface's velocity there from its turning. A
@@ -54,12 +61,19 @@ inline Eigen::Vector3d turningVelocity(const SolverBody& body, const Eigen::Vect
 /// u = (v_b + w_b x r_b) - (v_a + w_a x r_a), less its part along the normal, u - (u.n) n
 /// (friction.h). kSpin false: bodies do not turn (no rotational terms).
 template <bool kSpin>
-Eigen::Vector3d slipAt(const SolverBody& a, const SolverBody& b, const ContactPoint& contact) {
+inline Eigen::Vector3d slipAt(const SolverBody& a, const SolverBody& b,
+                              const ContactPoint& contact) {
   const Eigen::Vector3d& normal = contact.normal;
   Eigen::Vector3d slip = b.velocity - a.velocity;
   if constexpr (kSpin) {
-    slip +=
-        turningVelocity(b, -normal, contact.lever_b) - turningVelocity(a, normal, contact.lever_a);
+    if (a.inertia_kind == InverseInertiaKind::kIsotropic &&
+        b.inertia_kind == InverseInertiaKind::kIsotropic) {
+      slip += b.angular_velocity.cross(-b.radius * normal) -
+              a.angular_velocity.cross(a.radius * normal);
+    } else {
+      slip += turningVelocity(b, -normal, contact.lever_b) -
+              turningVelocity(a, normal, contact.lever_a);
+    }
   }
   return slip - slip.dot(normal) * normal;
 }
@@ -86,8 +100,8 @@ inline ContactSide contactSideOf(const SolverBody& body, const Eigen::Vector3d& 
 /// (w_a + w_b) + (w_a / k_a + w_b / k_b) as the ball solvers always have. kSpin false: bodies do
 /// not turn, w_a + w_b.
 template <bool kSpin, class Direction>
-double tangentialInverseMass(const SolverBody& a, const SolverBody& b, const ContactPoint& contact,
-                             Direction&& direction) {
+inline double tangentialInverseMass(const SolverBody& a, const SolverBody& b,
+                                    const ContactPoint& contact, Direction&& direction) {
   double inverse_mass = a.inverse_mass + b.inverse_mass;
   if constexpr (kSpin) {
     if (a.inertia_kind == InverseInertiaKind::kIsotropic &&

@@ -28,8 +28,9 @@ void applyImpulse(std::vector<ClusterBody>& bodies, const ClusterContact& contac
     body.velocity += sign * (body.inverse_mass * impulse);
     if constexpr (kSpin) {
       if (turns(body)) {
-        const Eigen::Vector3d lever =
-            sign < 0 ? contact.lever_a : Eigen::Vector3d(-contact.lever_b);
+        const auto lever = [&, sign = sign] {
+          return sign < 0 ? contact.lever_a : Eigen::Vector3d(-contact.lever_b);
+        };
         body.angular_velocity -= turnOf<double>(body, contact.normal, lever, impulse);
       }
     }
