@@ -13,12 +13,13 @@ results="$ws/build/test_results/sanitized"
 mkdir -p "$results"
 # The fuzzers are built with the tests (the same objects): scripts/fuzz.sh then only links.
 build_sanitized core_tests fuzz_impact fuzz_time_of_impact fuzz_monitor
-# Every unit test but two that replay whole scenes a second way: the trace (every scene of the
-# package and the accuracy benchmark, 3.5 minutes under the sanitizers) and the broad phase
-# against every pair (1 minute). Their code runs in the other tests under the sanitizers, and
-# their answers are checked in the main build.
+# Every unit test but those that repeat one computation many times over: the trace (every scene
+# of the package and the accuracy benchmark, 3.5 minutes under the sanitizers), the broad phase
+# against every pair (1 minute) and the calibration's coverage over 1,000 seeds each (the same
+# fit 2,000 times). Their code runs in the other tests under the sanitizers, and their answers
+# are checked in the main build.
 declare -A filters=(
-  [core_tests]="-Trace.*:Monitor.BroadphaseGivesTheSameImpactsAsEveryPair"
+  [core_tests]="-Trace.*:Monitor.BroadphaseGivesTheSameImpactsAsEveryPair:Calibration.NinetyFivePercentIntervalsCoverTheTruth*"
 )
 # Each program in two shards side by side (gtest's GTEST_TOTAL_SHARDS): the two cores.
 run_shard() {
