@@ -37,6 +37,31 @@ std::string restitutionText(const core::Estimate& e) {
          decimal(e.high(), half) + ")";
 }
 
+/// One obstacle pair a plane material: the materials of the planes the fit's bounces were on, in
+/// the order first met.
+std::vector<std::string> materialsBouncedOn(const core::Calibration& fit,
+                                            const std::vector<std::string>& plane_materials) {
+  std::vector<std::string> materials;
+  for (const core::BounceEstimate& bounce : fit.bounces) {
+    const std::string& material = plane_materials[bounce.plane];
+    if (std::find(materials.begin(), materials.end(), material) == materials.end()) {
+      materials.push_back(material);
+    }
+  }
+  return materials;
+}
+
+/// The fit's bounces (indices) on the planes of `material`: its pair's bounces together.
+std::vector<std::size_t> bouncesOn(const core::Calibration& fit,
+                                   const std::vector<std::string>& plane_materials,
+                                   const std::string& material) {
+  std::vector<std::size_t> which;
+  for (std::size_t j = 0; j < fit.bounces.size(); ++j) {
+    if (plane_materials[fit.bounces[j].plane] == material) which.push_back(j);
+  }
+  return which;
+}
+
 }  // namespace
 
 CalibrationWindow::CalibrationWindow(std::size_t bodies, double seconds, std::size_t max_samples)
@@ -197,21 +222,11 @@ void LiveCalibration::answer(const EstimateRestitution::Request& request,
     fit = core::calibrate(recent, options);
     if (!fit) return refuse(what + ": " + fit.error().message());
   }
-  // One obstacle pair a plane material: its planes' bounces together.
-  std::vector<std::string> materials;
-  for (const core::BounceEstimate& bounce : fit->bounces) {
-    const std::string& material = plane_materials_[bounce.plane];
-    if (std::find(materials.begin(), materials.end(), material) == materials.end()) {
-      materials.push_back(material);
-    }
-  }
   std::string text;
   std::size_t most = 0;
+  const std::vector<std::string> materials = materialsBouncedOn(*fit, plane_materials_);
   for (const std::string& material : materials) {
-    std::vector<std::size_t> which;
-    for (std::size_t j = 0; j < fit->bounces.size(); ++j) {
-      if (plane_materials_[fit->bounces[j].plane] == material) which.push_back(j);
-    }
+    const std::vector<std::size_t> which = bouncesOn(*fit, plane_materials_, material);
     PairEstimate estimate{"[" + body.material + ", " + material + "]", body.id,
                           core::combine(*fit, which), ""};
     const core::Coefficients& c = estimate.coefficients;
