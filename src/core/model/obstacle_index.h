@@ -30,6 +30,10 @@ class ObstacleIndex {
     return built_ && bounds_.size() == obstacles && from_ <= from && to <= to_;
   }
 
+  /// Forgets what was entered: an obstacle placed anew, or a time line started again, may break
+  /// the bounds it holds even for a span it covers.
+  void invalidate() { built_ = false; }
+
   /// The entered obstacles whose bound overlaps `box` (all of them for a box that is not
   /// finite), and those found by every query: sorted, each once.
   void query(const Box& box, std::vector<std::size_t>& found) const;

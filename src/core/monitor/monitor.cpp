@@ -855,11 +855,13 @@ void ImpactMonitor::setObstaclePose(std::size_t obstacle, const RigidPose& frame
   world_->obstacle_tracks[obstacle] =
       monitor::ObstacleTrack{true, place(world_->obstacles[obstacle], frame)};
   world_->groups_current = false;
+  world_->scratch.obstacles.invalidate();
 }
 
 void ImpactMonitor::placeObstacle(std::size_t obstacle, const PlacedShape& placed) {
   world_->obstacle_tracks[obstacle] = monitor::ObstacleTrack{true, placed};
   world_->groups_current = false;
+  world_->scratch.obstacles.invalidate();
 }
 
 void ImpactMonitor::reset() {
@@ -875,6 +877,7 @@ void ImpactMonitor::reset() {
   world.stalled.clear();
   world.started = false;
   world.now = 0.0;
+  world.scratch.obstacles.invalidate();
 }
 
 std::size_t ImpactMonitor::trackedBodies() const {
