@@ -306,7 +306,6 @@ struct FoundBounce {
   double height = 0.0;
 };
 
-/// Bounces: the speed towards a plane reversing (calibration.h), one per window.
 /// The tracker's noise (m, each coordinate) before any fit: the median absolute second
 /// difference of the positions over evenly spaced triples, gravity's g dt^2 taken out, as a
 /// normal distribution's standard deviation (1.4826 median |d|; d = p+ - 2 p + p- has 6 sigma^2).
@@ -328,6 +327,7 @@ double noiseBeforeTheFit(const std::vector<TrackedSample>& samples,
   return 1.4826 * second[second.size() / 2] / std::sqrt(6.0);
 }
 
+/// Bounces: the speed towards a plane reversing (calibration.h), one per window.
 std::vector<FoundBounce> findBounces(const std::vector<TrackedSample>& samples,
                                      const CalibrationOptions& options) {
   std::vector<FoundBounce> found;
@@ -504,92 +504,103 @@ std::pair<Estimate, double> commonMean(const Eigen::VectorXd& values,
 /// approach speed, e, the friction ratio, the slip before and after (along the slip before).
 constexpr Eigen::Index kPerBounce = 6;
 
-RecordingResult<Calibration> run(const std::vector<TrackedSample>& recorded,
-                                 const CalibrationOptions& given, bool with_bounces) {
-  if (auto error = checkSamples(recorded)) return *error;
-  if (auto error = checkOptions(given, with_bounces)) return *error;
-  CalibrationOptions options = given;
+/// The recording with times counted from its first sample's (a stamp of 1.7e9 s, a ROS clock's,
+/// has a resolution of 2e-7 s).
+std::vector<TrackedSample> fromTheFirstSample(const std::vector<TrackedSample>& recorded) {
+  std::vector<TrackedSample> samples = recorded;
+  for (auto& sample : samples) sample.time -= recorded.front().time;
+  return samples;
+}
 
+/// The bounces to fit and the samples they are fitted from.
+struct BouncesToFit {
   std::vector<FoundBounce> found;
-  // Times from the first sample's: a stamp of 1.7e9 s (a ROS clock's) has a resolution of 2e-7 s.
-  const double epoch = recorded.front().time;
-  std::vector<TrackedSample> all_samples = recorded;
-  for (auto& sample : all_samples) sample.time -= epoch;
-  std::vector<TrackedSample> samples = all_samples;
-  const double spacing = medianSpacing(all_samples);
-  if (with_bounces) {
-    found = findBounces(all_samples, options);
-    if (found.empty()) {
-      return problem(RecordingProblem::kNoBounce, "samples",
-                     "no bounce off a plane: no reversal of the speed towards one from at least " +
-                         number(options.min_bounce_speed) + " m/s (min_bounce_speed)");
-    }
-    for (std::size_t j = 0; j < found.size(); ++j) {
-      const std::size_t k = found[j].sample;
-      const double gap = std::max(all_samples[k].time - all_samples[k - 1].time,
-                                  all_samples[k + 1].time - all_samples[k].time);
-      if (gap > longestSpacing(options, spacing)) {
-        return problem(RecordingProblem::kGapAcrossBounce, "bounce " + std::to_string(j + 1),
-                       "near " + number(recorded[k].time) + " s the samples are " + number(gap) +
-                           " s apart, more than " + number(options.max_gap_periods) +
-                           " sample periods (" + number(spacing) + " s)");
-      }
-    }
-    std::size_t used = found.size();
-    if (options.max_bounces > 0 && used > options.max_bounces) used = options.max_bounces;
-    // The last flight: up to the next bounce found, else until past its top it has fallen
-    // halfway back (a body settling afterwards is no flight).
-    std::size_t end = all_samples.size();
-    if (used < found.size()) {
-      end = found[used].sample - 1;
-    } else {
-      // A top is one well above the noise (a noisy sample just after the bounce is none).
-      const Plane& plane = options.planes[found[used - 1].plane];
-      const double noise = noiseBeforeTheFit(all_samples, options.gravity);
-      double top = -kInf;
-      for (std::size_t k = found[used - 1].sample + 1; k < all_samples.size(); ++k) {
-        const double h = height(plane, options.radius, all_samples[k].position);
-        top = std::max(top, h);
-        if (top > 10.0 * noise && h < 0.5 * top && plane.normal.dot(options.gravity) < 0.0) {
-          end = k;
-          break;
-        }
-      }
-    }
-    found.resize(used);
-    samples.assign(all_samples.begin(), all_samples.begin() + static_cast<std::ptrdiff_t>(end));
+  std::size_t end = 0;  ///< the samples [0, end) are fitted
+};
+
+/// Stage 1: the bounces found (none is a problem), each with samples close enough on either side,
+/// the first max_bounces of them, and where the last flight ends: at the next bounce found, else
+/// where past its top it has fallen halfway back (a body settling afterwards is no flight).
+RecordingResult<BouncesToFit> bouncesToFit(const std::vector<TrackedSample>& samples,
+                                           const std::vector<TrackedSample>& recorded,
+                                           const CalibrationOptions& options, double spacing) {
+  BouncesToFit fit;
+  fit.found = findBounces(samples, options);
+  if (fit.found.empty()) {
+    return problem(RecordingProblem::kNoBounce, "samples",
+                   "no bounce off a plane: no reversal of the speed towards one from at least " +
+                       number(options.min_bounce_speed) + " m/s (min_bounce_speed)");
   }
+  for (std::size_t j = 0; j < fit.found.size(); ++j) {
+    const std::size_t k = fit.found[j].sample;
+    const double gap =
+        std::max(samples[k].time - samples[k - 1].time, samples[k + 1].time - samples[k].time);
+    if (gap > longestSpacing(options, spacing)) {
+      return problem(RecordingProblem::kGapAcrossBounce, "bounce " + std::to_string(j + 1),
+                     "near " + number(recorded[k].time) + " s the samples are " + number(gap) +
+                         " s apart, more than " + number(options.max_gap_periods) +
+                         " sample periods (" + number(spacing) + " s)");
+    }
+  }
+  std::size_t used = fit.found.size();
+  if (options.max_bounces > 0 && used > options.max_bounces) used = options.max_bounces;
+  fit.end = samples.size();
+  if (used < fit.found.size()) {
+    fit.end = fit.found[used].sample - 1;
+  } else {
+    // A top is one well above the noise (a noisy sample just after the bounce is none).
+    const Plane& plane = options.planes[fit.found[used - 1].plane];
+    const double noise = noiseBeforeTheFit(samples, options.gravity);
+    double top = -kInf;
+    for (std::size_t k = fit.found[used - 1].sample + 1; k < samples.size(); ++k) {
+      const double h = height(plane, options.radius, samples[k].position);
+      top = std::max(top, h);
+      if (top > 10.0 * noise && h < 0.5 * top && plane.normal.dot(options.gravity) < 0.0) {
+        fit.end = k;
+        break;
+      }
+    }
+  }
+  fit.found.resize(used);
+  return fit;
+}
+
+/// Stage 2: the flights, [first, last] samples, between the samples found nearest each bounce
+/// (which side of it that sample is on is left to the fit); each needs kMinFlightSamples.
+using Flights = std::vector<std::pair<std::size_t, std::size_t>>;
+RecordingResult<Flights> flightsBetween(const std::vector<FoundBounce>& found,
+                                        std::size_t samples) {
+  Flights flights;
   const std::size_t bounces = found.size();
-
-  // Flights by the samples found nearest each bounce (which side of it that sample is on is
-  // left to the fit).
-  std::vector<std::pair<std::size_t, std::size_t>> flights;
-  {
-    std::size_t first = 0;
-    for (std::size_t j = 0; j <= bounces; ++j) {
-      const std::size_t last = j < bounces ? found[j].sample - 1 : samples.size() - 1;
-      if (last < first || last - first + 1 < kMinFlightSamples) {
-        return problem(RecordingProblem::kTooFewSamples, "flight " + std::to_string(j),
-                       std::to_string(last >= first ? last - first + 1 : 0) + " samples between " +
-                           (j == 0 ? "the start" : "bounce " + std::to_string(j)) + " and " +
-                           (j < bounces ? "bounce " + std::to_string(j + 1) : "the end") +
-                           "; a flight's fit needs " + std::to_string(kMinFlightSamples));
-      }
-      flights.emplace_back(first, last);
-      if (j < bounces) first = found[j].sample + 1;
+  std::size_t first = 0;
+  for (std::size_t j = 0; j <= bounces; ++j) {
+    const std::size_t last = j < bounces ? found[j].sample - 1 : samples - 1;
+    if (last < first || last - first + 1 < kMinFlightSamples) {
+      return problem(RecordingProblem::kTooFewSamples, "flight " + std::to_string(j),
+                     std::to_string(last >= first ? last - first + 1 : 0) + " samples between " +
+                         (j == 0 ? "the start" : "bounce " + std::to_string(j)) + " and " +
+                         (j < bounces ? "bounce " + std::to_string(j + 1) : "the end") +
+                         "; a flight's fit needs " + std::to_string(kMinFlightSamples));
     }
+    flights.emplace_back(first, last);
+    if (j < bounces) first = found[j].sample + 1;
   }
+  return flights;
+}
 
-  Layout layout{bounces, options.fit_gravity, options.drag && options.fit_drag};
+/// Stage 3: where the fit starts: each flight's line with gravity taken out (its start for the
+/// first, its velocity for the others), the given gravity and C_d.
+Eigen::VectorXd startOfTheFit(const std::vector<TrackedSample>& samples, const Flights& flights,
+                              const std::vector<FoundBounce>& found, const Layout& layout,
+                              const CalibrationOptions& options) {
   Eigen::VectorXd start = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(layout.size()));
-  const double origin = samples.front().time;
   {
-    const auto [position, velocity] =
-        lineThrough(samples, flights[0].first, flights[0].second, origin, options.gravity);
+    const auto [position, velocity] = lineThrough(samples, flights[0].first, flights[0].second,
+                                                  samples.front().time, options.gravity);
     start.segment<3>(0) = position;
     start.segment<3>(3) = velocity;
   }
-  for (std::size_t j = 0; j < bounces; ++j) {
+  for (std::size_t j = 0; j < found.size(); ++j) {
     const double bounce_time = samples[found[j].sample].time;
     const auto line = lineThrough(samples, flights[j + 1].first, flights[j + 1].second, bounce_time,
                                   options.gravity);
@@ -598,23 +609,14 @@ RecordingResult<Calibration> run(const std::vector<TrackedSample>& recorded,
   if (layout.gravity)
     start.segment<3>(static_cast<Eigen::Index>(layout.gravityAt())) = options.gravity;
   if (layout.drag) start[static_cast<Eigen::Index>(layout.dragAt())] = options.drag_coefficient;
+  return start;
+}
 
-  std::vector<std::size_t> planes;
-  for (const auto& bounce : found) planes.push_back(bounce.plane);
-  const double horizon = samples.back().time + 1.0;
-  Motion motion(options, layout, planes, origin, horizon);
-  const auto fit = leastSquares(motion, samples, start);
-  if (!fit) {
-    return problem(RecordingProblem::kFitFailed, "samples",
-                   "the flights could not be fitted (a flight that does not meet its bounce's "
-                   "plane, a motion past the doubles, or no settling in " +
-                       std::to_string(kMaxIterations) + " iterations)");
-  }
-
-  // The spin before each bounce: the tracker's (its mean over the flight before), else carried
-  // from spin_before through the earlier bounces' friction impulses, else unknown.
-  const double spin_factor = spinFactor(1.0, options.radius, options.inertia);
-  std::vector<std::optional<Eigen::Vector3d>> measured_spin(bounces);
+/// The tracker's spin before each bounce: its mean over the flight before, where the samples
+/// carry it.
+std::vector<std::optional<Eigen::Vector3d>> trackedSpinBefore(
+    const std::vector<TrackedSample>& samples, const Flights& flights, std::size_t bounces) {
+  std::vector<std::optional<Eigen::Vector3d>> measured(bounces);
   for (std::size_t j = 0; j < bounces; ++j) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     int count = 0;
@@ -624,22 +626,42 @@ RecordingResult<Calibration> run(const std::vector<TrackedSample>& recorded,
         ++count;
       }
     }
-    if (count > 0) measured_spin[j] = sum / count;
+    if (count > 0) measured[j] = sum / count;
   }
-  const auto derived = [&](const Eigen::VectorXd& p, Eigen::VectorXd& out) {
-    if (!motion.build(p)) return false;
-    out.resize(static_cast<Eigen::Index>(kPerBounce * bounces + (layout.drag ? 1 : 0)));
+  return measured;
+}
+
+/// Stage 5: what each bounce gives (kPerBounce values a bounce, and C_d last when fitted) as a
+/// function of the parameters, so that the fit's covariance is carried to them by their gradient.
+/// The spin before each bounce: the tracker's, else carried from spin_before through the earlier
+/// bounces' friction impulses, else unknown.
+class BounceQuantities {
+ public:
+  BounceQuantities(Motion& motion, const CalibrationOptions& options, const Layout& layout,
+                   const std::vector<std::size_t>& planes,
+                   std::vector<std::optional<Eigen::Vector3d>> measured_spin)
+      : motion_(motion),
+        options_(options),
+        layout_(layout),
+        planes_(planes),
+        measured_spin_(std::move(measured_spin)),
+        spin_factor_(spinFactor(1.0, options.radius, options.inertia)) {}
+
+  bool operator()(const Eigen::VectorXd& p, Eigen::VectorXd& out) const {
+    if (!motion_.build(p)) return false;
+    const std::size_t bounces = layout_.bounces;
+    out.resize(static_cast<Eigen::Index>(kPerBounce * bounces + (layout_.drag ? 1 : 0)));
     // A flag beside a vector, not an optional: GCC takes the optional's vector for uninitialised.
-    bool spin_known = options.spin_before.has_value();
-    Eigen::Vector3d spin = options.spin_before.value_or(Eigen::Vector3d::Zero());
+    bool spin_known = options_.spin_before.has_value();
+    Eigen::Vector3d spin = options_.spin_before.value_or(Eigen::Vector3d::Zero());
     for (std::size_t j = 0; j < bounces; ++j) {
-      const Eigen::Vector3d& n = options.planes[planes[j]].normal;
-      const Eigen::Vector3d before = motion.velocityBefore(j);
-      const Eigen::Vector3d after = motion.pieces()[j + 1].velocity;
+      const Eigen::Vector3d& n = options_.planes[planes_[j]].normal;
+      const Eigen::Vector3d before = motion_.velocityBefore(j);
+      const Eigen::Vector3d after = motion_.pieces()[j + 1].velocity;
       const Eigen::Vector3d change = after - before;
       const Eigen::Vector3d tangential_change = change - change.dot(n) * n;
-      if (measured_spin[j]) {
-        spin = *measured_spin[j];
+      if (measured_spin_[j]) {
+        spin = *measured_spin_[j];
         spin_known = true;
       }
       double slip_before = 0.0;
@@ -648,115 +670,111 @@ RecordingResult<Calibration> run(const std::vector<TrackedSample>& recorded,
         // The contact point (at -r n from the centre) slips at u = v + w x (-r n), tangentially;
         // the tangential impulse changes u by (1 + 1/k) dv_t and w by -(1 / (k r)) n x dv_t
         // (I = k m r^2): friction.h's tangential inverse mass.
-        const Eigen::Vector3d u = before + spin.cross(-options.radius * n);
+        const Eigen::Vector3d u = before + spin.cross(-options_.radius * n);
         const Eigen::Vector3d u_t = u - u.dot(n) * n;
         slip_before = u_t.norm();
-        const Eigen::Vector3d u_after = u_t + (1.0 + spin_factor) * tangential_change;
+        const Eigen::Vector3d u_after = u_t + (1.0 + spin_factor_) * tangential_change;
         slip_after = slip_before > 0.0 ? u_after.dot(u_t) / slip_before : u_after.norm();
-        if (options.radius > 0.0) {
-          spin -= (spin_factor / options.radius) * n.cross(tangential_change);
+        if (options_.radius > 0.0) {
+          spin -= (spin_factor_ / options_.radius) * n.cross(tangential_change);
         }
       }
       const auto row = static_cast<Eigen::Index>(kPerBounce * j);
-      out[row] = motion.pieces()[j + 1].start;
+      out[row] = motion_.pieces()[j + 1].start;
       out[row + 1] = -before.dot(n);
       out[row + 2] = -after.dot(n) / before.dot(n);
       out[row + 3] = tangential_change.norm() / change.dot(n);
       out[row + 4] = slip_before;
       out[row + 5] = slip_after;
     }
-    if (layout.drag) out[out.size() - 1] = p[static_cast<Eigen::Index>(layout.dragAt())];
+    if (layout_.drag) out[out.size() - 1] = p[static_cast<Eigen::Index>(layout_.dragAt())];
     return out.allFinite();
-  };
-  Eigen::VectorXd values;
-  Eigen::MatrixXd gradient;
-  if (!derived(fit->parameters, values) ||
-      !jacobian(derived, fit->parameters, values.size(), gradient)) {
-    return problem(RecordingProblem::kFitFailed, "samples",
-                   "the fitted flights give no coefficients (a bounce without an approach)");
   }
-  const Eigen::MatrixXd covariance = gradient * fit->covariance * gradient.transpose();
-  motion.build(fit->parameters);
 
-  Calibration result;
-  result.noise = fit->noise;
-  result.samples_used = samples.size();
-  result.parameters = layout.size();
-  result.iterations = fit->iterations;
-  result.fitted_parameters.assign(fit->parameters.data(),
-                                  fit->parameters.data() + fit->parameters.size());
-  result.start_time = origin + epoch;
-  result.end_time = samples.back().time + epoch;
-  for (int i = 0; i < 3; ++i) {
-    if (layout.gravity) {
-      const auto at = static_cast<Eigen::Index>(layout.gravityAt()) + i;
-      result.gravity[i] = estimate(fit->parameters[at], fit->covariance(at, at));
-    } else {
-      result.gravity[i] = Estimate{options.gravity[i], 0.0};
-    }
+  /// Whether the spin before bounce j is known: tracked over the flight before it, or carried
+  /// from spin_before.
+  bool spinKnown(std::size_t j) const {
+    return measured_spin_[j].has_value() || options_.spin_before.has_value();
   }
-  if (layout.drag) {
-    const Eigen::Index at = values.size() - 1;
-    result.drag_coefficient = estimate(values[at], covariance(at, at));
+
+ private:
+  Motion& motion_;
+  const CalibrationOptions& options_;
+  Layout layout_;
+  std::vector<std::size_t> planes_;
+  std::vector<std::optional<Eigen::Vector3d>> measured_spin_;
+  double spin_factor_;
+};
+
+/// How a bounce's friction reads, from its slip before and after (calibration.h).
+FrictionReading frictionReading(bool spin_known, const Estimate& slip_before,
+                                const Estimate& slip_after, const Estimate& approach_speed) {
+  if (!spin_known) return FrictionReading::kSpinUnknown;
+  if (slip_before.low() <= 0.0 || slip_before.value <= 1e-9 * (1.0 + approach_speed.value)) {
+    // No slip, or one within the rounding of a track without noise (a vertical drop played).
+    return FrictionReading::kNoSlip;
   }
-  const auto variance = [&](Eigen::Index i) { return covariance(i, i); };
-  for (std::size_t j = 0; j < bounces; ++j) {
-    const auto row = static_cast<Eigen::Index>(kPerBounce * j);
-    BounceEstimate bounce;
-    bounce.plane = planes[j];
-    bounce.time = estimate(values[row], variance(row));
-    bounce.point = motion.pieces()[j + 1].position;
-    bounce.velocity_before = motion.velocityBefore(j);
-    bounce.velocity_after = motion.pieces()[j + 1].velocity;
-    bounce.approach_speed = estimate(values[row + 1], variance(row + 1));
-    bounce.restitution = estimate(values[row + 2], variance(row + 2));
-    bounce.friction_ratio = estimate(values[row + 3], variance(row + 3));
-    bounce.slip_after = estimate(values[row + 5], variance(row + 5));
-    const bool spin_known = measured_spin[j] || options.spin_before;
-    const Estimate slip_before = estimate(values[row + 4], variance(row + 4));
-    if (!spin_known) {
-      bounce.friction = FrictionReading::kSpinUnknown;
-    } else if (slip_before.low() <= 0.0 ||
-               slip_before.value <= 1e-9 * (1.0 + bounce.approach_speed.value)) {
-      // No slip, or one within the rounding of a track without noise (a vertical drop played).
-      bounce.friction = FrictionReading::kNoSlip;
-    } else if (bounce.slip_after.low() > 0.0) {
-      bounce.friction = FrictionReading::kSliding;
-    } else {
-      bounce.friction = FrictionReading::kStoppedSlipping;
-    }
-    bounce.samples_before = 0;
-    bounce.samples_after = 0;
-    for (const auto& sample : samples) {
-      const std::size_t piece = motion.pieceAt(sample.time);
-      if (piece == j) ++bounce.samples_before;
-      if (piece == j + 1) ++bounce.samples_after;
-    }
-    // The samples either side of the fitted instant.
-    double last_before = -kInf;
-    double first_after = kInf;
-    for (const auto& sample : samples) {
-      if (sample.time <= bounce.time.value) last_before = std::max(last_before, sample.time);
-      if (sample.time > bounce.time.value) first_after = std::min(first_after, sample.time);
-    }
-    if (!(first_after - last_before <= longestSpacing(options, spacing))) {
-      return problem(RecordingProblem::kGapAcrossBounce, "bounce " + std::to_string(j + 1),
-                     "at " + number(bounce.time.value + epoch) + " s the samples either side are " +
-                         number(first_after - last_before) + " s apart, more than " +
-                         number(options.max_gap_periods) + " sample periods (" + number(spacing) +
-                         " s)");
-    }
-    if (bounce.samples_before < kMinFlightSamples || bounce.samples_after < kMinFlightSamples) {
-      return problem(RecordingProblem::kTooFewSamples, "bounce " + std::to_string(j + 1),
-                     "the fitted flights on either side have " +
-                         std::to_string(bounce.samples_before) + " and " +
-                         std::to_string(bounce.samples_after) + " samples; each needs " +
-                         std::to_string(kMinFlightSamples));
-    }
-    bounce.time.value += epoch;
-    result.bounces.push_back(bounce);
+  if (slip_after.low() > 0.0) return FrictionReading::kSliding;
+  return FrictionReading::kStoppedSlipping;
+}
+
+/// Stage 6: bounce j's estimate from the quantities' values and covariance (its instant still
+/// counted from the first sample), refused when the samples either side of the fitted instant
+/// are too far apart or a flight either side has too few.
+RecordingResult<BounceEstimate> bounceEstimate(std::size_t j, const Eigen::VectorXd& values,
+                                               const Eigen::MatrixXd& covariance,
+                                               const Motion& motion, std::size_t plane,
+                                               bool spin_known,
+                                               const std::vector<TrackedSample>& samples,
+                                               const CalibrationOptions& options, double spacing,
+                                               double epoch) {
+  const auto row = static_cast<Eigen::Index>(kPerBounce * j);
+  const auto at = [&](Eigen::Index i) { return estimate(values[i], covariance(i, i)); };
+  BounceEstimate bounce;
+  bounce.plane = plane;
+  bounce.time = at(row);
+  bounce.point = motion.pieces()[j + 1].position;
+  bounce.velocity_before = motion.velocityBefore(j);
+  bounce.velocity_after = motion.pieces()[j + 1].velocity;
+  bounce.approach_speed = at(row + 1);
+  bounce.restitution = at(row + 2);
+  bounce.friction_ratio = at(row + 3);
+  bounce.slip_after = at(row + 5);
+  bounce.friction =
+      frictionReading(spin_known, at(row + 4), bounce.slip_after, bounce.approach_speed);
+  for (const auto& sample : samples) {
+    const std::size_t piece = motion.pieceAt(sample.time);
+    if (piece == j) ++bounce.samples_before;
+    if (piece == j + 1) ++bounce.samples_after;
   }
-  // The joint covariance of the bounces' e and friction ratios, for combine().
+  // The samples either side of the fitted instant.
+  double last_before = -kInf;
+  double first_after = kInf;
+  for (const auto& sample : samples) {
+    if (sample.time <= bounce.time.value) last_before = std::max(last_before, sample.time);
+    if (sample.time > bounce.time.value) first_after = std::min(first_after, sample.time);
+  }
+  if (!(first_after - last_before <= longestSpacing(options, spacing))) {
+    return problem(RecordingProblem::kGapAcrossBounce, "bounce " + std::to_string(j + 1),
+                   "at " + number(bounce.time.value + epoch) + " s the samples either side are " +
+                       number(first_after - last_before) + " s apart, more than " +
+                       number(options.max_gap_periods) + " sample periods (" + number(spacing) +
+                       " s)");
+  }
+  if (bounce.samples_before < kMinFlightSamples || bounce.samples_after < kMinFlightSamples) {
+    return problem(RecordingProblem::kTooFewSamples, "bounce " + std::to_string(j + 1),
+                   "the fitted flights on either side have " +
+                       std::to_string(bounce.samples_before) + " and " +
+                       std::to_string(bounce.samples_after) + " samples; each needs " +
+                       std::to_string(kMinFlightSamples));
+  }
+  return bounce;
+}
+
+/// Stage 7: the joint covariance of the bounces' e and of their friction ratios (for combine()),
+/// and the bounces together, all and each plane's.
+void summarise(Calibration& result, const Eigen::MatrixXd& covariance, std::size_t planes) {
+  const std::size_t bounces = result.bounces.size();
   result.restitution_covariance.resize(static_cast<Eigen::Index>(bounces),
                                        static_cast<Eigen::Index>(bounces));
   result.friction_ratio_covariance.resizeLike(result.restitution_covariance);
@@ -773,13 +791,98 @@ RecordingResult<Calibration> run(const std::vector<TrackedSample>& recorded,
   std::vector<std::size_t> every(bounces);
   for (std::size_t j = 0; j < bounces; ++j) every[j] = j;
   result.all = combine(result, every);
-  for (std::size_t i = 0; i < options.planes.size(); ++i) {
+  for (std::size_t i = 0; i < planes; ++i) {
     std::vector<std::size_t> on_plane;
     for (std::size_t j = 0; j < bounces; ++j) {
-      if (planes[j] == i) on_plane.push_back(j);
+      if (result.bounces[j].plane == i) on_plane.push_back(j);
     }
     result.per_plane.push_back(combine(result, on_plane));
   }
+}
+
+/// What the fit says of the motion as a whole: the noise, the parameters, gravity and C_d.
+Calibration fittedMotion(const Fit& fit, const Layout& layout, const CalibrationOptions& options,
+                         const Eigen::VectorXd& values, const Eigen::MatrixXd& covariance) {
+  Calibration result;
+  result.noise = fit.noise;
+  result.parameters = layout.size();
+  result.iterations = fit.iterations;
+  result.fitted_parameters.assign(fit.parameters.data(),
+                                  fit.parameters.data() + fit.parameters.size());
+  for (int i = 0; i < 3; ++i) {
+    if (layout.gravity) {
+      const auto at = static_cast<Eigen::Index>(layout.gravityAt()) + i;
+      result.gravity[i] = estimate(fit.parameters[at], fit.covariance(at, at));
+    } else {
+      result.gravity[i] = Estimate{options.gravity[i], 0.0};
+    }
+  }
+  if (layout.drag) {
+    const Eigen::Index at = values.size() - 1;
+    result.drag_coefficient = estimate(values[at], covariance(at, at));
+  }
+  return result;
+}
+
+/// The fit (calibration.h): the recording checked, its bounces found (stage 1, with_bounces), the
+/// flights between them (2), the fit's start (3), the least-squares fit (4), what each bounce
+/// gives with its covariance (5), each bounce's estimate (6), the bounces together (7).
+RecordingResult<Calibration> run(const std::vector<TrackedSample>& recorded,
+                                 const CalibrationOptions& options, bool with_bounces) {
+  if (auto error = checkSamples(recorded)) return *error;
+  if (auto error = checkOptions(options, with_bounces)) return *error;
+  const double epoch = recorded.front().time;
+  std::vector<TrackedSample> samples = fromTheFirstSample(recorded);
+  const double spacing = medianSpacing(samples);
+  std::vector<FoundBounce> found;
+  if (with_bounces) {
+    auto to_fit = bouncesToFit(samples, recorded, options, spacing);
+    if (!to_fit) return to_fit.error();
+    found = to_fit->found;
+    samples.resize(to_fit->end);
+  }
+  const std::size_t bounces = found.size();
+  const auto flights = flightsBetween(found, samples.size());
+  if (!flights) return flights.error();
+
+  const Layout layout{bounces, options.fit_gravity, options.drag && options.fit_drag};
+  std::vector<std::size_t> planes;
+  for (const auto& bounce : found) planes.push_back(bounce.plane);
+  const double origin = samples.front().time;
+  Motion motion(options, layout, planes, origin, samples.back().time + 1.0);
+  const auto fit =
+      leastSquares(motion, samples, startOfTheFit(samples, *flights, found, layout, options));
+  if (!fit) {
+    return problem(RecordingProblem::kFitFailed, "samples",
+                   "the flights could not be fitted (a flight that does not meet its bounce's "
+                   "plane, a motion past the doubles, or no settling in " +
+                       std::to_string(kMaxIterations) + " iterations)");
+  }
+
+  const BounceQuantities quantities(motion, options, layout, planes,
+                                    trackedSpinBefore(samples, *flights, bounces));
+  Eigen::VectorXd values;
+  Eigen::MatrixXd gradient;
+  if (!quantities(fit->parameters, values) ||
+      !jacobian(quantities, fit->parameters, values.size(), gradient)) {
+    return problem(RecordingProblem::kFitFailed, "samples",
+                   "the fitted flights give no coefficients (a bounce without an approach)");
+  }
+  const Eigen::MatrixXd covariance = gradient * fit->covariance * gradient.transpose();
+  motion.build(fit->parameters);
+
+  Calibration result = fittedMotion(*fit, layout, options, values, covariance);
+  result.samples_used = samples.size();
+  result.start_time = origin + epoch;
+  result.end_time = samples.back().time + epoch;
+  for (std::size_t j = 0; j < bounces; ++j) {
+    auto bounce = bounceEstimate(j, values, covariance, motion, planes[j], quantities.spinKnown(j),
+                                 samples, options, spacing, epoch);
+    if (!bounce) return bounce.error();
+    result.bounces.push_back(*bounce);
+    result.bounces.back().time.value += epoch;
+  }
+  summarise(result, covariance, options.planes.size());
   return result;
 }
 
