@@ -15,16 +15,12 @@
 //   To achieve perfect restitution ... set stiffness to some reasonably large value and damping
 //   to zero"), with the damping for e < 1 from the linear spring-dashpot contact that MuJoCo's
 //   reference acceleration a_ref = -b v - k r describes (computation chapter, "Solver
-//   parameters"). A unilateral spring-dashpot lets go when its force returns to zero, before the
-//   penetration does; its coefficient of restitution is then
-//     e = exp(-(beta / w) (pi - atan2(2 beta w, w^2 - beta^2))),  beta = b / 2, w^2 = k - beta^2
-//   (T. Schwager, T. Poeschel, "Coefficient of restitution and linear-dashpot model revisited",
-//   Granular Matter 9 (2007) 465), inverted here for b by bisection. The naive e = exp(-pi beta /
-//   w) of a bilateral oscillator is what gives the e = 0.75 -> 0.82 users report. The stiffness:
-//   a contact's half period pi / sqrt(k) spans kContactSteps steps (MuJoCo's own guidance is a
-//   time constant of at least two steps, XML reference, solref); solimp 0.9999 0.9999 (mjMAXIMP)
-//   so that the contact follows a_ref (the impedance d blends a_ref with the unconstrained
-//   acceleration, a = d a_ref + (1 - d) a0).
+//   parameters"): a unilateral spring-dashpot's coefficient (spring_dashpot.h). The naive e =
+//   exp(-pi beta / w) of a bilateral oscillator is what gives the e = 0.75 -> 0.82 users report.
+//   The stiffness: a contact's half period pi / sqrt(k) spans kContactSteps steps (MuJoCo's own
+//   guidance is a time constant of at least two steps, XML reference, solref); solimp 0.9999 0.9999
+//   (mjMAXIMP) so that the contact follows a_ref (the impedance d blends a_ref with the
+//   unconstrained acceleration, a = d a_ref + (1 - d) a0).
 #include <mujoco/mujoco.h>
 
 #include <algorithm>
@@ -35,6 +31,7 @@
 #include <stdexcept>
 
 #include "harness.h"
+#include "spring_dashpot.h"
 
 namespace collision_response::bench {
 namespace {
@@ -46,27 +43,6 @@ namespace {
 /// the contact is soft, and gravity pulls during it.
 constexpr double kContactSteps = 8.0;
 
-constexpr double kPi = 3.14159265358979323846;
-
-/// The coefficient of restitution of a unilateral spring-dashpot of damping ratio zeta (above).
-double springDashpotRestitution(double zeta) {
-  if (zeta <= 0) return 1.0;
-  if (zeta >= 1) return 0.0;
-  const double w = std::sqrt(1 - zeta * zeta);  // in units of sqrt(k)
-  return std::exp(-(zeta / w) * (kPi - std::atan2(2 * zeta * w, w * w - zeta * zeta)));
-}
-
-/// The damping ratio zeta = b / (2 sqrt(k)) that gives `restitution`.
-double dampingRatioFor(double restitution) {
-  if (restitution >= 1) return 0.0;
-  double low = 0, high = 1;  // e falls from 1 to 0 as zeta goes from 0 to 1
-  for (int i = 0; i < 200; ++i) {
-    const double mid = 0.5 * (low + high);
-    (springDashpotRestitution(mid) > restitution ? low : high) = mid;
-  }
-  return 0.5 * (low + high);
-}
-
 std::string number(double value) {
   char text[32];
   std::snprintf(text, sizeof text, "%.17g", value);
@@ -77,10 +53,9 @@ std::string triple(const V& v) { return number(v.x()) + " " + number(v.y()) + " 
 /// solref and solimp attributes giving `restitution` at time step dt; empty: MuJoCo's defaults.
 std::string contactAttributes(bool restitution_on, double restitution, double dt) {
   if (!restitution_on) return "";
-  const double omega = kPi / (kContactSteps * dt);  // sqrt(k): half period kContactSteps steps
-  const double stiffness = omega * omega;
-  const double damping = 2 * dampingRatioFor(restitution) * omega;
-  return " solref=\"" + number(-stiffness) + " " + number(-damping) +
+  // Half period kContactSteps steps.
+  const SpringDashpot contact = springDashpotFor(restitution, dt, kContactSteps);
+  return " solref=\"" + number(-contact.stiffness) + " " + number(-contact.damping) +
          "\" solimp=\"0.9999 0.9999 0.001 0.5 2\"";
 }
 
