@@ -1,0 +1,377 @@
+// The real cube tosses replayed by the peer engines (scripts/cube_tosses.sh writes
+// doc/cube_tosses.md from what this prints). For each peer found at build time:
+// 1. the tosses are split: every 4th one by file name (toss_000, toss_008, ...) is a fitting
+//    toss, the others are evaluation tosses;
+// 2. e and mu are fitted on the fitting tosses by a grid, coarse then fine (the least mean, over
+//    the fitting tosses, of each toss's mean centre error in cube widths);
+// 3. each evaluation toss is played from its first recorded state at the fitted e and mu, for
+//    the recorded duration, sampled at 1/148 s, and measured against the recording: the centre's
+//    distance in cube widths and the orientation's angle (deg), mean over the toss and at rest
+//    (the last sample); the CPU per toss;
+// 4. what no parameter explains: each evaluation toss's least error over the coarse grid (its
+//    own best e and mu).
+//   cube_tosses_peers [--tosses DIR] [--out FILE.json] [--only PEER]
+// The tosses are read from DIR, else COLLISION_RESPONSE_CUBE_TOSSES (environment), else the
+// folder beside the project's root; missing, the program says so and exits with 77 (skipped).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "cube_tosses.h"
+
+namespace collision_response::bench::cube_tosses {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+/// Every kFitStride-th toss (by file name) is a fitting toss.
+constexpr std::size_t kFitStride = 4;
+/// The coarse grid, denser in mu (the slide's length, and so the error, turns on it sharply); the
+/// fine one: kFineSteps steps either side of the coarse best, of kFineRestitutionStep and
+/// kFineFrictionStep.
+const std::vector<double> kCoarseRestitutions = {0.0, 0.15, 0.3, 0.45, 0.6, 0.75, 0.9};
+const std::vector<double> kCoarseFrictions = {0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5, 0.7, 1.0};
+constexpr double kFineRestitutionStep = 0.05;
+constexpr double kFineFrictionStep = 0.025;
+constexpr int kFineSteps = 2;
+
+struct Recorded {
+  Pose pose;
+  V velocity = V::Zero();
+  V body_angular_velocity = V::Zero();  ///< rad/s, in the cube's frame, as the data give it
+};
+
+struct Toss {
+  std::string name;  ///< its file's name
+  std::vector<Recorded> samples;
+};
+
+/// One toss's file: a header line, then t,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz (README of the
+/// data set). A malformed line is an error naming the file and the line.
+Toss readToss(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw std::runtime_error(file.string() + ": cannot be read");
+  Toss toss{file.filename().string(), {}};
+  std::string line;
+  std::getline(in, line);
+  for (int number = 2; std::getline(in, line); ++number) {
+    if (line.empty()) continue;
+    std::replace(line.begin(), line.end(), ',', ' ');
+    std::istringstream words(line);
+    double value[14];
+    for (double& v : value) {
+      if (!(words >> v) || !std::isfinite(v)) {
+        throw std::runtime_error(file.string() + ":" + std::to_string(number) +
+                                 ": expected 14 finite numbers (t,x,y,z,qw,qx,qy,qz,vx,vy,vz,"
+                                 "wx,wy,wz)");
+      }
+    }
+    Recorded sample;
+    sample.pose.position = V(value[1], value[2], value[3]);
+    const Q q(value[4], value[5], value[6], value[7]);
+    if (q.norm() < 0.5) {
+      throw std::runtime_error(file.string() + ":" + std::to_string(number) +
+                               ": the orientation (qw,qx,qy,qz) is not a unit quaternion");
+    }
+    sample.pose.orientation = q.normalized();
+    sample.velocity = V(value[8], value[9], value[10]);
+    sample.body_angular_velocity = V(value[11], value[12], value[13]);
+    toss.samples.push_back(sample);
+  }
+  if (toss.samples.size() < 2) throw std::runtime_error(file.string() + ": fewer than 2 samples");
+  return toss;
+}
+
+/// The toss's first state in the world frame (the angular velocity turned out of the body's).
+State firstState(const Toss& toss) {
+  const Recorded& first = toss.samples.front();
+  return State{first.pose, first.velocity, first.pose.orientation * first.body_angular_velocity};
+}
+
+/// A played toss against its recording.
+struct Errors {
+  std::vector<double> distance;  ///< the centres' distance, in cube widths, per sample
+  std::vector<double> angle;     ///< the angle of the turn from one orientation to the other, deg
+  double mean_distance = 0.0, rest_distance = 0.0, mean_angle = 0.0, rest_angle = 0.0;
+};
+
+/// The angle of the rotation between two orientations, in [0, 180] deg.
+double angleBetween(const Q& a, const Q& b) {
+  const Q turn = a.conjugate() * b;
+  return 2.0 * std::atan2(turn.vec().norm(), std::abs(turn.w())) * 180.0 / kPi;
+}
+
+Errors measure(const std::vector<Pose>& path, const Toss& toss) {
+  Errors errors;
+  const std::size_t n = toss.samples.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    const Pose& recorded = toss.samples[k].pose;
+    errors.distance.push_back((path[k].position - recorded.position).norm() / kWidth);
+    errors.angle.push_back(angleBetween(path[k].orientation, recorded.orientation));
+    errors.mean_distance += errors.distance.back() / static_cast<double>(n);
+    errors.mean_angle += errors.angle.back() / static_cast<double>(n);
+  }
+  errors.rest_distance = errors.distance.back();
+  errors.rest_angle = errors.angle.back();
+  return errors;
+}
+
+double cpuSeconds() {
+  timespec now{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
+  return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
+}
+
+/// The fitting objective: the mean over `tosses` of each toss's mean centre error (widths).
+double meanError(const Peer& peer, const Contact& contact, const std::vector<const Toss*>& tosses) {
+  const Simulate simulate = peer.make(contact);
+  double sum = 0.0;
+  for (const Toss* toss : tosses) {
+    sum += measure(simulate(firstState(*toss), toss->samples.size()), *toss).mean_distance;
+  }
+  return sum / static_cast<double>(tosses.size());
+}
+
+struct Fit {
+  Contact best;
+  double objective = std::numeric_limits<double>::infinity();
+  std::size_t evaluations = 0;
+  double cpu = 0.0;  ///< s
+};
+
+std::vector<double> fineValues(double centre, double step, double low, double high) {
+  std::vector<double> values;
+  for (int i = -kFineSteps; i <= kFineSteps; ++i) {
+    const double value = centre + static_cast<double>(i) * step;
+    if (value >= low - 1e-12 && value <= high + 1e-12) values.push_back(value);
+  }
+  return values;
+}
+
+Fit fit(const Peer& peer, const std::vector<const Toss*>& tosses) {
+  const double started = cpuSeconds();
+  Fit result;
+  const auto grid = [&](const std::vector<double>& restitutions,
+                        const std::vector<double>& frictions) {
+    for (const double e : peer.fits_restitution ? restitutions : std::vector<double>{0.0}) {
+      for (const double mu : frictions) {
+        const Contact contact{e, mu};
+        const double objective = meanError(peer, contact, tosses);
+        ++result.evaluations;
+        std::cerr << "   e " << e << ", mu " << mu << ": " << objective << " widths\n";
+        if (objective < result.objective) {
+          result.objective = objective;
+          result.best = contact;
+        }
+      }
+    }
+  };
+  grid(kCoarseRestitutions, kCoarseFrictions);
+  const Contact coarse = result.best;
+  grid(fineValues(coarse.restitution, kFineRestitutionStep, 0.0, 1.0),
+       fineValues(coarse.friction, kFineFrictionStep, 0.01, 1.5));
+  result.cpu = cpuSeconds() - started;
+  return result;
+}
+
+std::string json(double value) {
+  if (!std::isfinite(value)) return "null";
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", value);
+  return text;
+}
+
+std::string jsonList(const std::vector<double>& values) {
+  std::string text = "[";
+  for (std::size_t i = 0; i < values.size(); ++i) text += (i ? ", " : "") + json(values[i]);
+  return text + "]";
+}
+
+std::string jsonNames(const std::vector<const Toss*>& tosses) {
+  std::string text = "[";
+  for (std::size_t i = 0; i < tosses.size(); ++i) {
+    text += (i ? ", \"" : "\"") + tosses[i]->name + "\"";
+  }
+  return text + "]";
+}
+
+/// Everything measured for one peer, as a JSON object.
+std::string runPeer(const Peer& peer, const std::vector<const Toss*>& fitting,
+                    const std::vector<const Toss*>& evaluation) {
+  std::cerr << "== " << peer.name << ": fitting on " << fitting.size() << " tosses\n";
+  const Fit fitted = fit(peer, fitting);
+  std::cerr << "   e " << fitted.best.restitution << ", mu " << fitted.best.friction
+            << ", mean error " << fitted.objective << " widths (" << fitted.evaluations
+            << " grid points, " << fitted.cpu << " s CPU)\n";
+
+  const Simulate simulate = peer.make(fitted.best);
+  std::vector<Errors> errors;
+  double played = 0.0;  // s simulated
+  const double started = cpuSeconds();
+  for (const Toss* toss : evaluation) {
+    errors.push_back(measure(simulate(firstState(*toss), toss->samples.size()), *toss));
+    played += static_cast<double>(toss->samples.size() - 1) / kSampleRate;
+  }
+  const double cpu = cpuSeconds() - started;
+
+  // Each evaluation toss's own best over the coarse grid: what no parameter explains.
+  const double oracle_started = cpuSeconds();
+  std::vector<double> best_mean(evaluation.size(), std::numeric_limits<double>::infinity());
+  std::vector<double> best_rest(evaluation.size(), std::numeric_limits<double>::infinity());
+  for (const double e :
+       peer.fits_restitution ? kCoarseRestitutions : std::vector<double>{fitted.best.restitution}) {
+    for (const double mu : kCoarseFrictions) {
+      const Simulate at = peer.make(Contact{e, mu});
+      for (std::size_t i = 0; i < evaluation.size(); ++i) {
+        const Toss& toss = *evaluation[i];
+        const Errors own = measure(at(firstState(toss), toss.samples.size()), toss);
+        best_mean[i] = std::min(best_mean[i], own.mean_distance);
+        best_rest[i] = std::min(best_rest[i], own.rest_distance);
+      }
+    }
+  }
+  const double oracle_cpu = cpuSeconds() - oracle_started;
+  std::cerr << "   evaluated " << evaluation.size() << " tosses in " << cpu << " s CPU; each's "
+            << "own best in " << oracle_cpu << " s CPU\n";
+
+  // The median toss (by its mean centre error): its errors over time, for the plot.
+  std::vector<std::size_t> order(evaluation.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return errors[a].mean_distance < errors[b].mean_distance;
+  });
+  const std::size_t median = order[order.size() / 2];
+
+  std::vector<double> column[4];
+  for (const Errors& toss : errors) {
+    column[0].push_back(toss.mean_distance);
+    column[1].push_back(toss.rest_distance);
+    column[2].push_back(toss.mean_angle);
+    column[3].push_back(toss.rest_angle);
+  }
+  std::ostringstream out;
+  out << "    {\"name\": \"" << peer.name << "\", \"setting\": \"" << peer.setting << "\",\n"
+      << "     \"fits_restitution\": " << (peer.fits_restitution ? "true" : "false") << ",\n"
+      << "     \"fit\": {\"restitution\": " << json(fitted.best.restitution)
+      << ", \"friction\": " << json(fitted.best.friction)
+      << ", \"mean_distance\": " << json(fitted.objective)
+      << ", \"grid_points\": " << fitted.evaluations << ", \"cpu_s\": " << json(fitted.cpu)
+      << "},\n"
+      << "     \"cpu_per_toss_s\": " << json(cpu / static_cast<double>(evaluation.size()))
+      << ", \"cpu_per_simulated_s\": " << json(cpu / played) << ",\n"
+      << "     \"mean_distance\": " << jsonList(column[0]) << ",\n"
+      << "     \"rest_distance\": " << jsonList(column[1]) << ",\n"
+      << "     \"mean_angle\": " << jsonList(column[2]) << ",\n"
+      << "     \"rest_angle\": " << jsonList(column[3]) << ",\n"
+      << "     \"own_best_mean_distance\": " << jsonList(best_mean) << ",\n"
+      << "     \"own_best_rest_distance\": " << jsonList(best_rest) << ",\n"
+      << "     \"own_best_cpu_s\": " << json(oracle_cpu) << ",\n"
+      << "     \"median_toss\": {\"name\": \"" << evaluation[median]->name
+      << "\", \"distance\": " << jsonList(errors[median].distance)
+      << ", \"angle\": " << jsonList(errors[median].angle) << "}}";
+  return out.str();
+}
+
+std::vector<Peer> peers() {
+  std::vector<Peer> found;
+#ifdef COLLISION_RESPONSE_WITH_BULLET
+  found.push_back(bulletPeer());
+#endif
+#ifdef COLLISION_RESPONSE_WITH_ODE
+  found.push_back(odePeer());
+#endif
+#ifdef COLLISION_RESPONSE_WITH_MUJOCO
+  found.push_back(mujocoPeer(true));
+  found.push_back(mujocoPeer(false));
+#endif
+  return found;
+}
+
+int run(int argc, char** argv) {
+  std::filesystem::path folder = COLLISION_RESPONSE_CUBE_TOSSES;
+  if (const char* given = std::getenv("COLLISION_RESPONSE_CUBE_TOSSES")) folder = given;
+  std::string out_path, only;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (i + 1 < argc && arg == "--tosses") {
+      folder = argv[++i];
+    } else if (i + 1 < argc && arg == "--out") {
+      out_path = argv[++i];
+    } else if (i + 1 < argc && arg == "--only") {
+      only = argv[++i];
+    } else {
+      std::cerr << "usage: cube_tosses_peers [--tosses DIR] [--out FILE.json] [--only PEER]\n";
+      return 2;
+    }
+  }
+  if (!std::filesystem::is_directory(folder)) {
+    std::cerr << "cube_tosses_peers: skipped: no cube tosses at " << folder
+              << " (give --tosses DIR or set COLLISION_RESPONSE_CUBE_TOSSES)\n";
+    return 77;
+  }
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("toss_", 0) == 0 && entry.path().extension() == ".csv") {
+      files.push_back(entry.path());
+    }
+  }
+  std::sort(files.begin(), files.end());
+  if (files.empty()) {
+    std::cerr << "cube_tosses_peers: no toss_*.csv in " << folder << "\n";
+    return 1;
+  }
+  std::vector<Toss> tosses;
+  for (const auto& file : files) tosses.push_back(readToss(file));
+  std::vector<const Toss*> fitting, evaluation;
+  for (std::size_t i = 0; i < tosses.size(); ++i) {
+    (i % kFitStride == 0 ? fitting : evaluation).push_back(&tosses[i]);
+  }
+
+  std::vector<std::string> results;
+  for (const Peer& peer : peers()) {
+    if (!only.empty() && peer.name.rfind(only, 0) != 0) continue;
+    results.push_back(runPeer(peer, fitting, evaluation));
+  }
+  std::ostringstream out;
+  out << "{\"tosses\": " << tosses.size() << ", \"fit_stride\": " << kFitStride
+      << ",\n \"step_s\": " << json(kStep) << ", \"sample_rate_hz\": " << json(kSampleRate)
+      << ", \"width_m\": " << json(kWidth) << ", \"mass_kg\": " << json(kMass)
+      << ", \"inertia_kg_m2\": " << json(kInertia) << ", \"table_top_m\": " << json(kTableTop)
+      << ", \"gravity\": " << json(kGravity)
+      << ",\n \"coarse_restitutions\": " << jsonList(kCoarseRestitutions)
+      << ", \"coarse_frictions\": " << jsonList(kCoarseFrictions)
+      << ", \"fine_restitution_step\": " << json(kFineRestitutionStep)
+      << ", \"fine_friction_step\": " << json(kFineFrictionStep)
+      << ", \"fine_steps\": " << kFineSteps << ",\n \"fitting\": " << jsonNames(fitting)
+      << ",\n \"evaluation\": " << jsonNames(evaluation) << ",\n \"peers\": [\n";
+  for (std::size_t i = 0; i < results.size(); ++i) out << (i ? ",\n" : "") << results[i];
+  out << "\n]}\n";
+  if (out_path.empty()) {
+    std::cout << out.str();
+  } else {
+    std::ofstream file(out_path);
+    file << out.str();
+    if (!file) throw std::runtime_error(out_path + ": cannot be written");
+  }
+  return 0;
+}
+
+}  // namespace
+}  // namespace collision_response::bench::cube_tosses
+
+int main(int argc, char** argv) {
+  try {
+    return collision_response::bench::cube_tosses::run(argc, argv);
+  } catch (const std::exception& error) {
+    std::cerr << "cube_tosses_peers: " << error.what() << "\n";
+    return 1;
+  }
+}

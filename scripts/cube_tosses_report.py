@@ -1,0 +1,299 @@
+#!/usr/bin/env python3
+"""The real cube tosses' report: doc/cube_tosses.md and doc/cube_tosses.png from what
+bench/cube_tosses/main.cpp (cube_tosses_peers) wrote. Run by scripts/cube_tosses.sh:
+
+    cube_tosses_report.py RESULTS.json TOSSES_DIR DOC_DIR [VERSIONS]
+
+RESULTS.json: the benchmark's output; TOSSES_DIR: the tosses (read again for the free flight's
+floor, below); DOC_DIR: where the page and the plot go; VERSIONS: the peers' Debian packages, one
+line of text. Besides the peers' figures it measures, from the recording alone, the part of the
+error no contact model explains: each evaluation toss's free flight (its first samples, before
+its lowest corner comes within 5 mm of the table) against the parabola from its first recorded
+state under g = 9.81 m/s^2, which every engine follows until the first contact.
+"""
+import csv
+import json
+import math
+import os
+import sys
+import textwrap
+
+import numpy as np
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+CLEARANCE = 0.005  # m: a flight's samples are this far above the table (test_cube_tosses.cpp)
+
+
+def quantiles(values):
+    """Median and 90th percentile (numpy's linear interpolation)."""
+    a = np.asarray(values, dtype=float)
+    return float(np.median(a)), float(np.percentile(a, 90))
+
+
+def pair(values, digits):
+    median, p90 = quantiles(values)
+    return f"{median:.{digits}f} / {p90:.{digits}f}"
+
+
+def read_toss(path):
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    return np.array([[float(x) for x in row] for row in rows[1:] if row])
+
+
+def lowest_corner(row, half_width):
+    """z of the cube's lowest corner: each body axis turned down by its half width."""
+    w, x, y, z = row[4:8] / np.linalg.norm(row[4:8])
+    # The third row of the rotation matrix (world z of each body axis).
+    third = np.array([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)])
+    return row[3] - half_width * np.abs(third).sum()
+
+
+def quaternion_product(a, b):
+    """Hamilton product of quaternions given as (w, x, y, z)."""
+    w1, v1 = a[0], np.asarray(a[1:])
+    w2, v2 = b[0], np.asarray(b[1:])
+    return np.concatenate(([w1 * w2 - v1 @ v2], w1 * v2 + w2 * v1 + np.cross(v1, v2)))
+
+
+def angle_deg(a, b):
+    """The angle of the rotation from orientation a to orientation b, deg."""
+    turn = quaternion_product(np.concatenate(([a[0]], -np.asarray(a[1:]))), b)
+    return float(np.degrees(2 * math.atan2(np.linalg.norm(turn[1:]), abs(turn[0]))))
+
+
+def free_motion(row, t, g):
+    """The exact free motion of a cube (isotropic inertia: a constant angular velocity) from the
+    recorded state `row` after t s: the centre's parabola and q0 (cos(|w| t / 2), sin(|w| t / 2)
+    w / |w|), w in the body's frame (the data set's README)."""
+    centre = row[1:4] + row[8:11] * t + 0.5 * g * t * t
+    q0 = row[4:8] / np.linalg.norm(row[4:8])
+    w = row[11:14]
+    rate = np.linalg.norm(w)
+    half = 0.5 * rate * t
+    turn = np.concatenate(([math.cos(half)], math.sin(half) * w / rate)) if rate > 0 else \
+        np.array([1.0, 0.0, 0.0, 0.0])
+    return centre, quaternion_product(q0, turn)
+
+
+def flight_samples(rows, half_width, table_top):
+    """How many samples the toss flies free: before its lowest corner comes within CLEARANCE."""
+    for k, row in enumerate(rows):
+        if lowest_corner(row, half_width) < table_top + CLEARANCE:
+            return k
+    return len(rows)
+
+
+def flight_floor(results, folder):
+    """Each evaluation toss's free flight against the exact free motion from its first recorded
+    state, at the flight's last sample: the centre's distance (widths), the orientation's angle
+    (deg), and that sample's time (s). Also each engine's median toss in flight against the same
+    exact motion: the largest difference of its errors from the exact motion's (widths, deg), a
+    check of the engines' start (frames, conventions)."""
+    width = results["width_m"]
+    g = np.array([0.0, 0.0, -results["gravity"]])
+    distance, angle, durations = [], [], []
+    for name in results["evaluation"]:
+        rows = read_toss(os.path.join(folder, name))
+        last = max(flight_samples(rows, 0.5 * width, results["table_top_m"]) - 1, 0)
+        t = rows[last, 0] - rows[0, 0]
+        centre, orientation = free_motion(rows[0], t, g)
+        distance.append(np.linalg.norm(centre - rows[last, 1:4]) / width)
+        angle.append(angle_deg(orientation, rows[last, 4:8] / np.linalg.norm(rows[last, 4:8])))
+        durations.append(t)
+    check = []
+    for p in results["peers"]:
+        toss = p["median_toss"]
+        rows = read_toss(os.path.join(folder, toss["name"]))
+        n = flight_samples(rows, 0.5 * width, results["table_top_m"])
+        worst_distance = worst_angle = 0.0
+        for k in range(n):
+            centre, orientation = free_motion(rows[0], rows[k, 0] - rows[0, 0], g)
+            exact_distance = np.linalg.norm(centre - rows[k, 1:4]) / width
+            exact_angle = angle_deg(orientation, rows[k, 4:8] / np.linalg.norm(rows[k, 4:8]))
+            worst_distance = max(worst_distance, abs(toss["distance"][k] - exact_distance))
+            worst_angle = max(worst_angle, abs(toss["angle"][k] - exact_angle))
+        check.append((p["name"], n, worst_distance, worst_angle))
+    return distance, angle, durations, check
+
+
+def wrapped(line):
+    """A paragraph or a list item wrapped at 100 columns; tables, headings, pictures and
+    comments as they are."""
+    if line.startswith(("|", "#", "<!--", "![")) or len(line) <= 100:
+        return line
+    indent = "  " if line.startswith("- ") else ""
+    return textwrap.fill(line, 100, subsequent_indent=indent, break_long_words=False,
+                         break_on_hyphens=False)
+
+
+def main():
+    if len(sys.argv) not in (4, 5):
+        sys.exit(__doc__)
+    results_path, folder, doc = sys.argv[1:4]
+    versions = sys.argv[4] if len(sys.argv) == 5 else ""
+    with open(results_path) as f:
+        results = json.load(f)
+    peers = results["peers"]
+    fitting, evaluation = results["fitting"], results["evaluation"]
+    width = results["width_m"]
+    floor, floor_angle, flight_times, check = flight_floor(results, folder)
+
+    lines = []
+    add = lines.append
+    add("# The real cube tosses: Bullet, ODE and MuJoCo beside the recording")
+    add("")
+    add("Regenerate: `bash scripts/cube_tosses.sh` (it builds `cube_tosses_peers`, "
+        "`bench/cube_tosses/`, runs it on the tosses in `../shared/data/cube_tosses`, or the "
+        "folder given as its argument, and writes this page and `doc/cube_tosses.png` with "
+        "`scripts/cube_tosses_report.py`; about 2 minutes on one core). The tosses are read where "
+        "they are, never copied into the repository; without them the script says so and stops.")
+    if versions:
+        add("")
+        add(f"Peers: {versions}.")
+    add("")
+    add("## The tosses and the model")
+    add("")
+    add(f"{results['tosses']} real tosses of a {1000 * width:g} mm acrylic cube "
+        f"({results['mass_kg']} kg) thrown by hand onto a table and tracked at "
+        f"{results['sample_rate_hz']:.0f} Hz: the real-world data set of ContactNets (Pfrommer, "
+        "Halm and Posa, CoRL 2020), on which Acosta, Yang and Posa (IEEE RA-L 2022) compared "
+        "Drake, MuJoCo and Bullet with reality. Every engine is given the same cube: a box of side "
+        f"{width} m, {results['mass_kg']} kg, the uniform solid's inertia m w^2 / 6 = "
+        f"{results['inertia_kg_m2']:.4g} kg m^2 (the data set's own authors fitted 8.1e-4 for "
+        "their simulator; not used here), over a plane, the table's top, at z = "
+        f"{results['table_top_m']} m, under g = {results['gravity']} m/s^2. Each toss starts "
+        "from its first recorded state: the centre, the orientation, the velocity and the angular "
+        "velocity (recorded in the cube's frame: turned into the world's for Bullet and ODE, given "
+        "as it is to MuJoCo, whose free joint takes it in the body's frame). Each engine steps at "
+        f"1/({results['sample_rate_hz']:.0f} x 7) s = {1000 * results['step_s']:.3f} ms (1036 Hz, "
+        "so that every sample's instant ends a step) over the recorded duration, and its pose is "
+        "taken at every sample.")
+    add("")
+    add(f"- **Fitting tosses** ({len(fitting)}): every {results['fit_stride']}th toss by file name "
+        f"(`{fitting[0]}`, `{fitting[1]}`, ..., `{fitting[-1]}`). e and mu are fitted on them by a "
+        "grid, coarse (e in " + ", ".join(f"{v:g}" for v in results["coarse_restitutions"]) +
+        "; mu in " + ", ".join(f"{v:g}" for v in results["coarse_frictions"]) +
+        f") then fine ({results['fine_steps']} steps of {results['fine_restitution_step']:g} in e "
+        f"and {results['fine_friction_step']:g} in mu either side of the coarse best): the pair of "
+        "least mean, over the fitting tosses, of each toss's mean centre error.")
+    add(f"- **Evaluation tosses** ({len(evaluation)}): all the others, played at the fitted e "
+        "and mu. Measured against the recording: the centre's distance as a fraction of the "
+        "cube's width, and the angle of the rotation from the played orientation to the recorded "
+        "one (deg; a cube that comes to rest on another face than the recorded one is off by 90 "
+        "deg or more, though it looks the same), each the mean over the toss and at rest (the "
+        "last sample, the cube still).")
+    add("")
+    add("## The figures")
+    add("")
+    add("Median / 90th percentile over the evaluation tosses. CPU per toss: this process's CPU "
+        "time for one evaluation toss (its mean over them), one core, at the fitted e and mu; "
+        "one run on a shared 2-core machine, where two runs' CPU times differ by up to a third.")
+    add("")
+    add("<!-- The row \"ours\" is filled by issue 42, step 8, when our engine moves a cube: "
+        "config/scenes/cube_toss.yaml, each evaluation toss's first state through ~predict_impacts "
+        "with sample_period 1/148 s, measured as the peers are here. -->")
+    add("| engine | e | mu | centre, mean over the toss (widths) | centre at rest (widths) | "
+        "angle, mean over the toss (deg) | angle at rest (deg) | tosses over 1 width at rest "
+        "(mean over the toss) | CPU per toss (ms) |")
+    add("|---|---|---|---|---|---|---|---|---|")
+    add("| **ours** | (not yet) | | not yet: our engine moves only spheres (issue 42) | | | | | |")
+    for p in peers:
+        e = f"{p['fit']['restitution']:.2f}" if p["fits_restitution"] else "(none)"
+        over_rest = sum(1 for v in p["rest_distance"] if v > 1)
+        over_mean = sum(1 for v in p["mean_distance"] if v > 1)
+        add(f"| {p['name']} | {e} | {p['fit']['friction']:.3f} | {pair(p['mean_distance'], 3)} | "
+            f"{pair(p['rest_distance'], 3)} | {pair(p['mean_angle'], 1)} | "
+            f"{pair(p['rest_angle'], 1)} | {over_rest} ({over_mean}) of {len(p['rest_distance'])} "
+            f"| {1000 * p['cpu_per_toss_s']:.2f} |")
+    add("")
+    add("Fit: the least mean error over the fitting tosses (widths), the grid's points, and the "
+        "fit's CPU time:")
+    add("")
+    for p in peers:
+        add(f"- {p['name']}: {p['fit']['mean_distance']:.3f} widths, {p['fit']['grid_points']} "
+            f"points, {p['fit']['cpu_s']:.1f} s.")
+    add("")
+    add("## What no parameter explains")
+    add("")
+    floor_median, floor_p90 = quantiles(floor)
+    angle_median, angle_p90 = quantiles(floor_angle)
+    add("- **The free flight.** Before any contact every engine should follow the exact free "
+        "motion from the first recorded state: the centre's parabola, and a constant angular "
+        "velocity (a cube's inertia is isotropic). Against the recording, at the flight's last "
+        "sample (the lowest corner still 5 mm above the table; "
+        f"{1000 * float(np.median(flight_times)):.0f} ms after the start, median), that motion "
+        f"is off by {floor_median:.3f} widths (median; 90th percentile {floor_p90:.3f}) and "
+        f"{angle_median:.2f} deg (median; 90th percentile {angle_p90:.2f}): the recorded "
+        "velocities are not exactly the recorded poses' rates (the rows are processed odometry), "
+        "and the flights fit g = 9.61 m/s^2 at the stated 148 Hz "
+        "(test/core/test_cube_tosses.cpp). No contact parameter removes this part; it grows "
+        "with the time to the first contact.")
+    add("- **Check of the engines' start.** In flight, each engine's median toss differs from "
+        "that exact free motion's errors by at most " +
+        "; ".join(f"{name} {d:.1e} widths and {a:.1e} deg over {n} samples"
+                  for name, n, d, a in check) +
+        ": the first states reach every engine in its own conventions (frames, quaternion "
+        "order) as the recording gives them (the centre's part is the steps' discretisation of "
+        "the parabola, about g dt t / 2: 0.5 mm at 0.1 s).")
+    add("- **Each toss's own best.** Each evaluation toss played at every point of the coarse "
+        "grid, keeping its least error: what the best single pair could do for that toss alone. "
+        "The gap between this and the fitted figures is the spread of the tosses' parameters; "
+        "what remains is what no (e, mu) of the model explains.")
+    add("")
+    add("| engine | centre, mean over the toss, own best (widths) | centre at rest, own best "
+        "(widths) | tosses over 1 width at rest even at their own best | CPU of this search (s) |")
+    add("|---|---|---|---|---|")
+    for p in peers:
+        stuck = sum(1 for v in p["own_best_rest_distance"] if v > 1)
+        add(f"| {p['name']} | {pair(p['own_best_mean_distance'], 3)} | "
+            f"{pair(p['own_best_rest_distance'], 3)} | {stuck} of "
+            f"{len(p['own_best_rest_distance'])} | {p['own_best_cpu_s']:.1f} |")
+    add("")
+    add("## The settings")
+    add("")
+    for p in peers:
+        add(f"- **{p['name']}**: {p['setting']}.")
+    add("- MuJoCo has no coefficient of restitution: its contacts are soft, set by solref and "
+        "solimp. \"e through solref\" is its closest setting to e, the direct solref whose "
+        "unilateral spring-dashpot has restitution e (`bench/accuracy/spring_dashpot.h`, as the "
+        "accuracy benchmark sets it), e and mu fitted; \"default contact\" keeps MuJoCo's soft "
+        "contact, mu alone fitted. Acosta, Yang and Posa fitted MuJoCo's solref in the same way.")
+    add("")
+    add("## The median toss, over time")
+    add("")
+    add("![The centre's distance and the orientation's angle over the toss](cube_tosses.png)")
+    add("")
+    add("Each engine's median evaluation toss (by its mean centre error): " +
+        "; ".join(f"{p['name']}: `{p['median_toss']['name']}`" for p in peers) + ".")
+    add("")
+    with open(os.path.join(doc, "cube_tosses.md"), "w") as f:
+        f.write("\n".join(wrapped(line) for line in lines))
+
+    figure, (left, right) = plt.subplots(1, 2, figsize=(11, 4))
+    for p in peers:
+        toss = p["median_toss"]
+        t = np.arange(len(toss["distance"])) / results["sample_rate_hz"]
+        label = f"{p['name']} ({toss['name'].replace('.csv', '')})"
+        left.plot(t, toss["distance"], label=label)
+        right.plot(t, toss["angle"], label=label)
+    left.set_xlabel("t (s)")
+    left.set_ylabel("centre's distance (cube widths)")
+    right.set_xlabel("t (s)")
+    right.set_ylabel("orientation's angle (deg)")
+    left.set_title("centre")
+    right.set_title("orientation")
+    left.legend(fontsize=8)
+    for axis in (left, right):
+        axis.grid(True, alpha=0.3)
+    figure.suptitle("Each engine's median cube toss against the recording")
+    figure.tight_layout()
+    figure.savefig(os.path.join(doc, "cube_tosses.png"), dpi=80)
+
+
+if __name__ == "__main__":
+    main()
