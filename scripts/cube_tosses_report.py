@@ -262,7 +262,8 @@ def main():
         "solimp. \"e through solref\" is its closest setting to e, the direct solref whose "
         "unilateral spring-dashpot has restitution e (`bench/accuracy/spring_dashpot.h`, as the "
         "accuracy benchmark sets it), e and mu fitted; \"default contact\" keeps MuJoCo's soft "
-        "contact, mu alone fitted. Acosta, Yang and Posa fitted MuJoCo's solref in the same way.")
+        "contact, mu alone fitted. Acosta, Yang and Posa likewise tuned MuJoCo's contact stiffness "
+        "and damping (solref) on these tosses, for want of an e.")
     add("")
     add("## The median toss, over time")
     add("")
