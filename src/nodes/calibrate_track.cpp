@@ -14,6 +14,7 @@
 // Prints the result as one JSON object on standard output; exit status 0, or 1 with
 // {"error": {"problem": ..., "field": ..., "reason": ..., "message": ...}} when the recording gives
 // no coefficients, or 2 with a message on standard error when INPUT cannot be read.
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <fstream>
@@ -57,6 +58,10 @@ std::string number(double value) {
 std::string estimate(const Estimate& e) {
   return "{\"value\": " + number(e.value) + ", \"standard_error\": " + number(e.standard_error) +
          ", \"low\": " + number(e.low()) + ", \"high\": " + number(e.high()) + "}";
+}
+
+std::string estimates(const std::array<Estimate, 3>& e) {
+  return "[" + estimate(e[0]) + ", " + estimate(e[1]) + ", " + estimate(e[2]) + "]";
 }
 
 std::string vector(const Eigen::Vector3d& v) {
@@ -122,6 +127,8 @@ std::string json(const Calibration& c, const std::vector<std::vector<std::size_t
         << ", \"friction_ratio\": " << estimate(b.friction_ratio)
         << ", \"friction\": " << quoted(collision_response::core::toString(b.friction))
         << ", \"slip_after\": " << estimate(b.slip_after)
+        << ", \"spin_change\": " << estimates(b.spin_change)
+        << ", \"spin_after\": " << (b.spin_after ? estimates(*b.spin_after) : std::string("null"))
         << ", \"samples_before\": " << b.samples_before
         << ", \"samples_after\": " << b.samples_after << "}";
   }

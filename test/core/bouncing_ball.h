@@ -24,6 +24,8 @@ struct TrueBounce {
   double time = 0.0;
   V before = V::Zero();
   V after = V::Zero();
+  V spin_before = V::Zero();  ///< rad/s
+  V spin_after = V::Zero();
   bool stuck = false;
 };
 
@@ -83,7 +85,9 @@ inline Track throwBall(const Throw& t) {
       tangential_change = -std::min(stick, t.mu * normal_change) * u_t.normalized();
     }
     after += tangential_change;
+    bounce.spin_before = w;
     w -= (2.5 / t.radius) * n.cross(tangential_change);
+    bounce.spin_after = w;
     bounce.after = after;
     track.bounces.push_back(bounce);
     p = at;

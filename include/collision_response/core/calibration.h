@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstddef>
 #include <optional>
 #include <string>
@@ -90,6 +91,15 @@ struct BounceEstimate {
   FrictionReading friction = FrictionReading::kSpinUnknown;
   /// m/s: the contact point's slip after the bounce along its slip before (with a known spin).
   Estimate slip_after;
+  /// rad/s, each component: the change of spin the bounce's tangential impulse implies, for a
+  /// ball dw = (r x J_t) / I with r = -R n (the contact point from the centre), J_t = m dv_t and
+  /// I = k m R^2: -(1 / (k R)) n x dv_t (1/k friction.h's spinFactor). Known without the spin
+  /// before (the impulse is the fitted velocities'); 0 for a ball of radius 0.
+  std::array<Estimate, 3> spin_change;
+  /// rad/s, each component: the spin after the bounce, the spin before (the tracker's over the
+  /// flight before, else spin_before carried through the earlier bounces) plus spin_change; none
+  /// when the spin before is unknown.
+  std::optional<std::array<Estimate, 3>> spin_after;
   std::size_t samples_before = 0;  ///< in the flight that ends here
   std::size_t samples_after = 0;   ///< in the flight that starts here
 };

@@ -501,8 +501,11 @@ std::pair<Estimate, double> commonMean(const Eigen::VectorXd& values,
 }
 
 /// What each bounce gives, from a motion built of the parameters: per bounce its instant, the
-/// approach speed, e, the friction ratio, the slip before and after (along the slip before).
-constexpr Eigen::Index kPerBounce = 6;
+/// approach speed, e, the friction ratio, the slip before and after (along the slip before), the
+/// spin change (3) and the spin after (3; 0 while the spin is unknown).
+constexpr Eigen::Index kPerBounce = 12;
+constexpr Eigen::Index kSpinChangeAt = 6;
+constexpr Eigen::Index kSpinAfterAt = 9;
 
 /// The recording with times counted from its first sample's (a stamp of 1.7e9 s, a ROS clock's,
 /// has a resolution of 2e-7 s).
@@ -664,20 +667,24 @@ class BounceQuantities {
         spin = *measured_spin_[j];
         spin_known = true;
       }
+      // The turn of the tangential impulse J_t = m dv_t at the contact point r = -R n from the
+      // centre: dw = (r x J_t) / I with I = k m R^2, -(1 / (k R)) n x dv_t (calibration.h).
+      const Eigen::Vector3d spin_change =
+          options_.radius > 0.0
+              ? Eigen::Vector3d(-(spin_factor_ / options_.radius) * n.cross(tangential_change))
+              : Eigen::Vector3d::Zero();
       double slip_before = 0.0;
       double slip_after = 0.0;
       if (spin_known) {
         // The contact point (at -r n from the centre) slips at u = v + w x (-r n), tangentially;
-        // the tangential impulse changes u by (1 + 1/k) dv_t and w by -(1 / (k r)) n x dv_t
-        // (I = k m r^2): friction.h's tangential inverse mass.
+        // the tangential impulse changes u by (1 + 1/k) dv_t and w by spin_change: friction.h's
+        // tangential inverse mass.
         const Eigen::Vector3d u = before + spin.cross(-options_.radius * n);
         const Eigen::Vector3d u_t = u - u.dot(n) * n;
         slip_before = u_t.norm();
         const Eigen::Vector3d u_after = u_t + (1.0 + spin_factor_) * tangential_change;
         slip_after = slip_before > 0.0 ? u_after.dot(u_t) / slip_before : u_after.norm();
-        if (options_.radius > 0.0) {
-          spin -= (spin_factor_ / options_.radius) * n.cross(tangential_change);
-        }
+        spin += spin_change;
       }
       const auto row = static_cast<Eigen::Index>(kPerBounce * j);
       out[row] = motion_.pieces()[j + 1].start;
@@ -686,15 +693,21 @@ class BounceQuantities {
       out[row + 3] = tangential_change.norm() / change.dot(n);
       out[row + 4] = slip_before;
       out[row + 5] = slip_after;
+      out.segment<3>(row + kSpinChangeAt) = spin_change;
+      out.segment<3>(row + kSpinAfterAt) = spin_known ? spin : Eigen::Vector3d::Zero();
     }
     if (layout_.drag) out[out.size() - 1] = p[static_cast<Eigen::Index>(layout_.dragAt())];
     return out.allFinite();
   }
 
-  /// Whether the spin before bounce j is known: tracked over the flight before it, or carried
-  /// from spin_before.
+  /// Whether the spin before bounce j is known: given (spin_before), or tracked over the flight
+  /// before it or an earlier one, and carried from there.
   bool spinKnown(std::size_t j) const {
-    return measured_spin_[j].has_value() || options_.spin_before.has_value();
+    if (options_.spin_before) return true;
+    for (std::size_t i = 0; i <= j; ++i) {
+      if (measured_spin_[i]) return true;
+    }
+    return false;
   }
 
  private:
@@ -742,6 +755,12 @@ RecordingResult<BounceEstimate> bounceEstimate(std::size_t j, const Eigen::Vecto
   bounce.slip_after = at(row + 5);
   bounce.friction =
       frictionReading(spin_known, at(row + 4), bounce.slip_after, bounce.approach_speed);
+  std::array<Estimate, 3> spin_after;
+  for (Eigen::Index i = 0; i < 3; ++i) {
+    bounce.spin_change[static_cast<std::size_t>(i)] = at(row + kSpinChangeAt + i);
+    spin_after[static_cast<std::size_t>(i)] = at(row + kSpinAfterAt + i);
+  }
+  if (spin_known) bounce.spin_after = spin_after;
   for (const auto& sample : samples) {
     const std::size_t piece = motion.pieceAt(sample.time);
     if (piece == j) ++bounce.samples_before;
