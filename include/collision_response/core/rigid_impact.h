@@ -1,0 +1,113 @@
+// One impact of two rigid bodies with rotation, exact, never gaining energy (issue 42, build
+// step 3): one contact with Chatterjee and Ruina's law (frictionless: Newton's e along the normal
+// with the effective mass), and several contacts of shaped bodies at one instant by Newton's
+// joint rule with the lever arms (frictionless). Balls keep today's code, bit for bit.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "collision_response/core/expected.h"
+#include "collision_response/core/simultaneous.h"
+#include "collision_response/core/solver_body.h"
+
+namespace collision_response::core {
+
+/// What one impact did.
+struct RigidImpactOutcome {
+  Eigen::Vector3d impulse = Eigen::Vector3d::Zero();  ///< N s, on b at the contact; -impulse on a
+  double normal_impulse = 0.0;                        ///< N s, impulse.n, >= 0
+  Eigen::Vector3d tangential_impulse = Eigen::Vector3d::Zero();  ///< N s, impulse - (impulse.n) n
+  double approach_speed = 0.0;  ///< m/s, -u.n before (u: b's contact point relative to a's)
+  /// The impulse lies inside the friction cone (kappa = 1 + e_t below): the contact did not
+  /// slide. Balls: applyFriction's sticking, or no slip to stop.
+  bool sticking = false;
+  double energy_lost = 0.0;  ///< J, >= 0
+};
+
+/// Resolves one impact of `a` and `b` at `contact` (normal a -> b, lever arms r_a, r_b from each
+/// centre of mass to the contact point), updating their velocities and angular velocities. No
+/// impulse where the contact points do not approach (u.n >= 0).
+///
+/// Two balls (both kIsotropic) and e_t = 0: today's code, bit for bit: resolveImpact (impact.h)
+/// along the normal, then, where mu > 0, Coulomb friction with the spin effect
+/// (applyFriction<true>, friction.h) on the slip left after it, as a single contact of the
+/// monitor's clusters is resolved (cluster_solver.cpp, solveContact). Every other pair:
+/// resolveRigidImpactByLaw.
+///
+/// Bad input, named: restitution outside [0, 1], friction < 0 or not finite, tangential
+/// restitution outside [-1, 1], a normal not finite or not of unit length (to 1e-9), a lever arm,
+/// velocity or angular velocity not finite, an inverse mass < 0 or not finite, both sides
+/// immovable, an inverse inertia tensor not finite or with a negative diagonal entry, a ball's
+/// spin factor or radius < 0 or not finite. Whether a tensor is positive definite is
+/// checkInertiaTensor's (mass_properties.h), where a user gives it.
+Expected<RigidImpactOutcome> resolveRigidImpact(SolverBody& a, SolverBody& b,
+                                                const ContactPoint& contact, double restitution,
+                                                double friction,
+                                                double tangential_restitution = 0.0);
+
+/// Chatterjee and Ruina's algebraic law ("A new algebraic rigid-body collision law based on
+/// impulse space considerations", J. Appl. Mech. 65:939-951, 1998, section "A new collision law"),
+/// for any two bodies, balls included (resolveRigidImpact uses it for every pair but two balls).
+/// With K the contact's inverse effective mass (effective_mass.h) and u0 the contact points'
+/// relative velocity before (u_n = u0.n < 0):
+///
+///   P_I  = (-u_n / n.K.n) n          the frictionless, perfectly plastic impulse;
+///   P_II = K^-1 (-u0)                the sticking, perfectly plastic impulse; D = P_II - P_I;
+///   P^   = (1 + e) P_I + (1 + e_t) D,
+///
+/// P = P^ where it lies inside the friction cone |P_t| <= mu P_n (sticking); otherwise
+/// P = (1 + e) P_I + kappa D with kappa = mu (1 + e) |P_I| / (|D_t| - mu D.n), on the cone.
+/// (The law as an impulse of the frictionless restitution plus a share of the tangential one,
+/// e_t the tangential restitution, 0 by default: Chatterjee and Ruina's own default.)
+///
+/// What it guarantees, exactly (not only for these tests):
+/// - Newton's e along the normal whatever mu: n.K.D = n.(-u0) - n.K.P_I = 0, so
+///   u'.n = u_n + (1 + e) P_I.K.n = -e u_n. With mu = 0 it is the frictionless impact, P =
+///   (1 + e) m_eff (-u_n) n with m_eff = 1 / n.K.n, losing (1/2) m_eff (1 - e^2) u_n^2.
+/// - It never gains energy for e in [0, 1], e_t in [-1, 1], mu >= 0: the energy changes by
+///   P.u0 + P.K.P / 2 = -(1 - e^2) P_I.K.P_I / 2 - kappa (2 - kappa) D.K.D / 2 (P_I and D are
+///   K-orthogonal), and 0 <= kappa <= 1 + e_t <= 2 (the cone is reached before P^). energy_lost
+///   is this closed form, each term >= 0.
+/// - Coulomb's cone |P_t| <= mu P_n, P_n >= 0; angular momentum about the contact point is
+///   conserved for each body (its impulse acts there).
+/// - Balls (K block-diagonal: r along n): P_I the normal impulse of resolveImpact, D the
+///   sticking impulse of applyFriction, so P is today's answer (to rounding; the tests: a few
+///   ulps).
+/// A reading of the law that splits the sticking impulse (P_hat = (1 + e) P_II,n n + P_II,t)
+/// instead of P_I and D gains energy where K couples the normal and the slip (a rod on its end):
+/// test/exact/rigid_impact.py finds such cases and none for this one.
+///
+/// Computed in long double from K (double) and rounded once into the bodies. Not checked here
+/// (resolveRigidImpact checks).
+RigidImpactOutcome resolveRigidImpactByLaw(SolverBody& a, SolverBody& b,
+                                           const ContactPoint& contact, double restitution,
+                                           double friction, double tangential_restitution);
+
+/// Resolves contacts of shaped bodies that all strike at one instant (a box landing flat touches
+/// the floor at four corners), frictionless, updating the bodies' velocities and angular
+/// velocities; outcomes in the order of `contacts`. Friction at several contacts at once of a
+/// shaped body is not here yet (a body given by its tensor with friction: one contact at a time,
+/// resolveRigidImpact).
+///
+/// The rule: Newton's joint rule of resolveSimultaneous (simultaneous.h) with the lever arms:
+/// impulses J_k >= 0 such that every contact that receives one leaves with d_k' = -e_k d_k, d_k
+/// the contact points' relative normal velocity, A J = (1 + e) (-d) with the Delassus matrix
+/// A_kl = sum over the bodies i that contacts k and l share of s_ik s_il n_k.K_i(r_ik, r_il).n_l
+/// = s_ik s_il (w_i n_k.n_l + (r_ik x n_k).I_i^-1 (r_il x n_l)) (s = +1 on b, -1 on a); a
+/// contact that would pull is dropped and the rest solved again. Independent of the order of the
+/// contacts: they are put in one canonical order first (by point, then normal, lever arms,
+/// bodies and e), A is solved in long double by a complete orthogonal decomposition (A is
+/// singular for four coplanar corners: the least-norm impulses, which give the only velocities
+/// the rule allows), the impulses rounded to doubles and each body's changes summed order-free.
+/// The energy changes by -sum_k J_k (1 - e_k)(-d_k) / 2 <= 0. A box of e = 1 landing flat
+/// leaves at -v without spin; with any e in [0, 1] it loses (1/2) m (1 - e^2) v^2.
+///
+/// All bodies balls (kIsotropic): resolveSimultaneous itself, bit for bit.
+///
+/// Bad input, named (contacts[k].field, bodies[i].field): as resolveRigidImpact, and a contact's
+/// body index out of range or both sides one body.
+Expected<std::vector<ContactOutcome>> resolveRigidSimultaneous(
+    std::vector<SolverBody>& bodies, const std::vector<ClusterContact>& contacts);
+
+}  // namespace collision_response::core

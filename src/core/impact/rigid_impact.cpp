@@ -1,0 +1,413 @@
+#include "collision_response/core/rigid_impact.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numeric>
+#include <string>
+#include <tuple>
+#include <utility>
+
+#include "collision_response/core/friction.h"
+#include "collision_response/core/impact.h"
+#include "collision_response/core/validation.h"
+#include "solver/effective_mass.h"
+#include "solver/impulse_response.h"
+#include "solver/order_free.h"
+
+namespace collision_response::core {
+namespace {
+
+using RealL = long double;
+using Vector3L = Eigen::Matrix<RealL, 3, 1>;
+using Matrix3L = Eigen::Matrix<RealL, 3, 3>;
+
+/// |n| = 1 to this: a normal that is a unit vector to the rounding of its computation.
+constexpr double kUnitTolerance = 1e-9;
+
+Status checkBodyForImpact(const SolverBody& body, const std::string& field) {
+  if (!std::isfinite(body.inverse_mass) || body.inverse_mass < 0.0) {
+    return Error{field + ".inverse_mass", "must be a finite number >= 0 (0: immovable), got " +
+                                              formatNumber(body.inverse_mass)};
+  }
+  if (auto status = checkFinite(body.velocity, field + ".velocity"); !status) return status;
+  if (auto status = checkFinite(body.angular_velocity, field + ".angular_velocity"); !status) {
+    return status;
+  }
+  if (body.inertia_kind == InverseInertiaKind::kIsotropic) {
+    if (!std::isfinite(body.spin_factor) || body.spin_factor < 0.0) {
+      return Error{field + ".spin_factor",
+                   "must be a finite number >= 0 (1/k of I = k m r^2; 0: does not turn), got " +
+                       formatNumber(body.spin_factor)};
+    }
+    if (!std::isfinite(body.radius) || body.radius < 0.0) {
+      return Error{field + ".radius",
+                   "must be a finite number >= 0 m, got " + formatNumber(body.radius)};
+    }
+    return Ok{};
+  }
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      const double entry = body.inverse_inertia(i, j);
+      if (!std::isfinite(entry) || (i == j && entry < 0.0)) {
+        return Error{
+            field + ".inverse_inertia(" + std::to_string(i) + ", " + std::to_string(j) + ")",
+            i == j ? "a diagonal entry of I^-1 must be a finite number >= 0, got " +
+                         formatNumber(entry)
+                   : "must be a finite number, got " + formatNumber(entry)};
+      }
+    }
+  }
+  return Ok{};
+}
+
+/// The normal and lever arms of a contact, named `field` + "normal", ...
+Status checkContactGeometry(const ContactPoint& contact, const std::string& field) {
+  if (auto status = checkFinite(contact.normal, field + "normal"); !status) return status;
+  if (!(std::abs(contact.normal.norm() - 1.0) <= kUnitTolerance)) {
+    return Error{field + "normal", "must be a unit vector (to 1e-9), got " +
+                                       formatVector(contact.normal) + " of length " +
+                                       formatNumber(contact.normal.norm())};
+  }
+  if (auto status = checkFinite(contact.lever_a, field + "lever_a"); !status) return status;
+  return checkFinite(contact.lever_b, field + "lever_b");
+}
+
+Status checkPair(const SolverBody& a, const SolverBody& b, const std::string& field_a,
+                 const std::string& field_b) {
+  if (auto status = checkBodyForImpact(a, field_a); !status) return status;
+  if (auto status = checkBodyForImpact(b, field_b); !status) return status;
+  if (a.inverse_mass == 0.0 && b.inverse_mass == 0.0) {
+    return Error{field_b + ".inverse_mass",
+                 "both sides of the contact are immovable (inverse mass 0): nothing can move"};
+  }
+  return Ok{};
+}
+
+/// I^-1 of a side as the law sees it: a ball's from its spin factor, 0 where it does not turn.
+Matrix3L inverseInertiaOf(const SolverBody& body) {
+  if (!turns(body)) return Matrix3L::Zero();
+  if (body.inertia_kind == InverseInertiaKind::kIsotropic) {
+    return sphereInverseInertia(body.inverse_mass, body.spin_factor, body.radius).cast<RealL>();
+  }
+  return body.inverse_inertia.cast<RealL>();
+}
+
+/// The velocity of `body`'s material point at lever arm `lever`: v + w x r.
+Vector3L pointVelocity(const SolverBody& body, const Eigen::Vector3d& lever) {
+  return body.velocity.cast<RealL>() +
+         body.angular_velocity.cast<RealL>().cross(lever.cast<RealL>());
+}
+
+/// `impulse` (long double) on `body` at `lever`: v += w P, w += I^-1 (r x P), each rounded once.
+void applyImpulse(SolverBody& body, const Eigen::Vector3d& lever, const Vector3L& impulse) {
+  if (body.inverse_mass == 0.0) return;
+  body.velocity = (body.velocity.cast<RealL>() + RealL(body.inverse_mass) * impulse).cast<double>();
+  if (!turns(body)) return;
+  body.angular_velocity = (body.angular_velocity.cast<RealL>() +
+                           inverseInertiaOf(body) * lever.cast<RealL>().cross(impulse))
+                              .cast<double>();
+}
+
+/// Today's single contact of two balls (cluster_solver.cpp, solveContact with the spin effect).
+RigidImpactOutcome resolveBalls(SolverBody& a, SolverBody& b, const ContactPoint& contact,
+                                double restitution, double friction) {
+  RigidImpactOutcome outcome;
+  const ImpactResponse<double> response = resolveImpact(a.inverse_mass, a.velocity, b.inverse_mass,
+                                                        b.velocity, contact.normal, restitution);
+  outcome.approach_speed = response.approach_speed;
+  if (!response.approaching) return outcome;
+  a.velocity = response.velocity_a;
+  b.velocity = response.velocity_b;
+  outcome.normal_impulse = response.normal_impulse;
+  outcome.energy_lost = response.energy_lost;
+  const Eigen::Vector3d slip = slipAt<true>(a, b, contact);
+  outcome.sticking = !(slip.norm() > 0);
+  if (friction > 0) {
+    const FrictionOutcome sliding =
+        applyFriction<true>(a, b, contact, friction, response.normal_impulse);
+    outcome.sticking = outcome.sticking || sliding.sticking;
+    if (sliding.impulse > 0) outcome.tangential_impulse = -sliding.impulse * (slip / slip.norm());
+    outcome.energy_lost += sliding.energy_lost;
+  }
+  outcome.impulse = outcome.normal_impulse * contact.normal + outcome.tangential_impulse;
+  return outcome;
+}
+
+}  // namespace
+
+RigidImpactOutcome resolveRigidImpactByLaw(SolverBody& a, SolverBody& b,
+                                           const ContactPoint& contact, double restitution,
+                                           double friction, double tangential_restitution) {
+  RigidImpactOutcome outcome;
+  const Vector3L n = contact.normal.cast<RealL>();
+  const Vector3L u0 = pointVelocity(b, contact.lever_b) - pointVelocity(a, contact.lever_a);
+  const RealL normal_velocity = u0.dot(n);  // u_n
+  outcome.approach_speed = static_cast<double>(-normal_velocity);
+  if (!(normal_velocity < 0)) return outcome;
+
+  const Matrix3L k =
+      inverseEffectiveMass(contactSideOf(a, contact.lever_a), contactSideOf(b, contact.lever_b))
+          .cast<RealL>();
+  const Vector3L kn = k * n;
+  const RealL nkn = n.dot(kn);
+  const RealL plastic_normal = -normal_velocity / nkn;  // |P_I|, > 0
+  // D = P_II - P_I = K^-1 (-u0 - K P_I): the sticking impulse's part that K holds orthogonal to n.
+  const Vector3L d = k.ldlt().solve(-u0 - plastic_normal * kn);
+  const RealL d_normal = d.dot(n);
+  const RealL d_tangential = (d - d_normal * n).norm();
+
+  const RealL e = restitution;
+  const RealL one_plus_et = RealL(1) + RealL(tangential_restitution);
+  const RealL mu = friction;
+  const RealL frictionless_normal = (RealL(1) + e) * plastic_normal;  // (1 + e) |P_I|
+  RealL kappa = one_plus_et;
+  outcome.sticking =
+      one_plus_et * d_tangential <= mu * (frictionless_normal + one_plus_et * d_normal);
+  if (!outcome.sticking) {
+    // On the cone: kappa |D_t| = mu ((1 + e) |P_I| + kappa D.n), whose denominator is > 0
+    // where P^ lies outside (1 + e_t > 0 there); held in [0, 1 + e_t] against rounding.
+    const RealL denominator = d_tangential - mu * d_normal;
+    kappa = denominator > 0
+                ? std::clamp(mu * frictionless_normal / denominator, RealL(0), one_plus_et)
+                : RealL(0);
+  }
+  const Vector3L impulse = frictionless_normal * n + kappa * d;
+  const RealL lost =
+      RealL(0.5) * (RealL(1) - e) * (RealL(1) + e) * plastic_normal * (-normal_velocity) +
+      RealL(0.5) * kappa * (RealL(2) - kappa) * d.dot(k * d);
+
+  applyImpulse(a, contact.lever_a, -impulse);
+  applyImpulse(b, contact.lever_b, impulse);
+  outcome.impulse = impulse.cast<double>();
+  const RealL normal_impulse = impulse.dot(n);
+  outcome.normal_impulse = static_cast<double>(normal_impulse);
+  outcome.tangential_impulse = (impulse - normal_impulse * n).cast<double>();
+  outcome.energy_lost = static_cast<double>(lost);
+  return outcome;
+}
+
+Expected<RigidImpactOutcome> resolveRigidImpact(SolverBody& a, SolverBody& b,
+                                                const ContactPoint& contact, double restitution,
+                                                double friction, double tangential_restitution) {
+  if (auto status = checkContactGeometry(contact, "contact."); !status) return status.error();
+  if (auto status = checkRestitution(restitution, "restitution"); !status) return status.error();
+  if (auto status = checkFriction(friction, "friction"); !status) return status.error();
+  if (!(tangential_restitution >= -1.0 && tangential_restitution <= 1.0)) {
+    return Error{"tangential_restitution", "must be in [-1, 1] (0: the default), got " +
+                                               formatNumber(tangential_restitution)};
+  }
+  if (auto status = checkPair(a, b, "a", "b"); !status) return status.error();
+  SolverBody after_a = a, after_b = b;
+  const RigidImpactOutcome outcome =
+      a.inertia_kind == InverseInertiaKind::kIsotropic &&
+              b.inertia_kind == InverseInertiaKind::kIsotropic && tangential_restitution == 0.0
+          ? resolveBalls(after_a, after_b, contact, restitution, friction)
+          : resolveRigidImpactByLaw(after_a, after_b, contact, restitution, friction,
+                                    tangential_restitution);
+  if (auto status = checkRepresentable({namedResult("a.velocity", after_a.velocity),
+                                        namedResult("a.angular_velocity", after_a.angular_velocity),
+                                        namedResult("b.velocity", after_b.velocity),
+                                        namedResult("b.angular_velocity", after_b.angular_velocity),
+                                        namedResult("impulse", outcome.impulse),
+                                        namedResult("energy_lost", outcome.energy_lost)});
+      !status) {
+    return status.error();
+  }
+  a = after_a;
+  b = after_b;
+  return outcome;
+}
+
+namespace {
+
+using MatrixL = Eigen::Matrix<RealL, Eigen::Dynamic, Eigen::Dynamic>;
+using VectorL = Eigen::Matrix<RealL, Eigen::Dynamic, 1>;
+
+/// The canonical order of the contacts: by point, normal, lever arms, bodies and e, each
+/// compared lexicographically, so that any listing of the same contacts is solved alike.
+std::vector<std::size_t> canonicalOrder(const std::vector<ClusterContact>& contacts) {
+  const auto key = [&](std::size_t k) {
+    const ClusterContact& c = contacts[k];
+    return std::make_tuple(c.point.x(), c.point.y(), c.point.z(), c.normal.x(), c.normal.y(),
+                           c.normal.z(), c.lever_a.x(), c.lever_a.y(), c.lever_a.z(), c.lever_b.x(),
+                           c.lever_b.y(), c.lever_b.z(), c.a, c.b, c.restitution);
+  };
+  std::vector<std::size_t> order(contacts.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t k, std::size_t l) { return key(k) < key(l); });
+  return order;
+}
+
+/// The impulses of Newton's joint rule for contacts already in canonical order: A J = target,
+/// the least-norm solution by a complete orthogonal decomposition in long double, a contact
+/// that would pull dropped (the most negative first) and the rest solved again.
+std::vector<double> jointImpulses(const MatrixL& delassus, const VectorL& target) {
+  const auto count = delassus.rows();
+  std::vector<bool> active(static_cast<std::size_t>(count), true);
+  std::vector<double> impulses(static_cast<std::size_t>(count), 0.0);
+  for (Eigen::Index round = 0; round < count; ++round) {
+    std::vector<Eigen::Index> kept;
+    for (Eigen::Index k = 0; k < count; ++k) {
+      if (active[static_cast<std::size_t>(k)]) kept.push_back(k);
+    }
+    const auto size = static_cast<Eigen::Index>(kept.size());
+    MatrixL system(size, size);
+    VectorL right(size);
+    for (Eigen::Index i = 0; i < size; ++i) {
+      right[i] = target[kept[static_cast<std::size_t>(i)]];
+      for (Eigen::Index j = 0; j < size; ++j) {
+        system(i, j) =
+            delassus(kept[static_cast<std::size_t>(i)], kept[static_cast<std::size_t>(j)]);
+      }
+    }
+    // Rounded once to doubles: contacts that are mirror images of each other receive the same
+    // impulse to the bit, and their turns cancel exactly.
+    const Eigen::VectorXd solution =
+        system.completeOrthogonalDecomposition().solve(right).cast<double>();
+    std::fill(impulses.begin(), impulses.end(), 0.0);
+    Eigen::Index most_negative = -1;
+    for (Eigen::Index i = 0; i < size; ++i) {
+      impulses[static_cast<std::size_t>(kept[static_cast<std::size_t>(i)])] = solution[i];
+      if (solution[i] < 0 && (most_negative < 0 || solution[i] < solution[most_negative])) {
+        most_negative = i;
+      }
+    }
+    if (most_negative < 0) break;
+    active[static_cast<std::size_t>(kept[static_cast<std::size_t>(most_negative)])] = false;
+    if (size == 1) {
+      std::fill(impulses.begin(), impulses.end(), 0.0);
+      break;
+    }
+  }
+  for (double& impulse : impulses) impulse = std::max(impulse, 0.0);
+  return impulses;
+}
+
+}  // namespace
+
+Expected<std::vector<ContactOutcome>> resolveRigidSimultaneous(
+    std::vector<SolverBody>& bodies, const std::vector<ClusterContact>& contacts) {
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    if (auto status = checkBodyForImpact(bodies[i], "bodies[" + std::to_string(i) + "]"); !status) {
+      return status.error();
+    }
+  }
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    const ClusterContact& contact = contacts[k];
+    const std::string field = "contacts[" + std::to_string(k) + "].";
+    if (contact.a >= bodies.size() || contact.b >= bodies.size() || contact.a == contact.b) {
+      return Error{field + "b", "the bodies must be two different ones of the " +
+                                    std::to_string(bodies.size()) +
+                                    ", got a = " + std::to_string(contact.a) +
+                                    ", b = " + std::to_string(contact.b)};
+    }
+    if (auto status = checkContactGeometry(contact, field); !status) return status.error();
+    if (auto status = checkRestitution(contact.restitution, field + "restitution"); !status) {
+      return status.error();
+    }
+    if (bodies[contact.a].inverse_mass == 0.0 && bodies[contact.b].inverse_mass == 0.0) {
+      return Error{field + "b",
+                   "both sides of the contact are immovable (inverse mass 0): nothing can move"};
+    }
+  }
+  if (contacts.empty()) return std::vector<ContactOutcome>{};
+  if (std::all_of(bodies.begin(), bodies.end(), [](const SolverBody& body) {
+        return body.inertia_kind == InverseInertiaKind::kIsotropic;
+      })) {
+    return resolveSimultaneous(bodies, contacts);
+  }
+
+  const std::vector<std::size_t> order = canonicalOrder(contacts);
+  const auto count = static_cast<Eigen::Index>(contacts.size());
+  std::vector<Matrix3L> inverse_inertia(bodies.size());
+  for (std::size_t i = 0; i < bodies.size(); ++i) inverse_inertia[i] = inverseInertiaOf(bodies[i]);
+  // Each contact's side on a body: the body, its sign s (b: +1, a: -1), its lever arm.
+  struct Side {
+    std::size_t body;
+    RealL sign;
+    Vector3L lever;
+  };
+  const auto sidesOf = [&](const ClusterContact& c) {
+    return std::array<Side, 2>{Side{c.a, RealL(-1), c.lever_a.cast<RealL>()},
+                               Side{c.b, RealL(1), c.lever_b.cast<RealL>()}};
+  };
+  MatrixL delassus = MatrixL::Zero(count, count);
+  VectorL target(count);
+  VectorL approach(count);  // -d_k
+  for (Eigen::Index i = 0; i < count; ++i) {
+    const ClusterContact& ci = contacts[order[static_cast<std::size_t>(i)]];
+    const Vector3L ni = ci.normal.cast<RealL>();
+    approach[i] =
+        -(pointVelocity(bodies[ci.b], ci.lever_b) - pointVelocity(bodies[ci.a], ci.lever_a))
+             .dot(ni);
+    target[i] = (RealL(1) + RealL(ci.restitution)) * approach[i];
+    for (Eigen::Index j = 0; j < count; ++j) {
+      const ClusterContact& cj = contacts[order[static_cast<std::size_t>(j)]];
+      const Vector3L nj = cj.normal.cast<RealL>();
+      RealL value = 0;
+      for (const Side& si : sidesOf(ci)) {
+        for (const Side& sj : sidesOf(cj)) {
+          if (si.body != sj.body || bodies[si.body].inverse_mass == 0.0) continue;
+          value += si.sign * sj.sign *
+                   (RealL(bodies[si.body].inverse_mass) * ni.dot(nj) +
+                    si.lever.cross(ni).dot(inverse_inertia[si.body] * sj.lever.cross(nj)));
+        }
+      }
+      delassus(i, j) = value;
+    }
+  }
+  const std::vector<double> impulses = jointImpulses(delassus, target);
+
+  std::vector<ContactOutcome> outcomes(contacts.size());
+  std::vector<std::array<std::vector<RealL>, 6>> changes(bodies.size());  // dv, dw per axis
+  for (Eigen::Index i = 0; i < count; ++i) {
+    const std::size_t k = order[static_cast<std::size_t>(i)];
+    const ClusterContact& contact = contacts[k];
+    const RealL impulse = impulses[static_cast<std::size_t>(i)];
+    for (const Side& side : sidesOf(contact)) {
+      const SolverBody& body = bodies[side.body];
+      if (body.inverse_mass == 0.0 || impulse == 0) continue;
+      const Vector3L force = side.sign * impulse * contact.normal.cast<RealL>();
+      const Vector3L dv = RealL(body.inverse_mass) * force;
+      const Vector3L dw = inverse_inertia[side.body] * side.lever.cross(force);
+      for (int axis = 0; axis < 3; ++axis) {
+        changes[side.body][static_cast<std::size_t>(axis)].push_back(dv[axis]);
+        changes[side.body][static_cast<std::size_t>(axis) + 3].push_back(dw[axis]);
+      }
+    }
+    outcomes[k].impulse = impulses[static_cast<std::size_t>(i)];
+    outcomes[k].approach_speed = static_cast<double>(approach[i]);
+    outcomes[k].energy_lost = static_cast<double>(
+        RealL(0.5) * impulse * (RealL(1) - RealL(contact.restitution)) * approach[i]);
+  }
+  std::vector<SolverBody> after = bodies;
+  for (std::size_t b = 0; b < bodies.size(); ++b) {
+    if (changes[b][0].empty()) continue;
+    for (int axis = 0; axis < 3; ++axis) {
+      const auto index = static_cast<std::size_t>(axis);
+      after[b].velocity[axis] =
+          static_cast<double>(RealL(bodies[b].velocity[axis]) + orderFreeSum(changes[b][index]));
+      after[b].angular_velocity[axis] = static_cast<double>(
+          RealL(bodies[b].angular_velocity[axis]) + orderFreeSum(changes[b][index + 3]));
+    }
+    if (auto status =
+            checkRepresentable({namedResult("velocity", after[b].velocity),
+                                namedResult("angular_velocity", after[b].angular_velocity)});
+        !status) {
+      return Error{"bodies[" + std::to_string(b) + "]." + status.error().field,
+                   status.error().reason};
+    }
+  }
+  for (const ContactOutcome& outcome : outcomes) {
+    if (!std::isfinite(outcome.impulse) || !std::isfinite(outcome.energy_lost)) {
+      return Error{"impulse", kBeyondDoubles};
+    }
+  }
+  bodies = std::move(after);
+  return outcomes;
+}
+
+}  // namespace collision_response::core
