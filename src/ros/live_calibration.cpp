@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 
 #include "collision_response/core/validation.h"
 
@@ -35,6 +36,25 @@ std::string restitutionText(const core::Estimate& e) {
   const double half = e.high() - e.value;
   return "e " + decimal(e.value, half) + " (95 %: " + decimal(e.low(), half) + " to " +
          decimal(e.high(), half) + ")";
+}
+
+/// "mu 0.0301 (95 %: 0.0287 to 0.0315)", and/or "mu >= 0.0123 (...)", or "mu: nothing (...)":
+/// what the pair's bounces say of friction (calibration.h, Coefficients).
+std::string frictionText(const core::Coefficients& c) {
+  std::string text;
+  if (c.friction) {
+    const double half = c.friction->high() - c.friction->value;
+    text = "mu " + decimal(c.friction->value, half) +
+           " (95 %: " + decimal(c.friction->low(), half) + " to " +
+           decimal(c.friction->high(), half) + ")";
+  }
+  if (c.friction_lower_bound) {
+    text += std::string(text.empty() ? "" : "; ") +
+            "mu >= " + decimal(*c.friction_lower_bound, 0.005) +
+            " (a contact that stopped slipping, or the spin before unknown: a lower bound only)";
+  }
+  if (text.empty()) text = "mu: nothing (the contact did not slide)";
+  return text;
 }
 
 /// One obstacle pair a plane material: the materials of the planes the fit's bounces were on, in
@@ -169,6 +189,17 @@ void LiveCalibration::answer(const EstimateRestitution::Request& request,
     return refuse("max_bounces: must be 0 (every bounce in the window) or more, got " +
                   std::to_string(request.max_bounces));
   }
+  std::optional<Eigen::Vector3d> spin_before;
+  if (!request.spin_before.empty()) {
+    if (request.spin_before.size() != 3) {
+      return refuse(
+          "spin_before: must be empty (unknown) or 3 values (rad/s, the fixed frame), got " +
+          std::to_string(request.spin_before.size()));
+    }
+    spin_before =
+        Eigen::Vector3d(request.spin_before[0], request.spin_before[1], request.spin_before[2]);
+    if (!spin_before->allFinite()) return refuse("spin_before: must be finite");
+  }
   if (!window_.enabled()) {
     return refuse("body: ~calibration_window is 0: the node keeps no states to fit '" +
                   request.body + "' from (set it to the seconds of states to keep)");
@@ -202,23 +233,30 @@ void LiveCalibration::answer(const EstimateRestitution::Request& request,
   options.inertia = body.inertia;
   options.mass = body.mass;
   options.drag_coefficient = body.drag_coefficient;
+  options.spin_before = spin_before;
   std::string what = "body '" + body.id + "', " + std::to_string(samples.size()) + " states over " +
                      decimal(samples.back().time - samples.front().time, 0.01) + " s (" +
                      window_text + ")";
   auto fit = core::calibrate(samples, options);
   if (!fit) return refuse(what + ": " + fit.error().message());
+  // Friction from the whole window's fit: the spin before its first bounce is the one given, and
+  // the fit carries it (and its uncertainty) to each later bounce.
+  const auto whole = fit;
+  std::size_t skipped = 0;
   const auto wanted = static_cast<std::size_t>(request.max_bounces);
   if (wanted > 0 && fit->bounces.size() > wanted) {
     // The most recent bounces: the states from just after the one before them, fitted again.
-    const std::size_t skipped = fit->bounces.size() - wanted;
+    skipped = fit->bounces.size() - wanted;
     const double after = fit->bounces[skipped - 1].time.value;
     std::vector<core::TrackedSample> recent;
     for (const core::TrackedSample& sample : samples) {
       if (sample.time > after) recent.push_back(sample);
     }
     options.max_bounces = wanted;
+    options.spin_before.reset();  // the spin there is the whole fit's: friction is read from it
     what += ", the last " + std::to_string(wanted) + " bounces from its " +
-            std::to_string(recent.size()) + " states after bounce " + std::to_string(skipped);
+            std::to_string(recent.size()) + " states after bounce " + std::to_string(skipped) +
+            " (friction: those bounces of the whole window's fit)";
     fit = core::calibrate(recent, options);
     if (!fit) return refuse(what + ": " + fit.error().message());
   }
@@ -229,21 +267,40 @@ void LiveCalibration::answer(const EstimateRestitution::Request& request,
     const std::vector<std::size_t> which = bouncesOn(*fit, plane_materials_, material);
     PairEstimate estimate{"[" + body.material + ", " + material + "]", body.id,
                           core::combine(*fit, which), ""};
-    const core::Coefficients& c = estimate.coefficients;
+    core::Coefficients& c = estimate.coefficients;
+    // The pair's friction: its bounces among the whole window's fit's last ones.
+    std::vector<std::size_t> in_whole;
+    for (const std::size_t j : bouncesOn(*whole, plane_materials_, material)) {
+      if (j >= skipped) in_whole.push_back(j);
+    }
+    const core::Coefficients friction = core::combine(*whole, in_whole);
+    c.friction = friction.friction;
+    c.friction_lower_bound = friction.friction_lower_bound;
     const std::string bounces =
         std::to_string(c.bounces) + " bounce" + (c.bounces == 1 ? "" : "s") + " at " +
         decimal(c.slowest_approach, 0.01) + " to " + decimal(c.fastest_approach, 0.01) + " m/s";
-    estimate.summary = restitutionText(c.restitution) + ", " + bounces + " of '" + body.id + "'";
+    estimate.summary = restitutionText(c.restitution) + ", " + frictionText(c) + ", " + bounces +
+                       " of '" + body.id + "'";
     text += "; pair " + estimate.pair + ": " + bounces + ": " + restitutionText(c.restitution) +
             (c.bounces > 1 ? ", spread " + decimal(c.restitution_spread, 0.1) +
                                  " (about 1 when one e fits them all)"
-                           : " (one bounce: no spread)");
+                           : " (one bounce: no spread)") +
+            ", " + frictionText(c);
     if (c.bounces > most) {
       most = c.bounces;
       response.restitution = c.restitution.value;
       response.restitution_low = c.restitution.low();
       response.restitution_high = c.restitution.high();
       response.bounces = static_cast<std::int32_t>(c.bounces);
+      response.friction_known = c.friction.has_value();
+      if (c.friction) {
+        response.friction = c.friction->value;
+        response.friction_low = c.friction->low();
+        response.friction_high = c.friction->high();
+      } else {
+        response.friction = response.friction_low = response.friction_high = 0.0;
+      }
+      response.friction_lower_bound = c.friction_lower_bound.value_or(0.0);
     }
     pairs.push_back(std::move(estimate));
   }

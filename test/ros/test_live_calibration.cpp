@@ -213,6 +213,127 @@ TEST(LiveCalibration, TheLastBouncesIntervalCoversTheTruth) {
   std::cout << "the last 3 bounces' 95 % interval covered e in " << covered << " of 100 seeds\n";
 }
 
+/// ~estimate_restitution's answer for `body` (max_bounces, spin_before) from `live`.
+EstimateRestitution::Response ask(const LiveCalibration& live, const std::string& body,
+                                  int max_bounces = 0, std::vector<double> spin_before = {}) {
+  EstimateRestitution::Request request;
+  request.body = body;
+  request.max_bounces = max_bounces;
+  request.spin_before = std::move(spin_before);
+  EstimateRestitution::Response response;
+  std::vector<PairEstimate> pairs;
+  live.answer(request, response, pairs);
+  return response;
+}
+
+/// |mu - truth| within 4 standard errors of the answer's (its 95 % half width is 1.96 of them).
+bool muWithin4(const EstimateRestitution::Response& response, double truth) {
+  return std::abs(response.friction - truth) <=
+         4.0 / 1.96 * (response.friction_high - response.friction);
+}
+
+// mu answered live (issue 44): the closed-form throw (mu = 0.03, every bounce sliding: it takes
+// 3.5 mu (1 + e) |vz| = 0.2 |vz| of the 3 m/s slip a bounce) played into the window. Given the
+// spin before its first bounce (thrown without spin: 0 0 0), mu with its 95 % interval; without
+// it only mu >= a bound below the truth; the last 3 bounces' mu from the whole window's fit (the
+// spin carried through the first two); a bounce that stops slipping (mu = 0.5, 1 m/s along the
+// floor: J_stick = |u| / 3.5 below mu J_n) gives only a bound below 0.5; a spin_before of the
+// wrong size or not finite is named.
+TEST(LiveCalibration, MuIsAnsweredWithItsIntervalWhereTheBouncesSlid) {
+  namespace bb = core::bouncing_ball;
+  bb::Throw t;
+  t.seed = 44;
+  LiveCalibration live(floorScene(), 10.0);
+  play(live.window(), bb::throwBall(t).samples, 0, 100.0);
+
+  auto response = ask(live, "ball", 0, {0.0, 0.0, 0.0});
+  ASSERT_TRUE(response.success) << response.message;
+  EXPECT_TRUE(response.friction_known) << response.message;
+  EXPECT_TRUE(muWithin4(response, t.mu)) << response.message;
+  EXPECT_LT(response.friction_low, response.friction);
+  EXPECT_GT(response.friction_high, response.friction);
+  EXPECT_LT(response.friction_high - response.friction_low, 0.01) << response.message;
+  EXPECT_NE(response.message.find(", mu 0.0"), std::string::npos) << response.message;
+  std::cout << response.message << "\n";
+
+  response = ask(live, "ball", 3, {0.0, 0.0, 0.0});
+  ASSERT_TRUE(response.success) << response.message;
+  EXPECT_EQ(response.bounces, 3);
+  EXPECT_TRUE(response.friction_known) << response.message;
+  EXPECT_TRUE(muWithin4(response, t.mu)) << response.message;
+
+  response = ask(live, "ball");  // the spin before unknown
+  ASSERT_TRUE(response.success) << response.message;
+  EXPECT_FALSE(response.friction_known) << response.message;
+  EXPECT_GT(response.friction_lower_bound, 0.0) << response.message;
+  EXPECT_LT(response.friction_lower_bound, t.mu) << response.message;
+  EXPECT_NE(response.message.find("mu >= "), std::string::npos) << response.message;
+
+  bb::Throw sticking;
+  sticking.mu = 0.5;
+  sticking.velocity = Eigen::Vector3d(1.0, 0.0, -1.0);
+  sticking.bounces = 3;
+  const bb::Track track = bb::throwBall(sticking);
+  ASSERT_TRUE(track.bounces[0].stuck);
+  LiveCalibration stuck(floorScene(), 10.0);
+  play(stuck.window(), track.samples, 0);
+  response = ask(stuck, "ball", 0, {0.0, 0.0, 0.0});
+  ASSERT_TRUE(response.success) << response.message;
+  EXPECT_FALSE(response.friction_known) << response.message;
+  EXPECT_GT(response.friction_lower_bound, 0.0) << response.message;
+  EXPECT_LT(response.friction_lower_bound, sticking.mu) << response.message;
+
+  response = ask(live, "ball", 0, {0.0, 0.0});
+  EXPECT_FALSE(response.success);
+  EXPECT_EQ(response.message,
+            "spin_before: must be empty (unknown) or 3 values (rad/s, the fixed frame), got 2");
+  response = ask(live, "ball", 0, {0.0, std::nan(""), 0.0});
+  EXPECT_FALSE(response.success);
+  EXPECT_EQ(response.message, "spin_before: must be finite");
+}
+
+// A scene the fit cannot fly or bounce in is refused, named: one with `magnus` (the fit flies
+// with gravity and drag only), one whose only plane moves with a frame, one without obstacles.
+TEST(LiveCalibration, AScenesMagnusOrNoFixedPlaneIsRefusedNamed) {
+  core::Scene magnus = floorScene();
+  magnus.effects.magnus = true;
+  auto response = ask(LiveCalibration(magnus, 10.0), "ball");
+  EXPECT_FALSE(response.success);
+  EXPECT_EQ(response.message.rfind("body: the scene has `magnus`", 0), 0u) << response.message;
+
+  core::Scene moving = floorScene();
+  moving.obstacles[0].frame = "paddle";
+  response = ask(LiveCalibration(moving, 10.0), "ball");
+  EXPECT_FALSE(response.success);
+  EXPECT_EQ(response.message.rfind("body: the scene has no fixed plane obstacle", 0), 0u)
+      << response.message;
+
+  core::Scene bare = floorScene();
+  bare.obstacles.clear();
+  response = ask(LiveCalibration(bare, 10.0), "ball");
+  EXPECT_FALSE(response.success);
+  EXPECT_EQ(response.message.rfind("body: the scene has no fixed plane obstacle", 0), 0u)
+      << response.message;
+}
+
+// A body of the scene with no state in the window is named: none received yet, and one no longer
+// tracked (its states older than the window's 1 s before the newest state of another body).
+TEST(LiveCalibration, ABodyWithNoStateInTheWindowIsNamed) {
+  LiveCalibration live(floorScene(), 1.0);
+  auto response = ask(live, "ball");
+  EXPECT_FALSE(response.success);
+  EXPECT_EQ(
+      response.message.rfind("body: no state of 'ball' in the window (~calibration_window 1 s", 0),
+      0u)
+      << response.message;
+  live.window().record({at(0, 0.0), at(1, 0.0)});
+  live.window().record({at(1, 5.0)});
+  response = ask(live, "ball");
+  EXPECT_FALSE(response.success);
+  EXPECT_EQ(response.message.rfind("body: no state of 'ball' in the window", 0), 0u)
+      << response.message;
+}
+
 // The monitor's cycle records each state it takes, as received and on its time line (a ball
 // hanging 1 m up, 100 Hz for 1 s: 101 states, 0.01 s apart), and forgets them when its line
 // restarts (the stamps went back by more than ~clock_jump_back and the next input continued

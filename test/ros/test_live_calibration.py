@@ -9,7 +9,10 @@ ball 'still' hangs 1 m above the table. Then the service, given the ball's id: e
 of 0.9 and inside its 95 % interval, from 5 bounces; max_bounces 3: the last 3, e within
 +-0.005; an unknown id and the bounceless 'still' refused, named; with `body` empty the
 drop test as before (e = sqrt(0.25 / 1) = 0.5); /diagnostics shows the last estimate of the
-pair [legal_ball, concrete].
+pair [legal_ball, concrete]. Given spin_before 0 0 0 (the ball is thrown without spin; each
+bounce slides, its tangential impulse MU times the normal one), mu is known and within its
+interval of MU; without it only a lower bound. A second node without a ~scene refuses a body,
+named.
 """
 import random
 import time
@@ -20,9 +23,10 @@ from diagnostic_msgs.msg import DiagnosticArray
 
 from collision_response.msg import BodyState, BodyStateArray
 from collision_response.srv import EstimateRestitution, EstimateRestitutionRequest
-from test_calibrate_bag import E, G, NOISE, RATE, position, throw
+from test_calibrate_bag import E, G, MU, NOISE, RATE, position, throw
 
 SERVICE = "/collision_response/estimate_restitution"
+BARE_SERVICE = "/collision_response_bare/estimate_restitution"
 
 
 def velocity(pieces, t):
@@ -73,10 +77,12 @@ class LiveCalibration(unittest.TestCase):
         cls.played = k
         time.sleep(0.5)  # the last states through the node's queue
 
-    def ask(self, body, max_bounces=0, drop_height=0.0, bounce_height=0.0):
+    def ask(self, body, max_bounces=0, drop_height=0.0, bounce_height=0.0, spin_before=(),
+            service=None):
         request = EstimateRestitutionRequest(drop_height=drop_height, bounce_height=bounce_height,
-                                             body=body, max_bounces=max_bounces)
-        answer = self.estimate(request)
+                                             body=body, max_bounces=max_bounces,
+                                             spin_before=list(spin_before))
+        answer = (service or self.estimate)(request)
         print(f"{body!r} ({max_bounces}): {answer.success}: {answer.message}")
         return answer
 
@@ -136,6 +142,30 @@ class LiveCalibration(unittest.TestCase):
                         self.assertIn("of 'ball'", item.value)
                         return
         self.fail("no `restitution estimate [legal_ball, concrete]` on /diagnostics")
+
+    def test_6_given_the_spin_before_mu_is_known(self):
+        answer = self.ask("ball", spin_before=(0.0, 0.0, 0.0))
+        self.assertTrue(answer.success, answer.message)
+        self.assertTrue(answer.friction_known, answer.message)
+        # Within 4 standard errors (the 95 % half width is 1.96 of them) of the closed form's mu.
+        self.assertAlmostEqual(answer.friction, MU,
+                               delta=4 / 1.96 * (answer.friction_high - answer.friction),
+                               msg=answer.message)
+        self.assertLess(answer.friction_low, answer.friction)
+        self.assertGreater(answer.friction_high, answer.friction)
+        self.assertIn(", mu 0.0", answer.message)
+        answer = self.ask("ball")
+        self.assertTrue(answer.success, answer.message)
+        self.assertFalse(answer.friction_known, answer.message)
+        self.assertIn("mu >= ", answer.message)
+
+    def test_7_a_node_without_a_scene_refuses_a_body(self):
+        rospy.wait_for_service(BARE_SERVICE, 30.0)
+        bare = rospy.ServiceProxy(BARE_SERVICE, EstimateRestitution)
+        answer = self.ask("ball", service=bare)
+        self.assertFalse(answer.success)
+        self.assertTrue(answer.message.startswith("body: 'ball': no ~scene loaded"),
+                        answer.message)
 
 
 if __name__ == "__main__":

@@ -94,7 +94,8 @@ struct PairEstimate {
   std::string pair;  ///< "[body material, plane material]"
   std::string body;  ///< the body's id
   core::Coefficients coefficients;
-  /// "e 0.89999 (95 %: 0.89989 to 0.90009), 5 bounces at 2.117 to 3.227 m/s of 'ball'"
+  /// "e 0.89999 (95 %: 0.89989 to 0.90009), mu 0.030000 (95 %: 0.029961 to 0.030038), 5 bounces
+  /// at 2.117 to 3.227 m/s of 'ball'"
   std::string summary;
 };
 
@@ -108,9 +109,12 @@ class LiveCalibration {
 
   /// ~estimate_restitution for a tracked body (request.body not empty): its window fitted with
   /// the core's calibrate against the scene's fixed planes; the most recent request.max_bounces
-  /// bounces (0: all). Refused (success false, the message naming the field or the core's
-  /// named problem: no bounce, too few samples, a gap across a bounce, ...) otherwise. Each
-  /// obstacle pair's estimate is appended to `pairs` when the fit succeeds. From any thread.
+  /// bounces (0: all). e from them; mu (the response's friction fields) from the whole window's
+  /// fit, its spin before the first bounce request.spin_before (empty: unknown, mu >= only),
+  /// carried by the fit through the bounces not asked for. Refused (success false, the message
+  /// naming the field or the core's named problem: no bounce, too few samples, a gap across a
+  /// bounce, ...) otherwise. Each obstacle pair's estimate is appended to `pairs` when the fit
+  /// succeeds. From any thread.
   void answer(const EstimateRestitution::Request& request, EstimateRestitution::Response& response,
               std::vector<PairEstimate>& pairs) const;
 
