@@ -7,6 +7,7 @@
 #include <functional>
 #include <string>
 
+#include "collision_response/core/body.h"
 #include "collision_response/core/expected.h"
 #include "collision_response/core/mass_properties.h"
 #include "collision_response/core/scene.h"
@@ -35,6 +36,19 @@ Status checkBodyShape(const BodySpec& body, const std::function<std::string(cons
 /// tensor, the shape's volume, the tensor, and the centre of mass at the body's origin. For a
 /// movable body (finite mass) of nonzero size that checkBodyShape accepted.
 Expected<MassProperties> bodyMassProperties(const BodySpec& body, const std::string& field);
+
+/// A single collision's body (Body, body.h) as a scene body of its shape, mass and inertia, for
+/// checkBodyShape, shapeOf and the mass properties.
+BodySpec shapeSpecOf(const Body& body);
+
+/// A single collision's body: its shape, inertia and orientation, named as ComputeCollision's
+/// fields under `prefix` ("a.shape", "a.size", "a.inertia_tensor.ixy", "a.orientation"): a mesh
+/// is refused (not yet in a single collision: no resource is loaded there); a number another
+/// shape has and this one has not must be 0 (a box's radius, a sphere's size, ...), so that no
+/// value is silently ignored; the shape's numbers and the inertia as checkBodyShape has them (a
+/// tensor given and `hollow` both is refused); the orientation all zero (not given) only for a
+/// ball (isBall), otherwise checkOrientation's.
+Status checkBodyShape(const Body& body, const std::string& prefix);
 
 /// For now (issue 42: the model moves spheres only), the first body that is not a sphere, or a
 /// sphere given a tensor, is refused, naming its `shape` (or `inertia`) key under `prefix` and

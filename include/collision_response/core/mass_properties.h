@@ -9,6 +9,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
 #include <string>
@@ -94,6 +95,13 @@ Expected<MassProperties> polyhedronMassProperties(const Polyhedron& polyhedron, 
 /// zero edge, radius or hull; a cylinder of zero length is a disc and has none either).
 Expected<MassProperties> uniformMassProperties(const Shape& shape, double mass,
                                                Inertia sphere_inertia, const std::string& field);
+
+/// I^-1 in the world (the common frame) of a body turned by `orientation` (world from body, of
+/// unit length to checkOrientation's tolerance; normalised here): R I^-1 R^T, with I the tensor
+/// about the centre of mass in the body's own frame (positive definite: a uniform solid's, or
+/// one checkInertiaTensor accepted). Symmetric to the bit (its two triangles averaged).
+Eigen::Matrix3d worldInverseInertia(const Eigen::Matrix3d& inertia,
+                                    const Eigen::Quaterniond& orientation);
 
 /// A tensor a user gives (`field`.ixx, ... name its entries): every entry finite; positive
 /// definite (each moment > 0, each 2 x 2 minor ixx iyy - ixy^2 ... > 0, naming the product that

@@ -1,6 +1,7 @@
 #include "collision_response/core/mass_properties.h"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -409,6 +410,13 @@ Status checkInertiaTensor(const InertiaTensor& tensor, const std::string& field)
                      "third principal axis"};
   }
   return Ok{};
+}
+
+Eigen::Matrix3d worldInverseInertia(const Eigen::Matrix3d& inertia,
+                                    const Eigen::Quaterniond& orientation) {
+  const Eigen::Matrix3d rotation = orientation.normalized().toRotationMatrix();
+  const Eigen::Matrix3d turned = rotation * inertia.inverse() * rotation.transpose();
+  return 0.5 * (turned + turned.transpose());
 }
 
 }  // namespace collision_response::core

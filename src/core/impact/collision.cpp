@@ -1,10 +1,15 @@
 #include "collision_response/core/collision.h"
 
+#include <Eigen/Geometry>
 #include <cmath>
 
+#include "collision_response/core/body_shape.h"
 #include "collision_response/core/friction.h"
+#include "collision_response/core/mass_properties.h"
+#include "collision_response/core/rigid_impact.h"
 #include "collision_response/core/scene.h"
 #include "collision_response/core/validation.h"
+#include "geometry/narrow_phase.h"
 #include "solver/cluster_solver.h"
 
 namespace collision_response::core {
@@ -77,54 +82,179 @@ ClusterBody clusterBody(const Body& body, bool spin) {
   return cluster_body;
 }
 
-}  // namespace
+/// Where the request's bodies meet: the unit normal a -> b, the point, and each body's lever arm
+/// from its centre to its own surface point there (ContactPoint, solver_body.h).
+struct RequestContact {
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d lever_a = Eigen::Vector3d::Zero();
+  Eigen::Vector3d lever_b = Eigen::Vector3d::Zero();
+};
 
-Expected<CollisionOutcome> computeCollision(const CollisionRequest& request,
-                                            const MaterialTable& materials) {
-  if (auto status = checkBody(request.a, "a"); !status) return status.error();
-  if (auto status = checkBody(request.b, "b"); !status) return status.error();
-  if (isImmovable(request.a) && isImmovable(request.b)) {
-    return Error{"b.mass",
-                 "a and b are both immovable (mass .inf): at least one body must have "
-                 "a finite mass"};
+/// A shaped body's shape where it is: at its position, turned by its orientation.
+PlacedShape placedShapeOf(const Body& body) {
+  PlacedShape placed;
+  placed.shape = shapeOf(shapeSpecOf(body));
+  placed.pose.transform = Eigen::Translation3d(body.position) * body.orientation.normalized();
+  placed.pose.velocity = body.velocity;
+  placed.pose.angular_velocity = body.angular_velocity;
+  return placed;
+}
+
+/// A given contact point must be within the shaped body's reach (its bounding sphere about its
+/// centre, to the rounding of the positions): a lever arm longer than the body is no point of
+/// it, most likely a point in another frame.
+Status checkWithinReach(const Body& body, const Eigen::Vector3d& point, const std::string& side) {
+  constexpr double kEps = 2.220446049250313e-16;
+  const double reach = boundingRadiusOf(shapeOf(shapeSpecOf(body)));
+  const double distance = (point - body.position).norm();
+  const double rounding =
+      16 * kEps *
+      (point.lpNorm<Eigen::Infinity>() + body.position.lpNorm<Eigen::Infinity>() + reach);
+  if (distance <= reach + rounding) return Ok{};
+  return Error{"contact_point",
+               formatVector(point) + " is " + formatNumber(distance) + " m from " + side +
+                   "'s centre, farther than any point of the " + toString(body.shape) + " " + side +
+                   " (" + formatNumber(reach) +
+                   " m at most): not a point of its surface (is it in the caller's frame?)"};
+}
+
+/// Two spheres: the line of impact (given, or centre to centre), their lever arms their radii
+/// along it, the point in the middle of the gap. A given contact point is refused: it would be
+/// ignored.
+Expected<RequestContact> contactOfSpheres(const CollisionRequest& request) {
+  if (request.contact_point) {
+    return Error{"contact_point_given",
+                 "is true for two spheres: their contact lies on the line of impact, at their "
+                 "radii; a contact point is where a box, cylinder or capsule is struck"};
   }
-  if (!request.a.id.empty() && request.a.id == request.b.id) {
-    return Error{"b.id",
-                 "is the same as a.id ('" + request.a.id + "'): a body cannot collide with itself"};
-  }
-  const auto effects = parseEffects(request.effects);
-  if (!effects) return effects.error();
   const auto line_of_impact = lineOfImpact(request.normal, request.a.position, request.b.position);
   if (!line_of_impact) return line_of_impact.error();
-  const auto restitution = chooseRestitution(request, materials);
-  if (!restitution) return restitution.error();
-  if (!effects->friction && request.friction != 0.0) {
-    return Error{"friction", "is " + formatNumber(request.friction) +
-                                 " but the friction effect is not requested (add \"friction\" "
-                                 "to effects)"};
-  }
-  const auto friction =
-      effects->friction ? chooseFriction(request, materials) : Expected<double>(0.0);
-  if (!friction) return friction.error();
+  RequestContact contact;
+  contact.normal = *line_of_impact;
+  contact.lever_a = request.a.radius * contact.normal;  // the balls' lever arms
+  contact.lever_b = -request.b.radius * contact.normal;
+  // Halves first: two surface points near the largest doubles have a midpoint too.
+  contact.point = 0.5 * Eigen::Vector3d(request.a.position + contact.lever_a) +
+                  0.5 * Eigen::Vector3d(request.b.position + contact.lever_b);
+  return contact;
+}
 
-  // A cluster of one contact, through the monitor's solver: friction and spin are chosen in one
-  // place (frictionModelFor), and one contact alone is resolveImpact, exact to the last bit.
-  const Effects runnable = runnableEffects(*effects);
+/// A sphere and a shaped body, or two shaped bodies: the normal given or (a sphere and a shaped
+/// body) the narrow phase's, the point given or the narrow phase's, a sphere's lever arm its
+/// radius along the normal, a shaped body's from its centre to the point (given) or to its own
+/// surface point (found).
+Expected<RequestContact> contactOfShapes(const CollisionRequest& request) {
+  const Body& a = request.a;
+  const Body& b = request.b;
+  if (auto status = checkFinite(request.normal, "normal"); !status) return status.error();
+  if (request.contact_point) {
+    if (auto status = checkFinite(*request.contact_point, "contact_point"); !status) {
+      return status.error();
+    }
+  }
+  const bool given_normal = request.normal != Eigen::Vector3d::Zero();
+  RequestContact contact;
+  const bool a_sphere = a.shape == BodyShape::kSphere;
+  const bool b_sphere = b.shape == BodyShape::kSphere;
+  if (!a_sphere && !b_sphere) {
+    const std::string pair = std::string("two shaped bodies (a ") + toString(a.shape) + " and a " +
+                             toString(b.shape) + ")";
+    if (!request.contact_point) {
+      return Error{"contact_point_given",
+                   "is false, but " + pair +
+                       " need their contact point given: finding it between two shaped bodies "
+                       "is not yet (issue 42)"};
+    }
+    if (!given_normal) {
+      return Error{"normal", "is zero, but " + pair +
+                                 " need their line of impact given (from a into b): finding it "
+                                 "between two shaped bodies is not yet (issue 42)"};
+    }
+    contact.normal = unitVector(request.normal);
+    contact.point = *request.contact_point;
+    contact.lever_a = contact.point - a.position;
+    contact.lever_b = contact.point - b.position;
+  } else {
+    const Body& sphere = a_sphere ? a : b;
+    const Body& shaped = a_sphere ? b : a;
+    // The narrow phase's normal runs from the sphere into the shaped body: a -> b when the
+    // sphere is a, b -> a when it is b.
+    const double sphere_is_a = a_sphere ? 1.0 : -1.0;
+    const ContactGeometry geometry =
+        contactGeometry(sphere.position, sphere.radius, placedShapeOf(shaped), 0.0,
+                        [] { return Eigen::Vector3d(Eigen::Vector3d::Zero()); });
+    contact.normal = given_normal ? unitVector(request.normal) : sphere_is_a * geometry.normal;
+    const Eigen::Vector3d sphere_lever = sphere.radius * (sphere_is_a * contact.normal);
+    contact.point = request.contact_point ? *request.contact_point : geometry.point;
+    const Eigen::Vector3d shaped_lever =
+        request.contact_point ? Eigen::Vector3d(contact.point - shaped.position) : geometry.lever_b;
+    contact.lever_a = a_sphere ? sphere_lever : shaped_lever;
+    contact.lever_b = a_sphere ? shaped_lever : sphere_lever;
+  }
+  if (request.contact_point) {
+    for (const auto& [body, side] : {std::pair<const Body*, const char*>{&a, "a"},
+                                     std::pair<const Body*, const char*>{&b, "b"}}) {
+      if (body->shape == BodyShape::kSphere) continue;
+      if (auto status = checkWithinReach(*body, contact.point, side); !status) {
+        return status.error();
+      }
+    }
+  }
+  return contact;
+}
+
+/// A side of a rigid impact as the solver sees it. A ball: its sphere's inverse inertia with the
+/// spin effect (clusterBody), and without it no turning at all (its angular velocity neither
+/// enters the contact's velocity nor changes). A shaped body: its world inverse inertia
+/// R I^-1 R^T (its tensor, or the uniform solid of its shape; an immovable body none), turning
+/// whatever the effects.
+Expected<SolverBody> rigidSideOf(const Body& body, bool spin, const std::string& prefix) {
+  if (isBall(body)) {
+    SolverBody ball = clusterBody(body, spin);
+    if (!spin) ball.angular_velocity = Eigen::Vector3d::Zero();
+    return ball;
+  }
+  SolverBody side;
+  side.inverse_mass = inverseMass(body);
+  side.velocity = body.velocity;
+  side.angular_velocity = body.angular_velocity;
+  side.inertia_kind = InverseInertiaKind::kTensor;
+  side.radius = body.radius;
+  if (isImmovable(body)) return side;  // turned by no inertia of its own: I^-1 = 0
+  Eigen::Matrix3d inertia;
+  if (body.inertia_tensor) {
+    inertia = body.inertia_tensor->matrix();
+  } else {
+    const auto solid = uniformMassProperties(shapeOf(shapeSpecOf(body)), body.mass, body.inertia,
+                                             prefix + ".shape");
+    if (!solid) return solid.error();
+    inertia = solid->inertia;
+  }
+  side.inverse_inertia = worldInverseInertia(inertia, body.orientation);
+  return side;
+}
+
+/// Two balls: a cluster of one contact, through the monitor's solver: friction and spin are
+/// chosen in one place (frictionModelFor), and one contact alone is resolveImpact, exact to the
+/// last bit.
+CollisionOutcome resolveBalls(const CollisionRequest& request, const Eigen::Vector3d& normal,
+                              double restitution, double friction, const Effects& runnable) {
   ClusterBody a = clusterBody(request.a, runnable.spin);
   ClusterBody b = clusterBody(request.b, runnable.spin);
   ClusterContact contact;
   contact.a = 0;
   contact.b = 1;
-  contact.normal = *line_of_impact;
+  contact.normal = normal;
   contact.lever_a = request.a.radius * contact.normal;  // the balls' lever arms
   contact.lever_b = -request.b.radius * contact.normal;
-  contact.restitution = *restitution;
+  contact.restitution = restitution;
   const ContactResolution solved =
-      solveContact(a, b, contact, *friction, frictionModelFor(runnable));
+      solveContact(a, b, contact, friction, frictionModelFor(runnable));
 
   CollisionOutcome outcome;
-  outcome.line_of_impact = *line_of_impact;
-  outcome.restitution = *restitution;
+  outcome.line_of_impact = normal;
+  outcome.restitution = restitution;
   outcome.impact.velocity_a = a.velocity;
   outcome.impact.velocity_b = b.velocity;
   outcome.impact.normal_impulse = solved.normal.impulse;
@@ -140,6 +270,101 @@ Expected<CollisionOutcome> computeCollision(const CollisionRequest& request,
     outcome.sticking = solved.friction.sticking;
     outcome.impact.energy_lost += solved.friction.energy_lost;
   }
+  return outcome;
+}
+
+/// One impact of two rigid bodies at `contact` (resolveRigidImpact: Chatterjee and Ruina's law,
+/// Newton's e along the normal with the effective mass where frictionless); not approaching,
+/// nothing changes. A ball without the spin effect keeps the angular velocity it was given.
+Expected<CollisionOutcome> resolveRigid(const CollisionRequest& request,
+                                        const RequestContact& contact, double restitution,
+                                        double friction, bool spin) {
+  const auto side_a = rigidSideOf(request.a, spin, "a");
+  if (!side_a) return side_a.error();
+  const auto side_b = rigidSideOf(request.b, spin, "b");
+  if (!side_b) return side_b.error();
+  SolverBody a = *side_a;
+  SolverBody b = *side_b;
+  ContactPoint point;
+  point.a = 0;
+  point.b = 1;
+  point.normal = contact.normal;
+  point.point = contact.point;
+  point.lever_a = contact.lever_a;
+  point.lever_b = contact.lever_b;
+  const auto impact = resolveRigidImpact(a, b, point, restitution, friction);
+  if (!impact) return impact.error();
+
+  CollisionOutcome outcome;
+  outcome.line_of_impact = contact.normal;
+  outcome.restitution = restitution;
+  outcome.impact.velocity_a = a.velocity;
+  outcome.impact.velocity_b = b.velocity;
+  outcome.impact.normal_impulse = impact->normal_impulse;
+  outcome.impact.approach_speed = impact->approach_speed;
+  outcome.impact.approaching = impact->approach_speed > 0;
+  outcome.impact.energy_lost = impact->energy_lost;
+  outcome.oblique = hasObliqueComponent(request.a.velocity, outcome.line_of_impact) ||
+                    hasObliqueComponent(request.b.velocity, outcome.line_of_impact);
+  const auto turned = [spin](const Body& body, const SolverBody& side) {
+    return isBall(body) && !spin ? body.angular_velocity : side.angular_velocity;
+  };
+  outcome.angular_velocity_a = turned(request.a, a);
+  outcome.angular_velocity_b = turned(request.b, b);
+  // Frictionless, the law's impulse is along the normal: its tangential part only the rounding
+  // of splitting it.
+  outcome.friction_impulse = friction > 0 ? impact->tangential_impulse.norm() : 0.0;
+  outcome.sticking = friction > 0 && outcome.impact.approaching && impact->sticking;
+  return outcome;
+}
+
+}  // namespace
+
+Expected<CollisionOutcome> computeCollision(const CollisionRequest& request,
+                                            const MaterialTable& materials) {
+  for (const auto& [body, prefix] : {std::pair<const Body*, const char*>{&request.a, "a"},
+                                     std::pair<const Body*, const char*>{&request.b, "b"}}) {
+    if (auto status = checkBody(*body, prefix); !status) return status.error();
+    if (auto status = checkBodyShape(*body, prefix); !status) return status.error();
+  }
+  if (isImmovable(request.a) && isImmovable(request.b)) {
+    return Error{"b.mass",
+                 "a and b are both immovable (mass .inf): at least one body must have "
+                 "a finite mass"};
+  }
+  if (!request.a.id.empty() && request.a.id == request.b.id) {
+    return Error{"b.id",
+                 "is the same as a.id ('" + request.a.id + "'): a body cannot collide with itself"};
+  }
+  const auto effects = parseEffects(request.effects);
+  if (!effects) return effects.error();
+  const bool balls = isBall(request.a) && isBall(request.b);
+  const bool spheres =
+      request.a.shape == BodyShape::kSphere && request.b.shape == BodyShape::kSphere;
+  const auto meeting = spheres ? contactOfSpheres(request) : contactOfShapes(request);
+  if (!meeting) return meeting.error();
+  const auto restitution = chooseRestitution(request, materials);
+  if (!restitution) return restitution.error();
+  if (!effects->friction && request.friction != 0.0) {
+    return Error{"friction", "is " + formatNumber(request.friction) +
+                                 " but the friction effect is not requested (add \"friction\" "
+                                 "to effects)"};
+  }
+  const auto friction =
+      effects->friction ? chooseFriction(request, materials) : Expected<double>(0.0);
+  if (!friction) return friction.error();
+
+  const Effects runnable = runnableEffects(*effects);
+  CollisionOutcome outcome;
+  if (balls) {
+    outcome = resolveBalls(request, meeting->normal, *restitution, *friction, runnable);
+  } else {
+    auto rigid = resolveRigid(request, *meeting, *restitution, runnable.friction ? *friction : 0.0,
+                              runnable.spin);
+    if (!rigid) return rigid.error();
+    outcome = *rigid;
+  }
+  outcome.contact_point = meeting->point;
   // Finite inputs whose answer is beyond the doubles (masses and speeds of 1e200: an energy of
   // 1e600 J) are refused by name rather than answered with an infinity.
   if (auto status =
@@ -149,7 +374,8 @@ Expected<CollisionOutcome> computeCollision(const CollisionRequest& request,
                               namedResult("angular_velocity_b", outcome.angular_velocity_b),
                               namedResult("impulse", outcome.impact.normal_impulse),
                               namedResult("friction_impulse", outcome.friction_impulse),
-                              namedResult("energy_lost", outcome.impact.energy_lost)});
+                              namedResult("energy_lost", outcome.impact.energy_lost),
+                              namedResult("contact_point", outcome.contact_point)});
       !status) {
     return status.error();
   }

@@ -78,6 +78,77 @@ Expected<MassProperties> bodyMassProperties(const BodySpec& body, const std::str
   return properties;
 }
 
+BodySpec shapeSpecOf(const Body& body) {
+  BodySpec spec;
+  spec.id = body.id;
+  spec.mass = body.mass;
+  spec.radius = body.radius;
+  spec.inertia = body.inertia;
+  spec.shape = body.shape;
+  spec.size = body.size;
+  spec.length = body.length;
+  spec.inertia_tensor = body.inertia_tensor;
+  return spec;
+}
+
+namespace {
+
+/// A number of `body` its shape does not have must be 0 (named `field`): nothing is ignored.
+Status unusedIsZero(bool is_zero, const Body& body, const std::string& field, const char* which) {
+  if (is_zero) return Ok{};
+  return Error{field, std::string("must be 0: a ") + toString(body.shape) + " has no " + which +
+                          " (a box has edges `size`; a cylinder and a capsule a `radius` and a "
+                          "`length`; a sphere a `radius`)"};
+}
+
+}  // namespace
+
+Status checkBodyShape(const Body& body, const std::string& prefix) {
+  if (body.shape == BodyShape::kMesh) {
+    return Error{prefix + ".shape",
+                 "not yet: a mesh body in a single collision (no mesh resource is loaded here); "
+                 "a box, cylinder, capsule or sphere is taken"};
+  }
+  const bool round = body.shape == BodyShape::kSphere || body.shape == BodyShape::kCylinder ||
+                     body.shape == BodyShape::kCapsule;
+  if (auto status = unusedIsZero(round || body.radius == 0.0, body, prefix + ".radius", "radius");
+      !status) {
+    return status;
+  }
+  if (auto status = unusedIsZero(body.shape == BodyShape::kBox || body.size.isZero(0.0), body,
+                                 prefix + ".size", "edges (`size`)");
+      !status) {
+    return status;
+  }
+  if (auto status = unusedIsZero(body.shape == BodyShape::kCylinder ||
+                                     body.shape == BodyShape::kCapsule || body.length == 0.0,
+                                 body, prefix + ".length", "length");
+      !status) {
+    return status;
+  }
+  if (body.inertia_tensor && body.inertia == Inertia::kHollow) {
+    return Error{prefix + ".inertia",
+                 "is `hollow` while " + prefix +
+                     ".inertia_tensor is given: give one (the tensor says how the mass is spread)"};
+  }
+  const auto field = [&](const char* key) {
+    const std::string name = key;
+    if (name == "inertia" && body.inertia_tensor) return prefix + ".inertia_tensor";
+    return prefix + "." + name;
+  };
+  if (auto status = checkBodyShape(shapeSpecOf(body), field); !status) return status;
+  const Eigen::Quaterniond& orientation = body.orientation;
+  if (orientation.coeffs().isZero(0.0)) {
+    if (isBall(body)) return Ok{};
+    return Error{prefix + ".orientation",
+                 std::string("is zero (not given): a ") + toString(body.shape) +
+                     (body.shape == BodyShape::kSphere ? " given its tensor" : "") +
+                     " needs its orientation, world from body ([0, 0, 0, 1] as [x, y, z, w]: not "
+                     "turned)"};
+  }
+  return checkOrientation(orientation, prefix + ".orientation");
+}
+
 Status checkOnlySpheresMove(const Scene& scene, const std::string& prefix) {
   for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
     const BodySpec& body = scene.bodies[i];

@@ -1,0 +1,398 @@
+// computeCollision with shaped bodies (issue 42, steps 2 and 3 in a single collision): a box, a
+// cylinder or a capsule, or a sphere given its tensor, turns as a rigid body at its contact point.
+// The numbers come from closed forms worked out by hand in the comments (and checked in exact
+// rational arithmetic: test/exact/shaped_collision.py), never from the code under test.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "collision_response/core/collision.h"
+
+namespace collision_response::core {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+using V = Eigen::Vector3d;
+
+/// |actual - expected| within `ulps` of the largest of |expected|'s components (or of `scale`).
+void expectNear(const V& actual, const V& expected, double scale, const char* what) {
+  constexpr double kTolerance = 64 * std::numeric_limits<double>::epsilon();
+  EXPECT_LE((actual - expected).lpNorm<Eigen::Infinity>(), kTolerance * scale)
+      << what << ": " << actual.transpose() << " against " << expected.transpose();
+}
+
+// A box of 12 kg with edges (1, 2, 3) m, at rest at the origin, not turned: its uniform solid's
+// tensor is m/12 diag(b^2 + c^2, a^2 + c^2, a^2 + b^2) = diag(13, 10, 5) kg m^2. A ball (a point
+// of 1 kg on a sphere of radius 7/8) strikes its corner r = (1/2, 1, 3/2) along u = (2, 3, 6)/7,
+// its centre at r + (7/8) u = (3/4, 11/8, 9/4) (exact in binary), moving at -7 u, e = 1/2,
+// frictionless. The narrow phase's normal from the ball into the box is n = -u; with the ball as
+// a it is the line of impact a -> b.
+//   r x n = (-3/14, 0, 1/14);  n.K.n = 1/1 + 1/12 + (9/196)/13 + (1/196)/5 = 41579/38220.
+//   The approach speed d = 7; j = (1 + e) d / n.K.n = 10.5 * 38220 / 41579 N s.
+//   v_a' = v_a - j n; v_b' = j n / 12; w_b' = I^-1 (r x n) j = j (-3/182, 0, 1/70).
+//   Energy lost: (1/2) (1 - e^2) d^2 / n.K.n.
+CollisionRequest ballOnABoxCorner() {
+  CollisionRequest request;
+  request.a.id = "ball";
+  request.a.mass = 1.0;
+  request.a.radius = 7.0 / 8.0;
+  request.a.position = V(3.0 / 4.0, 11.0 / 8.0, 9.0 / 4.0);
+  request.a.velocity = V(-2, -3, -6);
+  request.b.id = "box";
+  request.b.mass = 12.0;
+  request.b.shape = BodyShape::kBox;
+  request.b.size = V(1, 2, 3);
+  request.b.orientation = Eigen::Quaterniond::Identity();
+  request.restitution = 0.5;
+  return request;
+}
+
+constexpr double kCornerInverseMass = 41579.0 / 38220.0;  // n.K.n
+constexpr double kCornerImpulse = 10.5 / kCornerInverseMass;
+
+TEST(ShapedCollision, ABoxStruckAtACornerFrictionlessIsTheClosedForm) {
+  const auto outcome = computeCollision(ballOnABoxCorner(), MaterialTable::seed());
+  ASSERT_TRUE(outcome.ok()) << outcome.error().message();
+  const V n = -V(2, 3, 6) / 7.0;
+  const double j = kCornerImpulse;
+  expectNear(outcome->line_of_impact, n, 1.0, "normal");
+  expectNear(outcome->contact_point, V(0.5, 1, 1.5), 1.0, "contact point: the corner");
+  EXPECT_TRUE(outcome->impact.approaching);
+  EXPECT_NEAR(outcome->impact.approach_speed, 7.0, 64 * 7.0 * 2.2e-16);
+  EXPECT_NEAR(outcome->impact.normal_impulse, j, 64 * j * 2.2e-16);
+  expectNear(outcome->impact.velocity_a, V(-2, -3, -6) - j * n, 7.0, "ball's velocity");
+  expectNear(outcome->impact.velocity_b, j * n / 12.0, 1.0, "box's velocity");
+  expectNear(outcome->angular_velocity_a, V::Zero(), 1.0, "the ball does not turn");
+  expectNear(outcome->angular_velocity_b, j * V(-3.0 / 182.0, 0, 1.0 / 70.0), 1.0,
+             "box's angular velocity");
+  const double lost = 0.5 * (1 - 0.25) * 49.0 / kCornerInverseMass;
+  EXPECT_NEAR(outcome->impact.energy_lost, lost, 64 * lost * 2.2e-16);
+  EXPECT_EQ(outcome->friction_impulse, 0.0);
+}
+
+// The same impact with the sides swapped (the box a, the ball b): the line of impact reversed,
+// the velocities exchanged, the same impulse and energy.
+TEST(ShapedCollision, TheBoxAsSideAGivesTheMirroredAnswer) {
+  CollisionRequest request = ballOnABoxCorner();
+  std::swap(request.a, request.b);
+  const auto outcome = computeCollision(request, MaterialTable::seed());
+  ASSERT_TRUE(outcome.ok()) << outcome.error().message();
+  const V n = V(2, 3, 6) / 7.0;  // box -> ball
+  const double j = kCornerImpulse;
+  expectNear(outcome->line_of_impact, n, 1.0, "normal");
+  EXPECT_NEAR(outcome->impact.normal_impulse, j, 64 * j * 2.2e-16);
+  expectNear(outcome->impact.velocity_b, V(-2, -3, -6) + j * n, 7.0, "ball's velocity");
+  expectNear(outcome->impact.velocity_a, -j * n / 12.0, 1.0, "box's velocity");
+  expectNear(outcome->angular_velocity_a, j * V(-3.0 / 182.0, 0, 1.0 / 70.0), 1.0,
+             "box's angular velocity");
+}
+
+// Kinetic energy of a body of mass m and body-frame tensor I turned by q.
+double kineticEnergy(double mass, const Eigen::Matrix3d& inertia, const Eigen::Quaterniond& q,
+                     const V& v, const V& w) {
+  const Eigen::Matrix3d world = q.toRotationMatrix() * inertia * q.toRotationMatrix().transpose();
+  return 0.5 * mass * v.squaredNorm() + 0.5 * w.dot(world * w);
+}
+
+// The whole corner impact turned by a rotation Q (the box's orientation, every position and
+// velocity), the box moving and turning too: frictionless, the impulse is the unturned one's
+// for the approach speed of the corner, and turns the box by Q times its unturned turn.
+// Frictionless, and with friction (mu = 0.4) and spin (the ball a solid sphere, I = 2/5 m
+// r^2, spinning): the energy lost is the energy the bodies lose (their kinetic energies before
+// and after), and the angular momentum about the contact point, m (c - p) x v + I w summed over
+// both bodies, is what it was (an impulse at p has no moment about p).
+TEST(ShapedCollision, TheCornerImpactTurnedIsTurnedAndConservesAngularMomentumAboutThePoint) {
+  const Eigen::Quaterniond q =
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.7, V(1, -2, 0.5).normalized()));
+  const Eigen::Matrix3d rotation = q.toRotationMatrix();
+  for (const bool friction : {false, true}) {
+    SCOPED_TRACE(friction ? "friction and spin" : "frictionless");
+    CollisionRequest request = ballOnABoxCorner();
+    request.a.position = rotation * request.a.position;
+    request.a.velocity = rotation * request.a.velocity;
+    request.b.orientation = q;
+    request.b.velocity = rotation * V(0.1, -0.2, 0.05);
+    request.b.angular_velocity = rotation * V(0.3, 0.1, -0.4);
+    const double ball_moment = friction ? 0.4 * 1.0 * (7.0 / 8.0) * (7.0 / 8.0) : 0.0;
+    if (friction) {
+      request.a.angular_velocity = V(2.0, -1.0, 0.5);
+      request.friction = 0.4;
+      request.effects = {"friction", "spin"};
+    }
+    const auto outcome = computeCollision(request, MaterialTable::seed());
+    ASSERT_TRUE(outcome.ok()) << outcome.error().message();
+    expectNear(outcome->line_of_impact, rotation * (-V(2, 3, 6) / 7.0), 1.0, "normal");
+    const V point = outcome->contact_point;
+    expectNear(point, rotation * V(0.5, 1, 1.5), 2.0, "contact point");
+    if (!friction) {
+      // The box's own motion at its corner Q r changes the approach speed d (not n.K.n, which
+      // turns with the problem): j = (1 + e) d / n.K.n.
+      const V n = rotation * (-V(2, 3, 6) / 7.0);
+      const V corner = rotation * V(0.5, 1, 1.5);
+      const double d = -n.dot(request.b.velocity + request.b.angular_velocity.cross(corner) -
+                              request.a.velocity);
+      const double j = 1.5 * d / kCornerInverseMass;
+      EXPECT_NEAR(outcome->impact.normal_impulse, j, 64 * j * 2.2e-16);
+      expectNear(outcome->angular_velocity_b - request.b.angular_velocity,
+                 rotation * (j * V(-3.0 / 182.0, 0, 1.0 / 70.0)), 1.0, "the box's turn");
+    } else {
+      EXPECT_GT(outcome->friction_impulse, 0.0);
+      EXPECT_LE(outcome->friction_impulse, 0.4 * outcome->impact.normal_impulse * (1 + 1e-15));
+    }
+
+    const Eigen::Matrix3d box_inertia = V(13, 10, 5).asDiagonal();
+    const Eigen::Matrix3d world_inertia = rotation * box_inertia * rotation.transpose();
+    const auto momentum = [&](const V& va, const V& wa, const V& vb, const V& wb) {
+      return V(1.0 * (request.a.position - point).cross(va) + ball_moment * wa +
+               12.0 * (request.b.position - point).cross(vb) + world_inertia * wb);
+    };
+    const V before = momentum(request.a.velocity, request.a.angular_velocity, request.b.velocity,
+                              request.b.angular_velocity);
+    const V after = momentum(outcome->impact.velocity_a, outcome->angular_velocity_a,
+                             outcome->impact.velocity_b, outcome->angular_velocity_b);
+    expectNear(after, before, before.norm(), "angular momentum about the contact point");
+
+    const auto energy = [&](const V& va, const V& wa, const V& vb, const V& wb) {
+      return 0.5 * va.squaredNorm() + 0.5 * ball_moment * wa.squaredNorm() +
+             kineticEnergy(12.0, box_inertia, q, vb, wb);
+    };
+    const double energy_before = energy(request.a.velocity, request.a.angular_velocity,
+                                        request.b.velocity, request.b.angular_velocity);
+    const double energy_after = energy(outcome->impact.velocity_a, outcome->angular_velocity_a,
+                                       outcome->impact.velocity_b, outcome->angular_velocity_b);
+    EXPECT_NEAR(energy_before - energy_after, outcome->impact.energy_lost, 1e-13 * energy_before);
+    EXPECT_GT(outcome->impact.energy_lost, 0.0);
+  }
+}
+
+// A rod on its end: a capsule of 2 kg (segment 1 m, radius 0.01 m) given a thin rod's tensor
+// (ixx = iyy = m L^2 / 12 = 1/6, izz = 1e-4), tilted by theta about x (sin 3/5, cos 4/5), falls
+// at 3 m/s onto the ground, an immovable box; its lowest point (0, 0, 0) is given, and the
+// normal +z (ground a -> rod b). The lever arm from the rod's centre (0, -0.3, 0.41) to the point
+// is r = (0, 0.3, -0.41); r x n = (0.3, 0, 0), along the body's x, a principal axis the tilt
+// keeps: n.K.n = 1/2 + 0.3^2 * 6 = 1.04, the classic (1 + 3 sin^2 theta) / m. With e = 1/2:
+// j = 1.5 * 3 / 1.04; v' = (0, 0, -3 + j / 2); w' = 6 (0.3 j, 0, 0); lost 0.75 * 9 / (2 * 1.04).
+CollisionRequest rodOnItsEnd() {
+  CollisionRequest request;
+  request.a.id = "ground";
+  request.a.mass = kInf;
+  request.a.shape = BodyShape::kBox;
+  request.a.size = V(10, 10, 2);
+  request.a.position = V(0, 0, -1);
+  request.a.orientation = Eigen::Quaterniond::Identity();
+  request.b.id = "rod";
+  request.b.mass = 2.0;
+  request.b.shape = BodyShape::kCapsule;
+  request.b.radius = 0.01;
+  request.b.length = 1.0;
+  request.b.position = V(0, -0.3, 0.41);
+  request.b.velocity = V(0, 0, -3);
+  request.b.orientation = Eigen::Quaterniond(3 / std::sqrt(10.0), 1 / std::sqrt(10.0), 0, 0);
+  InertiaTensor rod;
+  rod.ixx = rod.iyy = 1.0 / 6.0;
+  rod.izz = 1e-4;
+  request.b.inertia_tensor = rod;
+  request.normal = V(0, 0, 1);
+  request.contact_point = V(0, 0, 0);
+  request.restitution = 0.5;
+  return request;
+}
+
+TEST(ShapedCollision, ARodOnItsEndFrictionlessIsTheClosedForm) {
+  const auto outcome = computeCollision(rodOnItsEnd(), MaterialTable::seed());
+  ASSERT_TRUE(outcome.ok()) << outcome.error().message();
+  const double j = 4.5 / 1.04;
+  EXPECT_NEAR(outcome->impact.normal_impulse, j, 64 * j * 2.2e-16);
+  expectNear(outcome->impact.velocity_b, V(0, 0, -3 + j / 2), 3.0, "rod's velocity");
+  expectNear(outcome->angular_velocity_b, V(1.8 * j, 0, 0), 8.0, "rod's angular velocity");
+  expectNear(outcome->impact.velocity_a, V::Zero(), 1.0, "the ground stays");
+  expectNear(outcome->angular_velocity_a, V::Zero(), 1.0, "the ground does not turn");
+  expectNear(outcome->contact_point, V::Zero(), 1.0, "the point given");
+  const double lost = 0.75 * 9 / (2 * 1.04);
+  EXPECT_NEAR(outcome->impact.energy_lost, lost, 64 * lost * 2.2e-16);
+}
+
+// A sphere given its own uniform solid's tensor (2/5 m r^2 about every axis) is the ball it was,
+// through the rigid bodies' law instead of the balls': with friction and spin, rolling onto an
+// immovable ball, the same velocities and spins to a few ulps.
+TEST(ShapedCollision, ASphereGivenItsSolidTensorAnswersAsTheBall) {
+  CollisionRequest request;
+  request.a.mass = 0.5;
+  request.a.radius = 0.1;
+  request.a.velocity = V(0.4, -0.3, -2.0);
+  request.a.angular_velocity = V(5, -3, 8);
+  request.b.mass = kInf;
+  request.b.radius = 1.0;
+  request.b.position = V(0.05, 0.02, -1.09);
+  request.restitution = 0.7;
+  request.friction = 0.3;
+  request.effects = {"friction", "spin"};
+  const auto ball = computeCollision(request, MaterialTable::seed());
+  ASSERT_TRUE(ball.ok()) << ball.error().message();
+  InertiaTensor solid;
+  solid.ixx = solid.iyy = solid.izz = 0.4 * 0.5 * 0.1 * 0.1;
+  request.a.inertia_tensor = solid;
+  request.a.orientation =
+      Eigen::Quaterniond(Eigen::AngleAxisd(1.1, V(0.3, 0.4, -0.2).normalized()));
+  const auto rigid = computeCollision(request, MaterialTable::seed());
+  ASSERT_TRUE(rigid.ok()) << rigid.error().message();
+  expectNear(rigid->impact.velocity_a, ball->impact.velocity_a, 2.0, "velocity");
+  expectNear(rigid->angular_velocity_a, ball->angular_velocity_a, 8.0, "angular velocity");
+  EXPECT_NEAR(rigid->impact.normal_impulse, ball->impact.normal_impulse, 1e-14);
+  EXPECT_NEAR(rigid->friction_impulse, ball->friction_impulse, 1e-14);
+  EXPECT_EQ(rigid->sticking, ball->sticking);
+  EXPECT_NEAR(rigid->impact.energy_lost, ball->impact.energy_lost, 1e-13);
+}
+
+// Separating at the corner (the ball moving away): nothing changes, no impulse.
+TEST(ShapedCollision, SeparatingAtACornerChangesNothing) {
+  CollisionRequest request = ballOnABoxCorner();
+  request.a.velocity = V(2, 3, 6);
+  const auto outcome = computeCollision(request, MaterialTable::seed());
+  ASSERT_TRUE(outcome.ok()) << outcome.error().message();
+  EXPECT_FALSE(outcome->impact.approaching);
+  EXPECT_EQ(outcome->impact.normal_impulse, 0.0);
+  EXPECT_EQ(outcome->impact.velocity_a, V(2, 3, 6));
+  EXPECT_EQ(outcome->impact.velocity_b, V::Zero());
+  EXPECT_EQ(outcome->angular_velocity_b, V::Zero());
+  EXPECT_EQ(outcome->impact.energy_lost, 0.0);
+}
+
+// Refused, naming `field`, with `words` in the reason.
+void expectRefused(const CollisionRequest& request, const std::string& field,
+                   const std::string& words) {
+  const auto outcome = computeCollision(request, MaterialTable::seed());
+  ASSERT_FALSE(outcome.ok()) << "expected a refusal naming " << field;
+  EXPECT_EQ(outcome.error().field, field) << outcome.error().message();
+  EXPECT_NE(outcome.error().reason.find(words), std::string::npos) << outcome.error().message();
+}
+
+TEST(ShapedCollision, BadShapedBodiesAreRefusedByName) {
+  {  // a box not turned by anything: all zero is "not given"
+    CollisionRequest request = ballOnABoxCorner();
+    request.b.orientation = Eigen::Quaterniond(0, 0, 0, 0);
+    expectRefused(request, "b.orientation", "needs its orientation");
+  }
+  {  // a sphere given a tensor needs its orientation too
+    CollisionRequest request = rodOnItsEnd();
+    request.b.shape = BodyShape::kSphere;
+    request.b.length = 0.0;
+    request.b.orientation = Eigen::Quaterniond(0, 0, 0, 0);
+    expectRefused(request, "b.orientation", "given its tensor");
+  }
+  {
+    CollisionRequest request = ballOnABoxCorner();
+    request.b.orientation = Eigen::Quaterniond(2, 0, 0, 0);
+    expectRefused(request, "b.orientation", "length 1");
+  }
+  {
+    CollisionRequest request = ballOnABoxCorner();
+    request.b.orientation = Eigen::Quaterniond(1, kNan, 0, 0);
+    expectRefused(request, "b.orientation.x", "finite");
+  }
+  {
+    CollisionRequest request = ballOnABoxCorner();
+    request.b.size = V(1, 0, 3);
+    expectRefused(request, "b.size", "> 0");
+  }
+  {
+    CollisionRequest request = ballOnABoxCorner();
+    request.b.size = V(1, -2, 3);
+    expectRefused(request, "b.size", "> 0");
+  }
+  {  // a number the shape has not is not ignored
+    CollisionRequest request = ballOnABoxCorner();
+    request.b.radius = 0.5;
+    expectRefused(request, "b.radius", "a box has no radius");
+  }
+  {
+    CollisionRequest request = ballOnABoxCorner();
+    request.a.size = V(1, 1, 1);
+    expectRefused(request, "a.size", "a sphere has no edges");
+  }
+  {
+    CollisionRequest request = ballOnABoxCorner();
+    request.b.length = 2.0;
+    expectRefused(request, "b.length", "a box has no length");
+  }
+  {
+    CollisionRequest request = rodOnItsEnd();
+    request.b.shape = BodyShape::kCylinder;
+    request.b.length = 0.0;
+    expectRefused(request, "b.length", "> 0");
+  }
+  {
+    CollisionRequest request = rodOnItsEnd();
+    request.b.radius = 0.0;
+    expectRefused(request, "b.radius", "> 0");
+  }
+  {
+    CollisionRequest request = ballOnABoxCorner();
+    request.b.shape = BodyShape::kMesh;
+    request.b.size = V::Zero();
+    expectRefused(request, "b.shape", "not yet");
+  }
+  {  // not positive definite: ixx iyy - ixy^2 < 0
+    CollisionRequest request = rodOnItsEnd();
+    request.b.inertia_tensor->ixy = 0.2;
+    expectRefused(request, "b.inertia_tensor.ixy", "");
+  }
+  {  // the triangle inequality: izz > ixx + iyy
+    CollisionRequest request = rodOnItsEnd();
+    request.b.inertia_tensor->izz = 1.0;
+    expectRefused(request, "b.inertia_tensor", "triangle");
+  }
+  {
+    CollisionRequest request = rodOnItsEnd();
+    request.b.inertia_tensor->ixx = kNan;
+    expectRefused(request, "b.inertia_tensor.ixx", "finite");
+  }
+  {
+    CollisionRequest request = rodOnItsEnd();
+    request.b.inertia = Inertia::kHollow;
+    expectRefused(request, "b.inertia", "hollow");
+  }
+  {  // a box is a uniform solid
+    CollisionRequest request = ballOnABoxCorner();
+    request.b.inertia = Inertia::kHollow;
+    expectRefused(request, "b.inertia", "hollow");
+  }
+}
+
+TEST(ShapedCollision, AContactThatCannotBeFoundOrIsNoPointOfTheBodyIsRefusedByName) {
+  {  // two shaped bodies: the point must be given
+    CollisionRequest request = rodOnItsEnd();
+    request.contact_point.reset();
+    expectRefused(request, "contact_point_given", "two shaped bodies");
+  }
+  {  // and the normal
+    CollisionRequest request = rodOnItsEnd();
+    request.normal = V::Zero();
+    expectRefused(request, "normal", "two shaped bodies");
+  }
+  {
+    CollisionRequest request = rodOnItsEnd();
+    request.contact_point = V(0, kInf, 0);
+    expectRefused(request, "contact_point.y", "finite");
+  }
+  {  // 1.2 m from the rod's centre: the capsule reaches 0.51 m
+    CollisionRequest request = rodOnItsEnd();
+    request.contact_point = V(0, 0, -0.8);
+    expectRefused(request, "contact_point", "farther than any point of the capsule b");
+  }
+  {  // two spheres: their contact is on the line of impact, a point given would be ignored
+    CollisionRequest request;
+    request.a.mass = 1.0;
+    request.b.mass = 1.0;
+    request.b.position = V(1, 0, 0);
+    request.contact_point = V(0.5, 0, 0);
+    expectRefused(request, "contact_point_given", "two spheres");
+  }
+}
+
+}  // namespace
+}  // namespace collision_response::core
