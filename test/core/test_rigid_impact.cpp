@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <limits>
 #include <random>
@@ -223,7 +224,8 @@ long randomImpactCount() {
 }
 
 // 10^6 random impacts (random masses, tensors in random orientations, balls among them, lever
-// arms, normals, velocities, e in [0, 1], mu in [0, 2] or 100): no energy gained past 1e-12 of
+// arms, normals, velocities, e in [0, 1] (1 a tenth of the time), mu in [0, 2], 0 or 100): no
+// energy gained past 1e-12 of
 // the energy before, Newton's e along the normal, the impulse in Coulomb's cone, and each
 // body's angular momentum about the contact point conserved (to 64 eps of its terms).
 TEST(RigidImpact, RandomImpactsNeverGainEnergyAndConserveAngularMomentumAboutTheContact) {
@@ -232,12 +234,16 @@ TEST(RigidImpact, RandomImpactsNeverGainEnergyAndConserveAngularMomentumAboutThe
   const long count = randomImpactCount();
   long impacts = 0, sliding = 0;
   RealL worst_gain = -1;
+  double worst_momentum = 0;  // in eps of its terms
   for (long trial = 0; trial < count; ++trial) {
     RandomBody a = randomBody(rng, unit(rng) < 0.3);
     RandomBody b = randomBody(rng, false);
     const ContactPoint contact = randomContact(rng, a.body, b.body);
-    const double restitution = unit(rng);
-    const double friction = unit(rng) < 0.1 ? 100.0 : 2.0 * unit(rng);
+    // e = 1 and mu = 0 a tenth of the time each: where the energy is kept (e = 1 frictionless),
+    // rounding is all that could gain it.
+    const double restitution = unit(rng) < 0.1 ? 1.0 : unit(rng);
+    const double pick = unit(rng);
+    const double friction = pick < 0.1 ? 100.0 : pick < 0.2 ? 0.0 : 2.0 * unit(rng);
     const RealL before = kineticEnergy(a.body, a.inertia) + kineticEnergy(b.body, b.inertia);
     const SolverBody a0 = a.body, b0 = b.body;
     const auto outcome = resolveRigidImpact(a.body, b.body, contact, restitution, friction);
@@ -280,13 +286,18 @@ TEST(RigidImpact, RandomImpactsNeverGainEnergyAndConserveAngularMomentumAboutThe
       const double terms =
           mass * lever.norm() * (start->velocity.norm() + body->velocity.norm()) +
           inertia->norm() * (start->angular_velocity.norm() + body->angular_velocity.norm());
-      ASSERT_LE((momentum(*body) - momentum(*start)).norm(), 64 * kEps * terms)
-          << "trial " << trial;
+      const double drift = (momentum(*body) - momentum(*start)).norm();
+      worst_momentum = std::max(worst_momentum, drift / (kEps * terms));
+      ASSERT_LE(drift, 64 * kEps * terms) << "trial " << trial;
     }
   }
   EXPECT_GT(impacts, count / 3);
   EXPECT_GT(sliding, impacts / 10);
   EXPECT_LE(worst_gain, 1e-12L);
+  std::printf(
+      "%ld impacts, %ld sliding: the largest energy change %.3Lg of the energy before, "
+      "angular momentum about the contact within %.3g eps of its terms\n",
+      impacts, sliding, worst_gain, worst_momentum);
 }
 
 /// Today's answer for one contact of two balls, as the monitor's solveContact gives it:
@@ -329,6 +340,7 @@ TEST(RigidImpact, BallsGiveTodaysAnswerBitForBitAndTheGeneralLawAgreesToAFewUlps
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   int compared = 0;
+  double worst = 0;  // the law's velocities against today's, in eps of the speeds
   for (int trial = 0; trial < 10000; ++trial) {
     SolverBody a = randomBall(rng, unit(rng) < 0.3);
     SolverBody b = randomBall(rng, false);
@@ -362,6 +374,8 @@ TEST(RigidImpact, BallsGiveTodaysAnswerBitForBitAndTheGeneralLawAgreesToAFewUlps
                          a.radius * a.angular_velocity.norm() +
                          b.radius * b.angular_velocity.norm();
     for (int i = 0; i < 3; ++i) {
+      worst = std::max({worst, std::abs(law_a.velocity[i] - today_a.velocity[i]) / (kEps * speed),
+                        std::abs(law_b.velocity[i] - today_b.velocity[i]) / (kEps * speed)});
       ASSERT_NEAR(law_a.velocity[i], today_a.velocity[i], 16 * kEps * speed) << trial;
       ASSERT_NEAR(law_b.velocity[i], today_b.velocity[i], 16 * kEps * speed) << trial;
       if (a.inverse_mass > 0) {
@@ -380,6 +394,8 @@ TEST(RigidImpact, BallsGiveTodaysAnswerBitForBitAndTheGeneralLawAgreesToAFewUlps
         << trial;
   }
   EXPECT_GT(compared, 3000);
+  std::printf("%d ball impacts: the law's velocities within %.3g eps of the speeds of today's\n",
+              compared, worst);
 }
 
 // The same impact of a cylinder (axisymmetric: I = diag(1, 1, 1/2) m r^2-like) on a floor, with

@@ -181,9 +181,10 @@ RigidImpactOutcome resolveRigidImpactByLaw(SolverBody& a, SolverBody& b,
   applyImpulse(a, contact.lever_a, -impulse);
   applyImpulse(b, contact.lever_b, impulse);
   outcome.impulse = impulse.cast<double>();
-  const RealL normal_impulse = impulse.dot(n);
-  outcome.normal_impulse = static_cast<double>(normal_impulse);
-  outcome.tangential_impulse = (impulse - normal_impulse * n).cast<double>();
+  // Its parts along n and across, from the law's own: P_I lies along n, D = D.n n + D_t (so
+  // that a frictionless impact has no tangential part at all, whatever |n|'s rounding).
+  outcome.normal_impulse = static_cast<double>(frictionless_normal + kappa * d_normal);
+  outcome.tangential_impulse = (kappa * (d - d_normal * n)).cast<double>();
   outcome.energy_lost = static_cast<double>(lost);
   return outcome;
 }
