@@ -2,12 +2,35 @@
 
 #include <tuple>
 
+#include "collision_response/core/body_shape.h"
 #include "collision_response/core/collision.h"
 #include "collision_response/core/restitution.h"
 #include "collision_response/core/validation.h"
 #include "collision_response/ros/conversions.h"
 
 namespace collision_response {
+namespace {
+
+/// A body's fields given by name: `inertia` (empty: solid; empty where inertia_tensor is given,
+/// which says how the mass is spread) and `shape` (empty: a sphere).
+core::Status parseNamedFields(const Body& message, const std::string& prefix, core::Body& body) {
+  if (!message.inertia.empty() && isGiven(message.inertia_tensor)) {
+    return core::Error{prefix + ".inertia", "is '" + message.inertia + "' while " + prefix +
+                                                ".inertia_tensor is given: give one (leave "
+                                                "inertia empty; the tensor says how the mass is "
+                                                "spread)"};
+  }
+  const auto inertia = core::parseInertia(message.inertia, prefix + ".inertia");
+  if (!inertia) return inertia.error();
+  body.inertia = *inertia;
+  if (message.shape.empty()) return core::Ok{};
+  const auto shape = core::parseBodyShape(message.shape, prefix + ".shape");
+  if (!shape) return shape.error();
+  body.shape = *shape;
+  return core::Ok{};
+}
+
+}  // namespace
 
 void answerComputeCollision(const ComputeCollision::Request& request,
                             const core::MaterialTable& materials,
@@ -20,16 +43,15 @@ void answerComputeCollision(const ComputeCollision::Request& request,
   core_request.restitution = request.restitution;
   core_request.friction = request.friction;
   core_request.effects = request.effects;
-  for (const auto& [body, message, field] :
-       {std::make_tuple(&core_request.a, &request.a, "a.inertia"),
-        std::make_tuple(&core_request.b, &request.b, "b.inertia")}) {
-    const auto inertia = core::parseInertia(message->inertia, field);
-    if (!inertia) {
+  if (request.contact_point_given) core_request.contact_point = toEigen(request.contact_point);
+  for (const auto& [body, message, prefix] :
+       {std::make_tuple(&core_request.a, &request.a, std::string("a")),
+        std::make_tuple(&core_request.b, &request.b, std::string("b"))}) {
+    if (auto status = parseNamedFields(*message, prefix, *body); !status) {
       response.success = false;
-      response.message = inertia.error().message();
+      response.message = status.error().message();
       return;
     }
-    body->inertia = *inertia;
   }
   const auto outcome = core::computeCollision(core_request, materials);
   if (!outcome) {
@@ -44,6 +66,7 @@ void answerComputeCollision(const ComputeCollision::Request& request,
   response.angular_velocity_a = toVector3Msg(outcome->angular_velocity_a);
   response.angular_velocity_b = toVector3Msg(outcome->angular_velocity_b);
   response.normal = toVector3Msg(outcome->line_of_impact);
+  response.contact_point = toPointMsg(outcome->contact_point);
   response.restitution = outcome->restitution;
   response.impulse = impact.normal_impulse;
   response.oblique = outcome->oblique;

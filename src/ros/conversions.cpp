@@ -35,7 +35,27 @@ core::Body toCore(const collision_response::Body& msg) {
   body.position = toEigen(msg.position);
   body.velocity = toEigen(msg.velocity);
   body.angular_velocity = toEigen(msg.angular_velocity);
+  body.size = toEigen(msg.size);
+  body.length = msg.length;
+  body.orientation = Eigen::Quaterniond(msg.orientation.w, msg.orientation.x, msg.orientation.y,
+                                        msg.orientation.z);
+  if (isGiven(msg.inertia_tensor)) {
+    const InertiaTensor& given = msg.inertia_tensor;
+    core::InertiaTensor tensor;
+    tensor.ixx = given.ixx;
+    tensor.iyy = given.iyy;
+    tensor.izz = given.izz;
+    tensor.ixy = given.ixy;
+    tensor.ixz = given.ixz;
+    tensor.iyz = given.iyz;
+    body.inertia_tensor = tensor;
+  }
   return body;
+}
+
+bool isGiven(const InertiaTensor& tensor) {
+  return !(tensor.ixx == 0.0 && tensor.iyy == 0.0 && tensor.izz == 0.0 && tensor.ixy == 0.0 &&
+           tensor.ixz == 0.0 && tensor.iyz == 0.0);
 }
 
 std::optional<core::ImpactRecord> toImpactRecord(const Impact& impact,

@@ -184,6 +184,43 @@ TEST(PredictServe, EveryBadRequestIsNamedAndTheNodeKeepsServing) {
   EXPECT_EQ(refusal(servedBall(ref)), "accepted");
 }
 
+// Body.msg's shape fields (ComputeCollision's, issue 42): a prediction moves balls only yet, so
+// a body given its own shape or tensor is refused by name rather than predicted as a ball, and a
+// number a sphere has not (its size) is not ignored.
+TEST(PredictServe, AShapedBodyIsRefusedNotPredictedAsABall) {
+  ASSERT_TRUE(ros::service::waitForService("/collision_response/predict_impacts", 30000));
+  PredictImpacts probe;
+  probe.request.header.frame_id = "world";
+  probe.request.body.id = "probe";
+  probe.request.body.mass = 0.0027;
+  probe.request.body.radius = 0.02;
+  probe.request.body.material = "celluloid";
+  probe.request.body.position.x = -3.0;
+  probe.request.body.position.z = 1.0;
+  probe.request.effects = {"gravity"};
+  probe.request.horizon = 0.1;
+  probe.request.max_impacts = 1;
+  const auto refusal = [](PredictImpacts call) {
+    if (!callService(call)) return std::string("no answer");
+    if (call.response.success) return std::string("accepted");
+    return call.response.message;
+  };
+  PredictImpacts call = probe;
+  call.request.body.shape = "box";
+  call.request.body.radius = 0.0;
+  call.request.body.size.x = call.request.body.size.y = call.request.body.size.z = 0.04;
+  call.request.body.orientation.w = 1.0;
+  EXPECT_EQ(refusal(call).rfind("body.shape: not yet", 0), 0u) << refusal(call);
+  call = probe;
+  call.request.body.inertia_tensor.ixx = call.request.body.inertia_tensor.iyy =
+      call.request.body.inertia_tensor.izz = 1e-6;
+  EXPECT_EQ(refusal(call).rfind("body.inertia_tensor: not yet", 0), 0u) << refusal(call);
+  call = probe;
+  call.request.body.size.x = 0.04;
+  EXPECT_EQ(refusal(call).rfind("body.size: must be 0", 0), 0u) << refusal(call);
+  EXPECT_EQ(refusal(probe), "accepted");
+}
+
 // Issue 41, item 8: absurd numbers answered rightly, each against its closed form.
 //  - crossing_normal (0, 0, 1e-300) was taken for no plane (Eigen's isZero is approximate): any
 //    nonzero length is a direction, as the srv says; the probe falling from z = 1.0 at

@@ -195,6 +195,98 @@ TEST_F(Services, FrictionAndSpinMakeTheBallRoll) {
   expectRefused(request, "a.inertia");
 }
 
+// Shaped bodies over ROS (issue 42): a 12 kg box of edges (1, 2, 3) m at rest, not turned, struck
+// at its corner (1/2, 1, 3/2) by a 1 kg ball of radius 7/8 m moving at -(2, 3, 6) m/s, e = 1/2,
+// frictionless. The node finds the contact (the corner) and the normal n = -(2, 3, 6)/7 from
+// the shapes; the closed form (test/exact/shaped_collision.py): n.K.n = 1 + 1/12 + (9/196)/13 +
+// (1/196)/5 = 41579/38220, j = 10.5 / n.K.n, v_box' = j n / 12, w_box' = j (-3/182, 0, 1/70).
+ComputeCollision::Request ballOnABoxCorner() {
+  ComputeCollision::Request request;
+  request.a.mass = 1.0;
+  request.a.radius = 7.0 / 8.0;
+  request.a.position.x = 3.0 / 4.0;
+  request.a.position.y = 11.0 / 8.0;
+  request.a.position.z = 9.0 / 4.0;
+  request.a.velocity.x = -2.0;
+  request.a.velocity.y = -3.0;
+  request.a.velocity.z = -6.0;
+  request.b.mass = 12.0;
+  request.b.shape = "box";
+  request.b.size.x = 1.0;
+  request.b.size.y = 2.0;
+  request.b.size.z = 3.0;
+  request.b.orientation.w = 1.0;
+  request.restitution = 0.5;
+  return request;
+}
+
+TEST_F(Services, ABoxStruckAtACornerFrictionlessIsTheClosedForm) {
+  const auto response = call(ballOnABoxCorner());
+  ASSERT_TRUE(response.success) << response.message;
+  const double j = 10.5 / (41579.0 / 38220.0);
+  const double tolerance = 1e-14;
+  EXPECT_NEAR(response.impulse, j, tolerance * j);
+  EXPECT_NEAR(response.normal.x, -2.0 / 7.0, tolerance);
+  EXPECT_NEAR(response.normal.z, -6.0 / 7.0, tolerance);
+  EXPECT_NEAR(response.contact_point.x, 0.5, tolerance);
+  EXPECT_NEAR(response.contact_point.y, 1.0, tolerance);
+  EXPECT_NEAR(response.contact_point.z, 1.5, tolerance);
+  EXPECT_NEAR(response.velocity_b.x, -2.0 / 7.0 * j / 12.0, tolerance);
+  EXPECT_NEAR(response.velocity_b.y, -3.0 / 7.0 * j / 12.0, tolerance);
+  EXPECT_NEAR(response.velocity_b.z, -6.0 / 7.0 * j / 12.0, tolerance);
+  EXPECT_NEAR(response.velocity_a.z, -6.0 + 6.0 / 7.0 * j, 8 * tolerance);
+  EXPECT_NEAR(response.angular_velocity_b.x, -3.0 / 182.0 * j, tolerance);
+  EXPECT_NEAR(response.angular_velocity_b.y, 0.0, tolerance);
+  EXPECT_NEAR(response.angular_velocity_b.z, 1.0 / 70.0 * j, tolerance);
+  EXPECT_EQ(response.angular_velocity_a.x, 0.0);  // a ball without the spin effect
+  const double lost = 0.5 * 0.75 * 49.0 / (41579.0 / 38220.0);
+  EXPECT_NEAR(response.energy_lost, lost, tolerance * lost);
+  EXPECT_TRUE(response.approaching);
+}
+
+TEST_F(Services, BadShapedBodiesNameTheFieldAndTheNodeKeepsServing) {
+  auto request = ballOnABoxCorner();
+  request.b.orientation.w = 0.0;  // all zero: not given
+  expectRefused(request, "b.orientation");
+
+  request = ballOnABoxCorner();
+  request.b.shape = "cube";
+  expectRefused(request, "b.shape");
+
+  request = ballOnABoxCorner();
+  request.b.shape = "mesh";
+  expectRefused(request, "b.shape");
+
+  request = ballOnABoxCorner();
+  request.b.size.y = 0.0;
+  expectRefused(request, "b.size");
+
+  request = ballOnABoxCorner();
+  request.b.radius = 0.5;  // a box has none: not silently ignored
+  expectRefused(request, "b.radius");
+
+  request = ballOnABoxCorner();
+  request.b.inertia_tensor.ixx = 1.0;
+  request.b.inertia_tensor.iyy = 1.0;
+  request.b.inertia_tensor.izz = 1.0;
+  request.b.inertia_tensor.ixy = 1.5;  // not positive definite
+  expectRefused(request, "b.inertia_tensor.ixy");
+
+  request.b.inertia_tensor.ixy = 0.0;
+  request.b.inertia = "solid";  // and a tensor: which?
+  expectRefused(request, "b.inertia");
+
+  request = ballOnABoxCorner();
+  request.a.shape = "cylinder";
+  request.a.length = 1.0;
+  request.a.orientation.w = 1.0;  // two shaped bodies, no contact point given
+  expectRefused(request, "contact_point_given");
+
+  request = seedRequest();
+  request.contact_point_given = true;  // two balls: their contact is on the line of impact
+  expectRefused(request, "contact_point_given");
+}
+
 TEST_F(Services, EstimateRestitutionFromHeights) {
   EstimateRestitution srv;
   srv.request.drop_height = 2.0;

@@ -11,6 +11,7 @@
 
 #include "collision_response/Body.h"
 #include "collision_response/Impact.h"
+#include "collision_response/InertiaTensor.h"
 #include "collision_response/core/body.h"
 #include "collision_response/core/monitor.h"
 
@@ -21,8 +22,12 @@ Eigen::Vector3d toEigen(const geometry_msgs::Vector3& vector);
 geometry_msgs::Vector3 toVector3Msg(const Eigen::Vector3d& vector);
 geometry_msgs::Point toPointMsg(const Eigen::Vector3d& point);
 
-/// Copies every field; validation is the core's (core::checkBody).
+/// Copies every field but the strings parsed by name (`inertia`, `shape`: the caller's, which
+/// can name their errors); an all-zero inertia_tensor is none (isGiven). Validation is the
+/// core's (core::checkBody, core::checkBodyShape).
 core::Body toCore(const collision_response::Body& msg);
+/// A tensor with an entry other than 0 (a NaN too): given; all zero: not given.
+bool isGiven(const InertiaTensor& tensor);
 
 /// The record of an impact message, indexed as `monitor` indexes its bodies, at `time` on the
 /// caller's time line: what core::Playback::applyImpact takes. Empty when body_a is not one of
