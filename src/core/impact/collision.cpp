@@ -311,9 +311,7 @@ Expected<CollisionOutcome> resolveRigid(const CollisionRequest& request,
   };
   outcome.angular_velocity_a = turned(request.a, a);
   outcome.angular_velocity_b = turned(request.b, b);
-  // Frictionless, the law's impulse is along the normal: its tangential part only the rounding
-  // of splitting it.
-  outcome.friction_impulse = friction > 0 ? impact->tangential_impulse.norm() : 0.0;
+  outcome.friction_impulse = impact->tangential_impulse.norm();  // 0 frictionless
   outcome.sticking = friction > 0 && outcome.impact.approaching && impact->sticking;
   return outcome;
 }
