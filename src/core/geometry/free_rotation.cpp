@@ -43,6 +43,43 @@ std::string exact(double x) {
   return text.str();
 }
 
+/// FreeRotation::create's bad input, by name: moments finite and > 0 meeting the triangle
+/// inequality, an orientation checkOrientation takes, a finite angular velocity.
+Status checkRotationInput(const Eigen::Vector3d& principal_moments,
+                          const Eigen::Quaterniond& orientation,
+                          const Eigen::Vector3d& angular_velocity) {
+  for (int i = 0; i < 3; ++i) {
+    const double j = principal_moments[i];
+    if (!std::isfinite(j) || j <= 0.0) {
+      return Error{std::string("principal_moments.") + axisName(i),
+                   "must be finite and > 0, got " + exact(j)};
+    }
+    if (!std::isfinite(angular_velocity[i])) {
+      return Error{std::string("angular_velocity.") + axisName(i),
+                   "must be finite, got " + exact(angular_velocity[i])};
+    }
+  }
+  // The triangle inequality J_i <= J_j + J_k, to checkInertiaTensor's rounding (16 eps of the
+  // sum): a flat body meets it with equality.
+  const double sum = principal_moments.sum();
+  for (int i = 0; i < 3; ++i) {
+    const double others = principal_moments[(i + 1) % 3] + principal_moments[(i + 2) % 3];
+    if (principal_moments[i] > others + 16.0 * std::numeric_limits<double>::epsilon() * sum) {
+      return Error{std::string("principal_moments.") + axisName(i),
+                   "breaks the triangle inequality: " + exact(principal_moments[i]) + " > " +
+                       exact(others) + ", the sum of the other two"};
+    }
+  }
+  return checkOrientation(orientation, "orientation");
+}
+
+/// The body axes in the ascending order of their moments: lo, mid, hi.
+std::array<int, 3> ascendingAxes(const Eigen::Vector3d& moments) {
+  std::array<int, 3> order{0, 1, 2};
+  std::sort(order.begin(), order.end(), [&](int x, int y) { return moments[x] < moments[y]; });
+  return order;
+}
+
 }  // namespace
 
 JacobiElliptic jacobiElliptic(double u, double m, double m1) {
@@ -87,31 +124,8 @@ double ellipticF(double sine, double cosine, double m1) {
 Expected<FreeRotation> FreeRotation::create(const Eigen::Vector3d& principal_moments,
                                             const Eigen::Quaterniond& orientation,
                                             const Eigen::Vector3d& angular_velocity) {
-  for (int i = 0; i < 3; ++i) {
-    const double j = principal_moments[i];
-    if (!std::isfinite(j) || j <= 0.0) {
-      return Error{std::string("principal_moments.") + axisName(i),
-                   "must be finite and > 0, got " + exact(j)};
-    }
-    if (!std::isfinite(angular_velocity[i])) {
-      return Error{std::string("angular_velocity.") + axisName(i),
-                   "must be finite, got " + exact(angular_velocity[i])};
-    }
-  }
-  // The triangle inequality J_i <= J_j + J_k, to checkInertiaTensor's rounding (16 eps of the
-  // sum): a flat body meets it with equality.
-  const double sum = principal_moments.sum();
-  for (int i = 0; i < 3; ++i) {
-    const double others = principal_moments[(i + 1) % 3] + principal_moments[(i + 2) % 3];
-    if (principal_moments[i] > others + 16.0 * std::numeric_limits<double>::epsilon() * sum) {
-      return Error{std::string("principal_moments.") + axisName(i),
-                   "breaks the triangle inequality: " + exact(principal_moments[i]) + " > " +
-                       exact(others) + ", the sum of the other two"};
-    }
-  }
-  const Status orientation_ok = checkOrientation(orientation, "orientation");
-  if (!orientation_ok) return orientation_ok.error();
-
+  const Status input_ok = checkRotationInput(principal_moments, orientation, angular_velocity);
+  if (!input_ok) return input_ok.error();
   FreeRotation r;
   r.orientation0_ = orientation.normalized();
   r.omega0_world_ = angular_velocity;
@@ -129,53 +143,72 @@ Expected<FreeRotation> FreeRotation::create(const Eigen::Vector3d& principal_mom
     return r;
   }
   r.momentum_axis_ = r.momentum_world_.stableNormalized();
-  // The moments in ascending order: lo, mid, hi (body axes).
-  std::array<int, 3> order{0, 1, 2};
-  std::sort(order.begin(), order.end(), [&](int x, int y) { return j[x] < j[y]; });
+  const std::array<int, 3> order = ascendingAxes(j);
   const int lo = order[0], mid = order[1], hi = order[2];
   const bool low_pair = j[lo] == j[mid];
   const bool high_pair = j[mid] == j[hi];
   if (low_pair && high_pair) {
     r.kind_ = Kind::kIsotropic;
-    return r;
+  } else if (low_pair || high_pair) {
+    r.startAxisymmetric(j, low_pair ? hi : lo, mid);
+  } else if ((w.array() != 0.0).count() == 1) {
+    r.kind_ = Kind::kIsotropic;  // a steady turn about a principal axis
+  } else {
+    r.startAsymmetric(j, order);
   }
-  if (low_pair || high_pair) {
-    r.kind_ = Kind::kAxisymmetric;
-    const int s = low_pair ? hi : lo;
-    const double js = j[s];
-    const double jt = j[mid];
-    r.symmetry_axis_ = Eigen::Vector3d::Unit(s);
-    r.body_rate_ = (js - jt) / jt * w[s];
-    r.precession_rate_ = r.momentum_world_.stableNorm() / jt;
-    return r;
-  }
+  return r;
+}
+
+void FreeRotation::startAxisymmetric(const Eigen::Vector3d& moments, int symmetry, int transverse) {
+  kind_ = Kind::kAxisymmetric;
+  const double js = moments[symmetry];
+  const double jt = moments[transverse];
+  symmetry_axis_ = Eigen::Vector3d::Unit(symmetry);
+  body_rate_ = (js - jt) / jt * omega0_body_[symmetry];
+  precession_rate_ = momentum_world_.stableNorm() / jt;
+}
+
+void FreeRotation::startAsymmetric(const Eigen::Vector3d& moments,
+                                   const std::array<int, 3>& ascending) {
   // The asymmetric body's parameters are homogeneous in w (the amplitudes and the rates of
   // degree 1, the rest of degree 0): computed for w scaled by a power of two to |w|_max in
   // [1, 2), exactly, so that no square underflows or overflows, and scaled back.
-  const int exponent = std::ilogb(w.cwiseAbs().maxCoeff());
-  const Eigen::Vector3d ws = w.unaryExpr([&](double x) { return std::ldexp(x, -exponent); });
+  const int exponent = std::ilogb(omega0_body_.cwiseAbs().maxCoeff());
+  const Eigen::Vector3d ws =
+      omega0_body_.unaryExpr([&](double x) { return std::ldexp(x, -exponent); });
+  setWorkingFrame(moments, ws, ascending);
+  const Eigen::Vector3d ww = working_ * ws;
+  const WorkingStart start = setEllipticMotion(ww, exponent);
+  setPhase(start.phase);
+  frame0_ = orientation0_ * Eigen::Quaterniond(working_.transpose()) *
+            leastRotationFromZ(start.momentum_direction);
+}
+
+void FreeRotation::setWorkingFrame(const Eigen::Vector3d& moments, const Eigen::Vector3d& ws,
+                                   const std::array<int, 3>& ascending) {
+  const Eigen::Vector3d& j = moments;
+  const int lo = ascending[0], mid = ascending[1], hi = ascending[2];
   // M^2 - 2 E J_mid, written so that nothing cancels but the separatrix's own difference.
   const double separation =
       j[lo] * (j[lo] - j[mid]) * ws[lo] * ws[lo] + j[hi] * (j[hi] - j[mid]) * ws[hi] * ws[hi];
-  if ((w.array() != 0.0).count() == 1) {
-    r.kind_ = Kind::kIsotropic;  // a steady turn about a principal axis
-    return r;
-  }
   // The working frame: axis 3 the one the polhode goes round, axis 2 the middle one.
   const std::array<int, 3> p =
       separation < 0.0 ? std::array<int, 3>{hi, mid, lo} : std::array<int, 3>{lo, mid, hi};
-  r.kind_ = separation == 0.0 ? Kind::kSeparatrix : Kind::kAsymmetric;
-  const double s3 = sign(w[p[2]]);
-  const double s1 = r.kind_ == Kind::kSeparatrix ? sign(w[p[0]]) : 1.0;
+  kind_ = separation == 0.0 ? Kind::kSeparatrix : Kind::kAsymmetric;
+  const double s3 = sign(omega0_body_[p[2]]);
+  const double s1 = kind_ == Kind::kSeparatrix ? sign(omega0_body_[p[0]]) : 1.0;
   Eigen::Matrix3d frame = Eigen::Matrix3d::Zero();
   frame(0, p[0]) = s1;
   frame(2, p[2]) = s3;
   frame(1, p[1]) = 1.0;
   if (frame.determinant() < 0.0) frame(1, p[1]) = -1.0;
-  r.working_ = frame;
-  const Eigen::Vector3d jw(j[p[0]], j[p[1]], j[p[2]]);
-  r.moments_ = jw;
-  const Eigen::Vector3d ww = frame * ws;
+  working_ = frame;
+  moments_ = Eigen::Vector3d(j[p[0]], j[p[1]], j[p[2]]);
+}
+
+FreeRotation::WorkingStart FreeRotation::setEllipticMotion(const Eigen::Vector3d& ww,
+                                                           int exponent) {
+  const Eigen::Vector3d& jw = moments_;
   const double w1 = ww.x(), w2 = ww.y(), w3 = ww.z();
   const double j1 = jw.x(), j2 = jw.y(), j3 = jw.z();
   // 2 E J_3 - M^2, M^2 - 2 E J_1, M^2 - 2 E J_2 (signed: in the frame of the smallest axis
@@ -186,46 +219,48 @@ Expected<FreeRotation> FreeRotation::create(const Eigen::Vector3d& principal_mom
   const double m2 = ww.cwiseProduct(jw).squaredNorm();
   const double momentum = std::sqrt(m2);
   const double two_energy = ww.dot(jw.cwiseProduct(ww));
-  r.amplitude_ = Eigen::Vector3d(std::sqrt(w1 * w1 + j2 * (j3 - j2) / (j1 * (j3 - j1)) * w2 * w2),
-                                 std::sqrt(j1 * (j3 - j1) / (j2 * (j3 - j2)) * w1 * w1 + w2 * w2),
-                                 std::sqrt(j2 * (j2 - j1) / (j3 * (j3 - j1)) * w2 * w2 + w3 * w3));
-  r.rate_ = sign(j3 - j2) * std::sqrt((j3 - j2) * bottom / (j1 * j2 * j3));
-  r.m_ = (j2 - j1) * top / ((j3 - j2) * bottom);
-  r.m1_ = (j3 - j1) * middle / ((j3 - j2) * bottom);
+  amplitude_ = Eigen::Vector3d(std::sqrt(w1 * w1 + j2 * (j3 - j2) / (j1 * (j3 - j1)) * w2 * w2),
+                               std::sqrt(j1 * (j3 - j1) / (j2 * (j3 - j2)) * w1 * w1 + w2 * w2),
+                               std::sqrt(j2 * (j2 - j1) / (j3 * (j3 - j1)) * w2 * w2 + w3 * w3));
+  rate_ = sign(j3 - j2) * std::sqrt((j3 - j2) * bottom / (j1 * j2 * j3));
+  m_ = (j2 - j1) * top / ((j3 - j2) * bottom);
+  m1_ = (j3 - j1) * middle / ((j3 - j2) * bottom);
+  WorkingStart start;
   // sn u0 and cn u0: (w_2 / A_2, w_1 / A_1), scaled alike (A_1 / A_2 is sqrt(J_2 |J_3 - J_2|) /
   // sqrt(J_1 |J_3 - J_1|)) and made a unit vector; no angle in between, whose rounding near
   // pi / 2 the near-separatrix F would magnify.
-  const Eigen::Vector2d phase = Eigen::Vector2d(w2 * std::sqrt(j2 * std::abs(j3 - j2)),
-                                                w1 * std::sqrt(j1 * std::abs(j3 - j1)))
-                                    .normalized();
-  r.a_ = j3 * r.amplitude_.z() / momentum;
-  r.psi_factor_ = j1 * j2 * r.amplitude_.x() * r.amplitude_.y() / m2;
-  r.energy_rate_ = std::ldexp(two_energy / momentum, exponent);
-  r.amplitude_ = r.amplitude_.unaryExpr([&](double x) { return std::ldexp(x, exponent); });
-  r.rate_ = std::ldexp(r.rate_, exponent);
-  if (r.kind_ == Kind::kSeparatrix) {
-    r.m_ = 1.0;
-    r.m1_ = 0.0;
-    r.u0_ = std::asinh(phase.x() / phase.y());  // F(phi | 1) = asinh(tan phi); cn u0 > 0
-    r.quarter_period_ = std::numeric_limits<double>::infinity();
+  start.phase = Eigen::Vector2d(w2 * std::sqrt(j2 * std::abs(j3 - j2)),
+                                w1 * std::sqrt(j1 * std::abs(j3 - j1)))
+                    .normalized();
+  start.momentum_direction = jw.cwiseProduct(ww) / momentum;
+  a_ = j3 * amplitude_.z() / momentum;
+  psi_factor_ = j1 * j2 * amplitude_.x() * amplitude_.y() / m2;
+  energy_rate_ = std::ldexp(two_energy / momentum, exponent);
+  amplitude_ = amplitude_.unaryExpr([&](double x) { return std::ldexp(x, exponent); });
+  rate_ = std::ldexp(rate_, exponent);
+  return start;
+}
+
+void FreeRotation::setPhase(const Eigen::Vector2d& phase) {
+  if (kind_ == Kind::kSeparatrix) {
+    m_ = 1.0;
+    m1_ = 0.0;
+    u0_ = std::asinh(phase.x() / phase.y());  // F(phi | 1) = asinh(tan phi); cn u0 > 0
+    quarter_period_ = std::numeric_limits<double>::infinity();
   } else {
-    r.u0_ = ellipticF(phase.x(), phase.y(), r.m1_);
-    r.quarter_period_ = completeEllipticK(r.m1_);
+    u0_ = ellipticF(phase.x(), phase.y(), m1_);
+    quarter_period_ = completeEllipticK(m1_);
     // G at the pieces' ends over one period, once: an evaluation integrates one piece.
-    const double pieces = std::max(1.0, std::ceil(2.0 * r.quarter_period_ / kPieceLength));
-    r.piece_ = 2.0 * r.quarter_period_ / pieces;
-    r.piece_ends_.assign(static_cast<std::size_t>(pieces) + 1, 0.0);
-    for (std::size_t k = 1; k < r.piece_ends_.size(); ++k) {
-      r.piece_ends_[k] =
-          r.piece_ends_[k - 1] + r.integrateThirdKind(r.piece_ * static_cast<double>(k - 1),
-                                                      r.piece_ * static_cast<double>(k));
+    const double pieces = std::max(1.0, std::ceil(2.0 * quarter_period_ / kPieceLength));
+    piece_ = 2.0 * quarter_period_ / pieces;
+    piece_ends_.assign(static_cast<std::size_t>(pieces) + 1, 0.0);
+    for (std::size_t k = 1; k < piece_ends_.size(); ++k) {
+      piece_ends_[k] = piece_ends_[k - 1] + integrateThirdKind(piece_ * static_cast<double>(k - 1),
+                                                               piece_ * static_cast<double>(k));
     }
-    r.period_integral_ = r.piece_ends_.back();
+    period_integral_ = piece_ends_.back();
   }
-  r.start_integral_ = r.thirdKindIntegral(r.u0_);
-  const Eigen::Vector3d l0 = jw.cwiseProduct(ww) / momentum;
-  r.frame0_ = r.orientation0_ * Eigen::Quaterniond(frame.transpose()) * leastRotationFromZ(l0);
-  return r;
+  start_integral_ = thirdKindIntegral(u0_);
 }
 
 double FreeRotation::thirdKindIntegral(double u) const {

@@ -30,6 +30,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <array>
 #include <vector>
 
 #include "collision_response/core/expected.h"
@@ -90,6 +91,26 @@ class FreeRotation {
 
  private:
   FreeRotation() = default;
+  // create's stages once the input is checked and w, L and the kind's family are known.
+  // Axisymmetric: lambda and M / J_t about the body axis `symmetry`.
+  void startAxisymmetric(const Eigen::Vector3d& moments, int symmetry, int transverse);
+  // Asymmetric: w scaled by a power of two, then each stage below, then R0 D(l0).
+  void startAsymmetric(const Eigen::Vector3d& moments, const std::array<int, 3>& ascending);
+  // The kind (either side of the separatrix or on it), the working frame and its moments, from
+  // the scaled w `ws` and the axes in ascending order of their moments.
+  void setWorkingFrame(const Eigen::Vector3d& moments, const Eigen::Vector3d& ws,
+                       const std::array<int, 3>& ascending);
+  // Where the elliptic motion starts in the working frame: (sn u0, cn u0) as a unit vector and
+  // l0 = J w / M.
+  struct WorkingStart {
+    Eigen::Vector2d phase;
+    Eigen::Vector3d momentum_direction;
+  };
+  // The amplitudes, omega, m, m1, a, the factor of G and 2E/M from the working frame's scaled
+  // w `ww`, scaled back by 2^exponent.
+  WorkingStart setEllipticMotion(const Eigen::Vector3d& ww, int exponent);
+  // u0, K, G at the quadrature's pieces' ends, G(2K) and G(u0).
+  void setPhase(const Eigen::Vector2d& phase);
   Eigen::Vector3d workingAngularVelocity(double time) const;
   double psi(double time) const;
   double thirdKindIntegral(double u) const;                 // G(u) = integral_0^u dn / (1 + a dn)
