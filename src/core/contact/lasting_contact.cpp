@@ -147,13 +147,7 @@ std::vector<ForceContact> forceContactsOf(const World& world, const Candidates& 
     ForceContact contact;
     contact.a = participants.slot(pair.first);
     contact.b = participants.slot(pair.second);
-    contact.normal = g.normal;
-    contact.point = g.point;
-    contact.lever_a = g.lever_a;
-    contact.lever_b = g.lever_b;
-    contact.curvature = g.curvature;
-    contact.turning_axis = g.turning_axis;
-    contact.axial_share = g.axial_share;
+    setContactGeometry(g, contact);
     if (world.friction_model && !frictionless) contact.friction = world.frictionOf(pair);
     contacts.push_back(contact);
   }

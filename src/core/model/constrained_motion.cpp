@@ -5,8 +5,6 @@
 #include <boost/numeric/odeint.hpp>
 #include <cmath>
 
-#include "geometry/narrow_phase.h"
-
 namespace collision_response::core::monitor {
 namespace {
 
@@ -131,13 +129,7 @@ ContactForceSolution ConstrainedStep::forces(const State& state, double time) co
       const ContactGeometry g =
           contactGeometry(positions[c.a], bodies[c.a].radius, shapeAt(*c.shape, time), 0.0,
                           [] { return Eigen::Vector3d(Eigen::Vector3d::Zero()); });
-      contact.normal = g.normal;
-      contact.point = g.point;
-      contact.lever_a = g.lever_a;
-      contact.lever_b = g.lever_b;
-      contact.curvature = g.curvature;
-      contact.turning_axis = g.turning_axis;
-      contact.axial_share = g.axial_share;
+      setContactGeometry(g, contact);
     } else {
       const Eigen::Vector3d centres = positions[c.b] - positions[c.a];
       const double distance = centres.norm();

@@ -11,6 +11,7 @@
 
 #include "collision_response/core/shape.h"
 #include "geometry/integrated_motion.h"
+#include "geometry/narrow_phase.h"
 #include "solver/contact_forces.h"
 
 namespace collision_response::core::monitor {
@@ -32,6 +33,19 @@ struct ConstrainedContact {
   /// Sliding: the direction of the slip it starts with (ContactForce::slide_direction).
   Eigen::Vector3d slide_direction = Eigen::Vector3d::Zero();
 };
+
+/// The narrow phase's geometry of a contact (narrow_phase.h) into the force solver's: its
+/// normal, point, lever arms and how its normal turns (curvature, turning axis, axial share).
+/// The bodies, friction and slide direction are the caller's.
+inline void setContactGeometry(const ContactGeometry& g, ForceContact& contact) {
+  contact.normal = g.normal;
+  contact.point = g.point;
+  contact.lever_a = g.lever_a;
+  contact.lever_b = g.lever_b;
+  contact.curvature = g.curvature;
+  contact.turning_axis = g.turning_axis;
+  contact.axial_share = g.axial_share;
+}
 
 /// One step of a group's motion: from `start` to `until`, as Dormand-Prince 5(4) with error
 /// control (Boost.Odeint) gives it, or to the first instant within it where a mode stops
