@@ -154,25 +154,22 @@ std::size_t CalibrationWindow::size() const {
 
 LiveCalibration::LiveCalibration(const core::Scene& scene, double window_seconds)
     : window_(scene.bodies.size(), window_seconds) {
-  magnus_ = scene.effects.magnus;
-  // The scene's own motion model, as `rosrun collision_response calibrate` reads it: gravity
-  // with the effect (none without), drag with the air's density and each body's C_d.
-  options_.gravity = scene.effects.gravity ? scene.gravity : Eigen::Vector3d::Zero();
-  options_.drag = scene.effects.drag;
-  options_.air_density = scene.air_density;
-  // Only the fixed planes are bounced off (README, "Calibration").
-  for (const core::ObstacleSpec& obstacle : scene.obstacles) {
-    if (obstacle.shape != core::ObstacleShape::kPlane || !obstacle.frame.empty()) continue;
-    options_.planes.push_back(core::Plane{obstacle.normal, obstacle.offset});
-    plane_ids_.push_back(obstacle.id);
-    plane_materials_.push_back(obstacle.material);
+  // The scene's own motion model and fixed planes, read as `rosrun collision_response calibrate`
+  // reads them (core::sceneCalibration, one place for both); a scene the fit cannot take is
+  // refused at each request, after its body is named.
+  const auto reading = core::sceneCalibration(scene);
+  if (reading) {
+    options_ = reading->options;
+    plane_materials_ = reading->plane_materials;
+  } else {
+    scene_refusal_ = "body: " + reading.error().reason;
   }
   if (!window_.enabled()) return;  // no body is fitted: nothing more kept
   bodies_.reserve(scene.bodies.size());
   for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
     const core::BodySpec& spec = scene.bodies[i];
-    bodies_.push_back(
-        {spec.id, spec.material, spec.radius, spec.mass, spec.inertia, spec.drag_coefficient});
+    // What the fit reads of the body (core::bodyCalibration), and its names.
+    bodies_.push_back({spec.id, spec.material, core::bodyCalibration(spec)});
     body_index_.emplace(spec.id, i);
   }
 }
@@ -210,16 +207,7 @@ void LiveCalibration::answer(const EstimateRestitution::Request& request,
                   std::to_string(bodies_.size()) + " bodies; ids are the scene's bodies[].id)");
   }
   const Body& body = bodies_[found->second];
-  if (magnus_) {
-    return refuse(
-        "body: the scene has `magnus`: the fit flies with gravity and drag only (not "
-        "yet Magnus)");
-  }
-  if (options_.planes.empty()) {
-    return refuse(
-        "body: the scene has no fixed plane obstacle to bounce off (only planes are "
-        "fitted yet)");
-  }
+  if (!scene_refusal_.empty()) return refuse(scene_refusal_);
   // The window copied under its own lock; the fit without any.
   const std::vector<core::TrackedSample> samples = window_.copy(found->second);
   const std::string window_text =
@@ -228,11 +216,7 @@ void LiveCalibration::answer(const EstimateRestitution::Request& request,
   if (samples.empty()) {
     return refuse("body: no state of '" + body.id + "' in the window (" + window_text + ")");
   }
-  core::CalibrationOptions options = options_;
-  options.radius = body.radius;
-  options.inertia = body.inertia;
-  options.mass = body.mass;
-  options.drag_coefficient = body.drag_coefficient;
+  core::CalibrationOptions options = core::forBody(options_, body.fit);
   options.spin_before = spin_before;
   std::string what = "body '" + body.id + "', " + std::to_string(samples.size()) + " states over " +
                      decimal(samples.back().time - samples.front().time, 0.01) + " s (" +

@@ -131,6 +131,27 @@ class CalibrateBag(unittest.TestCase):
         self.assertEqual(run.returncode, 1, run.stdout + run.stderr)
         self.assertIn("stamps going back: samples[31].time", run.stderr)
 
+    def test_a_scene_the_fit_cannot_take_is_named(self):
+        """The scene read as the live fit reads it (calibrate_track, core::sceneCalibration):
+        `magnus` and no fixed plane refused with the live fit's words, a bad key with the node's
+        loader's; all before any fit (exit 2)."""
+        bag = os.path.join(self.folder, "ball.bag")
+        write_bag(bag, self.track)
+        cases = [
+            ("effects: [gravity, friction, spin]", "effects: [gravity, friction, spin, magnus]",
+             "the scene has `magnus`: the fit flies with gravity and drag only"),
+            ("type: plane", "type: plane, frame: paddle",
+             "the scene has no fixed plane obstacle to bounce off"),
+            ("radius: 0.02", "radius: -0.02", "scene/bodies[0]/radius"),
+        ]
+        for old, new, expected in cases:
+            self.assertIn(old, SCENE)
+            with open(self.scene, "w", encoding="utf-8") as handle:
+                handle.write(SCENE.replace(old, new, 1))
+            run = self.calibrate(bag)
+            self.assertEqual(run.returncode, 2, run.stdout + run.stderr)
+            self.assertIn(expected, run.stderr)
+
 
 if __name__ == "__main__":
     import rostest

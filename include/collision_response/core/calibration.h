@@ -11,7 +11,9 @@
 #include <variant>
 #include <vector>
 
+#include "collision_response/core/expected.h"
 #include "collision_response/core/friction.h"
+#include "collision_response/core/scene.h"
 #include "collision_response/core/shape.h"
 
 namespace collision_response::core {
@@ -146,6 +148,33 @@ struct Calibration {
   double start_time = 0.0;
   double end_time = 0.0;
 };
+
+/// What the fit takes from a scene, read in this one place for the live fit (LiveCalibration)
+/// and `rosrun collision_response calibrate` (through calibrate_track).
+struct SceneCalibration {
+  /// The scene's fixed planes (no `frame`: only those are bounced off), gravity with the
+  /// `gravity` effect (none without), drag with the `drag` effect and the air's density; the
+  /// body's part by forBody(), the fit's own settings (fit_gravity, max_bounces, ...) as given.
+  CalibrationOptions options;
+  std::vector<std::string> plane_ids;        ///< the obstacles' ids, of options.planes
+  std::vector<std::string> plane_materials;  ///< their materials: one obstacle pair a material
+};
+
+/// The scene's part of the fit; refused, named, for a scene with `magnus` (the fit flies with
+/// gravity and drag only) or without a fixed plane obstacle.
+Expected<SceneCalibration> sceneCalibration(const Scene& scene);
+
+/// What the fit reads of a scene's body.
+struct BodyCalibration {
+  double radius = 0.0;  ///< m
+  Inertia inertia = Inertia::kSolid;
+  double mass = 1.0;  ///< kg
+  double drag_coefficient = 0.47;
+};
+BodyCalibration bodyCalibration(const BodySpec& body);
+
+/// `options` for the body: its radius, inertia, mass and C_d.
+CalibrationOptions forBody(CalibrationOptions options, const BodyCalibration& body);
 
 /// Why a recording gives no coefficients.
 enum class RecordingProblem {

@@ -99,7 +99,7 @@ struct PairEstimate {
   std::string summary;
 };
 
-/// The window and what a fit needs of the scene, copied at construction.
+/// The window and what a fit needs of the scene (core::sceneCalibration), copied at construction.
 class LiveCalibration {
  public:
   LiveCalibration(const core::Scene& scene, double window_seconds);
@@ -122,17 +122,15 @@ class LiveCalibration {
   struct Body {
     std::string id;
     std::string material;
-    double radius = 0.0;
-    double mass = 1.0;
-    core::Inertia inertia = core::Inertia::kSolid;
-    double drag_coefficient = 0.0;
+    core::BodyCalibration fit;  ///< what the fit reads of it
   };
   std::vector<Body> bodies_;
   std::unordered_map<std::string, std::size_t> body_index_;
-  /// The fit's options but for the body's: the fixed planes, gravity, drag.
+  /// The fit's options but for the body's: the fixed planes, gravity, drag (sceneCalibration).
   core::CalibrationOptions options_;
-  std::vector<std::string> plane_ids_, plane_materials_;
-  bool magnus_ = false;
+  std::vector<std::string> plane_materials_;
+  /// Why the scene gives no fit (magnus, no fixed plane), or empty.
+  std::string scene_refusal_;
   CalibrationWindow window_;
 };
 

@@ -996,6 +996,43 @@ RecordingResult<Calibration> fitFlight(const std::vector<TrackedSample>& samples
   return run(samples, options, false);
 }
 
+Expected<SceneCalibration> sceneCalibration(const Scene& scene) {
+  if (scene.effects.magnus) {
+    return Error{"effects",
+                 "the scene has `magnus`: the fit flies with gravity and drag only (not yet "
+                 "Magnus)"};
+  }
+  SceneCalibration reading;
+  CalibrationOptions& options = reading.options;
+  options.gravity = scene.effects.gravity ? scene.gravity : Eigen::Vector3d::Zero();
+  options.drag = scene.effects.drag;
+  options.air_density = scene.air_density;
+  for (const ObstacleSpec& obstacle : scene.obstacles) {
+    if (obstacle.shape != ObstacleShape::kPlane || !obstacle.frame.empty()) continue;
+    options.planes.push_back(Plane{obstacle.normal, obstacle.offset});
+    reading.plane_ids.push_back(obstacle.id);
+    reading.plane_materials.push_back(obstacle.material);
+  }
+  if (options.planes.empty()) {
+    return Error{"obstacles",
+                 "the scene has no fixed plane obstacle to bounce off (only planes are fitted "
+                 "yet)"};
+  }
+  return reading;
+}
+
+BodyCalibration bodyCalibration(const BodySpec& body) {
+  return BodyCalibration{body.radius, body.inertia, body.mass, body.drag_coefficient};
+}
+
+CalibrationOptions forBody(CalibrationOptions options, const BodyCalibration& body) {
+  options.radius = body.radius;
+  options.inertia = body.inertia;
+  options.mass = body.mass;
+  options.drag_coefficient = body.drag_coefficient;
+  return options;
+}
+
 Eigen::Vector3d fittedPosition(const Calibration& calibration, const CalibrationOptions& options,
                                double time) {
   Layout layout{calibration.bounces.size(), options.fit_gravity, options.drag && options.fit_drag};
