@@ -216,6 +216,50 @@ TEST(ShapedCollision, ARodOnItsEndFrictionlessIsTheClosedForm) {
   EXPECT_NEAR(outcome->impact.energy_lost, lost, 64 * lost * 2.2e-16);
 }
 
+// Kane and Levinson's rod (test/exact/rigid_impact.py, RigidImpact.ARodOnItsEnd...), here as a
+// user gives it: a box of 1 kg and edges (0.2, 2, 0.2) m (its uniform solid, not a tensor),
+// turned by theta about z (sin 5/13, cos 12/13; q = (0, 0, 1/sqrt 26, 5/sqrt 26)), its lower end's
+// centre (5/13, -12/13, 0) given as the contact point on an immovable box floor, the normal y,
+// falling at (-0.1, -1, 0) m/s, e = 1, mu = 1/2. Newton's law with Coulomb friction along the
+// initial slip would gain 0.678 J (of the 0.505 J the rod has); Chatterjee and Ruina's sticks:
+// v' = (-22320/67769, 928257361/1665016561, 0), w' = (0, 0, 147351840/128078197), and loses
+// 24158795761/333003312200 J. (The box's world inverse inertia R diag(300/101, 150, 300/101) R^T
+// is that test's: its xx entry (144/169)(300/101) + (25/169) 150 = 421950/17069.)
+CollisionRequest kaneAndLevinsonsRod() {
+  CollisionRequest request;
+  request.a.id = "floor";
+  request.a.mass = kInf;
+  request.a.shape = BodyShape::kBox;
+  request.a.size = V(10, 2, 10);
+  request.a.position = V(5.0 / 13, -12.0 / 13 - 1, 0);
+  request.a.orientation = Eigen::Quaterniond::Identity();
+  request.b.id = "rod";
+  request.b.mass = 1.0;
+  request.b.shape = BodyShape::kBox;
+  request.b.size = V(0.2, 2, 0.2);
+  request.b.velocity = V(-0.1, -1, 0);
+  request.b.orientation = Eigen::Quaterniond(5 / std::sqrt(26.0), 0, 0, 1 / std::sqrt(26.0));
+  request.normal = V(0, 1, 0);
+  request.contact_point = V(5.0 / 13, -12.0 / 13, 0);
+  request.restitution = 1.0;
+  request.friction = 0.5;
+  request.effects = {"friction"};
+  return request;
+}
+
+TEST(ShapedCollision, ARodOnItsEndWithFrictionLosesEnergyWhereNewtonsLawWouldGainIt) {
+  const auto outcome = computeCollision(kaneAndLevinsonsRod(), MaterialTable::seed());
+  ASSERT_TRUE(outcome.ok()) << outcome.error().message();
+  EXPECT_TRUE(outcome->sticking);
+  expectNear(outcome->impact.velocity_b, V(-22320.0 / 67769, 928257361.0 / 1665016561, 0), 1.0,
+             "rod's velocity");
+  expectNear(outcome->angular_velocity_b, V(0, 0, 147351840.0 / 128078197), 1.2,
+             "rod's angular velocity");
+  const double lost = 24158795761.0 / 333003312200;
+  EXPECT_NEAR(outcome->impact.energy_lost, lost, 64 * 2.2e-16);
+  EXPECT_GT(outcome->impact.energy_lost, 0.0);
+}
+
 // A sphere given its own uniform solid's tensor (2/5 m r^2 about every axis) is the ball it was,
 // through the rigid bodies' law instead of the balls': with friction and spin, rolling onto an
 // immovable ball, the same velocities and spins to a few ulps.

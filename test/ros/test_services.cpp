@@ -244,6 +244,48 @@ TEST_F(Services, ABoxStruckAtACornerFrictionlessIsTheClosedForm) {
   EXPECT_TRUE(response.approaching);
 }
 
+// Kane and Levinson's rod over ROS (test/exact/rigid_impact.py; ShapedCollision.ARodOnItsEnd...
+// in the core): a 1 kg box of edges (0.2, 2, 0.2) m turned by theta about z (sin 5/13), struck
+// at its lower end's centre (5/13, -12/13, 0), given, by an immovable box floor (normal y),
+// falling at (-0.1, -1, 0) m/s, e = 1, mu = 1/2. Newton's law with Coulomb friction along the
+// initial slip would gain 0.678 J; the service's law sticks and loses
+// 24158795761/333003312200 J: v' = (-22320/67769, 928257361/1665016561, 0),
+// w' = (0, 0, 147351840/128078197).
+TEST_F(Services, ARodOnItsEndWithFrictionLosesEnergyWhereNewtonsLawWouldGainIt) {
+  ComputeCollision::Request request;
+  request.a.mass = kInf;
+  request.a.shape = "box";
+  request.a.size.x = 10.0;
+  request.a.size.y = 2.0;
+  request.a.size.z = 10.0;
+  request.a.position.x = 5.0 / 13.0;
+  request.a.position.y = -12.0 / 13.0 - 1.0;
+  request.a.orientation.w = 1.0;
+  request.b.mass = 1.0;
+  request.b.shape = "box";
+  request.b.size.x = 0.2;
+  request.b.size.y = 2.0;
+  request.b.size.z = 0.2;
+  request.b.velocity.x = -0.1;
+  request.b.velocity.y = -1.0;
+  request.b.orientation.z = 1.0 / std::sqrt(26.0);
+  request.b.orientation.w = 5.0 / std::sqrt(26.0);
+  request.normal.y = 1.0;
+  request.contact_point_given = true;
+  request.contact_point.x = 5.0 / 13.0;
+  request.contact_point.y = -12.0 / 13.0;
+  request.restitution = 1.0;
+  request.friction = 0.5;
+  request.effects = {"friction"};
+  const auto response = call(request);
+  ASSERT_TRUE(response.success) << response.message;
+  EXPECT_TRUE(response.sticking);
+  EXPECT_NEAR(response.velocity_b.x, -22320.0 / 67769.0, 1e-14);
+  EXPECT_NEAR(response.velocity_b.y, 928257361.0 / 1665016561.0, 1e-14);
+  EXPECT_NEAR(response.angular_velocity_b.z, 147351840.0 / 128078197.0, 1e-14);
+  EXPECT_NEAR(response.energy_lost, 24158795761.0 / 333003312200.0, 1e-14);
+}
+
 TEST_F(Services, BadShapedBodiesNameTheFieldAndTheNodeKeepsServing) {
   auto request = ballOnABoxCorner();
   request.b.orientation.w = 0.0;  // all zero: not given
