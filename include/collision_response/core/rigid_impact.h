@@ -40,7 +40,9 @@ struct RigidImpactOutcome {
 /// velocity or angular velocity not finite, an inverse mass < 0 or not finite, both sides
 /// immovable, an inverse inertia tensor not finite or with a negative diagonal entry, a ball's
 /// spin factor or radius < 0 or not finite. Whether a tensor is positive definite is
-/// checkInertiaTensor's (mass_properties.h), where a user gives it.
+/// checkInertiaTensor's (mass_properties.h), where a user gives it. An answer beyond the range of
+/// double is refused naming its first output (validation.h, kBeyondDoubles), the bodies left as
+/// they were: K is formed in double, so a lever arm whose |r|^2 I^-1 passes ~1e308 is refused so.
 Expected<RigidImpactOutcome> resolveRigidImpact(SolverBody& a, SolverBody& b,
                                                 const ContactPoint& contact, double restitution,
                                                 double friction,

@@ -226,6 +226,11 @@ namespace {
 using MatrixL = Eigen::Matrix<RealL, Eigen::Dynamic, Eigen::Dynamic>;
 using VectorL = Eigen::Matrix<RealL, Eigen::Dynamic, 1>;
 
+/// Contacts whose rows of the Delassus matrix are dependent to this relative size are redundant
+/// (jointImpulses): far above the rounding of lever arms given as doubles (~1e-16), far below any
+/// contact geometry a body's shape gives on purpose.
+constexpr RealL kRedundantContacts = 1e-12L;
+
 /// The canonical order of the contacts: by point, normal, lever arms, bodies and e, each
 /// compared lexicographically, so that any listing of the same contacts is solved alike.
 std::vector<std::size_t> canonicalOrder(const std::vector<ClusterContact>& contacts) {
@@ -264,10 +269,15 @@ std::vector<double> jointImpulses(const MatrixL& delassus, const VectorL& target
             delassus(kept[static_cast<std::size_t>(i)], kept[static_cast<std::size_t>(j)]);
       }
     }
+    // A's rank as its doubles give it: a pivot below kRedundantContacts of the largest is 0
+    // (four corners coplanar but for the rounding of their lever arms to doubles, which leaves
+    // A's smallest singular value ~1e-16 of its largest: long double's own default, 4e-19 n,
+    // would call that full rank and give impulses of any size along A's near-null direction).
     // Rounded once to doubles: contacts that are mirror images of each other receive the same
     // impulse to the bit, and their turns cancel exactly.
-    const Eigen::VectorXd solution =
-        system.completeOrthogonalDecomposition().solve(right).cast<double>();
+    Eigen::CompleteOrthogonalDecomposition<MatrixL> decomposition(system.rows(), system.cols());
+    decomposition.setThreshold(kRedundantContacts);
+    const Eigen::VectorXd solution = decomposition.compute(system).solve(right).cast<double>();
     std::fill(impulses.begin(), impulses.end(), 0.0);
     Eigen::Index most_negative = -1;
     for (Eigen::Index i = 0; i < size; ++i) {
