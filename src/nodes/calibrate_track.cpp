@@ -168,6 +168,8 @@ std::string json(const Calibration& c, const std::vector<std::vector<std::size_t
         << ", \"slip_after\": " << estimate(b.slip_after)
         << ", \"spin_change\": " << estimates(b.spin_change)
         << ", \"spin_after\": " << (b.spin_after ? estimates(*b.spin_after) : std::string("null"))
+        << ", \"tracked_spin_after\": "
+        << (b.tracked_spin_after ? estimates(*b.tracked_spin_after) : std::string("null"))
         << ", \"samples_before\": " << b.samples_before
         << ", \"samples_after\": " << b.samples_after << "}";
   }

@@ -432,6 +432,48 @@ TEST(Calibration, ATrackedSpinIsCarriedThroughTheLaterBounces) {
   EXPECT_TRUE(within4(*fit->all.friction, t.mu)) << fit->all.friction->value;
 }
 
+// A tracker that measures the spin (each sample the closed form's spin of its flight and 0.5 rad/s
+// of Gaussian noise a component, 200 Hz): each bounce's tracked spin after (the flight's mean, its
+// standard error the scatter over sqrt(n)) within 4 standard errors of the truth, beside the
+// spin after the tangential impulse implies (from the tracked spin before); without tracked spin,
+// none.
+TEST(Calibration, ATrackersSpinAfterABounceStandsBesideTheImpliedOne) {
+  Throw t;
+  t.spin = V(4.0, -15.0, 2.0);
+  t.seed = 12;
+  const Track track = throwBall(t);
+  std::mt19937_64 random(12);
+  std::normal_distribution<double> noise(0.0, 0.5);
+  std::vector<TrackedSample> spun = track.samples;
+  for (auto& sample : spun) {
+    V spin = t.spin;
+    for (const auto& bounce : track.bounces) {
+      if (sample.time >= bounce.time) spin = bounce.spin_after;
+    }
+    sample.angular_velocity = spin + V(noise(random), noise(random), noise(random));
+  }
+  CalibrationOptions options = floorOptions(t);
+  options.spin_before.reset();
+  const auto fit = calibrate(spun, options);
+  ASSERT_TRUE(fit.ok()) << fit.error().message();
+  expectSpinRecovered(track, *fit, true);
+  for (std::size_t j = 0; j < fit->bounces.size(); ++j) {
+    SCOPED_TRACE("bounce " + std::to_string(j + 1));
+    const auto& tracked = fit->bounces[j].tracked_spin_after;
+    ASSERT_TRUE(tracked.has_value());
+    for (std::size_t i = 0; i < 3; ++i) {
+      const double truth = track.bounces[j].spin_after[static_cast<Eigen::Index>(i)];
+      EXPECT_TRUE(within4((*tracked)[i], truth))
+          << (*tracked)[i].value << " +- " << (*tracked)[i].standard_error << " vs " << truth;
+      // About 0.5 / sqrt(n) for the flight's n samples (tens of them).
+      EXPECT_LT((*tracked)[i].standard_error, 0.2);
+    }
+  }
+  const auto untracked = calibrate(track.samples, floorOptions(t));
+  ASSERT_TRUE(untracked.ok()) << untracked.error().message();
+  for (const auto& bounce : untracked->bounces) EXPECT_FALSE(bounce.tracked_spin_after);
+}
+
 TEST(Calibration, BadRecordingsAreNamed) {
   Throw t;
   t.bounces = 3;

@@ -102,6 +102,10 @@ struct BounceEstimate {
   /// flight before, else spin_before carried through the earlier bounces) plus spin_change; none
   /// when the spin before is unknown.
   std::optional<std::array<Estimate, 3>> spin_after;
+  /// rad/s, each component: what the tracker saw of the spin after the bounce, the mean of the
+  /// samples' angular_velocity over the flight after it (its standard error their scatter over
+  /// sqrt(count)), beside spin_after; none with fewer than 2 such samples.
+  std::optional<std::array<Estimate, 3>> tracked_spin_after;
   std::size_t samples_before = 0;  ///< in the flight that ends here
   std::size_t samples_after = 0;   ///< in the flight that starts here
 };

@@ -731,16 +731,42 @@ FrictionReading frictionReading(bool spin_known, const Estimate& slip_before,
   return FrictionReading::kStoppedSlipping;
 }
 
+/// The tracker's spin over a flight (samples [first, last]): each component's mean over the
+/// samples that carry it, its standard error their scatter over sqrt(count); none with fewer
+/// than 2 such samples.
+std::optional<std::array<Estimate, 3>> trackedSpinOver(const std::vector<TrackedSample>& samples,
+                                                       std::size_t first, std::size_t last) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int count = 0;
+  for (std::size_t k = first; k <= last; ++k) {
+    if (!samples[k].angular_velocity) continue;
+    sum += *samples[k].angular_velocity;
+    ++count;
+  }
+  if (count < 2) return std::nullopt;
+  const Eigen::Vector3d mean = sum / count;
+  Eigen::Vector3d squares = Eigen::Vector3d::Zero();  // about the mean
+  for (std::size_t k = first; k <= last; ++k) {
+    if (samples[k].angular_velocity) squares += (*samples[k].angular_velocity - mean).cwiseAbs2();
+  }
+  std::array<Estimate, 3> spin;
+  for (Eigen::Index i = 0; i < 3; ++i) {
+    // The samples' variance over n - 1, over n again for the mean's.
+    spin[static_cast<std::size_t>(i)] = estimate(mean[i], squares[i] / (count - 1) / count);
+  }
+  return spin;
+}
+
 /// Stage 6: bounce j's estimate from the quantities' values and covariance (its instant still
 /// counted from the first sample), refused when the samples either side of the fitted instant
 /// are too far apart or a flight either side has too few.
-RecordingResult<BounceEstimate> bounceEstimate(std::size_t j, const Eigen::VectorXd& values,
-                                               const Eigen::MatrixXd& covariance,
-                                               const Motion& motion, std::size_t plane,
-                                               bool spin_known,
-                                               const std::vector<TrackedSample>& samples,
-                                               const CalibrationOptions& options, double spacing,
-                                               double epoch) {
+RecordingResult<BounceEstimate> bounceEstimate(
+    std::size_t j, const Eigen::VectorXd& values, const Eigen::MatrixXd& covariance,
+    const Motion& motion, std::size_t plane, bool spin_known,
+    const Eigen::Vector3d& spin_source_error,
+    const std::pair<std::size_t, std::size_t>& flight_after,
+    const std::vector<TrackedSample>& samples, const CalibrationOptions& options, double spacing,
+    double epoch) {
   const auto row = static_cast<Eigen::Index>(kPerBounce * j);
   const auto at = [&](Eigen::Index i) { return estimate(values[i], covariance(i, i)); };
   BounceEstimate bounce;
@@ -760,7 +786,17 @@ RecordingResult<BounceEstimate> bounceEstimate(std::size_t j, const Eigen::Vecto
     bounce.spin_change[static_cast<std::size_t>(i)] = at(row + kSpinChangeAt + i);
     spin_after[static_cast<std::size_t>(i)] = at(row + kSpinAfterAt + i);
   }
-  if (spin_known) bounce.spin_after = spin_after;
+  if (spin_known) {
+    // Beside the fit's, the variance of the tracked spin it starts from (independent of the
+    // positions' noise; 0 for a given spin_before).
+    for (std::size_t i = 0; i < 3; ++i) {
+      const double se = spin_after[i].standard_error;
+      const double source = spin_source_error[static_cast<Eigen::Index>(i)];
+      spin_after[i].standard_error = std::sqrt(se * se + source * source);
+    }
+    bounce.spin_after = spin_after;
+  }
+  bounce.tracked_spin_after = trackedSpinOver(samples, flight_after.first, flight_after.second);
   for (const auto& sample : samples) {
     const std::size_t piece = motion.pieceAt(sample.time);
     if (piece == j) ++bounce.samples_before;
@@ -878,8 +914,8 @@ RecordingResult<Calibration> run(const std::vector<TrackedSample>& recorded,
                        std::to_string(kMaxIterations) + " iterations)");
   }
 
-  const BounceQuantities quantities(motion, options, layout, planes,
-                                    trackedSpinBefore(samples, *flights, bounces));
+  const auto tracked_spin = trackedSpinBefore(samples, *flights, bounces);
+  const BounceQuantities quantities(motion, options, layout, planes, tracked_spin);
   Eigen::VectorXd values;
   Eigen::MatrixXd gradient;
   if (!quantities(fit->parameters, values) ||
@@ -894,9 +930,20 @@ RecordingResult<Calibration> run(const std::vector<TrackedSample>& recorded,
   result.samples_used = samples.size();
   result.start_time = origin + epoch;
   result.end_time = samples.back().time + epoch;
+  // The standard error of the tracked spin each bounce's spin after starts from (the mean over
+  // the latest flight before it that carries one; 0 from spin_before or a single sample).
+  Eigen::Vector3d spin_source_error = Eigen::Vector3d::Zero();
   for (std::size_t j = 0; j < bounces; ++j) {
-    auto bounce = bounceEstimate(j, values, covariance, motion, planes[j], quantities.spinKnown(j),
-                                 samples, options, spacing, epoch);
+    if (tracked_spin[j]) {
+      const auto spread = trackedSpinOver(samples, (*flights)[j].first, (*flights)[j].second);
+      for (std::size_t i = 0; i < 3; ++i) {
+        spin_source_error[static_cast<Eigen::Index>(i)] =
+            spread ? (*spread)[i].standard_error : 0.0;
+      }
+    }
+    auto bounce =
+        bounceEstimate(j, values, covariance, motion, planes[j], quantities.spinKnown(j),
+                       spin_source_error, (*flights)[j + 1], samples, options, spacing, epoch);
     if (!bounce) return bounce.error();
     result.bounces.push_back(*bounce);
     result.bounces.back().time.value += epoch;
