@@ -1,0 +1,541 @@
+#include "geometry/tumbling_contact.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "collision_response/core/triangle_mesh.h"
+#include "geometry/narrow_phase.h"
+
+namespace collision_response::core {
+
+namespace {
+
+constexpr double kEps = std::numeric_limits<double>::epsilon();
+
+std::string indexed(const char* field, std::size_t i) {
+  return std::string(field) + "[" + std::to_string(i) + "]";
+}
+
+Status checkFiniteVector(const Eigen::Vector3d& v, const std::string& field) {
+  const char* axes[] = {".x", ".y", ".z"};
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(v[i]))
+      return Error{field + axes[i], "must be finite, got " + std::to_string(v[i])};
+  }
+  return Ok{};
+}
+
+Status checkPositive(double value, const std::string& field) {
+  if (!(std::isfinite(value) && value > 0)) {
+    return Error{field, "must be finite and > 0, got " + std::to_string(value)};
+  }
+  return Ok{};
+}
+
+Status checkConvexShape(const ConvexShape& shape) {
+  if (const auto* sphere = std::get_if<Sphere>(&shape)) {
+    if (Status s = checkFiniteVector(sphere->centre, "shape.centre"); !s) return s;
+    return checkPositive(sphere->radius, "shape.radius");
+  }
+  if (const auto* box = std::get_if<Cuboid>(&shape)) {
+    const char* names[] = {"shape.half_size.x", "shape.half_size.y", "shape.half_size.z"};
+    for (int i = 0; i < 3; ++i) {
+      if (Status s = checkPositive(box->half_size[i], names[i]); !s) return s;
+    }
+    return Ok{};
+  }
+  if (const auto* cylinder = std::get_if<Cylinder>(&shape)) {
+    if (Status s = checkPositive(cylinder->radius, "shape.radius"); !s) return s;
+    return checkPositive(cylinder->half_length, "shape.half_length");
+  }
+  if (const auto* capsule = std::get_if<Capsule>(&shape)) {
+    if (Status s = checkPositive(capsule->radius, "shape.radius"); !s) return s;
+    if (!(std::isfinite(capsule->half_length) && capsule->half_length >= 0)) {
+      return Error{"shape.half_length",
+                   "must be finite and >= 0, got " + std::to_string(capsule->half_length)};
+    }
+    return Ok{};
+  }
+  const auto& hull = std::get<ConvexHull>(shape);
+  if (hull.vertices.size() < 4) {
+    return Error{"shape.vertices",
+                 "a hull needs at least 4 vertices, got " + std::to_string(hull.vertices.size())};
+  }
+  for (std::size_t i = 0; i < hull.vertices.size(); ++i) {
+    if (!hull.vertices[i].allFinite()) {
+      return Error{indexed("shape.vertices", i), "must be finite"};
+    }
+  }
+  return Ok{};
+}
+
+/// The body placed at `time` (world from body).
+PlacedConvex placedBody(const TumblingBody& body, double time) {
+  return PlacedConvex(body.shape(), body.orientationAt(time).toRotationMatrix(),
+                      body.positionAt(time));
+}
+
+/// A SurfaceGap from GJK's answer, the lever arms from the sides' centres.
+SurfaceGap fromDistance(const ConvexDistance& d, const Eigen::Vector3d& centre_a,
+                        const Eigen::Vector3d& centre_b) {
+  SurfaceGap g;
+  g.gap = d.lower;
+  g.gap_upper = d.upper;
+  g.overlapping = d.overlapping;
+  g.normal = d.normal;
+  g.point_a = d.point_a;
+  g.point_b = d.point_b;
+  g.lever_a = d.point_a - centre_a;
+  g.lever_b = d.point_b - centre_b;
+  return g;
+}
+
+/// A finite obstacle's shape as a ConvexShape (boxes, cylinders and capsules are the same).
+template <class Finite>
+ConvexShape convexOf(const Finite& shape) {
+  return ConvexShape(shape);
+}
+
+bool turns(const Shape& shape) {
+  return !std::holds_alternative<Plane>(shape) && !std::holds_alternative<Sphere>(shape);
+}
+
+/// The body against a mesh placed at `pose` (both at one instant): the unsigned distance to its
+/// triangles, those whose boxes meet the cube about the body's centre that holds every point
+/// within the centre's distance to the mesh plus the body's reach (the nearest triangle is among
+/// them: the gap is at most the centre's distance). Far from the mesh (the centre's distance
+/// beyond twice the reach) a lower bound only: the centre's distance less the reach.
+SurfaceGap meshGap(const TumblingBody& body, double time, const Mesh& mesh, const RigidPose& pose,
+                   double tolerance, std::vector<std::uint32_t>* near_triangles) {
+  const Eigen::Matrix3d axes = pose.transform.linear();
+  const Eigen::Vector3d origin = pose.transform.translation();
+  const Eigen::Vector3d centre = body.positionAt(time);
+  const Eigen::Matrix3d turn = body.orientationAt(time).toRotationMatrix();
+  const Eigen::Vector3d local_centre = axes.transpose() * (centre - origin);
+  const Eigen::Matrix3d local_turn = axes.transpose() * turn;
+  const PlacedConvex local_body(body.shape(), local_turn, local_centre);
+  const TriangleMesh& triangles = *mesh.triangles;
+  const TriangleMesh::NearestPoint nearest = triangles.nearest(local_centre);
+  const double reach = body.reach();
+  SurfaceGap g;
+  const auto toWorld = [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+    return origin + axes * p;
+  };
+  if (nearest.distance > 3 * reach) {
+    const Eigen::Vector3d towards = nearest.point - local_centre;
+    const Eigen::Vector3d on_body =
+        local_body.support(towards) + local_body.margin() * towards.normalized();
+    const double slack = 64 * kEps * (local_centre.norm() + reach + nearest.point.norm());
+    g.gap = nearest.distance - reach - slack;
+    g.gap_upper = (nearest.point - on_body).norm() + slack;
+    g.normal = axes * towards.normalized();
+    g.point_a = toWorld(on_body);
+    g.point_b = toWorld(nearest.point);
+  } else {
+    const double half = nearest.distance + reach;
+    std::vector<std::uint32_t> found;
+    triangles.overlapping(local_centre - Eigen::Vector3d::Constant(half),
+                          local_centre + Eigen::Vector3d::Constant(half), found);
+    g.gap = INFINITY;
+    g.gap_upper = INFINITY;
+    double best_upper = INFINITY;
+    for (const std::uint32_t t : found) {
+      const auto& corners = triangles.triangles()[t];
+      const TriangleSupport triangle(triangles.vertices()[corners[0]],
+                                     triangles.vertices()[corners[1]],
+                                     triangles.vertices()[corners[2]]);
+      const ConvexDistance d = convexDistance(local_body, triangle, tolerance);
+      g.gap = std::min(g.gap, d.lower);
+      if (d.upper < best_upper) {
+        best_upper = d.upper;
+        g.gap_upper = d.upper;
+        g.overlapping = d.overlapping;
+        g.normal = axes * d.normal;
+        g.point_a = toWorld(d.point_a);
+        g.point_b = toWorld(d.point_b);
+      }
+      if (d.overlapping) g.overlapping = true;
+    }
+    if (near_triangles) *near_triangles = std::move(found);
+  }
+  g.lever_a = g.point_a - centre;
+  g.lever_b = g.point_b - origin;
+  return g;
+}
+
+/// The body against `obstacle` already moved to `time`.
+SurfaceGap obstacleGap(const TumblingBody& body, double time, const PlacedShape& moved,
+                       double tolerance, std::vector<std::uint32_t>* near_triangles = nullptr) {
+  const Eigen::Vector3d centre = body.positionAt(time);
+  const Eigen::Vector3d origin = moved.pose.transform.translation();
+  SurfaceGap g;
+  if (const auto* plane = std::get_if<Plane>(&moved.shape)) {
+    // Exact by the support function: the body's point farthest along -n.
+    const double length = plane->normal.norm();
+    const Eigen::Vector3d n = plane->normal / length;
+    const PlacedConvex placed = placedBody(body, time);
+    const Eigen::Vector3d deepest = placed.support(-n) - placed.margin() * n;
+    const double height = (plane->normal.dot(deepest) - plane->offset) / length;
+    const double slack = 64 * kEps * (centre.norm() + body.reach() + std::abs(plane->offset));
+    g.gap = height - slack;
+    g.gap_upper = height + slack;
+    g.overlapping = height < -slack;
+    g.normal = -n;
+    g.point_a = deepest;
+    g.point_b = deepest - height * n;
+    g.lever_a = g.point_a - centre;
+    g.lever_b = g.point_b - origin;
+  } else if (const auto* sphere = std::get_if<Sphere>(&moved.shape)) {
+    const ConvexDistance d = convexDistance(
+        placedBody(body, time), PointSupport(sphere->centre, sphere->radius), tolerance);
+    g = fromDistance(d, centre, sphere->centre);
+  } else if (const auto* mesh = std::get_if<Mesh>(&moved.shape)) {
+    g = meshGap(body, time, *mesh, moved.pose, tolerance, near_triangles);
+  } else {
+    const ConvexShape shape = std::visit(
+        [](const auto& finite) -> ConvexShape {
+          using Kind = std::decay_t<decltype(finite)>;
+          if constexpr (std::is_same_v<Kind, Cuboid> || std::is_same_v<Kind, Cylinder> ||
+                        std::is_same_v<Kind, Capsule>) {
+            return convexOf(finite);
+          } else {
+            return Sphere{};  // not reached: planes, spheres and meshes are above
+          }
+        },
+        moved.shape);
+    const PlacedConvex other(shape, moved.pose.transform.linear(), origin);
+    g = fromDistance(convexDistance(placedBody(body, time), other, tolerance), centre, origin);
+  }
+  const Eigen::Vector3d surface =
+      turns(moved.shape) ? moved.pose.velocityAt(g.point_b - origin) : moved.pose.velocity;
+  g.approach_speed = g.normal.dot(body.pointVelocityAt(time, g.point_a) - surface);
+  return g;
+}
+
+SurfaceGap bodiesGap(const TumblingBody& a, const TumblingBody& b, double time, double tolerance) {
+  SurfaceGap g = fromDistance(convexDistance(placedBody(a, time), placedBody(b, time), tolerance),
+                              a.positionAt(time), b.positionAt(time));
+  g.approach_speed =
+      g.normal.dot(a.pointVelocityAt(time, g.point_a) - b.pointVelocityAt(time, g.point_b));
+  return g;
+}
+
+/// Reduces a manifold to at most 4 points spanning the largest area across the normal: the
+/// deepest (the first of equals), the farthest from it, the largest triangle with those, the
+/// point that adds the most area outside that triangle (none where all are inside it).
+void reduceManifold(std::vector<ManifoldPoint>& points, const Eigen::Vector3d& normal) {
+  if (points.size() <= 4) return;
+  const auto at = [&](std::size_t i) -> Eigen::Vector3d {
+    const Eigen::Vector3d mid = 0.5 * (points[i].point_a + points[i].point_b);
+    return mid - normal.dot(mid) * normal;
+  };
+  std::vector<std::size_t> chosen;
+  std::size_t first = 0;
+  for (std::size_t i = 1; i < points.size(); ++i) {
+    if (points[i].gap < points[first].gap) first = i;
+  }
+  chosen.push_back(first);
+  const auto best = [&](auto score) {
+    std::size_t index = points.size();
+    double value = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      if (std::find(chosen.begin(), chosen.end(), i) != chosen.end()) continue;
+      const double s = score(at(i));
+      if (s > value) {
+        value = s;
+        index = i;
+      }
+    }
+    if (index < points.size()) chosen.push_back(index);
+    return index < points.size();
+  };
+  const Eigen::Vector3d p1 = at(first);
+  if (best([&](const Eigen::Vector3d& p) { return (p - p1).squaredNorm(); })) {
+    const Eigen::Vector3d p2 = at(chosen[1]);
+    if (best([&](const Eigen::Vector3d& p) {
+          return std::abs(normal.dot((p2 - p1).cross(p - p1)));
+        })) {
+      const Eigen::Vector3d p3 = at(chosen[2]);
+      const double turn = normal.dot((p2 - p1).cross(p3 - p1)) >= 0 ? 1.0 : -1.0;
+      best([&](const Eigen::Vector3d& p) {
+        // The area q adds outside each edge of the triangle (counter-clockwise about n).
+        double added = 0;
+        const Eigen::Vector3d corners[3] = {p1, p2, p3};
+        for (int k = 0; k < 3; ++k) {
+          const Eigen::Vector3d& from = corners[k];
+          const Eigen::Vector3d& to = corners[(k + 1) % 3];
+          added = std::max(added, -turn * normal.dot((to - from).cross(p - from)));
+        }
+        return added;
+      });
+    }
+  }
+  std::vector<ManifoldPoint> kept;
+  for (const std::size_t i : chosen) kept.push_back(points[i]);
+  points = std::move(kept);
+}
+
+/// Adds `point` unless one of `points` is within `band` of it (its pair's midpoint).
+void addUnique(std::vector<ManifoldPoint>& points, const ManifoldPoint& point, double band) {
+  const Eigen::Vector3d mid = 0.5 * (point.point_a + point.point_b);
+  for (const ManifoldPoint& p : points) {
+    if ((0.5 * (p.point_a + p.point_b) - mid).norm() <= band) return;
+  }
+  points.push_back(point);
+}
+
+/// The other side of a first-contact query: what it is at an instant and how fast its points
+/// may move.
+struct ObstacleSide {
+  const PlacedShape& placed;
+  double tolerance;
+  PlacedShape at(double time) const { return shapeAt(placed, time); }
+  SurfaceGap gap(const TumblingBody& body, double time) const {
+    return obstacleGap(body, time, at(time), tolerance);
+  }
+  Eigen::Vector3d centreVelocity(double time) const { return at(time).pose.velocity; }
+  double angularSpeed() const {
+    return turns(placed.shape) ? placed.pose.angular_velocity.norm() : 0.0;
+  }
+  double pointSpeedAboutCentre() const { return angularSpeed() * turningReach(placed.shape); }
+  double accelerationBound(const TumblingBody& body) const {
+    return body.acceleration().norm() + angularSpeed() * placed.pose.velocity.norm();
+  }
+  void manifold(const TumblingBody& body, double time, const SurfaceGap& closest, double band,
+                std::vector<ManifoldPoint>& out) const;
+};
+
+struct BodySide {
+  const TumblingBody& other;
+  double tolerance;
+  SurfaceGap gap(const TumblingBody& body, double time) const {
+    return bodiesGap(body, other, time, tolerance);
+  }
+  Eigen::Vector3d centreVelocity(double time) const { return other.velocityAt(time); }
+  double pointSpeedAboutCentre() const { return other.angularSpeedBound() * other.reach(); }
+  double accelerationBound(const TumblingBody& body) const {
+    return (body.acceleration() - other.acceleration()).norm();
+  }
+  void manifold(const TumblingBody& body, double time, const SurfaceGap& closest, double band,
+                std::vector<ManifoldPoint>& out) const;
+};
+
+/// The candidates of `body` (side a) towards the normal whose distance to the other side
+/// (`distance(p)`: the distance and the other side's nearest point) is within the band.
+template <class Distance>
+void candidatesOfA(const TumblingBody& body, double time, const SurfaceGap& closest, double band,
+                   const Distance& distance, const Eigen::Vector3d& centre_b,
+                   std::vector<ManifoldPoint>& out) {
+  const Eigen::Matrix3d turn = body.orientationAt(time).toRotationMatrix();
+  const Eigen::Vector3d centre = body.positionAt(time);
+  std::vector<Eigen::Vector3d> candidates;
+  contactCandidates(body.shape(), turn.transpose() * closest.normal, candidates);
+  for (const Eigen::Vector3d& local : candidates) {
+    const Eigen::Vector3d p = centre + turn * local;
+    const auto [d, q] = distance(p);
+    if (d <= closest.gap_upper + band) {
+      addUnique(out, ManifoldPoint{p, q, p - centre, q - centre_b, d}, band);
+    }
+  }
+}
+
+/// The candidates of a convex side b (world points) whose distance to the body is within the band.
+void candidatesOfB(const TumblingBody& body, double time, const SurfaceGap& closest, double band,
+                   double tolerance, const std::vector<Eigen::Vector3d>& candidates,
+                   const Eigen::Vector3d& centre_b, std::vector<ManifoldPoint>& out) {
+  const PlacedConvex a = placedBody(body, time);
+  const Eigen::Vector3d centre = body.positionAt(time);
+  for (const Eigen::Vector3d& p : candidates) {
+    const ConvexDistance d = convexDistance(a, PointSupport(p), tolerance);
+    if (d.upper <= closest.gap_upper + band) {
+      addUnique(
+          out,
+          ManifoldPoint{d.point_a, p, d.point_a - centre, p - centre_b, std::max(d.upper, 0.0)},
+          band);
+    }
+  }
+}
+
+void ObstacleSide::manifold(const TumblingBody& body, double time, const SurfaceGap& closest,
+                            double band, std::vector<ManifoldPoint>& out) const {
+  const PlacedShape moved = at(time);
+  const Eigen::Vector3d origin = moved.pose.transform.translation();
+  if (const auto* plane = std::get_if<Plane>(&moved.shape)) {
+    const double length = plane->normal.norm();
+    const Eigen::Vector3d n = plane->normal / length;
+    candidatesOfA(
+        body, time, closest, band,
+        [&](const Eigen::Vector3d& p) {
+          const double height = (plane->normal.dot(p) - plane->offset) / length;
+          return std::pair<double, Eigen::Vector3d>(height, p - height * n);
+        },
+        origin, out);
+    return;
+  }
+  if (const auto* mesh = std::get_if<Mesh>(&moved.shape)) {
+    const Eigen::Matrix3d axes = moved.pose.transform.linear();
+    const TriangleMesh& triangles = *mesh->triangles;
+    candidatesOfA(
+        body, time, closest, band,
+        [&](const Eigen::Vector3d& p) {
+          const TriangleMesh::NearestPoint q = triangles.nearest(axes.transpose() * (p - origin));
+          return std::pair<double, Eigen::Vector3d>(q.distance, origin + axes * q.point);
+        },
+        origin, out);
+    std::vector<std::uint32_t> near;
+    obstacleGap(body, time, moved, tolerance, &near);
+    std::vector<Eigen::Vector3d> corners;
+    for (const std::uint32_t t : near) {
+      for (const std::uint32_t v : triangles.triangles()[t]) {
+        corners.push_back(origin + axes * triangles.vertices()[v]);
+      }
+    }
+    candidatesOfB(body, time, closest, band, tolerance, corners, origin, out);
+    return;
+  }
+  if (std::holds_alternative<Sphere>(moved.shape)) return;  // the closest pair alone
+  const ConvexShape shape = std::visit(
+      [](const auto& finite) -> ConvexShape {
+        using Kind = std::decay_t<decltype(finite)>;
+        if constexpr (std::is_same_v<Kind, Cuboid> || std::is_same_v<Kind, Cylinder> ||
+                      std::is_same_v<Kind, Capsule>) {
+          return convexOf(finite);
+        } else {
+          return Sphere{};
+        }
+      },
+      moved.shape);
+  const PlacedConvex other(shape, moved.pose.transform.linear(), origin);
+  candidatesOfA(
+      body, time, closest, band,
+      [&](const Eigen::Vector3d& p) {
+        const ConvexDistance d = convexDistance(PointSupport(p), other, tolerance);
+        return std::pair<double, Eigen::Vector3d>(std::max(d.upper, 0.0), d.point_b);
+      },
+      origin, out);
+  std::vector<Eigen::Vector3d> local;
+  contactCandidates(shape, moved.pose.transform.linear().transpose() * (-closest.normal), local);
+  for (Eigen::Vector3d& p : local) p = origin + moved.pose.transform.linear() * p;
+  candidatesOfB(body, time, closest, band, tolerance, local, origin, out);
+}
+
+void BodySide::manifold(const TumblingBody& body, double time, const SurfaceGap& closest,
+                        double band, std::vector<ManifoldPoint>& out) const {
+  const PlacedConvex b = placedBody(other, time);
+  const Eigen::Vector3d centre_b = other.positionAt(time);
+  candidatesOfA(
+      body, time, closest, band,
+      [&](const Eigen::Vector3d& p) {
+        const ConvexDistance d = convexDistance(PointSupport(p), b, tolerance);
+        return std::pair<double, Eigen::Vector3d>(std::max(d.upper, 0.0), d.point_b);
+      },
+      centre_b, out);
+  const Eigen::Matrix3d turn = other.orientationAt(time).toRotationMatrix();
+  std::vector<Eigen::Vector3d> local;
+  contactCandidates(other.shape(), turn.transpose() * (-closest.normal), local);
+  for (Eigen::Vector3d& p : local) p = centre_b + turn * p;
+  candidatesOfB(body, time, closest, band, tolerance, local, centre_b, out);
+}
+
+/// Conservative advancement (the header's comment) of `body` against `side`.
+template <class Side>
+FirstContactResult advance(const TumblingBody& body, const Side& side, double from, double horizon,
+                           const FirstContactOptions& options) {
+  FirstContactResult result;
+  result.clear_until = from;
+  const double end = from + horizon;
+  const double turning = body.angularSpeedBound() * body.reach() + side.pointSpeedAboutCentre();
+  const double acceleration = side.accelerationBound(body);
+  const auto contactAt = [&](double t, const SurfaceGap& g) {
+    TumblingContact contact;
+    contact.time = t;
+    contact.closest = g;
+    side.manifold(body, t, g, options.manifold_band, contact.manifold);
+    addUnique(contact.manifold,
+              ManifoldPoint{g.point_a, g.point_b, g.lever_a, g.lever_b, g.gap_upper},
+              options.manifold_band);
+    reduceManifold(contact.manifold, g.normal);
+    result.contact = std::move(contact);
+    result.clear_until = t;
+  };
+  double t = from;
+  SurfaceGap g = side.gap(body, t);
+  if (g.overlapping || g.gap_upper < 0) {
+    result.inside_at_start = true;
+    return result;
+  }
+  for (; result.steps < options.max_steps; ++result.steps) {
+    const double stop = options.time_tolerance + 4 * kEps * std::abs(t);
+    if (!(g.gap > 0)) {
+      contactAt(t, g);
+      return result;
+    }
+    const double speed = (body.velocityAt(t) - side.centreVelocity(t)).norm() + turning;
+    const double step = 2 * g.gap / (speed + std::sqrt(speed * speed + 2 * acceleration * g.gap));
+    if (step <= stop) {
+      contactAt(t, g);
+      return result;
+    }
+    result.clear_until = std::min(t + step, end);
+    if (!(t + step <= end)) return result;  // apart until the horizon's end
+    t += step;
+    g = side.gap(body, t);
+  }
+  return result;  // the step budget ran out: apart until clear_until
+}
+
+}  // namespace
+
+Expected<TumblingBody> TumblingBody::create(const ConvexShape& shape,
+                                            const Eigen::Vector3d& principal_moments, double time,
+                                            const Eigen::Vector3d& position,
+                                            const Eigen::Vector3d& velocity,
+                                            const Eigen::Vector3d& acceleration,
+                                            const Eigen::Quaterniond& orientation,
+                                            const Eigen::Vector3d& angular_velocity) {
+  if (Status s = checkConvexShape(shape); !s) return s.error();
+  if (!std::isfinite(time)) return Error{"time", "must be finite, got " + std::to_string(time)};
+  if (Status s = checkFiniteVector(position, "position"); !s) return s.error();
+  if (Status s = checkFiniteVector(velocity, "velocity"); !s) return s.error();
+  if (Status s = checkFiniteVector(acceleration, "acceleration"); !s) return s.error();
+  Expected<FreeRotation> rotation =
+      FreeRotation::create(principal_moments, orientation, angular_velocity);
+  if (!rotation) return rotation.error();
+  TumblingBody body(shape, rotation.value());
+  body.time_ = time;
+  body.position_ = position;
+  body.velocity_ = velocity;
+  body.acceleration_ = acceleration;
+  body.reach_ = reachOf(shape);
+  // |w| <= sqrt(2 E / J_min): 2 E = sum J_i w_i^2 >= J_min |w|^2 (body frame), a few ulps over
+  // for the rounding of E and of the rotation's w(t).
+  const Eigen::Vector3d w_body = orientation.normalized().conjugate() * angular_velocity;
+  const double twice_energy = principal_moments.dot(w_body.cwiseAbs2());
+  body.angular_speed_bound_ =
+      std::sqrt(twice_energy / principal_moments.minCoeff()) * (1 + 64 * kEps);
+  return body;
+}
+
+SurfaceGap gapAt(const TumblingBody& body, const PlacedShape& obstacle, double time,
+                 double distance_tolerance) {
+  return obstacleGap(body, time, shapeAt(obstacle, time), distance_tolerance);
+}
+
+SurfaceGap gapAt(const TumblingBody& a, const TumblingBody& b, double time,
+                 double distance_tolerance) {
+  return bodiesGap(a, b, time, distance_tolerance);
+}
+
+FirstContactResult firstContact(const TumblingBody& body, const PlacedShape& obstacle, double from,
+                                double horizon, const FirstContactOptions& options) {
+  return advance(body, ObstacleSide{obstacle, options.distance_tolerance}, from, horizon, options);
+}
+
+FirstContactResult firstContact(const TumblingBody& a, const TumblingBody& b, double from,
+                                double horizon, const FirstContactOptions& options) {
+  return advance(a, BodySide{b, options.distance_tolerance}, from, horizon, options);
+}
+
+}  // namespace collision_response::core
