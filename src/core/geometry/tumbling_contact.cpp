@@ -104,9 +104,10 @@ bool turns(const Shape& shape) {
 
 /// The body against a mesh placed at `pose` (both at one instant): the unsigned distance to its
 /// triangles, those whose boxes meet the cube about the body's centre that holds every point
-/// within the centre's distance to the mesh plus the body's reach (the nearest triangle is among
-/// them: the gap is at most the centre's distance). Far from the mesh (the centre's distance
-/// beyond twice the reach) a lower bound only: the centre's distance less the reach.
+/// within U plus the body's reach, U the body's distance to the triangle nearest its centre (or
+/// the centre's distance, whichever is less: both bound the gap from above, so the nearest
+/// triangle is among them). Far from the mesh (the centre's distance beyond three times the
+/// reach) a lower bound only: the centre's distance less the reach.
 SurfaceGap meshGap(const TumblingBody& body, double time, const Mesh& mesh, const RigidPose& pose,
                    double tolerance, std::vector<std::uint32_t>* near_triangles) {
   const Eigen::Matrix3d axes = pose.transform.linear();
@@ -134,7 +135,15 @@ SurfaceGap meshGap(const TumblingBody& body, double time, const Mesh& mesh, cons
     g.point_a = toWorld(on_body);
     g.point_b = toWorld(nearest.point);
   } else {
-    const double half = nearest.distance + reach;
+    // The triangle nearest the centre bounds the gap from above: every triangle nearer the body
+    // lies within that bound plus the reach of the centre.
+    const auto& first = triangles.triangles()[nearest.triangle];
+    const ConvexDistance nearest_triangle = convexDistance(
+        local_body,
+        TriangleSupport(triangles.vertices()[first[0]], triangles.vertices()[first[1]],
+                        triangles.vertices()[first[2]]),
+        tolerance);
+    const double half = std::min(nearest.distance, std::max(0.0, nearest_triangle.upper)) + reach;
     std::vector<std::uint32_t> found;
     triangles.overlapping(local_centre - Eigen::Vector3d::Constant(half),
                           local_centre + Eigen::Vector3d::Constant(half), found);
