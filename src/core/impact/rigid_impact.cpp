@@ -417,7 +417,7 @@ Expected<std::vector<ContactOutcome>> resolveRigidSimultaneous(
       return Error{"impulse", kBeyondDoubles};
     }
   }
-  bodies = std::move(after);
+  std::copy(after.begin(), after.end(), bodies.begin());  // in place: references to them stay valid
   return outcomes;
 }
 
