@@ -15,6 +15,13 @@
 
 namespace collision_response::core {
 
+/// Whether a body moves as a rigid body of its shape rather than as a ball: any shape but a
+/// sphere, or a sphere given a tensor. Such a body turns whatever the effects (the spin effect
+/// is a ball's).
+inline bool isShapedBody(const BodySpec& body) {
+  return body.shape != BodyShape::kSphere || body.inertia_tensor.has_value();
+}
+
 /// The body's shape in its own frame: a sphere about the origin, a box, a cylinder or a capsule
 /// (half its `size` or `length`), or its mesh (whose convex hull the body is).
 Shape shapeOf(const BodySpec& body);

@@ -145,12 +145,18 @@ struct Scene {
   std::vector<ObstacleSpec> obstacles;
 };
 
+/// Which bodies a scene may move: spheres only (the monitor's, for now), or any shape (a shaped
+/// body's prediction, which moves it by a model of its own: src/core/monitor/shaped_prediction.h).
+enum class MovingShapes { kSpheresOnly, kAny };
+
 /// Every value and cross-reference of a scene: ids unique among bodies and obstacles, masses,
 /// radii, known materials, finite vectors, nonzero plane normals, each body's shape and inertia
-/// (checkBodyShape), and last, for now, that every body is a sphere (checkOnlySpheresMove: "not
-/// yet"). Fields are named as scene file keys under `prefix` ("~scene/bodies[2]/mass").
-/// Start-up cost: O(n log n) in the bodies, plus one check per pair of distinct materials.
-Status validateScene(const Scene& scene, const std::string& prefix);
+/// (checkBodyShape), and last, with kSpheresOnly, that every body is a sphere
+/// (checkOnlySpheresMove: "not yet"). Fields are named as scene file keys under `prefix`
+/// ("~scene/bodies[2]/mass"). Start-up cost: O(n log n) in the bodies, plus one check per pair of
+/// distinct materials.
+Status validateScene(const Scene& scene, const std::string& prefix,
+                     MovingShapes moving = MovingShapes::kSpheresOnly);
 
 /// A warning for each body whose scene `position` lies inside a fixed obstacle (one without a
 /// `frame`: tf places the others at run time) by more than the touching band, naming both and

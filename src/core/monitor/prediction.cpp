@@ -6,8 +6,11 @@
 #include <limits>
 #include <map>
 
+#include "collision_response/core/body_shape.h"
 #include "collision_response/core/validation.h"
 #include "geometry/narrow_phase.h"
+#include "monitor/crossing.h"
+#include "monitor/shaped_prediction.h"
 
 namespace collision_response::core {
 
@@ -72,6 +75,7 @@ Status checkRequest(const Scene& scene, const PredictionRequest& request) {
                  "names magnus without spin: the Magnus force comes from the spin, "
                  "which only the spin effect carries (add spin)"};
   }
+  if (isShapedBody(body)) return checkShapedRequest(request);
   if (!request.effects.spin && !request.state.angular_velocity.isZero()) {
     return Error{"body.angular_velocity",
                  "is nonzero but the effects do not include spin: the model would ignore it "
@@ -130,15 +134,20 @@ std::vector<std::optional<PlacedShape>> livePlacements(const Scene& ahead,
   return placed;
 }
 
-/// The obstacles on tf frames where the live monitor placed them; an error where the state
-/// starts inside an obstacle.
-Status placeObstacles(ImpactMonitor& model, const PredictionStart& start) {
-  const PredictionRequest& request = start.request;
+/// The obstacles on tf frames where the live monitor placed them.
+void placeLiveObstacles(ImpactMonitor& model, const PredictionStart& start) {
   for (std::size_t i = 0; i < model.obstacleCount(); ++i) {
-    const ObstacleSpec& obstacle = model.obstacle(i);
-    if (!obstacle.frame.empty() && i < start.placed.size() && start.placed[i]) {
+    if (!model.obstacle(i).frame.empty() && i < start.placed.size() && start.placed[i]) {
       model.placeObstacle(i, *start.placed[i]);
     }
+  }
+}
+
+/// The obstacles placed (placeLiveObstacles); an error where the ball starts inside one.
+Status placeObstacles(ImpactMonitor& model, const PredictionStart& start) {
+  placeLiveObstacles(model, start);
+  const PredictionRequest& request = start.request;
+  for (std::size_t i = 0; i < model.obstacleCount(); ++i) {
     const auto placed = model.obstaclePose(i);
     if (!placed) continue;  // on a frame tf has not given yet
     const ContactGeometry g = contactGeometry(
@@ -146,7 +155,8 @@ Status placeObstacles(ImpactMonitor& model, const PredictionStart& start) {
         start.settings.contact_tolerance, [] { return Eigen::Vector3d(Eigen::Vector3d::Zero()); });
     if (g.gap < -g.tolerance) {
       return Error{"body.position", "is " + formatNumber(-g.gap) + " m inside obstacle '" +
-                                        obstacle.id + "' (a prediction starts in free space)"};
+                                        model.obstacle(i).id +
+                                        "' (a prediction starts in free space)"};
     }
   }
   return Ok{};
@@ -160,25 +170,6 @@ BodyStateSample stateOf(const ImpactMonitor& model, double time) {
   sample.velocity = state->second;
   sample.angular_velocity = model.predictedAngularVelocity(0, time);
   return sample;
-}
-
-double across(const Plane& plane, const Eigen::Vector3d& position) {
-  return plane.normal.dot(position) - plane.offset;
-}
-
-/// The first crossing of `plane` within (from, to] (the centre changes sides there) by the body
-/// whose state at an instant is `stateAt(t)`: bisected to the last bit of the instant.
-template <class StateAt>
-BodyStateSample bisectCrossing(const Plane& plane, double from, double to, StateAt stateAt) {
-  const double side = across(plane, stateAt(from).position);
-  double open = from, closed = to;
-  for (int i = 0; i < 200; ++i) {
-    const double middle = open + 0.5 * (closed - open);
-    if (!(middle > open && middle < closed)) break;
-    const double now = across(plane, stateAt(middle).position);
-    ((now > 0) == (side > 0) && now != 0 ? open : closed) = middle;
-  }
-  return stateAt(closed);
 }
 
 /// One prediction run: the model advanced piece by piece (at the sample period, the crossing's
@@ -379,14 +370,30 @@ Expected<PredictionStart> startPrediction(const Scene& scene, const ImpactMonito
 Expected<Prediction> runPrediction(const PredictionStart& start, const PredictionBudget& budget) {
   const double began =
       budget.seconds > 0 ? (budget.clock ? budget.clock() : threadCpuSeconds()) : 0.0;
-  if (auto status = validateScene(start.ahead, "request"); !status) return status.error();
-  {
-    ImpactMonitor check(start.ahead, start.settings);
-    if (auto status = placeObstacles(check, start); !status) return status.error();
+  const bool shaped = isShapedBody(start.request.body);
+  if (auto status = validateScene(start.ahead, "request",
+                                  shaped ? MovingShapes::kAny : MovingShapes::kSpheresOnly);
+      !status) {
+    return status.error();
   }
   // The prediction's own time line starts at the state (0), where its instants hold every digit.
   std::vector<std::string> cut;
-  Prediction prediction = PredictionRun(start, budget, began).run(cut);
+  Prediction prediction;
+  if (shaped) {
+    // The model holds the scene ahead (the obstacles placed, the answer's ids); it moves
+    // nothing: the shaped body's run does.
+    auto model = std::make_shared<ImpactMonitor>(start.ahead, start.settings);
+    placeLiveObstacles(*model, start);
+    auto shaped_prediction = runShapedPrediction(start, budget, began, std::move(model), cut);
+    if (!shaped_prediction) return shaped_prediction.error();
+    prediction = std::move(shaped_prediction.value());
+  } else {
+    {
+      ImpactMonitor check(start.ahead, start.settings);
+      if (auto status = placeObstacles(check, start); !status) return status.error();
+    }
+    prediction = PredictionRun(start, budget, began).run(cut);
+  }
   prediction.cut_short = !cut.empty();
   for (const std::string& reason : cut) {
     prediction.message += (prediction.message.empty() ? "" : "; ") + reason;
