@@ -9,36 +9,12 @@
 #include "collision_response/ros/conversions.h"
 
 namespace collision_response {
-namespace {
-
-/// A body's fields given by name: `inertia` (empty: solid; empty where inertia_tensor is given,
-/// which says how the mass is spread) and `shape` (empty: a sphere).
-core::Status parseNamedFields(const Body& message, const std::string& prefix, core::Body& body) {
-  if (!message.inertia.empty() && isGiven(message.inertia_tensor)) {
-    return core::Error{prefix + ".inertia", "is '" + message.inertia + "' while " + prefix +
-                                                ".inertia_tensor is given: give one (leave "
-                                                "inertia empty; the tensor says how the mass is "
-                                                "spread)"};
-  }
-  const auto inertia = core::parseInertia(message.inertia, prefix + ".inertia");
-  if (!inertia) return inertia.error();
-  body.inertia = *inertia;
-  if (message.shape.empty()) return core::Ok{};
-  const auto shape = core::parseBodyShape(message.shape, prefix + ".shape");
-  if (!shape) return shape.error();
-  body.shape = *shape;
-  return core::Ok{};
-}
-
-}  // namespace
 
 void answerComputeCollision(const ComputeCollision::Request& request,
                             const core::MaterialTable& materials,
                             ComputeCollision::Response& response) {
   response = ComputeCollision::Response();
   core::CollisionRequest core_request;
-  core_request.a = toCore(request.a);
-  core_request.b = toCore(request.b);
   core_request.normal = toEigen(request.normal);
   core_request.restitution = request.restitution;
   core_request.friction = request.friction;
@@ -47,11 +23,13 @@ void answerComputeCollision(const ComputeCollision::Request& request,
   for (const auto& [body, message, prefix] :
        {std::make_tuple(&core_request.a, &request.a, std::string("a")),
         std::make_tuple(&core_request.b, &request.b, std::string("b"))}) {
-    if (auto status = parseNamedFields(*message, prefix, *body); !status) {
+    auto parsed = bodyFromMessage(*message, prefix);
+    if (!parsed) {
       response.success = false;
-      response.message = status.error().message();
+      response.message = parsed.error().message();
       return;
     }
+    *body = std::move(parsed.value());
   }
   const auto outcome = core::computeCollision(core_request, materials);
   if (!outcome) {

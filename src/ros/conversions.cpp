@@ -2,6 +2,8 @@
 
 #include <tf2_eigen/tf2_eigen.h>
 
+#include "collision_response/core/body_shape.h"
+
 #include <cstdio>
 
 namespace collision_response {
@@ -50,6 +52,25 @@ core::Body toCore(const collision_response::Body& msg) {
     tensor.iyz = given.iyz;
     body.inertia_tensor = tensor;
   }
+  return body;
+}
+
+core::Expected<core::Body> bodyFromMessage(const collision_response::Body& msg,
+                                           const std::string& prefix) {
+  if (!msg.inertia.empty() && isGiven(msg.inertia_tensor)) {
+    return core::Error{prefix + ".inertia", "is '" + msg.inertia + "' while " + prefix +
+                                                ".inertia_tensor is given: give one (leave "
+                                                "inertia empty; the tensor says how the mass is "
+                                                "spread)"};
+  }
+  core::Body body = toCore(msg);
+  const auto inertia = core::parseInertia(msg.inertia, prefix + ".inertia");
+  if (!inertia) return inertia.error();
+  body.inertia = *inertia;
+  if (msg.shape.empty()) return body;
+  const auto shape = core::parseBodyShape(msg.shape, prefix + ".shape");
+  if (!shape) return shape.error();
+  body.shape = *shape;
   return body;
 }
 

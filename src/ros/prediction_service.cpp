@@ -1,5 +1,6 @@
 #include "collision_response/ros/prediction_service.h"
 
+#include <tf2_eigen/tf2_eigen.h>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -24,29 +25,13 @@ core::Expected<core::BodySpec> requestedBody(const Body& body, const core::Scene
                                         "' as it is, but the scene has no body of that id "
                                         "(give the body's mass, radius and material)"};
   }
-  core::BodySpec spec;
-  spec.id = body.id;
-  spec.mass = body.mass;
-  spec.radius = body.radius;
+  auto parsed = bodyFromMessage(body, "body");
+  if (!parsed) return parsed.error();
+  if (auto status = core::checkBodyShape(*parsed, "body"); !status) return status.error();
+  // A ball as before; a shaped body (a box, cylinder, capsule, or a tensor given) predicted by
+  // its own model (the core's shaped prediction).
+  core::BodySpec spec = core::shapeSpecOf(*parsed);
   spec.material = body.material;
-  if (!body.inertia.empty()) {
-    const auto inertia = core::parseInertia(body.inertia, "body.inertia");
-    if (!inertia) return inertia.error();
-    spec.inertia = *inertia;
-  }
-  // Body's shape fields (ComputeCollision's): a prediction moves balls only, so a shaped body is
-  // refused by name rather than predicted as a ball.
-  if (!body.shape.empty() && body.shape != "sphere") {
-    return core::Error{"body.shape", "not yet: ~predict_impacts predicts a sphere ('" + body.shape +
-                                         "' given); a shaped body's flight and contacts are "
-                                         "issue 42's next steps"};
-  }
-  if (isGiven(body.inertia_tensor)) {
-    return core::Error{"body.inertia_tensor",
-                       "not yet: ~predict_impacts predicts a sphere of uniform mass (`inertia`: "
-                       "solid or hollow); leave the tensor all zero"};
-  }
-  if (auto status = core::checkBodyShape(toCore(body), "body"); !status) return status.error();
   return spec;
 }
 
@@ -106,7 +91,15 @@ core::Expected<core::PredictionRequest> requestInFixedFrame(const PredictImpacts
   // The frame's own turning is the body's spin only where the model carries spin (as on the
   // topics, where the monitor then ignores it); without it a spin given is the core's error.
   predict.state.angular_velocity = motion->pose.linear() * toEigen(request.body.angular_velocity);
-  if (predict.effects.spin) predict.state.angular_velocity += motion->angular_velocity;
+  // A shaped body turns whatever the effects: its orientation (world from body, in the frame)
+  // into the fixed frame, and the frame's turning its own.
+  const bool shaped = core::isShapedBody(predict.body);
+  if (predict.effects.spin || shaped) predict.state.angular_velocity += motion->angular_velocity;
+  if (shaped) {
+    const geometry_msgs::Quaternion& q = request.body.orientation;
+    predict.state.orientation = Eigen::Quaterniond(motion->pose.linear()) *
+                                Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized();
+  }
   predict.horizon = request.horizon;
   predict.max_impacts = request.max_impacts;
   predict.sample_period = request.sample_period;
@@ -131,7 +124,7 @@ BodyState stateMessage(const core::BodyStateSample& sample, const std::string& i
   state.header.frame_id = frame;
   state.id = id;
   state.pose.position = toPointMsg(sample.position);
-  state.pose.orientation.w = 1.0;
+  state.pose.orientation = tf2::toMsg(sample.orientation);
   state.twist.linear = toVector3Msg(sample.velocity);
   state.twist.angular = toVector3Msg(sample.angular_velocity);
   return state;

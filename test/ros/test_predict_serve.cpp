@@ -14,6 +14,7 @@
 #include <ros/ros.h>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -184,41 +185,73 @@ TEST(PredictServe, EveryBadRequestIsNamedAndTheNodeKeepsServing) {
   EXPECT_EQ(refusal(servedBall(ref)), "accepted");
 }
 
-// Body.msg's shape fields (ComputeCollision's, issue 42): a prediction moves balls only yet, so
-// a body given its own shape or tensor is refused by name rather than predicted as a ball, and a
-// number a sphere has not (its size) is not ignored.
-TEST(PredictServe, AShapedBodyIsRefusedNotPredictedAsABall) {
+// A shaped body over ROS (issue 42): a box of celluloid (e = 0.9 on the table's concrete) of
+// edges 0.04 m, given in the `court` frame 0.25 m above the world's, turned about the vertical,
+// dropped flat from rest 0.22 m above the table's top (its centre at z = 1.0 in the world, its
+// bottom at 0.98, the top at 0.76). Its four corners strike at once at t = sqrt(2 (0.22) / g),
+// and it leaves at e g t upwards without turning; the answer's final state carries its
+// orientation back (in the fixed frame: the court's turns not). What is not modelled yet for a
+// shaped body (drag, a mesh body) is refused by name, and a number a shape has not (a sphere's
+// size) is not ignored.
+TEST(PredictServe, ABoxDroppedFlatIsPredictedAsTheClosedFormSays) {
   ASSERT_TRUE(ros::service::waitForService("/collision_response/predict_impacts", 30000));
-  PredictImpacts probe;
-  probe.request.header.frame_id = "world";
-  probe.request.body.id = "probe";
-  probe.request.body.mass = 0.0027;
-  probe.request.body.radius = 0.02;
-  probe.request.body.material = "celluloid";
-  probe.request.body.position.x = -3.0;
-  probe.request.body.position.z = 1.0;
-  probe.request.effects = {"gravity"};
-  probe.request.horizon = 0.1;
-  probe.request.max_impacts = 1;
-  const auto refusal = [](PredictImpacts call) {
-    if (!callService(call)) return std::string("no answer");
-    if (call.response.success) return std::string("accepted");
-    return call.response.message;
+  PredictImpacts box;
+  box.request.header.frame_id = "court";
+  box.request.header.stamp = ros::Time(300.0);
+  box.request.body.id = "block";
+  box.request.body.shape = "box";
+  box.request.body.mass = 0.05;
+  box.request.body.material = "celluloid";
+  box.request.body.size.x = box.request.body.size.y = box.request.body.size.z = 0.04;
+  box.request.body.position.x = -1.0;
+  box.request.body.position.z = 0.75;  // 1.0 in the world
+  const Eigen::Quaterniond turn(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()));
+  box.request.body.orientation.w = turn.w();
+  box.request.body.orientation.z = turn.z();
+  box.request.effects = {"gravity"};
+  box.request.horizon = 0.5;
+  box.request.max_impacts = 4;
+  PredictImpacts call = box;
+  for (int i = 0; i < 50 && (!callService(call) || !call.response.success); ++i) {
+    ros::WallDuration(0.1).sleep();
+  }
+  ASSERT_TRUE(call.response.success) << call.response.message;
+  ASSERT_EQ(call.response.impacts.size(), 4u) << call.response.message;
+  const double t = std::sqrt(2 * 0.22 / 9.81);
+  for (const collision_response::Impact& impact : call.response.impacts) {
+    EXPECT_EQ(impact.body_a, "block");
+    EXPECT_EQ(impact.body_b, "table");
+    EXPECT_NEAR((impact.header.stamp - ros::Time(300.0)).toSec(), t, 1e-9);
+    EXPECT_NEAR(impact.contact_point.z, 0.76, 1e-9);
+    EXPECT_NEAR(impact.velocity_a_before.linear.z, -9.81 * t, 1e-9);
+    EXPECT_NEAR(impact.velocity_a_after.linear.z, 0.9 * 9.81 * t, 1e-9);
+    EXPECT_NEAR(impact.velocity_a_after.angular.x, 0.0, 1e-9);
+    EXPECT_NEAR(impact.velocity_a_after.angular.y, 0.0, 1e-9);
+    EXPECT_NEAR(impact.impulse, 0.05 * 1.9 * 9.81 * t / 4, 1e-9);
+  }
+  const auto& q = call.response.final_state.pose.orientation;
+  EXPECT_NEAR(std::abs(q.w * turn.w() + q.z * turn.z()), 1.0, 1e-12);
+  EXPECT_EQ(call.response.final_state.header.frame_id, "world");
+  EXPECT_NEAR(call.response.final_state.pose.position.z, 0.78, 1e-9);
+
+  const auto refusal = [](PredictImpacts request) {
+    if (!callService(request)) return std::string("no answer");
+    if (request.response.success) return std::string("accepted");
+    return request.response.message;
   };
-  PredictImpacts call = probe;
-  call.request.body.shape = "box";
-  call.request.body.radius = 0.0;
-  call.request.body.size.x = call.request.body.size.y = call.request.body.size.z = 0.04;
-  call.request.body.orientation.w = 1.0;
+  call = box;
+  call.request.effects = {"gravity", "drag"};
+  EXPECT_EQ(refusal(call).rfind("effects: ", 0), 0u) << refusal(call);
+  call = box;
+  call.request.body.shape = "mesh";
   EXPECT_EQ(refusal(call).rfind("body.shape: not yet", 0), 0u) << refusal(call);
-  call = probe;
-  call.request.body.inertia_tensor.ixx = call.request.body.inertia_tensor.iyy =
-      call.request.body.inertia_tensor.izz = 1e-6;
-  EXPECT_EQ(refusal(call).rfind("body.inertia_tensor: not yet", 0), 0u) << refusal(call);
-  call = probe;
-  call.request.body.size.x = 0.04;
+  call = box;
+  call.request.body.orientation = geometry_msgs::Quaternion();
+  EXPECT_EQ(refusal(call).rfind("body.orientation", 0), 0u) << refusal(call);
+  call = box;
+  call.request.body.shape = "";
+  call.request.body.radius = 0.02;
   EXPECT_EQ(refusal(call).rfind("body.size: must be 0", 0), 0u) << refusal(call);
-  EXPECT_EQ(refusal(probe), "accepted");
 }
 
 // Issue 41, item 8: absurd numbers answered rightly, each against its closed form.

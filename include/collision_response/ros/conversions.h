@@ -28,6 +28,11 @@ geometry_msgs::Point toPointMsg(const Eigen::Vector3d& point);
 core::Body toCore(const collision_response::Body& msg);
 /// A tensor with an entry other than 0 (a NaN too): given; all zero: not given.
 bool isGiven(const InertiaTensor& tensor);
+/// toCore, and the fields given by name parsed into it: `inertia` (empty: solid; must be empty
+/// where inertia_tensor is given, which says how the mass is spread) and `shape` (empty: a
+/// sphere), each error naming `prefix`.field. The values are not checked otherwise.
+core::Expected<core::Body> bodyFromMessage(const collision_response::Body& msg,
+                                           const std::string& prefix);
 
 /// The record of an impact message, indexed as `monitor` indexes its bodies, at `time` on the
 /// caller's time line: what core::Playback::applyImpact takes. Empty when body_a is not one of
