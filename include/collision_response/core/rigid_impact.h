@@ -49,7 +49,7 @@ Expected<RigidImpactOutcome> resolveRigidImpact(SolverBody& a, SolverBody& b,
                                                 double tangential_restitution = 0.0);
 
 /// Chatterjee and Ruina's algebraic law ("A new algebraic rigid-body collision law based on
-/// impulse space considerations", J. Appl. Mech. 65:939-951, 1998, section "A new collision law"),
+/// impulse space considerations", J. Appl. Mech. 65:939-951, 1998),
 /// for any two bodies, balls included (resolveRigidImpact uses it for every pair but two balls).
 /// With K the contact's inverse effective mass (effective_mass.h) and u0 the contact points'
 /// relative velocity before (u_n = u0.n < 0):
@@ -60,8 +60,8 @@ Expected<RigidImpactOutcome> resolveRigidImpact(SolverBody& a, SolverBody& b,
 ///
 /// P = P^ where it lies inside the friction cone |P_t| <= mu P_n (sticking); otherwise
 /// P = (1 + e) P_I + kappa D with kappa = mu (1 + e) |P_I| / (|D_t| - mu D.n), on the cone.
-/// (The law as an impulse of the frictionless restitution plus a share of the tangential one,
-/// e_t the tangential restitution, 0 by default: Chatterjee and Ruina's own default.)
+/// e_t is the tangential restitution, 0 here by default (the sticking impulse once: no tangential
+/// rebound).
 ///
 /// What it guarantees, exactly (not only for these tests):
 /// - Newton's e along the normal whatever mu: n.K.D = n.(-u0) - n.K.P_I = 0, so
