@@ -613,6 +613,35 @@ TEST(RigidImpact, SimultaneousBallsAreTodaysJointSolveBitForBit) {
 }
 
 // Bad input, each named by its field, the bodies untouched.
+// A lever arm along the normal (a sphere given a tensor, r = R n) turns nothing: the impact is
+// Newton's j = (1 + e) m d whatever the tensor. With I far below m R^2 (R = 5e6 m, I = 3.9e-8
+// kg m^2: R^2 / I ~ 6e20 against 1/m = 0.1), n.K.n taken from the matrix K lost w to the
+// cancellation of its rotational entries (~eps 6e20 = 1e5) and gave a negative impulse,
+// -1.05e7 N s, gaining energy; (r x n).I^-1 (r x n) itself is ~1e-11 (effective_mass.h).
+TEST(RigidImpact, ALeverArmAlongTheNormalWithATinyInertiaIsNewtonsImpulse) {
+  const Eigen::Vector3d n = Eigen::Vector3d(2, 3, 6) / 7;
+  SolverBody wall;  // immovable
+  wall.inertia_kind = InverseInertiaKind::kTensor;
+  SolverBody ball;
+  ball.inverse_mass = 0.1;
+  ball.inertia_kind = InverseInertiaKind::kTensor;
+  ball.inverse_inertia = Eigen::Matrix3d::Identity() / 3.9e-8;
+  ball.velocity = -1.36e11 * n;
+  ContactPoint contact;
+  contact.normal = n;
+  contact.lever_a = Eigen::Vector3d(1e5, -2e5, 3e5);
+  contact.lever_b = -5e6 * n;
+  for (const double mu : {0.0, 0.4}) {
+    SolverBody a = wall, b = ball;
+    const auto outcome = resolveRigidImpact(a, b, contact, 0.127, mu);
+    ASSERT_TRUE(outcome.ok()) << outcome.error().message();
+    const double newton = (1 + 0.127) * 1.36e11 / 0.1;
+    EXPECT_NEAR(outcome->normal_impulse, newton, 1e-12 * newton) << mu;
+    EXPECT_GE(outcome->energy_lost, 0.0) << mu;
+    EXPECT_NEAR(b.velocity.dot(n), 0.127 * 1.36e11, 1e-12 * 1.36e11) << mu;
+  }
+}
+
 TEST(RigidImpact, BadInputIsRefusedByName) {
   const SolverBody box = tensorBody(1.0, Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, -1),
                                     Eigen::Vector3d::Zero());

@@ -147,11 +147,19 @@ RigidImpactOutcome resolveRigidImpactByLaw(SolverBody& a, SolverBody& b,
   outcome.approach_speed = static_cast<double>(-normal_velocity);
   if (!(normal_velocity < 0)) return outcome;
 
-  const Matrix3L k =
-      inverseEffectiveMass(contactSideOf(a, contact.lever_a), contactSideOf(b, contact.lever_b))
-          .cast<RealL>();
-  const Vector3L kn = k * n;
-  const RealL nkn = n.dot(kn);
+  const ContactSide side_a = contactSideOf(a, contact.lever_a);
+  const ContactSide side_b = contactSideOf(b, contact.lever_b);
+  const Matrix3L k = inverseEffectiveMass(side_a, side_b).cast<RealL>();
+  // K n and n.K.n from each side's own terms, w n + (I^-1 (r x n)) x r, not from the matrix:
+  // where a lever arm lies along n (a sphere) its rotational entries, ~r^2 / I, cancel along n
+  // and would leave their rounding, which for I far below m r^2 swamps w (a negative impulse).
+  const auto turnAlong = [&](const ContactSide& side) -> Vector3L {
+    const Eigen::Vector3d arm = side.lever_arm.cross(contact.normal);
+    return (side.inverse_inertia * arm).cross(side.lever_arm).cast<RealL>();
+  };
+  const Vector3L kn =
+      RealL(side_a.inverse_mass + side_b.inverse_mass) * n + turnAlong(side_a) + turnAlong(side_b);
+  const RealL nkn = inverseEffectiveMassAlong(side_a, side_b, contact.normal);
   const RealL plastic_normal = -normal_velocity / nkn;  // |P_I|, > 0
   // D = P_II - P_I = K^-1 (-u0 - K P_I): the sticking impulse's part that K holds orthogonal to n.
   const Vector3L d = k.ldlt().solve(-u0 - plastic_normal * kn);
