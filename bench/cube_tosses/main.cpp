@@ -26,74 +26,10 @@
 #include <stdexcept>
 
 #include "cube_tosses.h"
+#include "tosses.h"
 
 namespace collision_response::bench::cube_tosses {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-/// Every kFitStride-th toss (by file name) is a fitting toss.
-constexpr std::size_t kFitStride = 4;
-/// The coarse grid, denser in mu (the slide's length, and so the error, turns on it sharply); the
-/// fine one: kFineSteps steps either side of the coarse best, of kFineRestitutionStep and
-/// kFineFrictionStep.
-const std::vector<double> kCoarseRestitutions = {0.0, 0.15, 0.3, 0.45, 0.6, 0.75, 0.9};
-const std::vector<double> kCoarseFrictions = {0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5, 0.7, 1.0};
-constexpr double kFineRestitutionStep = 0.05;
-constexpr double kFineFrictionStep = 0.025;
-constexpr int kFineSteps = 2;
-
-struct Recorded {
-  Pose pose;
-  V velocity = V::Zero();
-  V body_angular_velocity = V::Zero();  ///< rad/s, in the cube's frame, as the data give it
-};
-
-struct Toss {
-  std::string name;  ///< its file's name
-  std::vector<Recorded> samples;
-};
-
-/// One toss's file: a header line, then t,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz (README of the
-/// data set). A malformed line is an error naming the file and the line.
-Toss readToss(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw std::runtime_error(file.string() + ": cannot be read");
-  Toss toss{file.filename().string(), {}};
-  std::string line;
-  std::getline(in, line);
-  for (int number = 2; std::getline(in, line); ++number) {
-    if (line.empty()) continue;
-    std::replace(line.begin(), line.end(), ',', ' ');
-    std::istringstream words(line);
-    double value[14];
-    for (double& v : value) {
-      if (!(words >> v) || !std::isfinite(v)) {
-        throw std::runtime_error(file.string() + ":" + std::to_string(number) +
-                                 ": expected 14 finite numbers (t,x,y,z,qw,qx,qy,qz,vx,vy,vz,"
-                                 "wx,wy,wz)");
-      }
-    }
-    Recorded sample;
-    sample.pose.position = V(value[1], value[2], value[3]);
-    const Q q(value[4], value[5], value[6], value[7]);
-    if (q.norm() < 0.5) {
-      throw std::runtime_error(file.string() + ":" + std::to_string(number) +
-                               ": the orientation (qw,qx,qy,qz) is not a unit quaternion");
-    }
-    sample.pose.orientation = q.normalized();
-    sample.velocity = V(value[8], value[9], value[10]);
-    sample.body_angular_velocity = V(value[11], value[12], value[13]);
-    toss.samples.push_back(sample);
-  }
-  if (toss.samples.size() < 2) throw std::runtime_error(file.string() + ": fewer than 2 samples");
-  return toss;
-}
-
-/// The toss's first state in the world frame (the angular velocity turned out of the body's).
-State firstState(const Toss& toss) {
-  const Recorded& first = toss.samples.front();
-  return State{first.pose, first.velocity, first.pose.orientation * first.body_angular_velocity};
-}
 
 /// A played toss against its recording.
 struct Errors {
@@ -101,12 +37,6 @@ struct Errors {
   std::vector<double> angle;     ///< the angle of the turn from one orientation to the other, deg
   double mean_distance = 0.0, rest_distance = 0.0, mean_angle = 0.0, rest_angle = 0.0;
 };
-
-/// The angle of the rotation between two orientations, in [0, 180] deg.
-double angleBetween(const Q& a, const Q& b) {
-  const Q turn = a.conjugate() * b;
-  return 2.0 * std::atan2(turn.vec().norm(), std::abs(turn.w())) * 180.0 / kPi;
-}
 
 Errors measure(const std::vector<Pose>& path, const Toss& toss) {
   Errors errors;
@@ -123,12 +53,6 @@ Errors measure(const std::vector<Pose>& path, const Toss& toss) {
   return errors;
 }
 
-double cpuSeconds() {
-  timespec now{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
-  return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
-}
-
 /// The fitting objective: the mean over `tosses` of each toss's mean centre error (widths).
 double meanError(const Peer& peer, const Contact& contact, const std::vector<const Toss*>& tosses) {
   const Simulate simulate = peer.make(contact);
@@ -139,65 +63,22 @@ double meanError(const Peer& peer, const Contact& contact, const std::vector<con
   return sum / static_cast<double>(tosses.size());
 }
 
-struct Fit {
-  Contact best;
-  double objective = std::numeric_limits<double>::infinity();
-  std::size_t evaluations = 0;
-  double cpu = 0.0;  ///< s
-};
-
-std::vector<double> fineValues(double centre, double step, double low, double high) {
-  std::vector<double> values;
-  for (int i = -kFineSteps; i <= kFineSteps; ++i) {
-    const double value = centre + static_cast<double>(i) * step;
-    if (value >= low - 1e-12 && value <= high + 1e-12) values.push_back(value);
-  }
-  return values;
-}
-
 Fit fit(const Peer& peer, const std::vector<const Toss*>& tosses) {
-  const double started = cpuSeconds();
-  Fit result;
-  const auto grid = [&](const std::vector<double>& restitutions,
-                        const std::vector<double>& frictions) {
-    for (const double e : peer.fits_restitution ? restitutions : std::vector<double>{0.0}) {
-      for (const double mu : frictions) {
-        const Contact contact{e, mu};
-        const double objective = meanError(peer, contact, tosses);
-        ++result.evaluations;
-        std::cerr << "   e " << e << ", mu " << mu << ": " << objective << " widths\n";
-        if (objective < result.objective) {
-          result.objective = objective;
-          result.best = contact;
-        }
-      }
-    }
-  };
-  grid(kCoarseRestitutions, kCoarseFrictions);
-  const Contact coarse = result.best;
-  grid(fineValues(coarse.restitution, kFineRestitutionStep, 0.0, 1.0),
-       fineValues(coarse.friction, kFineFrictionStep, 0.01, 1.5));
-  result.cpu = cpuSeconds() - started;
-  return result;
+  return fitOnGrid(
+      peer.fits_restitution,
+      [&](const Contact& contact) { return meanError(peer, contact, tosses); },
+      [](const Contact& contact, double objective) {
+        std::cerr << "   e " << contact.restitution << ", mu " << contact.friction << ": "
+                  << objective << " widths\n";
+      });
 }
 
-std::string json(double value) {
-  if (!std::isfinite(value)) return "null";
-  char text[32];
-  std::snprintf(text, sizeof text, "%.6g", value);
-  return text;
-}
-
-std::string jsonList(const std::vector<double>& values) {
+/// Each evaluation toss's errors at every sample (`series` of its Errors), so that the report
+/// can take them over any span (ours.cpp's: where our prediction ends).
+std::string jsonSeries(const std::vector<Errors>& errors, std::vector<double> Errors::*series) {
   std::string text = "[";
-  for (std::size_t i = 0; i < values.size(); ++i) text += (i ? ", " : "") + json(values[i]);
-  return text + "]";
-}
-
-std::string jsonNames(const std::vector<const Toss*>& tosses) {
-  std::string text = "[";
-  for (std::size_t i = 0; i < tosses.size(); ++i) {
-    text += (i ? ", \"" : "\"") + tosses[i]->name + "\"";
+  for (std::size_t i = 0; i < errors.size(); ++i) {
+    text += (i ? ",\n       " : "") + jsonList(errors[i].*series);
   }
   return text + "]";
 }
@@ -273,6 +154,8 @@ std::string runPeer(const Peer& peer, const std::vector<const Toss*>& fitting,
       << "     \"own_best_mean_distance\": " << jsonList(best_mean) << ",\n"
       << "     \"own_best_rest_distance\": " << jsonList(best_rest) << ",\n"
       << "     \"own_best_cpu_s\": " << json(oracle_cpu) << ",\n"
+      << "     \"distance_series\": " << jsonSeries(errors, &Errors::distance) << ",\n"
+      << "     \"angle_series\": " << jsonSeries(errors, &Errors::angle) << ",\n"
       << "     \"median_toss\": {\"name\": \"" << evaluation[median]->name
       << "\", \"distance\": " << jsonList(errors[median].distance)
       << ", \"angle\": " << jsonList(errors[median].angle) << "}}";
@@ -316,24 +199,9 @@ int run(int argc, char** argv) {
               << " (give --tosses DIR or set COLLISION_RESPONSE_CUBE_TOSSES)\n";
     return 77;
   }
-  std::vector<std::filesystem::path> files;
-  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
-    const std::string name = entry.path().filename().string();
-    if (name.rfind("toss_", 0) == 0 && entry.path().extension() == ".csv") {
-      files.push_back(entry.path());
-    }
-  }
-  std::sort(files.begin(), files.end());
-  if (files.empty()) {
-    std::cerr << "cube_tosses_peers: no toss_*.csv in " << folder << "\n";
-    return 1;
-  }
-  std::vector<Toss> tosses;
-  for (const auto& file : files) tosses.push_back(readToss(file));
+  const std::vector<Toss> tosses = readTosses(folder);
   std::vector<const Toss*> fitting, evaluation;
-  for (std::size_t i = 0; i < tosses.size(); ++i) {
-    (i % kFitStride == 0 ? fitting : evaluation).push_back(&tosses[i]);
-  }
+  splitTosses(tosses, fitting, evaluation);
 
   std::vector<std::string> results;
   for (const Peer& peer : peers()) {
