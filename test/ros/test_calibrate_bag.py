@@ -8,7 +8,13 @@ slip reduced by 3.5 mu (1 + e) |vz|, which stays below it). Its positions at 200
 Gaussian noise (seeded) are written into a bag as BodyStateArray messages on /body_states, the
 scene file beside it; the tool's `pairs:` give e within +-0.005 of 0.9 (the issue's bar) and mu
 within 4 standard errors. A bag whose stamps go back is refused, naming the problem, exit 1.
+
+The same track recorded as a tf frame (`--frame`): the ball's transforms on /tf relative to a
+tracker's frame `mocap`, which /tf_static places in `world` (turned 30 degrees about an oblique
+axis and moved), give the same e as the states do, within its interval; a frame that is not in
+the bag is named.
 """
+import json
 import math
 import os
 import random
@@ -21,6 +27,8 @@ import rospkg
 import rospy
 import yaml
 from collision_response.msg import BodyState, BodyStateArray
+from geometry_msgs.msg import TransformStamped
+from tf2_msgs.msg import TFMessage
 
 G = 9.81
 R = 0.02
@@ -84,6 +92,52 @@ def write_bag(path, times_and_positions, t0=100.0):
             bag.write("/body_states", message, rospy.Time.from_sec(t0 + k / RATE))
 
 
+# The tracker's frame in the world: a turn of ANGLE about the unit AXIS, then MOVED.
+AXIS = [1 / math.sqrt(3)] * 3
+ANGLE = math.radians(30.0)
+MOVED = [0.4, -0.3, 0.05]
+
+
+def quaternion():
+    """(x, y, z, w) of the turn."""
+    s = math.sin(ANGLE / 2)
+    return [a * s for a in AXIS] + [math.cos(ANGLE / 2)]
+
+
+def in_mocap(p):
+    """A world point in the tracker's frame: R^T (p - MOVED), R the turn (Rodrigues' formula;
+    its transpose is the turn by -ANGLE)."""
+    d = [x - m for x, m in zip(p, MOVED)]
+    c, s = math.cos(-ANGLE), math.sin(-ANGLE)
+    k = AXIS
+    cross = [k[1] * d[2] - k[2] * d[1], k[2] * d[0] - k[0] * d[2], k[0] * d[1] - k[1] * d[0]]
+    dot = sum(a * b for a, b in zip(k, d))
+    return [d[i] * c + cross[i] * s + k[i] * dot * (1 - c) for i in range(3)]
+
+
+def write_tf_bag(path, times_and_positions, t0=100.0):
+    """The ball as tf frame `ball` under `mocap` on /tf; `mocap` under `world` on /tf_static."""
+    with rosbag.Bag(path, "w") as bag:
+        static = TransformStamped()
+        static.header.stamp = rospy.Time.from_sec(t0)
+        static.header.frame_id = "world"
+        static.child_frame_id = "mocap"
+        t = static.transform.translation
+        t.x, t.y, t.z = MOVED
+        q = static.transform.rotation
+        q.x, q.y, q.z, q.w = quaternion()
+        bag.write("/tf_static", TFMessage(transforms=[static]), rospy.Time.from_sec(t0))
+        for k, (time, p) in enumerate(times_and_positions):
+            transform = TransformStamped()
+            transform.header.stamp = rospy.Time.from_sec(t0 + time)
+            transform.header.frame_id = "mocap"
+            transform.child_frame_id = "ball"
+            t = transform.transform.translation
+            t.x, t.y, t.z = in_mocap(p)
+            transform.transform.rotation.w = 1.0
+            bag.write("/tf", TFMessage(transforms=[transform]), rospy.Time.from_sec(t0 + k / RATE))
+
+
 class CalibrateBag(unittest.TestCase):
     def setUp(self):
         self.folder = tempfile.mkdtemp(prefix="calibrate_bag_")
@@ -121,6 +175,42 @@ class CalibrateBag(unittest.TestCase):
         self.assertAlmostEqual(pairs[0]["restitution"], E, delta=0.005)
         self.assertIn("friction", pairs[0])
         self.assertAlmostEqual(pairs[0]["friction"], MU, delta=0.01)
+
+    def answer(self, bag, *extra):
+        """The core's whole answer (--json), printed before the summary."""
+        run = self.calibrate(bag, "--spin-before", "0", "0", "0", "--json", *extra)
+        self.assertEqual(run.returncode, 0, run.stdout + run.stderr)
+        return json.JSONDecoder().raw_decode(run.stdout)[0]
+
+    def test_a_tf_frame_gives_the_same_e(self):
+        states_bag = os.path.join(self.folder, "ball.bag")
+        write_bag(states_bag, self.track)
+        tf_bag = os.path.join(self.folder, "tf.bag")
+        write_tf_bag(tf_bag, self.track)
+        states = self.answer(states_bag)
+        frame = self.answer(tf_bag, "--frame", "ball")
+        self.assertEqual(frame["samples_used"], states["samples_used"])
+        self.assertEqual(len(frame["bounces"]), 5)
+        e = states["groups"][0]["restitution"]
+        e_frame = frame["groups"][0]["restitution"]["value"]
+        self.assertTrue(e["low"] <= e_frame <= e["high"], (e, e_frame))
+        # The positions differ only by the turn's rounding (1e-16 m): so do the answers.
+        self.assertAlmostEqual(e_frame, e["value"], delta=1e-9)
+        self.assertAlmostEqual(e_frame, E, delta=0.005)
+        # A tf topic named by --topic: the frame is the body's id.
+        by_topic = self.answer(tf_bag, "--topic", "/tf")
+        self.assertEqual(by_topic["groups"][0]["restitution"]["value"], e_frame)
+
+    def test_a_frame_not_in_the_bag_is_named(self):
+        tf_bag = os.path.join(self.folder, "tf.bag")
+        write_tf_bag(tf_bag, self.track)
+        run = self.calibrate(tf_bag, "--frame", "paddle")
+        self.assertEqual(run.returncode, 2, run.stdout + run.stderr)
+        self.assertIn("/tf: no transform of frame 'paddle' (frames: ball, mocap, world)",
+                      run.stderr)
+        run = self.calibrate(tf_bag, "--frame", "ball", "--tracked-spin")
+        self.assertEqual(run.returncode, 2, run.stdout + run.stderr)
+        self.assertIn("--tracked-spin: a tf frame ('ball') carries no velocity", run.stderr)
 
     def test_stamps_going_back_are_named(self):
         track = list(self.track)
