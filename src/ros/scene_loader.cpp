@@ -496,14 +496,9 @@ core::Status readObstacles(const XmlRpc::XmlRpcValue& value, const std::string& 
   return readList(value, field, scene.obstacles, readObstacle);
 }
 
-/// Only checked here: loadScene reads it again for the meshes it loads.
-core::Status checkMaxMeshBytes(const XmlRpc::XmlRpcValue& value, const std::string& field, Scene&) {
-  const auto limit = readMaxMeshBytes(value, field);
-  return limit ? core::Status(core::Ok{}) : core::Status(limit.error());
-}
-
-/// Read by loadScene, with the URDF it names.
-core::Status skipRobot(const XmlRpc::XmlRpcValue&, const std::string&, Scene&) {
+/// Read by loadScene, once the other keys are: `robot` with the URDF it names, `max_mesh_bytes`
+/// with the meshes it loads (the table's last keys, so that their errors come in its order).
+core::Status readByLoadScene(const XmlRpc::XmlRpcValue&, const std::string&, Scene&) {
   return core::Status(core::Ok{});
 }
 
@@ -534,8 +529,8 @@ const KeyTable<Scene>& sceneTable() {
           "exact_work_budget", [](Scene& s) -> int& { return s.exact_work_budget; }, 0),
       {"bodies", false, readBodies},
       {"obstacles", false, readObstacles},
-      {"robot", false, skipRobot},
-      {"max_mesh_bytes", false, checkMaxMeshBytes},
+      {"robot", false, readByLoadScene},
+      {"max_mesh_bytes", false, readByLoadScene},
   };
   return kKeys;
 }
