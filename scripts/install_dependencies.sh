@@ -37,6 +37,7 @@ declare -A DEBIAN_PACKAGES=(
   [tf2_geometry_msgs]="libtf2-geometry-msgs-dev python3-tf2-geometry-msgs"
   [eigen]="libeigen3-dev"
   [urdf]="liburdf-dev"
+  [tinyxml2]="libtinyxml2-dev"
   [roslib]="libroslib-dev"
   [geometric_shapes]="libgeometric-shapes-dev"
   [libqhull]="libqhull-dev"
