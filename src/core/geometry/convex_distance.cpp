@@ -357,8 +357,7 @@ ConvexDistance convexDistance(const SupportMapping& a, const SupportMapping& b, 
     for (int i = 0; i < s.size; ++i) {
       if (s.vertices[static_cast<std::size_t>(i)].w == w) repeated = true;
     }
-    if (repeated || vv - vw <= 4 * kEps * vv)
-      break;  // no new point: as near as it gets  // no new point: as near as it gets
+    if (repeated || vv - vw <= 4 * kEps * vv) break;  // no new point: as near as it gets
     s.vertices[static_cast<std::size_t>(s.size)] = {w, pa, pb};
     ++s.size;
     if (s.size == 2) {
@@ -383,8 +382,6 @@ ConvexDistance convexDistance(const SupportMapping& a, const SupportMapping& b, 
     if (!(next.squaredNorm() < vv)) break;  // no progress (rounding): keep the last v
     v = next;
   }
-  result.iterations = iteration;
-
   Eigen::Vector3d core_a = Eigen::Vector3d::Zero(), core_b = Eigen::Vector3d::Zero();
   double weight_sum = 0;
   for (int i = 0; i < s.size; ++i) weight_sum += s.weights[static_cast<std::size_t>(i)];
@@ -393,6 +390,36 @@ ConvexDistance convexDistance(const SupportMapping& a, const SupportMapping& b, 
     core_a += weight * s.vertices[static_cast<std::size_t>(i)].a;
     core_b += weight * s.vertices[static_cast<std::size_t>(i)].b;
   }
+  if (!overlapping && v.norm() - lower > tolerance) {
+    // Not converged: near touching a round side the simplex's corners crowd together and its
+    // nearest point stops coming nearer to rounding. Frank-Wolfe steps from there (x the point of
+    // A - B, moved to the nearest point of the segment to the support point w in the direction
+    // -x: nearer at every step, no simplex to round), each w bounding the distance from below
+    // by x.w / |x|; the witness points move along.
+    Eigen::Vector3d x = core_a - core_b;
+    for (int step = 0; step < 64 && !(x.norm() - lower <= tolerance); ++step) {
+      const double x_norm = x.norm();
+      if (!(x_norm > slack)) break;
+      const Eigen::Vector3d pa = a.support(-x), pb = b.support(x);
+      const Eigen::Vector3d w = pa - pb;
+      if (x.dot(w) / x_norm > lower) {
+        lower = x.dot(w) / x_norm;
+        lower_direction = x / x_norm;
+      }
+      const Eigen::Vector3d d = w - x;
+      const double length2 = d.squaredNorm();
+      if (!(length2 > 0)) break;
+      const double t = std::min(1.0, -x.dot(d) / length2);
+      if (!(t > 0)) break;
+      core_a += t * (pa - core_a);
+      core_b += t * (pb - core_b);
+      x = core_a - core_b;
+      ++iteration;
+    }
+    v = x;
+  }
+  result.iterations = iteration;
+
   // The closest points are points of the cores: their distance bounds the cores' from above.
   const Eigen::Vector3d between = core_b - core_a;
   const double apart = between.norm();
