@@ -9,6 +9,7 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "collision_response/core/collision.h"
 #include "collision_response/core/mass_properties.h"
@@ -527,15 +528,24 @@ TEST(ShapedCollision, BadShapedBodiesAreRefusedByName) {
 }
 
 TEST(ShapedCollision, AContactThatCannotBeFoundOrIsNoPointOfTheBodyIsRefusedByName) {
-  {  // two shaped bodies: the point must be given
+  {  // two shaped bodies that overlap: no point or normal is found
     CollisionRequest request = rodOnItsEnd();
+    request.b.position.z() -= 0.125;
     request.contact_point.reset();
-    expectRefused(request, "contact_point_given", "two shaped bodies");
-  }
-  {  // and the normal
-    CollisionRequest request = rodOnItsEnd();
     request.normal = V::Zero();
-    expectRefused(request, "normal", "two shaped bodies");
+    expectRefused(request, "contact_point_given", "a and b overlap by");
+    // The capsule's end 1/8 m into the ground: b moved along the line of the centres, from
+    // (0, 0, -1) to (0, -0.3, 0.285), rises 1.285 / |(0, -0.3, 1.285)| per metre, so it parts
+    // after 0.125 |(0, -0.3, 1.285)| / 1.285 m (the message's number, to the bisection's 2^-40).
+    const std::string message = computeCollision(request, MaterialTable::seed()).error().message();
+    const double said = std::stod(message.substr(message.find("overlap by ") + 11));
+    EXPECT_NEAR(said, 0.125 * std::hypot(0.3, 1.285) / 1.285, 1e-10) << message;
+  }
+  {  // the point given, the normal not: found, but they overlap
+    CollisionRequest request = rodOnItsEnd();
+    request.b.position.z() -= 0.125;
+    request.normal = V::Zero();
+    expectRefused(request, "normal", "a and b overlap by");
   }
   {
     CollisionRequest request = rodOnItsEnd();
@@ -555,6 +565,258 @@ TEST(ShapedCollision, AContactThatCannotBeFoundOrIsNoPointOfTheBodyIsRefusedByNa
     request.contact_point = V(0.5, 0, 0);
     expectRefused(request, "contact_point_given", "two spheres");
   }
+}
+
+// Two boxes, one's corner onto the other's face, the contact found from their shapes: the box
+// corner's closed form (ABoxStruckAtACornerFrictionlessIsTheClosedForm) with the ball replaced
+// by a 1 kg box a of edges (7/4, 1, 1) m whose +x face, turned to face the corner (its x axis
+// along n = -(2, 3, 6)/7: the rational rotation of columns (-2, -3, -6)/7, (3, -6, 2)/7,
+// (-6, -2, 3)/7), has its centre on the line through the corner along n, `gap` from it. a's lever
+// arm to its closest point is (7/8) n, along n: r_a x n = 0, so n.K.n, the impulse and b's
+// answer are the closed form's, and a does not turn. Its centre: the corner + (gap + 7/8) u,
+// u = (2, 3, 6)/7; the contact point found: the middle of the gap, the corner + (gap / 2) u.
+CollisionRequest boxOnABoxCorner(double gap) {
+  CollisionRequest request = ballOnABoxCorner();
+  request.a.id = "striker";
+  request.a.radius = 0.0;
+  request.a.shape = BodyShape::kBox;
+  request.a.size = V(7.0 / 4.0, 1, 1);
+  Eigen::Matrix3d turn;
+  turn.col(0) = V(-2, -3, -6) / 7.0;
+  turn.col(1) = V(3, -6, 2) / 7.0;
+  turn.col(2) = V(-6, -2, 3) / 7.0;
+  request.a.orientation = Eigen::Quaterniond(turn);
+  request.a.position = V(0.5, 1, 1.5) + (gap + 7.0 / 8.0) * V(2, 3, 6) / 7.0;
+  return request;
+}
+
+// The closed form's velocities (v_a' = v_a - j n, v_b' = j n / 12, w_b' = j (-3/182, 0, 1/70),
+// a not turning) and its energy, sides a and b as given (`box_is_b`) or swapped.
+void expectTheCornersClosedForm(const CollisionOutcome& outcome, bool box_is_b) {
+  const V n = (box_is_b ? -1.0 : 1.0) * V(2, 3, 6) / 7.0;
+  const double j = kCornerImpulse;
+  const V& striker_velocity = box_is_b ? outcome.impact.velocity_a : outcome.impact.velocity_b;
+  const V& box_velocity = box_is_b ? outcome.impact.velocity_b : outcome.impact.velocity_a;
+  const V& striker_spin = box_is_b ? outcome.angular_velocity_a : outcome.angular_velocity_b;
+  const V& box_spin = box_is_b ? outcome.angular_velocity_b : outcome.angular_velocity_a;
+  const V striker_n = box_is_b ? n : V(-n);  // from the striker into the box
+  expectNear(outcome.line_of_impact, n, 1.0, "normal: along the face's");
+  EXPECT_TRUE(outcome.impact.approaching);
+  EXPECT_NEAR(outcome.impact.normal_impulse, j, 64 * j * 2.2e-16);
+  expectNear(striker_velocity, V(-2, -3, -6) - j * striker_n, 7.0, "striker's velocity");
+  expectNear(box_velocity, j * striker_n / 12.0, 1.0, "box's velocity");
+  // Its lever arm is along n to the rounding of its turn: I^-1 (r_a x n) j with |I^-1| |r_a| j
+  // about 6 * 7/8 * 9.6, 50 (its least moment (1 + 1) / 12).
+  expectNear(striker_spin, V::Zero(), 64.0, "the striker's lever arm is along n: no turn");
+  expectNear(box_spin, j * V(-3.0 / 182.0, 0, 1.0 / 70.0), 1.0, "box's angular velocity");
+  const double lost = 0.5 * (1 - 0.25) * 49.0 / kCornerInverseMass;
+  EXPECT_NEAR(outcome.impact.energy_lost, lost, 64 * lost * 2.2e-16);
+}
+
+TEST(ShapedCollision, ABoxsCornerOntoABoxsFaceFoundFromTheShapesIsTheClosedForm) {
+  for (const double gap : {0.0, 7.0 / 4.0}) {
+    SCOPED_TRACE(gap == 0 ? "touching" : "7/4 m apart");
+    const auto outcome = computeCollision(boxOnABoxCorner(gap), MaterialTable::seed());
+    ASSERT_TRUE(outcome.ok()) << outcome.error().message();
+    expectTheCornersClosedForm(*outcome, true);
+    expectNear(outcome->contact_point, V(0.5, 1, 1.5) + (gap / 2) * V(2, 3, 6) / 7.0, 4.0,
+               "contact point: the middle of the gap over the corner");
+    ASSERT_TRUE(outcome->surface_gap.has_value());
+    // To the rounding of the positions (a's centre is (gap + 7/8) u rounded) and of GJK's
+    // simplex on a turned face.
+    EXPECT_NEAR(*outcome->surface_gap, gap, 1e-12);
+    if (gap != 0) continue;
+    // Touching, the point found given: the same answer (the lever arms differ along n only).
+    CollisionRequest given = boxOnABoxCorner(gap);
+    given.contact_point = outcome->contact_point;
+    given.normal = outcome->line_of_impact;
+    const auto with_point = computeCollision(given, MaterialTable::seed());
+    ASSERT_TRUE(with_point.ok()) << with_point.error().message();
+    expectTheCornersClosedForm(*with_point, true);
+  }
+}
+
+// The same with a and b swapped: the mirrored answer (the normal reversed, the same impulse, the
+// same point), and with the whole problem turned by a rotation Q (every position, velocity and
+// orientation): the turned answer.
+TEST(ShapedCollision, ACornerFoundFromTheShapesIsMirroredWithTheSidesAndTurnedWithTheProblem) {
+  for (const double gap : {0.0, 7.0 / 4.0}) {
+    SCOPED_TRACE(gap == 0 ? "touching" : "7/4 m apart");
+    CollisionRequest swapped = boxOnABoxCorner(gap);
+    std::swap(swapped.a, swapped.b);
+    const auto mirrored = computeCollision(swapped, MaterialTable::seed());
+    ASSERT_TRUE(mirrored.ok()) << mirrored.error().message();
+    expectTheCornersClosedForm(*mirrored, false);
+    expectNear(mirrored->contact_point, V(0.5, 1, 1.5) + (gap / 2) * V(2, 3, 6) / 7.0, 4.0,
+               "contact point");
+
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(0.7, V(1, -2, 0.5).normalized()));
+    const Eigen::Matrix3d turn = q.toRotationMatrix();
+    CollisionRequest turned = boxOnABoxCorner(gap);
+    for (Body* body : {&turned.a, &turned.b}) {
+      body->position = turn * body->position;
+      body->velocity = turn * body->velocity;
+      body->orientation = q * body->orientation;
+    }
+    const auto outcome = computeCollision(turned, MaterialTable::seed());
+    ASSERT_TRUE(outcome.ok()) << outcome.error().message();
+    const auto plain = computeCollision(boxOnABoxCorner(gap), MaterialTable::seed());
+    ASSERT_TRUE(plain.ok());
+    expectNear(outcome->line_of_impact, turn * plain->line_of_impact, 4.0, "normal turned");
+    expectNear(outcome->contact_point, turn * plain->contact_point, 8.0, "point turned");
+    EXPECT_NEAR(outcome->impact.normal_impulse, kCornerImpulse, 256 * kCornerImpulse * 2.2e-16);
+    expectNear(outcome->impact.velocity_a, turn * plain->impact.velocity_a, 16.0, "a turned");
+    expectNear(outcome->angular_velocity_b, turn * plain->angular_velocity_b, 4.0, "w_b turned");
+  }
+}
+
+// A capsule's end onto a box's face, found: the rod on its end (ARodOnItsEndFrictionlessIsThe-
+// ClosedForm) with neither the point nor the normal given finds its lowest point (0, 0, 0) and
+// +z, and answers the closed form n.K.n = 1.04; lifted by 1/4 m the point is (0, 0, 1/8), the
+// middle of the gap, and the answer the same (the lever arm differs along n only); swapped, the
+// mirrored answer; the point given and the normal not, the normal found (+z).
+TEST(ShapedCollision, ACapsulesEndOntoABoxsFaceFoundFromTheShapesIsTheClosedForm) {
+  const double j = 4.5 / 1.04;
+  for (const double lift : {0.0, 0.25}) {
+    SCOPED_TRACE(lift == 0 ? "touching" : "1/4 m apart");
+    for (const bool swap : {false, true}) {
+      SCOPED_TRACE(swap ? "the rod a" : "the rod b");
+      CollisionRequest request = rodOnItsEnd();
+      request.b.position.z() += lift;
+      request.contact_point.reset();
+      request.normal = V::Zero();
+      if (swap) std::swap(request.a, request.b);
+      const auto outcome = computeCollision(request, MaterialTable::seed());
+      ASSERT_TRUE(outcome.ok()) << outcome.error().message();
+      const V& rod_velocity = swap ? outcome->impact.velocity_a : outcome->impact.velocity_b;
+      const V& rod_spin = swap ? outcome->angular_velocity_a : outcome->angular_velocity_b;
+      expectNear(outcome->line_of_impact, V(0, 0, swap ? -1 : 1), 1.0, "normal: the face's");
+      expectNear(outcome->contact_point, V(0, 0, lift / 2), 1.0, "the rod's lowest point");
+      EXPECT_NEAR(outcome->impact.normal_impulse, j, 64 * j * 2.2e-16);
+      expectNear(rod_velocity, V(0, 0, -3 + j / 2), 3.0, "rod's velocity");
+      expectNear(rod_spin, V(1.8 * j, 0, 0), 8.0, "rod's angular velocity");
+      const double lost = 0.75 * 9 / (2 * 1.04);
+      EXPECT_NEAR(outcome->impact.energy_lost, lost, 64 * lost * 2.2e-16);
+    }
+  }
+  CollisionRequest request = rodOnItsEnd();
+  request.normal = V::Zero();
+  const auto outcome = computeCollision(request, MaterialTable::seed());
+  ASSERT_TRUE(outcome.ok()) << outcome.error().message();
+  expectNear(outcome->line_of_impact, V(0, 0, 1), 1.0, "the normal found");
+  expectNear(outcome->contact_point, V::Zero(), 1.0, "the point given");
+  EXPECT_NEAR(outcome->impact.normal_impulse, j, 64 * j * 2.2e-16);
+}
+
+// Where a face or an edge meets a face or an edge flat (within 2^-30 of the bodies' reaches), the
+// contact is no single point: refused, asking for the point, whichever body is a and however the
+// whole problem is turned: a box flat on a box, a box on its edge, a cylinder on its side and on
+// its cap, and two boxes edge on edge, parallel. Two edges that cross touch at one point: found.
+TEST(ShapedCollision, BodiesMeetingFlatAreRefusedAskingForThePointInAnyOrderAndTurn) {
+  const auto ground = [] {
+    Body body;
+    body.id = "ground";
+    body.mass = kInf;
+    body.shape = BodyShape::kBox;
+    body.size = V(10, 10, 2);
+    body.position = V(0, 0, -1);
+    body.orientation = Eigen::Quaterniond::Identity();
+    return body;
+  };
+  const auto falling = [](BodyShape shape, const Eigen::Quaterniond& orientation, double height) {
+    Body body;
+    body.id = "falling";
+    body.mass = 2.0;
+    body.shape = shape;
+    if (shape == BodyShape::kBox) body.size = V(1, 1, 1);
+    if (shape != BodyShape::kBox) {
+      body.radius = 0.25;
+      body.length = 1.0;
+    }
+    body.orientation = orientation;
+    body.position = V(0.125, -0.25, height);
+    body.velocity = V(0.5, 0, -2);
+    return body;
+  };
+  const Eigen::Quaterniond flat = Eigen::Quaterniond::Identity();
+  const Eigen::Quaterniond on_edge(Eigen::AngleAxisd(M_PI / 4, V::UnitX()));
+  const Eigen::Quaterniond on_side(Eigen::AngleAxisd(M_PI / 2, V::UnitX()));
+  struct Case {
+    const char* what;
+    Body a;
+    Body b;
+    const char* words;
+  };
+  const std::vector<Case> cases = {
+      {"a box flat on a box", ground(), falling(BodyShape::kBox, flat, 0.5),
+       "the face of the box a meets the face of the box b flat"},
+      {"a box on its edge", ground(), falling(BodyShape::kBox, on_edge, std::sqrt(0.5)),
+       "the face of the box a meets the edge of the box b flat"},
+      {"a cylinder on its side", ground(), falling(BodyShape::kCylinder, on_side, 0.25),
+       "the face of the box a meets the side of the cylinder b flat"},
+      {"a cylinder on its cap", ground(), falling(BodyShape::kCylinder, flat, 0.5),
+       "the face of the box a meets the cap of the cylinder b flat"},
+      {"a capsule on its side", ground(), falling(BodyShape::kCapsule, on_side, 0.25),
+       "the face of the box a meets the side of the capsule b flat"},
+  };
+  const Eigen::Quaterniond q(Eigen::AngleAxisd(0.7, V(1, -2, 0.5).normalized()));
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    for (const bool turned : {false, true}) {
+      for (const bool swap : {false, true}) {
+        CollisionRequest request;
+        request.a = c.a;
+        request.b = c.b;
+        if (turned) {
+          for (Body* body : {&request.a, &request.b}) {
+            body->position = q * body->position;
+            body->velocity = q * body->velocity;
+            body->orientation = q * body->orientation;
+          }
+        }
+        if (swap) std::swap(request.a, request.b);
+        SCOPED_TRACE(std::string(turned ? "turned" : "as built") + (swap ? ", swapped" : ""));
+        std::string words = c.words;
+        if (swap) {  // the same words with a and b exchanged
+          const std::string head = "the face of the box a";
+          const std::size_t tail = words.find(" meets the ");
+          std::string other = words.substr(tail + 11, words.size() - tail - 11 - 5);
+          other = other.substr(0, other.size() - 1) + "a";
+          words = "the " + other + " meets the face of the box b flat";
+        }
+        expectRefused(request, "contact_point_given", words);
+      }
+    }
+  }
+}
+
+// Two boxes edge on edge: crossing at right angles they touch at one point, found (the middle of
+// their top and bottom edges, the normal +z); parallel they touch along a segment, refused.
+TEST(ShapedCollision, TwoEdgesThatCrossTouchAtOnePointParallelOnesAreRefused) {
+  const double h = std::sqrt(0.5);  // a unit cube on its edge: the edge sqrt(1/2) below its centre
+  CollisionRequest request;
+  request.a.mass = 1.0;
+  request.a.shape = BodyShape::kBox;
+  request.a.size = V(1, 1, 1);
+  request.a.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 4, V::UnitY()));
+  request.a.position = V(0, 0, -h);  // its top edge along y through the origin
+  request.b = request.a;
+  request.b.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 4, V::UnitX()));
+  request.b.position = V(0, 0, h);  // its bottom edge along x through the origin
+  request.b.velocity = V(0, 0, -1);
+  request.restitution = 1.0;
+  const auto outcome = computeCollision(request, MaterialTable::seed());
+  ASSERT_TRUE(outcome.ok()) << outcome.error().message();
+  expectNear(outcome->line_of_impact, V(0, 0, 1), 4.0, "normal: across both edges");
+  expectNear(outcome->contact_point, V::Zero(), 4.0, "where the edges cross");
+  // Both lever arms along n (the centres above and below the crossing): the centres' exchange
+  // of velocity, e = 1 and equal masses.
+  expectNear(outcome->impact.velocity_a, V(0, 0, -1), 4.0, "a takes b's velocity");
+  expectNear(outcome->impact.velocity_b, V::Zero(), 4.0, "b stops");
+
+  request.b.orientation = request.a.orientation;  // parallel: touching along the edge
+  expectRefused(request, "contact_point_given",
+                "the edge of the box a meets the edge of the box b");
 }
 
 }  // namespace

@@ -109,6 +109,30 @@ def rod_on_its_end():
           "lost", float(lost))
 
 
+def box_on_a_box_corner():
+    # The box corner again, struck by a 1 kg box a of edges (7/4, 1, 1) instead of the ball (the
+    # contact found from the shapes): a's x axis along n (the rotation's columns below, a proper
+    # rotation), its +x face's centre on the line through the corner along u = -n, `gap` from it.
+    # a's lever arm to its closest point is (7/8) n: r_a x n = 0, so a adds only 1/m_a to n.K.n
+    # and does not turn: the ball's closed form (box_corner) holds for the two boxes.
+    u = [F(2, 7), F(3, 7), F(6, 7)]
+    n = [-x for x in u]
+    turn = transpose([n, [F(3, 7), F(-6, 7), F(2, 7)], [F(-6, 7), F(-2, 7), F(3, 7)]])
+    assert matmul(transpose(turn), turn) == diag([F(1)] * 3)
+    assert dot(transpose(turn)[0], cross(transpose(turn)[1], transpose(turn)[2])) == 1
+    corner = [F(1, 2), F(1), F(3, 2)]
+    half = F(7, 8)
+    for gap in (F(0), F(7, 4)):
+        centre = [corner[i] + (gap + half) * u[i] for i in range(3)]
+        face_point = [centre[i] + half * n[i] for i in range(3)]  # a's +x face's centre
+        assert face_point == [corner[i] + gap * u[i] for i in range(3)]
+        r_a = [face_point[i] - centre[i] for i in range(3)]
+        assert cross(r_a, n) == [0, 0, 0]
+        middle = [(face_point[i] + corner[i]) / 2 for i in range(3)]
+        print("box on a box corner, gap", gap, ": a's centre", centre, "contact point", middle)
+
+
 if __name__ == "__main__":
     box_corner()
     rod_on_its_end()
+    box_on_a_box_corner()

@@ -19,10 +19,11 @@ struct CollisionRequest {
   Body b;
   /// Line of impact from a to b, any length; zero: from a's centre to b's for two spheres, the
   /// narrow phase's for a sphere and a shaped body (from the sphere's centre to the shaped body's
-  /// surface point nearest it); two shaped bodies need it given.
+  /// surface point nearest it), for two shaped bodies along their closest points (a to b).
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
   /// m: where a shaped body (or both) is struck; none: found (a sphere and a shaped body: the
-  /// narrow phase's). Two shaped bodies need it; two spheres refuse it.
+  /// narrow phase's; two shaped bodies: the middle of their closest points, refused where they
+  /// overlap or meet flat, a face or an edge along a face or an edge). Two spheres refuse it.
   std::optional<Eigen::Vector3d> contact_point;
   /// Used when neither body names a material; must be 0 when both do.
   double restitution = 0.0;
@@ -38,7 +39,10 @@ struct CollisionOutcome {
   ImpactResponse<double> impact;   ///< velocities after, impulse, energy lost
   Eigen::Vector3d line_of_impact;  ///< unit, a -> b
   Eigen::Vector3d contact_point = Eigen::Vector3d::Zero();  ///< m: given, or mid-gap
-  double restitution = 0.0;                                 ///< the coefficient used
+  /// m: where two shaped bodies' contact point was found, their surfaces' distance at the poses
+  /// given (0 touching); none otherwise.
+  std::optional<double> surface_gap;
+  double restitution = 0.0;            ///< the coefficient used
   bool oblique = false;                ///< a velocity had a component across the line
   double friction_impulse = 0.0;       ///< N s, tangential (friction effect)
   bool sticking = false;               ///< friction stopped the slip
@@ -55,7 +59,8 @@ struct CollisionOutcome {
 /// contact point, a shaped body by its lever arm and its world inverse inertia R I^-1 R^T (the
 /// uniform solid of its shape, or its tensor), a ball by its radius along the normal and, with
 /// the spin effect, its sphere's inertia (without it a ball does not turn); a shaped body turns
-/// whatever the effects.
+/// whatever the effects. Two shaped bodies without a contact point or normal: found from their
+/// closest points at the poses given (convexDistance), refused where they overlap or meet flat.
 Expected<CollisionOutcome> computeCollision(const CollisionRequest& request,
                                             const MaterialTable& materials);
 

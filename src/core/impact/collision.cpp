@@ -9,11 +9,14 @@
 #include "collision_response/core/rigid_impact.h"
 #include "collision_response/core/scene.h"
 #include "collision_response/core/validation.h"
+#include "geometry/convex_distance.h"
 #include "geometry/narrow_phase.h"
 #include "solver/cluster_solver.h"
 
 namespace collision_response::core {
 namespace {
+
+constexpr double kEps = 2.220446049250313e-16;
 
 Expected<double> chooseRestitution(const CollisionRequest& request,
                                    const MaterialTable& materials) {
@@ -89,6 +92,8 @@ struct RequestContact {
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   Eigen::Vector3d lever_a = Eigen::Vector3d::Zero();
   Eigen::Vector3d lever_b = Eigen::Vector3d::Zero();
+  /// m: two shaped bodies whose point was found: their surfaces' distance at the poses given.
+  std::optional<double> surface_gap;
 };
 
 /// A shaped body's shape where it is: at its position, turned by its orientation.
@@ -105,7 +110,6 @@ PlacedShape placedShapeOf(const Body& body) {
 /// centre, to the rounding of the positions): a lever arm longer than the body is no point of
 /// it, most likely a point in another frame.
 Status checkWithinReach(const Body& body, const Eigen::Vector3d& point, const std::string& side) {
-  constexpr double kEps = 2.220446049250313e-16;
   const double reach = boundingRadiusOf(shapeOf(shapeSpecOf(body)));
   const double distance = (point - body.position).norm();
   const double rounding =
@@ -140,6 +144,187 @@ Expected<RequestContact> contactOfSpheres(const CollisionRequest& request) {
   return contact;
 }
 
+/// Two shaped bodies count as touching, and a face or an edge as lying flat, within this share
+/// of their reaches (plus the rounding of their positions): 2^-30, about 1e-9.
+constexpr double kTouchingShare = 0x1p-30;
+
+/// A shaped body's convex shape in its own frame (a mesh is refused before: checkBodyShape).
+ConvexShape convexShapeOf(const Body& body) {
+  const Shape shape = shapeOf(shapeSpecOf(body));
+  if (const auto* box = std::get_if<Cuboid>(&shape)) return *box;
+  if (const auto* cylinder = std::get_if<Cylinder>(&shape)) return *cylinder;
+  if (const auto* capsule = std::get_if<Capsule>(&shape)) return *capsule;
+  return std::get<Sphere>(shape);
+}
+
+/// The part of a shape farthest along a direction, to within a band: a point (a box's corner, a
+/// cylinder's rim point, a capsule's round end, a sphere's point), a segment (a box's edge, a
+/// cylinder's or a capsule's side: `length` long along `along`) or a face (a box's face, a
+/// cylinder's cap).
+struct TouchingFeature {
+  int dimension = 0;  ///< 0 a point, 1 a segment, 2 a face
+  Eigen::Vector3d along = Eigen::Vector3d::Zero();
+  double length = 0.0;
+  const char* name = "point";
+};
+
+/// The feature of `shape` (turned by `turn`, world from shape) farthest along the unit world
+/// direction `direction`: the two ends of an edge of a box across axis i differ along it by
+/// 2 h_i |d_i| (d the direction in the shape's frame), a cylinder's cap's rim points by
+/// 2 r |d_xy|, a side's ends by 2 h |d_z|; within `band` they are equally far.
+TouchingFeature touchingFeature(const ConvexShape& shape, const Eigen::Matrix3d& turn,
+                                const Eigen::Vector3d& direction, double band) {
+  const Eigen::Vector3d d = turn.transpose() * direction;
+  TouchingFeature feature;
+  const auto segment = [&](const Eigen::Vector3d& along, double length, const char* name) {
+    feature.dimension = 1;
+    feature.along = along;
+    feature.length = length;
+    feature.name = name;
+  };
+  if (const auto* box = std::get_if<Cuboid>(&shape)) {
+    int flat = 0;
+    for (int i = 0; i < 3; ++i) {
+      if (2 * box->half_size[i] * std::abs(d[i]) <= band) {
+        ++flat;
+        segment(turn.col(i), 2 * box->half_size[i], "edge");
+      }
+    }
+    if (flat == 0) feature.name = "corner";
+    if (flat >= 2) {
+      feature.dimension = 2;
+      feature.name = "face";
+    }
+  } else if (const auto* cylinder = std::get_if<Cylinder>(&shape)) {
+    if (2 * cylinder->radius * std::hypot(d.x(), d.y()) <= band) {
+      feature.dimension = 2;
+      feature.name = "cap";
+    } else if (2 * cylinder->half_length * std::abs(d.z()) <= band) {
+      segment(turn.col(2), 2 * cylinder->half_length, "side");
+    } else {
+      feature.name = "rim";
+    }
+  } else if (const auto* capsule = std::get_if<Capsule>(&shape)) {
+    if (2 * capsule->half_length * std::abs(d.z()) <= band) {
+      segment(turn.col(2), 2 * capsule->half_length, "side");
+    } else {
+      feature.name = "end";
+    }
+  }
+  return feature;
+}
+
+/// Whether two features touch at one point: one of them a point, or two segments that cross
+/// (not parallel: the shorter one's ends part from the other's line by more than the band).
+bool touchAtOnePoint(const TouchingFeature& a, const TouchingFeature& b, double band) {
+  if (a.dimension == 0 || b.dimension == 0) return true;
+  if (a.dimension == 1 && b.dimension == 1) {
+    return a.along.cross(b.along).norm() * std::min(a.length, b.length) > band;
+  }
+  return false;
+}
+
+/// Where two shaped bodies are nearest: the unit normal a -> b along their closest points, the
+/// closest point of each surface, and their surfaces' distance (0 touching).
+struct ClosestPoints {
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();
+  Eigen::Vector3d point_a = Eigen::Vector3d::Zero();
+  Eigen::Vector3d point_b = Eigen::Vector3d::Zero();
+  double gap = 0.0;
+};
+
+/// The closest points of two shaped bodies at their positions and orientations (convexDistance:
+/// GJK on their exact support functions), for a contact point or normal not given (`missing`:
+/// the field whose refusal it is, `unset` what it is, "is false"; `give`: what the caller should
+/// give instead). Touching: their
+/// distance is within the band (kTouchingShare of their reaches), or they overlap by so little
+/// that moving b from a by the band along the line of their centres parts them. Where they touch,
+/// the closest points alone give no direction (their difference is rounding): b is moved from a
+/// along the normal so far found by `lift` (1/16 of the smaller reach), the normal taken from the
+/// closest points there, until it settles; the true normal is such a search's fixed point (both
+/// bodies lie on either side of the plane through their closest points across it, so moving b
+/// along it moves the closest points apart along it and no nearer pair appears), reached at once
+/// where either side touches with a face, a flat side or a margin (a capsule's or a sphere's).
+/// Refused by name: bodies that overlap by more, and where the point is missing, bodies that
+/// touch along a face or an edge (a box flat on a box, a cylinder on its side): their contact is
+/// not one point.
+Expected<ClosestPoints> closestPointsOfShapes(const CollisionRequest& request,
+                                              const std::string& missing, const std::string& unset,
+                                              const std::string& give, bool need_point) {
+  const Body& a = request.a;
+  const Body& b = request.b;
+  const ConvexShape shape_a = convexShapeOf(a);
+  const ConvexShape shape_b = convexShapeOf(b);
+  const Eigen::Matrix3d turn_a = a.orientation.normalized().toRotationMatrix();
+  const Eigen::Matrix3d turn_b = b.orientation.normalized().toRotationMatrix();
+  const double reach_a = reachOf(shape_a);
+  const double reach_b = reachOf(shape_b);
+  const double scale = a.position.lpNorm<Eigen::Infinity>() + b.position.lpNorm<Eigen::Infinity>() +
+                       reach_a + reach_b;
+  const double band = kTouchingShare * (reach_a + reach_b) + 16 * kEps * scale;
+  const double tolerance = 16 * kEps * scale;
+  const PlacedConvex placed_a(shape_a, turn_a, a.position);
+  const auto distanceMovingB = [&](const Eigen::Vector3d& shift) {
+    return convexDistance(placed_a, PlacedConvex(shape_b, turn_b, b.position + shift), tolerance);
+  };
+  const std::string pair =
+      std::string("the ") + toString(a.shape) + " a and the " + toString(b.shape) + " b";
+  const ConvexDistance given = distanceMovingB(Eigen::Vector3d::Zero());
+  Eigen::Vector3d normal = given.normal;
+  if (given.overlapping || given.upper <= band) {
+    const Eigen::Vector3d centres = b.position - a.position;
+    if (centres == Eigen::Vector3d::Zero()) {
+      return Error{missing, unset + ", but a and b overlap (their centres are both at " +
+                                formatVector(a.position) + "): " + give};
+    }
+    const Eigen::Vector3d line = centres.normalized();
+    const ConvexDistance moved = distanceMovingB(band * line);
+    if (moved.overlapping || moved.upper < 0) {
+      // How far b must move from a along the line of their centres to part from it: at most
+      // the overlap of their shadows on that line (moved that far, the shadows part), found by
+      // bisection to 2^-40 of it (an upper bound: the end that is apart).
+      const PlacedConvex placed_b(shape_b, turn_b, b.position);
+      double apart = line.dot(placed_a.support(line)) + placed_a.margin() -
+                     line.dot(placed_b.support(-line)) + placed_b.margin();
+      double inside = 0.0;
+      for (int halving = 0; halving < 40; ++halving) {
+        const double middle = 0.5 * (inside + apart);
+        const ConvexDistance there = distanceMovingB(middle * line);
+        (there.overlapping || there.upper < 0 ? inside : apart) = middle;
+      }
+      return Error{missing, unset + ", but a and b overlap by " + formatNumber(apart) +
+                                " m along the line of their centres (" + pair +
+                                " intersect at the positions and orientations given; b moved " +
+                                "that far from a parts them): " + give};
+    }
+    normal = moved.normal;
+  }
+  ClosestPoints closest;
+  closest.gap = given.overlapping ? 0.0 : std::max(given.upper, 0.0);
+  const double lift = std::min(reach_a, reach_b) / 16;
+  for (int round = 0; round < 64; ++round) {
+    const Eigen::Vector3d shift = lift * normal;
+    const ConvexDistance apart = distanceMovingB(shift);
+    const bool settled = (apart.normal - normal).norm() <= 16 * kEps;
+    normal = apart.normal;
+    closest.point_a = apart.point_a;
+    closest.point_b = apart.point_b - shift;
+    if (settled) break;
+  }
+  closest.normal = normal;
+  if (need_point) {
+    const TouchingFeature on_a = touchingFeature(shape_a, turn_a, normal, band);
+    const TouchingFeature on_b = touchingFeature(shape_b, turn_b, -normal, band);
+    if (!touchAtOnePoint(on_a, on_b, band)) {
+      return Error{missing, unset + ", but the " + on_a.name + " of the " + toString(a.shape) +
+                                " a meets the " + on_b.name + " of the " + toString(b.shape) +
+                                " b flat (within " + formatNumber(band) +
+                                " m): their contact is not one point; give the contact point"};
+    }
+  }
+  return closest;
+}
+
 /// A sphere and a shaped body, or two shaped bodies: the normal given or (a sphere and a shaped
 /// body) the narrow phase's, the point given or the narrow phase's, a sphere's lever arm its
 /// radius along the normal, a shaped body's from its centre to the point (given) or to its own
@@ -158,23 +343,33 @@ Expected<RequestContact> contactOfShapes(const CollisionRequest& request) {
   const bool a_sphere = a.shape == BodyShape::kSphere;
   const bool b_sphere = b.shape == BodyShape::kSphere;
   if (!a_sphere && !b_sphere) {
-    const std::string pair = std::string("two shaped bodies (a ") + toString(a.shape) + " and a " +
-                             toString(b.shape) + ")";
-    if (!request.contact_point) {
-      return Error{"contact_point_given",
-                   "is false, but " + pair +
-                       " need their contact point given: finding it between two shaped bodies "
-                       "is not yet (issue 42)"};
+    // What is not given is found from the shapes: the normal along their closest points, the
+    // point in the middle of them, each lever arm to the body's own closest point.
+    if (!request.contact_point || !given_normal) {
+      const bool need_point = !request.contact_point;
+      const auto closest = closestPointsOfShapes(
+          request, need_point ? "contact_point_given" : "normal",
+          need_point ? "is false" : "is zero",
+          need_point
+              ? (given_normal ? "give the contact point" : "give the contact point and the normal")
+              : "give the normal",
+          need_point);
+      if (!closest) return closest.error();
+      contact.normal = closest->normal;
+      if (need_point) {
+        // Halves first, as for two spheres: the midpoint of points near the largest doubles.
+        contact.point = 0.5 * closest->point_a + 0.5 * closest->point_b;
+        contact.lever_a = closest->point_a - a.position;
+        contact.lever_b = closest->point_b - b.position;
+        contact.surface_gap = closest->gap;
+      }
     }
-    if (!given_normal) {
-      return Error{"normal", "is zero, but " + pair +
-                                 " need their line of impact given (from a into b): finding it "
-                                 "between two shaped bodies is not yet (issue 42)"};
+    if (given_normal) contact.normal = unitVector(request.normal);
+    if (request.contact_point) {
+      contact.point = *request.contact_point;
+      contact.lever_a = contact.point - a.position;
+      contact.lever_b = contact.point - b.position;
     }
-    contact.normal = unitVector(request.normal);
-    contact.point = *request.contact_point;
-    contact.lever_a = contact.point - a.position;
-    contact.lever_b = contact.point - b.position;
   } else {
     const Body& sphere = a_sphere ? a : b;
     const Body& shaped = a_sphere ? b : a;
@@ -363,6 +558,7 @@ Expected<CollisionOutcome> computeCollision(const CollisionRequest& request,
     outcome = *rigid;
   }
   outcome.contact_point = meeting->point;
+  outcome.surface_gap = meeting->surface_gap;
   // Finite inputs whose answer is beyond the doubles (masses and speeds of 1e200: an energy of
   // 1e600 J) are refused by name rather than answered with an infinity.
   if (auto status =
