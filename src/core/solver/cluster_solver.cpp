@@ -6,17 +6,60 @@
 
 namespace collision_response::core {
 
-template <bool kSpin>
-FrictionOutcome applyFriction(ClusterBody& a, ClusterBody& b, const ContactPoint& contact,
-                              double friction, double normal_impulse) {
+template <class Scalar>
+Eigen::Matrix<Scalar, 3, 1> tensorTurnOf(const SolverBody& body, const Eigen::Vector3d& lever,
+                                         const Eigen::Matrix<Scalar, 3, 1>& impulse) {
+  return body.inverse_inertia.cast<Scalar>() * lever.cast<Scalar>().cross(impulse);
+}
+
+template Eigen::Vector3d tensorTurnOf<double>(const SolverBody&, const Eigen::Vector3d&,
+                                              const Eigen::Vector3d&);
+template Eigen::Matrix<long double, 3, 1> tensorTurnOf<long double>(
+    const SolverBody&, const Eigen::Vector3d&, const Eigen::Matrix<long double, 3, 1>&);
+
+Eigen::Vector3d turningSlip(const SolverBody& a, const SolverBody& b, const ContactPoint& contact) {
+  return turningVelocity(b, -contact.normal, contact.lever_b) -
+         turningVelocity(a, contact.normal, contact.lever_a);
+}
+
+double tensorTangentialInverseMass(const SolverBody& a, const SolverBody& b,
+                                   const ContactPoint& contact, const Eigen::Vector3d& direction) {
+  return inverseEffectiveMassAlong(contactSideOf(a, contact.lever_a),
+                                   contactSideOf(b, contact.lever_b), direction);
+}
+
+namespace {
+
+/// applyFriction's turn of one side by its impulse `impulse_on_body` (`impulse` along
+/// `direction` on a, against it on b): a ball's dw = (1/I) (r n x J) = ((w/k) J / r) (n x t),
+/// the velocity change w J first, then / r (on both sides: b's -J t acts at -r_b n); a body
+/// given by its tensor: I^-1 (r x J) (turnOf).
+template <SolveBodies kBodies>
+void turnByFriction(ClusterBody& body, const Eigen::Vector3d& normal,
+                    const Eigen::Vector3d& direction, double impulse, const Eigen::Vector3d& lever,
+                    const Eigen::Vector3d& impulse_on_body) {
+  if (kBodies == SolveBodies::kBalls || body.inertia_kind == InverseInertiaKind::kIsotropic) {
+    if (body.spin_factor != 0.0) {
+      body.angular_velocity +=
+          (body.inverse_mass * impulse) * body.spin_factor / body.radius * normal.cross(direction);
+    }
+  } else if (turns(body)) {
+    body.angular_velocity += tensorTurnOf<double>(body, lever, impulse_on_body);
+  }
+}
+
+/// applyFriction for bodies that are `kBodies`.
+template <bool kSpin, SolveBodies kBodies>
+FrictionOutcome frictionAt(ClusterBody& a, ClusterBody& b, const ContactPoint& contact,
+                           double friction, double normal_impulse) {
   FrictionOutcome outcome;
   const Eigen::Vector3d& normal = contact.normal;
-  const Eigen::Vector3d tangential = slipAt<kSpin>(a, b, contact);
+  const Eigen::Vector3d tangential = slipAt<kSpin, kBodies>(a, b, contact);
   const double slip_speed = tangential.norm();
   if (!(slip_speed > 0) || !(normal_impulse > 0)) return outcome;
   const Eigen::Vector3d direction = tangential / slip_speed;
   const double tangential_inverse_mass =
-      tangentialInverseMass<kSpin>(a, b, contact, [&] { return direction; });
+      tangentialInverseMass<kSpin, kBodies>(a, b, contact, [&] { return direction; });
   if (!(tangential_inverse_mass > 0)) return outcome;
   const double sticking_impulse = slip_speed / tangential_inverse_mass;
   const double bound = friction * normal_impulse;
@@ -26,25 +69,25 @@ FrictionOutcome applyFriction(ClusterBody& a, ClusterBody& b, const ContactPoint
   a.velocity += a.inverse_mass * impulse_on_a;
   b.velocity -= b.inverse_mass * impulse_on_a;
   if constexpr (kSpin) {
-    // A ball: dw = (1/I) (r n x J) = ((w/k) J / r) (n x t), the velocity change w J first, then
-    // / r (on both sides: b's -J t acts at -r_b n); a body with a tensor: turnOf.
-    const auto turn = [&](ClusterBody& body, const Eigen::Vector3d& outward,
-                          const Eigen::Vector3d& lever, const Eigen::Vector3d& impulse) {
-      if (!turns(body)) return;
-      if (body.inertia_kind == InverseInertiaKind::kIsotropic) {
-        body.angular_velocity += (body.inverse_mass * outcome.impulse) * body.spin_factor /
-                                 body.radius * normal.cross(direction);
-      } else {
-        body.angular_velocity += turnOf<double>(
-            body, outward, [&] { return lever; }, impulse);
-      }
-    };
-    turn(a, normal, contact.lever_a, impulse_on_a);
-    turn(b, -normal, contact.lever_b, -impulse_on_a);
+    turnByFriction<kBodies>(a, normal, direction, outcome.impulse, contact.lever_a, impulse_on_a);
+    turnByFriction<kBodies>(b, normal, direction, outcome.impulse, contact.lever_b, -impulse_on_a);
   }
   outcome.energy_lost =
       0.5 * outcome.impulse * (2 * slip_speed - outcome.impulse * tangential_inverse_mass);
   return outcome;
+}
+
+}  // namespace
+
+template <bool kSpin>
+FrictionOutcome applyFriction(ClusterBody& a, ClusterBody& b, const ContactPoint& contact,
+                              double friction, double normal_impulse) {
+  // Without spin no body turns: a body's kind does not matter.
+  if (!kSpin || (a.inertia_kind == InverseInertiaKind::kIsotropic &&
+                 b.inertia_kind == InverseInertiaKind::kIsotropic)) {
+    return frictionAt<kSpin, SolveBodies::kBalls>(a, b, contact, friction, normal_impulse);
+  }
+  return frictionAt<kSpin, SolveBodies::kAny>(a, b, contact, friction, normal_impulse);
 }
 
 template FrictionOutcome applyFriction<true>(ClusterBody&, ClusterBody&, const ContactPoint&,
