@@ -10,6 +10,7 @@
 #include "model/motion_model.h"
 #include "solver/cluster_solver.h"
 #include "solver/contact_forces.h"
+#include "solver/order_free.h"
 
 namespace collision_response::core::monitor {
 namespace {
@@ -75,21 +76,17 @@ std::vector<std::vector<std::size_t>> formClusters(const World& world,
     return static_cast<std::size_t>(
         std::lower_bound(involved.begin(), involved.end(), participant) - involved.begin());
   };
-  std::vector<std::size_t> parent(involved.size());
-  std::iota(parent.begin(), parent.end(), 0);
-  const auto find = [&parent](std::size_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
+  ConnectedSets participants(involved.size());
   for (const std::size_t k : striking) {
     const auto [a, other] = contacts[k].pair;
     if (world.inverseMassOf(a) > 0 && world.inverseMassOf(other) > 0) {
-      parent[find(slot_of(a))] = find(slot_of(other));
+      participants.link(slot_of(a), slot_of(other));
     }
   }
   const auto cluster_of = [&](std::size_t k) {
     const auto [a, other] = contacts[k].pair;
-    return world.inverseMassOf(a) > 0 ? find(slot_of(a)) : find(slot_of(other));
+    return world.inverseMassOf(a) > 0 ? participants.root(slot_of(a))
+                                      : participants.root(slot_of(other));
   };
   std::vector<std::vector<std::size_t>> clusters;
   std::map<std::size_t, std::size_t> cluster_slot;
@@ -393,21 +390,16 @@ void recordImpacts(const World& world, double time, const std::vector<InstantCon
 std::vector<std::size_t> touchingComponent(const World& world,
                                            const std::vector<InstantContact>& contacts,
                                            const std::vector<std::size_t>& cluster) {
-  std::vector<std::size_t> parent(world.bodyCount());
-  std::iota(parent.begin(), parent.end(), 0);
-  const auto find = [&parent](std::size_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
+  ConnectedSets bodies(world.bodyCount());  // joined by the contacts between movable bodies
   const auto movable = [&world](std::size_t participant) {
     return !world.isObstacle(participant) && world.inverseMassOf(participant) > 0;
   };
   const auto root_of = [&](const Pair& pair) {
-    return movable(pair.first) ? find(pair.first) : find(pair.second);
+    return movable(pair.first) ? bodies.root(pair.first) : bodies.root(pair.second);
   };
   for (const InstantContact& contact : contacts) {
     const auto [a, other] = contact.pair;
-    if (movable(a) && movable(other)) parent[find(a)] = find(other);
+    if (movable(a) && movable(other)) bodies.link(a, other);
   }
   std::vector<char> reached(world.bodyCount(), 0);
   for (const std::size_t k : cluster) reached[root_of(contacts[k].pair)] = 1;
