@@ -12,6 +12,7 @@
 
 #include "bouncing_ball.h"
 #include "collision_response/core/calibration.h"
+#include "second_bounce.h"
 
 namespace collision_response::core {
 namespace {
@@ -53,6 +54,55 @@ void expectRecovered(const Throw& t, const Track& track, const Calibration& fit)
   }
   EXPECT_TRUE(within4(fit.all.restitution, t.e))
       << fit.all.restitution.value << " +- " << fit.all.restitution.standard_error;
+}
+
+// What a calibration buys (issue 44, item 5): the monitor's own prediction (predictImpacts) from
+// the state 50 ms before the first bounce puts the second bounce where the truth has it, with the
+// truth's e and mu to 1e-12 m (its impact law is the throw's); with the calibrated ones within
+// their propagated error: the second bounce lies T v_t' along the slip from the first, T = 2 e
+// |v_n| / g and v_t' = |v_t| - mu (1 + e) |v_n|, so it moves by (2 |v_n| / g) v_t' de + T (1 + e)
+// |v_n| dmu, held to 4 standard errors of each (the two added: an upper bound); and with the seed's
+// coefficients (e 0.688, mu 0.5) at the closed form's point: mu (1 + e) |v_n| > |v_t| / 3.5, the
+// slip stops and the ball leaves rolling at 5/7 |v_t| (a solid ball), T = 2 (0.688) |v_n| / g.
+TEST(Calibration, TheCalibratedCoefficientsPredictTheSecondBounce) {
+  using namespace second_bounce;  // NOLINT: the test's own fixtures
+  Throw t;
+  t.seed = 44;
+  const Track track = throwBall(t);
+  const auto fit = calibrate(track.samples, floorOptions(t));
+  ASSERT_TRUE(fit.ok()) << fit.error().message();
+  ASSERT_TRUE(fit->all.friction.has_value());
+  const Estimate e = fit->all.restitution;
+  const Estimate mu = *fit->all.friction;
+  const Truth truth = truthOf(t);
+
+  const double approach = -track.bounces[0].before.z();
+  const double slip = std::hypot(track.bounces[0].before.x(), track.bounces[0].before.y());
+  const double flight = 2.0 * t.e * approach / kG;
+  const double slip_after = slip - t.mu * (1.0 + t.e) * approach;
+  const double bound = 4.0 * (2.0 * approach / kG * slip_after * e.standard_error +
+                              flight * (1.0 + t.e) * approach * mu.standard_error);
+
+  const auto calibrated = floorScene(t, e.value, mu.value);
+  ASSERT_TRUE(calibrated.ok()) << calibrated.error().message();
+  const auto with_calibration = secondBounceError(t, truth, *calibrated, kGivenMaterial);
+  ASSERT_TRUE(with_calibration.ok()) << with_calibration.error().message();
+  ASSERT_TRUE(with_calibration->has_value());
+  EXPECT_LE(**with_calibration, bound) << "e " << e.value << ", mu " << mu.value;
+
+  const auto exact = floorScene(t, t.e, t.mu);
+  ASSERT_TRUE(exact.ok());
+  const auto with_truth = secondBounceError(t, truth, *exact, kGivenMaterial);
+  ASSERT_TRUE(with_truth.ok() && with_truth->has_value());
+  EXPECT_LT(**with_truth, 1e-12);
+
+  ASSERT_GT(0.5 * (1.0 + 0.688) * approach, slip / 3.5);  // the seed's: the slip stops
+  const double seed_miss =
+      std::abs(2.0 * 0.688 * approach / kG * (5.0 / 7.0) * slip - flight * slip_after);
+  const auto with_seed = secondBounceError(t, truth, *calibrated, kSeedMaterial);
+  ASSERT_TRUE(with_seed.ok() && with_seed->has_value());
+  EXPECT_NEAR(**with_seed, seed_miss, 1e-9);
+  EXPECT_GT(**with_seed, 1000.0 * bound);
 }
 
 // The issue's bar: 5 bounces at 200 Hz with 1 mm of noise give e within +-0.005 (the ITTF's
