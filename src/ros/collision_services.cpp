@@ -59,6 +59,13 @@ void answerComputeCollision(const ComputeCollision::Request& request,
                 core::formatNumber(impact.normal_impulse) + " N s"
           : "not approaching ((v_b - v_a).normal = " + core::formatNumber(-impact.approach_speed) +
                 " m/s >= 0): velocities unchanged";
+  if (outcome->surface_gap) {
+    // Two shaped bodies whose contact was found: how far apart the caller's poses had them.
+    response.message += *outcome->surface_gap > 0
+                            ? "; contact found from the shapes, their surfaces " +
+                                  core::formatNumber(*outcome->surface_gap) + " m apart"
+                            : "; contact found from the shapes, touching";
+  }
 }
 
 void answerEstimateRestitution(const EstimateRestitution::Request& request,

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
+#include <Eigen/Geometry>
+
 #include <cmath>
 #include <limits>
 #include <string>
@@ -244,6 +246,59 @@ TEST_F(Services, ABoxStruckAtACornerFrictionlessIsTheClosedForm) {
   EXPECT_TRUE(response.approaching);
 }
 
+// Two boxes, the contact found by the node: the ball replaced by a 1 kg box of edges (7/4, 1, 1)
+// m turned so that its x axis is along n = -(2, 3, 6)/7 (the rational rotation of columns
+// (-2, -3, -6)/7, (3, -6, 2)/7, (-6, -2, 3)/7, its quaternion Eigen's from the matrix, to the
+// rounding), its +x face's centre touching the corner
+// (1/2, 1, 3/2): its centre the ball's, (3/4, 11/8, 9/4). Its lever arm (7/8) n is along n, so
+// it adds only 1/m to n.K.n and does not turn: the same closed form (test/exact/
+// shaped_collision.py, box_on_a_box_corner), the contact point the corner, the normal n.
+ComputeCollision::Request boxOnABoxCorner() {
+  ComputeCollision::Request request = ballOnABoxCorner();
+  request.a.radius = 0.0;
+  request.a.shape = "box";
+  request.a.size.x = 7.0 / 4.0;
+  request.a.size.y = 1.0;
+  request.a.size.z = 1.0;
+  Eigen::Matrix3d turn;
+  turn.col(0) = Eigen::Vector3d(-2, -3, -6) / 7.0;
+  turn.col(1) = Eigen::Vector3d(3, -6, 2) / 7.0;
+  turn.col(2) = Eigen::Vector3d(-6, -2, 3) / 7.0;
+  const Eigen::Quaterniond q(turn);
+  request.a.orientation.x = q.x();
+  request.a.orientation.y = q.y();
+  request.a.orientation.z = q.z();
+  request.a.orientation.w = q.w();
+  return request;
+}
+
+TEST_F(Services, TwoBoxesContactFoundByTheNodeIsTheCornersClosedForm) {
+  const auto response = call(boxOnABoxCorner());
+  ASSERT_TRUE(response.success) << response.message;
+  const double j = 10.5 / (41579.0 / 38220.0);
+  const double tolerance = 1e-14;
+  EXPECT_NEAR(response.impulse, j, tolerance * j);
+  EXPECT_NEAR(response.normal.x, -2.0 / 7.0, tolerance);
+  EXPECT_NEAR(response.normal.y, -3.0 / 7.0, tolerance);
+  EXPECT_NEAR(response.normal.z, -6.0 / 7.0, tolerance);
+  EXPECT_NEAR(response.contact_point.x, 0.5, tolerance);
+  EXPECT_NEAR(response.contact_point.y, 1.0, tolerance);
+  EXPECT_NEAR(response.contact_point.z, 1.5, tolerance);
+  EXPECT_NEAR(response.velocity_b.x, -2.0 / 7.0 * j / 12.0, tolerance);
+  EXPECT_NEAR(response.velocity_b.y, -3.0 / 7.0 * j / 12.0, tolerance);
+  EXPECT_NEAR(response.velocity_b.z, -6.0 / 7.0 * j / 12.0, tolerance);
+  EXPECT_NEAR(response.velocity_a.z, -6.0 + 6.0 / 7.0 * j, 8 * tolerance);
+  EXPECT_NEAR(response.angular_velocity_b.x, -3.0 / 182.0 * j, tolerance);
+  EXPECT_NEAR(response.angular_velocity_b.y, 0.0, tolerance);
+  EXPECT_NEAR(response.angular_velocity_b.z, 1.0 / 70.0 * j, tolerance);
+  EXPECT_NEAR(response.angular_velocity_a.x, 0.0, 64 * tolerance);  // its lever arm along n
+  const double lost = 0.5 * 0.75 * 49.0 / (41579.0 / 38220.0);
+  EXPECT_NEAR(response.energy_lost, lost, tolerance * lost);
+  EXPECT_TRUE(response.approaching);
+  EXPECT_NE(response.message.find("contact found from the shapes, touching"), std::string::npos)
+      << response.message;
+}
+
 // Kane and Levinson's rod over ROS (test/exact/rigid_impact.py; ShapedCollision.ARodOnItsEnd...
 // in the core): a 1 kg box of edges (0.2, 2, 0.2) m turned by theta about z (sin 5/13), struck
 // at its lower end's centre (5/13, -12/13, 0), given, by an immovable box floor (normal y),
@@ -321,7 +376,11 @@ TEST_F(Services, BadShapedBodiesNameTheFieldAndTheNodeKeepsServing) {
   request = ballOnABoxCorner();
   request.a.shape = "cylinder";
   request.a.length = 1.0;
-  request.a.orientation.w = 1.0;  // two shaped bodies, no contact point given
+  request.a.orientation.w = 1.0;  // its cap over the box's top face: they meet flat, no one point
+  expectRefused(request, "contact_point_given");
+
+  request = boxOnABoxCorner();
+  request.a.position.z = 1.5;  // the striker's centre 3/4 m inside the box: they overlap
   expectRefused(request, "contact_point_given");
 
   request = seedRequest();
