@@ -252,6 +252,37 @@ TEST(ShapedPrediction, TumblingThrowsNeverGoInsideNorGainEnergy) {
   EXPECT_GE(impacts, 30);
 }
 
+// A box dropped flat 1 cm onto the floor (e = 0.5) while drifting at u = 1e-5 m/s towards a
+// wall 0.06 u away: its four corners strike the floor at sqrt(2 (0.01) / g), and in the flight
+// after it the face touches the wall at 0.06 s, approaching too slowly to bounce (lift u^2 / 2
+// below 1e-6 of its reach times g): the prediction ends there, saying its contact with the wall
+// would last. Before, the floor's points were looked at again from the floor's impact, where they
+// still touched it, and the wall's from its graze: found again at once, each in turn, for ever
+// (the CPU budget of 2 s ran out at +0.045 s, the floor's instant).
+TEST(ShapedPrediction, AGrazeAfterAnImpactDoesNotFindTheImpactAgainForEver) {
+  const V half(0.05, 0.05, 0.05);
+  Scene scene = floorScene(0.5, half);
+  scene.obstacles.push_back(plane("wall", V(-1, 0, 0), -0.1, "concrete"));
+  const double u = 1e-5, touch = 0.06;
+  auto request = dropped(scene, V(0.1 - half.x() - u * touch, 0, half.z() + 0.01),
+                         Eigen::Quaterniond::Identity(), 0.2, 100);
+  request.state.velocity = V(u, 0, 0);
+  PredictionBudget budget;
+  budget.seconds = 2.0;
+  const auto prediction = predictImpacts(scene, nullptr, MonitorSettings{}, request, budget);
+  ASSERT_TRUE(prediction.ok()) << prediction.error().message();
+  EXPECT_FALSE(prediction->out_of_budget) << prediction->message;
+  ASSERT_EQ(prediction->impacts.size(), 4u) << prediction->message;
+  for (const ImpactRecord& impact : prediction->impacts) {
+    EXPECT_NEAR(impact.time, std::sqrt(2 * 0.01 / kG), 1e-11);
+    EXPECT_EQ(prediction->model->obstacle(impact.other).id, "floor");
+  }
+  EXPECT_NE(prediction->message.find("lasting contact with 'wall'"), std::string::npos)
+      << prediction->message;
+  EXPECT_NEAR(prediction->final_state.time, touch, 1e-8);
+  EXPECT_NEAR(prediction->final_state.position.x() + half.x(), 0.1, 1e-12);
+}
+
 TEST(ShapedPrediction, ABoxRestingOnTheFloorIsSaidToLastNotPredicted) {
   const V half(0.05, 0.05, 0.05);
   const Scene scene = floorScene(0.5, half);

@@ -101,7 +101,8 @@ namespace {
 
 /// A contact of the body with one obstacle at an instant.
 struct ObstacleContact {
-  std::size_t obstacle = 0;
+  std::size_t obstacle = 0;  ///< the model's index
+  std::size_t slot = 0;      ///< in the run's placed obstacles
   TumblingContact contact;
 };
 
@@ -120,7 +121,7 @@ class ShapedRun {
   Expected<Prediction> run(std::vector<std::string>& cut) {
     limits(cut);
     for (std::size_t o = 0; o < model_.obstacleCount(); ++o) {
-      if (auto placed = model_.obstaclePose(o)) obstacles_.emplace_back(o, *placed);
+      if (auto placed = model_.obstaclePose(o)) obstacles_.push_back({o, *placed});
     }
     const Eigen::Vector3d acceleration =
         scene_.effects.gravity ? scene_.gravity : Eigen::Vector3d::Zero();
@@ -130,8 +131,6 @@ class ShapedRun {
     Eigen::Vector3d angular_velocity = request_.state.angular_velocity;
     Eigen::Quaterniond orientation =
         request_.state.orientation.normalized() * principal_.body_from_principal;
-    double search_from = 0.0;          // no contact before it (after an impact: its separation)
-    std::vector<std::size_t> leaving;  // the obstacles the last impact left
     for (bool first = true;; first = false) {
       auto created = TumblingBody::create(principal_.shape, principal_.moments, time, centre,
                                           velocity, acceleration, orientation, angular_velocity);
@@ -148,7 +147,7 @@ class ShapedRun {
         prediction_.out_of_budget = true;
         return finish(body, time);
       }
-      const std::vector<ObstacleContact> contacts = firstContacts(body, time, search_from, leaving);
+      const std::vector<ObstacleContact> contacts = firstContacts(body);
       const double until = contacts.empty() ? horizon_ : contacts.front().contact.time;
       flightUntil(body, time, until);
       if (contacts.empty()) return finish(body, horizon_);
@@ -160,15 +159,17 @@ class ShapedRun {
       if (!*resolved) {
         // Touching without approaching: parting, or a contact that lasts. Found again where
         // the body was last known apart from it (a slow graze, a roll on a rim), it lasts.
-        const bool again = !leaving.empty() && at == search_from;
-        leaving.clear();
-        for (const ObstacleContact& c : contacts) leaving.push_back(c.obstacle);
-        const auto apart = again ? std::nullopt : separation(body, at, leaving);
+        bool again = false;
+        for (const ObstacleContact& c : contacts) {
+          const Watched& w = obstacles_[c.slot];
+          again = again || (w.parted && at == w.clear_from);
+        }
+        const auto apart = again ? std::nullopt : separation(body, at, contacts);
         if (!apart) {
           cut.push_back(lastingContact(contacts, at));
           return finish(body, at);
         }
-        search_from = *apart;
+        clearUntil(at, contacts, *apart);
         continue;
       }
       time = at;
@@ -187,14 +188,12 @@ class ShapedRun {
       auto after = TumblingBody::create(principal_.shape, principal_.moments, time, centre,
                                         velocity, acceleration, orientation, angular_velocity);
       if (!after) return after.error();
-      leaving.clear();
-      for (const ObstacleContact& c : contacts) leaving.push_back(c.obstacle);
-      const auto apart = separation(*after, time, leaving);
+      const auto apart = separation(*after, time, contacts);
       if (!apart) {
         cut.push_back(lastingContact(contacts, at));
         return finish(*after, time);
       }
-      search_from = *apart;
+      clearUntil(at, contacts, *apart);
     }
   }
 
@@ -224,10 +223,10 @@ class ShapedRun {
   }
 
   Status checkStartsOutside(const TumblingBody& body) const {
-    for (const auto& [o, placed] : obstacles_) {
-      const SurfaceGap gap = gapAt(body, placed, 0.0);
+    for (const Watched& w : obstacles_) {
+      const SurfaceGap gap = gapAt(body, w.placed, 0.0);
       if (gap.overlapping || gap.gap_upper < 0) {
-        return Error{"body.position", "is inside obstacle '" + model_.obstacle(o).id +
+        return Error{"body.position", "is inside obstacle '" + model_.obstacle(w.obstacle).id +
                                           "' (a prediction starts in free space)"};
       }
     }
@@ -245,22 +244,21 @@ class ShapedRun {
     return state;
   }
 
-  /// The earliest contacts from `from` (every obstacle touching then, within the instant's
-  /// rounding); none within the horizon: empty. The obstacles in `leaving` from `search_from`.
-  std::vector<ObstacleContact> firstContacts(const TumblingBody& body, double from,
-                                             double search_from,
-                                             const std::vector<std::size_t>& leaving) const {
+  /// The earliest contacts (every obstacle touching then, within the instant's rounding), each
+  /// obstacle searched from the instant it is known apart until (Watched::clear_from); none
+  /// within the horizon: empty.
+  std::vector<ObstacleContact> firstContacts(const TumblingBody& body) const {
     std::vector<ObstacleContact> found;
-    for (const auto& [o, placed] : obstacles_) {
-      const bool left = std::find(leaving.begin(), leaving.end(), o) != leaving.end();
-      const double start = left ? search_from : from;
+    for (std::size_t slot = 0; slot < obstacles_.size(); ++slot) {
+      const PlacedShape& placed = obstacles_[slot].placed;
+      const double start = obstacles_[slot].clear_from;
       if (!(start < horizon_)) continue;
       // The advancement's step budget may run out on a slow graze before the horizon: it goes
       // on from where it is known apart.
       for (double clear = start;;) {
         const FirstContactResult result = firstContact(body, placed, clear, horizon_ - clear);
         if (result.contact) {
-          found.push_back({o, *result.contact});
+          found.push_back({obstacles_[slot].obstacle, slot, *result.contact});
           break;
         }
         if (!(result.clear_until > clear && result.clear_until < horizon_)) break;
@@ -322,11 +320,21 @@ class ShapedRun {
     return solver;
   }
 
-  const PlacedShape& placedOf(std::size_t obstacle) const {
-    for (const auto& [o, placed] : obstacles_) {
-      if (o == obstacle) return placed;
+  /// After an impact or a graze at `time` with `contacts`' obstacles, apart from them at
+  /// `apart`: those are looked at again from `apart`, every other one from `time` (no contact
+  /// with it before: the contacts were the earliest), never from an earlier instant than it
+  /// was known apart until. Each obstacle keeps its own instant: one struck before a graze of
+  /// another is not looked at again from that impact's instant, where its points still touch
+  /// it and would be found again at once, for ever.
+  void clearUntil(double time, const std::vector<ObstacleContact>& contacts, double apart) {
+    for (Watched& w : obstacles_) {
+      w.clear_from = std::max(w.clear_from, time);
+      w.parted = false;
     }
-    return obstacles_.front().second;  // not reached: contacts name placed obstacles
+    for (const ObstacleContact& c : contacts) {
+      obstacles_[c.slot].clear_from = apart;
+      obstacles_[c.slot].parted = true;
+    }
   }
 
   /// Resolves the impact at `time` of `moving` (updated) with the contacts' points: one point
@@ -339,7 +347,7 @@ class ShapedRun {
     std::vector<std::size_t> point_obstacle;
     double fastest = 0.0;
     for (const ObstacleContact& c : contacts) {
-      const PlacedShape& placed = placedOf(c.obstacle);
+      const PlacedShape& placed = obstacles_[c.slot].placed;
       bodies.push_back(obstacleBody(placed, time));
       const auto restitution = restitutionWith(c.obstacle);
       if (!restitution) return restitution.error();
@@ -452,11 +460,11 @@ class ShapedRun {
   /// slowly to part: plastic, or bounces that accumulate), or where nothing moves at all, the
   /// contact lasts: empty.
   std::optional<double> separation(const TumblingBody& body, double time,
-                                   const std::vector<std::size_t>& left) const {
+                                   const std::vector<ObstacleContact>& left) const {
     double speed = body.velocityAt(time).norm() + body.angularSpeedBound() * body.reach();
     double acceleration = body.acceleration().norm();
-    for (const std::size_t o : left) {
-      const PlacedShape now = shapeAt(placedOf(o), time);
+    for (const ObstacleContact& c : left) {
+      const PlacedShape now = shapeAt(obstacles_[c.slot].placed, time);
       const double turning = now.pose.angular_velocity.norm();
       const double arm =
           (body.positionAt(time) - now.pose.transform.translation()).norm() + body.reach();
@@ -469,8 +477,8 @@ class ShapedRun {
                                  4 * std::numeric_limits<double>::epsilon() * std::abs(time));
     const double apart = time + step;
     if (!(apart < horizon_)) return apart;
-    for (const std::size_t o : left) {
-      const SurfaceGap gap = gapAt(body, placedOf(o), apart);
+    for (const ObstacleContact& c : left) {
+      const SurfaceGap gap = gapAt(body, obstacles_[c.slot].placed, apart);
       if (gap.overlapping || !(gap.gap > 0)) return std::nullopt;
     }
     return apart;
@@ -513,7 +521,15 @@ class ShapedRun {
   double began_ = 0.0;
   const ImpactMonitor& model_;
   PrincipalBody principal_;
-  std::vector<std::pair<std::size_t, PlacedShape>> obstacles_;
+  /// An obstacle placed, and from when it is looked at: no contact with it before clear_from;
+  /// parted: clear_from is where the body was found apart from it after touching it.
+  struct Watched {
+    std::size_t obstacle = 0;
+    PlacedShape placed;
+    double clear_from = 0.0;
+    bool parted = false;
+  };
+  std::vector<Watched> obstacles_;
   Prediction prediction_;
   double horizon_ = 0.0, period_ = 0.0;
   std::size_t max_impacts_ = 0;
