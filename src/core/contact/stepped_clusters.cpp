@@ -60,7 +60,7 @@ std::vector<Pair> nearPairs(const World& world, double time, double span,
     centres[i] = centre;
     const double half = world.radius[i] * (1 + 2 * world.settings.contact_tolerance) + reach[i] +
                         64 * kEps * centre.lpNorm<Eigen::Infinity>();
-    boxes[i] = Box{centre.array() - half, centre.array() + half};
+    boxes[i] = Box::about(centre, half);
   }
   SpatialHash hash;
   hash.build(boxes, active);
@@ -682,14 +682,14 @@ Box nearObstacleBox(const World& world, std::size_t o, double time, double movin
   const double travel = placed.pose.velocity.norm() * std::abs(time - placed.pose.time);
   double half = bounding * (1 + world.settings.contact_tolerance) + travel + moving;
   half += 1e-9 * (origin.lpNorm<Eigen::Infinity>() + bounding + travel + moving);
-  return Box{origin.array() - half, origin.array() + half};
+  return Box::about(origin, half);
 }
 
 // The ball's side of nearObstacleBox.
 Box nearBodyBox(const World& world, double radius, const Eigen::Vector3d& centre, double reach) {
   double half = radius * (1 + world.settings.contact_tolerance) + reach;
   half += 1e-9 * (centre.lpNorm<Eigen::Infinity>() + radius + reach);
-  return Box{centre.array() - half, centre.array() + half};
+  return Box::about(centre, half);
 }
 
 double nextSteppedEvent(const World& world, double time) {
@@ -778,7 +778,7 @@ void joinStepped(World& world, double time, const std::vector<std::size_t>& move
     const double reach = reachBefore(world, body, time, span);
     const Eigen::Vector3d centre = positionAt<Motion>(world, body, time);
     const double half = world.radius[body] * (1 + 2 * world.settings.contact_tolerance) + reach;
-    const Box box{centre.array() - half, centre.array() + half};
+    const Box box = Box::about(centre, half);
     for (std::size_t c = 0; c < stepping.clusters.size(); ++c) {
       if (!cluster_boxes[c].overlaps(box)) continue;
       for (const std::size_t other : stepping.clusters[c].bodies) {

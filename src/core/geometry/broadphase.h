@@ -12,6 +12,11 @@ namespace collision_response::core {
 struct Box {
   Eigen::Vector3d low = Eigen::Vector3d::Zero();
   Eigen::Vector3d high = Eigen::Vector3d::Zero();
+  /// The cube of half-width `half` about `centre`: a sphere's box (its radius), a shape's
+  /// bounding sphere's (its reach), a ball's grown by how far it may move.
+  static Box about(const Eigen::Vector3d& centre, double half) {
+    return Box{centre.array() - half, centre.array() + half};
+  }
   bool overlaps(const Box& other) const {
     return (low.array() <= other.high.array()).all() && (other.low.array() <= high.array()).all();
   }

@@ -552,27 +552,23 @@ ContactGeometry finiteGeometry(const Eigen::Vector3d& centre, double radius, con
 }
 
 bool mayReach(const PlacedShape& placed, const Box& box) {
-  return std::visit(Dispatch{[&](const Plane& plane) {
-                               // The box's lowest point along the normal: does it reach the plane?
-                               const Eigen::Vector3d centre = 0.5 * (box.low + box.high);
-                               const Eigen::Vector3d half = 0.5 * (box.high - box.low);
-                               return plane.normal.dot(centre) -
-                                          plane.normal.cwiseAbs().dot(half) <=
-                                      plane.offset;
-                             },
-                             [&](const Sphere& sphere) {
-                               const Box post{sphere.centre.array() - sphere.radius,
-                                              sphere.centre.array() + sphere.radius};
-                               return post.overlaps(box);
-                             },
-                             [&](const auto& finite) {
-                               // Its bounding sphere's box.
-                               const Eigen::Vector3d& centre = placed.pose.transform.translation();
-                               const double reach = boundingRadius(finite);
-                               const Box bound{centre.array() - reach, centre.array() + reach};
-                               return bound.overlaps(box);
-                             }},
-                    placed.shape);
+  return std::visit(
+      Dispatch{[&](const Plane& plane) {
+                 // The box's lowest point along the normal: does it reach the plane?
+                 const Eigen::Vector3d centre = 0.5 * (box.low + box.high);
+                 const Eigen::Vector3d half = 0.5 * (box.high - box.low);
+                 return plane.normal.dot(centre) - plane.normal.cwiseAbs().dot(half) <=
+                        plane.offset;
+               },
+               [&](const Sphere& sphere) {
+                 return Box::about(sphere.centre, sphere.radius).overlaps(box);
+               },
+               [&](const auto& finite) {
+                 // Its bounding sphere's box.
+                 return Box::about(placed.pose.transform.translation(), boundingRadius(finite))
+                     .overlaps(box);
+               }},
+      placed.shape);
 }
 
 double boundingRadiusOf(const Shape& shape) {
@@ -587,11 +583,13 @@ bool mayReachMoving(const PlacedShape& placed, const Box& box, double from, doub
   if (pose.velocity.isZero() && pose.angular_velocity.isZero()) return mayReach(placed, box);
   if (std::holds_alternative<Plane>(placed.shape)) return true;
   // The pose's origin is the shape's centre (a sphere's too) and moves at |v| (shapeAt).
-  const double reach =
-      boundingRadiusOf(placed.shape) +
-      pose.velocity.norm() * std::max(std::abs(from - pose.time), std::abs(to - pose.time));
-  const Eigen::Vector3d& centre = pose.transform.translation();
-  return Box{centre.array() - reach, centre.array() + reach}.overlaps(box);
+  return Box::about(pose.transform.translation(), reachOver(placed, from, to)).overlaps(box);
+}
+
+double reachOver(const PlacedShape& placed, double from, double to) {
+  const RigidPose& pose = placed.pose;
+  return boundingRadiusOf(placed.shape) +
+         pose.velocity.norm() * std::max(std::abs(from - pose.time), std::abs(to - pose.time));
 }
 
 double contactRadius(const Shape& shape) {

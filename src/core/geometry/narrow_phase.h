@@ -315,6 +315,11 @@ bool mayReach(const PlacedShape& placed, const Box& box);
 /// the longest time from the placement bounds it; a moving plane always may.
 bool mayReachMoving(const PlacedShape& placed, const Box& box, double from, double to);
 
+/// m: how far from its pose's origin at its placement a moving shape's points may be over
+/// [from, to]: its bounding radius (boundingRadiusOf) grown by |v| times the longest time from the
+/// placement (the origin moves at |v|: shapeAt). Infinite for a plane.
+double reachOver(const PlacedShape& placed, double from, double to);
+
 /// m: the size of a shape about its pose's origin that a ball's contact distance counts (a
 /// sphere's radius; 0 for a plane, whose distance is along its normal, and for a finite shape,
 /// whose distance is from the nearest point of its surface).

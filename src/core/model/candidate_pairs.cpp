@@ -6,6 +6,7 @@
 #include <utility>
 #include <variant>
 
+#include "geometry/narrow_phase.h"
 #include "model/motion_model.h"
 
 namespace collision_response::core::monitor {
@@ -48,14 +49,12 @@ Box obstacleReachBound(const World& world, std::size_t obstacle, double from, do
   const bool moves =
       !spec.frame.empty() && !(pose.velocity.isZero() && pose.angular_velocity.isZero());
   Eigen::Vector3d centre = pose.transform.translation();
-  double reach = boundingRadiusOf(placed.shape);
-  if (moves) {
-    reach += pose.velocity.norm() * std::max(std::abs(from - pose.time), std::abs(to - pose.time));
-  } else if (const Sphere* sphere = std::get_if<Sphere>(&placed.shape)) {
+  double reach = moves ? reachOver(placed, from, to) : boundingRadiusOf(placed.shape);
+  if (const Sphere* sphere = std::get_if<Sphere>(&placed.shape); sphere && !moves) {
     centre = sphere->centre;
   }
   reach += 1e-9 * (centre.lpNorm<Eigen::Infinity>() + reach);
-  return Box{centre.array() - reach, centre.array() + reach};
+  return Box::about(centre, reach);
 }
 
 void ObstacleIndex::build(std::vector<Box> bounds, const std::vector<char>& entered, double from,
