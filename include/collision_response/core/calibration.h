@@ -72,7 +72,9 @@ struct Estimate {
 /// What a bounce says of friction. The ratio |tangential impulse| / normal impulse is always a
 /// lower bound of Coulomb's mu; it is mu itself only when the contact slid throughout.
 enum class FrictionReading {
-  kSliding,          ///< the contact point still slid after the bounce: mu = the ratio
+  /// The contact point still slid after the bounce (its slip after 4 standard errors above 0,
+  /// not 1.96: a stuck bounce read as sliding would give a wrong mu): mu = the ratio.
+  kSliding,
   kStoppedSlipping,  ///< the slip stopped (stuck, or rolling): only mu >= the ratio
   kSpinUnknown,      ///< no spin before the bounce known: only mu >= the ratio
   kNoSlip,           ///< the contact did not slide before it: nothing about mu

@@ -719,6 +719,13 @@ class BounceQuantities {
   double spin_factor_;
 };
 
+/// Standard errors the slip after must lie above 0 for a bounce to read kSliding. A stuck bounce
+/// read as sliding gives a wrong mu (its ratio, below mu, joins the sliding bounces' mean and
+/// pulls it down), where a sliding one read as stuck gives only a weaker, true, lower bound: the
+/// test is one-sided at 4 (a stuck contact passes it 3e-5 of the time), not at the intervals'
+/// 1.96 (2.5 %: Calibration.AStuckBounceIsNotReadAsSliding).
+constexpr double kSlidingStandardErrors = 4.0;
+
 /// How a bounce's friction reads, from its slip before and after (calibration.h).
 FrictionReading frictionReading(bool spin_known, const Estimate& slip_before,
                                 const Estimate& slip_after, const Estimate& approach_speed) {
@@ -727,7 +734,9 @@ FrictionReading frictionReading(bool spin_known, const Estimate& slip_before,
     // No slip, or one within the rounding of a track without noise (a vertical drop played).
     return FrictionReading::kNoSlip;
   }
-  if (slip_after.low() > 0.0) return FrictionReading::kSliding;
+  if (slip_after.value > kSlidingStandardErrors * slip_after.standard_error) {
+    return FrictionReading::kSliding;
+  }
   return FrictionReading::kStoppedSlipping;
 }
 
