@@ -26,10 +26,13 @@ run_shard() {
   local test=$1 shard=$2 name="$1-$2"
   # The random throws at the finite shapes (core_tests) 2,000 a shape here rather than 20,000:
   # every path of the code runs, in a tenth of the time the sanitizers make it take. The random
-  # rigid impacts likewise: 10^5 here, 10^6 in the main build.
+  # rigid impacts likewise: 10^5 here, 10^6 in the main build; and a tumbling body's contacts and
+  # a shaped body's throws 2 and 1 a pair here against 6 and 2 there.
   (cd "$repo/test" && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
     FINITE_SHAPE_THROWS="${FINITE_SHAPE_THROWS:-2000}" GTEST_TOTAL_SHARDS=2 GTEST_SHARD_INDEX="$shard" \
     COLLISION_RESPONSE_RANDOM_IMPACTS="${COLLISION_RESPONSE_RANDOM_IMPACTS:-100000}" \
+    COLLISION_RESPONSE_TUMBLING_FUZZ="${COLLISION_RESPONSE_TUMBLING_FUZZ:-2}" \
+    COLLISION_RESPONSE_SHAPED_THROWS="${COLLISION_RESPONSE_SHAPED_THROWS:-1}" \
     "$sanitized/devel/lib/collision_response/$test" --gtest_filter="${filters[$test]}" \
     --gtest_output="xml:$results/sanitized-$name.xml") >"$sanitized/$name.log" 2>&1 || {
     tail -30 "$sanitized/$name.log"
