@@ -44,6 +44,14 @@ struct CalibrationOptions {
   double drag_coefficient = 0.47;
   /// With `drag`: fit C_d as well (one more parameter).
   bool fit_drag = false;
+  /// Flights with the Magnus force (the scene's `magnus` effect), integrated by AirFlight as drag
+  /// is: its factor rho C_L A / (2 m) from air_density, radius, mass and `lift_coefficient`; the
+  /// spin in flight spin_before (required) over the first flight, turned at each bounce by its
+  /// tangential impulse (BounceEstimate::spin_change).
+  bool magnus = false;
+  double lift_coefficient = 0.2;
+  /// With `magnus`: fit C_L as well (one more parameter).
+  bool fit_lift = false;
   double flight_integration_tolerance = 1e-11;
   /// The spin before the first bounce when the samples carry none (a ball dropped without spin:
   /// zero). Without either, friction gives only a lower bound (whether the contact slid cannot
@@ -143,6 +151,7 @@ struct Calibration {
   Eigen::MatrixXd friction_ratio_covariance;
   Estimate gravity[3];  ///< m/s^2, the fitted gravity (or the given one, standard error 0)
   std::optional<Estimate> drag_coefficient;  ///< C_d when fitted
+  std::optional<Estimate> lift_coefficient;  ///< C_L when fitted
   /// m: the tracker's noise, the root mean square residual of each coordinate (sqrt(RSS / dof)).
   double noise = 0.0;
   std::size_t samples_used = 0;
@@ -176,6 +185,7 @@ struct BodyCalibration {
   Inertia inertia = Inertia::kSolid;
   double mass = 1.0;  ///< kg
   double drag_coefficient = 0.47;
+  double lift_coefficient = 0.2;
 };
 BodyCalibration bodyCalibration(const BodySpec& body);
 

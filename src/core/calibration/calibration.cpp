@@ -36,23 +36,40 @@ RecordingError problem(RecordingProblem kind, std::string field, std::string rea
 }
 
 /// Where the parameters are: the state at the first sample (position, velocity), each bounce's
-/// velocity after, then gravity and the drag factor when they are fitted.
+/// velocity after, then gravity, C_d and C_L when they are fitted.
 struct Layout {
   std::size_t bounces = 0;
   bool gravity = false;
   bool drag = false;
+  bool lift = false;
   std::size_t gravityAt() const { return 6 + 3 * bounces; }
   std::size_t dragAt() const { return gravityAt() + (gravity ? 3 : 0); }
-  std::size_t size() const { return dragAt() + (drag ? 1 : 0); }
+  std::size_t liftAt() const { return dragAt() + (drag ? 1 : 0); }
+  std::size_t size() const { return liftAt() + (lift ? 1 : 0); }
 };
 
-/// One flight of a candidate motion: its start and state there, and with drag its integration.
+Layout layoutOf(std::size_t bounces, const CalibrationOptions& options) {
+  return Layout{bounces, options.fit_gravity, options.drag && options.fit_drag,
+                options.magnus && options.fit_lift};
+}
+
+/// One flight of a candidate motion: its start and state there, and through air (drag, Magnus)
+/// its integration.
 struct Piece {
   double start = 0.0;
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
   std::shared_ptr<AirFlight> air;
 };
+
+/// The turn a ball's tangential change of velocity dv_t at a bounce off the plane of normal n
+/// gives its spin: the impulse J_t = m dv_t at r = -R n from the centre, dw = (r x J_t) / I with
+/// I = k m R^2, -(1 / (k R)) n x dv_t (calibration.h; 1/k friction.h's spinFactor). 0 for R = 0.
+Eigen::Vector3d spinChange(const Eigen::Vector3d& n, const Eigen::Vector3d& tangential_change,
+                           double radius, Inertia inertia) {
+  if (!(radius > 0.0)) return Eigen::Vector3d::Zero();
+  return -(spinFactor(1.0, radius, inertia) / radius) * n.cross(tangential_change);
+}
 
 double height(const Plane& plane, double radius, const Eigen::Vector3d& position) {
   return plane.normal.dot(position) - plane.offset - radius;
@@ -75,22 +92,32 @@ class Motion {
     pieces_.clear();
     gravity_ = layout_.gravity ? Eigen::Vector3d(parameters.segment<3>(layout_.gravityAt()))
                                : options_.gravity;
-    if (options_.drag) {
-      const double coefficient = layout_.drag
-                                     ? parameters[static_cast<Eigen::Index>(layout_.dragAt())]
-                                     : options_.drag_coefficient;
-      if (!(coefficient >= 0.0)) return false;
-      air_ =
-          airFactors(options_.air_density, options_.radius, 1.0 / options_.mass, coefficient, 0.0);
+    if (air()) {
+      const double drag = !options_.drag ? 0.0
+                          : layout_.drag ? parameters[static_cast<Eigen::Index>(layout_.dragAt())]
+                                         : options_.drag_coefficient;
+      const double lift = !options_.magnus ? 0.0
+                          : layout_.lift   ? parameters[static_cast<Eigen::Index>(layout_.liftAt())]
+                                           : options_.lift_coefficient;
+      if (!(drag >= 0.0) || !std::isfinite(lift)) return false;
+      air_ = airFactors(options_.air_density, options_.radius, 1.0 / options_.mass, drag, lift);
     }
-    pieces_.push_back(makePiece(start_, parameters.segment<3>(0), parameters.segment<3>(3)));
+    // The spin in flight (Magnus): spin_before over the first flight (checkOptions), then turned
+    // at each bounce by its tangential impulse, as BounceQuantities carries it.
+    Eigen::Vector3d spin = options_.magnus ? *options_.spin_before : Eigen::Vector3d::Zero();
+    pieces_.push_back(makePiece(start_, parameters.segment<3>(0), parameters.segment<3>(3), spin));
     for (std::size_t j = 0; j < layout_.bounces; ++j) {
       const Plane& plane = options_.planes[bounce_planes_[j]];
       const auto meeting = nextMeeting(pieces_.back(), plane);
       if (!meeting) return false;
       const Eigen::Vector3d point = position(pieces_.back(), *meeting);
-      pieces_.push_back(
-          makePiece(*meeting, point, parameters.segment<3>(static_cast<Eigen::Index>(6 + 3 * j))));
+      const Eigen::Vector3d after = parameters.segment<3>(static_cast<Eigen::Index>(6 + 3 * j));
+      if (options_.magnus) {
+        const Eigen::Vector3d change = after - velocity(pieces_.back(), *meeting);
+        spin += spinChange(plane.normal, change - change.dot(plane.normal) * plane.normal,
+                           options_.radius, options_.inertia);
+      }
+      pieces_.push_back(makePiece(*meeting, point, after, spin));
     }
     return true;
   }
@@ -108,12 +135,13 @@ class Motion {
   const Eigen::Vector3d& gravity() const { return gravity_; }
 
  private:
-  Piece makePiece(double start, const Eigen::Vector3d& position, const Eigen::Vector3d& velocity) {
+  bool air() const { return options_.drag || options_.magnus; }
+  Piece makePiece(double start, const Eigen::Vector3d& position, const Eigen::Vector3d& velocity,
+                  const Eigen::Vector3d& spin) {
     Piece piece{start, position, velocity, nullptr};
-    if (options_.drag) {
-      piece.air =
-          std::make_shared<AirFlight>(start, position, velocity, Eigen::Vector3d::Zero(), gravity_,
-                                      air_, options_.flight_integration_tolerance);
+    if (air()) {
+      piece.air = std::make_shared<AirFlight>(start, position, velocity, spin, gravity_, air_,
+                                              options_.flight_integration_tolerance);
     }
     return piece;
   }
@@ -418,7 +446,7 @@ std::optional<RecordingError> checkOptions(const CalibrationOptions& options, bo
   if (!options.gravity.allFinite()) {
     return problem(RecordingProblem::kBadValue, "gravity", "must be finite");
   }
-  if (options.drag) {
+  if (options.drag || options.magnus) {
     if (!(options.air_density > 0.0) || !std::isfinite(options.air_density)) {
       return problem(RecordingProblem::kBadValue, "air_density", "must be finite and > 0");
     }
@@ -426,10 +454,20 @@ std::optional<RecordingError> checkOptions(const CalibrationOptions& options, bo
       return problem(RecordingProblem::kBadValue, "mass", "must be finite and > 0");
     }
     if (!(options.radius > 0.0)) {
-      return problem(RecordingProblem::kBadValue, "radius", "must be > 0 with drag");
+      return problem(RecordingProblem::kBadValue, "radius", "must be > 0 with drag or magnus");
     }
     if (!(options.drag_coefficient >= 0.0) || !std::isfinite(options.drag_coefficient)) {
       return problem(RecordingProblem::kBadValue, "drag_coefficient", "must be finite and >= 0");
+    }
+  }
+  if (options.magnus) {
+    if (!(options.lift_coefficient >= 0.0) || !std::isfinite(options.lift_coefficient)) {
+      return problem(RecordingProblem::kBadValue, "lift_coefficient", "must be finite and >= 0");
+    }
+    if (!options.spin_before) {
+      return problem(RecordingProblem::kBadValue, "spin_before",
+                     "magnus flies the spin: give the spin before the first bounce (the "
+                     "tracker's spin is not flown)");
     }
   }
   if (!(options.min_bounce_speed > 0.0) || !std::isfinite(options.min_bounce_speed)) {
@@ -612,6 +650,7 @@ Eigen::VectorXd startOfTheFit(const std::vector<TrackedSample>& samples, const F
   if (layout.gravity)
     start.segment<3>(static_cast<Eigen::Index>(layout.gravityAt())) = options.gravity;
   if (layout.drag) start[static_cast<Eigen::Index>(layout.dragAt())] = options.drag_coefficient;
+  if (layout.lift) start[static_cast<Eigen::Index>(layout.liftAt())] = options.lift_coefficient;
   return start;
 }
 
@@ -653,7 +692,8 @@ class BounceQuantities {
   bool operator()(const Eigen::VectorXd& p, Eigen::VectorXd& out) const {
     if (!motion_.build(p)) return false;
     const std::size_t bounces = layout_.bounces;
-    out.resize(static_cast<Eigen::Index>(kPerBounce * bounces + (layout_.drag ? 1 : 0)));
+    out.resize(static_cast<Eigen::Index>(kPerBounce * bounces + (layout_.drag ? 1 : 0) +
+                                         (layout_.lift ? 1 : 0)));
     // A flag beside a vector, not an optional: GCC takes the optional's vector for uninitialised.
     bool spin_known = options_.spin_before.has_value();
     Eigen::Vector3d spin = options_.spin_before.value_or(Eigen::Vector3d::Zero());
@@ -667,12 +707,8 @@ class BounceQuantities {
         spin = *measured_spin_[j];
         spin_known = true;
       }
-      // The turn of the tangential impulse J_t = m dv_t at the contact point r = -R n from the
-      // centre: dw = (r x J_t) / I with I = k m R^2, -(1 / (k R)) n x dv_t (calibration.h).
       const Eigen::Vector3d spin_change =
-          options_.radius > 0.0
-              ? Eigen::Vector3d(-(spin_factor_ / options_.radius) * n.cross(tangential_change))
-              : Eigen::Vector3d::Zero();
+          spinChange(n, tangential_change, options_.radius, options_.inertia);
       double slip_before = 0.0;
       double slip_after = 0.0;
       if (spin_known) {
@@ -696,7 +732,9 @@ class BounceQuantities {
       out.segment<3>(row + kSpinChangeAt) = spin_change;
       out.segment<3>(row + kSpinAfterAt) = spin_known ? spin : Eigen::Vector3d::Zero();
     }
-    if (layout_.drag) out[out.size() - 1] = p[static_cast<Eigen::Index>(layout_.dragAt())];
+    Eigen::Index at = kPerBounce * static_cast<Eigen::Index>(bounces);
+    if (layout_.drag) out[at++] = p[static_cast<Eigen::Index>(layout_.dragAt())];
+    if (layout_.lift) out[at] = p[static_cast<Eigen::Index>(layout_.liftAt())];
     return out.allFinite();
   }
 
@@ -881,10 +919,12 @@ Calibration fittedMotion(const Fit& fit, const Layout& layout, const Calibration
       result.gravity[i] = Estimate{options.gravity[i], 0.0};
     }
   }
+  Eigen::Index at = kPerBounce * static_cast<Eigen::Index>(layout.bounces);
   if (layout.drag) {
-    const Eigen::Index at = values.size() - 1;
     result.drag_coefficient = estimate(values[at], covariance(at, at));
+    ++at;
   }
+  if (layout.lift) result.lift_coefficient = estimate(values[at], covariance(at, at));
   return result;
 }
 
@@ -909,7 +949,7 @@ RecordingResult<Calibration> run(const std::vector<TrackedSample>& recorded,
   const auto flights = flightsBetween(found, samples.size());
   if (!flights) return flights.error();
 
-  const Layout layout{bounces, options.fit_gravity, options.drag && options.fit_drag};
+  const Layout layout = layoutOf(bounces, options);
   std::vector<std::size_t> planes;
   for (const auto& bounce : found) planes.push_back(bounce.plane);
   const double origin = samples.front().time;
@@ -1078,7 +1118,8 @@ Expected<SceneCalibration> sceneCalibration(const Scene& scene) {
 }
 
 BodyCalibration bodyCalibration(const BodySpec& body) {
-  return BodyCalibration{body.radius, body.inertia, body.mass, body.drag_coefficient};
+  return BodyCalibration{body.radius, body.inertia, body.mass, body.drag_coefficient,
+                         body.lift_coefficient};
 }
 
 CalibrationOptions forBody(CalibrationOptions options, const BodyCalibration& body) {
@@ -1086,12 +1127,13 @@ CalibrationOptions forBody(CalibrationOptions options, const BodyCalibration& bo
   options.inertia = body.inertia;
   options.mass = body.mass;
   options.drag_coefficient = body.drag_coefficient;
+  options.lift_coefficient = body.lift_coefficient;
   return options;
 }
 
 Eigen::Vector3d fittedPosition(const Calibration& calibration, const CalibrationOptions& options,
                                double time) {
-  Layout layout{calibration.bounces.size(), options.fit_gravity, options.drag && options.fit_drag};
+  const Layout layout = layoutOf(calibration.bounces.size(), options);
   std::vector<std::size_t> planes;
   for (const auto& bounce : calibration.bounces) planes.push_back(bounce.plane);
   // The fit's times are from its first sample's (run()).
