@@ -166,6 +166,12 @@ struct TouchingFeature {
   Eigen::Vector3d along = Eigen::Vector3d::Zero();
   double length = 0.0;
   const char* name = "point";
+  /// A corner, an edge or a rim: its surface has no one normal there (a face, a cap, a round
+  /// side or end has).
+  bool sharp = false;
+  /// Unit, world: a sharp curve's direction at the point (an edge's, a rim's tangent); zero at a
+  /// corner.
+  Eigen::Vector3d tangent = Eigen::Vector3d::Zero();
 };
 
 /// The feature of `shape` (turned by `turn`, world from shape) farthest along the unit world
@@ -190,6 +196,8 @@ TouchingFeature touchingFeature(const ConvexShape& shape, const Eigen::Matrix3d&
         segment(turn.col(i), 2 * box->half_size[i], "edge");
       }
     }
+    feature.sharp = flat < 2;
+    if (flat == 1) feature.tangent = feature.along;
     if (flat == 0) feature.name = "corner";
     if (flat >= 2) {
       feature.dimension = 2;
@@ -203,6 +211,9 @@ TouchingFeature touchingFeature(const ConvexShape& shape, const Eigen::Matrix3d&
       segment(turn.col(2), 2 * cylinder->half_length, "side");
     } else {
       feature.name = "rim";
+      feature.sharp = true;
+      // The rim point's radial direction is d's across the axis; its tangent z x that.
+      feature.tangent = turn * Eigen::Vector3d(-d.y(), d.x(), 0.0).normalized();
     }
   } else if (const auto* capsule = std::get_if<Capsule>(&shape)) {
     if (2 * capsule->half_length * std::abs(d.z()) <= band) {
@@ -222,6 +233,17 @@ bool touchAtOnePoint(const TouchingFeature& a, const TouchingFeature& b, double 
     return a.along.cross(b.along).norm() * std::min(a.length, b.length) > band;
   }
   return false;
+}
+
+/// Whether two touching features have one normal: one of them a face or round (a cap, a round
+/// side or end), or two sharp curves that cross (edges or rims: the normal across both
+/// tangents, which part by more than the band over the smaller body's reach). A corner on
+/// anything sharp, or two such curves along each other, has a cone of normals: any plane through
+/// the point between them separates them.
+bool touchWithOneNormal(const TouchingFeature& a, const TouchingFeature& b, double band,
+                        double reach) {
+  if (!a.sharp || !b.sharp) return true;
+  return a.tangent.cross(b.tangent).norm() * reach > band;
 }
 
 /// Where two shaped bodies are nearest: the unit normal a -> b along their closest points, the
@@ -250,7 +272,8 @@ struct ClosestPoints {
 /// not one point.
 Expected<ClosestPoints> closestPointsOfShapes(const CollisionRequest& request,
                                               const std::string& missing, const std::string& unset,
-                                              const std::string& give, bool need_point) {
+                                              const std::string& give, bool need_point,
+                                              bool need_normal) {
   const Body& a = request.a;
   const Body& b = request.b;
   const ConvexShape shape_a = convexShapeOf(a);
@@ -271,7 +294,8 @@ Expected<ClosestPoints> closestPointsOfShapes(const CollisionRequest& request,
       std::string("the ") + toString(a.shape) + " a and the " + toString(b.shape) + " b";
   const ConvexDistance given = distanceMovingB(Eigen::Vector3d::Zero());
   Eigen::Vector3d normal = given.normal;
-  if (given.overlapping || given.upper <= band) {
+  const bool touching = given.overlapping || given.upper <= band;
+  if (touching) {
     const Eigen::Vector3d centres = b.position - a.position;
     if (centres == Eigen::Vector3d::Zero()) {
       return Error{missing, unset + ", but a and b overlap (their centres are both at " +
@@ -312,15 +336,23 @@ Expected<ClosestPoints> closestPointsOfShapes(const CollisionRequest& request,
     if (settled) break;
   }
   closest.normal = normal;
+  const TouchingFeature on_a = touchingFeature(shape_a, turn_a, normal, band);
+  const TouchingFeature on_b = touchingFeature(shape_b, turn_b, -normal, band);
   if (need_point) {
-    const TouchingFeature on_a = touchingFeature(shape_a, turn_a, normal, band);
-    const TouchingFeature on_b = touchingFeature(shape_b, turn_b, -normal, band);
     if (!touchAtOnePoint(on_a, on_b, band)) {
       return Error{missing, unset + ", but the " + on_a.name + " of the " + toString(a.shape) +
                                 " a meets the " + on_b.name + " of the " + toString(b.shape) +
                                 " b flat (within " + formatNumber(band) +
                                 " m): their contact is not one point; give the contact point"};
     }
+  }
+  if (need_normal && touching &&
+      !touchWithOneNormal(on_a, on_b, band, std::min(reach_a, reach_b))) {
+    return Error{"normal", "is zero, but the " + std::string(on_a.name) + " of the " +
+                               toString(a.shape) + " a touches the " + on_b.name + " of the " +
+                               toString(b.shape) +
+                               " b: there the normal is not one direction (any plane between "
+                               "them through the point separates them); give the normal"};
   }
   return closest;
 }
@@ -353,7 +385,7 @@ Expected<RequestContact> contactOfShapes(const CollisionRequest& request) {
           need_point
               ? (given_normal ? "give the contact point" : "give the contact point and the normal")
               : "give the normal",
-          need_point);
+          need_point, !given_normal);
       if (!closest) return closest.error();
       contact.normal = closest->normal;
       if (need_point) {
