@@ -8,9 +8,10 @@
 //   scene FILE     (the scene, the `scene:` mapping of a scene file as an XML-RPC <value>, as
 //                   rosparam gives it to the node: read by the node's loader and the core's
 //                   sceneCalibration, the live fit's reading: its fixed planes, gravity, drag,
-//                   one obstacle pair a plane material)
-//   body ID        (the scene's body whose states these are: its radius, inertia, mass, C_d)
+//                   Magnus, one obstacle pair a plane material)
+//   body ID        (the scene's body whose states these are: its radius, inertia, mass, C_d, C_L)
 //   fit_drag 0|1   (with the scene's drag: fit C_d)
+//   fit_lift 0|1   (with the scene's magnus: fit C_L)
 // or the fit's settings one by one:
 //   radius R | inertia solid|hollow | gravity X Y Z
 //   drag AIR_DENSITY MASS DRAG_COEFFICIENT FIT_DRAG(0|1) | plane NX NY NZ OFFSET (one a plane)
@@ -120,6 +121,8 @@ std::string json(const Calibration& c, const std::vector<std::vector<std::size_t
       << ",\n \"gravity\": [" << estimate(c.gravity[0]) << ", " << estimate(c.gravity[1]) << ", "
       << estimate(c.gravity[2]) << "],\n \"drag_coefficient\": "
       << (c.drag_coefficient ? estimate(*c.drag_coefficient) : std::string("null"))
+      << ",\n \"lift_coefficient\": "
+      << (c.lift_coefficient ? estimate(*c.lift_coefficient) : std::string("null"))
       << ",\n \"all\": " << coefficients(c.all) << ",\n \"per_plane\": [";
   for (std::size_t i = 0; i < c.per_plane.size(); ++i) {
     out << (i ? ",\n  " : "\n  ") << coefficients(c.per_plane[i]);
@@ -187,6 +190,7 @@ struct Input {
   std::string scene_file;  ///< `scene`: the fit's settings from the scene
   std::string body;
   bool fit_drag = false;
+  bool fit_lift = false;
   std::string one_by_one;  ///< the first setting given one by one (refused beside `scene`)
 };
 
@@ -239,6 +243,8 @@ bool read(std::istream& in, Input& input, std::string& error) {
       input.body = text;
     } else if (key == "fit_drag" && count(1)) {
       input.fit_drag = values[0] != 0.0;
+    } else if (key == "fit_lift" && count(1)) {
+      input.fit_lift = values[0] != 0.0;
     } else if (key == "radius" && count(1)) {
       options.radius = values[0];
     } else if (key == "inertia") {
@@ -331,6 +337,11 @@ bool applyScene(Input& input, Names& names, std::string& error) {
     return false;
   }
   options.fit_drag = input.fit_drag;
+  if (input.fit_lift && !options.magnus) {
+    error = "fit_lift: the scene has no `magnus` effect";
+    return false;
+  }
+  options.fit_lift = input.fit_lift;
   options.fit_gravity = input.options.fit_gravity;
   options.spin_before = input.options.spin_before;
   options.max_bounces = input.options.max_bounces;

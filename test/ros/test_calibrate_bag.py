@@ -8,6 +8,7 @@ slip reduced by 3.5 mu (1 + e) |vz|, which stays below it). Its positions at 200
 Gaussian noise (seeded) are written into a bag as BodyStateArray messages on /body_states, the
 scene file beside it; the tool's `pairs:` give e within +-0.005 of 0.9 (the issue's bar) and mu
 within 4 standard errors. A bag whose stamps go back is refused, naming the problem, exit 1.
+In a scene with `magnus`, --fit-lift gives C_L 0 (the track has no Magnus force).
 
 The same track recorded as a tf frame (`--frame`): the ball's transforms on /tf relative to a
 tracker's frame `mocap`, which /tf_static places in `world` (turned 30 degrees about an oblique
@@ -222,25 +223,45 @@ class CalibrateBag(unittest.TestCase):
         self.assertIn("stamps going back: samples[31].time", run.stderr)
 
     def test_a_scene_the_fit_cannot_take_is_named(self):
-        """The scene read as the live fit reads it (calibrate_track, core::sceneCalibration):
-        `magnus` and no fixed plane refused with the live fit's words, a bad key with the node's
-        loader's; all before any fit (exit 2)."""
+        """The scene read as the live fit reads it (calibrate_track, core::sceneCalibration): no
+        fixed plane refused with the live fit's words, a bad key with the node's loader's, and
+        --fit-lift without `magnus`; all before any fit (exit 2)."""
         bag = os.path.join(self.folder, "ball.bag")
         write_bag(bag, self.track)
         cases = [
-            ("effects: [gravity, friction, spin]", "effects: [gravity, friction, spin, magnus]",
-             "the scene has `magnus`: the fit flies with gravity and drag only"),
             ("type: plane", "type: plane, frame: paddle",
              "the scene has no fixed plane obstacle to bounce off"),
             ("radius: 0.02", "radius: -0.02", "scene/bodies[0]/radius"),
+            ("", "", "fit_lift: the scene has no `magnus` effect"),
         ]
         for old, new, expected in cases:
             self.assertIn(old, SCENE)
             with open(self.scene, "w", encoding="utf-8") as handle:
-                handle.write(SCENE.replace(old, new, 1))
-            run = self.calibrate(bag)
+                handle.write(SCENE.replace(old, new, 1) if old else SCENE)
+            run = self.calibrate(bag, *([] if old else ["--fit-lift"]))
             self.assertEqual(run.returncode, 2, run.stdout + run.stderr)
             self.assertIn(expected, run.stderr)
+
+    def test_a_scene_with_magnus_is_flown_with_its_spin(self):
+        """`magnus` is flown (AirFlight) with the spin before, carried through the bounces by
+        their friction impulses (the ball spins up to 90 rad/s here): the track, flown without a
+        Magnus force, gives C_L 0 within 4 standard errors with --fit-lift, and e and mu back;
+        without --spin-before the fit names it (exit 1)."""
+        bag = os.path.join(self.folder, "ball.bag")
+        write_bag(bag, self.track)
+        with open(self.scene, "w", encoding="utf-8") as handle:
+            handle.write(SCENE.replace("spin]", "spin, magnus]", 1))
+        run = self.calibrate(bag)
+        self.assertEqual(run.returncode, 1, run.stdout + run.stderr)
+        self.assertIn("bad value: spin_before: magnus flies the spin", run.stderr)
+        answer = self.answer(bag, "--fit-lift")
+        lift = answer["lift_coefficient"]
+        self.assertLessEqual(abs(lift["value"]), 4 * lift["standard_error"], lift)
+        self.assertLess(lift["standard_error"], 0.01)
+        group = answer["groups"][0]
+        self.assertAlmostEqual(group["restitution"]["value"], E, delta=0.005)
+        self.assertLessEqual(abs(group["friction"]["value"] - MU),
+                             4 * group["friction"]["standard_error"], group["friction"])
 
 
 if __name__ == "__main__":

@@ -292,14 +292,26 @@ TEST(LiveCalibration, MuIsAnsweredWithItsIntervalWhereTheBouncesSlid) {
   EXPECT_EQ(response.message, "spin_before: must be finite");
 }
 
-// A scene the fit cannot fly or bounce in is refused, named: one with `magnus` (the fit flies
-// with gravity and drag only), one whose only plane moves with a frame, one without obstacles.
-TEST(LiveCalibration, AScenesMagnusOrNoFixedPlaneIsRefusedNamed) {
+// A scene with `magnus` is flown with the request's spin_before (core calibrate: the spin its
+// flights fly with), refused naming spin_before without it; a body of C_L 0 feels no Magnus force,
+// so e comes back as without the effect. A scene the fit cannot bounce in is refused, named: one
+// whose only plane moves with a frame, one without obstacles.
+TEST(LiveCalibration, AScenesMagnusNeedsTheSpinAndNoFixedPlaneIsRefusedNamed) {
+  namespace bb = core::bouncing_ball;
+  bb::Throw t;
+  t.seed = 44;
   core::Scene magnus = floorScene();
-  magnus.effects.magnus = true;
-  auto response = ask(LiveCalibration(magnus, 10.0), "ball");
+  magnus.effects.spin = magnus.effects.magnus = true;
+  magnus.bodies[0].lift_coefficient = 0.0;
+  LiveCalibration flown(magnus, 10.0);
+  play(flown.window(), bb::throwBall(t).samples, 0, 100.0);
+  auto response = ask(flown, "ball");
   EXPECT_FALSE(response.success);
-  EXPECT_EQ(response.message.rfind("body: the scene has `magnus`", 0), 0u) << response.message;
+  EXPECT_NE(response.message.find("spin_before: magnus flies the spin"), std::string::npos)
+      << response.message;
+  response = ask(flown, "ball", 0, {0.0, 0.0, 0.0});
+  ASSERT_TRUE(response.success) << response.message;
+  EXPECT_NEAR(response.restitution, t.e, 0.005) << response.message;
 
   core::Scene moving = floorScene();
   moving.obstacles[0].frame = "paddle";

@@ -168,15 +168,15 @@ struct Calibration {
 /// and `rosrun collision_response calibrate` (through calibrate_track).
 struct SceneCalibration {
   /// The scene's fixed planes (no `frame`: only those are bounced off), gravity with the
-  /// `gravity` effect (none without), drag with the `drag` effect and the air's density; the
+  /// `gravity` effect (none without), drag and Magnus with their effects and the air's density; the
   /// body's part by forBody(), the fit's own settings (fit_gravity, max_bounces, ...) as given.
   CalibrationOptions options;
   std::vector<std::string> plane_ids;        ///< the obstacles' ids, of options.planes
   std::vector<std::string> plane_materials;  ///< their materials: one obstacle pair a material
 };
 
-/// The scene's part of the fit; refused, named, for a scene with `magnus` (the fit flies with
-/// gravity and drag only) or without a fixed plane obstacle.
+/// The scene's part of the fit (with `magnus` the fit flies the Magnus force and needs
+/// spin_before); refused, named, for a scene without a fixed plane obstacle.
 Expected<SceneCalibration> sceneCalibration(const Scene& scene);
 
 /// What the fit reads of a scene's body.

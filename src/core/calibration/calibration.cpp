@@ -1093,15 +1093,11 @@ RecordingResult<Calibration> fitFlight(const std::vector<TrackedSample>& samples
 }
 
 Expected<SceneCalibration> sceneCalibration(const Scene& scene) {
-  if (scene.effects.magnus) {
-    return Error{"effects",
-                 "the scene has `magnus`: the fit flies with gravity and drag only (not yet "
-                 "Magnus)"};
-  }
   SceneCalibration reading;
   CalibrationOptions& options = reading.options;
   options.gravity = scene.effects.gravity ? scene.gravity : Eigen::Vector3d::Zero();
   options.drag = scene.effects.drag;
+  options.magnus = scene.effects.magnus;
   options.air_density = scene.air_density;
   for (const ObstacleSpec& obstacle : scene.obstacles) {
     if (obstacle.shape != ObstacleShape::kPlane || !obstacle.frame.empty()) continue;
