@@ -834,6 +834,8 @@ TEST(ShapedPrediction, ThrowsAtEveryObstacleKindNeverGoInsideNorGainEnergy) {
   const int each = throwsEach();
   for (int target_index = 0; target_index < 8; ++target_index) {
     const auto target = static_cast<Target>(target_index);
+    int struck = 0;     // throws that strike the obstacle aimed at
+    int off_table = 0;  // throws that strike the table, then the floor
     for (const BodyShape shape : {BodyShape::kBox, BodyShape::kCylinder, BodyShape::kCapsule}) {
       for (int n = 0; n < each; ++n) {
         const Throw t = throwAt(target, shape, random);
@@ -860,7 +862,23 @@ TEST(ShapedPrediction, ThrowsAtEveryObstacleKindNeverGoInsideNorGainEnergy) {
             << what;
         EXPECT_FALSE(findings.ending.empty())
             << what << " ended at " << prediction->final_state.time << ": " << prediction->message;
+        const std::string aimed_at = t.scene.obstacles.back().id;  // the floor's after it
+        bool on_it = false, then_floor = false;
+        for (const ImpactRecord& impact : prediction->impacts) {
+          const std::string& id = prediction->model->obstacle(impact.other).id;
+          const bool aimed = id == aimed_at || (target == Target::kHeldBall && id == "target");
+          then_floor = then_floor || (on_it && id == "floor");
+          on_it = on_it || aimed;
+        }
+        struck += on_it ? 1 : 0;
+        off_table += then_floor ? 1 : 0;
       }
+    }
+    // Each kind is met by most of its throws (of 720, 76 to 90 of each kind's 90), and the table
+    // is left over its edge.
+    EXPECT_GE(2 * struck, 3 * each) << nameOf(target);
+    if (target == Target::kTable) {
+      EXPECT_GE(off_table, 1);
     }
   }
 }
