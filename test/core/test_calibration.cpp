@@ -844,6 +844,8 @@ TEST(Calibration, LiftCoefficientFromACurvingBallsFlights) {
   ASSERT_FALSE(unknown_spin.ok());
   EXPECT_EQ(unknown_spin.error().problem, RecordingProblem::kBadValue);
   EXPECT_EQ(unknown_spin.error().field, "spin_before");
+  // The fitted motion replayed without the spin it was flown with: none (not a spin made up).
+  EXPECT_TRUE(fittedPosition(*given, options, 0.5).hasNaN());
 }
 
 }  // namespace

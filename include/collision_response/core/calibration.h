@@ -257,7 +257,8 @@ Coefficients combine(const Calibration& calibration, const std::vector<std::size
 RecordingResult<Calibration> fitFlight(const std::vector<TrackedSample>& samples,
                                        const CalibrationOptions& options);
 
-/// The fitted motion's centre at `time` (within the fit's samples' span).
+/// The fitted motion's centre at `time` (within the fit's samples' span); NaN where `options`
+/// cannot fly it (`magnus` without spin_before).
 Eigen::Vector3d fittedPosition(const Calibration& calibration, const CalibrationOptions& options,
                                double time);
 

@@ -102,9 +102,11 @@ class Motion {
       if (!(drag >= 0.0) || !std::isfinite(lift)) return false;
       air_ = airFactors(options_.air_density, options_.radius, 1.0 / options_.mass, drag, lift);
     }
-    // The spin in flight (Magnus): spin_before over the first flight (checkOptions), then turned
-    // at each bounce by its tangential impulse, as BounceQuantities carries it.
-    Eigen::Vector3d spin = options_.magnus ? *options_.spin_before : Eigen::Vector3d::Zero();
+    // The spin in flight (Magnus): spin_before over the first flight (checkOptions; without it,
+    // as fittedPosition may be given, no motion), then turned at each bounce by its tangential
+    // impulse, as BounceQuantities carries it.
+    if (options_.magnus && !options_.spin_before) return false;
+    Eigen::Vector3d spin = options_.spin_before.value_or(Eigen::Vector3d::Zero());
     pieces_.push_back(makePiece(start_, parameters.segment<3>(0), parameters.segment<3>(3), spin));
     for (std::size_t j = 0; j < layout_.bounces; ++j) {
       const Plane& plane = options_.planes[bounce_planes_[j]];
