@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <functional>
 #include <limits>
 #include <map>
 #include <memory>
@@ -15,6 +14,7 @@
 #include <random>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "collision_response/core/prediction.h"
@@ -327,11 +327,12 @@ TEST(ShapedPrediction, WhatIsNotModelledYetIsRefusedByName) {
 // standard closed forms, e.g. Ericson, "Real-Time Collision Detection", 2005, chapter 5), to a
 // sphere, and to a closed convex mesh from its triangles (the nearest point of each triangle,
 // inside where behind every triangle's plane). Between a body and an obstacle, each side's edges
-// (a box's twelve, a mesh's triangles' sides), rims (a cylinder's two circles) and cores (a
-// capsule's segment, a sphere's centre, with their radius) are looked at in the other side: the
-// least signed distance along a segment by golden-section search (the distance to a convex set
-// is convex along a line), along a circle by 96 samples refined the same way. Two convex solids
-// whose interiors meet have an edge, a rim or a core of one inside the other.
+// (a box's twelve, a mesh's triangles' sides), sides (a cylinder's generators, from rim to rim)
+// and cores (a capsule's segment, a sphere's centre, with their radius) are looked at in the
+// other side: the least signed distance along a segment by golden-section search (the distance to
+// a convex set is convex along a line), over a cylinder's generators by 96 angles refined the
+// same way. Two convex solids whose interiors meet have a point of an edge, a side or a core of
+// one inside the other.
 
 /// A convex solid (or the open floor mesh's sheet) at one instant, in the fixed frame.
 struct Solid {
@@ -457,16 +458,10 @@ struct Solid {
     return out;
   }
 
-  /// A cylinder's rims: the point at angle phi on each, in the fixed frame.
-  std::vector<std::function<V(double)>> rims() const {
-    if (kind != kCylinder) return {};
-    std::vector<std::function<V(double)>> out;
-    for (const double z : {-half_length, half_length}) {
-      out.push_back([this, z](double phi) {
-        return V(pose * V(radius * std::cos(phi), radius * std::sin(phi), z));
-      });
-    }
-    return out;
+  /// A cylinder's side: its generator at angle phi, from rim to rim, in the fixed frame.
+  std::pair<V, V> generator(double phi) const {
+    const double x = radius * std::cos(phi), y = radius * std::sin(phi);
+    return {pose * V(x, y, -half_length), pose * V(x, y, half_length)};
   }
 };
 
@@ -487,28 +482,36 @@ double leastOn(double lo, double hi, F&& f) {
   return std::min({f(lo), f(hi), fc, fd});
 }
 
-/// m: how deep the segments and rims of `a` reach into `b` (< 0: how far the nearest is from it).
+/// m: the least signed distance to `b` along the segment from p to q.
+double leastAlong(const Solid& b, const V& p, const V& q) {
+  return leastOn(0.0, 1.0, [&](double s) { return b.distance(p + s * (q - p)); });
+}
+
+/// m: how deep the segments and the side of `a` reach into `b` (< 0: how far the nearest is).
 double depthOf(const Solid& a, const Solid& b) {
   double depth = -std::numeric_limits<double>::infinity();
-  for (const auto& [p, q, r] : a.segments()) {
-    const double least =
-        leastOn(0.0, 1.0, [&, &p = p, &q = q](double s) { return b.distance(p + s * (q - p)); });
-    depth = std::max(depth, r - least);
-  }
+  for (const auto& [p, q, r] : a.segments()) depth = std::max(depth, r - leastAlong(b, p, q));
+  if (a.kind != Solid::kCylinder) return depth;
+  // The cylinder lies within the capsule of its axis and radius: further than 1 mm from b, it
+  // cannot reach it. Nearer, its side's generators (their ends its rims) at 96 angles, the
+  // nearest refined between its neighbours.
+  const double axis =
+      leastAlong(b, a.pose * V(0, 0, -a.half_length), a.pose * V(0, 0, a.half_length)) - a.radius;
+  if (axis > 1e-3) return std::max(depth, -axis);
+  const auto along = [&](double phi) {
+    const auto [p, q] = a.generator(phi);
+    return leastAlong(b, p, q);
+  };
   constexpr int kSamples = 96;
   const double slice = 2 * M_PI / kSamples;
-  for (const auto& rim : a.rims()) {
-    int best = 0;
-    double least = std::numeric_limits<double>::infinity();
-    for (int k = 0; k < kSamples; ++k) {
-      const double d = b.distance(rim(k * slice));
-      if (d < least) least = d, best = k;
-    }
-    least = std::min(least, leastOn((best - 1) * slice, (best + 1) * slice,
-                                    [&](double phi) { return b.distance(rim(phi)); }));
-    depth = std::max(depth, -least);
+  int best = 0;
+  double least = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < kSamples; ++k) {
+    const double d = along(k * slice);
+    if (d < least) least = d, best = k;
   }
-  return depth;
+  least = std::min(least, leastOn((best - 1) * slice, (best + 1) * slice, along));
+  return std::max(depth, -least);
 }
 
 /// m: how deep two solids are in each other (< 0: apart).
@@ -578,7 +581,8 @@ std::optional<Solid> obstacleSolid(const ObstacleSpec& o, const V& position, con
 // turned up, crossing at right angles d = 1e-6 deep, has the point of the edge above the ridge
 // inside by d / sqrt(2) (its distance to either face of the ridge); a cylinder tilted by alpha
 // with the lowest point of its rim d below a table's top, inside by d; a capsule lying on a
-// cube mesh sunk by d, inside by d; each raised by 2 d, apart (< 0).
+// cube mesh sunk by d, inside by d; two cylinders crossing side to side d deep, inside by d; each
+// raised by 2 d, apart (< 0).
 TEST(ShapedPrediction, TheThrowsCheckSeesAPointInsideByTheClosedForm) {
   const double d = 1e-6, s2 = std::sqrt(2.0);
   Solid edge, ridge;
@@ -619,6 +623,22 @@ TEST(ShapedPrediction, TheThrowsCheckSeesAPointInsideByTheClosedForm) {
   };
   EXPECT_NEAR(pillAt(0.2 + 0.03 - d), d, 1e-12);
   EXPECT_LT(pillAt(0.2 + 0.03 + d), 0.0);
+
+  // Two cylinders crossing at right angles side to side, their axes D = r1 + r2 - d apart: the
+  // point of either's side nearest the other's axis is inside it by d (no rim is inside).
+  Solid log, can_across;
+  log.kind = can_across.kind = Solid::kCylinder;
+  log.radius = 0.12;
+  log.half_length = 0.3;
+  log.pose = Eigen::Translation3d(0, 0, 0.12) * Eigen::AngleAxisd(M_PI / 2, V::UnitY());
+  can_across.radius = 0.04;
+  can_across.half_length = 0.06;
+  const auto acrossAt = [&](double z) {
+    can_across.pose = Eigen::Translation3d(0.05, 0.01, z) * Eigen::AngleAxisd(M_PI / 2, V::UnitX());
+    return overlapOf(can_across, log);
+  };
+  EXPECT_NEAR(acrossAt(0.12 + 0.16 - d), d, 1e-12);
+  EXPECT_LT(acrossAt(0.12 + 0.16 + d), 0.0);
 }
 
 enum class Target {
