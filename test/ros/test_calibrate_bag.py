@@ -202,6 +202,45 @@ class CalibrateBag(unittest.TestCase):
         by_topic = self.answer(tf_bag, "--topic", "/tf")
         self.assertEqual(by_topic["groups"][0]["restitution"]["value"], e_frame)
 
+    def test_transforms_before_the_chain_is_known_are_counted(self):
+        """The tracker's frame on /tf (a moving link) only from 0.5 s on: the ball's 100
+        transforms before it have no chain to the fixed frame at their stamps; they are left out
+        and counted, the rest fitted (4 bounces, e back)."""
+        bag = os.path.join(self.folder, "late.bag")
+        with rosbag.Bag(bag, "w") as out:
+            for k, (time, p) in enumerate(self.track):
+                stamp = rospy.Time.from_sec(100.0 + time)
+                transforms = []
+                if time >= 0.5 - 1e-9:
+                    link = TransformStamped()
+                    link.header.stamp = stamp
+                    link.header.frame_id = "world"
+                    link.child_frame_id = "mocap"
+                    t = link.transform.translation
+                    t.x, t.y, t.z = MOVED
+                    q = link.transform.rotation
+                    q.x, q.y, q.z, q.w = quaternion()
+                    transforms.append(link)
+                ball = TransformStamped()
+                ball.header.stamp = stamp
+                ball.header.frame_id = "mocap"
+                ball.child_frame_id = "ball"
+                t = ball.transform.translation
+                t.x, t.y, t.z = in_mocap(p)
+                ball.transform.rotation.w = 1.0
+                transforms.append(ball)
+                out.write("/tf", TFMessage(transforms=transforms),
+                          rospy.Time.from_sec(100.0 + k / RATE))
+        left_out = sum(1 for time, _ in self.track if time < 0.5 - 1e-9)
+        self.assertEqual(left_out, 100)
+        run = self.calibrate(bag, "--frame", "ball", "--spin-before", "0", "0", "0", "--json")
+        self.assertEqual(run.returncode, 0, run.stdout + run.stderr)
+        self.assertIn(f"{left_out} of {len(self.track)} transforms of 'ball' left out: their chain "
+                      "to 'world' is not known at their stamps", run.stderr)
+        answer = json.JSONDecoder().raw_decode(run.stdout)[0]
+        self.assertEqual(len(answer["bounces"]), 4)
+        self.assertAlmostEqual(answer["groups"][0]["restitution"]["value"], E, delta=0.005)
+
     def test_a_frame_not_in_the_bag_is_named(self):
         tf_bag = os.path.join(self.folder, "tf.bag")
         write_tf_bag(tf_bag, self.track)
