@@ -174,9 +174,14 @@ SurfaceGap meshGap(const TumblingBody& body, double time, const Mesh& mesh, cons
   return g;
 }
 
+/// Whether a gap carries its approach speed: the advancement looks at the gap alone, and the
+/// approach speed costs the body's orientation and angular velocity once more.
+enum class Approach { kWith, kWithout };
+
 /// The body against `obstacle` already moved to `time`.
 SurfaceGap obstacleGap(const TumblingBody& body, double time, const PlacedShape& moved,
-                       double tolerance, std::vector<std::uint32_t>* near_triangles = nullptr) {
+                       double tolerance, std::vector<std::uint32_t>* near_triangles = nullptr,
+                       Approach approach = Approach::kWith) {
   const Eigen::Vector3d centre = body.positionAt(time);
   const Eigen::Vector3d origin = moved.pose.transform.translation();
   SurfaceGap g;
@@ -217,15 +222,18 @@ SurfaceGap obstacleGap(const TumblingBody& body, double time, const PlacedShape&
     const PlacedConvex other(shape, moved.pose.transform.linear(), origin);
     g = fromDistance(convexDistance(placedBody(body, time), other, tolerance), centre, origin);
   }
+  if (approach == Approach::kWithout) return g;
   const Eigen::Vector3d surface =
       turns(moved.shape) ? moved.pose.velocityAt(g.point_b - origin) : moved.pose.velocity;
   g.approach_speed = g.normal.dot(body.pointVelocityAt(time, g.point_a) - surface);
   return g;
 }
 
-SurfaceGap bodiesGap(const TumblingBody& a, const TumblingBody& b, double time, double tolerance) {
+SurfaceGap bodiesGap(const TumblingBody& a, const TumblingBody& b, double time, double tolerance,
+                     Approach approach = Approach::kWith) {
   SurfaceGap g = fromDistance(convexDistance(placedBody(a, time), placedBody(b, time), tolerance),
                               a.positionAt(time), b.positionAt(time));
+  if (approach == Approach::kWithout) return g;
   g.approach_speed =
       g.normal.dot(a.pointVelocityAt(time, g.point_a) - b.pointVelocityAt(time, g.point_b));
   return g;
@@ -301,8 +309,8 @@ struct ObstacleSide {
   const PlacedShape& placed;
   double tolerance;
   PlacedShape at(double time) const { return shapeAt(placed, time); }
-  SurfaceGap gap(const TumblingBody& body, double time) const {
-    return obstacleGap(body, time, at(time), tolerance);
+  SurfaceGap gap(const TumblingBody& body, double time, Approach approach = Approach::kWith) const {
+    return obstacleGap(body, time, at(time), tolerance, nullptr, approach);
   }
   Eigen::Vector3d centreVelocity(double time) const { return at(time).pose.velocity; }
   double angularSpeed() const {
@@ -319,8 +327,8 @@ struct ObstacleSide {
 struct BodySide {
   const TumblingBody& other;
   double tolerance;
-  SurfaceGap gap(const TumblingBody& body, double time) const {
-    return bodiesGap(body, other, time, tolerance);
+  SurfaceGap gap(const TumblingBody& body, double time, Approach approach = Approach::kWith) const {
+    return bodiesGap(body, other, time, tolerance, approach);
   }
   Eigen::Vector3d centreVelocity(double time) const { return other.velocityAt(time); }
   double pointSpeedAboutCentre() const { return other.angularSpeedBound() * other.reach(); }
@@ -457,7 +465,10 @@ FirstContactResult advance(const TumblingBody& body, const Side& side, double fr
   const double end = from + horizon;
   const double turning = body.angularSpeedBound() * body.reach() + side.pointSpeedAboutCentre();
   const double acceleration = side.accelerationBound(body);
-  const auto contactAt = [&](double t, const SurfaceGap& g) {
+  // The steps look at the gap alone; the contact found carries its approach speed too (the same
+  // gap, computed once more with it).
+  const auto contactAt = [&](double t) {
+    const SurfaceGap g = side.gap(body, t);
     TumblingContact contact;
     contact.time = t;
     contact.closest = g;
@@ -470,7 +481,7 @@ FirstContactResult advance(const TumblingBody& body, const Side& side, double fr
     result.clear_until = t;
   };
   double t = from;
-  SurfaceGap g = side.gap(body, t);
+  SurfaceGap g = side.gap(body, t, Approach::kWithout);
   if (g.overlapping || g.gap_upper < 0) {
     result.inside_at_start = true;
     return result;
@@ -478,19 +489,19 @@ FirstContactResult advance(const TumblingBody& body, const Side& side, double fr
   for (; result.steps < options.max_steps; ++result.steps) {
     const double stop = options.time_tolerance + 4 * kEps * std::abs(t);
     if (!(g.gap > 0)) {
-      contactAt(t, g);
+      contactAt(t);
       return result;
     }
     const double speed = (body.velocityAt(t) - side.centreVelocity(t)).norm() + turning;
     const double step = 2 * g.gap / (speed + std::sqrt(speed * speed + 2 * acceleration * g.gap));
     if (step <= stop) {
-      contactAt(t, g);
+      contactAt(t);
       return result;
     }
     result.clear_until = std::min(t + step, end);
     if (!(t + step <= end)) return result;  // apart until the horizon's end
     t += step;
-    g = side.gap(body, t);
+    g = side.gap(body, t, Approach::kWithout);
   }
   return result;  // the step budget ran out: apart until clear_until
 }
