@@ -301,6 +301,12 @@ class CalibrateBag(unittest.TestCase):
         self.assertAlmostEqual(group["restitution"]["value"], E, delta=0.005)
         self.assertLessEqual(abs(group["friction"]["value"] - MU),
                              4 * group["friction"]["standard_error"], group["friction"])
+        # The key to paste is one the scene file takes: never a C_L below 0 (its interval holds
+        # 0 here, so 0, said).
+        run = self.calibrate(bag, "--spin-before", "0", "0", "0", "--fit-lift")
+        self.assertEqual(run.returncode, 0, run.stdout + run.stderr)
+        self.assertNotIn("lift_coefficient: -", run.stdout)
+        self.assertRegex(run.stdout, r"bodies\[\]\): lift_coefficient: (0  \(fitted|0\.)")
 
 
 if __name__ == "__main__":
