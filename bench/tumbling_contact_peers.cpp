@@ -19,7 +19,8 @@
 // poses), sampled; and CCDC_CONSERVATIVE_ADVANCEMENT. Where a peer's motion is not the true one
 // (a chord for the parabola, a screw for a fall), its error holds the motion's too. Prints one
 // Markdown table: each query's error of the instant (s; > 0: late, the bodies inside by then),
-// CPU per query (thread CPU time over repetitions) and its ratio to ours. About 3 s.
+// CPU per query (thread CPU time over repetitions) and its ratio to ours (ours: its advancement
+// steps). About 3 s.
 //   cmake --build .ws/build --target tumbling_contact_peers
 //   .ws/devel/lib/collision_response/tumbling_contact_peers
 // Or bash scripts/tumbling_contact_peers.sh (installs Bullet and FCL first).
@@ -366,7 +367,12 @@ int run() {
           std::printf(" **missed**,");
         }
         std::printf(" %s", seconds(m.cpu).c_str());
-        if (&engine != &all.front()) std::printf(" (%.2g x)", m.cpu / ours);
+        if (&engine == &all.front()) {
+          // Ours: its advancement steps too (each one orientation and one gap).
+          std::printf(", %d steps", firstContact(bodyOf(c), obstacleOf(c), from, step).steps);
+        } else {
+          std::printf(" (%.2g x)", m.cpu / ours);
+        }
         std::printf(" |");
       }
       std::printf("\n");
