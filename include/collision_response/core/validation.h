@@ -117,6 +117,9 @@ Expected<Eigen::Vector3d> lineOfImpact(const Eigen::Vector3d& normal,
 /// How far a unit quaternion's squared length may be from 1: tf2's tolerance for a transform's
 /// rotation (its buffer refuses a quaternion whose x^2 + y^2 + z^2 + w^2 is 0.01 or more away).
 inline constexpr double kQuaternionNormTolerance = 0.01;
+/// Whether checkOrientation takes it: every component finite, not zero, of length 1 to
+/// kQuaternionNormTolerance on its square.
+bool isRotation(const Eigen::Quaterniond& orientation);
 /// An orientation (world from body): every component finite (`field`.x, .y, .z, .w named), not
 /// zero (no rotation has it), and of unit length to kQuaternionNormTolerance in its square (a
 /// quaternion of another length is a mistake, not a rotation: the caller then normalises it).

@@ -94,11 +94,15 @@ BodySpec shapeSpecOf(const Body& body) {
 namespace {
 
 /// A number of `body` its shape does not have must be 0 (named `field`): nothing is ignored.
-Status unusedIsZero(bool is_zero, const Body& body, const std::string& field, const char* which) {
+/// (Its field's name `prefix`.`key` is built only for the error: a ball's request, the common
+/// one, builds none.)
+Status unusedIsZero(bool is_zero, const Body& body, const std::string& prefix, const char* key,
+                    const char* which) {
   if (is_zero) return Ok{};
-  return Error{field, std::string("must be 0: a ") + toString(body.shape) + " has no " + which +
-                          " (a box has edges `size`; a cylinder and a capsule a `radius` and a "
-                          "`length`; a sphere a `radius`)"};
+  return Error{prefix + "." + key,
+               std::string("must be 0: a ") + toString(body.shape) + " has no " + which +
+                   " (a box has edges `size`; a cylinder and a capsule a `radius` and a "
+                   "`length`; a sphere a `radius`)"};
 }
 
 }  // namespace
@@ -111,18 +115,18 @@ Status checkBodyShape(const Body& body, const std::string& prefix) {
   }
   const bool round = body.shape == BodyShape::kSphere || body.shape == BodyShape::kCylinder ||
                      body.shape == BodyShape::kCapsule;
-  if (auto status = unusedIsZero(round || body.radius == 0.0, body, prefix + ".radius", "radius");
+  if (auto status = unusedIsZero(round || body.radius == 0.0, body, prefix, "radius", "radius");
       !status) {
     return status;
   }
   if (auto status = unusedIsZero(body.shape == BodyShape::kBox || body.size.isZero(0.0), body,
-                                 prefix + ".size", "edges (`size`)");
+                                 prefix, "size", "edges (`size`)");
       !status) {
     return status;
   }
   if (auto status = unusedIsZero(body.shape == BodyShape::kCylinder ||
                                      body.shape == BodyShape::kCapsule || body.length == 0.0,
-                                 body, prefix + ".length", "length");
+                                 body, prefix, "length", "length");
       !status) {
     return status;
   }
@@ -131,21 +135,27 @@ Status checkBodyShape(const Body& body, const std::string& prefix) {
                  "is `hollow` while " + prefix +
                      ".inertia_tensor is given: give one (the tensor says how the mass is spread)"};
   }
+  const Eigen::Quaterniond& orientation = body.orientation;
+  // A ball's radius and inertia are checkBody's; its orientation does not matter, and is checked
+  // only where given (checkOrientation builds the field's name only for an error).
+  if (isBall(body)) {
+    if (orientation.coeffs().isZero(0.0) || isRotation(orientation)) return Ok{};
+    return checkOrientation(orientation, prefix + ".orientation");
+  }
   const auto field = [&](const char* key) {
     const std::string name = key;
     if (name == "inertia" && body.inertia_tensor) return prefix + ".inertia_tensor";
     return prefix + "." + name;
   };
   if (auto status = checkBodyShape(shapeSpecOf(body), field); !status) return status;
-  const Eigen::Quaterniond& orientation = body.orientation;
   if (orientation.coeffs().isZero(0.0)) {
-    if (isBall(body)) return Ok{};
     return Error{prefix + ".orientation",
                  std::string("is zero (not given): a ") + toString(body.shape) +
                      (body.shape == BodyShape::kSphere ? " given its tensor" : "") +
                      " needs its orientation, world from body ([0, 0, 0, 1] as [x, y, z, w]: not "
                      "turned)"};
   }
+  if (isRotation(orientation)) return Ok{};
   return checkOrientation(orientation, prefix + ".orientation");
 }
 

@@ -200,7 +200,15 @@ Eigen::Vector3d unitVector(const Eigen::Vector3d& v) {
   return scaled / scaled.norm();
 }
 
+bool isRotation(const Eigen::Quaterniond& orientation) {
+  const Eigen::Vector4d& q = orientation.coeffs();
+  if (!q.allFinite() || q.isZero(0.0)) return false;
+  const double length = q.stableNorm();
+  return std::abs(length * length - 1.0) < kQuaternionNormTolerance;
+}
+
 Status checkOrientation(const Eigen::Quaterniond& orientation, const std::string& field) {
+  if (isRotation(orientation)) return Ok{};
   static const std::array<const char*, 4> kComponents = {"x", "y", "z", "w"};
   const Eigen::Vector4d& q = orientation.coeffs();  // x, y, z, w
   for (int k = 0; k < 4; ++k) {
