@@ -222,13 +222,7 @@ int run(int argc, char** argv) {
       << ",\n \"evaluation\": " << jsonNames(evaluation) << ",\n \"peers\": [\n";
   for (std::size_t i = 0; i < results.size(); ++i) out << (i ? ",\n" : "") << results[i];
   out << "\n]}\n";
-  if (out_path.empty()) {
-    std::cout << out.str();
-  } else {
-    std::ofstream file(out_path);
-    file << out.str();
-    if (!file) throw std::runtime_error(out_path + ": cannot be written");
-  }
+  writeJson(out.str(), out_path);
   return 0;
 }
 
@@ -236,10 +230,6 @@ int run(int argc, char** argv) {
 }  // namespace collision_response::bench::cube_tosses
 
 int main(int argc, char** argv) {
-  try {
-    return collision_response::bench::cube_tosses::run(argc, argv);
-  } catch (const std::exception& error) {
-    std::cerr << "cube_tosses_peers: " << error.what() << "\n";
-    return 1;
-  }
+  return collision_response::bench::cube_tosses::mainOf(
+      "cube_tosses_peers", collision_response::bench::cube_tosses::run, argc, argv);
 }

@@ -373,13 +373,7 @@ int run(int argc, char** argv) {
       << ",\n \"runs\": [\n";
   for (std::size_t i = 0; i < runs.size(); ++i) out << (i ? ",\n" : "") << runs[i];
   out << "\n]}\n";
-  if (out_path.empty()) {
-    std::cout << out.str();
-  } else {
-    std::ofstream file(out_path);
-    file << out.str();
-    if (!file) throw std::runtime_error(out_path + ": cannot be written");
-  }
+  writeJson(out.str(), out_path);
   return 0;
 }
 
@@ -387,10 +381,6 @@ int run(int argc, char** argv) {
 }  // namespace collision_response::bench::cube_tosses
 
 int main(int argc, char** argv) {
-  try {
-    return collision_response::bench::cube_tosses::run(argc, argv);
-  } catch (const std::exception& error) {
-    std::cerr << "cube_tosses_ours: " << error.what() << "\n";
-    return 1;
-  }
+  return collision_response::bench::cube_tosses::mainOf(
+      "cube_tosses_ours", collision_response::bench::cube_tosses::run, argc, argv);
 }

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iostream>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -207,6 +208,28 @@ inline std::string jsonText(const std::string& text) {
     }
   }
   return quoted + "\"";
+}
+
+/// The run's JSON to standard output (`path` empty) or to `path`, a file that cannot be written
+/// an error naming it.
+inline void writeJson(const std::string& text, const std::string& path) {
+  if (path.empty()) {
+    std::cout << text;
+    return;
+  }
+  std::ofstream file(path);
+  file << text;
+  if (!file) throw std::runtime_error(path + ": cannot be written");
+}
+
+/// A run's main: its errors said on standard error under its `name`, exit 1.
+inline int mainOf(const char* name, int (*run)(int, char**), int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& error) {
+    std::cerr << name << ": " << error.what() << "\n";
+    return 1;
+  }
 }
 
 }  // namespace collision_response::bench::cube_tosses
