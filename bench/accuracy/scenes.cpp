@@ -268,13 +268,13 @@ BenchScene ballOnMeshFloorScene() {
   scene.materials = lastingMaterials();
   const double r = 0.05;
   scene.bodies.push_back(ball("ball", 0.1, r, kLastingMaterial, V(-0.9, -0.7, r), V(1.5, 0.9, 0)));
-  const int n = 8;
+  constexpr int n = 8;
   std::vector<V> vertices;
   for (int j = 0; j <= n; ++j) {
     for (int i = 0; i <= n; ++i) vertices.emplace_back(0.25 * i - 1.0, 0.25 * j - 1.0, 0.0);
   }
   std::vector<core::TriangleMesh::Triangle> triangles;
-  const auto at = [n](int i, int j) { return static_cast<std::uint32_t>(j * (n + 1) + i); };
+  const auto at = [](int i, int j) { return static_cast<std::uint32_t>(j * (n + 1) + i); };
   for (int j = 0; j < n; ++j) {
     for (int i = 0; i < n; ++i) {
       triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});

@@ -275,9 +275,14 @@ TEST(RigidImpact, RandomImpactsNeverGainEnergyAndConserveAngularMomentumAboutThe
           << "trial " << trial;
     }
     // L about the contact point of each body: m (-r) x v + I w, which the impulse there leaves.
-    for (const auto& [body, start, inertia, lever] :
-         {std::tuple{&a.body, &a0, &a.inertia, contact.lever_a},
-          std::tuple{&b.body, &b0, &b.inertia, contact.lever_b}}) {
+    for (const auto& side : {std::tuple{&a.body, &a0, &a.inertia, contact.lever_a},
+                             std::tuple{&b.body, &b0, &b.inertia, contact.lever_b}}) {
+      // Named copies rather than a structured binding: the lambda below captures them (C++17,
+      // and clang, allow no capture of a binding).
+      const SolverBody* body = std::get<0>(side);
+      const SolverBody* start = std::get<1>(side);
+      const auto* inertia = std::get<2>(side);
+      const Eigen::Vector3d lever = std::get<3>(side);
       if (body->inverse_mass == 0.0) continue;
       const double mass = 1.0 / body->inverse_mass;
       const auto momentum = [&](const SolverBody& s) -> Eigen::Vector3d {
