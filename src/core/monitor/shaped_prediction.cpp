@@ -545,7 +545,7 @@ Expected<Prediction> runShapedPrediction(const PredictionStart& start,
                                          std::vector<std::string>& cut) {
   auto principal = principalBody(start.request.body, "body");
   if (!principal) return principal.error();
-  ShapedRun run(start, budget, began, *model, std::move(*principal));
+  ShapedRun run(start, budget, began, *model, std::move(principal.value()));
   auto prediction = run.run(cut);
   if (!prediction) return prediction;
   cut.insert(cut.end(), run.extra_.begin(), run.extra_.end());
