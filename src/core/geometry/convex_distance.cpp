@@ -316,16 +316,34 @@ double TriangleSupport::scale() const {
   return std::max({corners_[0].norm(), corners_[1].norm(), corners_[2].norm()});
 }
 
-ConvexDistance convexDistance(const SupportMapping& a, const SupportMapping& b, double tolerance,
-                              int max_iterations) {
-  ConvexDistance result;
-  const double margins = a.margin() + b.margin();
-  // The rounding of a support point (a rotation and a translation of the shape's point) and of
-  // the dot products below: a few ulps of the sets' sizes and positions.
-  const double slack = 64 * kEps * (a.scale() + b.scale());
-  Eigen::Vector3d direction = b.centre() - a.centre();  // from a towards b
-  if (!(direction.squaredNorm() > 0)) direction = Eigen::Vector3d::UnitZ();
+namespace {
+
+/// What the search for the cores' distance knows: its simplex, the simplex's nearest point v,
+/// the best lower bound and its direction, whether the cores overlap, the iterations, and the
+/// witness points on each core.
+struct DistanceSearch {
   Simplex s;
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  double lower = 0.0;
+  Eigen::Vector3d lower_direction = Eigen::Vector3d::Zero();  // the lower bound's
+  bool overlapping = false;
+  int iteration = 0;
+  Eigen::Vector3d core_a = Eigen::Vector3d::Zero(), core_b = Eigen::Vector3d::Zero();
+
+  void bound(double value, const Eigen::Vector3d& along) {
+    if (value > lower) {
+      lower = value;
+      lower_direction = along;
+    }
+  }
+};
+
+/// GJK's iterations from the support points along `direction`, until the bounds meet within
+/// `tolerance`, no new support point comes, no progress is made, or the origin is found on or in
+/// the simplex (the cores overlap).
+void gjk(const SupportMapping& a, const SupportMapping& b, const Eigen::Vector3d& direction,
+         double tolerance, double slack, int max_iterations, DistanceSearch& search) {
+  Simplex& s = search.s;
   {
     const Eigen::Vector3d pa = a.support(direction), pb = b.support(-direction);
     s.vertices[0] = {pa - pb, pa, pb};
@@ -333,31 +351,25 @@ ConvexDistance convexDistance(const SupportMapping& a, const SupportMapping& b, 
     s.size = 1;
     s.point = s.vertices[0].w;
   }
-  Eigen::Vector3d v = s.vertices[0].w;
-  double lower = 0.0;
-  Eigen::Vector3d lower_direction = Eigen::Vector3d::Zero();  // the lower bound's: v's
-  bool overlapping = false;
-  int iteration = 0;
-  for (; iteration < max_iterations; ++iteration) {
+  Eigen::Vector3d& v = search.v;
+  v = s.vertices[0].w;
+  for (; search.iteration < max_iterations; ++search.iteration) {
     const double vv = v.squaredNorm();
     if (!(vv > slack * slack)) {
-      overlapping = true;  // the origin on the simplex, within rounding: the cores touch
-      break;
+      search.overlapping = true;  // the origin on the simplex, within rounding: the cores touch
+      return;
     }
     const double v_norm = std::sqrt(vv);
     const Eigen::Vector3d pa = a.support(-v), pb = b.support(v);
     const Eigen::Vector3d w = pa - pb;
     const double vw = v.dot(w);
-    if (vw / v_norm > lower) {
-      lower = vw / v_norm;
-      lower_direction = v / v_norm;
-    }
-    if (v_norm - lower <= tolerance) break;
+    search.bound(vw / v_norm, v / v_norm);
+    if (v_norm - search.lower <= tolerance) return;
     bool repeated = false;
     for (int i = 0; i < s.size; ++i) {
       if (s.vertices[static_cast<std::size_t>(i)].w == w) repeated = true;
     }
-    if (repeated || vv - vw <= 4 * kEps * vv) break;  // no new point: as near as it gets
+    if (repeated || vv - vw <= 4 * kEps * vv) return;  // no new point: as near as it gets
     s.vertices[static_cast<std::size_t>(s.size)] = {w, pa, pb};
     ++s.size;
     if (s.size == 2) {
@@ -365,87 +377,110 @@ ConvexDistance convexDistance(const SupportMapping& a, const SupportMapping& b, 
     } else if (s.size == 3) {
       keepTriangle(s, nearestOnTriangle(s, 0, 1, 2));
     } else if (!nearestOnTetrahedron(s)) {
-      overlapping = true;  // the origin inside the tetrahedron: the cores overlap
-      break;
+      search.overlapping = true;  // the origin inside the tetrahedron: the cores overlap
+      return;
     }
     const Eigen::Vector3d next = s.point;
     if (s.face_normal.squaredNorm() > 0) {
       // A second lower bound along the face's normal (any direction gives one): exact for a
       // polytope's face however near the origin.
       const Eigen::Vector3d d = s.face_normal.normalized();
-      const double along = d.dot(Eigen::Vector3d(a.support(-d) - b.support(d)));
-      if (along > lower) {
-        lower = along;
-        lower_direction = d;
-      }
+      search.bound(d.dot(Eigen::Vector3d(a.support(-d) - b.support(d))), d);
     }
-    if (!(next.squaredNorm() < vv)) break;  // no progress (rounding): keep the last v
+    if (!(next.squaredNorm() < vv)) return;  // no progress (rounding): keep the last v
     v = next;
   }
-  Eigen::Vector3d core_a = Eigen::Vector3d::Zero(), core_b = Eigen::Vector3d::Zero();
+}
+
+/// The witness points on each core: the simplex's vertices' points by their weights.
+void witnessPoints(DistanceSearch& search) {
+  const Simplex& s = search.s;
   double weight_sum = 0;
   for (int i = 0; i < s.size; ++i) weight_sum += s.weights[static_cast<std::size_t>(i)];
   for (int i = 0; i < s.size; ++i) {
     const double weight = s.weights[static_cast<std::size_t>(i)] / weight_sum;
-    core_a += weight * s.vertices[static_cast<std::size_t>(i)].a;
-    core_b += weight * s.vertices[static_cast<std::size_t>(i)].b;
+    search.core_a += weight * s.vertices[static_cast<std::size_t>(i)].a;
+    search.core_b += weight * s.vertices[static_cast<std::size_t>(i)].b;
   }
-  if (!overlapping && v.norm() - lower > tolerance) {
-    // Not converged: near touching a round side the simplex's corners crowd together and its
-    // nearest point stops coming nearer to rounding. Frank-Wolfe steps from there (x the point of
-    // A - B, moved to the nearest point of the segment to the support point w in the direction
-    // -x: nearer at every step, no simplex to round), each w bounding the distance from below
-    // by x.w / |x|; the witness points move along.
-    Eigen::Vector3d x = core_a - core_b;
-    for (int step = 0; step < 64 && !(x.norm() - lower <= tolerance); ++step) {
-      const double x_norm = x.norm();
-      if (!(x_norm > slack)) break;
-      const Eigen::Vector3d pa = a.support(-x), pb = b.support(x);
-      const Eigen::Vector3d w = pa - pb;
-      if (x.dot(w) / x_norm > lower) {
-        lower = x.dot(w) / x_norm;
-        lower_direction = x / x_norm;
-      }
-      const Eigen::Vector3d d = w - x;
-      const double length2 = d.squaredNorm();
-      if (!(length2 > 0)) break;
-      const double t = std::min(1.0, -x.dot(d) / length2);
-      if (!(t > 0)) break;
-      core_a += t * (pa - core_a);
-      core_b += t * (pb - core_b);
-      x = core_a - core_b;
-      ++iteration;
-    }
-    v = x;
-  }
-  result.iterations = iteration;
+}
 
+/// Where GJK did not converge (near touching a round side the simplex's corners crowd together
+/// and its nearest point stops coming nearer to rounding): Frank-Wolfe steps from there (x the
+/// point of A - B, moved to the nearest point of the segment to the support point w in the
+/// direction -x: nearer at every step, no simplex to round), each w bounding the distance from
+/// below by x.w / |x|; the witness points move along.
+void frankWolfe(const SupportMapping& a, const SupportMapping& b, double tolerance, double slack,
+                DistanceSearch& search) {
+  Eigen::Vector3d x = search.core_a - search.core_b;
+  for (int step = 0; step < 64 && !(x.norm() - search.lower <= tolerance); ++step) {
+    const double x_norm = x.norm();
+    if (!(x_norm > slack)) break;
+    const Eigen::Vector3d pa = a.support(-x), pb = b.support(x);
+    const Eigen::Vector3d w = pa - pb;
+    search.bound(x.dot(w) / x_norm, x / x_norm);
+    const Eigen::Vector3d d = w - x;
+    const double length2 = d.squaredNorm();
+    if (!(length2 > 0)) break;
+    const double t = std::min(1.0, -x.dot(d) / length2);
+    if (!(t > 0)) break;
+    search.core_a += t * (pa - search.core_a);
+    search.core_b += t * (pb - search.core_b);
+    x = search.core_a - search.core_b;
+    ++search.iteration;
+  }
+  search.v = x;
+}
+
+/// The answer from the search: the normal along the best lower bound (a face's normal is known to
+/// the shapes' relative rounding even where the distance is 1e-10, v's direction or the witness
+/// points' difference only to their absolute rounding), the bounds less the margins, the
+/// surface points.
+ConvexDistance answerOf(const DistanceSearch& search, const SupportMapping& a,
+                        const SupportMapping& b, const Eigen::Vector3d& direction, double slack) {
+  ConvexDistance result;
+  result.iterations = search.iteration;
+  const double margins = a.margin() + b.margin();
   // The closest points are points of the cores: their distance bounds the cores' from above.
-  const Eigen::Vector3d between = core_b - core_a;
+  const Eigen::Vector3d between = search.core_b - search.core_a;
   const double apart = between.norm();
-  // The normal: the direction of the best lower bound (a face's normal is known to the shapes'
-  // relative rounding even where the distance is 1e-10, v's direction or the witness points'
-  // difference only to their absolute rounding).
-  if (lower_direction.squaredNorm() > 0) {
-    result.normal = -lower_direction;
-  } else if (v.norm() > 0) {
-    result.normal = -v.normalized();
+  if (search.lower_direction.squaredNorm() > 0) {
+    result.normal = -search.lower_direction;
+  } else if (search.v.norm() > 0) {
+    result.normal = -search.v.normalized();
   } else if (apart > 0) {
     result.normal = between / apart;
   } else {
     result.normal = direction.normalized();
   }
-  result.overlapping = overlapping;
-  if (overlapping) {
+  result.overlapping = search.overlapping;
+  if (search.overlapping) {
     result.lower = -INFINITY;
     result.upper = slack - margins;
   } else {
-    result.lower = std::min(lower, apart) - slack - margins;
+    result.lower = std::min(search.lower, apart) - slack - margins;
     result.upper = apart + slack - margins;
   }
-  result.point_a = core_a + a.margin() * result.normal;
-  result.point_b = core_b - b.margin() * result.normal;
+  result.point_a = search.core_a + a.margin() * result.normal;
+  result.point_b = search.core_b - b.margin() * result.normal;
   return result;
+}
+
+}  // namespace
+
+ConvexDistance convexDistance(const SupportMapping& a, const SupportMapping& b, double tolerance,
+                              int max_iterations) {
+  // The rounding of a support point (a rotation and a translation of the shape's point) and of
+  // the dot products below: a few ulps of the sets' sizes and positions.
+  const double slack = 64 * kEps * (a.scale() + b.scale());
+  Eigen::Vector3d direction = b.centre() - a.centre();  // from a towards b
+  if (!(direction.squaredNorm() > 0)) direction = Eigen::Vector3d::UnitZ();
+  DistanceSearch search;
+  gjk(a, b, direction, tolerance, slack, max_iterations, search);
+  witnessPoints(search);
+  if (!search.overlapping && search.v.norm() - search.lower > tolerance) {
+    frankWolfe(a, b, tolerance, slack, search);
+  }
+  return answerOf(search, a, b, direction, slack);
 }
 
 }  // namespace collision_response::core
