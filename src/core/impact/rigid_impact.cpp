@@ -307,11 +307,25 @@ std::vector<double> jointImpulses(const MatrixL& delassus, const VectorL& target
 
 }  // namespace
 
-Expected<std::vector<ContactOutcome>> resolveRigidSimultaneous(
-    std::vector<SolverBody>& bodies, const std::vector<ClusterContact>& contacts) {
+namespace {
+
+/// Each contact's side on a body: the body, its sign s (b: +1, a: -1), its lever arm.
+struct ContactSideL {
+  std::size_t body;
+  RealL sign;
+  Vector3L lever;
+};
+std::array<ContactSideL, 2> sidesOf(const ClusterContact& c) {
+  return {ContactSideL{c.a, RealL(-1), c.lever_a.cast<RealL>()},
+          ContactSideL{c.b, RealL(1), c.lever_b.cast<RealL>()}};
+}
+
+/// Every body and contact of a simultaneous impact checked, each refusal naming its field.
+Status checkSimultaneous(const std::vector<SolverBody>& bodies,
+                         const std::vector<ClusterContact>& contacts) {
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     if (auto status = checkBodyForImpact(bodies[i], "bodies[" + std::to_string(i) + "]"); !status) {
-      return status.error();
+      return status;
     }
   }
   for (std::size_t k = 0; k < contacts.size(); ++k) {
@@ -323,39 +337,41 @@ Expected<std::vector<ContactOutcome>> resolveRigidSimultaneous(
                                     ", got a = " + std::to_string(contact.a) +
                                     ", b = " + std::to_string(contact.b)};
     }
-    if (auto status = checkContactGeometry(contact, field); !status) return status.error();
+    if (auto status = checkContactGeometry(contact, field); !status) return status;
     if (auto status = checkRestitution(contact.restitution, field + "restitution"); !status) {
-      return status.error();
+      return status;
     }
     if (bodies[contact.a].inverse_mass == 0.0 && bodies[contact.b].inverse_mass == 0.0) {
       return Error{field + "b",
                    "both sides of the contact are immovable (inverse mass 0): nothing can move"};
     }
   }
-  if (contacts.empty()) return std::vector<ContactOutcome>{};
-  if (std::all_of(bodies.begin(), bodies.end(), [](const SolverBody& body) {
-        return body.inertia_kind == InverseInertiaKind::kIsotropic;
-      })) {
-    return resolveSimultaneous(bodies, contacts);
-  }
+  return Ok{};
+}
 
-  const std::vector<std::size_t> order = canonicalOrder(contacts);
+/// Newton's joint rule A J = (1 + e)(-d) over the contacts in `order`: the Delassus matrix A,
+/// the target and each contact's approach speed -d, in long double, and each body's inverse
+/// inertia.
+struct JointSystem {
+  std::vector<Matrix3L> inverse_inertia;
+  MatrixL delassus;
+  VectorL target;
+  VectorL approach;  // -d_k
+};
+JointSystem jointSystem(const std::vector<SolverBody>& bodies,
+                        const std::vector<ClusterContact>& contacts,
+                        const std::vector<std::size_t>& order) {
   const auto count = static_cast<Eigen::Index>(contacts.size());
-  std::vector<Matrix3L> inverse_inertia(bodies.size());
+  JointSystem system;
+  std::vector<Matrix3L>& inverse_inertia = system.inverse_inertia;
+  inverse_inertia.resize(bodies.size());
   for (std::size_t i = 0; i < bodies.size(); ++i) inverse_inertia[i] = inverseInertiaOf(bodies[i]);
-  // Each contact's side on a body: the body, its sign s (b: +1, a: -1), its lever arm.
-  struct Side {
-    std::size_t body;
-    RealL sign;
-    Vector3L lever;
-  };
-  const auto sidesOf = [&](const ClusterContact& c) {
-    return std::array<Side, 2>{Side{c.a, RealL(-1), c.lever_a.cast<RealL>()},
-                               Side{c.b, RealL(1), c.lever_b.cast<RealL>()}};
-  };
-  MatrixL delassus = MatrixL::Zero(count, count);
-  VectorL target(count);
-  VectorL approach(count);  // -d_k
+  MatrixL& delassus = system.delassus;
+  delassus = MatrixL::Zero(count, count);
+  VectorL& target = system.target;
+  target.resize(count);
+  VectorL& approach = system.approach;
+  approach.resize(count);
   for (Eigen::Index i = 0; i < count; ++i) {
     const ClusterContact& ci = contacts[order[static_cast<std::size_t>(i)]];
     const Vector3L ni = ci.normal.cast<RealL>();
@@ -367,8 +383,8 @@ Expected<std::vector<ContactOutcome>> resolveRigidSimultaneous(
       const ClusterContact& cj = contacts[order[static_cast<std::size_t>(j)]];
       const Vector3L nj = cj.normal.cast<RealL>();
       RealL value = 0;
-      for (const Side& si : sidesOf(ci)) {
-        for (const Side& sj : sidesOf(cj)) {
+      for (const ContactSideL& si : sidesOf(ci)) {
+        for (const ContactSideL& sj : sidesOf(cj)) {
           if (si.body != sj.body || bodies[si.body].inverse_mass == 0.0) continue;
           value += si.sign * sj.sign *
                    (RealL(bodies[si.body].inverse_mass) * ni.dot(nj) +
@@ -378,15 +394,26 @@ Expected<std::vector<ContactOutcome>> resolveRigidSimultaneous(
       delassus(i, j) = value;
     }
   }
-  const std::vector<double> impulses = jointImpulses(delassus, target);
+  return system;
+}
 
+/// The impulses applied: each body's velocity changes summed free of order, every result checked
+/// representable; the bodies updated in place only where all is (references to them stay
+/// valid), the outcomes in the order of `contacts`.
+Expected<std::vector<ContactOutcome>> applyJointImpulses(
+    std::vector<SolverBody>& bodies, const std::vector<ClusterContact>& contacts,
+    const std::vector<std::size_t>& order, const JointSystem& system,
+    const std::vector<double>& impulses) {
+  const auto count = static_cast<Eigen::Index>(contacts.size());
+  const std::vector<Matrix3L>& inverse_inertia = system.inverse_inertia;
+  const VectorL& approach = system.approach;
   std::vector<ContactOutcome> outcomes(contacts.size());
   std::vector<std::array<std::vector<RealL>, 6>> changes(bodies.size());  // dv, dw per axis
   for (Eigen::Index i = 0; i < count; ++i) {
     const std::size_t k = order[static_cast<std::size_t>(i)];
     const ClusterContact& contact = contacts[k];
     const RealL impulse = impulses[static_cast<std::size_t>(i)];
-    for (const Side& side : sidesOf(contact)) {
+    for (const ContactSideL& side : sidesOf(contact)) {
       const SolverBody& body = bodies[side.body];
       if (body.inverse_mass == 0.0 || impulse == 0) continue;
       const Vector3L force = side.sign * impulse * contact.normal.cast<RealL>();
@@ -427,6 +454,23 @@ Expected<std::vector<ContactOutcome>> resolveRigidSimultaneous(
   }
   std::copy(after.begin(), after.end(), bodies.begin());  // in place: references to them stay valid
   return outcomes;
+}
+
+}  // namespace
+
+Expected<std::vector<ContactOutcome>> resolveRigidSimultaneous(
+    std::vector<SolverBody>& bodies, const std::vector<ClusterContact>& contacts) {
+  if (auto status = checkSimultaneous(bodies, contacts); !status) return status.error();
+  if (contacts.empty()) return std::vector<ContactOutcome>{};
+  if (std::all_of(bodies.begin(), bodies.end(), [](const SolverBody& body) {
+        return body.inertia_kind == InverseInertiaKind::kIsotropic;
+      })) {
+    return resolveSimultaneous(bodies, contacts);
+  }
+  const std::vector<std::size_t> order = canonicalOrder(contacts);
+  const JointSystem system = jointSystem(bodies, contacts, order);
+  const std::vector<double> impulses = jointImpulses(system.delassus, system.target);
+  return applyJointImpulses(bodies, contacts, order, system, impulses);
 }
 
 }  // namespace collision_response::core
