@@ -174,6 +174,43 @@ LiveCalibration::LiveCalibration(const core::Scene& scene, double window_seconds
   }
 }
 
+namespace {
+
+/// The request's spin before the window's first bounce: none (empty), or 3 finite values; an
+/// error names `spin_before`.
+core::Expected<std::optional<Eigen::Vector3d>> spinBeforeOf(
+    const EstimateRestitution::Request& request) {
+  if (request.spin_before.empty()) return std::optional<Eigen::Vector3d>{};
+  if (request.spin_before.size() != 3) {
+    return core::Error{"spin_before",
+                       "must be empty (unknown) or 3 values (rad/s, the fixed frame), got " +
+                           std::to_string(request.spin_before.size())};
+  }
+  const Eigen::Vector3d spin(request.spin_before[0], request.spin_before[1],
+                             request.spin_before[2]);
+  if (!spin.allFinite()) return core::Error{"spin_before", "must be finite"};
+  return std::optional<Eigen::Vector3d>{spin};
+}
+
+/// The response's e, mu and bounces: one pair's.
+void answerWith(const core::Coefficients& c, EstimateRestitution::Response& response) {
+  response.restitution = c.restitution.value;
+  response.restitution_low = c.restitution.low();
+  response.restitution_high = c.restitution.high();
+  response.bounces = static_cast<std::int32_t>(c.bounces);
+  response.friction_known = c.friction.has_value();
+  if (c.friction) {
+    response.friction = c.friction->value;
+    response.friction_low = c.friction->low();
+    response.friction_high = c.friction->high();
+  } else {
+    response.friction = response.friction_low = response.friction_high = 0.0;
+  }
+  response.friction_lower_bound = c.friction_lower_bound.value_or(0.0);
+}
+
+}  // namespace
+
 void LiveCalibration::answer(const EstimateRestitution::Request& request,
                              EstimateRestitution::Response& response,
                              std::vector<PairEstimate>& pairs) const {
@@ -186,17 +223,8 @@ void LiveCalibration::answer(const EstimateRestitution::Request& request,
     return refuse("max_bounces: must be 0 (every bounce in the window) or more, got " +
                   std::to_string(request.max_bounces));
   }
-  std::optional<Eigen::Vector3d> spin_before;
-  if (!request.spin_before.empty()) {
-    if (request.spin_before.size() != 3) {
-      return refuse(
-          "spin_before: must be empty (unknown) or 3 values (rad/s, the fixed frame), got " +
-          std::to_string(request.spin_before.size()));
-    }
-    spin_before =
-        Eigen::Vector3d(request.spin_before[0], request.spin_before[1], request.spin_before[2]);
-    if (!spin_before->allFinite()) return refuse("spin_before: must be finite");
-  }
+  const auto spin_before = spinBeforeOf(request);
+  if (!spin_before) return refuse(spin_before.error().message());
   if (!window_.enabled()) {
     return refuse("body: ~calibration_window is 0: the node keeps no states to fit '" +
                   request.body + "' from (set it to the seconds of states to keep)");
@@ -217,7 +245,7 @@ void LiveCalibration::answer(const EstimateRestitution::Request& request,
     return refuse("body: no state of '" + body.id + "' in the window (" + window_text + ")");
   }
   core::CalibrationOptions options = core::forBody(options_, body.fit);
-  options.spin_before = spin_before;
+  options.spin_before = *spin_before;
   std::string what = "body '" + body.id + "', " + std::to_string(samples.size()) + " states over " +
                      decimal(samples.back().time - samples.front().time, 0.01) + " s (" +
                      window_text + ")";
@@ -272,19 +300,7 @@ void LiveCalibration::answer(const EstimateRestitution::Request& request,
             ", " + frictionText(c);
     if (c.bounces > most) {
       most = c.bounces;
-      response.restitution = c.restitution.value;
-      response.restitution_low = c.restitution.low();
-      response.restitution_high = c.restitution.high();
-      response.bounces = static_cast<std::int32_t>(c.bounces);
-      response.friction_known = c.friction.has_value();
-      if (c.friction) {
-        response.friction = c.friction->value;
-        response.friction_low = c.friction->low();
-        response.friction_high = c.friction->high();
-      } else {
-        response.friction = response.friction_low = response.friction_high = 0.0;
-      }
-      response.friction_lower_bound = c.friction_lower_bound.value_or(0.0);
+      answerWith(c, response);
     }
     pairs.push_back(std::move(estimate));
   }
