@@ -1,0 +1,94 @@
+// A shaped body's lasting contact with one flat face (issue 42, build step 6): a box, cylinder or
+// capsule resting, sliding or rolling on a plane or on a face of a box obstacle, under gravity,
+// by closed forms. What is not modelled yet (tipping over an edge, rocking, spin about the
+// face's normal while the body slides, a cylinder rolling with its axis not across the slope) is
+// refused by name, so that the caller says so instead of moving the body through the face.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "collision_response/core/expected.h"
+#include "collision_response/core/monitor.h"
+#include "geometry/convex_distance.h"
+
+namespace collision_response::core {
+
+/// The body at the instant its contact begins to last, in its principal frame (as
+/// PrincipalBody: its shape about its centre of mass along its principal axes).
+struct LastingBody {
+  ConvexShape shape;
+  Eigen::Vector3d moments = Eigen::Vector3d::Ones();  ///< kg m^2, principal, about x, y, z
+  double mass = 0.0;                                  ///< kg
+  double time = 0.0;                                  ///< s
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();   ///< m, the centre of mass
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();       ///< rad/s, world
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< world from principal
+  Eigen::Vector3d gravity = Eigen::Vector3d::Zero();                ///< m/s^2
+};
+
+/// The fixed flat face it lasts on: a plane obstacle (unbounded), or a face of a box obstacle
+/// (bounded: `half_extent` along `along_u` and `along_v` about `point`).
+struct FlatFace {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();    ///< on the face
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< unit, out of the face, towards the body
+  double friction = 0.0;                              ///< the pair's mu (0: frictionless)
+  bool bounded = false;
+  Eigen::Vector3d along_u = Eigen::Vector3d::UnitX();  ///< unit, in the face (bounded only)
+  Eigen::Vector3d along_v = Eigen::Vector3d::UnitY();
+  Eigen::Vector2d half_extent = Eigen::Vector2d::Zero();  ///< m (bounded only)
+};
+
+/// One point of the contact's manifold and what it carries.
+struct SupportForce {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();           ///< on the face, world
+  double normal_force = 0.0;                                 ///< N, >= 0, on the body along n
+  Eigen::Vector3d friction_force = Eigen::Vector3d::Zero();  ///< N, on the body, in the face
+};
+
+/// A lasting motion on one face, in closed form over [start, until].
+struct LastingMotion {
+  ContactState state = ContactState::kResting;
+  double start = 0.0;  ///< s
+  /// s: where this motion ends (sliding stops, a roll reaches the face's edge, ...); +inf: never.
+  double until = std::numeric_limits<double>::infinity();
+  /// What happens at `until` (empty for never): "stops" (the caller asks lastingOnFace again
+  /// from the state there), or why it is no longer modelled ("reaches the face's edge").
+  std::string ends;
+  // The state at t in [start, until]: the centre's parabola and the turn, by the closed form.
+  Eigen::Vector3d centre0 = Eigen::Vector3d::Zero(), velocity0 = Eigen::Vector3d::Zero(),
+                  acceleration = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity0 = Eigen::Vector3d::Zero(),
+                  angular_acceleration = Eigen::Vector3d::Zero();    ///< about a fixed axis
+  Eigen::Quaterniond orientation0 = Eigen::Quaterniond::Identity();  ///< world from principal
+  /// The contact's points (the manifold) and their forces, at `start`; forcesAt gives them at t.
+  std::vector<SupportForce> forces;
+
+  Eigen::Vector3d centreAt(double t) const;
+  Eigen::Vector3d velocityAt(double t) const;
+  Eigen::Vector3d angularVelocityAt(double t) const;
+  Eigen::Quaterniond orientationAt(double t) const;
+  std::vector<SupportForce> forcesAt(double t) const;
+};
+
+/// The lasting motion that starts from `body` touching `face` (within the touching band, not
+/// approaching it), or an Error whose message says what is not modelled yet, for the caller to
+/// report (e.g. "not yet: tipping over an edge", "not yet: spin about the face's normal while
+/// sliding"). The body must not gain energy, and no point of it goes below the face.
+Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& face);
+
+/// Bounces on one face that accumulate: a body landing flat on a face or a side (every point of
+/// its manifold approaching at the same speed u, no slip, no spin about the normal), which the
+/// joint frictionless rule sends back at e u, lands again and again under gravity's component
+/// into the face g_n; the series ends 2 e u / (g_n (1 - e)) after `body.time` (as a ball's,
+/// doc/model.md "Coming to rest"), where the body rests on the face. Empty where the landing is
+/// not such a flat one, or e is 1.
+std::optional<double> flatBouncesEnd(const LastingBody& body, const FlatFace& face,
+                                     double restitution);
+
+}  // namespace collision_response::core
