@@ -1,0 +1,387 @@
+#include "monitor/shaped_motion.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include "collision_response/core/body_shape.h"
+#include "collision_response/core/rigid_impact.h"
+#include "geometry/narrow_phase.h"
+
+namespace collision_response::core {
+
+namespace {
+
+/// The shape's points about the centre of mass in the principal frame: a box's corners, where
+/// the frame is turned or the centre moved.
+ConvexHull boxCorners(const Cuboid& box, const Eigen::Matrix3d& principal_from_body,
+                      const Eigen::Vector3d& centre_of_mass) {
+  ConvexHull hull;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d sign((corner & 1) ? 1.0 : -1.0, (corner & 2) ? 1.0 : -1.0,
+                               (corner & 4) ? 1.0 : -1.0);
+    hull.vertices.push_back(principal_from_body *
+                            (sign.cwiseProduct(box.half_size) - centre_of_mass));
+  }
+  return hull;
+}
+
+}  // namespace
+
+Expected<PrincipalBody> principalBody(const BodySpec& body, const std::string& field) {
+  if (body.shape == BodyShape::kMesh) {
+    return Error{field + ".shape",
+                 "not yet: a mesh body is not predicted (a box, cylinder, capsule or sphere is)"};
+  }
+  auto properties = bodyMassProperties(body, field + ".inertia");
+  if (!properties) return properties.error();
+  PrincipalBody principal;
+  principal.mass = properties->mass;
+  principal.centre_of_mass = properties->centre_of_mass;
+  const Eigen::Matrix3d& inertia = properties->inertia;
+  const bool diagonal = inertia(0, 1) == 0.0 && inertia(0, 2) == 0.0 && inertia(1, 2) == 0.0 &&
+                        inertia(1, 0) == 0.0 && inertia(2, 0) == 0.0 && inertia(2, 1) == 0.0;
+  Eigen::Matrix3d body_from_principal = Eigen::Matrix3d::Identity();
+  if (diagonal) {
+    principal.moments = inertia.diagonal();
+  } else {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(inertia);
+    principal.moments = solver.eigenvalues();
+    body_from_principal = solver.eigenvectors();
+    if (body_from_principal.determinant() < 0) body_from_principal.col(2) *= -1.0;
+  }
+  principal.body_from_principal = Eigen::Quaterniond(body_from_principal);
+  const bool moved = !diagonal || !principal.centre_of_mass.isZero(0.0);
+  const Eigen::Matrix3d principal_from_body = body_from_principal.transpose();
+  const Shape shape = shapeOf(body);
+  if (const auto* sphere = std::get_if<Sphere>(&shape)) {
+    principal.shape =
+        Sphere{principal_from_body * (sphere->centre - principal.centre_of_mass), sphere->radius};
+  } else if (const auto* box = std::get_if<Cuboid>(&shape)) {
+    if (moved) {
+      principal.shape = boxCorners(*box, principal_from_body, principal.centre_of_mass);
+    } else {
+      principal.shape = *box;
+    }
+  } else if (moved) {
+    return Error{field + ".inertia",
+                 "not yet: a cylinder's or a capsule's tensor must have no products of inertia "
+                 "(its axis and two across it principal), as its uniform solid's has"};
+  } else if (const auto* cylinder = std::get_if<Cylinder>(&shape)) {
+    principal.shape = *cylinder;
+  } else if (const auto* capsule = std::get_if<Capsule>(&shape)) {
+    principal.shape = *capsule;
+  }
+  return principal;
+}
+
+namespace {
+
+/// A rebound lifting no point by more than this fraction of the body's reach: settled.
+constexpr double kSettled = 1e-6;
+/// Contacts this close to the earliest (relative to the instant, 1e-12) strike together.
+constexpr double kSimultaneous = 1e-12;
+
+/// An obstacle as the solver sees it at `time`: immovable, moving on as it moves.
+SolverBody obstacleBody(const PlacedShape& placed, double time) {
+  const PlacedShape now = shapeAt(placed, time);
+  SolverBody solver;
+  solver.velocity = now.pose.velocity;
+  solver.angular_velocity = now.pose.angular_velocity;
+  solver.inertia_kind = InverseInertiaKind::kTensor;
+  return solver;
+}
+
+}  // namespace
+
+Expected<ShapedMotion> ShapedMotion::create(PrincipalBody principal,
+                                            std::vector<ShapedObstacle> placed, ShapedScene scene,
+                                            const BodyStateSample& state) {
+  const Eigen::Quaterniond orientation =
+      state.orientation.normalized() * principal.body_from_principal;
+  auto flight =
+      TumblingBody::create(principal.shape, principal.moments, state.time, state.position,
+                           state.velocity, scene.acceleration, orientation, state.angular_velocity);
+  if (!flight) return flight.error();
+  ShapedMotion motion(std::move(principal), std::move(scene), std::move(flight.value()),
+                      state.time);
+  for (ShapedObstacle& obstacle : placed) {
+    motion.obstacles_.push_back({std::move(obstacle), state.time, false});
+  }
+  return motion;
+}
+
+BodyStateSample ShapedMotion::stateOn(const TumblingBody& flight, double time) const {
+  BodyStateSample state;
+  state.body = scene_.body;
+  state.time = time;
+  state.position = flight.positionAt(time);
+  state.velocity = flight.velocityAt(time);
+  state.angular_velocity = flight.angularVelocityAt(time);
+  state.orientation = flight.orientationAt(time) * principal_.body_from_principal.conjugate();
+  return state;
+}
+
+std::optional<std::size_t> ShapedMotion::insideAtStart() const {
+  for (const Watched& w : obstacles_) {
+    const SurfaceGap gap = gapAt(flight_, w.placed.placed, time_);
+    if (gap.overlapping || gap.gap_upper < 0) return w.placed.obstacle;
+  }
+  return std::nullopt;
+}
+
+std::vector<std::size_t> ShapedMotion::lastingWith() const {
+  std::vector<std::size_t> with;
+  for (const ObstacleContact& c : lasting_) with.push_back(c.obstacle);
+  return with;
+}
+
+Expected<ShapedMotion::Found> ShapedMotion::next(double horizon,
+                                                 std::vector<ImpactRecord>& impacts) {
+  const std::vector<ObstacleContact> contacts = firstContacts(flight_, horizon);
+  if (contacts.empty()) return Found{Event::kFree, horizon};
+  // An impact: every obstacle touching at the instant, each point of its manifold.
+  const double at = contacts.front().contact.time;
+  SolverBody moving = solverBody(flight_, at);
+  const auto resolved = resolve(flight_, moving, contacts, at, impacts);
+  if (!resolved) return resolved.error();
+  if (!*resolved) {
+    // Touching without approaching: parting, or a contact that lasts. Found again where the
+    // body was last known apart from it (a slow graze, a roll on a rim), it lasts.
+    bool again = false;
+    for (const ObstacleContact& c : contacts) {
+      const Watched& w = obstacles_[c.slot];
+      again = again || (w.parted && at == w.clear_from);
+    }
+    const auto apart = again ? std::nullopt : separation(flight_, at, contacts, horizon);
+    if (!apart) {
+      lasting_ = contacts;
+      return Found{Event::kLasting, at};
+    }
+    clearUntil(at, contacts, *apart);
+    return Found{Event::kGrazed, at};
+  }
+  auto after = TumblingBody::create(principal_.shape, principal_.moments, at,
+                                    flight_.positionAt(at), moving.velocity, flight_.acceleration(),
+                                    flight_.orientationAt(at), moving.angular_velocity);
+  if (!after) return after.error();
+  flight_ = std::move(after.value());
+  time_ = at;
+  struck_ = contacts;
+  return Found{Event::kImpact, at};
+}
+
+bool ShapedMotion::leave(double horizon) {
+  // The points just struck leave their obstacles: the next contact with those is looked for
+  // once they are apart (separation), with every other obstacle from now.
+  const auto apart = separation(flight_, time_, struck_, horizon);
+  if (!apart) {
+    lasting_ = struck_;
+    return false;
+  }
+  clearUntil(time_, struck_, *apart);
+  return true;
+}
+
+/// The earliest contacts (every obstacle touching then, within the instant's rounding), each
+/// obstacle searched from the instant it is known apart until (Watched::clear_from); none
+/// within the horizon: empty.
+std::vector<ShapedMotion::ObstacleContact> ShapedMotion::firstContacts(const TumblingBody& body,
+                                                                       double horizon) const {
+  std::vector<ObstacleContact> found;
+  for (std::size_t slot = 0; slot < obstacles_.size(); ++slot) {
+    const PlacedShape& placed = obstacles_[slot].placed.placed;
+    const double start = obstacles_[slot].clear_from;
+    if (!(start < horizon)) continue;
+    // The advancement's step budget may run out on a slow graze before the horizon: it goes
+    // on from where it is known apart.
+    for (double clear = start;;) {
+      const FirstContactResult result = firstContact(body, placed, clear, horizon - clear);
+      if (result.contact) {
+        found.push_back({obstacles_[slot].placed.obstacle, slot, *result.contact});
+        break;
+      }
+      if (!(result.clear_until > clear && result.clear_until < horizon)) break;
+      clear = result.clear_until;
+    }
+  }
+  if (found.empty()) return found;
+  double earliest = std::numeric_limits<double>::infinity();
+  for (const ObstacleContact& c : found) earliest = std::min(earliest, c.contact.time);
+  const double together = earliest + kSimultaneous * std::max(1.0, std::abs(earliest));
+  std::vector<ObstacleContact> first;
+  for (ObstacleContact& c : found) {
+    if (c.contact.time <= together) first.push_back(std::move(c));
+  }
+  return first;
+}
+
+/// The body as the impact's solver sees it at `time`.
+SolverBody ShapedMotion::solverBody(const TumblingBody& body, double time) const {
+  SolverBody solver;
+  solver.inverse_mass = 1.0 / principal_.mass;
+  solver.velocity = body.velocityAt(time);
+  solver.angular_velocity = body.angularVelocityAt(time);
+  solver.inertia_kind = InverseInertiaKind::kTensor;
+  const Eigen::Matrix3d rotation = body.orientationAt(time).toRotationMatrix();
+  solver.inverse_inertia =
+      rotation * principal_.moments.cwiseInverse().asDiagonal() * rotation.transpose();
+  return solver;
+}
+
+/// After an impact or a graze at `time` with `contacts`' obstacles, apart from them at `apart`:
+/// those are looked at again from `apart`, every other one from `time` (no contact with it
+/// before: the contacts were the earliest), never from an earlier instant than it was known
+/// apart until. Each obstacle keeps its own instant: one struck before a graze of another is not
+/// looked at again from that impact's instant, where its points still touch it and would be found
+/// again at once, for ever.
+void ShapedMotion::clearUntil(double time, const std::vector<ObstacleContact>& contacts,
+                              double apart) {
+  for (Watched& w : obstacles_) {
+    w.clear_from = std::max(w.clear_from, time);
+    w.parted = false;
+  }
+  for (const ObstacleContact& c : contacts) {
+    obstacles_[c.slot].clear_from = apart;
+    obstacles_[c.slot].parted = true;
+  }
+}
+
+/// Resolves the impact at `time` of `moving` (updated) with the contacts' points: one point by
+/// Chatterjee and Ruina's law with the pair's friction, several at once by the joint frictionless
+/// rule (rigid_impact.h). False where no point approaches (a lasting contact).
+Expected<bool> ShapedMotion::resolve(const TumblingBody& body, SolverBody& moving,
+                                     const std::vector<ObstacleContact>& contacts, double time,
+                                     std::vector<ImpactRecord>& impacts) {
+  std::vector<SolverBody> bodies{moving};
+  std::vector<ClusterContact> points;
+  std::vector<std::size_t> point_obstacle;
+  double fastest = 0.0;
+  for (const ObstacleContact& c : contacts) {
+    const PlacedShape& placed = obstacles_[c.slot].placed.placed;
+    bodies.push_back(obstacleBody(placed, time));
+    const auto restitution = scene_.restitution(c.obstacle);
+    if (!restitution) return restitution.error();
+    for (const ManifoldPoint& point : c.contact.manifold) {
+      ClusterContact contact;
+      contact.a = 0;
+      contact.b = bodies.size() - 1;
+      contact.normal = c.contact.closest.normal;
+      contact.point = 0.5 * (point.point_a + point.point_b);
+      contact.lever_a = point.lever_a;
+      contact.lever_b = point.lever_b;
+      contact.restitution = *restitution;
+      const Eigen::Vector3d relative = body.pointVelocityAt(time, point.point_a) -
+                                       bodies.back().velocity -
+                                       bodies.back().angular_velocity.cross(point.lever_b);
+      fastest = std::max(fastest, contact.normal.dot(relative));
+      points.push_back(contact);
+      point_obstacle.push_back(c.obstacle);
+    }
+  }
+  if (!(fastest > 0)) return false;
+  // Bounces that accumulate (a body settling, rocking from edge to edge) would go on for ever in
+  // finitely many seconds: where even an elastic rebound could lift no point by more than
+  // kSettled of the body's reach, the contact is taken to last.
+  const double lift = body.acceleration().norm() * kSettled * body.reach();
+  if (fastest * fastest <= 2 * lift) return false;
+  const bool bounces = fastest >= scene_.restitution_threshold;
+  if (!bounces) {
+    for (ClusterContact& point : points) point.restitution = 0.0;
+  }
+  const Eigen::Vector3d velocity_before = moving.velocity;
+  const Eigen::Vector3d angular_before = moving.angular_velocity;
+  std::vector<ImpactRecord> records;
+  if (points.size() == 1) {
+    const auto friction = scene_.friction(point_obstacle.front());
+    if (!friction) return friction.error();
+    auto outcome = resolveRigidImpact(bodies[0], bodies[1], points.front(),
+                                      points.front().restitution, *friction);
+    if (!outcome) return outcome.error();
+    ImpactRecord record = recordOf(points.front(), point_obstacle.front(), time, bodies[1]);
+    record.impulse = outcome->normal_impulse;
+    record.friction_impulse = outcome->tangential_impulse.norm();
+    record.energy_lost = outcome->energy_lost;
+    records.push_back(record);
+  } else {
+    bool frictional = false;
+    for (const std::size_t o : point_obstacle) {
+      const auto friction = scene_.friction(o);
+      if (!friction) return friction.error();
+      frictional = frictional || *friction > 0;
+    }
+    if (frictional && !frictionless_at_) frictionless_at_ = time;
+    auto outcomes = resolveRigidSimultaneous(bodies, points);
+    if (!outcomes) return outcomes.error();
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      ImpactRecord record = recordOf(points[k], point_obstacle[k], time, bodies[points[k].b]);
+      record.impulse = (*outcomes)[k].impulse;
+      record.energy_lost = (*outcomes)[k].energy_lost;
+      records.push_back(record);
+    }
+  }
+  moving = bodies[0];
+  for (ImpactRecord& record : records) {
+    record.velocity_a_before = velocity_before;
+    record.angular_velocity_a_before = angular_before;
+    record.velocity_a_after = moving.velocity;
+    record.angular_velocity_a_after = moving.angular_velocity;
+    impacts.push_back(record);
+  }
+  return true;
+}
+
+ImpactRecord ShapedMotion::recordOf(const ClusterContact& point, std::size_t obstacle, double time,
+                                    const SolverBody& other) const {
+  ImpactRecord record;
+  record.time = time;
+  record.body_a = scene_.body;
+  record.other = obstacle;
+  record.other_is_obstacle = true;
+  record.contact_point = point.point;
+  record.normal = point.normal;
+  record.restitution = point.restitution;
+  record.velocity_b_before = other.velocity;
+  record.velocity_b_after = other.velocity;
+  record.angular_velocity_b_before = other.angular_velocity;
+  record.angular_velocity_b_after = other.angular_velocity;
+  return record;
+}
+
+/// After an impact at `time`: the instant from which the obstacles it left are looked at again,
+/// once every point of the body is apart from them: a step short enough that no point of the
+/// body moves by half the manifold's band relative to them (V s + A s^2 / 2 <= band / 2, V the
+/// bound on the points' relative speed, A on their acceleration: a point further than the band
+/// from an obstacle at the impact was not struck, and cannot reach it within the step), after
+/// which the gap to each obstacle must be open. Where it is not (the points struck leave too
+/// slowly to part: plastic, or bounces that accumulate), or where nothing moves at all, the
+/// contact lasts: empty.
+std::optional<double> ShapedMotion::separation(const TumblingBody& body, double time,
+                                               const std::vector<ObstacleContact>& left,
+                                               double horizon) const {
+  double speed = body.velocityAt(time).norm() + body.angularSpeedBound() * body.reach();
+  double acceleration = body.acceleration().norm();
+  for (const ObstacleContact& c : left) {
+    const PlacedShape now = shapeAt(obstacles_[c.slot].placed.placed, time);
+    const double turning = now.pose.angular_velocity.norm();
+    const double arm =
+        (body.positionAt(time) - now.pose.transform.translation()).norm() + body.reach();
+    speed += now.pose.velocity.norm() + turning * arm;
+    acceleration += turning * (now.pose.velocity.norm() + turning * arm);
+  }
+  if (!(speed > 0) && !(acceleration > 0)) return std::nullopt;  // at rest, touching
+  const double band = FirstContactOptions{}.manifold_band;
+  const double step = std::max(band / (speed + std::sqrt(speed * speed + acceleration * band)),
+                               4 * std::numeric_limits<double>::epsilon() * std::abs(time));
+  const double apart = time + step;
+  if (!(apart < horizon)) return apart;
+  for (const ObstacleContact& c : left) {
+    const SurfaceGap gap = gapAt(body, obstacles_[c.slot].placed.placed, apart);
+    if (gap.overlapping || !(gap.gap > 0)) return std::nullopt;
+  }
+  return apart;
+}
+
+}  // namespace collision_response::core

@@ -1,0 +1,141 @@
+// The motion of a shaped body among obstacles (issue 42): a box, cylinder or capsule (or a sphere
+// given a tensor) moved by its exact flight (its centre's parabola, its torque-free rotation:
+// free_rotation.h), its certified first contacts (tumbling_contact.h) and its impacts with
+// rotation (rigid_impact.h), until its contact with an obstacle would last. One engine, which the
+// shaped body's prediction (shaped_prediction.h: its samples, crossing and budgets) and the
+// monitor (monitor.cpp: a shaped body's track) both run.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "collision_response/core/expected.h"
+#include "collision_response/core/monitor.h"
+#include "collision_response/core/scene.h"
+#include "geometry/convex_distance.h"
+#include "geometry/tumbling_contact.h"
+
+namespace collision_response::core {
+
+/// A body in its principal frame: its shape about its centre of mass, along the axes of its
+/// principal moments, and where that frame is in the body's own.
+struct PrincipalBody {
+  ConvexShape shape;
+  Eigen::Vector3d moments = Eigen::Vector3d::Ones();  ///< kg m^2, about the frame's x, y, z
+  double mass = 0.0;                                  ///< kg
+  /// The body's frame from the principal frame (a rotation), and the centre of mass in the
+  /// body's frame.
+  Eigen::Quaterniond body_from_principal = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d centre_of_mass = Eigen::Vector3d::Zero();
+};
+
+/// A shaped body's principal frame from its shape and mass (bodyMassProperties). A tensor with
+/// products of inertia turns the frame: a box then becomes the hull of its corners; a cylinder
+/// or a capsule given such a tensor is refused (`field`.inertia: not yet). A mesh body is
+/// refused (`field`.shape: not yet predicted).
+Expected<PrincipalBody> principalBody(const BodySpec& body, const std::string& field);
+
+/// An obstacle the shaped body may meet: the model's index and where it is placed.
+struct ShapedObstacle {
+  std::size_t obstacle = 0;
+  PlacedShape placed;
+};
+
+/// What the shaped body's motion needs of the scene.
+struct ShapedScene {
+  Eigen::Vector3d acceleration = Eigen::Vector3d::Zero();  ///< gravity, or zero
+  double restitution_threshold = 0.0;                      ///< m/s, as the scene's
+  /// The pair's coefficients with an obstacle (by its model index); an Error ends the motion.
+  std::function<Expected<double>(std::size_t obstacle)> restitution;
+  std::function<Expected<double>(std::size_t obstacle)> friction;
+  std::size_t body = 0;  ///< the body index its impact records name
+};
+
+/// A shaped body moving among obstacles from a state, flight by flight. next() finds the next
+/// event up to a horizon: no contact (a free flight), an impact (resolved: the records appended,
+/// the flight after it started; then leave() looks for where the struck points are apart), a
+/// graze (touching without approaching, apart again at once), or a contact that lasts.
+class ShapedMotion {
+ public:
+  enum class Event { kFree, kImpact, kGrazed, kLasting };
+  struct Found {
+    Event event = Event::kFree;
+    double time = 0.0;  ///< s: the event's instant (kFree: the horizon)
+  };
+
+  /// The body from `state` (its time, centre, velocities and the body frame's orientation).
+  static Expected<ShapedMotion> create(PrincipalBody principal, std::vector<ShapedObstacle> placed,
+                                       ShapedScene scene, const BodyStateSample& state);
+
+  /// The flight the body is on, from time() on.
+  const TumblingBody& flight() const { return flight_; }
+  double time() const { return time_; }
+  const PrincipalBody& principal() const { return principal_; }
+
+  /// The body's state at `time` on `flight` (a flight of this body): its centre's, and the body
+  /// frame's orientation.
+  BodyStateSample stateOn(const TumblingBody& flight, double time) const;
+
+  /// The first obstacle (model index) the body overlaps or touches from inside at its start.
+  std::optional<std::size_t> insideAtStart() const;
+
+  /// The next event up to `horizon`: the impacts' records appended to `impacts`.
+  Expected<Found> next(double horizon, std::vector<ImpactRecord>& impacts);
+  /// After an impact (next() said kImpact): whether the points struck leave their obstacles
+  /// (they are looked at again from there); false: the contact lasts (lastingWith()).
+  bool leave(double horizon);
+
+  /// The obstacles (model indices) of the contact found to last, and its manifold.
+  std::vector<std::size_t> lastingWith() const;
+  /// The instant friction at several points struck at once was first left out (their joint rule
+  /// is frictionless), if ever.
+  std::optional<double> frictionlessAt() const { return frictionless_at_; }
+
+ private:
+  /// A contact of the body with one obstacle at an instant.
+  struct ObstacleContact {
+    std::size_t obstacle = 0;  ///< the model's index
+    std::size_t slot = 0;      ///< in obstacles_
+    TumblingContact contact;
+  };
+  /// An obstacle placed, and from when it is looked at: no contact with it before clear_from;
+  /// parted: clear_from is where the body was found apart from it after touching it.
+  struct Watched {
+    ShapedObstacle placed;
+    double clear_from = 0.0;
+    bool parted = false;
+  };
+
+  ShapedMotion(PrincipalBody principal, ShapedScene scene, TumblingBody flight, double time)
+      : principal_(std::move(principal)),
+        scene_(std::move(scene)),
+        flight_(std::move(flight)),
+        time_(time) {}
+
+  std::vector<ObstacleContact> firstContacts(const TumblingBody& body, double horizon) const;
+  SolverBody solverBody(const TumblingBody& body, double time) const;
+  void clearUntil(double time, const std::vector<ObstacleContact>& contacts, double apart);
+  Expected<bool> resolve(const TumblingBody& body, SolverBody& moving,
+                         const std::vector<ObstacleContact>& contacts, double time,
+                         std::vector<ImpactRecord>& impacts);
+  ImpactRecord recordOf(const ClusterContact& point, std::size_t obstacle, double time,
+                        const SolverBody& other) const;
+  std::optional<double> separation(const TumblingBody& body, double time,
+                                   const std::vector<ObstacleContact>& left, double horizon) const;
+
+  PrincipalBody principal_;
+  ShapedScene scene_;
+  TumblingBody flight_;
+  double time_ = 0.0;
+  std::vector<Watched> obstacles_;
+  std::vector<ObstacleContact> struck_;   // the last impact's, until leave()
+  std::vector<ObstacleContact> lasting_;  // the contact found to last
+  std::optional<double> frictionless_at_;
+};
+
+}  // namespace collision_response::core
