@@ -664,94 +664,19 @@ DragState rk4(const DragState& x, double k, double h, double l = 0.0, const V& w
                    x.v + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v)};
 }
 
-// A table-tennis ball (2.7 g, 20 mm, C_d 0.5 in air of 1.2 kg/m^3: k = 0.14 1/m, drag 3.5 m/s^2
-// at 5 m/s) thrown at 5 m/s and bouncing twice (e = 0.9, no friction): C_d and e are recovered
-// with drag fitted, starting from C_d 0.47. 200 Hz, 1 mm of noise.
-TEST(Calibration, DragCoefficientFromTheFlights) {
-  const double e = 0.9, radius = 0.02, mass = 0.0027, density = 1.2, cd = 0.5;
-  const double k = density * cd * 3.14159265358979323846 * radius * radius / (2 * mass);
-  const double rate = 200.0, step = 1e-5;
-  std::mt19937_64 random(5);
-  std::normal_distribution<double> noise(0.0, 1e-3);
-  DragState x{V(0, 0, 0.6), V(5.0, 0.0, 1.0)};
-  std::vector<TrackedSample> samples;
-  std::vector<double> bounce_times;
-  double time = 0.0;
-  int next_sample = 0;
-  const double end = 1.6;
-  while (time < end) {
-    DragState y = rk4(x, k, step);
-    if (y.p.z() < radius && bounce_times.size() < 2) {
-      // Bisect the step's length to the crossing, then bounce (no friction: v_t kept).
-      double low = 0.0, high = step;
-      for (int i = 0; i < 60; ++i) {
-        const double mid = 0.5 * (low + high);
-        (rk4(x, k, mid).p.z() >= radius ? low : high) = mid;
-      }
-      while (next_sample / rate <= time + low) {
-        const double s = next_sample / rate - time;
-        samples.push_back({next_sample / rate,
-                           rk4(x, k, s).p + V(noise(random), noise(random), noise(random)),
-                           std::nullopt});
-        ++next_sample;
-      }
-      x = rk4(x, k, low);
-      time += low;
-      bounce_times.push_back(time);
-      x.v.z() = -e * x.v.z();
-      continue;
-    }
-    while (next_sample / rate <= time + step && next_sample / rate <= end) {
-      const double s = next_sample / rate - time;
-      samples.push_back({next_sample / rate,
-                         rk4(x, k, s).p + V(noise(random), noise(random), noise(random)),
-                         std::nullopt});
-      ++next_sample;
-    }
-    x = y;
-    time += step;
-  }
-  ASSERT_EQ(bounce_times.size(), 2u);
-  CalibrationOptions options;
-  options.planes = {Plane{V(0, 0, 1), 0.0}};
-  options.radius = radius;
-  options.drag = true;
-  options.fit_drag = true;
-  options.air_density = density;
-  options.mass = mass;
-  options.drag_coefficient = 0.47;
-  options.spin_before = V::Zero();
-  options.max_bounces = 2;
-  const auto fit = calibrate(samples, options);
-  ASSERT_TRUE(fit.ok()) << fit.error().message();
-  ASSERT_EQ(fit->bounces.size(), 2u);
-  ASSERT_TRUE(fit->drag_coefficient.has_value());
-  EXPECT_TRUE(within4(*fit->drag_coefficient, cd))
-      << fit->drag_coefficient->value << " +- " << fit->drag_coefficient->standard_error;
-  EXPECT_LT(fit->drag_coefficient->standard_error, 0.05);
-  for (std::size_t j = 0; j < 2; ++j) {
-    EXPECT_TRUE(within4(fit->bounces[j].restitution, e)) << fit->bounces[j].restitution.value;
-    EXPECT_TRUE(within4(fit->bounces[j].time, bounce_times[j])) << fit->bounces[j].time.value;
-  }
-  EXPECT_NEAR(fit->noise, 1e-3, 1e-4);
-  std::printf("C_d %.5f +- %.5f (truth %.2f), e %.5f %.5f, %zu samples, %d iterations\n",
-              fit->drag_coefficient->value, 1.96 * fit->drag_coefficient->standard_error, cd,
-              fit->bounces[0].restitution.value, fit->bounces[1].restitution.value,
-              fit->samples_used, fit->iterations);
-}
-
-/// A table-tennis ball (2.7 g, 20 mm, C_d 0.5, C_L 0.3 in air of 1.2 kg/m^3) thrown at 5 m/s
-/// spinning at 40 rad/s about the vertical (its Magnus force 2 m/s^2 sideways at 5 m/s), bouncing
-/// twice without friction (e = 0.9; the spin unchanged), flown by rk4; 200 Hz, 1 mm of noise.
-std::pair<std::vector<TrackedSample>, std::vector<double>> curvingThrow(double radius, double mass,
-                                                                        double density, double cd,
-                                                                        double cl, const V& spin) {
+/// A table-tennis ball (2.7 g, 20 mm, C_d `cd`, C_L `cl` in air of `density`) thrown at 5 m/s
+/// from 0.6 m, spinning at `spin` (40 rad/s about the vertical with C_L 0.3: a Magnus force of
+/// 2 m/s^2 sideways at 5 m/s), bouncing twice without friction (e = 0.9; the spin unchanged),
+/// flown by rk4 (the crossing bisected to the last bit); 200 Hz, 1 mm of noise drawn from `seed`.
+std::pair<std::vector<TrackedSample>, std::vector<double>> throwThroughAir(
+    double radius, double mass, double density, double cd, double cl, const V& spin,
+    unsigned seed) {
   const double e = 0.9;
   const double area = 3.14159265358979323846 * radius * radius;
   const double k = density * cd * area / (2 * mass);
   const double l = density * cl * area / (2 * mass);
   const double rate = 200.0, step = 1e-5;
-  std::mt19937_64 random(6);
+  std::mt19937_64 random(seed);
   std::normal_distribution<double> noise(0.0, 1e-3);
   DragState x{V(0, 0, 0.6), V(5.0, 0.0, 1.0)};
   std::vector<TrackedSample> samples;
@@ -789,13 +714,49 @@ std::pair<std::vector<TrackedSample>, std::vector<double>> curvingThrow(double r
   return {samples, bounce_times};
 }
 
+// A table-tennis ball (2.7 g, 20 mm, C_d 0.5 in air of 1.2 kg/m^3: k = 0.14 1/m, drag 3.5 m/s^2
+// at 5 m/s) thrown at 5 m/s and bouncing twice (e = 0.9, no friction): C_d and e are recovered
+// with drag fitted, starting from C_d 0.47. 200 Hz, 1 mm of noise.
+TEST(Calibration, DragCoefficientFromTheFlights) {
+  const double e = 0.9, radius = 0.02, mass = 0.0027, density = 1.2, cd = 0.5;
+  const auto [samples, bounce_times] =
+      throwThroughAir(radius, mass, density, cd, 0.0, V::Zero(), 5);
+  ASSERT_EQ(bounce_times.size(), 2u);
+  CalibrationOptions options;
+  options.planes = {Plane{V(0, 0, 1), 0.0}};
+  options.radius = radius;
+  options.drag = true;
+  options.fit_drag = true;
+  options.air_density = density;
+  options.mass = mass;
+  options.drag_coefficient = 0.47;
+  options.spin_before = V::Zero();
+  options.max_bounces = 2;
+  const auto fit = calibrate(samples, options);
+  ASSERT_TRUE(fit.ok()) << fit.error().message();
+  ASSERT_EQ(fit->bounces.size(), 2u);
+  ASSERT_TRUE(fit->drag_coefficient.has_value());
+  EXPECT_TRUE(within4(*fit->drag_coefficient, cd))
+      << fit->drag_coefficient->value << " +- " << fit->drag_coefficient->standard_error;
+  EXPECT_LT(fit->drag_coefficient->standard_error, 0.05);
+  for (std::size_t j = 0; j < 2; ++j) {
+    EXPECT_TRUE(within4(fit->bounces[j].restitution, e)) << fit->bounces[j].restitution.value;
+    EXPECT_TRUE(within4(fit->bounces[j].time, bounce_times[j])) << fit->bounces[j].time.value;
+  }
+  EXPECT_NEAR(fit->noise, 1e-3, 1e-4);
+  std::printf("C_d %.5f +- %.5f (truth %.2f), e %.5f %.5f, %zu samples, %d iterations\n",
+              fit->drag_coefficient->value, 1.96 * fit->drag_coefficient->standard_error, cd,
+              fit->bounces[0].restitution.value, fit->bounces[1].restitution.value,
+              fit->samples_used, fit->iterations);
+}
+
 // The Magnus force in the fit: C_L recovered within 4 standard errors from 0.2 (fit_lift), and with
 // the scene's C_L given, e and the instants; without `magnus` the sideways curve is left in the
 // residuals (the noise read 6.5 mm for 1); magnus without the spin before is named.
 TEST(Calibration, LiftCoefficientFromACurvingBallsFlights) {
   const double radius = 0.02, mass = 0.0027, density = 1.2, cd = 0.5, cl = 0.3;
   const V spin(0, 0, 40);
-  const auto [samples, bounce_times] = curvingThrow(radius, mass, density, cd, cl, spin);
+  const auto [samples, bounce_times] = throwThroughAir(radius, mass, density, cd, cl, spin, 6);
   ASSERT_EQ(bounce_times.size(), 2u);
   CalibrationOptions options;
   options.planes = {Plane{V(0, 0, 1), 0.0}};
