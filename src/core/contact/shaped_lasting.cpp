@@ -1,4 +1,34 @@
+// A shaped body's lasting contact with one flat face, by closed forms (shaped_lasting.h; the
+// model and its rules: doc/model.md, "Lasting contact of a shaped body").
+//
+// The body touches the face at its manifold: a box's face 4 corners, a cylinder's cap 4 rim
+// points, a cylinder's or capsule's side the two ends of its lowest line. What it does there:
+// - without turning (resting or sliding, w = 0) every point moves with the centre, whose
+//   acceleration is a = g_t - mu g_n v_hat sliding (Coulomb), 0 resting (|g_t| <= mu g_n);
+// - a cylinder or capsule on its side, its axis across the slope, turns about its axis: rolling
+//   without slip a = g_t / (1 + J / (m r^2)) where the friction this needs, m g_t J / (J + m r^2),
+//   is within mu m g_n; slipping otherwise, a = g_t - mu g_n s_hat and J alpha = mu m g_n r
+//   (s the slip of the contact line), until the slip stops.
+// The contact force is m (a - g) in all (the centre's acceleration, the body not turning or
+// turning about a principal axis fixed in the world): N = m g_n along n and F = m (a - g_t) in
+// the face. Its moment about the centre of mass is the turning's (0, or J alpha about the axis),
+// which puts the centre of pressure at P = foot + h (g_t - a) / g_n (the centre's foot, its
+// height h above the face: where the line through the centre along g - a meets the face). The
+// normal forces are the least-norm ones >= 0 with sum f_i = N and sum f_i q_i = N P; each point's
+// friction is f_i (a - g_t) / g_n, in proportion to its normal force (the same ratio at every
+// point, so each is within mu f_i where the whole is within mu N, and the friction has no moment
+// about the normal).
 #include "contact/shaped_lasting.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numeric>
+#include <variant>
+
+#include <Eigen/Dense>
+
+#include "collision_response/core/validation.h"
 
 namespace collision_response::core {
 
@@ -23,14 +53,635 @@ Eigen::Quaterniond LastingMotion::orientationAt(double t) const {
   return Eigen::Quaterniond(Eigen::AngleAxisd(angle, turn / angle)) * orientation0;
 }
 
-std::vector<SupportForce> LastingMotion::forcesAt(double) const { return forces; }
-
-Expected<LastingMotion> lastingOnFace(const LastingBody&, const FlatFace&) {
-  return Error{"contact", "not yet: a shaped body's lasting contact is not modelled"};
+std::vector<SupportForce> LastingMotion::forcesAt(double t) const {
+  // The manifold's points stay under the body: they move with its centre (a body that does not
+  // turn, or a round side turning about its axis), and the forces are constant.
+  std::vector<SupportForce> moved = forces;
+  const Eigen::Vector3d shift = centreAt(t) - centre0;
+  for (SupportForce& force : moved) force.point += shift;
+  return moved;
 }
 
-std::optional<double> flatBouncesEnd(const LastingBody&, const FlatFace&, double) {
-  return std::nullopt;
+namespace {
+
+using Vec = Eigen::Vector3d;
+
+template <typename... Branches>
+struct Visit : Branches... {
+  using Branches::operator()...;
+};
+template <typename... Branches>
+Visit(Branches...) -> Visit<Branches...>;
+
+Error notYet(const std::string& what) { return Error{"contact", "not yet: " + what}; }
+
+bool isUnit(const Vec& v) { return v.allFinite() && std::abs(v.norm() - 1.0) <= kLastingBand; }
+
+Status checkLasting(const LastingBody& body, const FlatFace& face) {
+  if (!(std::isfinite(body.mass) && body.mass > 0)) {
+    return Error{"body.mass", "must be finite and > 0, got " + formatNumber(body.mass)};
+  }
+  if (!(body.moments.allFinite() && body.moments.minCoeff() > 0)) {
+    return Error{"body.moments", "must be finite and > 0 (principal moments, kg m^2)"};
+  }
+  if (!std::isfinite(body.time)) return Error{"body.time", "must be finite"};
+  if (!body.centre.allFinite()) return Error{"body.centre", "must be finite"};
+  if (!body.velocity.allFinite()) return Error{"body.velocity", "must be finite"};
+  if (!body.angular_velocity.allFinite()) {
+    return Error{"body.angular_velocity", "must be finite"};
+  }
+  if (!body.gravity.allFinite()) return Error{"body.gravity", "must be finite"};
+  if (!(body.orientation.coeffs().allFinite() &&
+        std::abs(body.orientation.norm() - 1.0) <= kLastingBand)) {
+    return Error{"body.orientation", "must be a unit quaternion (its norm within 1e-9 of 1)"};
+  }
+  if (!face.point.allFinite()) return Error{"face.point", "must be finite"};
+  if (!isUnit(face.normal)) return Error{"face.normal", "must be a unit vector (within 1e-9)"};
+  if (!(std::isfinite(face.friction) && face.friction >= 0)) {
+    return Error{"face.friction", "must be finite and >= 0, got " + formatNumber(face.friction)};
+  }
+  if (face.bounded) {
+    if (!(face.half_extent.allFinite() && face.half_extent.minCoeff() > 0)) {
+      return Error{"face.half_extent", "must be finite and > 0 for a bounded face"};
+    }
+    if (!isUnit(face.along_u) || !isUnit(face.along_v) ||
+        std::abs(face.along_u.dot(face.along_v)) > kLastingBand ||
+        std::abs(face.along_u.dot(face.normal)) > kLastingBand ||
+        std::abs(face.along_v.dot(face.normal)) > kLastingBand) {
+      return Error{"face.along_u",
+                   "along_u and along_v must be unit vectors in the face, at right angles "
+                   "(within 1e-9)"};
+    }
+  }
+  const double pressing = -body.gravity.dot(face.normal);
+  if (!(pressing > 0)) {
+    return Error{"body.gravity",
+                 "does not press the body onto the face (its part into the face is " +
+                     formatNumber(pressing) + " m/s^2): no lasting contact"};
+  }
+  return std::visit(
+      Visit{[](const Sphere&) -> Status {
+              return Error{"body.shape",
+                           "not yet: a sphere's lasting contact is a ball's (the monitor's), "
+                           "not a shaped body's"};
+            },
+            [](const Cuboid& box) -> Status {
+              if (!(box.half_size.allFinite() && box.half_size.minCoeff() > 0)) {
+                return Error{"body.shape", "a box's half sizes must be finite and > 0"};
+              }
+              return Ok{};
+            },
+            [](const Cylinder& cylinder) -> Status {
+              if (!(std::isfinite(cylinder.radius) && cylinder.radius > 0 &&
+                    std::isfinite(cylinder.half_length) && cylinder.half_length > 0)) {
+                return Error{"body.shape",
+                             "a cylinder's radius and half length must be finite and > 0"};
+              }
+              return Ok{};
+            },
+            [](const Capsule& capsule) -> Status {
+              if (!(std::isfinite(capsule.radius) && capsule.radius > 0 &&
+                    std::isfinite(capsule.half_length) && capsule.half_length > 0)) {
+                return Error{"body.shape",
+                             "a capsule's radius and half length must be finite and > 0"};
+              }
+              return Ok{};
+            },
+            [](const ConvexHull& hull) -> Status {
+              if (hull.vertices.size() < 4) {
+                return Error{"body.shape", "a hull needs at least 4 vertices"};
+              }
+              for (const Vec& vertex : hull.vertices) {
+                if (!vertex.allFinite()) {
+                  return Error{"body.shape", "a hull's vertices must be finite"};
+                }
+              }
+              return Ok{};
+            }},
+      body.shape);
+}
+
+/// Where the body touches the face.
+enum class SupportKind {
+  kPolygon,  ///< 3 or 4 corners (a box's face, a hull's)
+  kDisc,     ///< a cylinder's cap: its rim
+  kLine,     ///< a cylinder's or capsule's side: the two ends of its lowest line
+};
+
+struct Support {
+  SupportKind kind = SupportKind::kPolygon;
+  std::vector<Vec> feet;      ///< on the face (polygon, line)
+  Vec axis = Vec::Zero();     ///< a line's: unit, in the face, from its first foot to its second
+  Vec centre = Vec::Zero();   ///< a disc's centre, on the face
+  double radius = 0.0;        ///< a disc's, or a side's (the roll's)
+  double axial_moment = 0.0;  ///< a side's moment about its axis (the roll's J)
+};
+
+/// The face's frame and what the body is there.
+struct Setting {
+  Vec n, e1, e2;      ///< the normal and two unit directions in the face
+  Vec g_t;            ///< gravity's part in the face
+  double g_n = 0;     ///< gravity's part into the face (> 0)
+  double height = 0;  ///< the centre's height above the face
+  Vec foot;           ///< the centre's foot on the face
+  double reach = 0;   ///< the body's farthest point from its centre
+};
+
+Vec onFace(const Vec& x, const FlatFace& face, const Vec& n) {
+  return x - n.dot(x - face.point) * n;
+}
+
+Expected<Support> supportOf(const LastingBody& body, const Eigen::Matrix3d& rotation,
+                            const FlatFace& face, const Setting& setting) {
+  const Vec& n = setting.n;
+  const Vec down = rotation.transpose() * (-n);
+  const double lowest = n.dot(body.centre + rotation * coreSupport(body.shape, down) - face.point) -
+                        marginOf(body.shape);
+  if (lowest > kLastingBand) {
+    return Error{"body.centre", "the body does not touch the face: its lowest point is " +
+                                    formatNumber(lowest) +
+                                    " m above it (the touching band is 1e-9 m)"};
+  }
+  if (lowest < -kLastingBand) {
+    return Error{"body.centre", "the body is " + formatNumber(-lowest) +
+                                    " m inside the face (more than the touching band, 1e-9 m)"};
+  }
+  Support support;
+  const auto round = [&](double radius, double half_length, bool cylinder) -> Expected<Support> {
+    const Vec axis = rotation.col(2);
+    const double rise = 2 * half_length * std::abs(axis.dot(n));
+    if (rise <= kLastingBand) {  // on its side: the lowest line's two ends
+      support.kind = SupportKind::kLine;
+      support.axis = (axis - axis.dot(n) * n).normalized();
+      const Vec below = body.centre - radius * n;
+      support.feet = {onFace(below - half_length * support.axis, face, n),
+                      onFace(below + half_length * support.axis, face, n)};
+      support.radius = radius;
+      support.axial_moment = body.moments.z();
+      return support;
+    }
+    if (cylinder && 2 * radius * axis.cross(n).norm() <= kLastingBand) {  // on its cap
+      support.kind = SupportKind::kDisc;
+      const double side = axis.dot(n) > 0 ? -1.0 : 1.0;  // the cap nearer the face
+      support.centre = onFace(body.centre + side * half_length * axis, face, n);
+      support.radius = radius;
+      return support;
+    }
+    return notYet(cylinder ? "tipping: a cylinder leaning on its rim (one point of it touches)"
+                           : "tipping: a capsule leaning on one end (one point of it touches)");
+  };
+  if (const auto* cylinder = std::get_if<Cylinder>(&body.shape)) {
+    return round(cylinder->radius, cylinder->half_length, true);
+  }
+  if (const auto* capsule = std::get_if<Capsule>(&body.shape)) {
+    return round(capsule->radius, capsule->half_length, false);
+  }
+  std::vector<Vec> candidates;
+  contactCandidates(body.shape, down, candidates);
+  for (const Vec& corner : candidates) {
+    const Vec point = body.centre + rotation * corner;
+    if (n.dot(point - face.point) - lowest <= kLastingBand) {
+      support.feet.push_back(onFace(point, face, n));
+    }
+  }
+  if (support.feet.size() == 1) {
+    return notYet("tipping over a corner: the body touches the face at one point");
+  }
+  if (support.feet.size() > 4) {
+    return notYet("a face of more than four points on the face (a hull's)");
+  }
+  if (support.feet.size() >= 3) {
+    // Collinear corners are an edge: the polygon's area against its size.
+    double area = 0, size = 0;
+    for (std::size_t i = 1; i + 1 < support.feet.size(); ++i) {
+      area = std::max(
+          area,
+          (support.feet[i] - support.feet[0]).cross(support.feet[i + 1] - support.feet[0]).norm());
+    }
+    for (const Vec& foot : support.feet) size = std::max(size, (foot - support.feet[0]).norm());
+    if (area > kLastingBand * size) return support;
+  }
+  return notYet("tipping over an edge: the body touches the face along one edge");
+}
+
+/// The smallest s > 0 with v s + a s^2 / 2 = target (target >= 0), or infinity: written
+/// without cancellation (the root 2 target / (v + sqrt(v^2 + 2 a target))).
+double firstReach(double v, double a, double target) {
+  if (target <= 0) {
+    if (v > 0 || (v == 0 && a > 0)) return 0.0;
+    return a > 0 ? -2 * v / a : std::numeric_limits<double>::infinity();
+  }
+  const double discriminant = v * v + 2 * a * target;
+  if (discriminant < 0) return std::numeric_limits<double>::infinity();
+  const double root = std::sqrt(discriminant);
+  if (v >= 0) return 2 * target / (v + root);
+  // v < 0: coming back only where a > 0, at the later root (-v + root) / a.
+  if (!(a > 0)) return std::numeric_limits<double>::infinity();
+  return (root - v) / a;
+}
+
+/// The centre's motion along one direction of the face: displacement v s + a s^2 / 2.
+struct Track {
+  Vec direction = Vec::Zero();  ///< unit (zero where the centre stays)
+  double speed = 0;             ///< along it, at the start
+  double acceleration = 0;      ///< along it
+};
+
+/// The first instant (after the start) a point of the manifold reaches a bounded face's edge.
+double edgeReached(const std::vector<Vec>& feet, const FlatFace& face, const Track& track) {
+  double first = std::numeric_limits<double>::infinity();
+  if (!face.bounded || track.direction.isZero(0.0)) return first;
+  const std::array<Vec, 2> axes{face.along_u, face.along_v};
+  for (int k = 0; k < 2; ++k) {
+    const double along = track.direction.dot(axes[static_cast<std::size_t>(k)]);
+    if (along == 0) continue;
+    const double bound = face.half_extent[k];
+    for (const Vec& foot : feet) {
+      const double u = (foot - face.point).dot(axes[static_cast<std::size_t>(k)]);
+      // u + along x = +-bound: forward where the direction goes, backward the other way.
+      const double forward = along > 0 ? (bound - u) / along : (-bound - u) / along;
+      const double backward = along > 0 ? (u + bound) / along : (u - bound) / along;
+      first = std::min({first, firstReach(track.speed, track.acceleration, forward),
+                        firstReach(-track.speed, -track.acceleration, backward)});
+    }
+  }
+  return first;
+}
+
+/// Whether the point p lies strictly inside the convex polygon of `corners` (2D, any order).
+bool strictlyInside(std::vector<Eigen::Vector2d> corners, const Eigen::Vector2d& p) {
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const auto& corner : corners) mean += corner;
+  mean /= static_cast<double>(corners.size());
+  std::sort(corners.begin(), corners.end(), [&](const auto& a, const auto& b) {
+    return std::atan2(a.y() - mean.y(), a.x() - mean.x()) <
+           std::atan2(b.y() - mean.y(), b.x() - mean.x());
+  });
+  for (std::size_t i = 0; i < corners.size(); ++i) {
+    const Eigen::Vector2d edge = corners[(i + 1) % corners.size()] - corners[i];
+    const Eigen::Vector2d to = p - corners[i];
+    if (!(edge.x() * to.y() - edge.y() * to.x() > 0)) return false;
+  }
+  return true;
+}
+
+/// The normal forces on 3 or 4 points q_i of the face (coordinates about their centroid) that
+/// carry N with their centre of pressure at p: the least-norm f with sum f_i = N and
+/// sum f_i q_i = N p (f_i = l0 + l1 x_i + l2 y_i, a 3x3 solve), and where that has a negative
+/// share (4 points, p inside the polygon but outside the region the linear rule reaches), the
+/// least-norm f >= 0 along the one null direction of the balance (its closed form: the share
+/// that went negative is 0).
+std::vector<double> polygonForces(const std::vector<Eigen::Vector2d>& q, const Eigen::Vector2d& p,
+                                  double total, bool nonnegative) {
+  const std::size_t k = q.size();
+  Eigen::Matrix<double, 3, Eigen::Dynamic> balance(3, static_cast<Eigen::Index>(k));
+  for (std::size_t i = 0; i < k; ++i) {
+    balance.col(static_cast<Eigen::Index>(i)) = Vec(1.0, q[i].x(), q[i].y());
+  }
+  const Vec target = total * Vec(1.0, p.x(), p.y());
+  const Eigen::Matrix3d normal = balance * balance.transpose();
+  const Vec l = normal.partialPivLu().solve(target);
+  const Eigen::VectorXd least = balance.transpose() * l;
+  std::vector<double> f(least.data(), least.data() + k);
+  if (!nonnegative || k != 4 || *std::min_element(f.begin(), f.end()) >= 0) return f;
+  // The null direction of the 3x4 balance: its signed 3x3 minors.
+  std::array<double, 4> null{};
+  for (int i = 0; i < 4; ++i) {
+    Eigen::Matrix3d minor;
+    int c = 0;
+    for (int j = 0; j < 4; ++j) {
+      if (j != i) minor.col(c++) = balance.col(j);
+    }
+    null[static_cast<std::size_t>(i)] = (i % 2 == 0 ? 1.0 : -1.0) * minor.determinant();
+  }
+  double lo = -std::numeric_limits<double>::infinity(), hi = -lo;
+  std::size_t lo_at = 0, hi_at = 0;
+  for (std::size_t i = 0; i < 4; ++i) {
+    if (null[i] > 0 && -f[i] / null[i] > lo) lo = -f[i] / null[i], lo_at = i;
+    if (null[i] < 0 && -f[i] / null[i] < hi) hi = -f[i] / null[i], hi_at = i;
+  }
+  const double t = std::clamp(0.0, lo, std::max(lo, hi));
+  for (std::size_t i = 0; i < 4; ++i) f[i] = std::max(0.0, f[i] + t * null[i]);
+  if (t == lo) f[lo_at] = 0.0;
+  if (t == hi) f[hi_at] = 0.0;
+  return f;
+}
+
+/// The normal force on each point of the manifold, with the centre of pressure `pressure` (a
+/// point of the face), or the Error that says which tipping it would be.
+Expected<std::vector<SupportForce>> supportForces(Support& support, const Setting& setting,
+                                                  const Vec& pressure, double total,
+                                                  const Vec& friction_ratio,
+                                                  const Eigen::Matrix3d& rotation,
+                                                  const std::string& tipping) {
+  std::vector<double> f;
+  if (support.kind == SupportKind::kLine) {
+    const double l1 = (support.feet[0] - setting.foot).dot(support.axis);
+    const double l2 = (support.feet[1] - setting.foot).dot(support.axis);
+    const double at = (pressure - setting.foot).dot(support.axis);
+    if (!(l1 < at && at < l2)) {
+      return notYet(tipping + ": the centre of pressure " + formatNumber(at) +
+                    " m along the axis is not strictly between its ends' " + formatNumber(l1) +
+                    " and " + formatNumber(l2) + " m");
+    }
+    f = {total * (l2 - at) / (l2 - l1), total * (at - l1) / (l2 - l1)};
+  } else {
+    if (support.kind == SupportKind::kDisc) {
+      // The rim's 4 points: along the centre of pressure's offset from the cap's centre and a
+      // quarter turn either side and opposite, so that the square they make reaches the rim
+      // where the centre of pressure is (the disc's own criterion); where it is at the centre,
+      // along the body's first principal axis.
+      const Vec offset = pressure - support.centre;
+      if (!(offset.norm() < support.radius)) {
+        return notYet(tipping + ": the centre of pressure is " + formatNumber(offset.norm()) +
+                      " m from the cap's centre, not strictly within its radius " +
+                      formatNumber(support.radius) + " m");
+      }
+      Vec along = offset;
+      if (!(along.norm() > 0)) along = rotation.col(0) - rotation.col(0).dot(setting.n) * setting.n;
+      along.normalize();
+      const Vec across = setting.n.cross(along);
+      const double r = support.radius;
+      support.feet = {support.centre + r * along, support.centre + r * across,
+                      support.centre - r * along, support.centre - r * across};
+    }
+    Vec centroid = Vec::Zero();
+    for (const Vec& foot : support.feet) centroid += foot;
+    centroid /= static_cast<double>(support.feet.size());
+    std::vector<Eigen::Vector2d> q;
+    for (const Vec& foot : support.feet) {
+      q.emplace_back((foot - centroid).dot(setting.e1), (foot - centroid).dot(setting.e2));
+    }
+    const Eigen::Vector2d p((pressure - centroid).dot(setting.e1),
+                            (pressure - centroid).dot(setting.e2));
+    if (support.kind == SupportKind::kPolygon && !strictlyInside(q, p)) {
+      return notYet(tipping +
+                    ": the centre of pressure (the centre of mass's projection along "
+                    "g - a) is not strictly inside the support polygon");
+    }
+    f = polygonForces(q, p, total, true);
+  }
+  std::vector<SupportForce> forces;
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    forces.push_back({support.feet[i], f[i], f[i] * friction_ratio});
+  }
+  return forces;
+}
+
+/// The motion before its forces.
+struct Plan {
+  ContactState state = ContactState::kResting;
+  Vec velocity = Vec::Zero(), acceleration = Vec::Zero();
+  Vec angular_velocity = Vec::Zero(), angular_acceleration = Vec::Zero();
+  double lasts = std::numeric_limits<double>::infinity();  ///< s after the start
+  std::string ends;
+  Track track;
+};
+
+/// Resting or sliding without turning: Coulomb's closed form. `velocity` and `g_t` (gravity's
+/// part) in the face, g_n gravity's part into it.
+Expected<Plan> translationPlan(const Vec& velocity, const Vec& g_t, double g_n, double mu) {
+  Plan plan;
+  const double speed = velocity.norm();
+  const double slope = g_t.norm();
+  if (!(speed > kLastingStillSpeed)) {
+    if (slope <= mu * g_n) return plan;  // static friction holds it
+    // It starts sliding down: v_hat = g_t's direction, a = (|g_t| - mu g_n) along it.
+    const Vec down = g_t / slope;
+    plan.state = ContactState::kSliding;
+    plan.track = {down, 0.0, slope - mu * g_n};
+    plan.acceleration = plan.track.acceleration * down;
+    return plan;
+  }
+  const Vec ahead = velocity / speed;
+  const double downhill = g_t.dot(ahead);
+  if ((g_t - downhill * ahead).norm() > kLastingAcrossGravity * (slope + g_n)) {
+    return notYet(
+        "sliding across the slope (gravity's part in the face not along the velocity: the slide "
+        "turns)");
+  }
+  plan.state = ContactState::kSliding;
+  plan.velocity = speed * ahead;
+  plan.track = {ahead, speed, downhill - mu * g_n};
+  plan.acceleration = plan.track.acceleration * ahead;
+  if (plan.track.acceleration < 0) {  // it stops: speed + a t = 0
+    plan.lasts = speed / -plan.track.acceleration;
+    plan.ends = "stops";
+  }
+  return plan;
+}
+
+/// A cylinder or capsule on its side, turning about its axis (or still): rolling or slipping.
+Expected<Plan> rollPlan(const LastingBody& body, const Support& support, const Setting& setting,
+                        double mu, const Vec& velocity, double spin) {
+  const Vec& axis = support.axis;
+  const Vec across = axis.cross(setting.n);  // the roll's direction: the contact line's slip
+  const double g_across = setting.g_t.dot(across), g_along = setting.g_t.dot(axis);
+  const double v_across = velocity.dot(across), v_along = velocity.dot(axis);
+  const double r = support.radius, m = body.mass, J = support.axial_moment;
+  const double still = kLastingStillSpeed;
+  const double scale = setting.g_t.norm() + setting.g_n;
+  if (std::abs(v_across) <= still && std::abs(spin) * r <= still &&
+      std::abs(g_across) <= kLastingAcrossGravity * scale) {
+    // Not rolling: resting or sliding along its axis, as a body that does not turn (gravity's
+    // part across the axis, below kLastingAcrossGravity, left out).
+    return translationPlan(v_along * axis, g_along * axis, setting.g_n, mu);
+  }
+  if (std::abs(v_along) > still) {
+    return notYet("a cylinder or capsule sliding along its axis while it rolls");
+  }
+  if (std::abs(g_along) > kLastingAcrossGravity * scale) {
+    return notYet("rolling with the axis not across the slope (gravity along the axis too)");
+  }
+  Plan plan;
+  plan.track.direction = across;
+  plan.track.speed = v_across;
+  plan.velocity = v_across * across;
+  plan.angular_velocity = spin * axis;
+  // The contact line's slip: v + w x (-r n) = (v_across - spin r) along `across`.
+  const double slip = v_across - spin * r;
+  const double rolling = g_across * m * r * r / (m * r * r + J);  // a = g / (1 + J / (m r^2))
+  const double friction_needed = std::abs(g_across - rolling);  // per unit mass: g J / (J + m r^2)
+  if (std::abs(slip) <= still && friction_needed <= mu * setting.g_n) {
+    plan.state = ContactState::kRolling;
+    plan.track.acceleration = rolling;
+    plan.acceleration = rolling * across;
+    plan.angular_acceleration = (rolling / r) * axis;
+    return plan;
+  }
+  // Slipping: friction mu N against the slip (its sign; from no slip, the way gravity drives it).
+  const double sign =
+      std::abs(slip) > still ? (slip > 0 ? 1.0 : -1.0) : (g_across > 0 ? 1.0 : -1.0);
+  plan.state = ContactState::kSliding;
+  plan.track.acceleration = g_across - sign * mu * setting.g_n;
+  plan.acceleration = plan.track.acceleration * across;
+  // J alpha = -r F, F = -sign mu m g_n along `across`.
+  const double alpha = sign * mu * m * setting.g_n * r / J;
+  plan.angular_acceleration = alpha * axis;
+  const double slip_rate = plan.track.acceleration - alpha * r;
+  if (std::abs(slip) > still && slip_rate * sign < 0) {  // the slip stops: it rolls from there
+    plan.lasts = std::abs(slip) / std::abs(slip_rate);
+    plan.ends = "stops";
+  }
+  return plan;
+}
+
+}  // namespace
+
+Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& face) {
+  if (Status status = checkLasting(body, face); !status) return status.error();
+  const Eigen::Quaterniond orientation = body.orientation.normalized();
+  const Eigen::Matrix3d rotation = orientation.toRotationMatrix();
+  Setting setting;
+  setting.n = face.normal.normalized();
+  setting.e1 = face.bounded ? face.along_u : setting.n.unitOrthogonal();
+  setting.e2 = setting.n.cross(setting.e1);
+  setting.g_n = -body.gravity.dot(setting.n);
+  setting.g_t = body.gravity + setting.g_n * setting.n;
+  setting.height = setting.n.dot(body.centre - face.point);
+  setting.foot = body.centre - setting.height * setting.n;
+  setting.reach = reachOf(body.shape);
+  auto found = supportOf(body, rotation, face, setting);
+  if (!found) return found.error();
+  Support support = found.value();
+
+  // Its turning: none, a roll about a side's axis, or what is not modelled.
+  const Vec& v = body.velocity;
+  const Vec& w = body.angular_velocity;
+  const Vec in_face = v - v.dot(setting.n) * setting.n;
+  const bool turning = w.norm() * setting.reach > kLastingStillSpeed;
+  double spin = 0;
+  if (turning) {
+    const bool rolls =
+        support.kind == SupportKind::kLine &&
+        (w - w.dot(support.axis) * support.axis).norm() * setting.reach <= kLastingStillSpeed;
+    if (rolls) {
+      spin = w.dot(support.axis);
+    } else if (std::abs(w.dot(setting.n)) * setting.reach > kLastingStillSpeed) {
+      return notYet("spin about the face's normal while sliding or resting (pivoting friction)");
+    } else {
+      return notYet("rocking: turning about an axis in the face that is not a side's own");
+    }
+  }
+  // The manifold neither approaches nor leaves the face.
+  const std::vector<Vec> points =
+      support.kind == SupportKind::kDisc ? std::vector<Vec>{support.centre} : support.feet;
+  for (const Vec& point : points) {
+    const double normal_speed = (v + w.cross(point - body.centre)).dot(setting.n);
+    if (std::abs(normal_speed) > kLastingStillSpeed) {
+      return Error{"body.velocity", std::string("a point of the contact ") +
+                                        (normal_speed < 0 ? "approaches" : "leaves") +
+                                        " the face at " + formatNumber(std::abs(normal_speed)) +
+                                        " m/s: not a lasting contact (within 1e-9 m/s)"};
+    }
+  }
+  if (face.bounded) {
+    const std::vector<Vec> reaching =
+        support.kind == SupportKind::kDisc
+            ? std::vector<Vec>{support.centre + support.radius * face.along_u,
+                               support.centre - support.radius * face.along_u,
+                               support.centre + support.radius * face.along_v,
+                               support.centre - support.radius * face.along_v}
+            : support.feet;
+    for (const Vec& foot : reaching) {
+      const Vec offset = foot - face.point;
+      if (std::abs(offset.dot(face.along_u)) > face.half_extent.x() + kLastingBand ||
+          std::abs(offset.dot(face.along_v)) > face.half_extent.y() + kLastingBand) {
+        return notYet("the body overhangs the face's edge (a point of its support is off it)");
+      }
+    }
+  }
+
+  const double mu = face.friction;
+  Expected<Plan> planned = support.kind == SupportKind::kLine
+                               ? rollPlan(body, support, setting, mu, in_face, spin)
+                               : translationPlan(in_face, setting.g_t, setting.g_n, mu);
+  if (!planned) return planned.error();
+  const Plan& plan = planned.value();
+
+  // The forces: N = m g_n, friction m (a - g_t), the centre of pressure h (g_t - a) / g_n from
+  // the centre's foot.
+  const double total = body.mass * setting.g_n;
+  const Vec friction_ratio = (plan.acceleration - setting.g_t) / setting.g_n;
+  const Vec pressure =
+      setting.foot + setting.height * (setting.g_t - plan.acceleration) / setting.g_n;
+  // A side's centre of pressure is taken along its axis only: across it, the roll's J alpha
+  // balances the friction's moment. The friction's moment about the normal is 0 there too:
+  // gravity has no part along the axis while the body rolls, none across it while it rests or
+  // slides (rollPlan's cases).
+  auto forces = supportForces(
+      support, setting, pressure, total, friction_ratio, rotation,
+      plan.state == ContactState::kResting ? "tipping over" : "tipping while sliding");
+  if (!forces) return forces.error();
+
+  LastingMotion motion;
+  motion.state = plan.state;
+  motion.start = body.time;
+  motion.centre0 = body.centre;
+  motion.velocity0 = plan.velocity;
+  motion.acceleration = plan.acceleration;
+  motion.angular_velocity0 = plan.angular_velocity;
+  motion.angular_acceleration = plan.angular_acceleration;
+  motion.orientation0 = orientation;
+  motion.forces = forces.value();
+  const double edge = edgeReached(support.feet, face, plan.track);
+  double lasts = plan.lasts;
+  motion.ends = plan.ends;
+  if (edge < lasts) {
+    lasts = edge;
+    motion.ends = "a point of its support reaches the face's edge";
+  }
+  if (std::isfinite(lasts)) motion.until = body.time + lasts;
+  return motion;
+}
+
+std::optional<double> flatBouncesEnd(const LastingBody& body, const FlatFace& face,
+                                     double restitution) {
+  if (!(std::isfinite(restitution) && restitution >= 0 && restitution < 1)) return std::nullopt;
+  if (!checkLasting(body, face)) return std::nullopt;
+  const Eigen::Matrix3d rotation = body.orientation.normalized().toRotationMatrix();
+  Setting setting;
+  setting.n = face.normal.normalized();
+  setting.e1 = setting.n.unitOrthogonal();
+  setting.e2 = setting.n.cross(setting.e1);
+  setting.g_n = -body.gravity.dot(setting.n);
+  setting.g_t = body.gravity + setting.g_n * setting.n;
+  setting.height = setting.n.dot(body.centre - face.point);
+  setting.foot = body.centre - setting.height * setting.n;
+  setting.reach = reachOf(body.shape);
+  auto found = supportOf(body, rotation, face, setting);
+  if (!found) return std::nullopt;
+  Support support = found.value();
+  // Flat: approaching along the normal, no slip and no turning (every point of the manifold
+  // approaches at u, to 1e-9 m/s).
+  const double approach = -body.velocity.dot(setting.n);
+  const Vec slip = body.velocity + approach * setting.n;
+  if (!(approach > kLastingStillSpeed) || slip.norm() > kLastingStillSpeed ||
+      body.angular_velocity.norm() * setting.reach > kLastingStillSpeed) {
+    return std::nullopt;
+  }
+  // The joint frictionless rule sends every point back at e u without turning only where its
+  // least-norm impulses, centred under the centre of mass, are >= 0 (none dropped).
+  if (support.kind == SupportKind::kPolygon) {
+    Vec centroid = Vec::Zero();
+    for (const Vec& foot : support.feet) centroid += foot;
+    centroid /= static_cast<double>(support.feet.size());
+    std::vector<Eigen::Vector2d> q;
+    for (const Vec& foot : support.feet) {
+      q.emplace_back((foot - centroid).dot(setting.e1), (foot - centroid).dot(setting.e2));
+    }
+    const Eigen::Vector2d p((setting.foot - centroid).dot(setting.e1),
+                            (setting.foot - centroid).dot(setting.e2));
+    const std::vector<double> shares = polygonForces(q, p, 1.0, false);
+    if (*std::min_element(shares.begin(), shares.end()) < 0) return std::nullopt;
+  } else if (support.kind == SupportKind::kLine) {
+    const double l1 = (support.feet[0] - setting.foot).dot(support.axis);
+    const double l2 = (support.feet[1] - setting.foot).dot(support.axis);
+    if (!(l1 <= 0 && 0 <= l2)) return std::nullopt;
+  }
+  // The k-th bounce leaves at e^k e u and lands 2 e^k e u / g_n later: the sum
+  // 2 e u / (g_n (1 - e)) (doc/model.md, "Coming to rest (Zeno)").
+  return body.time + 2 * restitution * approach / (setting.g_n * (1 - restitution));
 }
 
 }  // namespace collision_response::core

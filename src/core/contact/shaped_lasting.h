@@ -18,6 +18,16 @@
 
 namespace collision_response::core {
 
+/// m: the touching band. The body's lowest point is within it of the face, and its manifold is
+/// its points within it of the lowest (as TumblingContact's manifold band).
+constexpr double kLastingBand = 1e-9;
+/// m/s: a speed below it counts as none: a point's approach to the face, a slide, a slip, a turn
+/// (|w| times the body's reach), as the balls' slips (doc/model.md, "Lasting contact").
+constexpr double kLastingStillSpeed = 1e-9;
+/// Of |g_t| + g_n: gravity's part across a slide (or along a rolling side's axis, or across a
+/// resting side's) below it counts as none.
+constexpr double kLastingAcrossGravity = 1e-12;
+
 /// The body at the instant its contact begins to last, in its principal frame (as
 /// PrincipalBody: its shape about its centre of mass along its principal axes).
 struct LastingBody {

@@ -1,0 +1,657 @@
+// A shaped body's lasting contact with one flat face (contact/shaped_lasting.h), against closed
+// forms worked by hand in the comments (rational where the geometry allows: the incline of
+// tan theta = 3/4, sin 3/5, cos 4/5): resting (a cube's m g / 4 per corner, a box and a standing
+// cylinder leaning their weight downhill, an off-centre body whose far corner the rule leaves
+// unloaded), sliding (to a stop at |v| / (mu g) after v^2 / (2 mu g), down a steep incline for
+// ever, up one to a stop), rolling (2/3 g sin theta for a solid cylinder, a given J's own), a
+// slip that ends in a roll at its closed-form instant, a table top's edge, the accumulation
+// instant of flat bounces, and what is refused by name. Every motion is sampled over its span:
+// no point below the face, no energy gained, no force < 0.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "contact/shaped_lasting.h"
+
+namespace collision_response::core {
+namespace {
+
+using V = Eigen::Vector3d;
+using Q = Eigen::Quaterniond;
+
+constexpr double kG = 9.81;
+const V kDown(0, 0, -kG);
+
+// The incline rising along +x with tan theta = 3/4: its normal (-sin, 0, cos), up the slope
+// (cos, 0, sin), down the slope the opposite.
+const V kInclineNormal(-0.6, 0.0, 0.8);
+const V kUphill(0.8, 0.0, 0.6);
+constexpr double kSin = 0.6, kCos = 0.8;
+
+/// World from body: the body's x up the slope, y across it, z along the incline's normal.
+Q onIncline() {
+  Eigen::Matrix3d r;
+  r.col(0) = kUphill;
+  r.col(1) = V::UnitY();
+  r.col(2) = kInclineNormal;
+  return Q(r);
+}
+
+/// World from body: the body's z (a cylinder's axis) across the incline (world y), its x along
+/// the incline's normal.
+Q sideOnIncline() {
+  Eigen::Matrix3d r;
+  r.col(0) = kInclineNormal;
+  r.col(1) = kUphill;
+  r.col(2) = V::UnitY();
+  return Q(r);
+}
+
+LastingBody box(const V& half, double mass, const V& centre, const Q& orientation = Q::Identity()) {
+  LastingBody body;
+  body.shape = Cuboid{half};
+  body.mass = mass;
+  // m / 12 (b^2 + c^2) with b, c the edges: m / 3 times the half sizes' squares.
+  body.moments =
+      mass / 3 *
+      V(half.y() * half.y() + half.z() * half.z(), half.x() * half.x() + half.z() * half.z(),
+        half.x() * half.x() + half.y() * half.y());
+  body.centre = centre;
+  body.orientation = orientation;
+  body.gravity = kDown;
+  return body;
+}
+
+LastingBody cylinder(double radius, double half_length, double mass, double axial, const V& centre,
+                     const Q& orientation) {
+  LastingBody body;
+  body.shape = Cylinder{radius, half_length};
+  body.mass = mass;
+  const double across = mass * (3 * radius * radius + 4 * half_length * half_length) / 12;
+  body.moments = V(across, across, axial);
+  body.centre = centre;
+  body.orientation = orientation;
+  body.gravity = kDown;
+  return body;
+}
+
+FlatFace plane(const V& normal, double mu) {
+  FlatFace face;
+  face.normal = normal;
+  face.friction = mu;
+  return face;
+}
+
+double energy(const LastingBody& body, const LastingMotion& motion, double t) {
+  const Eigen::Matrix3d r = motion.orientationAt(t).toRotationMatrix();
+  const Eigen::Matrix3d inertia = r * body.moments.asDiagonal() * r.transpose();
+  const V v = motion.velocityAt(t), w = motion.angularVelocityAt(t);
+  return 0.5 * body.mass * v.squaredNorm() + 0.5 * w.dot(inertia * w) -
+         body.mass * body.gravity.dot(motion.centreAt(t));
+}
+
+double lowest(const LastingBody& body, const FlatFace& face, const LastingMotion& motion,
+              double t) {
+  const Eigen::Matrix3d r = motion.orientationAt(t).toRotationMatrix();
+  const V& n = face.normal;
+  return n.dot(motion.centreAt(t) + r * coreSupport(body.shape, r.transpose() * -n) - face.point) -
+         marginOf(body.shape);
+}
+
+/// Over [start, until] (or `horizon` s of a motion that lasts for ever), at 201 instants: no
+/// point of the body below the face (beyond 1e-12 m: the rotations' rounding), the energy never
+/// above the start's (1e-12 of the body's m g reach and kinetic energy), nor the start's above
+/// the body's own, every normal force >= 0 and every friction within mu times it.
+void expectNeverBelowNorGaining(const LastingBody& body, const FlatFace& face,
+                                const LastingMotion& motion, double horizon = 2.0) {
+  const double end = std::isfinite(motion.until) ? motion.until : motion.start + horizon;
+  const double reach = reachOf(body.shape);
+  const double scale = body.mass * (body.gravity.norm() * reach + body.velocity.squaredNorm()) +
+                       body.angular_velocity.squaredNorm() * body.moments.maxCoeff();
+  LastingMotion given = motion;
+  given.velocity0 = body.velocity;
+  given.angular_velocity0 = body.angular_velocity;
+  const double start = energy(body, motion, motion.start);
+  EXPECT_LE(start, energy(body, given, motion.start) + 1e-12 * scale);
+  for (int k = 0; k <= 200; ++k) {
+    const double t = motion.start + (end - motion.start) * k / 200.0;
+    EXPECT_GE(lowest(body, face, motion, t), -1e-12) << "at t = " << t;
+    const double now = energy(body, motion, t);
+    EXPECT_LE(now, start + 1e-12 * scale) << "at t = " << t;
+    for (const SupportForce& force : motion.forcesAt(t)) {
+      EXPECT_GE(force.normal_force, 0.0);
+      EXPECT_LE(force.friction_force.norm(), face.friction * force.normal_force * (1 + 1e-12));
+      EXPECT_NEAR(face.normal.dot(force.point - face.point), 0.0, 1e-12);
+    }
+  }
+}
+
+/// The forces' sum is m (a - g) and their moment about the centre of mass the turning's
+/// I alpha (0 for a body that does not turn), each within `tolerance` of m g and m g reach.
+void expectBalance(const LastingBody& body, const FlatFace& face, const LastingMotion& motion,
+                   double tolerance) {
+  V force = V::Zero(), torque = V::Zero();
+  for (const SupportForce& f : motion.forces) {
+    const V total = f.normal_force * face.normal + f.friction_force;
+    force += total;
+    torque += (f.point - body.centre).cross(total);
+  }
+  const double weight = body.mass * body.gravity.norm();
+  EXPECT_LE((force - body.mass * (motion.acceleration - body.gravity)).norm(), tolerance * weight);
+  const Eigen::Matrix3d r = motion.orientation0.toRotationMatrix();
+  const V turning = r * body.moments.asDiagonal() * r.transpose() * motion.angular_acceleration;
+  EXPECT_LE((torque - turning).norm(), tolerance * weight * reachOf(body.shape));
+}
+
+std::string errorOf(const Expected<LastingMotion>& motion) {
+  return motion.ok() ? std::string("(no error)") : motion.error().message();
+}
+
+}  // namespace
+
+TEST(ShapedLasting, ACubeRestingFlatCarriesAQuarterOfItsWeightAtEachCorner) {
+  // The 10.48 cm, 0.37 kg cube on a floor: by symmetry and the rule (least norm), m g / 4 at each
+  // corner, no friction, at rest for ever.
+  const double half = 0.0524, m = 0.37;
+  const LastingBody body = box(V(half, half, half), m, V(0, 0, half));
+  const FlatFace floor = plane(V::UnitZ(), 0.5);
+  const auto motion = lastingOnFace(body, floor);
+  ASSERT_TRUE(motion.ok()) << errorOf(motion);
+  EXPECT_EQ(motion->state, ContactState::kResting);
+  EXPECT_TRUE(std::isinf(motion->until));
+  EXPECT_EQ(motion->ends, "");
+  EXPECT_EQ(motion->velocity0, V::Zero());
+  EXPECT_EQ(motion->acceleration, V::Zero());
+  ASSERT_EQ(motion->forces.size(), 4u);
+  double sum = 0;
+  for (const SupportForce& force : motion->forces) {
+    EXPECT_DOUBLE_EQ(force.normal_force, m * kG / 4);
+    EXPECT_EQ(force.friction_force, V::Zero());
+    EXPECT_NEAR(std::abs(force.point.x()), half, 1e-17);
+    EXPECT_NEAR(std::abs(force.point.y()), half, 1e-17);
+    EXPECT_EQ(force.point.z(), 0.0);
+    sum += force.normal_force;
+  }
+  EXPECT_DOUBLE_EQ(sum, m * kG);
+  expectBalance(body, floor, *motion, 1e-15);
+  expectNeverBelowNorGaining(body, floor, *motion);
+
+  // Turned by 0.7 rad about the vertical: the same quarters (its corners still symmetric about
+  // the centre), to rounding.
+  const LastingBody turned =
+      box(V(half, half, half), m, V(0, 0, half), Q(Eigen::AngleAxisd(0.7, V::UnitZ())));
+  const auto again = lastingOnFace(turned, floor);
+  ASSERT_TRUE(again.ok()) << errorOf(again);
+  for (const SupportForce& force : again->forces) {
+    EXPECT_NEAR(force.normal_force, m * kG / 4, 1e-14 * m * kG);
+  }
+}
+
+TEST(ShapedLasting, ABoxRestingOnAnInclineWithinFrictionLeansItsWeightDownhill) {
+  // Half sizes a = 0.5 up the slope, b = 0.3 across, c = 0.2 along the normal, 2 kg, on the
+  // incline tan theta = 3/4 with mu = 0.8 >= 3/4: static friction holds it. N = m g cos theta;
+  // friction m g sin theta up the slope. The moment about the centre puts the centre of pressure
+  // c tan theta = 0.15 m down the slope of the centre's foot (the centre's projection along g).
+  // The rule's shares f_i = l0 + l1 x_i + l2 y_i (x up the slope, y across, from the face's
+  // centre): sum f = 4 l0 = N, sum f x = 4 a^2 l1 = N (-0.15), sum f y = 4 b^2 l2 = 0, so
+  // f = N / 4 (1 + x_i (-0.15) / a^2): the lower corners N / 4 (1 + 0.3) = 0.325 N, the upper
+  // N / 4 (1 - 0.3) = 0.175 N; each one's friction f_i tan theta, up the slope.
+  const double a = 0.5, b = 0.3, c = 0.2, m = 2;
+  const LastingBody body = box(V(a, b, c), m, c * kInclineNormal, onIncline());
+  const FlatFace incline = plane(kInclineNormal, 0.8);
+  const auto motion = lastingOnFace(body, incline);
+  ASSERT_TRUE(motion.ok()) << errorOf(motion);
+  EXPECT_EQ(motion->state, ContactState::kResting);
+  const double N = m * kG * kCos;
+  ASSERT_EQ(motion->forces.size(), 4u);
+  for (const SupportForce& force : motion->forces) {
+    const double up = force.point.dot(kUphill);
+    ASSERT_NEAR(std::abs(up), a, 1e-15);
+    const double expected = up < 0 ? 0.325 * N : 0.175 * N;
+    EXPECT_NEAR(force.normal_force, expected, 1e-14 * N);
+    EXPECT_LE((force.friction_force - expected * 0.75 * kUphill).norm(), 1e-14 * N);
+  }
+  expectBalance(body, incline, *motion, 1e-14);
+  expectNeverBelowNorGaining(body, incline, *motion);
+
+  // The same box at mu = 0.75 exactly (tan theta) would hold in exact arithmetic; at 0.7 it
+  // slides from rest at g (sin - mu cos) = 0.04 g down the slope.
+  const auto slides = lastingOnFace(body, plane(kInclineNormal, 0.7));
+  ASSERT_TRUE(slides.ok()) << errorOf(slides);
+  EXPECT_EQ(slides->state, ContactState::kSliding);
+  EXPECT_LE((slides->acceleration + kG * (kSin - 0.7 * kCos) * kUphill).norm(), 1e-14 * kG);
+}
+
+TEST(ShapedLasting, AnOffCentreBodyLeavesItsFarCornerUnloadedWhereTheLinearRuleWouldPull) {
+  // A hull (a box's corners) whose centre of mass is off its face's centre: x, y in {-0.2, 0.8},
+  // on a floor, the centre of pressure at the centre's foot, (-0.3, -0.3) from the face's centre,
+  // a = b = 0.5. The linear rule's shares N / 4 (1 + s_x (-0.3) / 0.5 + s_y (-0.3) / 0.5) give
+  // the corner (+, +) N / 4 (1 - 1.2) < 0. The balance leaves one free direction, k_i = s_x s_y
+  // (sum k = sum k x = sum k y = 0), orthogonal to the linear shares: the least |f| with f >= 0 is
+  // where (+, +) is 0, t = N / 4 (0.2): (-, -) N / 4 (2.2 + 0.2) = 0.6 N, (+, -) and (-, +)
+  // N / 4 (1 - 0.2) = 0.2 N. (Their sum N, their moment 0.6 (-0.5) + 0.2 (0.5 - 0.5) = -0.3 N.)
+  LastingBody body;
+  ConvexHull hull;
+  for (const double x : {-0.2, 0.8}) {
+    for (const double y : {-0.2, 0.8}) {
+      for (const double z : {-0.1, 0.1}) hull.vertices.emplace_back(x, y, z);
+    }
+  }
+  body.shape = hull;
+  body.mass = 1.5;
+  body.moments = V(0.2, 0.3, 0.4);
+  body.centre = V(0, 0, 0.1);
+  body.gravity = kDown;
+  const FlatFace floor = plane(V::UnitZ(), 0.0);
+  const auto motion = lastingOnFace(body, floor);
+  ASSERT_TRUE(motion.ok()) << errorOf(motion);
+  const double N = 1.5 * kG;
+  ASSERT_EQ(motion->forces.size(), 4u);
+  for (const SupportForce& force : motion->forces) {
+    const bool low_x = force.point.x() < 0, low_y = force.point.y() < 0;
+    const double expected = low_x && low_y ? 0.6 * N : (!low_x && !low_y ? 0.0 : 0.2 * N);
+    EXPECT_NEAR(force.normal_force, expected, 1e-14 * N);
+  }
+  expectBalance(body, floor, *motion, 1e-14);
+  expectNeverBelowNorGaining(body, floor, *motion);
+}
+
+TEST(ShapedLasting, AStandingCylinderOnAnInclineLeansItsWeightTowardsItsLowerRim) {
+  // r = 0.2, half length 0.1, 1 kg, standing on its cap on the incline (mu = 1): the centre of
+  // pressure 0.1 x 3/4 = 0.075 m down the slope of the cap's centre. The rim points chosen there,
+  // a quarter turn either side and opposite (+-r along p, +-r across): the shares
+  // l0 + l1 x + l2 y with sum 4 l0 = N, sum x^2 = 2 r^2 so l1 = N p / (2 r^2): the lower point
+  // N (1/4 + p / (2 r)) = 0.4375 N, the upper 0.0625 N, the two across N / 4.
+  const double r = 0.2, h = 0.1, m = 1;
+  const LastingBody body = cylinder(r, h, m, m * r * r / 2, h * kInclineNormal, onIncline());
+  const FlatFace incline = plane(kInclineNormal, 1.0);
+  const auto motion = lastingOnFace(body, incline);
+  ASSERT_TRUE(motion.ok()) << errorOf(motion);
+  EXPECT_EQ(motion->state, ContactState::kResting);
+  const double N = m * kG * kCos;
+  ASSERT_EQ(motion->forces.size(), 4u);
+  for (const SupportForce& force : motion->forces) {
+    const double up = force.point.dot(kUphill);
+    const double expected = up < -0.1 ? 0.4375 * N : (up > 0.1 ? 0.0625 * N : 0.25 * N);
+    EXPECT_NEAR(force.normal_force, expected, 1e-14 * N);
+  }
+  expectBalance(body, incline, *motion, 1e-14);
+  expectNeverBelowNorGaining(body, incline, *motion);
+  // Taller (h = 0.3): h tan theta = 0.225 > r, it would tip over its lower rim: refused.
+  const LastingBody tall = cylinder(r, 0.3, m, m * r * r / 2, 0.3 * kInclineNormal, onIncline());
+  const auto tips = lastingOnFace(tall, incline);
+  ASSERT_FALSE(tips.ok());
+  EXPECT_NE(tips.error().reason.find("not yet: tipping over"), std::string::npos)
+      << tips.error().message();
+}
+
+TEST(ShapedLasting, ABoxSlidingOnAFloorStopsAfterVOverMuGAtVSquaredOverTwoMuG) {
+  // Half sizes (0.3, 0.2, 0.1), 3 kg, at 2 m/s along (0.6, 0.8), mu = 0.5: a = -mu g v_hat until
+  // t = |v| / (mu g), after |v|^2 / (2 mu g). While it slides the friction's moment about the
+  // centre puts the centre of pressure mu c = 0.05 m ahead of the centre's foot.
+  const double m = 3, mu = 0.5;
+  LastingBody body = box(V(0.3, 0.2, 0.1), m, V(1, -2, 0.1));
+  body.time = 4;
+  const V ahead(0.6, 0.8, 0);
+  body.velocity = 2 * ahead;
+  const FlatFace floor = plane(V::UnitZ(), mu);
+  const auto motion = lastingOnFace(body, floor);
+  ASSERT_TRUE(motion.ok()) << errorOf(motion);
+  EXPECT_EQ(motion->state, ContactState::kSliding);
+  EXPECT_EQ(motion->ends, "stops");
+  EXPECT_NEAR(motion->until, 4 + 2 / (mu * kG), 1e-15 * 4);
+  EXPECT_LE((motion->acceleration + mu * kG * ahead).norm(), 1e-15 * kG);
+  const V travelled = motion->centreAt(motion->until) - body.centre;
+  EXPECT_LE((travelled - 4 / (2 * mu * kG) * ahead).norm(), 1e-14);
+  EXPECT_LE(motion->velocityAt(motion->until).norm(), 1e-14);
+  expectBalance(body, floor, *motion, 1e-14);
+  expectNeverBelowNorGaining(body, floor, *motion);
+  // The shares: the corners ahead carry more. In the box's axes (x, y), p = 0.05 (0.6, 0.8):
+  // f = N / 4 (1 + x p_x / a^2 + y p_y / b^2) = N / 4 (1 + s_x 0.03 / 0.3 + s_y 0.04 / 0.2).
+  const double N = m * kG;
+  for (const SupportForce& force : motion->forces) {
+    const double sx = force.point.x() > 1 ? 1 : -1, sy = force.point.y() > -2 ? 1 : -1;
+    EXPECT_NEAR(force.normal_force, N / 4 * (1 + 0.1 * sx + 0.2 * sy), 1e-14 * N);
+    EXPECT_LE((force.friction_force + mu * force.normal_force * ahead).norm(), 1e-14 * N);
+  }
+  // Asked again from its state at the stop: it rests.
+  LastingBody stopped = body;
+  stopped.time = motion->until;
+  stopped.centre = motion->centreAt(motion->until);
+  stopped.velocity = motion->velocityAt(motion->until);
+  const auto rests = lastingOnFace(stopped, floor);
+  ASSERT_TRUE(rests.ok()) << errorOf(rests);
+  EXPECT_EQ(rests->state, ContactState::kResting);
+}
+
+TEST(ShapedLasting, ABoxOnASteepInclineSlidesDownForEverAndUpItToAStop) {
+  // tan theta = 3/4 > mu = 0.5: from rest a = g (sin - mu cos) = 0.2 g down the slope, for ever.
+  // The centre of pressure h (g_t - a) / g_n = 0.2 (0.4 g) / (0.8 g) = 0.1 m down the slope: the
+  // lower corners N / 4 (1 + 0.1 / 0.5), the upper N / 4 (1 - 0.2).
+  const double a = 0.5, b = 0.3, c = 0.2, m = 2, mu = 0.5;
+  LastingBody body = box(V(a, b, c), m, c * kInclineNormal, onIncline());
+  const FlatFace incline = plane(kInclineNormal, mu);
+  const auto down = lastingOnFace(body, incline);
+  ASSERT_TRUE(down.ok()) << errorOf(down);
+  EXPECT_EQ(down->state, ContactState::kSliding);
+  EXPECT_TRUE(std::isinf(down->until));
+  EXPECT_LE((down->acceleration + 0.2 * kG * kUphill).norm(), 1e-14 * kG);
+  const double N = m * kG * kCos;
+  for (const SupportForce& force : down->forces) {
+    const double expected = force.point.dot(kUphill) < 0 ? 0.3 * N : 0.2 * N;
+    EXPECT_NEAR(force.normal_force, expected, 1e-14 * N);
+    EXPECT_LE((force.friction_force - mu * force.normal_force * kUphill).norm(), 1e-14 * N);
+  }
+  expectBalance(body, incline, *down, 1e-14);
+  expectNeverBelowNorGaining(body, incline, *down);
+
+  // Up the slope at 3 m/s: a = -g (sin + mu cos) = -g, it stops after 3 / g s.
+  body.velocity = 3 * kUphill;
+  const auto up = lastingOnFace(body, incline);
+  ASSERT_TRUE(up.ok()) << errorOf(up);
+  EXPECT_EQ(up->ends, "stops");
+  EXPECT_NEAR(up->until, 3 / kG, 1e-15);
+  EXPECT_LE((up->acceleration + kG * kUphill).norm(), 1e-14 * kG);
+  expectNeverBelowNorGaining(body, incline, *up);
+
+  // Across the slope the slide's direction turns: refused by name.
+  body.velocity = V(0, 1, 0);
+  const auto across = lastingOnFace(body, incline);
+  ASSERT_FALSE(across.ok());
+  EXPECT_NE(across.error().reason.find("not yet: sliding across the slope"), std::string::npos)
+      << across.error().message();
+}
+
+TEST(ShapedLasting, ATallBoxSlidingWouldTipAndIsRefusedByName) {
+  // Half sizes (0.05, 0.05, 0.5) sliding at 1 m/s along x with mu = 0.5: the centre of pressure
+  // mu c = 0.25 m ahead, beyond its front edge at 0.05: it would tip forwards.
+  LastingBody body = box(V(0.05, 0.05, 0.5), 1, V(0, 0, 0.5));
+  body.velocity = V(1, 0, 0);
+  const auto motion = lastingOnFace(body, plane(V::UnitZ(), 0.5));
+  ASSERT_FALSE(motion.ok());
+  EXPECT_NE(motion.error().reason.find("not yet: tipping while sliding"), std::string::npos)
+      << motion.error().message();
+}
+
+TEST(ShapedLasting, TippingIsRefusedByName) {
+  const FlatFace floor = plane(V::UnitZ(), 0.5);
+  // On an edge: turned by 45 degrees about y, its edge down (half sizes 0.1: the centre
+  // 0.1 sqrt 2 above the floor).
+  const LastingBody edge = box(V(0.1, 0.1, 0.1), 1, V(0, 0, 0.1 * std::sqrt(2.0)),
+                               Q(Eigen::AngleAxisd(M_PI / 4, V::UnitY())));
+  const auto on_edge = lastingOnFace(edge, floor);
+  ASSERT_FALSE(on_edge.ok());
+  EXPECT_NE(on_edge.error().reason.find("not yet: tipping over an edge"), std::string::npos)
+      << on_edge.error().message();
+  // On a corner: the cube's diagonal vertical, the centre 0.1 sqrt 3 above the floor.
+  const Q corner_up = Q::FromTwoVectors(V(1, 1, 1).normalized(), V::UnitZ());
+  const auto on_corner =
+      lastingOnFace(box(V(0.1, 0.1, 0.1), 1, V(0, 0, 0.1 * std::sqrt(3.0)), corner_up), floor);
+  ASSERT_FALSE(on_corner.ok());
+  EXPECT_NE(on_corner.error().reason.find("not yet: tipping over a corner"), std::string::npos)
+      << on_corner.error().message();
+  // Flat on the incline but tall: c tan theta = 0.6 x 3/4 = 0.45 > a = 0.3: the centre's
+  // projection along g is outside its face.
+  const auto tall = lastingOnFace(box(V(0.3, 0.3, 0.6), 1, 0.6 * kInclineNormal, onIncline()),
+                                  plane(kInclineNormal, 1.0));
+  ASSERT_FALSE(tall.ok());
+  EXPECT_NE(tall.error().reason.find("not yet: tipping over"), std::string::npos)
+      << tall.error().message();
+}
+
+TEST(ShapedLasting, SpinAndRockingAreRefusedByName) {
+  const FlatFace floor = plane(V::UnitZ(), 0.5);
+  LastingBody body = box(V(0.2, 0.1, 0.05), 1, V(0, 0, 0.05));
+  body.angular_velocity = V(0, 0, 1);
+  const auto spins = lastingOnFace(body, floor);
+  ASSERT_FALSE(spins.ok());
+  EXPECT_NE(spins.error().reason.find("not yet: spin about the face's normal"), std::string::npos)
+      << spins.error().message();
+  body.velocity = V(1, 0, 0);  // sliding and spinning: the same
+  EXPECT_FALSE(lastingOnFace(body, floor).ok());
+  body.velocity = V::Zero();
+  body.angular_velocity = V(0.5, 0, 0);
+  const auto rocks = lastingOnFace(body, floor);
+  ASSERT_FALSE(rocks.ok());
+  EXPECT_NE(rocks.error().reason.find("not yet: rocking"), std::string::npos)
+      << rocks.error().message();
+}
+
+TEST(ShapedLasting, ASolidCylinderRollsDownAnInclineAtTwoThirdsGSinTheta) {
+  // r = 0.1, half length 0.2, 2 kg, J = m r^2 / 2, its axis across the incline (world y), from
+  // rest, mu = 0.5: a = g sin / (1 + J / (m r^2)) = 2/3 g sin = 0.4 g down the slope; the friction
+  // it needs, m g sin J / (J + m r^2) = m g 0.2, within mu m g cos = m g 0.4: it rolls, w' = a / r
+  // about -y (rolling towards -x). Each end carries m g cos / 2 and half the friction, up the
+  // slope.
+  const double r = 0.1, m = 2;
+  const LastingBody body = cylinder(r, 0.2, m, m * r * r / 2, r * kInclineNormal, sideOnIncline());
+  const FlatFace incline = plane(kInclineNormal, 0.5);
+  const auto motion = lastingOnFace(body, incline);
+  ASSERT_TRUE(motion.ok()) << errorOf(motion);
+  EXPECT_EQ(motion->state, ContactState::kRolling);
+  EXPECT_TRUE(std::isinf(motion->until));
+  EXPECT_LE((motion->acceleration + 0.4 * kG * kUphill).norm(), 1e-14 * kG);
+  EXPECT_LE((motion->angular_acceleration + 0.4 * kG / r * V::UnitY()).norm(), 1e-14 * kG / r);
+  ASSERT_EQ(motion->forces.size(), 2u);
+  for (const SupportForce& force : motion->forces) {
+    EXPECT_NEAR(force.normal_force, m * kG * kCos / 2, 1e-14 * m * kG);
+    EXPECT_LE((force.friction_force - m * kG * 0.2 / 2 * kUphill).norm(), 1e-14 * m * kG);
+  }
+  expectBalance(body, incline, *motion, 1e-14);
+  expectNeverBelowNorGaining(body, incline, *motion);
+  // No slip at any instant, and no energy lost (rolling): the energy the same to rounding.
+  const double start = energy(body, *motion, 0);
+  for (const double t : {0.5, 1.0, 2.0}) {
+    const V slip = motion->velocityAt(t) + motion->angularVelocityAt(t).cross(-r * kInclineNormal);
+    EXPECT_LE(slip.norm(), 1e-14 * kG * t);
+    EXPECT_NEAR(energy(body, *motion, t), start, 1e-13 * m * kG);
+  }
+}
+
+TEST(ShapedLasting, ACylinderOfAGivenAxialMomentRollsAtItsOwnRate) {
+  // J = 0.8 m r^2 (a hollow-ish tensor): a = g sin / 1.8 = g / 3; the friction it needs,
+  // m g sin 0.8 / 1.8 = m g 4/15 = 0.267 m g, within mu m g cos = 0.4 m g.
+  const double r = 0.1, m = 2;
+  const LastingBody body =
+      cylinder(r, 0.2, m, 0.8 * m * r * r, r * kInclineNormal, sideOnIncline());
+  const FlatFace incline = plane(kInclineNormal, 0.5);
+  const auto motion = lastingOnFace(body, incline);
+  ASSERT_TRUE(motion.ok()) << errorOf(motion);
+  EXPECT_EQ(motion->state, ContactState::kRolling);
+  EXPECT_LE((motion->acceleration + kG / 3 * kUphill).norm(), 1e-14 * kG);
+  for (const SupportForce& force : motion->forces) {
+    EXPECT_LE((force.friction_force - m * kG * 4 / 15 / 2 * kUphill).norm(), 1e-14 * m * kG);
+  }
+  expectBalance(body, incline, *motion, 1e-14);
+  expectNeverBelowNorGaining(body, incline, *motion);
+  // A capsule of the same J, radius and core: the same roll.
+  LastingBody capsule = body;
+  capsule.shape = Capsule{r, 0.2};
+  const auto rolls = lastingOnFace(capsule, incline);
+  ASSERT_TRUE(rolls.ok()) << errorOf(rolls);
+  EXPECT_LE((rolls->acceleration + kG / 3 * kUphill).norm(), 1e-14 * kG);
+}
+
+TEST(ShapedLasting, ACylinderThatSlipsThenRollsAtTheClosedFormInstant) {
+  // On a floor, a solid cylinder (J = m r^2 / 2) sliding across its axis at v0 = 1.5 m/s without
+  // turning, mu = 0.3: friction mu m g against the slip: v' = -mu g, w' = mu m g r / J =
+  // 2 mu g / r; the slip v - w r falls at 3 mu g and is 0 at t = v0 / (3 mu g), where
+  // v = v0 - mu g t = 2 v0 / 3 = 1 m/s (and w r the same). From there it rolls on at 1 m/s.
+  const double r = 0.1, m = 2, mu = 0.3;
+  const Q axis_y(Eigen::AngleAxisd(-M_PI / 2, V::UnitX()));  // its z along world y
+  LastingBody body = cylinder(r, 0.2, m, m * r * r / 2, V(0, 0, r), axis_y);
+  body.velocity = V(1.5, 0, 0);
+  const FlatFace floor = plane(V::UnitZ(), mu);
+  const auto motion = lastingOnFace(body, floor);
+  ASSERT_TRUE(motion.ok()) << errorOf(motion);
+  EXPECT_EQ(motion->state, ContactState::kSliding);
+  EXPECT_EQ(motion->ends, "stops");
+  EXPECT_NEAR(motion->until, 1.5 / (3 * mu * kG), 1e-15);
+  EXPECT_NEAR(motion->velocityAt(motion->until).x(), 1.0, 1e-14);
+  EXPECT_NEAR(motion->angularVelocityAt(motion->until).y() * r, 1.0, 1e-14);
+  expectBalance(body, floor, *motion, 1e-14);
+  expectNeverBelowNorGaining(body, floor, *motion);
+  LastingBody rolling = body;
+  rolling.time = motion->until;
+  rolling.centre = motion->centreAt(motion->until);
+  rolling.velocity = motion->velocityAt(motion->until);
+  rolling.angular_velocity = motion->angularVelocityAt(motion->until);
+  rolling.orientation = motion->orientationAt(motion->until);
+  const auto then = lastingOnFace(rolling, floor);
+  ASSERT_TRUE(then.ok()) << errorOf(then);
+  EXPECT_EQ(then->state, ContactState::kRolling);
+  EXPECT_EQ(then->acceleration, V::Zero());
+  EXPECT_TRUE(std::isinf(then->until));
+
+  // On the incline with mu = 0.1 it cannot roll (it needs 0.2 g of friction, has 0.08 g): from
+  // rest it slides and spins up for ever, a = g (sin - mu cos) = 0.52 g, w' = mu m g cos r / J =
+  // 0.16 g / r.
+  const LastingBody steep = cylinder(r, 0.2, m, m * r * r / 2, r * kInclineNormal, sideOnIncline());
+  const FlatFace slippery = plane(kInclineNormal, 0.1);
+  const auto slides = lastingOnFace(steep, slippery);
+  ASSERT_TRUE(slides.ok()) << errorOf(slides);
+  EXPECT_EQ(slides->state, ContactState::kSliding);
+  EXPECT_TRUE(std::isinf(slides->until));
+  EXPECT_LE((slides->acceleration + 0.52 * kG * kUphill).norm(), 1e-14 * kG);
+  EXPECT_LE((slides->angular_acceleration + 0.16 * kG / r * V::UnitY()).norm(), 1e-13 * kG / r);
+  expectBalance(steep, slippery, *slides, 1e-14);
+  expectNeverBelowNorGaining(steep, slippery, *slides);
+}
+
+TEST(ShapedLasting, ABoxSlidingOnATableTopEndsWhereItsFrontCornersReachTheEdge) {
+  // Half size 0.1 along x on a table top 2 m long (half extent 1): its front corners reach the
+  // edge after 0.9 m. At 3 m/s with mu = 0.2 (stopping after 9 / (2 mu g) = 2.29 m): the first
+  // root of 3 t - mu g t^2 / 2 = 0.9.
+  LastingBody body = box(V(0.1, 0.1, 0.1), 1, V(0, 0, 0.8));
+  body.velocity = V(3, 0, 0);
+  FlatFace table = plane(V::UnitZ(), 0.2);
+  table.point = V(0, 0, 0.7);
+  table.bounded = true;
+  table.half_extent = Eigen::Vector2d(1, 0.5);
+  const auto motion = lastingOnFace(body, table);
+  ASSERT_TRUE(motion.ok()) << errorOf(motion);
+  EXPECT_EQ(motion->ends, "a point of its support reaches the face's edge");
+  const double A = 0.2 * kG / 2;
+  EXPECT_NEAR(motion->until, (3 - std::sqrt(9 - 4 * A * 0.9)) / (2 * A), 1e-14);
+  EXPECT_NEAR(motion->centreAt(motion->until).x(), 0.9, 1e-14);
+  expectNeverBelowNorGaining(body, table, *motion);
+  // Slower, it stops on the table.
+  body.velocity = V(1, 0, 0);
+  const auto stops = lastingOnFace(body, table);
+  ASSERT_TRUE(stops.ok()) << errorOf(stops);
+  EXPECT_EQ(stops->ends, "stops");
+  // Overhanging the edge at the start: refused.
+  body.centre.x() = 0.95;
+  const auto over = lastingOnFace(body, table);
+  ASSERT_FALSE(over.ok());
+  EXPECT_NE(over.error().reason.find("not yet: the body overhangs"), std::string::npos);
+}
+
+TEST(ShapedLasting, ACylinderRollingOnATableTopEndsWhereItsSideReachesTheEdge) {
+  // Rolling at 1 m/s along x on a level table top (half extent 1 along x), its centre at
+  // x = -0.5, its axis along y: the contact line, under the centre, reaches x = 1 after 1.5 s.
+  const double r = 0.1, m = 2;
+  LastingBody body = cylinder(r, 0.2, m, m * r * r / 2, V(-0.5, 0, 0.7 + r),
+                              Q(Eigen::AngleAxisd(-M_PI / 2, V::UnitX())));
+  body.velocity = V(1, 0, 0);
+  body.angular_velocity = V(0, 1 / r, 0);
+  FlatFace table = plane(V::UnitZ(), 0.4);
+  table.point = V(0, 0, 0.7);
+  table.bounded = true;
+  table.half_extent = Eigen::Vector2d(1, 0.5);
+  const auto motion = lastingOnFace(body, table);
+  ASSERT_TRUE(motion.ok()) << errorOf(motion);
+  EXPECT_EQ(motion->state, ContactState::kRolling);
+  EXPECT_EQ(motion->ends, "a point of its support reaches the face's edge");
+  EXPECT_NEAR(motion->until, 1.5, 1e-15);
+  EXPECT_EQ(motion->acceleration, V::Zero());
+  expectNeverBelowNorGaining(body, table, *motion);
+  // Turning about the vertical as well: spin about the normal, refused by name.
+  body.angular_velocity.z() = 0.5;
+  const auto spins = lastingOnFace(body, table);
+  ASSERT_FALSE(spins.ok());
+  EXPECT_NE(spins.error().reason.find("not yet: spin about the face's normal"), std::string::npos)
+      << spins.error().message();
+}
+
+TEST(ShapedLasting, FlatBouncesEndAtTheGeometricSeriesSum) {
+  // A box landing flat at u = 2 m/s, e = 1/2, g_n = g: 2 e u / (g (1 - e)) = 4 / g after it.
+  LastingBody body = box(V(0.3, 0.2, 0.1), 1, V(0, 0, 0.1));
+  body.time = 1.25;
+  body.velocity = V(0, 0, -2);
+  const FlatFace floor = plane(V::UnitZ(), 0.5);
+  const auto end = flatBouncesEnd(body, floor, 0.5);
+  ASSERT_TRUE(end.has_value());
+  EXPECT_DOUBLE_EQ(*end, 1.25 + 4 / kG);
+  // e = 0: it stops at once; e = 0.9: 2 (0.9) 2 / (0.1 g) = 36 / g.
+  EXPECT_DOUBLE_EQ(*flatBouncesEnd(body, floor, 0.0), 1.25);
+  EXPECT_NEAR(*flatBouncesEnd(body, floor, 0.9), 1.25 + 36 / kG, 1e-13);
+  // On the incline, landing along its normal at 1 m/s: g_n = g cos, 2 (0.5) / (0.8 g 0.5).
+  LastingBody tilted = box(V(0.5, 0.3, 0.2), 2, 0.2 * kInclineNormal, onIncline());
+  tilted.velocity = -kInclineNormal;
+  const auto on_incline = flatBouncesEnd(tilted, plane(kInclineNormal, 1.0), 0.5);
+  ASSERT_TRUE(on_incline.has_value());
+  EXPECT_NEAR(*on_incline, 1 / (0.4 * kG), 1e-14);
+  // Not such a landing: e = 1, drifting, turning, leaving, on an edge.
+  EXPECT_FALSE(flatBouncesEnd(body, floor, 1.0).has_value());
+  LastingBody drifting = body;
+  drifting.velocity.x() = 0.1;
+  EXPECT_FALSE(flatBouncesEnd(drifting, floor, 0.5).has_value());
+  LastingBody turning = body;
+  turning.angular_velocity = V(0, 0, 1);
+  EXPECT_FALSE(flatBouncesEnd(turning, floor, 0.5).has_value());
+  LastingBody leaving = body;
+  leaving.velocity = V(0, 0, 1);
+  EXPECT_FALSE(flatBouncesEnd(leaving, floor, 0.5).has_value());
+  LastingBody edge = box(V(0.1, 0.1, 0.1), 1, V(0, 0, 0.1 * std::sqrt(2.0)),
+                         Q(Eigen::AngleAxisd(M_PI / 4, V::UnitY())));
+  edge.velocity = V(0, 0, -1);
+  EXPECT_FALSE(flatBouncesEnd(edge, floor, 0.5).has_value());
+  // A cylinder landing on its side: its two ends, under the centre.
+  LastingBody side =
+      cylinder(0.1, 0.2, 1, 0.005, V(0, 0, 0.1), Q(Eigen::AngleAxisd(M_PI / 2, V::UnitX())));
+  side.velocity = V(0, 0, -2);
+  const auto side_end = flatBouncesEnd(side, floor, 0.5);
+  ASSERT_TRUE(side_end.has_value());
+  EXPECT_DOUBLE_EQ(*side_end, 4 / kG);
+}
+
+TEST(ShapedLasting, BadInputIsNamed) {
+  const FlatFace floor = plane(V::UnitZ(), 0.5);
+  const LastingBody good = box(V(0.1, 0.1, 0.1), 1, V(0, 0, 0.1));
+  const auto fieldOf = [](const Expected<LastingMotion>& motion) {
+    return motion.ok() ? std::string("(ok)") : motion.error().field;
+  };
+  LastingBody body = good;
+  body.mass = 0;
+  EXPECT_EQ(fieldOf(lastingOnFace(body, floor)), "body.mass");
+  body = good;
+  body.velocity.x() = NAN;
+  EXPECT_EQ(fieldOf(lastingOnFace(body, floor)), "body.velocity");
+  body = good;
+  body.gravity = V(0, 0, 9.81);
+  EXPECT_EQ(fieldOf(lastingOnFace(body, floor)), "body.gravity");
+  body = good;
+  body.centre.z() = 0.2;  // 0.1 m above the floor
+  EXPECT_EQ(fieldOf(lastingOnFace(body, floor)), "body.centre");
+  body.centre.z() = 0.05;  // 0.05 m inside
+  EXPECT_EQ(fieldOf(lastingOnFace(body, floor)), "body.centre");
+  body = good;
+  body.velocity = V(0, 0, -0.5);  // approaching: an impact
+  EXPECT_EQ(fieldOf(lastingOnFace(body, floor)), "body.velocity");
+  body = good;
+  body.shape = Sphere{V::Zero(), 0.1};
+  EXPECT_EQ(fieldOf(lastingOnFace(body, floor)), "body.shape");
+  FlatFace face = floor;
+  face.friction = -1;
+  EXPECT_EQ(fieldOf(lastingOnFace(good, face)), "face.friction");
+  face = floor;
+  face.normal = V(0, 0, 2);
+  EXPECT_EQ(fieldOf(lastingOnFace(good, face)), "face.normal");
+  face = floor;
+  face.bounded = true;
+  EXPECT_EQ(fieldOf(lastingOnFace(good, face)), "face.half_extent");
+}
+
+}  // namespace collision_response::core
