@@ -25,12 +25,12 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <cstring>
 #include <map>
 #include <memory>
 #include <stdexcept>
 
 #include "harness.h"
+#include "mujoco_model.h"
 #include "spring_dashpot.h"
 
 namespace collision_response::bench {
@@ -43,11 +43,7 @@ namespace {
 /// the contact is soft, and gravity pulls during it.
 constexpr double kContactSteps = 8.0;
 
-std::string number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.17g", value);
-  return text;
-}
+std::string number(double value) { return mjcfNumber(value); }
 std::string triple(const V& v) { return number(v.x()) + " " + number(v.y()) + " " + number(v.z()); }
 
 /// solref and solimp attributes giving `restitution` at time step dt; empty: MuJoCo's defaults.
@@ -105,35 +101,12 @@ std::string modelXml(const core::Scene& scene, double dt, bool restitution_on) {
   return xml + "  </contact>\n</mujoco>\n";
 }
 
-struct Compiled {
-  std::unique_ptr<mjModel, void (*)(mjModel*)> model{nullptr, mj_deleteModel};
-  std::unique_ptr<mjData, void (*)(mjData*)> data{nullptr, mj_deleteData};
-};
-
-/// Compiles `xml` through MuJoCo's virtual file system.
-Compiled compile(const std::string& xml) {
-  auto vfs = std::make_unique<mjVFS>();
-  mj_defaultVFS(vfs.get());
-  if (mj_makeEmptyFileVFS(vfs.get(), "scene.xml", static_cast<int>(xml.size())) != 0) {
-    throw std::runtime_error("MuJoCo: cannot make the virtual model file");
-  }
-  const int file = mj_findFileVFS(vfs.get(), "scene.xml");
-  std::memcpy(vfs->filedata[file], xml.data(), xml.size());
-  char error[1000] = "";
-  Compiled compiled;
-  compiled.model.reset(mj_loadXML("scene.xml", vfs.get(), error, sizeof error));
-  mj_deleteVFS(vfs.get());
-  if (!compiled.model) throw std::runtime_error(std::string("MuJoCo: ") + error + "\n" + xml);
-  compiled.data.reset(mj_makeData(compiled.model.get()));
-  return compiled;
-}
-
 }  // namespace
 
 Engine mujocoEngine(bool restitution) {
   // Compiling a model (parsing the MJCF) is done once per scene and rate, outside the runs that
   // are timed: a user compiles once and steps many times.
-  auto models = std::make_shared<std::map<std::string, Compiled>>();
+  auto models = std::make_shared<std::map<std::string, std::shared_ptr<MujocoModel>>>();
   return [restitution, models](const core::Scene& scene, const Play& play) {
     if (movesObstacles(play)) {
       Run run;
@@ -148,9 +121,9 @@ Engine mujocoEngine(bool restitution) {
     const double dt = 1.0 / play.rate;
     const std::string xml = modelXml(scene, dt, restitution);
     auto found = models->find(xml);
-    if (found == models->end()) found = models->emplace(xml, compile(xml)).first;
-    const mjModel* m = found->second.model.get();
-    mjData* d = found->second.data.get();
+    if (found == models->end()) found = models->emplace(xml, compileMjcf(xml, "scene.xml")).first;
+    const mjModel* m = found->second->model.get();
+    mjData* d = found->second->data.get();
     mj_resetData(m, d);
     for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
       // A free joint's qvel: linear velocity in the world frame, then angular.

@@ -16,6 +16,7 @@
 #include <stdexcept>
 
 #include "cube_tosses.h"
+#include "mujoco_model.h"
 #include "spring_dashpot.h"
 
 namespace collision_response::bench::cube_tosses {
@@ -24,11 +25,7 @@ namespace {
 /// The contact's half period in steps (bench/accuracy/mujoco.cpp, kContactSteps).
 constexpr double kContactSteps = 8.0;
 
-std::string number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.17g", value);
-  return text;
-}
+std::string number(double value) { return mjcfNumber(value); }
 
 std::string modelXml(const Contact& contact, bool restitution) {
   std::string solver;
@@ -52,30 +49,7 @@ std::string modelXml(const Contact& contact, bool restitution) {
          mu + " " + mu + " 0.005 0.0001 0.0001\"" + solver + "/>\n  </contact>\n</mujoco>\n";
 }
 
-struct Compiled {
-  std::unique_ptr<mjModel, void (*)(mjModel*)> model{nullptr, mj_deleteModel};
-  std::unique_ptr<mjData, void (*)(mjData*)> data{nullptr, mj_deleteData};
-};
-
-/// Compiles `xml` through MuJoCo's virtual file system.
-std::shared_ptr<Compiled> compile(const std::string& xml) {
-  auto vfs = std::make_unique<mjVFS>();
-  mj_defaultVFS(vfs.get());
-  if (mj_makeEmptyFileVFS(vfs.get(), "cube_toss.xml", static_cast<int>(xml.size())) != 0) {
-    throw std::runtime_error("MuJoCo: cannot make the virtual model file");
-  }
-  const int file = mj_findFileVFS(vfs.get(), "cube_toss.xml");
-  std::memcpy(vfs->filedata[file], xml.data(), xml.size());
-  char error[1000] = "";
-  auto compiled = std::make_shared<Compiled>();
-  compiled->model.reset(mj_loadXML("cube_toss.xml", vfs.get(), error, sizeof error));
-  mj_deleteVFS(vfs.get());
-  if (!compiled->model) throw std::runtime_error(std::string("MuJoCo: ") + error + "\n" + xml);
-  compiled->data.reset(mj_makeData(compiled->model.get()));
-  return compiled;
-}
-
-std::vector<Pose> play(Compiled& compiled, const State& first, std::size_t samples) {
+std::vector<Pose> play(MujocoModel& compiled, const State& first, std::size_t samples) {
   const mjModel* m = compiled.model.get();
   mjData* d = compiled.data.get();
   mj_resetData(m, d);
@@ -114,7 +88,7 @@ Peer mujocoPeer(bool restitution) {
                                  "parameter)") +
                   "; 1036 Hz",
               restitution, [restitution](const Contact& contact) -> Simulate {
-                auto compiled = compile(modelXml(contact, restitution));
+                auto compiled = compileMjcf(modelXml(contact, restitution), "cube_toss.xml");
                 return [compiled](const State& first, std::size_t samples) {
                   return play(*compiled, first, samples);
                 };
