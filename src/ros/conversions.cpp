@@ -28,6 +28,19 @@ geometry_msgs::Vector3 toVector3Msg(const Eigen::Vector3d& vector) {
 
 geometry_msgs::Point toPointMsg(const Eigen::Vector3d& point) { return tf2::toMsg(point); }
 
+Eigen::Quaterniond toEigen(const geometry_msgs::Quaternion& quaternion) {
+  return Eigen::Quaterniond(quaternion.w, quaternion.x, quaternion.y, quaternion.z);
+}
+
+geometry_msgs::Quaternion toQuaternionMsg(const Eigen::Quaterniond& quaternion) {
+  geometry_msgs::Quaternion result;
+  result.x = quaternion.x();
+  result.y = quaternion.y();
+  result.z = quaternion.z();
+  result.w = quaternion.w();
+  return result;
+}
+
 core::Body toCore(const collision_response::Body& msg) {
   core::Body body;
   body.id = msg.id;
@@ -39,8 +52,7 @@ core::Body toCore(const collision_response::Body& msg) {
   body.angular_velocity = toEigen(msg.angular_velocity);
   body.size = toEigen(msg.size);
   body.length = msg.length;
-  body.orientation = Eigen::Quaterniond(msg.orientation.w, msg.orientation.x, msg.orientation.y,
-                                        msg.orientation.z);
+  body.orientation = toEigen(msg.orientation);
   if (isGiven(msg.inertia_tensor)) {
     const InertiaTensor& given = msg.inertia_tensor;
     core::InertiaTensor tensor;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "collision_response/core/body_shape.h"
 #include "collision_response/core/validation.h"
 #include "collision_response/ros/conversions.h"
 #include "collision_response/ros/frame_motion.h"
@@ -18,6 +19,16 @@ std::vector<std::string> bodyIds(const core::ImpactMonitor& monitor) {
   ids.reserve(monitor.bodyCount());
   for (std::size_t i = 0; i < monitor.bodyCount(); ++i) ids.push_back(monitor.body(i).id);
   return ids;
+}
+
+/// By body index: whether its state needs its orientation (a body that turns by its shape).
+std::vector<bool> shapedBodies(const core::ImpactMonitor& monitor) {
+  std::vector<bool> shaped;
+  shaped.reserve(monitor.bodyCount());
+  for (std::size_t i = 0; i < monitor.bodyCount(); ++i) {
+    shaped.push_back(core::isShapedBody(monitor.body(i)));
+  }
+  return shaped;
 }
 
 IntakeSettings intakeSettings(const core::Scene& scene, const MonitorParams& params) {
@@ -133,7 +144,7 @@ core::Expected<Contact> toContactMessage(const core::ContactRecord& record,
 MonitorCycle::MonitorCycle(const core::Scene& scene, const MonitorParams& params)
     : params_(params),
       monitor_(scene, core::MonitorSettings{params.contact_tolerance, params.body_timeout}),
-      intake_(bodyIds(monitor_), intakeSettings(scene, params)),
+      intake_(bodyIds(monitor_), shapedBodies(monitor_), intakeSettings(scene, params)),
       time_line_(params.clock_jump_back),
       live_calibration_(scene, params.calibration_window) {
   frame_jumped_.assign(monitor_.obstacleCount(), 0);

@@ -114,14 +114,20 @@ const char* counterName(Reason reason) {
       return "bodies of impacts over the impact work bound";
     case Reason::kOverSteppedWork:
       return "bodies held over the stepped work bound";
+    case Reason::kBadOrientation:
+      return "dropped: orientation not a rotation";
   }
   return "unknown";
 }
 
-bool isDrop(Reason reason) { return reason <= Reason::kContactNotFinite; }
+bool isDrop(Reason reason) {
+  return reason <= Reason::kContactNotFinite || reason == Reason::kBadOrientation;
+}
 
-StateIntake::StateIntake(std::vector<std::string> body_ids, IntakeSettings settings)
+StateIntake::StateIntake(std::vector<std::string> body_ids, std::vector<bool> shaped,
+                         IntakeSettings settings)
     : body_ids_(std::move(body_ids)),
+      shaped_(std::move(shaped)),
       settings_(std::move(settings)),
       seen_in_input_(body_ids_.size(), 0),
       seen_at_place_(body_ids_.size(), 0),
@@ -183,7 +189,8 @@ std::optional<std::size_t> StateIntake::bodyOf(const BodyState& state, const Pla
   return index;
 }
 
-std::optional<Report> StateIntake::problemOf(const BodyState& state, const ros::Time& clock) const {
+std::optional<Report> StateIntake::problemOf(const BodyState& state, std::size_t index,
+                                             const ros::Time& clock) const {
   if (state.header.stamp.isZero()) {
     return Report{Reason::kZeroStamp, "header.stamp: is zero; a state needs the instant it holds"};
   }
@@ -211,6 +218,18 @@ std::optional<Report> StateIntake::problemOf(const BodyState& state, const ros::
     report.variant = static_cast<int>(status.error().field.back() - 'x');
     return report;
   }
+  // A shaped body turns by its orientation (world from body): one that is no rotation is refused
+  // as ~compute_collision refuses it (core::checkOrientation); a ball's may be all zero (not
+  // given: a geometry_msgs/Quaternion's default), as its orientation does not matter.
+  const Eigen::Quaterniond orientation = toEigen(state.pose.orientation);
+  const bool shaped = index < shaped_.size() && shaped_[index];
+  if (!core::isRotation(orientation) && (shaped || !orientation.coeffs().isZero(0.0))) {
+    const auto status = core::checkOrientation(orientation, "pose.orientation");
+    return Report{
+        Reason::kBadOrientation,
+        status.error().message() +
+            (shaped ? " (a shaped body's state needs its orientation, world from body)" : "")};
+  }
   return std::nullopt;
 }
 
@@ -223,6 +242,12 @@ core::BodyStateSample StateIntake::inFixedFrame(const BodyState& state, std::siz
   sample.velocity = frame_motion.velocity(position, toEigen(state.twist.linear));
   sample.angular_velocity =
       frame_motion.pose.linear() * toEigen(state.twist.angular) + frame_motion.angular_velocity;
+  // A rotation (problemOf), or all zero for a ball: the identity then.
+  const Eigen::Quaterniond orientation = toEigen(state.pose.orientation);
+  if (!orientation.coeffs().isZero(0.0)) {
+    sample.orientation =
+        (Eigen::Quaterniond(frame_motion.pose.linear()) * orientation.normalized()).normalized();
+  }
   return sample;
 }
 
@@ -273,7 +298,7 @@ StateIntake::Outcome StateIntake::convert(const std::vector<BodyState>& states,
     const std::string& id = !place.array && state.id.empty() ? own_body : state.id;
     const auto index = bodyOf(state, place, own_body, reports);
     if (!index) continue;
-    if (auto problem = problemOf(state, clock)) {
+    if (auto problem = problemOf(state, *index, clock)) {
       problem->text = "dropped " + place.text(id) + ": " + problem->text;
       reports.push_back(std::move(*problem));
       continue;

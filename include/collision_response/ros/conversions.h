@@ -2,10 +2,12 @@
 #pragma once
 
 #include <geometry_msgs/Point.h>
+#include <geometry_msgs/Quaternion.h>
 #include <geometry_msgs/Vector3.h>
 #include <ros/time.h>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <optional>
 #include <string>
 
@@ -21,6 +23,9 @@ Eigen::Vector3d toEigen(const geometry_msgs::Point& point);
 Eigen::Vector3d toEigen(const geometry_msgs::Vector3& vector);
 geometry_msgs::Vector3 toVector3Msg(const Eigen::Vector3d& vector);
 geometry_msgs::Point toPointMsg(const Eigen::Vector3d& point);
+/// The quaternion as given (not normalised: an all-zero one stays zero, "not given").
+Eigen::Quaterniond toEigen(const geometry_msgs::Quaternion& quaternion);
+geometry_msgs::Quaternion toQuaternionMsg(const Eigen::Quaterniond& quaternion);
 
 /// Copies every field but the strings parsed by name (`inertia`, `shape`: the caller's, which
 /// can name their errors); an all-zero inertia_tensor is none (isGiven). Validation is the

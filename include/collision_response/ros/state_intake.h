@@ -52,8 +52,9 @@ enum class Reason {
   kFrameJumped,                ///< a tf frame moved faster than any body could follow
   kOverImpactWork,   ///< bodies of an impact past the update's impact work: cut short or locked
   kOverSteppedWork,  ///< bodies of stepped clusters held still past the update's stepped work
+  kBadOrientation,   ///< pose.orientation not a rotation (zero for a shaped body, or not unit)
 };
-inline constexpr int kReasonCount = static_cast<int>(Reason::kOverSteppedWork) + 1;
+inline constexpr int kReasonCount = static_cast<int>(Reason::kBadOrientation) + 1;
 
 /// The counter's name, as diagnostics shows it: "dropped: unknown id", "clock jumped back", ...
 const char* counterName(Reason reason);
@@ -105,8 +106,10 @@ struct IntakeSettings {
 
 class StateIntake {
  public:
-  /// `body_ids`: the monitor's bodies, by index (ImpactMonitor::body(i).id).
-  StateIntake(std::vector<std::string> body_ids, IntakeSettings settings);
+  /// `body_ids`: the monitor's bodies, by index (ImpactMonitor::body(i).id); `shaped`: by the
+  /// same index, whether the body turns as a rigid body of its shape (core::isShapedBody), whose
+  /// state needs its orientation (a ball's may be all zero: not given).
+  StateIntake(std::vector<std::string> body_ids, std::vector<bool> shaped, IntakeSettings settings);
 
   enum class Outcome {
     kDone,  ///< every state converted or dropped
@@ -136,10 +139,12 @@ class StateIntake {
   /// The body a state is of, or nothing (reported, but for another body's topic).
   std::optional<std::size_t> bodyOf(const BodyState& state, const Place& place,
                                     const std::string& own_body, std::vector<Report>& reports);
-  /// Why a state's values cannot be used (its stamp, a non-finite number, a position past the
-  /// monitor's resolution), or nothing.
-  std::optional<Report> problemOf(const BodyState& state, const ros::Time& clock) const;
-  /// The state in the fixed frame (the frame's own motion added); its time is set later.
+  /// Why a state of body `index` cannot be used (its stamp, a non-finite number, a position past
+  /// the monitor's resolution, an orientation that is no rotation), or nothing.
+  std::optional<Report> problemOf(const BodyState& state, std::size_t index,
+                                  const ros::Time& clock) const;
+  /// The state in the fixed frame (the frame's own motion added, its orientation turned by the
+  /// frame's and normalised); its time is set later.
   static core::BodyStateSample inFixedFrame(const BodyState& state, std::size_t index,
                                             const FrameMotion& frame_motion);
   /// Adds `sample`, stamped `stamp`, unless its body already has a state in this input (the
@@ -152,6 +157,7 @@ class StateIntake {
               std::vector<Report>& reports);
 
   std::vector<std::string> body_ids_;
+  std::vector<bool> shaped_;  ///< by body index: needs its orientation (core::isShapedBody)
   std::unordered_map<std::string, std::size_t> index_of_;
   IntakeSettings settings_;
   std::vector<std::size_t> index_hints_;  ///< body index of each place of the last input

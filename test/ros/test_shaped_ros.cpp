@@ -1,0 +1,125 @@
+// Shaped bodies on the ROS side (issue 42, step 7), without a master: the state intake reads a
+// body's orientation (checked, turned into the fixed frame, normalised). Every number is exact
+// or a quaternion product worked out by hand below.
+#include <gtest/gtest.h>
+#include <tf2/buffer_core.h>
+
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "collision_response/ros/state_intake.h"
+
+namespace collision_response {
+namespace {
+
+const double kHalfRoot2 = std::sqrt(0.5);
+
+BodyState stateOf(const std::string& id, double x, double y, double z, double w,
+                  const std::string& frame = "world") {
+  BodyState state;
+  state.header.stamp = ros::Time(1000, 0);
+  state.header.frame_id = frame;
+  state.id = id;
+  state.pose.position.x = 1.0;
+  state.pose.orientation.x = x;
+  state.pose.orientation.y = y;
+  state.pose.orientation.z = z;
+  state.pose.orientation.w = w;
+  return state;
+}
+
+/// A ball and a box: the box's state needs its orientation, the ball's may leave it all zero.
+class ShapedIntake : public ::testing::Test {
+ protected:
+  ShapedIntake() : intake_({"ball", "block"}, {false, true}, IntakeSettings{}) {
+    // "camera": turned a quarter turn about the world's x, (sqrt 1/2, 0, 0, sqrt 1/2).
+    geometry_msgs::TransformStamped camera;
+    camera.header.frame_id = "world";
+    camera.child_frame_id = "camera";
+    camera.transform.rotation.x = kHalfRoot2;
+    camera.transform.rotation.w = kHalfRoot2;
+    tf_.setTransform(camera, "test", /*is_static=*/true);
+  }
+
+  /// The states converted: the samples kept, the reports into reports_.
+  StampedSamples convert(const std::vector<BodyState>& states) {
+    StampedSamples samples;
+    reports_.clear();
+    intake_.convert(states, "", ros::Time(), false, tf_, samples, reports_);
+    return samples;
+  }
+
+  StateIntake intake_;
+  tf2::BufferCore tf_;
+  std::vector<Report> reports_;
+};
+
+// Item 1: a shaped body's state whose orientation is no rotation (all zero, or of another
+// length) is dropped under its own reason, the warning naming the field; the intake once read
+// only that it was finite, so the box's zero quaternion went into the monitor as it was.
+TEST_F(ShapedIntake, AShapedBodysOrientationThatIsNoRotationIsDroppedByName) {
+  struct Case {
+    BodyState state;
+    const char* words;
+  };
+  const std::vector<Case> cases = {
+      {stateOf("block", 0, 0, 0, 0), "pose.orientation: is zero"},
+      {stateOf("block", 0, 0, 0, 2), "pose.orientation: must have length 1"},
+      {stateOf("block", 0, 0, 0.8, 0.8), "got length 1.13137"},
+      {stateOf("ball", 0, 0, 0, 0.5), "pose.orientation: must have length 1"},
+  };
+  for (const Case& c : cases) {
+    const StampedSamples samples = convert({c.state});
+    EXPECT_TRUE(samples.empty()) << c.words;
+    ASSERT_EQ(reports_.size(), 1u) << c.words;
+    EXPECT_EQ(reports_[0].reason, Reason::kBadOrientation);
+    EXPECT_NE(reports_[0].text.find("dropped states[0] ('" + c.state.id + "')"), std::string::npos)
+        << reports_[0].text;
+    EXPECT_NE(reports_[0].text.find(c.words), std::string::npos) << reports_[0].text;
+  }
+  // Its own counter, a drop (the summary warns), as /diagnostics shows it.
+  EXPECT_EQ(std::string(counterName(Reason::kBadOrientation)),
+            "dropped: orientation not a rotation");
+  EXPECT_TRUE(isDrop(Reason::kBadOrientation));
+  // A non-finite component stays a non-finite value, named as before.
+  convert({stateOf("block", 0, NAN, 0, 1)});
+  ASSERT_EQ(reports_.size(), 1u);
+  EXPECT_EQ(reports_[0].reason, Reason::kNonFinite);
+  EXPECT_NE(reports_[0].text.find("pose.orientation.y"), std::string::npos) << reports_[0].text;
+}
+
+// Item 1: a good orientation reaches the monitor's sample, normalised, and turned by the state's
+// frame as its position is. The box's quarter turn about z, q_z = (0, 0, s, s) with s = sqrt 1/2,
+// given 0.1 % long (its squared length 1.002, within tf2's 0.01), in "camera" (q_x = (s, 0, 0,
+// s)): q_x q_z = (w_x w_z - v_x.v_z, w_x v_z + w_z v_x + v_x x v_z) = (1/2, (1/2, 0, 1/2) +
+// (0, -1/2, 0)) = (x, y, z, w) = (1/2, -1/2, 1/2, 1/2).
+TEST_F(ShapedIntake, AGoodOrientationIsNormalisedAndTurnedIntoTheFixedFrame) {
+  const double s = 1.001 * kHalfRoot2;
+  StampedSamples samples = convert({stateOf("block", 0, 0, s, s)});
+  ASSERT_EQ(samples.size(), 1u);
+  EXPECT_TRUE(reports_.empty());
+  const Eigen::Vector4d world = samples.samples[0].orientation.coeffs();  // x, y, z, w
+  EXPECT_NEAR((world - Eigen::Vector4d(0, 0, kHalfRoot2, kHalfRoot2)).norm(), 0, 4e-16) << world;
+
+  samples = convert({stateOf("block", 0, 0, s, s, "camera")});
+  ASSERT_EQ(samples.size(), 1u);
+  EXPECT_TRUE(reports_.empty());
+  const Eigen::Vector4d turned = samples.samples[0].orientation.coeffs();
+  EXPECT_NEAR((turned - Eigen::Vector4d(0.5, -0.5, 0.5, 0.5)).norm(), 0, 4e-16) << turned;
+  // The position turned alike: (1, 0, 0) lies on the turn's axis.
+  EXPECT_EQ(samples.samples[0].position, Eigen::Vector3d(1, 0, 0));
+}
+
+// A ball's orientation does not matter: all zero (a geometry_msgs/Quaternion's default, what
+// most trackers of balls send) is not given, and the ball's sample keeps the identity.
+TEST_F(ShapedIntake, ABallsOrientationLeftAllZeroIsNotGiven) {
+  const StampedSamples samples = convert({stateOf("ball", 0, 0, 0, 0)});
+  ASSERT_EQ(samples.size(), 1u);
+  EXPECT_TRUE(reports_.empty());
+  EXPECT_EQ(samples.samples[0].orientation.coeffs(), Eigen::Vector4d(0, 0, 0, 1));
+}
+
+}  // namespace
+}  // namespace collision_response
