@@ -169,6 +169,14 @@ Status checkResolvableObstaclePosition(const Eigen::Vector3d& position, double r
 }
 
 Status checkBody(const Body& body, const std::string& prefix) {
+  // Checked first without the fields' names, which are built only to say what failed: a valid
+  // body (every request's; a ball's collision the most frequent) builds no string.
+  static const std::string kUnnamed;
+  if (checkMass(body.mass, kUnnamed) && checkRadius(body.radius, kUnnamed) &&
+      checkFinite(body.position, kUnnamed) && checkFinite(body.velocity, kUnnamed) &&
+      checkFinite(body.angular_velocity, kUnnamed)) {
+    return Ok{};
+  }
   if (auto status = checkMass(body.mass, prefix + ".mass"); !status) return status;
   if (auto status = checkRadius(body.radius, prefix + ".radius"); !status) return status;
   if (auto status = checkFinite(body.position, prefix + ".position"); !status) return status;
