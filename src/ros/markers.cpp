@@ -9,6 +9,7 @@
 #include <type_traits>
 #include <variant>
 
+#include "collision_response/core/body_shape.h"
 #include "collision_response/core/triangle_mesh.h"
 #include "collision_response/ros/conversions.h"
 
@@ -70,62 +71,59 @@ std_msgs::ColorRGBA materialColour(const std::string& material) {
   return fromHue(static_cast<double>(hash % 360u) / 360.0);
 }
 
-visualization_msgs::Marker bodyMarker(const core::BodySpec& body, int index,
-                                      const std::optional<Eigen::Vector3d>& position,
-                                      const std::string& frame, const ros::Time& stamp) {
-  visualization_msgs::Marker marker =
-      base(kBodiesNamespace, index, visualization_msgs::Marker::SPHERE, frame, stamp);
-  if (!position) {
-    marker.action = visualization_msgs::Marker::DELETE;
-    return marker;
-  }
-  marker.pose.position = toPointMsg(*position);
-  marker.scale.x = marker.scale.y = marker.scale.z = 2.0 * body.radius;
-  marker.color = materialColour(body.material);
-  marker.text = body.id;
-  return marker;
-}
-
 namespace {
 
 void setPose(visualization_msgs::Marker& marker, const Eigen::Vector3d& position,
              const Eigen::Quaterniond& orientation) {
   marker.pose.position = toPointMsg(position);
-  marker.pose.orientation.x = orientation.x();
-  marker.pose.orientation.y = orientation.y();
-  marker.pose.orientation.z = orientation.z();
-  marker.pose.orientation.w = orientation.w();
+  marker.pose.orientation = toQuaternionMsg(orientation);
 }
 
-}  // namespace
+/// What a shape's markers carry besides the shape: their namespaces (the shape's, and its
+/// capsule ends'), id, frame, stamp, colour and text, and a mesh's resource and scale.
+struct ShapeLook {
+  const char* ns = kObstaclesNamespace;
+  const char* ends_ns = kObstacleEndsNamespace;
+  int index = 0;
+  std::string frame;
+  ros::Time stamp;
+  std_msgs::ColorRGBA colour;
+  std::string text;
+  std::string resource;
+  Eigen::Vector3d scale = Eigen::Vector3d::Ones();
+};
 
-void appendObstacleMarkers(const core::ObstacleSpec& obstacle, int index,
-                           const core::PlacedShape& placed, const std::string& frame,
-                           const ros::Time& stamp, const MarkerParams& params,
-                           visualization_msgs::MarkerArray& array) {
+/// A shape drawn where `centre` and `axes` (fixed <- the shape's frame) put it: a sphere about
+/// `centre` plus its own centre (a body's sphere is about its frame's origin, an obstacle's is
+/// given in the fixed frame with `centre` zero); a plane (in the fixed frame) as a thin square
+/// of side `plane_size` centred on its point nearest the origin, its z the normal; a box as a
+/// CUBE, a cylinder as a CYLINDER (rviz's is along its z, as ours), both turned by `axes`; a
+/// capsule as a CYLINDER (its segment) and its two ends as a SPHERE_LIST in `look.ends_ns`; a
+/// mesh as its resource (scaled), or as its triangles where it has none (built by a program).
+void appendShapeMarkers(const core::Shape& shape, const Eigen::Vector3d& centre,
+                        const Eigen::Quaterniond& axes, const ShapeLook& look,
+                        const MarkerParams& params, visualization_msgs::MarkerArray& array) {
   const auto marker_of = [&](std::int32_t type) {
-    visualization_msgs::Marker marker = base(kObstaclesNamespace, index, type, frame, stamp);
-    marker.color = materialColour(obstacle.material);
-    marker.text = obstacle.id;
+    visualization_msgs::Marker marker = base(look.ns, look.index, type, look.frame, look.stamp);
+    marker.color = look.colour;
+    marker.text = look.text;
     return marker;
   };
-  const Eigen::Vector3d& centre = placed.pose.transform.translation();
-  const Eigen::Quaterniond axes(placed.pose.transform.linear());
   std::optional<visualization_msgs::Marker> capsule_ends;
   visualization_msgs::Marker marker = std::visit(
-      [&](const auto& shape) {
-        using Kind = std::decay_t<decltype(shape)>;
+      [&](const auto& kind) {
+        using Kind = std::decay_t<decltype(kind)>;
         if constexpr (std::is_same_v<Kind, core::Sphere>) {
           visualization_msgs::Marker m = marker_of(visualization_msgs::Marker::SPHERE);
-          m.pose.position = toPointMsg(shape.centre);
-          m.scale.x = m.scale.y = m.scale.z = 2.0 * shape.radius;
+          setPose(m, centre + axes * kind.centre, axes);
+          m.scale.x = m.scale.y = m.scale.z = 2.0 * kind.radius;
           return m;
         } else if constexpr (std::is_same_v<Kind, core::Plane>) {
           // A thin square whose z axis is the plane's normal.
           visualization_msgs::Marker m = marker_of(visualization_msgs::Marker::CUBE);
-          setPose(m, Eigen::Vector3d(shape.offset * shape.normal),
+          setPose(m, Eigen::Vector3d(kind.offset * kind.normal),
                   Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(),
-                                                     shape.normal.normalized()));
+                                                     kind.normal.normalized()));
           m.scale.x = m.scale.y = params.plane_size;
           m.scale.z = 1e-3 * params.plane_size;
           m.color.a = 0.4f;  // see-through, so bodies behind it show
@@ -133,56 +131,113 @@ void appendObstacleMarkers(const core::ObstacleSpec& obstacle, int index,
         } else if constexpr (std::is_same_v<Kind, core::Cuboid>) {
           visualization_msgs::Marker m = marker_of(visualization_msgs::Marker::CUBE);
           setPose(m, centre, axes);
-          m.scale.x = 2 * shape.half_size.x();
-          m.scale.y = 2 * shape.half_size.y();
-          m.scale.z = 2 * shape.half_size.z();
+          m.scale.x = 2 * kind.half_size.x();
+          m.scale.y = 2 * kind.half_size.y();
+          m.scale.z = 2 * kind.half_size.z();
           return m;
         } else if constexpr (std::is_same_v<Kind, core::Mesh>) {
           // rviz loads the mesh's own resource, scaled as the scene says; a mesh built without
           // one (by a program) is drawn as its triangles.
-          if (!obstacle.resource.empty()) {
+          if (!look.resource.empty()) {
             visualization_msgs::Marker m = marker_of(visualization_msgs::Marker::MESH_RESOURCE);
             setPose(m, centre, axes);
-            m.mesh_resource = obstacle.resource;
-            m.scale.x = obstacle.scale.x();
-            m.scale.y = obstacle.scale.y();
-            m.scale.z = obstacle.scale.z();
+            m.mesh_resource = look.resource;
+            m.scale.x = look.scale.x();
+            m.scale.y = look.scale.y();
+            m.scale.z = look.scale.z();
             return m;
           }
           visualization_msgs::Marker m = marker_of(visualization_msgs::Marker::TRIANGLE_LIST);
           setPose(m, centre, axes);
           m.scale.x = m.scale.y = m.scale.z = 1.0;
-          for (const core::TriangleMesh::Triangle& t : shape.triangles->triangles()) {
-            for (const std::uint32_t v : t) {
-              m.points.push_back(toPointMsg(shape.triangles->vertices()[v]));
+          if (kind.triangles) {
+            for (const core::TriangleMesh::Triangle& t : kind.triangles->triangles()) {
+              for (const std::uint32_t v : t) {
+                m.points.push_back(toPointMsg(kind.triangles->vertices()[v]));
+              }
             }
           }
           return m;
         } else {
-          // A cylinder (rviz's is along its z, as ours); a capsule's segment as one, its ends as
-          // a sphere list in the namespace "obstacle_ends".
+          // A cylinder; a capsule's segment as one, its ends as a sphere list.
           visualization_msgs::Marker m = marker_of(visualization_msgs::Marker::CYLINDER);
           setPose(m, centre, axes);
-          m.scale.x = m.scale.y = 2 * shape.radius;
-          m.scale.z = 2 * shape.half_length;
+          m.scale.x = m.scale.y = 2 * kind.radius;
+          m.scale.z = 2 * kind.half_length;
           if constexpr (std::is_same_v<Kind, core::Capsule>) {
             visualization_msgs::Marker ends =
-                base(kObstacleEndsNamespace, index, visualization_msgs::Marker::SPHERE_LIST, frame,
-                     stamp);
+                base(look.ends_ns, look.index, visualization_msgs::Marker::SPHERE_LIST, look.frame,
+                     look.stamp);
             ends.color = m.color;
             const Eigen::Vector3d along = axes * Eigen::Vector3d::UnitZ();
-            ends.points = {toPointMsg(Eigen::Vector3d(centre + shape.half_length * along)),
-                           toPointMsg(Eigen::Vector3d(centre - shape.half_length * along))};
-            ends.scale.x = ends.scale.y = ends.scale.z = 2 * shape.radius;
+            ends.points = {toPointMsg(Eigen::Vector3d(centre + kind.half_length * along)),
+                           toPointMsg(Eigen::Vector3d(centre - kind.half_length * along))};
+            ends.scale.x = ends.scale.y = ends.scale.z = 2 * kind.radius;
             ends.pose.orientation.w = 1.0;
             capsule_ends = ends;
           }
           return m;
         }
       },
-      placed.shape);
+      shape);
   array.markers.push_back(marker);
   if (capsule_ends) array.markers.push_back(*capsule_ends);
+}
+
+}  // namespace
+
+void appendBodyMarkers(const core::BodySpec& body, int index, const std::optional<BodyPose>& pose,
+                       const std::string& frame, const ros::Time& stamp,
+                       visualization_msgs::MarkerArray& array) {
+  if (!pose) {
+    // Its shape's marker and, for a capsule, its ends (the ids of both namespaces are the body's).
+    visualization_msgs::Marker gone =
+        base(kBodiesNamespace, index, visualization_msgs::Marker::SPHERE, frame, stamp);
+    gone.action = visualization_msgs::Marker::DELETE;
+    array.markers.push_back(gone);
+    if (body.shape == core::BodyShape::kCapsule) {
+      gone.ns = kBodyEndsNamespace;
+      array.markers.push_back(gone);
+    }
+    return;
+  }
+  ShapeLook look;
+  look.ns = kBodiesNamespace;
+  look.ends_ns = kBodyEndsNamespace;
+  look.index = index;
+  look.frame = frame;
+  look.stamp = stamp;
+  look.colour = materialColour(body.material);
+  look.text = body.id;
+  look.resource = body.resource;
+  look.scale = body.scale;
+  // A ball's orientation does not matter: it is drawn unturned (its state may not give one).
+  const Eigen::Quaterniond axes =
+      core::isShapedBody(body) ? pose->orientation.normalized() : Eigen::Quaterniond::Identity();
+  appendShapeMarkers(core::shapeOf(body), pose->position, axes, look, MarkerParams{}, array);
+}
+
+void appendObstacleMarkers(const core::ObstacleSpec& obstacle, int index,
+                           const core::PlacedShape& placed, const std::string& frame,
+                           const ros::Time& stamp, const MarkerParams& params,
+                           visualization_msgs::MarkerArray& array) {
+  ShapeLook look;
+  look.index = index;
+  look.frame = frame;
+  look.stamp = stamp;
+  look.colour = materialColour(obstacle.material);
+  look.text = obstacle.id;
+  look.resource = obstacle.resource;
+  look.scale = obstacle.scale;
+  // A sphere and a plane are placed in the fixed frame; a finite shape in its pose's.
+  const bool in_fixed_frame = std::holds_alternative<core::Sphere>(placed.shape) ||
+                              std::holds_alternative<core::Plane>(placed.shape);
+  appendShapeMarkers(placed.shape,
+                     in_fixed_frame ? Eigen::Vector3d::Zero()
+                                    : Eigen::Vector3d(placed.pose.transform.translation()),
+                     in_fixed_frame ? Eigen::Quaterniond::Identity()
+                                    : Eigen::Quaterniond(placed.pose.transform.linear()),
+                     look, params, array);
 }
 
 void appendImpactMarkers(const Impact& impact, int id, const MarkerParams& params,
@@ -255,9 +310,9 @@ void appendSceneMarkers(const core::ImpactMonitor& monitor, double time, const s
                         visualization_msgs::MarkerArray& array) {
   for (std::size_t i = 0; i < monitor.bodyCount(); ++i) {
     const auto state = monitor.predictedState(i, time);
-    array.markers.push_back(bodyMarker(
-        monitor.body(i), static_cast<int>(i),
-        state ? std::optional<Eigen::Vector3d>(state->first) : std::nullopt, frame, stamp));
+    std::optional<BodyPose> pose;
+    if (state) pose = BodyPose{state->first, monitor.lastOrientation(i)};
+    appendBodyMarkers(monitor.body(i), static_cast<int>(i), pose, frame, stamp, array);
   }
   for (std::size_t i = 0; i < monitor.obstacleCount(); ++i) {
     const auto pose = monitor.obstaclePose(i);

@@ -1,6 +1,7 @@
 // Shaped bodies on the ROS side (issue 42, step 7), without a master: the state intake reads a
-// body's orientation (checked, turned into the fixed frame, normalised). Every number is exact
-// or a quaternion product worked out by hand below.
+// body's orientation (checked, turned into the fixed frame, normalised), and the markers draw
+// every body as its shape at its orientation. Every number is exact or a quaternion product
+// worked out by hand below.
 #include <gtest/gtest.h>
 #include <tf2/buffer_core.h>
 
@@ -9,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "collision_response/core/body_shape.h"
+#include "collision_response/ros/markers.h"
 #include "collision_response/ros/state_intake.h"
 
 namespace collision_response {
@@ -119,6 +122,107 @@ TEST_F(ShapedIntake, ABallsOrientationLeftAllZeroIsNotGiven) {
   ASSERT_EQ(samples.size(), 1u);
   EXPECT_TRUE(reports_.empty());
   EXPECT_EQ(samples.samples[0].orientation.coeffs(), Eigen::Vector4d(0, 0, 0, 1));
+}
+
+core::BodySpec bodyOf(const std::string& id, core::BodyShape shape) {
+  core::BodySpec body;
+  body.id = id;
+  body.mass = 0.5;
+  body.material = "wooden_ball";
+  body.shape = shape;
+  return body;
+}
+
+void expectQuaternion(const geometry_msgs::Quaternion& q, double x, double y, double z, double w) {
+  EXPECT_DOUBLE_EQ(q.x, x);
+  EXPECT_DOUBLE_EQ(q.y, y);
+  EXPECT_DOUBLE_EQ(q.z, z);
+  EXPECT_DOUBLE_EQ(q.w, w);
+}
+
+// Item 2: every body drawn as its shape, at its centre and orientation, as the obstacles of
+// that shape are: a box a CUBE of its edges, a cylinder a CYLINDER of its diameter and length,
+// a capsule a CYLINDER (its segment) and its two ends, a ball a SPHERE unturned.
+TEST(ShapedMarkers, EveryBodyIsDrawnAsItsShapeAtItsOrientation) {
+  const ros::Time stamp(1000, 0);
+  const BodyPose turned_about_z{{1, 2, 3}, {kHalfRoot2, 0, 0, kHalfRoot2}};  // (w, x, y, z)
+  const BodyPose turned_about_x{{1, 2, 3}, {kHalfRoot2, kHalfRoot2, 0, 0}};
+
+  core::BodySpec box = bodyOf("block", core::BodyShape::kBox);
+  box.size = Eigen::Vector3d(0.1, 0.2, 0.3);
+  visualization_msgs::MarkerArray array;
+  appendBodyMarkers(box, 4, turned_about_z, "world", stamp, array);
+  ASSERT_EQ(array.markers.size(), 1u);
+  const visualization_msgs::Marker& cube = array.markers[0];
+  EXPECT_EQ(cube.type, visualization_msgs::Marker::CUBE);
+  EXPECT_EQ(cube.action, visualization_msgs::Marker::ADD);
+  EXPECT_EQ(cube.ns, "bodies");
+  EXPECT_EQ(cube.id, 4);
+  EXPECT_EQ(cube.header.frame_id, "world");
+  EXPECT_EQ(cube.text, "block");
+  EXPECT_EQ(cube.scale.x, 0.1);
+  EXPECT_EQ(cube.scale.y, 0.2);
+  EXPECT_EQ(cube.scale.z, 0.3);
+  EXPECT_EQ(cube.pose.position.x, 1.0);
+  EXPECT_EQ(cube.pose.position.y, 2.0);
+  EXPECT_EQ(cube.pose.position.z, 3.0);
+  expectQuaternion(cube.pose.orientation, 0, 0, kHalfRoot2, kHalfRoot2);
+
+  core::BodySpec can = bodyOf("can", core::BodyShape::kCylinder);
+  can.radius = 0.05;
+  can.length = 0.2;
+  array.markers.clear();
+  appendBodyMarkers(can, 1, turned_about_x, "world", stamp, array);
+  ASSERT_EQ(array.markers.size(), 1u);
+  EXPECT_EQ(array.markers[0].type, visualization_msgs::Marker::CYLINDER);
+  EXPECT_EQ(array.markers[0].scale.x, 0.1);
+  EXPECT_EQ(array.markers[0].scale.y, 0.1);
+  EXPECT_EQ(array.markers[0].scale.z, 0.2);
+  expectQuaternion(array.markers[0].pose.orientation, kHalfRoot2, 0, 0, kHalfRoot2);
+
+  // A capsule turned a quarter about x: its axis z goes to -y, so its ends' centres are at the
+  // centre -/+ 0.1 m along y (+half_length along the axis first).
+  core::BodySpec pill = bodyOf("pill", core::BodyShape::kCapsule);
+  pill.radius = 0.05;
+  pill.length = 0.2;
+  array.markers.clear();
+  appendBodyMarkers(pill, 2, turned_about_x, "world", stamp, array);
+  ASSERT_EQ(array.markers.size(), 2u);
+  EXPECT_EQ(array.markers[0].type, visualization_msgs::Marker::CYLINDER);
+  EXPECT_EQ(array.markers[0].ns, "bodies");
+  EXPECT_EQ(array.markers[0].scale.z, 0.2);
+  const visualization_msgs::Marker& ends = array.markers[1];
+  EXPECT_EQ(ends.type, visualization_msgs::Marker::SPHERE_LIST);
+  EXPECT_EQ(ends.ns, "body_ends");
+  EXPECT_EQ(ends.id, 2);
+  EXPECT_EQ(ends.scale.x, 0.1);
+  ASSERT_EQ(ends.points.size(), 2u);
+  EXPECT_NEAR(ends.points[0].x, 1.0, 1e-16);
+  EXPECT_NEAR(ends.points[0].y, 1.9, 1e-15);
+  EXPECT_NEAR(ends.points[0].z, 3.0, 1e-15);
+  EXPECT_NEAR(ends.points[1].y, 2.1, 1e-15);
+
+  // A ball: a sphere of its diameter, unturned whatever its state's orientation.
+  core::BodySpec ball = bodyOf("ball", core::BodyShape::kSphere);
+  ball.radius = 0.05;
+  array.markers.clear();
+  appendBodyMarkers(ball, 0, turned_about_z, "world", stamp, array);
+  ASSERT_EQ(array.markers.size(), 1u);
+  EXPECT_EQ(array.markers[0].type, visualization_msgs::Marker::SPHERE);
+  EXPECT_EQ(array.markers[0].scale.x, 0.1);
+  EXPECT_EQ(array.markers[0].pose.position.z, 3.0);
+  expectQuaternion(array.markers[0].pose.orientation, 0, 0, 0, 1);
+
+  // Not tracked: the capsule's markers deleted in both namespaces.
+  array.markers.clear();
+  appendBodyMarkers(pill, 2, std::nullopt, "world", stamp, array);
+  ASSERT_EQ(array.markers.size(), 2u);
+  for (const visualization_msgs::Marker& gone : array.markers) {
+    EXPECT_EQ(gone.action, visualization_msgs::Marker::DELETE);
+    EXPECT_EQ(gone.id, 2);
+  }
+  EXPECT_EQ(array.markers[0].ns, "bodies");
+  EXPECT_EQ(array.markers[1].ns, "body_ends");
 }
 
 }  // namespace

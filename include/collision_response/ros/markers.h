@@ -5,6 +5,7 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstddef>
 #include <optional>
 #include <string>
@@ -32,6 +33,7 @@ struct MarkerParams {
 inline constexpr const char* kBodiesNamespace = "bodies";
 inline constexpr const char* kObstaclesNamespace = "obstacles";
 inline constexpr const char* kObstacleEndsNamespace = "obstacle_ends";
+inline constexpr const char* kBodyEndsNamespace = "body_ends";
 inline constexpr const char* kImpactsNamespace = "impacts";
 inline constexpr const char* kContactsNamespace = "contacts";
 inline constexpr const char* kLastingContactsNamespace = "lasting_contacts";
@@ -42,10 +44,20 @@ inline constexpr int kImpactIds = 10000;
 /// colour from its name (the same name, the same colour, in every run).
 std_msgs::ColorRGBA materialColour(const std::string& material);
 
-/// A body as a sphere (id `index`), or its deletion when it is not tracked (`position` empty).
-visualization_msgs::Marker bodyMarker(const core::BodySpec& body, int index,
-                                      const std::optional<Eigen::Vector3d>& position,
-                                      const std::string& frame, const ros::Time& stamp);
+/// Where a body is: its centre (of mass) and its orientation (world from body).
+struct BodyPose {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+};
+
+/// A body as its shape where `pose` puts it (id `index`, namespace `bodies`), as an obstacle of
+/// that shape is drawn (appendObstacleMarkers): a sphere (a ball unturned, whatever its
+/// orientation); a box as a CUBE of its edges and a cylinder as a CYLINDER, turned by the
+/// orientation; a capsule as a CYLINDER (its segment) and its two ends as a SPHERE_LIST in
+/// `body_ends`; a mesh body as its resource. Not tracked (`pose` empty): their deletion.
+void appendBodyMarkers(const core::BodySpec& body, int index, const std::optional<BodyPose>& pose,
+                       const std::string& frame, const ros::Time& stamp,
+                       visualization_msgs::MarkerArray& array);
 
 /// An obstacle where `placed` puts it (in `frame`), with id `index`: a sphere; a plane as a thin
 /// square of side `plane_size` centred on the plane's point nearest the origin with its normal;
