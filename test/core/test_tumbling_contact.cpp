@@ -207,6 +207,43 @@ TEST(TumblingContact, NoContactWithinTheHorizonIsClearToItsEnd) {
   EXPECT_TRUE(inside.inside_at_start);
 }
 
+TEST(TumblingContact, ACubeOnItsCornerSpinningRisesByItsTurningInFewSteps) {
+  // doc/performance.md's creep: a cube of half side s on its corner 5e-12 m above the floor, that
+  // corner straight below its centre, at rest but turning at 37 rad/s about x, gravity on. Its
+  // corner moves sideways at 37 s sqrt(3) = 3.2 m/s, and every point's speed bound let the
+  // advancement step 2 g / V from 5e-12 m, growing by little a step: the step budget (65,536)
+  // ran out before the next corner's contact. Along the floor's normal the corner below only
+  // rises (planeStep): tens of steps. The instant: test/core/tumbling_creep_reference.py (mpmath,
+  // the first root of the lowest corner's height).
+  const double s = 0.05;
+  const Q down = Q::FromTwoVectors(V(-1, -1, -1).normalized(), V(0, 0, -1));
+  const TumblingBody body =
+      makeBody(Cuboid{V(s, s, s)}, V(1, 1, 1), V(0, 0, s * std::sqrt(3.0) + 5e-12), V::Zero(),
+               V(0, 0, -kG), down, V(37, 0, 0));
+  const FirstContactResult r = firstContact(body, floorAt(0.0), 0.0, 0.1);
+  ASSERT_TRUE(r.contact) << "clear until " << r.clear_until << " s after " << r.steps << " steps";
+  const double exact = 0.04172675276319275472505689;
+  EXPECT_LE(r.contact->time, exact + 1e-15);
+  EXPECT_GE(r.contact->time, exact - 1e-11);
+  EXPECT_LT(r.steps, 200);
+}
+
+TEST(TumblingContact, ABoxSlidingAlongTheFloorSpinningAboutItsNormalIsClearInOneStep) {
+  // A box flat 1 mm above the floor, no gravity, sliding at 10 m/s along it and turning steadily
+  // at 20 rad/s about its z axis (a principal axis), the floor's normal: its height never
+  // changes, so it never meets the floor. Every point's speed bound (10 m/s plus sqrt(2 E / J_min)
+  // = 28.3 rad/s times its reach, 0.187 m) stepped 1e-3 m / 15.3 m/s at a time: 15,300 steps over
+  // the horizon; along the normal nothing approaches and the advancement clears the horizon at
+  // once.
+  const TumblingBody body = makeBody(Cuboid{V(0.15, 0.1, 0.05)}, V(2, 3, 4), V(0, 0, 0.051),
+                                     V(10, 0, 0), V::Zero(), Q::Identity(), V(0, 0, 20));
+  const FirstContactResult r = firstContact(body, floorAt(0.0), 0.0, 1.0);
+  EXPECT_FALSE(r.contact);
+  EXPECT_FALSE(r.inside_at_start);
+  EXPECT_EQ(r.clear_until, 1.0);
+  EXPECT_LE(r.steps, 1);
+}
+
 TEST(ConvexDistance, BoxesCylindersCapsulesAndHullsAgainstTheirClosedForms) {
   // A box and a cylinder standing apart along x: the box's face x = 0.3 and the cylinder's side
   // x = 1 - 0.25: 0.45 apart.

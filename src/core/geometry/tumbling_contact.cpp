@@ -303,6 +303,55 @@ void addUnique(std::vector<ManifoldPoint>& points, const ManifoldPoint& point, d
   points.push_back(point);
 }
 
+/// s: the first root after 0 of g - V s - A s^2 / 2 (g > 0, V and A of either sign), infinite
+/// where there is none, written without cancellation: closing (V > 0), 2 g / (V + sqrt(V^2 + 2 A
+/// g)), the smaller root where both are positive (A < 0); opening (V <= 0), (sqrt(V^2 + 2 A g) -
+/// V) / A where A > 0 pulls it back, none otherwise.
+double firstRoot(double gap, double speed, double acceleration) {
+  const double discriminant = speed * speed + 2 * acceleration * gap;
+  if (speed > 0) {
+    return discriminant >= 0 ? 2 * gap / (speed + std::sqrt(discriminant)) : INFINITY;
+  }
+  return acceleration > 0 ? (std::sqrt(discriminant) - speed) / acceleration : INFINITY;
+}
+
+/// s: how far the advancement may step from `time` where the other side is a plane (unit normal
+/// n towards the body's side, fixed or moving straight on at v_o) and the body's gap to it is at
+/// least `gap`: no contact before it. The gap is g(t) = n . c(t) - d(t) - h(t), d the plane's
+/// offset, h(t) = max over the body's points p of -n . (p - c): how far the body reaches below
+/// its centre c. Exactly on the parabola, n . c(t) - d(t) = n . c_0 - d_0 + n . (v_0 - v_o) s +
+/// n . a s^2 / 2 (s = t - t_0). h changes as the body turns: at a point p* where the maximum is
+/// reached, dh/dt <= -n . (w x r*) = w . (n x r*) <= |n x w| |n x r*| (r* = p* - c; the upper Dini
+/// derivative of a maximum of smooth functions is at most the largest of theirs), and
+/// |n x r*|^2 = |r*|^2 - (n . r*)^2 <= R^2 - h^2, R the body's reach (no point farther from c).
+/// With h = R cos(theta), theta in [0, pi], theta therefore falls no faster than W >= |n x w(t)|
+/// (spinAcrossBound: |w| <= sqrt(2 E / J_min) for all time where w is not fixed), and from h_0:
+/// h(t_0 + s) <= R cos(max(0, theta_0 - W s)) = h_0 + R f(W s), f(x) = cos(max(0, theta_0 - x))
+/// - cos(theta_0). Three quadratic bounds of f, each giving a lower bound of g whose first root
+/// is a safe step (the largest of the three is): f(x) <= x (f' <= 1); f(x) <= sin(theta_0) x +
+/// x^2 / 2 (Taylor's, f'' <= 1, and f constant after x = theta_0); f(x) <= 1 - cos(theta_0)
+/// (the body reaches no lower than R). h_0 is taken from the gap's lower bound, n . c_0 - d_0 -
+/// gap >= h(t_0), clamped to [-R, R] (conservative: the bound rises with h_0). A body moving
+/// along the plane (n . v = 0) or spinning about its normal (n x w = 0) takes long steps, and a
+/// corner straight below the centre (theta_0 = 0) rises only by its turning, quadratically.
+double planeStep(const TumblingBody& body, double time, double gap, const Plane& plane,
+                 const Eigen::Vector3d& plane_velocity) {
+  const double length = plane.normal.norm();
+  const Eigen::Vector3d n = plane.normal / length;
+  const double reach = body.reach() * (1 + 64 * kEps);
+  const double spin = body.spinAcrossBound(n);
+  const double closing = -n.dot(body.velocityAt(time) - plane_velocity);
+  const double pulled = -n.dot(body.acceleration());
+  const double centre_height = (plane.normal.dot(body.positionAt(time)) - plane.offset) / length;
+  const double below = std::clamp(centre_height - gap, -reach, reach);  // h_0, at least h(t_0)
+  const double across = std::sqrt((reach - below) * (reach + below));   // R sin(theta_0)
+  const double lipschitz = firstRoot(gap, closing + reach * spin, pulled);
+  const double taylor = firstRoot(gap, closing + across * spin, pulled + reach * spin * spin);
+  const double lowest = gap - (reach - below);
+  const double reached = lowest > 0 ? firstRoot(lowest, closing, pulled) : 0.0;
+  return std::max({lipschitz, taylor, reached});
+}
+
 /// The other side of a first-contact query: what it is at an instant and how fast its points
 /// may move.
 struct ObstacleSide {
@@ -313,6 +362,19 @@ struct ObstacleSide {
     return obstacleGap(body, time, at(time), tolerance, nullptr, approach);
   }
   Eigen::Vector3d centreVelocity(double time) const { return at(time).pose.velocity; }
+  /// s: no contact before it from `time`, where the gap is at least `gap`: the bound on every
+  /// point's speed (`speed`, `acceleration`: the header's comment), or a plane's own (planeStep)
+  /// where that is longer.
+  double step(const TumblingBody& body, double time, double gap, double speed,
+              double acceleration) const {
+    const double any = firstRoot(gap, speed, acceleration);
+    if (std::holds_alternative<Plane>(placed.shape)) {
+      const PlacedShape moved = at(time);
+      return std::max(
+          any, planeStep(body, time, gap, std::get<Plane>(moved.shape), placed.pose.velocity));
+    }
+    return any;
+  }
   double angularSpeed() const {
     return turns(placed.shape) ? placed.pose.angular_velocity.norm() : 0.0;
   }
@@ -331,6 +393,9 @@ struct BodySide {
     return bodiesGap(body, other, time, tolerance, approach);
   }
   Eigen::Vector3d centreVelocity(double time) const { return other.velocityAt(time); }
+  double step(const TumblingBody&, double, double gap, double speed, double acceleration) const {
+    return firstRoot(gap, speed, acceleration);
+  }
   double pointSpeedAboutCentre() const { return other.angularSpeedBound() * other.reach(); }
   double accelerationBound(const TumblingBody& body) const {
     return (body.acceleration() - other.acceleration()).norm();
@@ -493,7 +558,7 @@ FirstContactResult advance(const TumblingBody& body, const Side& side, double fr
       return result;
     }
     const double speed = (body.velocityAt(t) - side.centreVelocity(t)).norm() + turning;
-    const double step = 2 * g.gap / (speed + std::sqrt(speed * speed + 2 * acceleration * g.gap));
+    const double step = side.step(body, t, g.gap, speed, acceleration);
     if (step <= stop) {
       contactAt(t);
       return result;
@@ -535,6 +600,10 @@ Expected<TumblingBody> TumblingBody::create(const ConvexShape& shape,
   const double twice_energy = principal_moments.dot(w_body.cwiseAbs2());
   body.angular_speed_bound_ =
       std::sqrt(twice_energy / principal_moments.minCoeff()) * (1 + 64 * kEps);
+  const FreeRotation::Kind kind = body.rotation_.kind();
+  body.steady_spin_ =
+      kind == FreeRotation::Kind::kResting || kind == FreeRotation::Kind::kIsotropic;
+  body.angular_velocity_ = angular_velocity;
   return body;
 }
 

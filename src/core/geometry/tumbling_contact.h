@@ -91,6 +91,13 @@ class TumblingBody {
   }
   /// rad/s: |w| never exceeds it, sqrt(2 E / J_min) (with a few ulps).
   double angularSpeedBound() const { return angular_speed_bound_; }
+  /// rad/s: |n x w| never exceeds it for the unit `n`: exactly so (with a few ulps) where w is
+  /// fixed (at rest, an isotropic body, a steady turn about a principal axis), else
+  /// angularSpeedBound().
+  double spinAcrossBound(const Eigen::Vector3d& n) const {
+    return steady_spin_ ? n.cross(angular_velocity_).norm() * (1 + 64 * 2.220446049250313e-16)
+                        : angular_speed_bound_;
+  }
   /// m: the body's farthest point from its centre.
   double reach() const { return reach_; }
 
@@ -104,6 +111,8 @@ class TumblingBody {
   Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d acceleration_ = Eigen::Vector3d::Zero();
   double angular_speed_bound_ = 0.0;
+  bool steady_spin_ = false;                                    // w fixed in the world
+  Eigen::Vector3d angular_velocity_ = Eigen::Vector3d::Zero();  // w at time_ (world)
   double reach_ = 0.0;
 };
 
