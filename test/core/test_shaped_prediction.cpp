@@ -19,6 +19,7 @@
 
 #include "collision_response/core/prediction.h"
 #include "scene_builders.h"
+#include "shaped_scenes.h"
 
 namespace collision_response::core {
 namespace {
@@ -26,24 +27,9 @@ namespace {
 using V = Eigen::Vector3d;
 using scene_builders::plane;
 
-constexpr double kG = 9.81;
-
-/// A box of edges 2 half over a concrete floor at z = 0, its material `e` against concrete.
-Scene floorScene(double e, const V& half, double mass = 2.0) {
-  Scene scene;
-  scene.effects.gravity = true;
-  scene.gravity = V(0, 0, -kG);
-  EXPECT_TRUE(scene.materials.addMaterial("block", Material{e, 0.0}, "m").ok());
-  BodySpec body;
-  body.id = "block";
-  body.mass = mass;
-  body.material = "block";
-  body.shape = BodyShape::kBox;
-  body.size = 2 * half;
-  scene.bodies = {body};
-  scene.obstacles = {plane("floor", V::UnitZ(), 0.0, "concrete")};
-  return scene;
-}
+using shaped_scenes::EdgeLanding;
+using shaped_scenes::floorScene;
+using shaped_scenes::kG;
 
 PredictionRequest dropped(const Scene& scene, const V& position, const Eigen::Quaterniond& turn,
                           double horizon, std::size_t max_impacts) {
@@ -86,35 +72,25 @@ TEST(ShapedPrediction, ElasticBoxDroppedFlatReturnsToItsDropHeight) {
             1e-12);
 }
 
-// A box turned by theta about y lands on the edge of its two lowest corners, (a cos theta -
-// c sin theta, +-b, -(a sin theta + c cos theta)) from its centre. Frictionless, the two take
-// equal impulses whose moments about x cancel: as one contact at (x, 0, z), whose effective mass
-// along z is 1 / (1/m + x^2 / I_yy), I_yy = m (a^2 + c^2) / 3. So J = (1 + e) v / (1/m + x^2 /
-// I_yy), v_z' = -v + J / m, w_y' = -x J / I_yy (the floor's impulse +J z at r = (x, ., z)).
+// A box turned by theta about y lands on the edge of its two lowest corners: the closed form's
+// impulse and spin (shaped_scenes::EdgeLanding).
 TEST(ShapedPrediction, BoxLandingOnAnEdgeTurnsAsTheClosedFormSays) {
-  const double a = 0.1, b = 0.05, c = 0.025, m = 2.0, e = 0.5, theta = 0.3;
-  const Scene scene = floorScene(e, V(a, b, c), m);
-  const double low = a * std::sin(theta) + c * std::cos(theta);
-  const double height = 0.5;
-  const Eigen::Quaterniond turn(Eigen::AngleAxisd(theta, V::UnitY()));
-  auto request = dropped(scene, V(0, 0, height), turn, 0.5, 2);
+  const EdgeLanding edge;
+  const Scene scene = floorScene(edge.e, V(edge.a, edge.b, edge.c), edge.m);
+  auto request = dropped(scene, V(0, 0, edge.height), edge.turn(), 0.5, 2);
   const auto prediction = predictImpacts(scene, nullptr, MonitorSettings{}, request);
   ASSERT_TRUE(prediction.ok()) << prediction.error().message();
   ASSERT_EQ(prediction->impacts.size(), 2u) << prediction->message;
-  const double fall = std::sqrt(2 * (height - low) / kG), v = kG * fall;
-  const double x = a * std::cos(theta) - c * std::sin(theta);
-  const double inertia = m * (a * a + c * c) / 3;
-  const double impulse = (1 + e) * v / (1 / m + x * x / inertia);
   double total = 0.0;
   for (const ImpactRecord& impact : prediction->impacts) {
-    EXPECT_NEAR(impact.time, fall, 1e-11);
+    EXPECT_NEAR(impact.time, edge.fall(), 1e-11);
     total += impact.impulse;
-    EXPECT_NEAR(impact.velocity_a_after.z(), -v + impulse / m, 1e-9);
-    EXPECT_NEAR(impact.angular_velocity_a_after.y(), -x * impulse / inertia, 1e-9);
+    EXPECT_NEAR(impact.velocity_a_after.z(), edge.velocityAfter(), 1e-9);
+    EXPECT_NEAR(impact.angular_velocity_a_after.y(), edge.spinAfter(), 1e-9);
     EXPECT_NEAR(impact.angular_velocity_a_after.x(), 0.0, 1e-9);
     EXPECT_NEAR(impact.angular_velocity_a_after.z(), 0.0, 1e-9);
   }
-  EXPECT_NEAR(total, impulse, 1e-9);
+  EXPECT_NEAR(total, edge.impulse(), 1e-9);
 }
 
 // A cube's inertia is isotropic, so its answer does not depend on how it is turned about the
