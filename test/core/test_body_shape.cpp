@@ -1,6 +1,7 @@
 // A scene body's shape and inertia (body_shape.h): each bad value named at its scene key by
-// validateScene, before the one refusal that stands for now, "not yet: only spheres move", which
-// names the body; a ball's scene as before; each shape's mass properties its closed form's.
+// validateScene, before the refusals that stand for now ("not yet": a mesh body or an immovable
+// shaped body in the monitor, any shaped body in a ball's prediction), which name the body; a
+// ball's scene as before; each shape's mass properties its closed form's.
 #include <gtest/gtest.h>
 
 #include <limits>
@@ -49,32 +50,48 @@ TEST(BodyShape, BallsAreAsBefore) {
       << validateScene(scene, "scene").error().message();
 }
 
-TEST(BodyShape, AShapedBodyIsNotYetMovedAndSaysSo) {
+// The monitor moves a box, a cylinder, a capsule and a sphere given a tensor (validateScene's
+// default, MovingShapes::kMonitored); a mesh body and an immovable shaped body not yet, saying so.
+// A ball's prediction (kSpheresOnly), whose other bodies are held as spheres, still refuses every
+// shaped body by name: nothing silently becomes a ball.
+TEST(BodyShape, TheMonitorMovesShapedBodiesButAMeshOrAnImmovableOneNotYet) {
   for (const auto& [shape, name] :
        {std::pair{BodyShape::kBox, "box"}, std::pair{BodyShape::kCylinder, "cylinder"},
         std::pair{BodyShape::kCapsule, "capsule"}, std::pair{BodyShape::kMesh, "mesh"}}) {
     Scene scene = sceneWith([&, shape_kind = shape](BodySpec& body) {
       body.shape = shape_kind;
-      body.size = V(0.1, 0.2, 0.3);
-      body.radius = 0.05;
-      body.length = 0.1;
+      body.size = shape_kind == BodyShape::kBox ? V(0.1, 0.2, 0.3) : V::Zero();
+      body.radius = shape_kind == BodyShape::kBox || shape_kind == BodyShape::kMesh ? 0.0 : 0.05;
+      body.length =
+          shape_kind == BodyShape::kCylinder || shape_kind == BodyShape::kCapsule ? 0.1 : 0.0;
       body.mesh = scene_builders::cubeMesh(V(0.05, 0.05, 0.05));
     });
-    expectRefused(validateScene(scene, "~scene"), "~scene/bodies[1]/shape",
+    if (shape == BodyShape::kMesh) {
+      expectRefused(validateScene(scene, "~scene"), "~scene/bodies[1]/shape",
+                    "not yet: a mesh body does not move yet (body 'block' is a mesh");
+    } else {
+      EXPECT_TRUE(validateScene(scene, "~scene").ok())
+          << validateScene(scene, "~scene").error().message();
+    }
+    expectRefused(validateScene(scene, "~scene", MovingShapes::kSpheresOnly),
+                  "~scene/bodies[1]/shape",
                   std::string("not yet: only spheres move (body 'block' is a ") + name);
   }
-  // An immovable one too: nothing silently becomes a ball.
+  // An immovable one: not yet moved by the monitor, saying so.
   Scene immovable = sceneWith([](BodySpec& body) {
     box(body);
     body.mass = kInf;
   });
-  expectRefused(validateScene(immovable, "s"), "s/bodies[1]/shape", "not yet");
-  // A sphere given a tensor is not a uniform ball either.
+  expectRefused(validateScene(immovable, "s"), "s/bodies[1]/mass", "not yet");
+  // A sphere given a tensor is a shaped body: the monitor moves it as one, a ball's prediction
+  // does not take it.
   Scene tensor = sceneWith([](BodySpec& body) {
     body.radius = 0.05;
     body.inertia_tensor = InertiaTensor{1e-3, 1e-3, 1e-3, 0, 0, 0};
   });
-  expectRefused(validateScene(tensor, "s"), "s/bodies[1]/inertia", "not yet");
+  EXPECT_TRUE(validateScene(tensor, "s").ok()) << validateScene(tensor, "s").error().message();
+  expectRefused(validateScene(tensor, "s", MovingShapes::kSpheresOnly), "s/bodies[1]/inertia",
+                "not yet");
 }
 
 TEST(BodyShape, EachBadValueIsNamedAtItsKey) {

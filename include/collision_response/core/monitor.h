@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -16,6 +17,8 @@
 namespace collision_response::core {
 namespace monitor {
 struct World;
+struct ShapedRoom;
+using BallPositions = std::function<std::optional<Eigen::Vector3d>(std::size_t body)>;
 }  // namespace monitor
 
 struct MonitorSettings {
@@ -63,8 +66,8 @@ struct BodyStateSample {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
-  /// World from body, a unit quaternion: carried into the body's track, not yet read (a ball's
-  /// does not matter; issue 42 gives bodies shapes).
+  /// World from body, a unit quaternion: a shaped body's motion starts from it (a ball's is
+  /// carried into its track, and does not matter).
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
 };
 
@@ -118,6 +121,16 @@ struct ContradictedImpact {
   double missing = 0.0;
 };
 
+/// A contact of a shaped body that the model does not carry yet (issue 42): a lasting contact
+/// lastingOnFace refuses, or a shaped body touching a ball or another shaped body.
+struct UnmodelledContact {
+  std::size_t body = 0;   ///< the shaped body
+  std::size_t other = 0;  ///< a body index, or an obstacle index when other_is_obstacle
+  bool other_is_obstacle = false;
+  double time = 0.0;  ///< s, when it began
+  std::string what;   ///< why, e.g. lastingOnFace's message
+};
+
 /// A body's flight through air that its integrator could not carry on (StepReport::stalled).
 struct StalledFlight {
   std::size_t body = 0;
@@ -130,6 +143,10 @@ struct StepReport {
   /// pairs.
   std::vector<ContactRecord> contacts;
   std::size_t stale_states = 0;  ///< states not newer than their body's last one: dropped
+  /// States of shaped bodies whose motion cannot start from them (an orientation that is not a
+  /// rotation, a value not finite): dropped, the track kept. The node's intake refuses such
+  /// states first, naming the field.
+  std::size_t refused_states = 0;
   /// States older than their body's motion in the monitor (it starts at an impact or a change
   /// of lasting contact found after the state's instant, within the same step): set aside, the
   /// motion kept.
@@ -173,6 +190,11 @@ struct StepReport {
   /// step's stepped work was spent (sorted, each once; MonitorSettings::
   /// max_stepped_work_per_step). Not counted in `fallbacks`.
   std::vector<std::size_t> over_stepped_work;
+  /// Contacts of shaped bodies the model does not carry yet, each once, when it begins (a held
+  /// body's with its obstacle; a shaped body touching a ball or another shaped body at the
+  /// step's end): the shaped body is held where it is (an obstacle's), or not resolved (a
+  /// body's), never moved through silently.
+  std::vector<UnmodelledContact> unmodelled;
 };
 
 /// Watches the scene's bodies and obstacles and finds their impacts.
@@ -262,12 +284,24 @@ class ImpactMonitor {
   double motionSince(std::size_t body) const;
   /// A body's predicted angular velocity at `time` (zero when it is not tracked).
   Eigen::Vector3d predictedAngularVelocity(std::size_t body, double time) const;
-  /// The orientation of a body's last state (identity when it is not tracked): carried, not yet
-  /// followed between states nor read by the model (a ball's does not matter).
+  /// The orientation of a body's last state (identity when it is not tracked).
   Eigen::Quaterniond lastOrientation(std::size_t body) const;
+  /// A body's predicted orientation at `time` (world from body; identity when it is not
+  /// tracked): a shaped body's followed by its motion (flight, impacts, lasting contact); a
+  /// ball's is its last state's (a ball's does not matter).
+  Eigen::Quaterniond predictedOrientation(std::size_t body, double time) const;
+  /// Whether the body is moved as a shaped body (issue 42; doc/model.md, "Shaped bodies in the
+  /// monitor").
+  bool shaped(std::size_t body) const;
 
  private:
+  /// step() for the balls alone (the shaped bodies' states left out).
+  StepReport stepBalls(double time, const std::vector<BodyStateSample>& states);
+  /// Where each tracked ball is at `time` (for a shaped body's unmodelled contact with one).
+  monitor::BallPositions ballsAt(double time) const;
+
   std::unique_ptr<monitor::World> world_;  // the scene, the tracks and a step's working memory
+  std::unique_ptr<monitor::ShapedRoom> shaped_;  // the shaped bodies' tracks
 };
 
 }  // namespace collision_response::core

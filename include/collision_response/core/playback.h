@@ -1,6 +1,6 @@
 // Playing a scene without ROS: the bodies moved from their initial states by the monitor's own
-// model (free flight, and lasting contact: resting, sliding, rolling, stacked), the impacts it is
-// told of applied from their instants. The scene player (ROS) and the accuracy benchmark use it.
+// model (free flight, and lasting contact: resting, sliding, rolling, stacked; a shaped body by
+// its exact motion among the obstacles), the impacts it is told of applied from their instants. The scene player (ROS) and the accuracy benchmark use it.
 #pragma once
 
 #include <Eigen/Core>
@@ -49,8 +49,9 @@ class Playback {
   Eigen::Vector3d position(std::size_t body, double time) const;
   Eigen::Vector3d velocity(std::size_t body, double time) const;
   Eigen::Vector3d angularVelocity(std::size_t body, double time) const;
-  /// World from body: the scene's initial orientation, carried through the impacts applied, not
-  /// yet followed in flight (a ball's does not matter; issue 42 gives bodies shapes).
+  /// World from body: a shaped body's followed in flight, through its impacts and its lasting
+  /// contact (the monitor's predictedOrientation); a ball's the scene's initial one (a ball's does
+  /// not matter).
   Eigen::Quaterniond orientation(std::size_t body, double time) const;
 
   /// An impact on `body` at `time`: from then on it moves from `centre` with the velocities after

@@ -70,13 +70,13 @@ struct BodySpec {
   /// rad/s, initial, in the fixed frame; nonzero only with the spin effect (without it the
   /// model has no spin to give it)
   Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
-  /// Initial, world from body, a unit quaternion: carried into the body's first state, not yet
-  /// read (a ball's does not matter; issue 42 gives bodies shapes).
+  /// Initial, world from body, a unit quaternion: the body's first state's (a shaped body's
+  /// motion starts from it; a ball's does not matter).
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
   /// Its shape: a sphere of `radius` by default; a box of edges `size`, a cylinder or a capsule
   /// of `radius` and `length` (between the caps; of the capsule's segment), or the convex hull of
-  /// `mesh` (loaded from `resource`, scaled by `scale`, as an obstacle's). Checked and carried,
-  /// not yet moved: validateScene refuses a body that is not a sphere ("not yet", body_shape.h).
+  /// `mesh` (loaded from `resource`, scaled by `scale`, as an obstacle's). The monitor moves a
+  /// box, cylinder or capsule (validateScene refuses a mesh body: "not yet").
   BodyShape shape = BodyShape::kSphere;
   Eigen::Vector3d size = Eigen::Vector3d::Zero();  ///< box: edge lengths, m
   double length = 0.0;                             ///< cylinder, capsule: m
@@ -145,18 +145,20 @@ struct Scene {
   std::vector<ObstacleSpec> obstacles;
 };
 
-/// Which bodies a scene may move: spheres only (the monitor's, for now), or any shape (a shaped
-/// body's prediction, which moves it by a model of its own: src/core/monitor/shaped_prediction.h).
-enum class MovingShapes { kSpheresOnly, kAny };
+/// Which bodies a scene may move: spheres only (a ball's prediction, whose other bodies are held
+/// as spheres), any shape (a shaped body's prediction: src/core/monitor/shaped_prediction.h), or
+/// the monitor's: spheres, and boxes, cylinders and capsules of finite mass under gravity alone
+/// (a mesh body, an immovable shaped body, drag or magnus with a shaped body: "not yet").
+enum class MovingShapes { kSpheresOnly, kAny, kMonitored };
 
 /// Every value and cross-reference of a scene: ids unique among bodies and obstacles, masses,
 /// radii, known materials, finite vectors, nonzero plane normals, each body's shape and inertia
 /// (checkBodyShape), and last, with kSpheresOnly, that every body is a sphere
-/// (checkOnlySpheresMove: "not yet"). Fields are named as scene file keys under `prefix`
-/// ("~scene/bodies[2]/mass"). Start-up cost: O(n log n) in the bodies, plus one check per pair of
-/// distinct materials.
+/// (checkOnlySpheresMove: "not yet"), with kMonitored, that every shaped body is one the monitor
+/// moves. Fields are named as scene file keys under `prefix` ("~scene/bodies[2]/mass"). Start-up
+/// cost: O(n log n) in the bodies, plus one check per pair of distinct materials.
 Status validateScene(const Scene& scene, const std::string& prefix,
-                     MovingShapes moving = MovingShapes::kSpheresOnly);
+                     MovingShapes moving = MovingShapes::kMonitored);
 
 /// A warning for each body whose scene `position` lies inside a fixed obstacle (one without a
 /// `frame`: tf places the others at run time) by more than the touching band, naming both and

@@ -16,6 +16,7 @@
 #include "model/monitor_world.h"
 #include "model/motion_model.h"
 #include "monitor/contact_schedule.h"
+#include "monitor/shaped_tracks.h"
 #include "solver/cluster_solver.h"
 
 namespace collision_response::core {
@@ -803,12 +804,17 @@ ImpactMonitor::ImpactMonitor(const Scene& scene, const MonitorSettings& settings
     world.obstacle_tracks[i] = monitor::ObstacleTrack{true, placeFixed(obstacle)};
   }
   world.partners.assign(world.bodies.size(), {});
+  shaped_ = std::make_unique<monitor::ShapedRoom>(monitor::shapedRoomOf(world));
 }
 
 ImpactMonitor::ImpactMonitor(const ImpactMonitor& other)
-    : world_(std::make_unique<World>(*other.world_)) {}
+    : world_(std::make_unique<World>(*other.world_)),
+      shaped_(std::make_unique<monitor::ShapedRoom>(*other.shaped_)) {}
 ImpactMonitor& ImpactMonitor::operator=(const ImpactMonitor& other) {
-  if (this != &other) world_ = std::make_unique<World>(*other.world_);
+  if (this != &other) {
+    world_ = std::make_unique<World>(*other.world_);
+    shaped_ = std::make_unique<monitor::ShapedRoom>(*other.shaped_);
+  }
   return *this;
 }
 ImpactMonitor::ImpactMonitor(ImpactMonitor&&) noexcept = default;
@@ -856,12 +862,14 @@ void ImpactMonitor::setObstaclePose(std::size_t obstacle, const RigidPose& frame
       monitor::ObstacleTrack{true, place(world_->obstacles[obstacle], frame)};
   world_->groups_current = false;
   world_->scratch.obstacles.invalidate();
+  ++shaped_->placements;
 }
 
 void ImpactMonitor::placeObstacle(std::size_t obstacle, const PlacedShape& placed) {
   world_->obstacle_tracks[obstacle] = monitor::ObstacleTrack{true, placed};
   world_->groups_current = false;
   world_->scratch.obstacles.invalidate();
+  ++shaped_->placements;
 }
 
 void ImpactMonitor::reset() {
@@ -878,14 +886,26 @@ void ImpactMonitor::reset() {
   world.started = false;
   world.now = 0.0;
   world.scratch.obstacles.invalidate();
+  for (auto& track : shaped_->tracks) track.reset();
+  shaped_->unmodelled_now.clear();
 }
 
 std::size_t ImpactMonitor::trackedBodies() const {
-  return static_cast<std::size_t>(std::count_if(world_->tracks.begin(), world_->tracks.end(),
-                                                [](const Track& t) { return t.known; }));
+  const auto balls = std::count_if(world_->tracks.begin(), world_->tracks.end(),
+                                   [](const Track& t) { return t.known; });
+  const auto shaped = std::count_if(shaped_->tracks.begin(), shaped_->tracks.end(),
+                                    [](const auto& t) { return t.has_value(); });
+  return static_cast<std::size_t>(balls + shaped);
 }
 
+bool ImpactMonitor::shaped(std::size_t body) const { return shaped_->shaped(body); }
+
 std::optional<std::size_t> ImpactMonitor::restingOn(std::size_t body) const {
+  if (shaped_->shaped(body)) {
+    const auto& track = shaped_->tracks[body];
+    if (!track || track->mode() != monitor::ShapedTrack::Mode::kLasting) return std::nullopt;
+    return track->against();
+  }
   const World& world = *world_;
   if (!world.tracks[body].known) return std::nullopt;
   if (world.stepped(body)) {
@@ -907,6 +927,11 @@ std::optional<std::size_t> ImpactMonitor::restingOn(std::size_t body) const {
 
 std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> ImpactMonitor::predictedState(
     std::size_t body, double time) const {
+  if (shaped_->shaped(body)) {
+    if (!shaped_->tracks[body]) return std::nullopt;
+    const BodyStateSample state = shaped_->tracks[body]->stateAt(time);
+    return std::make_pair(state.position, state.velocity);
+  }
   const World& world = *world_;
   if (!world.tracks[body].known) return std::nullopt;
   return withMotionModel(world, [&](auto motion) {
@@ -916,9 +941,16 @@ std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> ImpactMonitor::predic
   });
 }
 
-double ImpactMonitor::motionSince(std::size_t body) const { return world_->tracks[body].time; }
+double ImpactMonitor::motionSince(std::size_t body) const {
+  if (shaped_->shaped(body) && shaped_->tracks[body]) return shaped_->tracks[body]->since();
+  return world_->tracks[body].time;
+}
 
 Eigen::Vector3d ImpactMonitor::predictedAngularVelocity(std::size_t body, double time) const {
+  if (shaped_->shaped(body)) {
+    if (!shaped_->tracks[body]) return Eigen::Vector3d::Zero();
+    return shaped_->tracks[body]->stateAt(time).angular_velocity;
+  }
   const World& world = *world_;
   if (!world.tracks[body].known) return Eigen::Vector3d::Zero();
   return withMotionModel(world, [&](auto motion) {
@@ -927,21 +959,71 @@ Eigen::Vector3d ImpactMonitor::predictedAngularVelocity(std::size_t body, double
 }
 
 Eigen::Quaterniond ImpactMonitor::lastOrientation(std::size_t body) const {
+  if (shaped_->shaped(body)) {
+    const auto& track = shaped_->tracks[body];
+    return track ? track->last_orientation : Eigen::Quaterniond::Identity();
+  }
   const monitor::Track& track = world_->tracks[body];
   return track.known ? track.orientation : Eigen::Quaterniond::Identity();
 }
+
+Eigen::Quaterniond ImpactMonitor::predictedOrientation(std::size_t body, double time) const {
+  if (shaped_->shaped(body)) {
+    const auto& track = shaped_->tracks[body];
+    return track ? track->stateAt(time).orientation : Eigen::Quaterniond::Identity();
+  }
+  return lastOrientation(body);
+}
+
+namespace {
+
+/// The states (or imposed states) of balls only: a shaped body's are the shaped tracks'.
+std::vector<BodyStateSample> ballStates(const monitor::ShapedRoom& room,
+                                        const std::vector<BodyStateSample>& states) {
+  std::vector<BodyStateSample> balls;
+  for (const BodyStateSample& state : states) {
+    if (!room.shaped(state.body)) balls.push_back(state);
+  }
+  return balls;
+}
+
+}  // namespace
 
 StepReport ImpactMonitor::advance(double time, const std::vector<BodyStateSample>& imposed) {
   World& world = *world_;
   if (!world.started || time <= world.now) return StepReport{};
   forgetStaleBodies(world, time);
   ++world.steps;
-  return withMotionModel(world, [&](auto motion) {
-    return continuousStep<decltype(motion)>(world, time, {}, imposed);
+  if (!shaped_->any()) {
+    return withMotionModel(world, [&](auto motion) {
+      return continuousStep<decltype(motion)>(world, time, {}, imposed);
+    });
+  }
+  StepReport report = withMotionModel(world, [&](auto motion) {
+    return continuousStep<decltype(motion)>(world, time, {}, ballStates(*shaped_, imposed));
   });
+  monitor::advanceShaped(world, *shaped_, time, imposed, ballsAt(time), report);
+  return report;
+}
+
+monitor::BallPositions ImpactMonitor::ballsAt(double time) const {
+  return [this, time](std::size_t body) -> std::optional<Eigen::Vector3d> {
+    const auto state = predictedState(body, time);
+    if (!state) return std::nullopt;
+    return state->first;
+  };
 }
 
 StepReport ImpactMonitor::step(double time, const std::vector<BodyStateSample>& states) {
+  if (!shaped_->any()) return stepBalls(time, states);
+  World& world = *world_;
+  StepReport report = stepBalls(time, ballStates(*shaped_, states));
+  monitor::stepShaped(world, *shaped_, std::max(time, world.now), states,
+                      ballsAt(std::max(time, world.now)), report);
+  return report;
+}
+
+StepReport ImpactMonitor::stepBalls(double time, const std::vector<BodyStateSample>& states) {
   World& world = *world_;
   if (!world.started || time <= world.now) {
     StepReport report;

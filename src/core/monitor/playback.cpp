@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "collision_response/core/body_shape.h"
 #include "geometry/motion.h"
 
 namespace collision_response::core {
@@ -121,7 +122,7 @@ Eigen::Vector3d Playback::angularVelocity(std::size_t body, double time) const {
 }
 
 Eigen::Quaterniond Playback::orientation(std::size_t body, double time) const {
-  return at(time).lastOrientation(model_index_[body]);
+  return at(time).predictedOrientation(model_index_[body], time);
 }
 
 std::vector<ContactRecord> Playback::contacts(double time) const {
@@ -169,10 +170,13 @@ bool Playback::applyImpact(const ImpactMonitor& monitor, const ImpactRecord& imp
                          const Eigen::Vector3d& angular_after) {
     const auto body = bodyIndex(monitor.body(monitor_body).id);
     if (!body) return true;  // not one of this scene's bodies: nothing to move
+    // A ball's centre from the contact (its radius along the normal); a shaped body's where its
+    // motion has it at the instant (its centre is no radius from the contact).
     const double radius = scene_.bodies[*body].radius;
+    const bool from_contact = exact_contact && !isShapedBody(scene_.bodies[*body]);
     const Eigen::Vector3d centre =
-        exact_contact ? Eigen::Vector3d(impact.contact_point + side * radius * impact.normal)
-                      : position(*body, impact.time);
+        from_contact ? Eigen::Vector3d(impact.contact_point + side * radius * impact.normal)
+                     : position(*body, impact.time);
     return applyImpact(*body, impact.time, centre, after, angular_after);
   };
   bool applied =

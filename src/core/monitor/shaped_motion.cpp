@@ -158,6 +158,7 @@ Expected<ShapedMotion::Found> ShapedMotion::next(double horizon,
     const auto apart = again ? std::nullopt : separation(flight_, at, contacts, horizon);
     if (!apart) {
       lasting_ = contacts;
+      lasting_time_ = at;
       return Found{Event::kLasting, at};
     }
     clearUntil(at, contacts, *apart);
@@ -167,6 +168,7 @@ Expected<ShapedMotion::Found> ShapedMotion::next(double horizon,
                                     flight_.positionAt(at), moving.velocity, flight_.acceleration(),
                                     flight_.orientationAt(at), moving.angular_velocity);
   if (!after) return after.error();
+  landed_ = flight_;
   flight_ = std::move(after.value());
   time_ = at;
   struck_ = contacts;
@@ -179,10 +181,87 @@ bool ShapedMotion::leave(double horizon) {
   const auto apart = separation(flight_, time_, struck_, horizon);
   if (!apart) {
     lasting_ = struck_;
+    lasting_time_ = time_;
     return false;
   }
   clearUntil(time_, struck_, *apart);
   return true;
+}
+
+Expected<std::pair<LastingBody, FlatFace>> ShapedMotion::lastingFace() const {
+  return faceOf(lasting_, flight_, lasting_time_);
+}
+
+std::optional<double> ShapedMotion::flatBouncesEnd() const {
+  if (!landed_ || struck_.empty()) return std::nullopt;
+  const auto face = faceOf(struck_, *landed_, time_);
+  if (!face) return std::nullopt;
+  const auto restitution = scene_.restitution(struck_.front().obstacle);
+  if (!restitution) return std::nullopt;
+  return core::flatBouncesEnd(face->first, face->second, *restitution);
+}
+
+/// The body on `body`'s flight at `time` touching the one obstacle of `contacts` on a flat face:
+/// a fixed plane, or the face of a fixed box whose outward normal is the contact's (within the
+/// manifold's band over the box's size: every point of the manifold on that face).
+Expected<std::pair<LastingBody, FlatFace>> ShapedMotion::faceOf(
+    const std::vector<ObstacleContact>& contacts, const TumblingBody& body, double time) const {
+  if (contacts.size() != 1) {
+    return Error{"contact", "not yet: a shaped body's lasting contact with " +
+                                std::to_string(contacts.size()) + " obstacles at once"};
+  }
+  const ObstacleContact& contact = contacts.front();
+  const PlacedShape& placed = obstacles_[contact.slot].placed.placed;
+  if (placed.pose.velocity != Eigen::Vector3d::Zero() ||
+      placed.pose.angular_velocity != Eigen::Vector3d::Zero()) {
+    return Error{"contact", "not yet: a shaped body's lasting contact with a moving obstacle"};
+  }
+  FlatFace face;
+  const auto friction = scene_.friction(contact.obstacle);
+  if (!friction) return friction.error();
+  face.friction = *friction;
+  const Eigen::Vector3d outward = -contact.contact.closest.normal;  // out of the face
+  if (const auto* plane = std::get_if<Plane>(&placed.shape)) {
+    face.normal = plane->normal;
+    face.point = plane->offset * plane->normal;
+  } else if (const auto* box = std::get_if<Cuboid>(&placed.shape)) {
+    const Eigen::Matrix3d axes = placed.pose.transform.linear();
+    const Eigen::Vector3d local = axes.transpose() * outward;
+    Eigen::Index axis = 0;
+    local.cwiseAbs().maxCoeff(&axis);
+    const double sign = local[axis] > 0 ? 1.0 : -1.0;
+    face.normal = sign * axes.col(axis);
+    const double band = FirstContactOptions{}.manifold_band;
+    for (const ManifoldPoint& point : contact.contact.manifold) {
+      const Eigen::Vector3d in_box =
+          axes.transpose() * (point.point_b - placed.pose.transform.translation());
+      if (!(std::abs(sign * in_box[axis] - box->half_size[axis]) <= band)) {
+        return Error{"contact",
+                     "not yet: a shaped body's lasting contact on an edge or a corner of a box"};
+      }
+    }
+    face.point = placed.pose.transform.translation() + sign * box->half_size[axis] * axes.col(axis);
+    face.bounded = true;
+    const Eigen::Index u = (axis + 1) % 3, v = (axis + 2) % 3;
+    face.along_u = axes.col(u);
+    face.along_v = axes.col(v);
+    face.half_extent = Eigen::Vector2d(box->half_size[u], box->half_size[v]);
+  } else {
+    return Error{"contact",
+                 "not yet: a shaped body's lasting contact on an obstacle that is not a plane or "
+                 "a box"};
+  }
+  LastingBody lasting;
+  lasting.shape = principal_.shape;
+  lasting.moments = principal_.moments;
+  lasting.mass = principal_.mass;
+  lasting.time = time;
+  lasting.centre = body.positionAt(time);
+  lasting.velocity = body.velocityAt(time);
+  lasting.angular_velocity = body.angularVelocityAt(time);
+  lasting.orientation = body.orientationAt(time);
+  lasting.gravity = body.acceleration();
+  return std::make_pair(lasting, face);
 }
 
 /// The earliest contacts (every obstacle touching then, within the instant's rounding), each

@@ -12,11 +12,13 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "collision_response/core/expected.h"
 #include "collision_response/core/monitor.h"
 #include "collision_response/core/scene.h"
+#include "contact/shaped_lasting.h"
 #include "geometry/convex_distance.h"
 #include "geometry/tumbling_contact.h"
 
@@ -76,6 +78,7 @@ class ShapedMotion {
   const TumblingBody& flight() const { return flight_; }
   double time() const { return time_; }
   const PrincipalBody& principal() const { return principal_; }
+  std::size_t body() const { return scene_.body; }
 
   /// The body's state at `time` on `flight` (a flight of this body): its centre's, and the body
   /// frame's orientation.
@@ -92,6 +95,14 @@ class ShapedMotion {
 
   /// The obstacles (model indices) of the contact found to last, and its manifold.
   std::vector<std::size_t> lastingWith() const;
+  /// The contact found to last as the body on one flat face there, for lastingOnFace: with one
+  /// fixed obstacle, a plane or a box whose face the manifold lies on (within its band); else an
+  /// Error naming what is not modelled yet.
+  Expected<std::pair<LastingBody, FlatFace>> lastingFace() const;
+  /// After an impact (kImpact): the instant a flat landing's bounces accumulate on the face
+  /// struck (flatBouncesEnd, from the body as it landed), if they do.
+  std::optional<double> flatBouncesEnd() const;
+
   /// The instant friction at several points struck at once was first left out (their joint rule
   /// is frictionless), if ever.
   std::optional<double> frictionlessAt() const { return frictionless_at_; }
@@ -127,6 +138,8 @@ class ShapedMotion {
                         const SolverBody& other) const;
   std::optional<double> separation(const TumblingBody& body, double time,
                                    const std::vector<ObstacleContact>& left, double horizon) const;
+  Expected<std::pair<LastingBody, FlatFace>> faceOf(const std::vector<ObstacleContact>& contacts,
+                                                    const TumblingBody& body, double time) const;
 
   PrincipalBody principal_;
   ShapedScene scene_;
@@ -135,6 +148,8 @@ class ShapedMotion {
   std::vector<Watched> obstacles_;
   std::vector<ObstacleContact> struck_;   // the last impact's, until leave()
   std::vector<ObstacleContact> lasting_;  // the contact found to last
+  double lasting_time_ = 0.0;             // and when
+  std::optional<TumblingBody> landed_;    // the flight the last impact ended
   std::optional<double> frictionless_at_;
 };
 

@@ -1,0 +1,487 @@
+#include "monitor/shaped_tracks.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <tuple>
+
+#include "collision_response/core/body_shape.h"
+#include "collision_response/core/validation.h"
+#include "geometry/narrow_phase.h"
+
+namespace collision_response::core::monitor {
+
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+/// The obstacles as `world` has them placed now.
+std::vector<ShapedObstacle> placedObstacles(const World& world) {
+  std::vector<ShapedObstacle> placed;
+  for (std::size_t o = 0; o < world.obstacles.size(); ++o) {
+    if (world.obstacle_tracks[o].known) placed.push_back({o, world.obstacle_tracks[o].placed});
+  }
+  return placed;
+}
+
+/// What the engine needs of `world`'s scene for `body`: gravity, the threshold, and the pair's
+/// coefficients with each obstacle (from the monitor's tables, as tuned when it starts).
+ShapedScene shapedScene(const World& world, std::size_t body) {
+  ShapedScene scene;
+  scene.acceleration = world.gravity;
+  scene.restitution_threshold = world.restitution_threshold;
+  scene.body = body;
+  std::vector<double> restitution, friction;
+  for (std::size_t o = 0; o < world.obstacles.size(); ++o) {
+    const Pair pair{body, world.bodyCount() + o};
+    restitution.push_back(world.restitutionOf(pair));
+    friction.push_back(world.effects.friction ? world.frictionOf(pair) : 0.0);
+  }
+  const std::string id = world.bodies[body].id;
+  const auto coefficient = [id](std::vector<double> values, const char* what) {
+    return [id, values = std::move(values), what](std::size_t o) -> Expected<double> {
+      if (!std::isfinite(values[o])) {
+        return Error{"materials", std::string("no coefficient of ") + what + " for body '" + id +
+                                      "' against obstacle " + std::to_string(o)};
+      }
+      return values[o];
+    };
+  };
+  scene.restitution = coefficient(std::move(restitution), "restitution");
+  scene.friction = coefficient(std::move(friction), "friction");
+  return scene;
+}
+
+/// The shaped body of `room` at `time` as a tumbling body (for its gap to another body).
+std::optional<TumblingBody> tumblingAt(const ShapedRoom& room, std::size_t body, double time) {
+  const PrincipalBody& principal = *room.principal[body];
+  const BodyStateSample state = room.tracks[body]->stateAt(time);
+  auto created = TumblingBody::create(principal.shape, principal.moments, time, state.position,
+                                      state.velocity, Eigen::Vector3d::Zero(),
+                                      state.orientation * principal.body_from_principal,
+                                      state.angular_velocity);
+  if (!created) return std::nullopt;
+  return std::move(created.value());
+}
+
+/// Touching: overlapping, or apart by no more than the manifold's band.
+bool touching(const SurfaceGap& gap) {
+  return gap.overlapping || gap.gap <= FirstContactOptions{}.manifold_band;
+}
+
+}  // namespace
+
+Expected<ShapedTrack> ShapedTrack::start(const PrincipalBody& principal,
+                                         std::vector<ShapedObstacle> obstacles,
+                                         const ShapedScene& scene, const BodyStateSample& state,
+                                         std::size_t placements) {
+  auto motion = ShapedMotion::create(principal, std::move(obstacles), scene, state);
+  if (!motion) return motion.error();
+  ShapedTrack track(std::move(motion.value()), placements);
+  track.last_orientation = state.orientation;
+  return track;
+}
+
+void ShapedTrack::advanceTo(double time, std::vector<ImpactRecord>& impacts,
+                            std::vector<UnmodelledContact>& unmodelled) {
+  // Each pass moves on by one event at least (an impact, a graze, a lasting motion's end), and
+  // a held body not at all: bounded as the prediction's run is.
+  for (;;) {
+    if (mode_ == Mode::kHeld) return;
+    if (mode_ == Mode::kLasting) {
+      if (time <= lasting_->until) return;
+      const double until = lasting_->until;
+      const std::string ends = lasting_->ends;
+      BodyStateSample there = stateAt(until);
+      if (ends == "stops") {
+        LastingBody body;
+        const PrincipalBody& principal = motion_.principal();
+        body.shape = principal.shape;
+        body.moments = principal.moments;
+        body.mass = principal.mass;
+        body.time = until;
+        body.centre = lasting_->centreAt(until);
+        body.velocity = lasting_->velocityAt(until);
+        body.angular_velocity = lasting_->angularVelocityAt(until);
+        body.orientation = lasting_->orientationAt(until);
+        body.gravity = motion_.flight().acceleration();
+        startLasting(body, face_, unmodelled);
+        if (mode_ == Mode::kLasting && !(lasting_->until > until)) {
+          hold(there, *against_, "its lasting contact ends where it starts", unmodelled);
+        }
+        continue;
+      }
+      hold(there, *against_, ends, unmodelled);
+      return;
+    }
+    if (leaving_) {
+      leaving_ = false;
+      // Apart is looked for at once (no horizon): a step shorter than the band's passage would
+      // otherwise be taken apart unseen.
+      if (!motion_.leave(kInfinity)) {
+        enterLasting(motion_.time(), unmodelled);
+        continue;
+      }
+    }
+    const std::size_t before = impacts.size();
+    const auto found = motion_.next(time, impacts);
+    if (!found) {
+      hold(stateAt(motion_.time()), motion_.lastingWith().empty() ? 0 : motion_.lastingWith()[0],
+           found.error().message(), unmodelled);
+      return;
+    }
+    switch (found->event) {
+      case ShapedMotion::Event::kFree:
+        return;
+      case ShapedMotion::Event::kGrazed:
+        continue;
+      case ShapedMotion::Event::kLasting:
+        enterLasting(found->time, unmodelled);
+        continue;
+      case ShapedMotion::Event::kImpact:
+        break;
+    }
+    since_ = found->time;
+    leaving_ = true;
+    if (impacts.size() > before) {
+      impact_change = impacts.back().velocity_a_after - impacts[before].velocity_a_before;
+      last_impact_time = found->time;
+    }
+    if (const auto end = motion_.flatBouncesEnd()) rests_from_ = end;
+  }
+}
+
+void ShapedTrack::enterLasting(double time, std::vector<UnmodelledContact>& unmodelled) {
+  const std::vector<std::size_t> with = motion_.lastingWith();
+  const std::size_t obstacle = with.empty() ? 0 : with.front();
+  auto face = motion_.lastingFace();
+  if (!face) {
+    hold(stateAt(time), obstacle, face.error().message(), unmodelled);
+    return;
+  }
+  against_ = obstacle;
+  startLasting(face->first, face->second, unmodelled);
+}
+
+void ShapedTrack::startLasting(const LastingBody& body, const FlatFace& face,
+                               std::vector<UnmodelledContact>& unmodelled) {
+  const std::size_t obstacle = against_.value_or(0);
+  auto motion = lastingOnFace(body, face);
+  if (!motion) {
+    BodyStateSample state;
+    state.body = motion_.body();
+    state.time = body.time;
+    state.position = body.centre;
+    state.orientation = body.orientation * motion_.principal().body_from_principal.conjugate();
+    hold(state, obstacle, motion.error().message(), unmodelled);
+    return;
+  }
+  const bool resting_again = mode_ == Mode::kLasting;
+  mode_ = Mode::kLasting;
+  lasting_ = std::move(motion.value());
+  face_ = face;
+  since_ = body.time;
+  against_ = obstacle;
+  if (!resting_again) {
+    // A flat landing's bounces accumulate at rests_from_ (flatBouncesEnd): the contact lasts
+    // from there (doc/model.md, "Coming to rest").
+    lasting_since_ = rests_from_ && *rests_from_ <= body.time ? *rests_from_ : body.time;
+  }
+}
+
+void ShapedTrack::hold(const BodyStateSample& state, std::size_t obstacle, const std::string& what,
+                       std::vector<UnmodelledContact>& unmodelled) {
+  mode_ = Mode::kHeld;
+  held_ = state;
+  held_.velocity.setZero();
+  held_.angular_velocity.setZero();
+  since_ = state.time;
+  against_ = obstacle;
+  lasting_.reset();
+  UnmodelledContact contact;
+  contact.body = motion_.body();
+  contact.other = obstacle;
+  contact.other_is_obstacle = true;
+  contact.time = state.time;
+  contact.what = what;
+  unmodelled.push_back(contact);
+}
+
+BodyStateSample ShapedTrack::stateAt(double time) const {
+  if (mode_ == Mode::kHeld) {
+    BodyStateSample state = held_;
+    state.time = time;
+    return state;
+  }
+  if (mode_ == Mode::kLasting) {
+    BodyStateSample state;
+    state.body = motion_.body();
+    state.time = time;
+    state.position = lasting_->centreAt(time);
+    state.velocity = lasting_->velocityAt(time);
+    state.angular_velocity = lasting_->angularVelocityAt(time);
+    state.orientation =
+        lasting_->orientationAt(time) * motion_.principal().body_from_principal.conjugate();
+    return state;
+  }
+  return motion_.stateOn(motion_.flight(), time);
+}
+
+std::vector<ContactRecord> ShapedTrack::contacts(double time) const {
+  std::vector<ContactRecord> records;
+  if (mode_ != Mode::kLasting) return records;
+  const std::size_t body = motion_.body();
+  for (const SupportForce& force : lasting_->forcesAt(time)) {
+    ContactRecord record;
+    record.time = time;
+    record.body_a = body;
+    record.other = against_.value_or(0);
+    record.other_is_obstacle = true;
+    record.contact_point = force.point;
+    record.normal = -face_.normal;  // from the body into the face
+    record.normal_force = force.normal_force;
+    record.friction_force = -force.friction_force;  // on the face
+    record.state = lasting_->state;
+    record.since = lasting_since_;
+    records.push_back(record);
+  }
+  return records;
+}
+
+bool ShapedRoom::any() const {
+  return std::any_of(principal.begin(), principal.end(),
+                     [](const auto& p) { return p.has_value(); });
+}
+
+ShapedRoom shapedRoomOf(const World& world) {
+  ShapedRoom room;
+  room.principal.resize(world.bodies.size());
+  room.tracks.resize(world.bodies.size());
+  for (std::size_t body = 0; body < world.bodies.size(); ++body) {
+    if (!isShapedBody(world.bodies[body])) continue;
+    auto principal = principalBody(world.bodies[body], "body");
+    if (principal) room.principal[body] = std::move(principal.value());
+  }
+  return room;
+}
+
+bool restartShaped(const World& world, ShapedRoom& room, const BodyStateSample& state) {
+  std::optional<ShapedTrack>& track = room.tracks[state.body];
+  auto started = ShapedTrack::start(*room.principal[state.body], placedObstacles(world),
+                                    shapedScene(world, state.body), state, room.placements);
+  if (!started) return false;  // the track kept as it was
+  if (track) {
+    started.value().last_state_time = track->last_state_time;
+    started.value().last_impact_time = track->last_impact_time;
+    started.value().impact_change = track->impact_change;
+  }
+  track = std::move(started.value());
+  return true;
+}
+
+namespace {
+
+/// A known flying track started among obstacles placed before the latest placement starts again
+/// from where it is at `time` (its motion since then, among the obstacles as they are now).
+void followPlacements(const World& world, ShapedRoom& room, double time) {
+  for (std::size_t body = 0; body < room.tracks.size(); ++body) {
+    std::optional<ShapedTrack>& track = room.tracks[body];
+    if (!track || track->placements() == room.placements ||
+        track->mode() != ShapedTrack::Mode::kFlying) {
+      continue;
+    }
+    const double since = std::max(track->since(), std::min(time, world.now));
+    BodyStateSample state = track->stateAt(since);
+    state.body = body;
+    const double last_state = track->last_state_time;
+    const Eigen::Quaterniond orientation = track->last_orientation;
+    restartShaped(world, room, state);
+    if (room.tracks[body]) {
+      room.tracks[body]->last_state_time = last_state;
+      room.tracks[body]->last_orientation = orientation;
+    }
+  }
+}
+
+/// The shaped states, oldest first, taken as the balls' are (applyStates in monitor.cpp): a state
+/// not newer than its body's last one is stale; one older than its track's motion is set aside;
+/// one lacking more than half of the velocity change of an impact since the body's previous state
+/// is reported as contradicting it (but at the impact's own instant, where the monitor keeps its
+/// motion after). Each taken is advanced to `time`.
+void takeStates(const World& world, ShapedRoom& room, double time,
+                const std::vector<BodyStateSample>& states, std::vector<UnmodelledContact>& held,
+                StepReport& report) {
+  std::vector<BodyStateSample> ordered;
+  for (const BodyStateSample& state : states) {
+    if (room.shaped(state.body)) ordered.push_back(state);
+  }
+  std::stable_sort(ordered.begin(), ordered.end(),
+                   [](const BodyStateSample& x, const BodyStateSample& y) {
+                     return x.time < y.time || (x.time == y.time && x.body < y.body);
+                   });
+  for (const BodyStateSample& state : ordered) {
+    std::optional<ShapedTrack>& track = room.tracks[state.body];
+    const double previous = track ? track->last_state_time : -kInfinity;
+    if (state.time <= previous) {
+      ++report.stale_states;
+      continue;
+    }
+    if (!checkOrientation(state.orientation, "orientation") ||
+        !ShapedTrack::start(*room.principal[state.body], {}, shapedScene(world, state.body), state,
+                            0)) {
+      ++report.refused_states;  // the node's intake refuses them first, by name
+      continue;
+    }
+    if (track) track->last_state_time = state.time;
+    if (track && state.time < track->since()) {
+      ++report.states_set_aside;
+      continue;
+    }
+    if (track && track->last_impact_time >= previous && track->last_impact_time <= state.time &&
+        track->impact_change != Eigen::Vector3d::Zero()) {
+      const Eigen::Vector3d predicted = track->stateAt(state.time).velocity;
+      const double change = track->impact_change.norm();
+      const double missing = -(state.velocity - predicted).dot(track->impact_change) / change;
+      if (missing > 0.5 * change) {
+        if (state.time == track->last_impact_time) continue;
+        report.contradicted.push_back({state.body, track->last_impact_time, state.time, missing});
+      }
+    }
+    if (!restartShaped(world, room, state)) continue;
+    room.tracks[state.body]->last_state_time = state.time;
+    room.tracks[state.body]->advanceTo(std::max(time, state.time), report.impacts, held);
+  }
+}
+
+/// The contacts not modelled at `time`: each held track's with its obstacle, and each shaped body
+/// touching a ball or another shaped body (its gap at `time`, overlapping or within the band);
+/// those that did not hold at the last step's end are reported, beginning at `time` (a held
+/// track's when it was held).
+void reportUnmodelled(const World& world, ShapedRoom& room, double time,
+                      const std::vector<UnmodelledContact>& held, const BallPositions& balls,
+                      StepReport& report) {
+  std::set<std::tuple<std::size_t, std::size_t, bool>> now;
+  std::vector<UnmodelledContact> found;
+  for (std::size_t body = 0; body < room.tracks.size(); ++body) {
+    const std::optional<ShapedTrack>& track = room.tracks[body];
+    if (!track || track->mode() != ShapedTrack::Mode::kHeld) continue;
+    const auto key = std::make_tuple(body, *track->against(), true);
+    if (!now.insert(key).second) continue;
+    UnmodelledContact contact{body, *track->against(), true, track->since(),
+                              "its contact with the obstacle is not modelled yet"};
+    for (const UnmodelledContact& h : held) {
+      if (h.body == body && h.other == contact.other) contact = h;
+    }
+    found.push_back(contact);
+  }
+  for (std::size_t body = 0; body < room.tracks.size(); ++body) {
+    if (!room.tracks[body]) continue;
+    const auto tumbling = tumblingAt(room, body, time);
+    if (!tumbling) continue;
+    const double reach = tumbling->reach();
+    const Eigen::Vector3d centre = tumbling->positionAt(time);
+    for (std::size_t other = 0; other < world.bodies.size(); ++other) {
+      if (other == body) continue;
+      std::optional<SurfaceGap> gap;
+      if (room.shaped(other)) {
+        if (other < body || !room.tracks[other]) continue;  // each pair once
+        const auto second = tumblingAt(room, other, time);
+        if (!second) continue;
+        if ((second->positionAt(time) - centre).norm() > reach + second->reach() + 1e-9) continue;
+        gap = gapAt(*tumbling, *second, time);
+      } else {
+        const std::optional<Eigen::Vector3d> at = balls(other);
+        if (!at) continue;
+        const Eigen::Vector3d ball = *at;
+        const double radius = std::max(world.radius[other], 1e-12);
+        if ((ball - centre).norm() > reach + radius + 1e-9) continue;
+        PlacedShape sphere;
+        sphere.shape = Sphere{ball, radius};
+        sphere.pose.time = time;
+        sphere.pose.transform.translation() = ball;
+        gap = gapAt(*tumbling, sphere, time);
+      }
+      if (!touching(*gap)) continue;
+      const auto key = std::make_tuple(body, other, false);
+      now.insert(key);
+      found.push_back({body, other, false, time,
+                       std::string("a shaped body touching ") +
+                           (room.shaped(other) ? "another shaped body" : "a ball") +
+                           " is not modelled yet: it is not resolved (no impulse, no force)"});
+    }
+  }
+  for (const UnmodelledContact& contact : found) {
+    const auto key = std::make_tuple(contact.body, contact.other, contact.other_is_obstacle);
+    if (room.unmodelled_now.count(key) == 0) report.unmodelled.push_back(contact);
+  }
+  room.unmodelled_now = std::move(now);
+}
+
+void finishStep(const World& world, ShapedRoom& room, double time,
+                const std::vector<UnmodelledContact>& held, const BallPositions& balls,
+                std::size_t ball_impacts, StepReport& report) {
+  reportUnmodelled(world, room, time, held, balls, report);
+  for (std::size_t body = 0; body < room.tracks.size(); ++body) {
+    if (!room.tracks[body]) continue;
+    const std::vector<ContactRecord> contacts = room.tracks[body]->contacts(time);
+    report.contacts.insert(report.contacts.end(), contacts.begin(), contacts.end());
+  }
+  if (report.impacts.size() > ball_impacts) {
+    std::stable_sort(report.impacts.begin(), report.impacts.end(),
+                     [](const ImpactRecord& x, const ImpactRecord& y) { return x.time < y.time; });
+  }
+}
+
+}  // namespace
+
+/// Shaped tracks with no state for longer than the body timeout are forgotten.
+void forgetStale(const World& world, ShapedRoom& room, double time) {
+  for (std::optional<ShapedTrack>& track : room.tracks) {
+    if (track && time - track->last_state_time > world.settings.body_timeout) track.reset();
+  }
+}
+
+void stepShaped(const World& world, ShapedRoom& room, double time,
+                const std::vector<BodyStateSample>& states, const BallPositions& balls,
+                StepReport& report) {
+  const std::size_t ball_impacts = report.impacts.size();
+  forgetStale(world, room, time);
+  followPlacements(world, room, time);
+  std::vector<UnmodelledContact> held;
+  for (std::optional<ShapedTrack>& track : room.tracks) {
+    if (track) track->advanceTo(time, report.impacts, held);
+  }
+  takeStates(world, room, time, states, held, report);
+  finishStep(world, room, time, held, balls, ball_impacts, report);
+}
+
+void advanceShaped(const World& world, ShapedRoom& room, double time,
+                   const std::vector<BodyStateSample>& imposed, const BallPositions& balls,
+                   StepReport& report) {
+  const std::size_t ball_impacts = report.impacts.size();
+  forgetStale(world, room, time);
+  followPlacements(world, room, time);
+  std::vector<UnmodelledContact> held;
+  for (const BodyStateSample& state : imposed) {
+    std::optional<ShapedTrack>& track = room.tracks[state.body];
+    if (!room.shaped(state.body) || !track) continue;
+    track->advanceTo(state.time, report.impacts, held);
+    // The motion just after an impact, which turns no body at its instant: the orientation the
+    // track has there is kept.
+    BodyStateSample after = state;
+    after.orientation = track->stateAt(state.time).orientation;
+    const double last_state = std::max(track->last_state_time, state.time);
+    const Eigen::Quaterniond orientation = track->last_orientation;
+    if (!restartShaped(world, room, after)) continue;
+    room.tracks[state.body]->last_state_time = last_state;
+    room.tracks[state.body]->last_orientation = orientation;
+    room.tracks[state.body]->last_impact_time = state.time;
+    room.tracks[state.body]->impact_change.setZero();
+  }
+  for (std::optional<ShapedTrack>& track : room.tracks) {
+    if (track) track->advanceTo(time, report.impacts, held);
+  }
+  finishStep(world, room, time, held, balls, ball_impacts, report);
+}
+
+}  // namespace collision_response::core::monitor

@@ -1,0 +1,124 @@
+// The monitor's shaped bodies (issue 42, steps 6 and 7): each one's track is its last state
+// (position, velocity, angular velocity, orientation) and its motion from there: the engine's
+// flights and impacts with the obstacles (shaped_motion.h), a lasting motion on one flat face
+// (shaped_lasting.h), or held where it is from the instant its contact is not modelled yet, which
+// is reported (UnmodelledContact), never passed through. The balls' world (monitor_world.h) does
+// not see them: their tracks there stay unknown.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstddef>
+#include <functional>
+#include <limits>
+#include <optional>
+#include <set>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "collision_response/core/expected.h"
+#include "collision_response/core/monitor.h"
+#include "contact/shaped_lasting.h"
+#include "model/monitor_world.h"
+#include "monitor/shaped_motion.h"
+
+namespace collision_response::core::monitor {
+
+/// A shaped body's motion from its last state.
+class ShapedTrack {
+ public:
+  enum class Mode { kFlying, kLasting, kHeld };
+
+  /// The motion from `state` among `obstacles`; an Error where the engine refuses the state (a
+  /// value not finite: TumblingBody::create).
+  static Expected<ShapedTrack> start(const PrincipalBody& principal,
+                                     std::vector<ShapedObstacle> obstacles,
+                                     const ShapedScene& scene, const BodyStateSample& state,
+                                     std::size_t placements);
+
+  /// On to `time`: the impacts with obstacles in (reached, time] appended to `impacts`, and the
+  /// contact whose model is missing, where the body is held from (once, when it begins), to
+  /// `unmodelled`. The velocity change of the latest impact is noted (impactChange).
+  void advanceTo(double time, std::vector<ImpactRecord>& impacts,
+                 std::vector<UnmodelledContact>& unmodelled);
+
+  /// The body's state at `time` (at or after since(), within what was advanced): its centre's,
+  /// and its body frame's orientation.
+  BodyStateSample stateAt(double time) const;
+  /// The instant its current motion holds from (its state, an impact, a lasting motion's
+  /// start, the instant it was held).
+  double since() const { return since_; }
+  Mode mode() const { return mode_; }
+  /// Its lasting contacts at `time`, one record per point of the manifold (kLasting).
+  std::vector<ContactRecord> contacts(double time) const;
+  /// The obstacle it lasts on or is held against (kLasting, kHeld).
+  std::optional<std::size_t> against() const { return against_; }
+  /// The obstacle placements (ShapedRoom::placements) its motion was started with.
+  std::size_t placements() const { return placements_; }
+
+  double last_state_time = -std::numeric_limits<double>::infinity();
+  double last_impact_time = -std::numeric_limits<double>::infinity();
+  Eigen::Vector3d impact_change = Eigen::Vector3d::Zero();  ///< m/s, the latest impact's
+  Eigen::Quaterniond last_orientation = Eigen::Quaterniond::Identity();  ///< its last state's
+
+ private:
+  ShapedTrack(ShapedMotion motion, std::size_t placements)
+      : motion_(std::move(motion)), since_(motion_.time()), placements_(placements) {}
+  /// The contact the engine found to last: on one flat face by lastingOnFace, or held.
+  void enterLasting(double time, std::vector<UnmodelledContact>& unmodelled);
+  void startLasting(const LastingBody& body, const FlatFace& face,
+                    std::vector<UnmodelledContact>& unmodelled);
+  void hold(const BodyStateSample& state, std::size_t obstacle, const std::string& what,
+            std::vector<UnmodelledContact>& unmodelled);
+
+  ShapedMotion motion_;
+  Mode mode_ = Mode::kFlying;
+  double since_ = 0.0;
+  bool leaving_ = false;  // after an impact: the struck points to part first (ShapedMotion::leave)
+  std::optional<double> rests_from_;  // a flat landing's bounces accumulate then
+  std::optional<LastingMotion> lasting_;
+  FlatFace face_;
+  double lasting_since_ = 0.0;
+  std::optional<std::size_t> against_;
+  BodyStateSample held_;
+  std::size_t placements_ = 0;
+};
+
+/// The shaped bodies of one monitor, by body index (balls: none), and the contacts not modelled
+/// that hold at the last step's end (each reported once, when it begins).
+struct ShapedRoom {
+  std::vector<std::optional<PrincipalBody>> principal;
+  std::vector<std::optional<ShapedTrack>> tracks;
+  std::set<std::tuple<std::size_t, std::size_t, bool>> unmodelled_now;
+  /// Obstacle placements so far (setObstaclePose, placeObstacle): a flying track started with
+  /// fewer starts again from where it is, among the obstacles as placed now.
+  std::size_t placements = 0;
+
+  bool any() const;
+  bool shaped(std::size_t body) const { return body < principal.size() && principal[body]; }
+};
+
+/// The shaped bodies of `world`'s scene (validateScene took them: principalBody holds).
+ShapedRoom shapedRoomOf(const World& world);
+
+/// A shaped body's track starts again from `state` (the obstacles as placed in `world`).
+/// False where its motion is refused (the track is kept as it was).
+bool restartShaped(const World& world, ShapedRoom& room, const BodyStateSample& state);
+
+/// The shaped bodies' step to `time`: each known track advanced (its impacts in (now, time]),
+/// then `states` of shaped bodies taken as in the balls' applyStates (stale, set aside,
+/// contradicted) and advanced to `time`; a shaped body touching a ball or another shaped body at
+/// `time` reported as unmodelled (once, when it begins); the lasting contacts at `time`.
+void stepShaped(const World& world, ShapedRoom& room, double time,
+                const std::vector<BodyStateSample>& states, const BallPositions& balls,
+                StepReport& report);
+
+/// As stepShaped, the states imposed at their instants (Playback: the motion just after an
+/// impact, the orientation kept) instead of taken at the step's end.
+void advanceShaped(const World& world, ShapedRoom& room, double time,
+                   const std::vector<BodyStateSample>& imposed, const BallPositions& balls,
+                   StepReport& report);
+
+}  // namespace collision_response::core::monitor
