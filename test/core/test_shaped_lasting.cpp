@@ -9,6 +9,7 @@
 // no point below the face, no energy gained, no force < 0.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -186,6 +187,57 @@ TEST(ShapedLasting, ACubeRestingFlatCarriesAQuarterOfItsWeightAtEachCorner) {
   for (const SupportForce& force : again->forces) {
     EXPECT_NEAR(force.normal_force, m * kG / 4, 1e-14 * m * kG);
   }
+}
+
+TEST(ShapedLasting, ACubeThatSettledRestsWithItsResidualMotionDropped) {
+  // The shaped motion takes a contact to last where no point's normal motion could lift it by
+  // more than 1e-6 of the body's reach (an elastic rise u^2 / (2 g)): for the cube (reach
+  // 0.0524 sqrt 3 = 0.0908 m) u up to sqrt(2 g 1e-6 0.0908) = 1.33e-3 m/s, a tilt whose far corners
+  // are up to 9.08e-8 m above the lowest. Such a cube rests, that motion dropped (energy lost);
+  // beyond it, refused.
+  const double half = 0.0524, m = 0.37;
+  const FlatFace floor = plane(V::UnitZ(), 0.5);
+  LastingBody body = box(V(half, half, half), m, V(0, 0, half));
+  body.velocity = V(0, 0, -1e-3);
+  body.angular_velocity = V(5e-3, 0, 0);  // rocking: its corners' normal speeds +-2.6e-4 m/s
+  const auto settled = lastingOnFace(body, floor);
+  ASSERT_TRUE(settled.ok()) << errorOf(settled);
+  EXPECT_EQ(settled->state, ContactState::kResting);
+  EXPECT_EQ(settled->velocity0, V::Zero());
+  EXPECT_EQ(settled->angular_velocity0, V::Zero());
+  expectNeverBelowNorGaining(body, floor, *settled);
+  body.velocity = V(0, 0, -2e-3);
+  body.angular_velocity = V::Zero();
+  const auto approaching = lastingOnFace(body, floor);
+  ASSERT_FALSE(approaching.ok());
+  EXPECT_EQ(approaching.error().field, "body.velocity");
+  // Tilted by 5e-7 rad about x: its corners 2 half sin(5e-7) = 5.2e-8 m apart in height, within
+  // the settled band: it rests on its four corners, about m g / 4 each (the tilt moves the
+  // centre's foot by half 5e-7 of the face's 0.0524 m half width).
+  const Q tilt(Eigen::AngleAxisd(5e-7, V::UnitX()));
+  const auto lowestCorner = [&](const Q& turn) {
+    double z = 0;
+    for (const double x : {-half, half}) {
+      for (const double y : {-half, half}) {
+        for (const double c : {-half, half}) z = std::min(z, (turn * V(x, y, c)).z());
+      }
+    }
+    return -z;
+  };
+  const auto tilted =
+      lastingOnFace(box(V(half, half, half), m, V(0, 0, lowestCorner(tilt)), tilt), floor);
+  ASSERT_TRUE(tilted.ok()) << errorOf(tilted);
+  ASSERT_EQ(tilted->forces.size(), 4u);
+  for (const SupportForce& force : tilted->forces) {
+    EXPECT_NEAR(force.normal_force, m * kG / 4, 1e-5 * m * kG);
+  }
+  // Tilted by 5e-6 rad (5.2e-7 m): on an edge, refused by name.
+  const Q more(Eigen::AngleAxisd(5e-6, V::UnitX()));
+  const auto on_edge =
+      lastingOnFace(box(V(half, half, half), m, V(0, 0, lowestCorner(more)), more), floor);
+  ASSERT_FALSE(on_edge.ok());
+  EXPECT_NE(on_edge.error().reason.find("not yet: tipping over an edge"), std::string::npos)
+      << on_edge.error().message();
 }
 
 TEST(ShapedLasting, ABoxRestingOnAnInclineWithinFrictionLeansItsWeightDownhill) {

@@ -185,6 +185,10 @@ struct Setting {
   double height = 0;  ///< the centre's height above the face
   Vec foot;           ///< the centre's foot on the face
   double reach = 0;   ///< the body's farthest point from its centre
+  /// The manifold's band: kLastingBand, or for a settled body kLastingSettled of its reach.
+  double band = kLastingBand;
+  /// m/s: the normal speed a point may have and be settled (kLastingSettled).
+  double settled_speed = kLastingStillSpeed;
 };
 
 Vec onFace(const Vec& x, const FlatFace& face, const Vec& n) {
@@ -210,7 +214,7 @@ Expected<Support> supportOf(const LastingBody& body, const Eigen::Matrix3d& rota
   const auto round = [&](double radius, double half_length, bool cylinder) -> Expected<Support> {
     const Vec axis = rotation.col(2);
     const double rise = 2 * half_length * std::abs(axis.dot(n));
-    if (rise <= kLastingBand) {  // on its side: the lowest line's two ends
+    if (rise <= setting.band) {  // on its side: the lowest line's two ends
       support.kind = SupportKind::kLine;
       support.axis = (axis - axis.dot(n) * n).normalized();
       const Vec below = body.centre - radius * n;
@@ -220,7 +224,7 @@ Expected<Support> supportOf(const LastingBody& body, const Eigen::Matrix3d& rota
       support.axial_moment = body.moments.z();
       return support;
     }
-    if (cylinder && 2 * radius * axis.cross(n).norm() <= kLastingBand) {  // on its cap
+    if (cylinder && 2 * radius * axis.cross(n).norm() <= setting.band) {  // on its cap
       support.kind = SupportKind::kDisc;
       const double side = axis.dot(n) > 0 ? -1.0 : 1.0;  // the cap nearer the face
       support.centre = onFace(body.centre + side * half_length * axis, face, n);
@@ -240,7 +244,7 @@ Expected<Support> supportOf(const LastingBody& body, const Eigen::Matrix3d& rota
   contactCandidates(body.shape, down, candidates);
   for (const Vec& corner : candidates) {
     const Vec point = body.centre + rotation * corner;
-    if (n.dot(point - face.point) - lowest <= kLastingBand) {
+    if (n.dot(point - face.point) - lowest <= setting.band) {
       support.feet.push_back(onFace(point, face, n));
     }
   }
@@ -541,6 +545,9 @@ Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& f
   setting.height = setting.n.dot(body.centre - face.point);
   setting.foot = body.centre - setting.height * setting.n;
   setting.reach = reachOf(body.shape);
+  setting.band = std::max(kLastingBand, kLastingSettled * setting.reach);
+  setting.settled_speed =
+      std::max(kLastingStillSpeed, std::sqrt(2 * setting.g_n * kLastingSettled * setting.reach));
   auto found = supportOf(body, rotation, face, setting);
   if (!found) return found.error();
   Support support = found.value();
@@ -549,30 +556,34 @@ Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& f
   const Vec& v = body.velocity;
   const Vec& w = body.angular_velocity;
   const Vec in_face = v - v.dot(setting.n) * setting.n;
-  const bool turning = w.norm() * setting.reach > kLastingStillSpeed;
-  double spin = 0;
-  if (turning) {
-    const bool rolls =
-        support.kind == SupportKind::kLine &&
-        (w - w.dot(support.axis) * support.axis).norm() * setting.reach <= kLastingStillSpeed;
-    if (rolls) {
-      spin = w.dot(support.axis);
-    } else if (std::abs(w.dot(setting.n)) * setting.reach > kLastingStillSpeed) {
-      return notYet("spin about the face's normal while sliding or resting (pivoting friction)");
-    } else {
-      return notYet("rocking: turning about an axis in the face that is not a side's own");
-    }
+  // A side keeps its turn about its axis (a roll); the rest of w is a spin about the normal,
+  // refused beyond kLastingStillSpeed, and a rocking turn about an axis in the face, refused
+  // beyond the settled speed and dropped within it (with it, energy: the axis is principal).
+  const double spin = support.kind == SupportKind::kLine ? w.dot(support.axis) : 0.0;
+  const Vec rest = support.kind == SupportKind::kLine ? Vec(w - spin * support.axis) : w;
+  const double about_normal = rest.dot(setting.n);
+  if (std::abs(about_normal) * setting.reach > kLastingStillSpeed) {
+    return notYet("spin about the face's normal while sliding or resting (pivoting friction)");
+  }
+  if ((rest - about_normal * setting.n).norm() * setting.reach > setting.settled_speed) {
+    return notYet("rocking: turning about an axis in the face that is not a side's own");
   }
   // The manifold neither approaches nor leaves the face.
+  const double r = support.radius;
   const std::vector<Vec> points =
-      support.kind == SupportKind::kDisc ? std::vector<Vec>{support.centre} : support.feet;
+      support.kind == SupportKind::kDisc
+          ? std::vector<Vec>{support.centre + r * setting.e1, support.centre - r * setting.e1,
+                             support.centre + r * setting.e2, support.centre - r * setting.e2}
+          : support.feet;
   for (const Vec& point : points) {
     const double normal_speed = (v + w.cross(point - body.centre)).dot(setting.n);
-    if (std::abs(normal_speed) > kLastingStillSpeed) {
+    if (std::abs(normal_speed) > setting.settled_speed) {
       return Error{"body.velocity", std::string("a point of the contact ") +
                                         (normal_speed < 0 ? "approaches" : "leaves") +
                                         " the face at " + formatNumber(std::abs(normal_speed)) +
-                                        " m/s: not a lasting contact (within 1e-9 m/s)"};
+                                        " m/s: not a lasting contact (settled within " +
+                                        formatNumber(setting.settled_speed) +
+                                        " m/s: an elastic rise of 1e-6 of the body's reach)"};
     }
   }
   if (face.bounded) {

@@ -18,12 +18,18 @@
 
 namespace collision_response::core {
 
-/// m: the touching band. The body's lowest point is within it of the face, and its manifold is
-/// its points within it of the lowest (as TumblingContact's manifold band).
+/// m: the touching band: the body's lowest point is within it of the face (as TumblingContact's
+/// manifold band).
 constexpr double kLastingBand = 1e-9;
-/// m/s: a speed below it counts as none: a point's approach to the face, a slide, a slip, a turn
-/// (|w| times the body's reach), as the balls' slips (doc/model.md, "Lasting contact").
+/// m/s: a speed below it counts as none: a slide, a slip, a spin about the face's normal (|w_n|
+/// times the body's reach), as the balls' slips (doc/model.md, "Lasting contact").
 constexpr double kLastingStillSpeed = 1e-9;
+/// Of the body's reach: a body whose every point's normal motion could lift it by no more than
+/// this (an elastic rise u^2 / (2 g_n)), as the shaped motion's rule for a contact that lasts, has
+/// settled: its manifold is its points within max(kLastingBand, kLastingSettled reach) of its
+/// lowest, and that normal motion (the points' approach or parting, a rocking turn) is dropped,
+/// as the bounces it would make accumulate (energy is lost, never gained).
+constexpr double kLastingSettled = 1e-6;
 /// Of |g_t| + g_n: gravity's part across a slide (or along a rolling side's axis, or across a
 /// resting side's) below it counts as none.
 constexpr double kLastingAcrossGravity = 1e-12;
