@@ -790,8 +790,10 @@ TEST(SceneKeys, EveryDocumentedKeyLoadsWithItsValue) {
 }
 
 // Issue 42, build step 2: a body's shape keys. Each bad value is named at its key; a good box,
-// cylinder, capsule or mesh body is read, checked and then refused at load, naming the body, as
-// only spheres move yet (nothing silently becomes a ball).
+// cylinder or capsule body (or a sphere given its tensor) is read, checked and taken, as the
+// monitor moves it (issue 42, step 7; it was refused "not yet: only spheres move" until the
+// monitor took shaped bodies); a mesh body is read and checked, then refused at load naming the
+// body, as it does not move yet (nothing silently becomes a ball).
 TEST(SceneLoader, Issue42_ShapedBodiesAreReadCheckedAndNotYetMoved) {
   const auto withBody = [](const std::function<void(XmlRpc::XmlRpcValue&)>& shape_it) {
     XmlRpc::XmlRpcValue scene = fullScene();
@@ -811,31 +813,39 @@ TEST(SceneLoader, Issue42_ShapedBodiesAreReadCheckedAndNotYetMoved) {
     EXPECT_NE(loaded.error().reason.find(words), std::string::npos) << loaded.error().message();
   };
   const std::string at = "~scene/bodies[2]/";
-  // Good shapes: read and checked, then "not yet".
-  refused(withBody([](XmlRpc::XmlRpcValue& b) {
-            b["shape"] = "box";
-            b["size"] = list3(0.1, 0.2, 0.3);
-          }),
-          at + "shape", "not yet: only spheres move (body 'block' is a box");
-  refused(withBody([](XmlRpc::XmlRpcValue& b) {
-            b["shape"] = "capsule";
-            b["radius"] = 0.05;
-            b["length"] = 0.0;
-          }),
-          at + "shape", "is a capsule");
+  const auto taken = [](const XmlRpc::XmlRpcValue& scene, core::BodyShape shape) {
+    const auto loaded = loadScene(scene, "~scene");
+    ASSERT_TRUE(loaded.ok()) << loaded.error().message();
+    const auto block = std::find_if(loaded->bodies.begin(), loaded->bodies.end(),
+                                    [](const core::BodySpec& b) { return b.id == "block"; });
+    ASSERT_NE(block, loaded->bodies.end());
+    EXPECT_EQ(block->shape, shape);
+  };
+  // Good shapes: read, checked and taken; a mesh body read and checked, then "not yet".
+  taken(withBody([](XmlRpc::XmlRpcValue& b) {
+          b["shape"] = "box";
+          b["size"] = list3(0.1, 0.2, 0.3);
+        }),
+        core::BodyShape::kBox);
+  taken(withBody([](XmlRpc::XmlRpcValue& b) {
+          b["shape"] = "capsule";
+          b["radius"] = 0.05;
+          b["length"] = 0.0;
+        }),
+        core::BodyShape::kCapsule);
   refused(withBody([](XmlRpc::XmlRpcValue& b) {
             b["shape"] = "mesh";
             b["resource"] = testMesh("grip.stl");
           }),
-          at + "shape", "is a mesh");
-  // A ball given a tensor.
-  refused(withBody([](XmlRpc::XmlRpcValue& b) {
-            b["radius"] = 0.05;
-            b["inertia"]["ixx"] = 1e-3;
-            b["inertia"]["iyy"] = 1e-3;
-            b["inertia"]["izz"] = 1e-3;
-          }),
-          at + "inertia", "not yet");
+          at + "shape", "not yet: a mesh body does not move yet (body 'block' is a mesh");
+  // A ball given a tensor: a shaped body of a sphere's shape.
+  taken(withBody([](XmlRpc::XmlRpcValue& b) {
+          b["radius"] = 0.05;
+          b["inertia"]["ixx"] = 1e-3;
+          b["inertia"]["iyy"] = 1e-3;
+          b["inertia"]["izz"] = 1e-3;
+        }),
+        core::BodyShape::kSphere);
   // Bad values, each at its key.
   refused(withBody([](XmlRpc::XmlRpcValue& b) { b["shape"] = "plane"; }), at + "shape",
           "unknown body shape 'plane'");
