@@ -375,6 +375,28 @@ void MonitorCycle::reportStep(const core::StepReport& step, Update& update) cons
              "there, the impact stays published (a source that applies the impacts sends that "
              "state before it hears of it; any other source says the impact did not happen)"});
   }
+  if (step.refused_states > 0) {
+    // The intake refuses such states first (naming the field): a count here is a state the
+    // intake took and the shaped body's motion could not start from.
+    update.reports.push_back(
+        {Reason::kBadOrientation,
+         "dropped " + std::to_string(step.refused_states) +
+             " state(s) of shaped bodies whose motion could not start from them (an orientation "
+             "that is not a rotation, or a value not finite): their tracks are kept",
+         step.refused_states});
+  }
+  for (const core::UnmodelledContact& contact : step.unmodelled) {
+    // Each once, when it begins (a counter, not a drop: the summary stays OK), throttled with
+    // the others of its reason; what the model does with the body meanwhile is core::StepReport's.
+    update.reports.push_back(
+        {Reason::kUnmodelledContact,
+         "the contact of " +
+             sides(monitor_, contact.body, contact.other, contact.other_is_obstacle) + " from " +
+             core::formatNumber(monitor_.now() - contact.time) +
+             " s before this update's end is not modelled yet: " + contact.what +
+             " (a shaped body with an obstacle is held where it is, with a ball or another "
+             "shaped body not resolved; doc/model.md, \"Shaped bodies in the monitor\")"});
+  }
   for (const core::StalledFlight& flight : step.stalled) {
     update.reports.push_back(
         {Reason::kFlightStalled,

@@ -116,6 +116,8 @@ const char* counterName(Reason reason) {
       return "bodies held over the stepped work bound";
     case Reason::kBadOrientation:
       return "dropped: orientation not a rotation";
+    case Reason::kUnmodelledContact:
+      return "contacts of shaped bodies not modelled yet";
   }
   return "unknown";
 }

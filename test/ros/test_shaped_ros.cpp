@@ -6,12 +6,15 @@
 #include <tf2/buffer_core.h>
 
 #include <cmath>
+#include <deque>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "collision_response/core/body_shape.h"
 #include "collision_response/ros/markers.h"
+#include "collision_response/ros/monitor_cycle.h"
+#include "collision_response/ros/monitor_diagnostics.h"
 #include "collision_response/ros/state_intake.h"
 
 namespace collision_response {
@@ -223,6 +226,79 @@ TEST(ShapedMarkers, EveryBodyIsDrawnAsItsShapeAtItsOrientation) {
   }
   EXPECT_EQ(array.markers[0].ns, "bodies");
   EXPECT_EQ(array.markers[1].ns, "body_ends");
+}
+
+/// A box (0.1 m cube, 2 kg) at rest with its centre at (0, 0, 0.5) and a ball (radius 0.02 m)
+/// at (0.2, 0, 0.5) moving at -1 m/s, no gravity: the ball reaches the box's face x = 0.05 when
+/// its centre is at 0.07, at (0.2 - 0.07) / 1 = 0.13 s. A shaped body touching a ball is not
+/// modelled yet (core::StepReport::unmodelled).
+core::Scene boxAndBallScene() {
+  core::Scene scene;
+  scene.materials.addMaterial("test_half", core::Material{0.5, std::nullopt}, "materials");
+  core::BodySpec box = bodyOf("block", core::BodyShape::kBox);
+  box.mass = 2.0;
+  box.size = Eigen::Vector3d(0.1, 0.1, 0.1);
+  box.material = "test_half";
+  core::BodySpec ball = bodyOf("ball", core::BodyShape::kSphere);
+  ball.mass = 0.1;
+  ball.radius = 0.02;
+  ball.material = "test_half";
+  scene.bodies = {box, ball};
+  return scene;
+}
+
+std::string diagnosticValue(const diagnostic_updater::DiagnosticStatusWrapper& status,
+                            const std::string& key) {
+  for (const diagnostic_msgs::KeyValue& value : status.values) {
+    if (value.key == key) return value.value;
+  }
+  return "(none)";
+}
+
+// Item 4: a contact of a shaped body that the model does not carry yet is said (a warning naming
+// the body, the other and why) and counted on /diagnostics under its own counter, once when it
+// begins, never passing silently; it drops nothing (the summary stays OK). Before, the node
+// did not read StepReport::unmodelled at all.
+TEST(ShapedDiagnostics, AnUnmodelledContactIsNamedAndCounted) {
+  MonitorCycle cycle(boxAndBallScene(), MonitorParams{});
+  tf2::BufferCore tf;
+  const ros::Time start(1000, 0);
+  std::vector<Report> reports;
+  MonitorDiagnostics diagnostics;
+  std::deque<std::vector<BodyState>> inputs;  // kept alive: the cycle reads them in place
+  for (int k = 0; k <= 3; ++k) {
+    const ros::Time stamp = start + ros::Duration(0.1 * k);
+    BodyState box = stateOf("block", 0, 0, 0, 1);
+    box.header.stamp = stamp;
+    box.pose.position.x = 0.0;
+    box.pose.position.z = 0.5;
+    inputs.push_back({box});
+    if (k == 0) {  // the ball once: the monitor moves it on from there
+      BodyState ball = stateOf("ball", 0, 0, 0, 0);
+      ball.header.stamp = stamp;
+      ball.pose.position.x = 0.2;
+      ball.pose.position.z = 0.5;
+      ball.twist.linear.x = -1.0;
+      inputs.back().push_back(ball);
+    }
+    const MonitorCycle::Input input{&inputs.back(), "/body_states", "/source", ""};
+    const MonitorCycle::Update update = cycle.process(input, start, false, tf);
+    diagnostics.received(inputs.back().size());
+    for (const Report& report : update.reports) {
+      diagnostics.count(report.reason, report.count);
+      reports.push_back(report);
+    }
+  }
+  ASSERT_EQ(reports.size(), 1u);
+  EXPECT_EQ(reports[0].reason, Reason::kUnmodelledContact);
+  EXPECT_NE(reports[0].text.find("the contact of 'block' and 'ball'"), std::string::npos)
+      << reports[0].text;
+  EXPECT_NE(reports[0].text.find("not modelled yet"), std::string::npos) << reports[0].text;
+  EXPECT_FALSE(isDrop(Reason::kUnmodelledContact));
+  diagnostic_updater::DiagnosticStatusWrapper status;
+  diagnostics.report(status, cycle, 0);
+  EXPECT_EQ(diagnosticValue(status, "contacts of shaped bodies not modelled yet (total)"), "1");
+  EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::OK) << status.message;
 }
 
 }  // namespace

@@ -50,11 +50,12 @@ enum class Reason {
   kPredictionCutShort,  ///< a ~predict_impacts request that spent ~prediction_cpu_budget
   kObstaclePlacementsLeftOut,  ///< an update's bound left out placements of near obstacles
   kFrameJumped,                ///< a tf frame moved faster than any body could follow
-  kOverImpactWork,   ///< bodies of an impact past the update's impact work: cut short or locked
-  kOverSteppedWork,  ///< bodies of stepped clusters held still past the update's stepped work
-  kBadOrientation,   ///< pose.orientation not a rotation (zero for a shaped body, or not unit)
+  kOverImpactWork,     ///< bodies of an impact past the update's impact work: cut short or locked
+  kOverSteppedWork,    ///< bodies of stepped clusters held still past the update's stepped work
+  kBadOrientation,     ///< pose.orientation not a rotation (zero for a shaped body, or not unit)
+  kUnmodelledContact,  ///< a shaped body's contact the model does not carry yet: counted, said
 };
-inline constexpr int kReasonCount = static_cast<int>(Reason::kBadOrientation) + 1;
+inline constexpr int kReasonCount = static_cast<int>(Reason::kUnmodelledContact) + 1;
 
 /// The counter's name, as diagnostics shows it: "dropped: unknown id", "clock jumped back", ...
 const char* counterName(Reason reason);
