@@ -254,6 +254,59 @@ TEST(PredictServe, ABoxDroppedFlatIsPredictedAsTheClosedFormSays) {
   EXPECT_EQ(refusal(call).rfind("body.size: must be 0", 0), 0u) << refusal(call);
 }
 
+// The intermediate axis's flip (Dzhanibekov's effect) over ROS: a box given the tensor J = (2, 3,
+// 4) kg m^2, far from everything without gravity, spun at w0 = (1e-6, 2, 1e-6) rad/s (body =
+// world at the start): Landau's solution gives w_2 = A_2 sn u, its zeros every 2K(m) / omega and
+// the period T = 4K(m) / omega, m1 = 1 - m = 2 (2e-12) / (1 (12 + 8e-12)), omega^2 = (12 + 8e-12)
+// / 24, K(m) = pi / (2 agm(1, sqrt(m1))) (the arithmetic-geometric mean, written here; as
+// FreeRotation.TheIntermediateAxisFlipsAtTheEllipticPeriod: test/exact/free_rotation.py's
+// integration finds w_2's first zero at 23.521885368606051 s). The answer's final state at the
+// first zero has w_2 = 0 in the body's frame, at half the period w_2 = -2: the box has flipped.
+TEST(PredictServe, TheIntermediateAxisFlipsAtTheEllipticPeriod) {
+  ASSERT_TRUE(ros::service::waitForService("/collision_response/predict_impacts", 30000));
+  double a = 1.0;
+  double b = std::sqrt(2.0 * 2e-12 / (12.0 + 8e-12));
+  for (int i = 0; i < 10; ++i) {
+    const double mean = 0.5 * (a + b);
+    b = std::sqrt(a * b);
+    a = mean;
+  }
+  const double period = 4.0 * (M_PI / (2.0 * a)) / std::sqrt((12.0 + 8e-12) / 24.0);
+  ASSERT_NEAR(period, 89.101739553302938, 1e-13 * period);
+  PredictImpacts spun;
+  spun.request.header.frame_id = "world";
+  spun.request.body.id = "spun";
+  spun.request.body.shape = "box";
+  spun.request.body.mass = 12.0;
+  spun.request.body.material = "celluloid";
+  spun.request.body.size.x = spun.request.body.size.y = spun.request.body.size.z = 0.1;
+  spun.request.body.inertia_tensor.ixx = 2.0;
+  spun.request.body.inertia_tensor.iyy = 3.0;
+  spun.request.body.inertia_tensor.izz = 4.0;
+  spun.request.body.orientation.w = 1.0;
+  spun.request.body.position.x = -1.0;
+  spun.request.body.position.z = 20.0;
+  spun.request.body.angular_velocity.x = 1e-6;
+  spun.request.body.angular_velocity.y = 2.0;
+  spun.request.body.angular_velocity.z = 1e-6;
+  spun.request.effects = {"spin"};  // not the scene's: no gravity, drag or magnus
+  spun.request.max_impacts = 1;
+  // w_2 in the body's frame at the end of a prediction `horizon` s long.
+  const auto middleSpinAfter = [&spun](double horizon) {
+    PredictImpacts call = spun;
+    call.request.horizon = horizon;
+    EXPECT_TRUE(callService(call));
+    EXPECT_TRUE(call.response.success) << call.response.message;
+    EXPECT_TRUE(call.response.impacts.empty());
+    const auto& q = call.response.final_state.pose.orientation;
+    const auto& w = call.response.final_state.twist.angular;
+    const Eigen::Quaterniond world_from_body(q.w, q.x, q.y, q.z);
+    return (world_from_body.conjugate() * Eigen::Vector3d(w.x, w.y, w.z)).y();
+  };
+  EXPECT_LT(std::abs(middleSpinAfter(23.521885368606051)), 1e-12);
+  EXPECT_NEAR(middleSpinAfter(period / 2.0), -2.0, 1e-9);
+}
+
 // Issue 41, item 8: absurd numbers answered rightly, each against its closed form.
 //  - crossing_normal (0, 0, 1e-300) was taken for no plane (Eigen's isZero is approximate): any
 //    nonzero length is a direction, as the srv says; the probe falling from z = 1.0 at
