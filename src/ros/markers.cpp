@@ -311,7 +311,7 @@ void appendSceneMarkers(const core::ImpactMonitor& monitor, double time, const s
   for (std::size_t i = 0; i < monitor.bodyCount(); ++i) {
     const auto state = monitor.predictedState(i, time);
     std::optional<BodyPose> pose;
-    if (state) pose = BodyPose{state->first, monitor.lastOrientation(i)};
+    if (state) pose = BodyPose{state->first, monitor.predictedOrientation(i, time)};
     appendBodyMarkers(monitor.body(i), static_cast<int>(i), pose, frame, stamp, array);
   }
   for (std::size_t i = 0; i < monitor.obstacleCount(); ++i) {

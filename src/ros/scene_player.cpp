@@ -263,7 +263,7 @@ void ScenePlayer::publishStates(const ros::Time& time) {
     state.header = array.header;
     state.id = scene_.bodies[i].id;
     state.pose.position = toPointMsg(playback_->position(i, t));
-    state.pose.orientation.w = 1.0;
+    state.pose.orientation = toQuaternionMsg(playback_->orientation(i, t));
     state.twist.linear = toVector3Msg(playback_->velocity(i, t));
     state.twist.angular = toVector3Msg(playback_->angularVelocity(i, t));
     array.states.push_back(state);
@@ -358,7 +358,7 @@ void ScenePlayer::publishApexes(const ros::Time& time) {
     state.header.frame_id = scene_.fixed_frame;
     state.id = body.id;
     state.pose.position = toPointMsg(apex.position);
-    state.pose.orientation.w = 1.0;
+    state.pose.orientation.w = 1.0;  // an apex is of the centre's flight (core::Apex)
     state.twist.linear = toVector3Msg(apex.velocity);
     state.twist.angular = toVector3Msg(apex.angular_velocity);
     apex_publisher_.publish(state);
