@@ -1,5 +1,5 @@
 // A shaped body's scenes and closed forms that the prediction's tests and the monitor's share: a
-// box over a concrete floor, and the closed form of a box landing on an edge.
+// box over a concrete floor, and the closed form of a box landing on an edge (edge_landing.h).
 #pragma once
 
 #include <gtest/gtest.h>
@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "collision_response/core/scene.h"
+#include "edge_landing.h"
 #include "scene_builders.h"
 
 namespace collision_response::core::shaped_scenes {
@@ -31,27 +32,5 @@ inline Scene floorScene(double e, const Eigen::Vector3d& half, double mass = 2.0
   scene.obstacles = {scene_builders::plane("floor", Eigen::Vector3d::UnitZ(), 0.0, "concrete")};
   return scene;
 }
-
-/// A box of half edges (a, b, c) and mass m, turned by theta about y, dropped from rest with its
-/// centre at `height`, lands on the edge of its two lowest corners, (a cos theta - c sin theta,
-/// +-b, -(a sin theta + c cos theta)) from its centre. Frictionless, the two take equal impulses
-/// whose moments about x cancel: as one contact at (x, 0, z), whose effective mass along z is
-/// 1 / (1/m + x^2 / I_yy), I_yy = m (a^2 + c^2) / 3. So J = (1 + e) v / (1/m + x^2 / I_yy),
-/// v_z' = -v + J / m, w_y' = -x J / I_yy (the floor's impulse +J z at r = (x, ., z)).
-struct EdgeLanding {
-  double a = 0.1, b = 0.05, c = 0.025, m = 2.0, e = 0.5, theta = 0.3, height = 0.5;
-
-  Eigen::Quaterniond turn() const {
-    return Eigen::Quaterniond(Eigen::AngleAxisd(theta, Eigen::Vector3d::UnitY()));
-  }
-  double low() const { return a * std::sin(theta) + c * std::cos(theta); }
-  double fall() const { return std::sqrt(2 * (height - low()) / kG); }
-  double speed() const { return kG * fall(); }  ///< v, down
-  double x() const { return a * std::cos(theta) - c * std::sin(theta); }
-  double inertia() const { return m * (a * a + c * c) / 3; }  ///< I_yy
-  double impulse() const { return (1 + e) * speed() / (1 / m + x() * x() / inertia()); }
-  double velocityAfter() const { return -speed() + impulse() / m; }  ///< v_z'
-  double spinAfter() const { return -x() * impulse() / inertia(); }  ///< w_y'
-};
 
 }  // namespace collision_response::core::shaped_scenes

@@ -25,6 +25,7 @@
 #include "collision_response/BodyStateArray.h"
 #include "collision_response/ImpactArray.h"
 #include "collision_response/PredictImpacts.h"
+#include "edge_landing.h"
 #include "reference/serve_reference.h"
 
 namespace {
@@ -252,6 +253,51 @@ TEST(PredictServe, ABoxDroppedFlatIsPredictedAsTheClosedFormSays) {
   call.request.body.shape = "";
   call.request.body.radius = 0.02;
   EXPECT_EQ(refusal(call).rfind("body.size: must be 0", 0), 0u) << refusal(call);
+}
+
+// A box landing on an edge over ROS, as in the core (edge_landing.h, ShapedPrediction.
+// BoxLandingOnAnEdgeTurnsAsTheClosedFormSays): a 2 kg box of half edges (0.1, 0.05, 0.025) m turned
+// by 0.3 rad about y, dropped from rest with its centre 0.5 m above the table's top (z = 0.76 in
+// the world), celluloid on the table (e = 0.9), frictionless: its two lowest corners strike at
+// once at t = sqrt(2 (0.5 - low) / g), and it leaves with v_z' = -v + J / m and w_y' = -x J / I_yy,
+// J = (1 + e) v / (1/m + x^2 / I_yy).
+TEST(PredictServe, ABoxDroppedOnAnEdgeTurnsAsTheClosedFormSays) {
+  ASSERT_TRUE(ros::service::waitForService("/collision_response/predict_impacts", 30000));
+  collision_response::core::shaped_scenes::EdgeLanding edge;
+  edge.e = 0.9;
+  PredictImpacts call;
+  call.request.header.frame_id = "world";
+  call.request.header.stamp = ros::Time(300.0);
+  call.request.body.id = "edge";
+  call.request.body.shape = "box";
+  call.request.body.mass = edge.m;
+  call.request.body.material = "celluloid";
+  call.request.body.size.x = 2 * edge.a;
+  call.request.body.size.y = 2 * edge.b;
+  call.request.body.size.z = 2 * edge.c;
+  call.request.body.orientation.w = edge.turn().w();
+  call.request.body.orientation.y = edge.turn().y();
+  call.request.body.position.x = -1.0;
+  call.request.body.position.z = 0.76 + edge.height;
+  call.request.effects = {"gravity"};
+  call.request.horizon = 0.5;
+  call.request.max_impacts = 2;
+  ASSERT_TRUE(callService(call));
+  ASSERT_TRUE(call.response.success) << call.response.message;
+  ASSERT_EQ(call.response.impacts.size(), 2u) << call.response.message;
+  double total = 0.0;
+  for (const collision_response::Impact& impact : call.response.impacts) {
+    EXPECT_EQ(impact.body_b, "table");
+    EXPECT_NEAR((impact.header.stamp - ros::Time(300.0)).toSec(), edge.fall(), 1e-9);
+    EXPECT_NEAR(impact.contact_point.z, 0.76, 1e-9);
+    EXPECT_NEAR(impact.contact_point.x, -1.0 + edge.x(), 1e-9);
+    EXPECT_NEAR(std::abs(impact.contact_point.y), edge.b, 1e-9);
+    EXPECT_NEAR(impact.velocity_a_after.linear.z, edge.velocityAfter(), 1e-9);
+    EXPECT_NEAR(impact.velocity_a_after.angular.y, edge.spinAfter(), 1e-9);
+    EXPECT_NEAR(impact.velocity_a_after.angular.x, 0.0, 1e-9);
+    total += impact.impulse;
+  }
+  EXPECT_NEAR(total, edge.impulse(), 1e-9);
 }
 
 // The intermediate axis's flip (Dzhanibekov's effect) over ROS: a box given the tensor J = (2, 3,
