@@ -8,7 +8,8 @@ Each body has its own colour (and, past ten bodies, a dashed line) in both panel
 the end of its path, and an entry in the legend beside the speeds; a body whose speeds are those
 of another (a mirror image in a symmetric scene) is dotted over that body's speed line, and its
 legend entry names the other. With the scene file, each
-body is drawn at its start and its end as a disc of its radius, and the fixed obstacles are
+body is drawn at its start and its end as a disc of its radius (a box body as the outline of its
+corners at its recorded orientation, faintly also along its path), and the fixed obstacles are
 drawn too: a plane across the drawing plane as a line (the billiards table's cushions, the drop
 test's floor), a sphere as a circle, a box along the axes as a rectangle (obstacles on tf frames,
 a robot's links among them, are not drawn: their impacts are). Impacts are marked at their contact points, with a short
@@ -65,21 +66,59 @@ def read_bag(bag_path):
                 predicted["impacts"] = list(dict.fromkeys(predicted["impacts"]))
             elif topic == "/body_states":
                 for state in message.states:
-                    p, v = state.pose.position, state.twist.linear
+                    p, v, q = state.pose.position, state.twist.linear, state.pose.orientation
                     speed = math.sqrt(v.x ** 2 + v.y ** 2 + v.z ** 2)
-                    paths[state.id].append((state.header.stamp.to_sec(), p.x, p.y, p.z, speed))
+                    paths[state.id].append((state.header.stamp.to_sec(), p.x, p.y, p.z, speed,
+                                            (q.x, q.y, q.z, q.w)))
             else:
                 impacts.extend(message.impacts)
     return paths, impacts, predicted
 
 
 def read_scene(scene_path):
+    """The balls' radii, the box bodies' edges, and the obstacles."""
     if not scene_path:
-        return {}, []
+        return {}, {}, []
     with open(scene_path) as stream:
         scene = (yaml.safe_load(stream) or {}).get("scene", {})
-    radii = {body["id"]: float(body["radius"]) for body in scene.get("bodies", [])}
-    return radii, scene.get("obstacles", [])
+    bodies = scene.get("bodies", [])
+    radii = {body["id"]: float(body["radius"]) for body in bodies
+             if body.get("shape", "sphere") == "sphere"}
+    boxes = {body["id"]: [float(c) for c in body["size"]] for body in bodies
+             if body.get("shape") == "box"}
+    return radii, boxes, scene.get("obstacles", [])
+
+
+def box_outline(centre, quaternion, size, axes):
+    """The outline of a box's eight corners in the drawing plane (their convex hull, in order):
+    corner = centre + R (+-a, +-b, +-c) / 2, R the rotation of the unit quaternion (x, y, z, w)."""
+    x, y, z, w = quaternion
+    norm = math.sqrt(x * x + y * y + z * z + w * w) or 1.0
+    x, y, z, w = x / norm, y / norm, z / norm, w / norm
+    rotation = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+    points = []
+    for sx in (-0.5, 0.5):
+        for sy in (-0.5, 0.5):
+            for sz in (-0.5, 0.5):
+                local = (sx * size[0], sy * size[1], sz * size[2])
+                corner = [centre[i] + sum(rotation[i][j] * local[j] for j in range(3))
+                          for i in range(3)]
+                points.append((corner[axes[0]], corner[axes[1]]))
+    # Andrew's monotone chain.
+    points = sorted(set(points))
+
+    def half(chain_points):
+        chain = []
+        for p in chain_points:
+            while len(chain) >= 2 and ((chain[-1][0] - chain[-2][0]) * (p[1] - chain[-2][1]) -
+                                       (chain[-1][1] - chain[-2][1]) * (p[0] - chain[-2][0])) <= 0:
+                chain.pop()
+            chain.append(p)
+        return chain[:-1]
+
+    return half(points) + half(points[::-1])
 
 
 def turned(obstacle):
@@ -89,12 +128,15 @@ def turned(obstacle):
     return quaternion[:3] != [0.0, 0.0, 0.0] or any(angles)
 
 
-def view_box(paths, axes, radii, obstacles):
-    """The drawn region: every path with its discs, and the planes close to it."""
+def view_box(paths, axes, radii, obstacles, boxes=None):
+    """The drawn region: every path with its discs (a box body's half diagonal), and the planes
+    close to it."""
     lows, highs = [], []
+    reaches = list(radii.values()) + [0.5 * math.sqrt(sum(c * c for c in size))
+                                      for size in (boxes or {}).values()]
     for k in axes:
         values = [p[k + 1] for path in paths.values() for p in path]
-        pad = max(radii.values(), default=0.0)
+        pad = max(reaches, default=0.0)
         lows.append(min(values) - pad)
         highs.append(max(values) + pad)
     for obstacle in obstacles:
@@ -164,7 +206,7 @@ def main():
     paths, impacts, predicted = read_bag(args.bag)
     if not paths:
         sys.exit(f"{args.bag}: no /body_states recorded")
-    radii, obstacles = read_scene(args.scene)
+    radii, boxes, obstacles = read_scene(args.scene)
     title = args.title or args.bag
     points = [p for path in paths.values() for p in path]
     spread = [max(p[k] for p in points) - min(p[k] for p in points) for k in (1, 2, 3)]
@@ -172,7 +214,7 @@ def main():
     start = min(p[0] for p in points)
     ids = sorted(paths)
     styles = body_styles(ids)
-    box = view_box(paths, axes, radii, obstacles)
+    box = view_box(paths, axes, radii, obstacles, boxes)
 
     figure, (plane, timeline) = plt.subplots(1, 2, figsize=(15, 6),
                                              gridspec_kw={"width_ratios": [1.4, 1]})
@@ -186,6 +228,18 @@ def main():
             plane.add_patch(plt.Circle((us[0], vs[0]), radii[body], color=colour, alpha=0.35,
                                        zorder=2))
             plane.add_patch(plt.Circle((us[-1], vs[-1]), radii[body], color=colour, zorder=3))
+        elif body in boxes:
+            # Its outline at its recorded orientation: at the start (pale), every twentieth of
+            # the path (faint: its tumbling) and at the end.
+            step = max(1, len(path) // 20)
+            for k, p in enumerate(path):
+                last = k == len(path) - 1
+                if k != 0 and not last and k % step:
+                    continue
+                alpha = 1.0 if last else 0.35 if k == 0 else 0.12
+                plane.add_patch(plt.Polygon(box_outline(p[1:4], p[5], boxes[body], axes),
+                                            closed=True, color=colour, alpha=alpha,
+                                            zorder=3 if last else 2))
         else:
             plane.plot([us[-1]], [vs[-1]], "o", color=colour, ms=5, zorder=3)
         plane.annotate(body, (us[-1], vs[-1]), xytext=(4, 4), textcoords="offset points",
@@ -222,7 +276,8 @@ def main():
     plane.set_xlabel(f"{AXES[axes[0]]} (m)")
     plane.set_ylabel(f"{AXES[axes[1]]} (m)")
     plane.set_aspect("equal", adjustable="datalim")
-    shown = "; discs at start (pale) and end" if radii else ""
+    shown = ("; discs at start (pale) and end" if radii else
+             "; outlines at start (pale), along the path and at the end" if boxes else "")
     plane.set_title(f"{title}: paths{shown}; impacts (x, normal)", fontsize=10)
     timeline.set_xlabel("time (s)")
     timeline.set_ylabel("speed (m/s)")

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "collision_response/BodyStateArray.h"
+#include "collision_response/core/body_shape.h"
 #include "collision_response/core/prediction.h"
 #include "collision_response/core/restitution.h"
 #include "collision_response/core/validation.h"
@@ -362,7 +363,11 @@ void ScenePlayer::publishApexes(const ros::Time& time) {
     state.twist.linear = toVector3Msg(apex.velocity);
     state.twist.angular = toVector3Msg(apex.angular_velocity);
     apex_publisher_.publish(state);
-    if (!params_.report_restitution || apex.impacts_before != 1) continue;
+    // The seed's method is a ball's (its lowest point one radius below its centre, whatever it
+    // turned): a shaped body's lowest point moves as it turns, and is not reported.
+    if (!params_.report_restitution || apex.impacts_before != 1 || core::isShapedBody(body)) {
+      continue;
+    }
     // The seed's method: dropped from rest, e from the heights of the lowest point above the
     // first plane obstacle (the floor), the drop's from the scene's initial position.
     const auto floor = std::find_if(
