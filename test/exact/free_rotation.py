@@ -69,6 +69,12 @@ CASES = [
     ("on_the_separatrix", (3.0, 5.0, 6.0), (1.0, 0.0, 0.0, 0.0), (1.0, 0.5, 1.0), (0.5, 3.0, 10.0)),
     ("near_the_separatrix", (3.0, 5.0, 6.0), (1.0, 0.0, 0.0, 0.0), (1.0, 0.5, 1.000000001),
      (0.5, 3.0, 10.0)),
+    # The angle about L's closed form cancels near a spin about axis 3 (a -> 1) and where L is
+    # nearly across it (a small, a nearly axisymmetric body).
+    ("near_a_spin_about_the_largest_axis", (2.0, 3.0, 4.0), (0.48, 0.64, 0.36, 0.48),
+     (1e-4, -1e-4, 2.0), (0.5, 3.0, 10.0)),
+    ("nearly_across_the_axis_of_a_nearly_symmetric_body", (2.0, 2.0002, 3.5),
+     (0.48, 0.64, 0.36, 0.48), (2.0, 0.0, 0.03), (0.5, 3.0, 10.0)),
 ]
 
 

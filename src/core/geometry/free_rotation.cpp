@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <array>
-#include <boost/math/quadrature/gauss.hpp>
 #include <boost/math/special_functions/ellint_rf.hpp>
+#include <boost/math/special_functions/ellint_rj.hpp>
 #include <cmath>
 #include <iomanip>
 #include <limits>
@@ -18,7 +18,9 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr int kMaxAgmSteps = 40;
-constexpr double kPieceLength = 0.5;
+// Carlson's R_F and R_J in double precision (Boost otherwise carries doubles as long doubles, at
+// several times the cost); their error stays a few ulps (Carlson 1995, the duplication's bound).
+using InDouble = boost::math::policies::policy<boost::math::policies::promote_double<false>>;
 
 const char* axisName(int i) { return i == 0 ? "x" : (i == 1 ? "y" : "z"); }
 
@@ -234,7 +236,11 @@ FreeRotation::WorkingStart FreeRotation::setEllipticMotion(const Eigen::Vector3d
                     .normalized();
   start.momentum_direction = jw.cwiseProduct(ww) / momentum;
   a_ = j3 * amplitude_.z() / momentum;
-  psi_factor_ = j1 * j2 * amplitude_.x() * amplitude_.y() / m2;
+  // 1 - a^2 = (J_1 A_1 / M)^2 (at sn u = 0, w = (A_1, 0, A_3)), without cancelling as a -> 1;
+  // the angle's factor J_1 J_2 A_1 A_2 / M^2 over it, J_2 A_2 / (J_1 A_1), stays bounded there.
+  const double lever = j1 * amplitude_.x() / momentum;
+  one_minus_a2_ = lever * lever;
+  psi_factor_ = j2 * amplitude_.y() / (j1 * amplitude_.x());
   energy_rate_ = std::ldexp(two_energy / momentum, exponent);
   amplitude_ = amplitude_.unaryExpr([&](double x) { return std::ldexp(x, exponent); });
   rate_ = std::ldexp(rate_, exponent);
@@ -247,62 +253,64 @@ void FreeRotation::setPhase(const Eigen::Vector2d& phase) {
     m1_ = 0.0;
     u0_ = std::asinh(phase.x() / phase.y());  // F(phi | 1) = asinh(tan phi); cn u0 > 0
     quarter_period_ = std::numeric_limits<double>::infinity();
-  } else {
-    u0_ = ellipticF(phase.x(), phase.y(), m1_);
-    quarter_period_ = completeEllipticK(m1_);
-    // G at the pieces' ends over one period, once: an evaluation integrates one piece.
-    const double pieces = std::max(1.0, std::ceil(2.0 * quarter_period_ / kPieceLength));
-    piece_ = 2.0 * quarter_period_ / pieces;
-    piece_ends_.assign(static_cast<std::size_t>(pieces) + 1, 0.0);
-    for (std::size_t k = 1; k < piece_ends_.size(); ++k) {
-      piece_ends_[k] = piece_ends_[k - 1] + integrateThirdKind(piece_ * static_cast<double>(k - 1),
-                                                               piece_ * static_cast<double>(k));
-    }
-    period_integral_ = piece_ends_.back();
+    start_integral_ = angleIntegral(u0_, {});
+    return;
   }
-  start_integral_ = thirdKindIntegral(u0_);
+  u0_ = ellipticF(phase.x(), phase.y(), m1_);
+  quarter_period_ = completeEllipticK(m1_);
+  // The third kind's characteristic n = -a^2 m / (1 - a^2), sqrt(1 - n) and a m / (3 (1 - a^2)).
+  const double ratio = m_ / one_minus_a2_;
+  characteristic_ = -a_ * a_ * ratio;
+  root_ = std::sqrt(1.0 + a_ * a_ * ratio);
+  rj_factor_ = a_ * ratio / 3.0;
+  // Over a half period (phi from -pi / 2 to pi / 2): T = pi / sqrt(1 - n), F = 2 K and the third
+  // kind's complete R_J(0, m1, 1, 1 - n) (DLMF 19.25.2).
+  period_integral_ =
+      2.0 * ((0.5 * kPi / root_ - a_ * quarter_period_) +
+             rj_factor_ * boost::math::ellint_rj(0.0, m1_, 1.0, 1.0 - characteristic_));
+  start_integral_ = angleIntegral(u0_, jacobiElliptic(u0_, m_, m1_));
 }
 
-double FreeRotation::thirdKindIntegral(double u) const {
+double FreeRotation::angleIntegral(double u, const JacobiElliptic& f) const {
   if (kind_ == Kind::kSeparatrix) {
     // integral_0^u sech / (1 + a sech) = integral_0^u 1 / (cosh s + a) ds
     // = 2 / sqrt(1 - a^2) atan(sqrt((1 - a) / (1 + a)) tanh(u / 2)), 0 <= a < 1 (with
     // tau = tanh(s / 2): cosh s + a = ((1 + a) + (1 - a) tau^2) / (1 - tau^2), ds = 2 dtau /
-    // (1 - tau^2)).
-    const double root = std::sqrt((1.0 - a_) * (1.0 + a_));
-    return 2.0 / root * std::atan((1.0 - a_) / root * std::tanh(0.5 * u));
+    // (1 - tau^2)); times 1 - a^2, sqrt((1 - a) / (1 + a)) = sqrt(1 - a^2) / (1 + a).
+    const double root = std::sqrt(one_minus_a2_);
+    return 2.0 * root * std::atan(root / (1.0 + a_) * std::tanh(0.5 * u));
   }
-  const double period = 2.0 * quarter_period_;
-  const double whole = std::floor(u / period);
-  const double rest = u - whole * period;
-  return (whole == 0.0 ? 0.0 : whole * period_integral_) + thirdKindIntegralWithin(rest);
+  // u = 2 K j + v, |v| <= K: G is odd and G(u + 2 K) = G(u) + G(2 K) (dn is even, of period
+  // 2 K). sn v = (-1)^j sn u, cn v = |cn u| >= 0 (either sign of cn's rounding at v = +-K).
+  const double half_periods = std::nearbyint(u / (2.0 * quarter_period_));
+  const double flip = std::fmod(half_periods, 2.0) == 0.0 ? 1.0 : -1.0;
+  const double whole = half_periods == 0.0 ? 0.0 : half_periods * period_integral_;
+  return whole + angleIntegralWithin(flip * f.sn, std::abs(f.cn));
 }
 
-double FreeRotation::thirdKindIntegralWithin(double u) const {
-  const std::size_t last = piece_ends_.size() - 2;
-  const std::size_t k = std::min(last, static_cast<std::size_t>(std::max(0.0, u / piece_)));
-  return piece_ends_[k] + integrateThirdKind(piece_ * static_cast<double>(k), u);
+double FreeRotation::angleIntegralWithin(double sine, double cosine) const {
+  // With phi = am v: G = integral_0^phi dtheta / (1 + a Delta), Delta^2 = 1 - m sin^2 theta = dn^2.
+  // 1 / (1 + a Delta) = (1 - a Delta) / ((1 - a^2) (1 - n sin^2 theta)), and Delta / (1 - n
+  // sin^2) = ((m / n) (1 - n sin^2) + 1 - m / n) / (Delta (1 - n sin^2)): (1 - a^2) G = (T - a F)
+  // + a m / (3 (1 - a^2)) sin^3 phi R_J(cos^2, Delta^2, 1, 1 - n sin^2), T = atan(sqrt(1 - n)
+  // tan phi) / sqrt(1 - n) (elementary), F = sin phi R_F(cos^2, Delta^2, 1) and Pi(n; phi | m) =
+  // F + (n / 3) sin^3 phi R_J(...) (Carlson, DLMF 19.25.5 and 19.25.14).
+  const double c2 = cosine * cosine;
+  const double d2 = m1_ + m_ * c2;
+  const double t = std::atan2(root_ * sine, cosine) / root_;
+  const double f = sine * boost::math::ellint_rf(c2, d2, 1.0, InDouble());
+  if (sine == 0.0) return t - a_ * f;
+  const double s2 = sine * sine;
+  return (t - a_ * f) +
+         rj_factor_ * sine * s2 *
+             boost::math::ellint_rj(c2, d2, 1.0, 1.0 - characteristic_ * s2, InDouble());
 }
 
-double FreeRotation::integrateThirdKind(double from, double to) const {
-  // The integrand is analytic near the real axis (dn's nearest poles are K(m1) >= pi / 2 off
-  // it; 1 + a dn >= 1 on it), so a 20-point Gauss-Legendre rule on a piece of at most
-  // kPieceLength leaves an error far below the doubles' rounding (of the order rho^-40, rho
-  // the ellipse of analyticity's sum of half-axes over the half-length, > 6 here).
-  const auto integrand = [this](double s) {
-    const double dn = jacobiElliptic(s, m_, m1_).dn;
-    return dn / (1.0 + a_ * dn);
-  };
-  return boost::math::quadrature::gauss<double, 20>::integrate(integrand, from, to);
-}
-
-Eigen::Vector3d FreeRotation::workingAngularVelocity(double time) const {
-  const double u = rate_ * time + u0_;
+Eigen::Vector3d FreeRotation::workingAngularVelocity(double u, const JacobiElliptic& f) const {
   if (kind_ == Kind::kSeparatrix) {
     const double sech = 1.0 / std::cosh(u);
     return amplitude_.cwiseProduct(Eigen::Vector3d(sech, std::tanh(u), sech));
   }
-  const JacobiElliptic f = jacobiElliptic(u, m_, m1_);
   return amplitude_.cwiseProduct(Eigen::Vector3d(f.cn, f.sn, f.dn));
 }
 
@@ -317,7 +325,10 @@ Eigen::Vector3d FreeRotation::bodyAngularVelocity(double time) const {
     case Kind::kSeparatrix:
       break;
   }
-  return working_.transpose() * workingAngularVelocity(time);
+  const double u = rate_ * time + u0_;
+  const JacobiElliptic f =
+      kind_ == Kind::kSeparatrix ? JacobiElliptic{} : jacobiElliptic(u, m_, m1_);
+  return working_.transpose() * workingAngularVelocity(u, f);
 }
 
 Eigen::Vector3d FreeRotation::angularVelocity(double time) const {
@@ -325,9 +336,9 @@ Eigen::Vector3d FreeRotation::angularVelocity(double time) const {
   return orientation(time) * bodyAngularVelocity(time);
 }
 
-double FreeRotation::psi(double time) const {
+double FreeRotation::psi(double time, const JacobiElliptic& f) const {
   return energy_rate_ * time -
-         psi_factor_ * (thirdKindIntegral(rate_ * time + u0_) - start_integral_);
+         psi_factor_ * (angleIntegral(rate_ * time + u0_, f) - start_integral_);
 }
 
 Eigen::Quaterniond FreeRotation::orientation(double time) const {
@@ -346,9 +357,12 @@ Eigen::Quaterniond FreeRotation::orientation(double time) const {
     case Kind::kSeparatrix:
       break;
   }
-  const Eigen::Vector3d l = moments_.cwiseProduct(workingAngularVelocity(time)).stableNormalized();
+  const double u = rate_ * time + u0_;
+  const JacobiElliptic f =
+      kind_ == Kind::kSeparatrix ? JacobiElliptic{} : jacobiElliptic(u, m_, m1_);
+  const Eigen::Vector3d l = moments_.cwiseProduct(workingAngularVelocity(u, f)).stableNormalized();
   const Eigen::Quaterniond working =
-      turn(momentum_axis_, psi(time)) * frame0_ * leastRotationFromZ(l).conjugate();
+      turn(momentum_axis_, psi(time, f)) * frame0_ * leastRotationFromZ(l).conjugate();
   return (working * Eigen::Quaterniond(working_)).normalized();
 }
 

@@ -20,18 +20,20 @@
 //   l_2 l_1') / (1 + l_3) = 2E / M - (J_1 J_2 A_1 A_2 omega / M^2) dn u / (1 + a dn u), a =
 //   J_3 A_3 / M: the angle about L is an elliptic integral of the third kind (van Zon and
 //   Schofield, J. Comput. Phys. 225:145, 2007; Celledoni, Fasso, Safstrom and Zanna, SIAM J.
-//   Sci. Comput. 30:2084, 2008, in another gauge). Its integrand dn / (1 + a dn) is smooth and
-//   bounded (1 + a dn >= 1) and analytic near the real axis (dn's poles are K(1 - m) >= pi / 2
-//   off it): integrated by 20-point Gauss-Legendre rules on pieces of at most 0.5 of its period
-//   2K, summed once at construction, so that an evaluation integrates one piece; not by stepping
-//   an ODE. (The third kind's Legendre form, Pi(n; am u | m) with n = -a^2 m / (1 - a^2), cancels
-//   when the body spins near its axis 3, a -> 1.)
+//   Sci. Comput. 30:2084, 2008, in another gauge). With phi = am u, its integral G(u) = integral
+//   dphi / (1 + a Delta) is, times 1 - a^2, (T - a F) + a m / (3 (1 - a^2)) sin^3 phi R_J(cos^2
+//   phi, Delta^2, 1, 1 - n sin^2 phi), n = -a^2 m / (1 - a^2), T = atan(sqrt(1 - n) tan phi) /
+//   sqrt(1 - n) and F = sin phi R_F(cos^2 phi, Delta^2, 1) (Carlson's symmetric forms: Carlson,
+//   Numer. Algorithms 10:13, 1995; DLMF 19.25.5, 19.25.14), over whole half periods of dn plus
+//   the rest (|phi| <= pi / 2), so that it stays accurate over long times. Near a spin about
+//   axis 3 (a -> 1) the bracket cancels, but the angle's factor over 1 - a^2, J_2 A_2 / (J_1 A_1),
+//   stays bounded: psi keeps the doubles' rounding (test/core/test_free_rotation.cpp). Not by
+//   stepping an ODE, nor by a quadrature per call.
 #pragma once
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <array>
-#include <vector>
 
 #include "collision_response/core/expected.h"
 
@@ -109,13 +111,16 @@ class FreeRotation {
   // The amplitudes, omega, m, m1, a, the factor of G and 2E/M from the working frame's scaled
   // w `ww`, scaled back by 2^exponent.
   WorkingStart setEllipticMotion(const Eigen::Vector3d& ww, int exponent);
-  // u0, K, G at the quadrature's pieces' ends, G(2K) and G(u0).
+  // u0, K, the third kind's n, sqrt(1 - n) and factor, H(2K) and H(u0).
   void setPhase(const Eigen::Vector2d& phase);
-  Eigen::Vector3d workingAngularVelocity(double time) const;
-  double psi(double time) const;
-  double thirdKindIntegral(double u) const;                 // G(u) = integral_0^u dn / (1 + a dn)
-  double thirdKindIntegralWithin(double u) const;           // the same, 0 <= u < 2K
-  double integrateThirdKind(double from, double to) const;  // by one Gauss-Legendre rule
+  // w in the working frame at u = omega t + u0, given sn, cn and dn of u (unused on the
+  // separatrix).
+  Eigen::Vector3d workingAngularVelocity(double u, const JacobiElliptic& f) const;
+  double psi(double time, const JacobiElliptic& f) const;
+  // H(u) = (1 - a^2) G(u), G(u) = integral_0^u dn / (1 + a dn), given sn, cn and dn of u; within
+  // a half period |v| <= K from sn v and cn v >= 0.
+  double angleIntegral(double u, const JacobiElliptic& f) const;
+  double angleIntegralWithin(double sine, double cosine) const;
 
   Kind kind_ = Kind::kResting;
   Eigen::Quaterniond orientation0_ = Eigen::Quaterniond::Identity();
@@ -138,12 +143,14 @@ class FreeRotation {
   double m1_ = 1.0;
   double quarter_period_ = 0.0;  // K(m)
   double a_ = 0.0;
-  double psi_factor_ = 0.0;
-  double energy_rate_ = 0.0;  // 2E / M
-  double period_integral_ = 0.0;
-  double piece_ = 0.0;              // the quadrature's pieces' length
-  std::vector<double> piece_ends_;  // G at 0, piece, 2 piece, ... 2K
-  double start_integral_ = 0.0;
+  double one_minus_a2_ = 1.0;     // 1 - a^2 = (J_1 A_1 / M)^2
+  double characteristic_ = 0.0;   // n = -a^2 m / (1 - a^2)
+  double root_ = 1.0;             // sqrt(1 - n)
+  double rj_factor_ = 0.0;        // a m / (3 (1 - a^2))
+  double psi_factor_ = 0.0;       // J_1 J_2 A_1 A_2 / (M^2 (1 - a^2)) = J_2 A_2 / (J_1 A_1)
+  double energy_rate_ = 0.0;      // 2E / M
+  double period_integral_ = 0.0;  // H(2K)
+  double start_integral_ = 0.0;   // H(u0)
   Eigen::Quaterniond frame0_ = Eigen::Quaterniond::Identity();
 };
 
