@@ -844,6 +844,7 @@ void ImpactMonitor::tune(Detection detection, double restitution_threshold,
   tuned->restitution_threshold = restitution_threshold;
   tuned->materials = materials;
   world.scene = std::move(tuned);
+  ++shaped_->revision;  // a flying shaped body goes on with the new coefficients
 }
 
 std::optional<PlacedShape> ImpactMonitor::obstaclePose(std::size_t obstacle) const {
@@ -862,14 +863,14 @@ void ImpactMonitor::setObstaclePose(std::size_t obstacle, const RigidPose& frame
       monitor::ObstacleTrack{true, place(world_->obstacles[obstacle], frame)};
   world_->groups_current = false;
   world_->scratch.obstacles.invalidate();
-  ++shaped_->placements;
+  ++shaped_->revision;
 }
 
 void ImpactMonitor::placeObstacle(std::size_t obstacle, const PlacedShape& placed) {
   world_->obstacle_tracks[obstacle] = monitor::ObstacleTrack{true, placed};
   world_->groups_current = false;
   world_->scratch.obstacles.invalidate();
-  ++shaped_->placements;
+  ++shaped_->revision;
 }
 
 void ImpactMonitor::reset() {
@@ -999,10 +1000,11 @@ StepReport ImpactMonitor::advance(double time, const std::vector<BodyStateSample
       return continuousStep<decltype(motion)>(world, time, {}, imposed);
     });
   }
+  const double from = world.now;
   StepReport report = withMotionModel(world, [&](auto motion) {
     return continuousStep<decltype(motion)>(world, time, {}, ballStates(*shaped_, imposed));
   });
-  monitor::advanceShaped(world, *shaped_, time, imposed, ballsAt(time), report);
+  monitor::advanceShaped(world, *shaped_, from, time, imposed, ballsAt(time), report);
   return report;
 }
 
@@ -1017,9 +1019,10 @@ monitor::BallPositions ImpactMonitor::ballsAt(double time) const {
 StepReport ImpactMonitor::step(double time, const std::vector<BodyStateSample>& states) {
   if (!shaped_->any()) return stepBalls(time, states);
   World& world = *world_;
+  const double from = world.now;
   StepReport report = stepBalls(time, ballStates(*shaped_, states));
-  monitor::stepShaped(world, *shaped_, std::max(time, world.now), states,
-                      ballsAt(std::max(time, world.now)), report);
+  const double to = std::max(time, world.now);
+  monitor::stepShaped(world, *shaped_, from, to, states, ballsAt(to), report);
   return report;
 }
 

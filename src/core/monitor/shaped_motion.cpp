@@ -138,10 +138,20 @@ std::vector<std::size_t> ShapedMotion::lastingWith() const {
   return with;
 }
 
-Expected<ShapedMotion::Found> ShapedMotion::next(double horizon,
-                                                 std::vector<ImpactRecord>& impacts) {
-  const std::vector<ObstacleContact> contacts = firstContacts(flight_, horizon);
-  if (contacts.empty()) return Found{Event::kFree, horizon};
+Expected<ShapedMotion::Found> ShapedMotion::next(double horizon, std::vector<ImpactRecord>& impacts,
+                                                 bool through) {
+  const std::vector<ObstacleContact> contacts = firstContacts(flight_, horizon, through);
+  if (contacts.empty()) {
+    if (through) {
+      for (Watched& w : obstacles_) {
+        if (w.clear_from < horizon) {
+          w.clear_from = horizon;
+          w.parted = false;
+        }
+      }
+    }
+    return Found{Event::kFree, horizon};
+  }
   // An impact: every obstacle touching at the instant, each point of its manifold.
   const double at = contacts.front().contact.time;
   SolverBody moving = solverBody(flight_, at);
@@ -155,7 +165,10 @@ Expected<ShapedMotion::Found> ShapedMotion::next(double horizon,
       const Watched& w = obstacles_[c.slot];
       again = again || (w.parted && at == w.clear_from);
     }
-    const auto apart = again ? std::nullopt : separation(flight_, at, contacts, horizon);
+    // Past a step's end the motion goes on: the gap after the separation's step is looked at
+    // whatever the horizon.
+    const double beyond = through ? std::numeric_limits<double>::infinity() : horizon;
+    const auto apart = again ? std::nullopt : separation(flight_, at, contacts, beyond);
     if (!apart) {
       lasting_ = contacts;
       lasting_time_ = at;
@@ -268,12 +281,13 @@ Expected<std::pair<LastingBody, FlatFace>> ShapedMotion::faceOf(
 /// obstacle searched from the instant it is known apart until (Watched::clear_from); none
 /// within the horizon: empty.
 std::vector<ShapedMotion::ObstacleContact> ShapedMotion::firstContacts(const TumblingBody& body,
-                                                                       double horizon) const {
+                                                                       double horizon,
+                                                                       bool through) const {
   std::vector<ObstacleContact> found;
   for (std::size_t slot = 0; slot < obstacles_.size(); ++slot) {
     const PlacedShape& placed = obstacles_[slot].placed.placed;
     const double start = obstacles_[slot].clear_from;
-    if (!(start < horizon)) continue;
+    if (!(start < horizon) && !(through && start == horizon)) continue;
     // The advancement's step budget may run out on a slow graze before the horizon: it goes
     // on from where it is known apart.
     for (double clear = start;;) {

@@ -87,8 +87,11 @@ class ShapedMotion {
   /// The first obstacle (model index) the body overlaps or touches from inside at its start.
   std::optional<std::size_t> insideAtStart() const;
 
-  /// The next event up to `horizon`: the impacts' records appended to `impacts`.
-  Expected<Found> next(double horizon, std::vector<ImpactRecord>& impacts);
+  /// The next event up to `horizon`: the impacts' records appended to `impacts`. `through`: the
+  /// horizon is a step's end that the motion goes on past (the monitor's): a contact at the
+  /// horizon itself is found too (a state given touching an obstacle), and an obstacle found apart
+  /// up to it is looked at from there on (kFree), not from its older instant again.
+  Expected<Found> next(double horizon, std::vector<ImpactRecord>& impacts, bool through = false);
   /// After an impact (next() said kImpact): whether the points struck leave their obstacles
   /// (they are looked at again from there); false: the contact lasts (lastingWith()).
   bool leave(double horizon);
@@ -128,7 +131,8 @@ class ShapedMotion {
         flight_(std::move(flight)),
         time_(time) {}
 
-  std::vector<ObstacleContact> firstContacts(const TumblingBody& body, double horizon) const;
+  std::vector<ObstacleContact> firstContacts(const TumblingBody& body, double horizon,
+                                             bool through) const;
   SolverBody solverBody(const TumblingBody& body, double time) const;
   void clearUntil(double time, const std::vector<ObstacleContact>& contacts, double apart);
   Expected<bool> resolve(const TumblingBody& body, SolverBody& moving,

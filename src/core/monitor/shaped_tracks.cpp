@@ -74,16 +74,28 @@ bool touching(const SurfaceGap& gap) {
 Expected<ShapedTrack> ShapedTrack::start(const PrincipalBody& principal,
                                          std::vector<ShapedObstacle> obstacles,
                                          const ShapedScene& scene, const BodyStateSample& state,
-                                         std::size_t placements) {
+                                         std::size_t revision) {
   auto motion = ShapedMotion::create(principal, std::move(obstacles), scene, state);
   if (!motion) return motion.error();
-  ShapedTrack track(std::move(motion.value()), placements);
+  ShapedTrack track(std::move(motion.value()), revision);
   track.last_orientation = state.orientation;
   return track;
 }
 
 void ShapedTrack::advanceTo(double time, std::vector<ImpactRecord>& impacts,
                             std::vector<UnmodelledContact>& unmodelled) {
+  if (fresh_) {
+    fresh_ = false;
+    // A state inside an obstacle (beyond its touching band) starts no motion there: its first
+    // contact would not be found (tumbling_contact.h), and the body would go on through it.
+    if (const auto inside = motion_.insideAtStart()) {
+      hold(stateAt(since_), *inside,
+           "its state is inside the obstacle: a shaped body's motion starts in free space or "
+           "touching",
+           unmodelled);
+      return;
+    }
+  }
   // Each pass moves on by one event at least (an impact, a graze, a lasting motion's end), and
   // a held body not at all: bounded as the prediction's run is.
   for (;;) {
@@ -124,7 +136,7 @@ void ShapedTrack::advanceTo(double time, std::vector<ImpactRecord>& impacts,
       }
     }
     const std::size_t before = impacts.size();
-    const auto found = motion_.next(time, impacts);
+    const auto found = motion_.next(time, impacts, true);
     if (!found) {
       hold(stateAt(motion_.time()), motion_.lastingWith().empty() ? 0 : motion_.lastingWith()[0],
            found.error().message(), unmodelled);
@@ -147,7 +159,7 @@ void ShapedTrack::advanceTo(double time, std::vector<ImpactRecord>& impacts,
       impact_change = impacts.back().velocity_a_after - impacts[before].velocity_a_before;
       last_impact_time = found->time;
     }
-    if (const auto end = motion_.flatBouncesEnd()) rests_from_ = end;
+    rests_from_ = motion_.flatBouncesEnd();
   }
 }
 
@@ -183,9 +195,10 @@ void ShapedTrack::startLasting(const LastingBody& body, const FlatFace& face,
   since_ = body.time;
   against_ = obstacle;
   if (!resting_again) {
-    // A flat landing's bounces accumulate at rests_from_ (flatBouncesEnd): the contact lasts
-    // from there (doc/model.md, "Coming to rest").
-    lasting_since_ = rests_from_ && *rests_from_ <= body.time ? *rests_from_ : body.time;
+    // Where its last impact was a flat landing, whose bounces accumulate at rests_from_
+    // (flatBouncesEnd), the contact lasts from there (as a ball's: doc/model.md, "Coming to
+    // rest"): a little after the settled bounce that ended the flights.
+    lasting_since_ = rests_from_ ? *rests_from_ : body.time;
   }
 }
 
@@ -268,7 +281,7 @@ ShapedRoom shapedRoomOf(const World& world) {
 bool restartShaped(const World& world, ShapedRoom& room, const BodyStateSample& state) {
   std::optional<ShapedTrack>& track = room.tracks[state.body];
   auto started = ShapedTrack::start(*room.principal[state.body], placedObstacles(world),
-                                    shapedScene(world, state.body), state, room.placements);
+                                    shapedScene(world, state.body), state, room.revision);
   if (!started) return false;  // the track kept as it was
   if (track) {
     started.value().last_state_time = track->last_state_time;
@@ -281,16 +294,17 @@ bool restartShaped(const World& world, ShapedRoom& room, const BodyStateSample& 
 
 namespace {
 
-/// A known flying track started among obstacles placed before the latest placement starts again
-/// from where it is at `time` (its motion since then, among the obstacles as they are now).
-void followPlacements(const World& world, ShapedRoom& room, double time) {
+/// A known flying track started before the room's latest revision (an obstacle placed, the
+/// coefficients tuned) starts again from where it is (its motion since then, among the obstacles
+/// and with the coefficients as they are now).
+void followRevisions(const World& world, ShapedRoom& room, double from) {
   for (std::size_t body = 0; body < room.tracks.size(); ++body) {
     std::optional<ShapedTrack>& track = room.tracks[body];
-    if (!track || track->placements() == room.placements ||
+    if (!track || track->revision() == room.revision ||
         track->mode() != ShapedTrack::Mode::kFlying) {
       continue;
     }
-    const double since = std::max(track->since(), std::min(time, world.now));
+    const double since = std::max(track->since(), from);
     BodyStateSample state = track->stateAt(since);
     state.body = body;
     const double last_state = track->last_state_time;
@@ -441,12 +455,12 @@ void forgetStale(const World& world, ShapedRoom& room, double time) {
   }
 }
 
-void stepShaped(const World& world, ShapedRoom& room, double time,
+void stepShaped(const World& world, ShapedRoom& room, double from, double time,
                 const std::vector<BodyStateSample>& states, const BallPositions& balls,
                 StepReport& report) {
   const std::size_t ball_impacts = report.impacts.size();
   forgetStale(world, room, time);
-  followPlacements(world, room, time);
+  followRevisions(world, room, from);
   std::vector<UnmodelledContact> held;
   for (std::optional<ShapedTrack>& track : room.tracks) {
     if (track) track->advanceTo(time, report.impacts, held);
@@ -455,12 +469,12 @@ void stepShaped(const World& world, ShapedRoom& room, double time,
   finishStep(world, room, time, held, balls, ball_impacts, report);
 }
 
-void advanceShaped(const World& world, ShapedRoom& room, double time,
+void advanceShaped(const World& world, ShapedRoom& room, double from, double time,
                    const std::vector<BodyStateSample>& imposed, const BallPositions& balls,
                    StepReport& report) {
   const std::size_t ball_impacts = report.impacts.size();
   forgetStale(world, room, time);
-  followPlacements(world, room, time);
+  followRevisions(world, room, from);
   std::vector<UnmodelledContact> held;
   for (const BodyStateSample& state : imposed) {
     std::optional<ShapedTrack>& track = room.tracks[state.body];

@@ -36,7 +36,7 @@ class ShapedTrack {
   static Expected<ShapedTrack> start(const PrincipalBody& principal,
                                      std::vector<ShapedObstacle> obstacles,
                                      const ShapedScene& scene, const BodyStateSample& state,
-                                     std::size_t placements);
+                                     std::size_t revision);
 
   /// On to `time`: the impacts with obstacles in (reached, time] appended to `impacts`, and the
   /// contact whose model is missing, where the body is held from (once, when it begins), to
@@ -55,8 +55,8 @@ class ShapedTrack {
   std::vector<ContactRecord> contacts(double time) const;
   /// The obstacle it lasts on or is held against (kLasting, kHeld).
   std::optional<std::size_t> against() const { return against_; }
-  /// The obstacle placements (ShapedRoom::placements) its motion was started with.
-  std::size_t placements() const { return placements_; }
+  /// The ShapedRoom::revision its motion was started with.
+  std::size_t revision() const { return revision_; }
 
   double last_state_time = -std::numeric_limits<double>::infinity();
   double last_impact_time = -std::numeric_limits<double>::infinity();
@@ -64,8 +64,8 @@ class ShapedTrack {
   Eigen::Quaterniond last_orientation = Eigen::Quaterniond::Identity();  ///< its last state's
 
  private:
-  ShapedTrack(ShapedMotion motion, std::size_t placements)
-      : motion_(std::move(motion)), since_(motion_.time()), placements_(placements) {}
+  ShapedTrack(ShapedMotion motion, std::size_t revision)
+      : motion_(std::move(motion)), since_(motion_.time()), revision_(revision) {}
   /// The contact the engine found to last: on one flat face by lastingOnFace, or held.
   void enterLasting(double time, std::vector<UnmodelledContact>& unmodelled);
   void startLasting(const LastingBody& body, const FlatFace& face,
@@ -76,6 +76,7 @@ class ShapedTrack {
   ShapedMotion motion_;
   Mode mode_ = Mode::kFlying;
   double since_ = 0.0;
+  bool fresh_ = true;     // not advanced yet: whether it starts inside an obstacle is asked first
   bool leaving_ = false;  // after an impact: the struck points to part first (ShapedMotion::leave)
   std::optional<double> rests_from_;  // a flat landing's bounces accumulate then
   std::optional<LastingMotion> lasting_;
@@ -83,7 +84,7 @@ class ShapedTrack {
   double lasting_since_ = 0.0;
   std::optional<std::size_t> against_;
   BodyStateSample held_;
-  std::size_t placements_ = 0;
+  std::size_t revision_ = 0;
 };
 
 /// The shaped bodies of one monitor, by body index (balls: none), and the contacts not modelled
@@ -92,9 +93,10 @@ struct ShapedRoom {
   std::vector<std::optional<PrincipalBody>> principal;
   std::vector<std::optional<ShapedTrack>> tracks;
   std::set<std::tuple<std::size_t, std::size_t, bool>> unmodelled_now;
-  /// Obstacle placements so far (setObstaclePose, placeObstacle): a flying track started with
-  /// fewer starts again from where it is, among the obstacles as placed now.
-  std::size_t placements = 0;
+  /// Changes of what the shaped motion reads of the monitor (an obstacle placed: setObstaclePose,
+  /// placeObstacle; the coefficients tuned: tune) so far: a flying track started before the
+  /// latest starts again from where it is, among the obstacles and coefficients as they are now.
+  std::size_t revision = 0;
 
   bool any() const;
   bool shaped(std::size_t body) const { return body < principal.size() && principal[body]; }
@@ -107,17 +109,18 @@ ShapedRoom shapedRoomOf(const World& world);
 /// False where its motion is refused (the track is kept as it was).
 bool restartShaped(const World& world, ShapedRoom& room, const BodyStateSample& state);
 
-/// The shaped bodies' step to `time`: each known track advanced (its impacts in (now, time]),
+/// The shaped bodies' step from `from` (the monitor's time before it) to `time`: each known track
+/// advanced (its impacts in (now, time]),
 /// then `states` of shaped bodies taken as in the balls' applyStates (stale, set aside,
 /// contradicted) and advanced to `time`; a shaped body touching a ball or another shaped body at
 /// `time` reported as unmodelled (once, when it begins); the lasting contacts at `time`.
-void stepShaped(const World& world, ShapedRoom& room, double time,
+void stepShaped(const World& world, ShapedRoom& room, double from, double time,
                 const std::vector<BodyStateSample>& states, const BallPositions& balls,
                 StepReport& report);
 
 /// As stepShaped, the states imposed at their instants (Playback: the motion just after an
 /// impact, the orientation kept) instead of taken at the step's end.
-void advanceShaped(const World& world, ShapedRoom& room, double time,
+void advanceShaped(const World& world, ShapedRoom& room, double from, double time,
                    const std::vector<BodyStateSample>& imposed, const BallPositions& balls,
                    StepReport& report);
 
