@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "collision_response/core/body_shape.h"
 #include "collision_response/core/rigid_impact.h"
 #include "collision_response/core/validation.h"
+#include "contact/shaped_lasting.h"
 #include "monitor/crossing.h"
 #include "monitor/shaped_motion.h"
 
@@ -88,17 +90,17 @@ class ShapedRun {
         case ShapedMotion::Event::kGrazed:
           continue;
         case ShapedMotion::Event::kLasting:
-          cut.push_back(lastingContact(motion.lastingWith(), found->time));
-          return finish(motion, body, found->time);
+          return lastingFrom(motion, body, found->time, cut);
         case ShapedMotion::Event::kImpact:
           break;
       }
+      rests_from_ = motion.flatBouncesEnd();
       if (prediction_.impacts.size() >= max_impacts_) {
         return finish(motion, motion.flight(), motion.time());
       }
       if (!motion.leave(horizon_)) {
-        cut.push_back(lastingContact(motion.lastingWith(), motion.time()));
-        return finish(motion, motion.flight(), motion.time());
+        const TumblingBody after = motion.flight();
+        return lastingFrom(motion, after, motion.time(), cut);
       }
     }
   }
@@ -130,23 +132,7 @@ class ShapedRun {
 
   /// The samples and the crossing of the flight from `from` to `to`.
   void flightUntil(const ShapedMotion& motion, const TumblingBody& body, double from, double to) {
-    if (period_ > 0) {
-      for (double k = std::floor(from / period_) + 1;; ++k) {
-        const double t = std::min(horizon_, k * period_);
-        if (t > to || t <= from) break;
-        if (prediction_.samples.empty() || prediction_.samples.back().time < t) {
-          prediction_.samples.push_back(motion.stateOn(body, t));
-        }
-        if (t >= horizon_) break;
-      }
-    }
-    if (!request_.crossing || prediction_.crossing) return;
-    const Plane& plane = *request_.crossing;
-    if ((across(plane, body.positionAt(from)) > 0) == (across(plane, body.positionAt(to)) > 0)) {
-      return;
-    }
-    prediction_.crossing =
-        bisectCrossing(plane, from, to, [&](double t) { return motion.stateOn(body, t); });
+    sampleUntil(from, to, [&](double t) { return motion.stateOn(body, t); });
   }
 
   Expected<double> restitutionWith(std::size_t obstacle) const {
@@ -160,18 +146,120 @@ class ShapedRun {
                                      "body.material", "obstacle material");
   }
 
-  std::string lastingContact(const std::vector<std::size_t>& obstacles, double time) const {
+  /// Why the prediction ends at a lasting contact with `obstacles` at `time`: `why`, what is not
+  /// modelled of it (lastingFace's or lastingOnFace's refusal).
+  std::string lastingContact(const std::vector<std::size_t>& obstacles, double time,
+                             const std::string& why) const {
     std::string ids;
     for (const std::size_t o : obstacles) {
       ids += (ids.empty() ? "'" : ", '") + model_.obstacle(o).id + "'";
     }
     return "the body comes into lasting contact with " + ids + " at +" + formatNumber(time) +
-           " s: a shaped body's lasting contact (resting, sliding, rolling, tipping) is not yet "
-           "modelled, and the prediction ends there";
+           " s, which is not yet modelled (" + why + "), and the prediction ends there";
+  }
+
+  /// The body's state at `time` on a lasting motion.
+  BodyStateSample stateOn(const LastingMotion& lasting, double time) const {
+    BodyStateSample state;
+    state.time = time;
+    state.position = lasting.centreAt(time);
+    state.velocity = lasting.velocityAt(time);
+    state.angular_velocity = lasting.angularVelocityAt(time);
+    state.orientation = lasting.orientationAt(time) * principal_.body_from_principal.conjugate();
+    return state;
+  }
+
+  /// The contact the engine found to last at `time` (on `body`'s flight): where it is on one flat
+  /// face, the body moves by lastingOnFace's motion (sampled; asked again where it `stops`) to
+  /// the horizon or to where that motion ends; where it is not modelled, the prediction ends
+  /// there, saying why.
+  Expected<Prediction> lastingFrom(const ShapedMotion& motion, const TumblingBody& body,
+                                   double time, std::vector<std::string>& cut) {
+    const std::vector<std::size_t> with = motion.lastingWith();
+    auto face = motion.lastingFace();
+    if (!face) {
+      cut.push_back(lastingContact(with, time, face.error().message()));
+      return finish(motion, body, time);
+    }
+    LastingBody on = face->first;
+    for (;;) {
+      auto lasting = lastingOnFace(on, face->second);
+      if (!lasting) {
+        cut.push_back(lastingContact(with, on.time, lasting.error().message()));
+        BodyStateSample state;
+        state.time = on.time;
+        state.position = on.centre;
+        state.velocity = on.velocity;
+        state.angular_velocity = on.angular_velocity;
+        state.orientation = on.orientation * principal_.body_from_principal.conjugate();
+        return finishWith(motion, state);
+      }
+      const LastingMotion& along = *lasting;
+      const double until = std::min(along.until, horizon_);
+      sampleUntil(on.time, until, [&](double t) { return stateOn(along, t); });
+      if (until >= horizon_ || along.ends != "stops") {
+        if (until < horizon_) {
+          cut.push_back("the body's lasting contact with '" + model_.obstacle(with.front()).id +
+                        "' ends at +" + formatNumber(until) + " s (" + along.ends +
+                        "), which is not yet modelled, and the prediction ends there");
+        }
+        for (const SupportForce& force : along.forcesAt(until)) {
+          ContactRecord record;
+          record.time = until;
+          record.other = with.front();
+          record.other_is_obstacle = true;
+          record.contact_point = force.point;
+          record.normal = -face->second.normal;
+          record.normal_force = force.normal_force;
+          record.friction_force = -force.friction_force;
+          record.state = along.state;
+          // After a flat landing whose bounces accumulate, the contact lasts from their end (as
+          // a ball's: doc/model.md, "Coming to rest").
+          record.since = rests_from_ ? *rests_from_ : time;
+          prediction_.contacts.push_back(record);
+        }
+        return finishWith(motion, stateOn(along, until));
+      }
+      on.time = until;
+      on.centre = along.centreAt(until);
+      on.velocity = along.velocityAt(until);
+      on.angular_velocity = along.angularVelocityAt(until);
+      on.orientation = along.orientationAt(until);
+      if (!(along.until > along.start)) {
+        cut.push_back(lastingContact(with, until, "its lasting motion ends where it starts"));
+        return finishWith(motion, stateOn(along, until));
+      }
+    }
+  }
+
+  /// The samples and the crossing of a motion given by `state_at` from `from` to `to`.
+  template <class StateAt>
+  void sampleUntil(double from, double to, const StateAt& state_at) {
+    if (period_ > 0) {
+      for (double k = std::floor(from / period_) + 1;; ++k) {
+        const double t = std::min(horizon_, k * period_);
+        if (t > to || t <= from) break;
+        if (prediction_.samples.empty() || prediction_.samples.back().time < t) {
+          prediction_.samples.push_back(state_at(t));
+        }
+        if (t >= horizon_) break;
+      }
+    }
+    if (!request_.crossing || prediction_.crossing) return;
+    const Plane& plane = *request_.crossing;
+    if ((across(plane, state_at(from).position) > 0) ==
+        (across(plane, state_at(to).position) > 0)) {
+      return;
+    }
+    prediction_.crossing = bisectCrossing(plane, from, to, state_at);
   }
 
   Expected<Prediction> finish(const ShapedMotion& motion, const TumblingBody& body, double time) {
-    prediction_.final_state = motion.stateOn(body, time);
+    return finishWith(motion, motion.stateOn(body, time));
+  }
+
+  Expected<Prediction> finishWith(const ShapedMotion& motion, const BodyStateSample& state) {
+    prediction_.final_state = state;
     if (const auto frictionless_at = motion.frictionlessAt()) {
       extra_.push_back(
           "friction at several points struck at once (a face or an edge landing, "
@@ -195,6 +283,7 @@ class ShapedRun {
   Prediction prediction_;
   double horizon_ = 0.0, period_ = 0.0;
   std::size_t max_impacts_ = 0;
+  std::optional<double> rests_from_;  // the last impact's flat bounces accumulate then
 };
 
 }  // namespace
