@@ -544,6 +544,17 @@ TEST(ShapedLasting, ACylinderThatSlipsThenRollsAtTheClosedFormInstant) {
   EXPECT_NEAR(motion->angularVelocityAt(motion->until).y() * r, 1.0, 1e-14);
   expectBalance(body, floor, *motion, 1e-14);
   expectNeverBelowNorGaining(body, floor, *motion);
+  // At rest on its side it rests, m g / 2 on each end of its lowest line.
+  LastingBody still = body;
+  still.velocity = V::Zero();
+  const auto rests = lastingOnFace(still, floor);
+  ASSERT_TRUE(rests.ok()) << errorOf(rests);
+  EXPECT_EQ(rests->state, ContactState::kResting);
+  ASSERT_EQ(rests->forces.size(), 2u);
+  for (const SupportForce& force : rests->forces) {
+    EXPECT_NEAR(force.normal_force, m * kG / 2, 1e-14 * m * kG);
+    EXPECT_NEAR(std::abs(force.point.y()), 0.2, 1e-15);
+  }
   LastingBody rolling = body;
   rolling.time = motion->until;
   rolling.centre = motion->centreAt(motion->until);
@@ -571,7 +582,7 @@ TEST(ShapedLasting, ACylinderThatSlipsThenRollsAtTheClosedFormInstant) {
   expectNeverBelowNorGaining(steep, slippery, *slides);
 }
 
-TEST(ShapedLasting, ABoxSlidingOnATableTopEndsWhereItsFrontCornersReachTheEdge) {
+TEST(ShapedLasting, SlidingOnATableTopEndsWhereTheSupportReachesTheEdge) {
   // Half size 0.1 along x on a table top 2 m long (half extent 1): its front corners reach the
   // edge after 0.9 m. At 3 m/s with mu = 0.2 (stopping after 9 / (2 mu g) = 2.29 m): the first
   // root of 3 t - mu g t^2 / 2 = 0.9.
@@ -588,6 +599,16 @@ TEST(ShapedLasting, ABoxSlidingOnATableTopEndsWhereItsFrontCornersReachTheEdge) 
   EXPECT_NEAR(motion->until, (3 - std::sqrt(9 - 4 * A * 0.9)) / (2 * A), 1e-14);
   EXPECT_NEAR(motion->centreAt(motion->until).x(), 0.9, 1e-14);
   expectNeverBelowNorGaining(body, table, *motion);
+  // A cylinder standing on its cap (r = 0.2, half length 0.1) from the middle at 3 m/s along
+  // (0.6, 0.8): its rim reaches the side y = 0.5 first, when its centre is at y = 0.3, after
+  // 0.3 / 0.8 = 0.375 m: the first root of 3 t - mu g t^2 / 2 = 0.375.
+  LastingBody can = cylinder(0.2, 0.1, 1, 0.02, V(0, 0, 0.8), Q::Identity());
+  can.velocity = V(1.8, 2.4, 0);
+  const auto slides = lastingOnFace(can, table);
+  ASSERT_TRUE(slides.ok()) << errorOf(slides);
+  EXPECT_EQ(slides->ends, "a point of its support reaches the face's edge");
+  EXPECT_NEAR(slides->until, (3 - std::sqrt(9 - 4 * A * 0.375)) / (2 * A), 1e-14);
+  expectNeverBelowNorGaining(can, table, *slides);
   // Slower, it stops on the table.
   body.velocity = V(1, 0, 0);
   const auto stops = lastingOnFace(body, table);
@@ -598,6 +619,27 @@ TEST(ShapedLasting, ABoxSlidingOnATableTopEndsWhereItsFrontCornersReachTheEdge) 
   const auto over = lastingOnFace(body, table);
   ASSERT_FALSE(over.ok());
   EXPECT_NE(over.error().reason.find("not yet: the body overhangs"), std::string::npos);
+}
+
+TEST(ShapedLasting, ABoxSlidingDownARampEndsAtItsLowerEdge) {
+  // A ramp: the face of a box obstacle on the incline, 4 m long up the slope (half extent 2) and
+  // 2 m across, its centre at the origin. The box (a = 0.5 up the slope) from rest at its middle,
+  // mu = 0.5: a = 0.2 g down the slope; its lower corners, 0.5 m below its centre, reach the
+  // ramp's lower edge after 1.5 m: 0.1 g t^2 = 1.5, t = sqrt(15 / g).
+  const double a = 0.5, c = 0.2;
+  const LastingBody body = box(V(a, 0.3, c), 2, c * kInclineNormal, onIncline());
+  FlatFace ramp = plane(kInclineNormal, 0.5);
+  ramp.bounded = true;
+  ramp.along_u = kUphill;
+  ramp.along_v = V::UnitY();
+  ramp.half_extent = Eigen::Vector2d(2, 1);
+  const auto motion = lastingOnFace(body, ramp);
+  ASSERT_TRUE(motion.ok()) << errorOf(motion);
+  EXPECT_EQ(motion->state, ContactState::kSliding);
+  EXPECT_EQ(motion->ends, "a point of its support reaches the face's edge");
+  EXPECT_NEAR(motion->until, std::sqrt(15 / kG), 1e-14);
+  EXPECT_NEAR(motion->centreAt(motion->until).dot(kUphill), -1.5, 1e-14);
+  expectNeverBelowNorGaining(body, ramp, *motion);
 }
 
 TEST(ShapedLasting, ACylinderRollingOnATableTopEndsWhereItsSideReachesTheEdge) {
@@ -695,7 +737,18 @@ TEST(ShapedLasting, BadInputIsNamed) {
   body = good;
   body.shape = Sphere{V::Zero(), 0.1};
   EXPECT_EQ(fieldOf(lastingOnFace(body, floor)), "body.shape");
+  body = good;
+  body.moments.y() = -1;
+  EXPECT_EQ(fieldOf(lastingOnFace(body, floor)), "body.moments");
+  body = good;
+  body.orientation = Q(2, 0, 0, 0);
+  EXPECT_EQ(fieldOf(lastingOnFace(body, floor)), "body.orientation");
   FlatFace face = floor;
+  face.bounded = true;
+  face.half_extent = Eigen::Vector2d(1, 1);
+  face.along_u = V(1, 1, 0).normalized();
+  EXPECT_EQ(fieldOf(lastingOnFace(good, face)), "face.along_u");
+  face = floor;
   face.friction = -1;
   EXPECT_EQ(fieldOf(lastingOnFace(good, face)), "face.friction");
   face = floor;

@@ -191,6 +191,26 @@ struct Setting {
   double settled_speed = kLastingStillSpeed;
 };
 
+/// The face's frame and the body's place over it; `settled`: the bands of a body handed over as
+/// settled (kLastingSettled), else the touching band alone.
+Setting settingOf(const LastingBody& body, const FlatFace& face, bool settled) {
+  Setting setting;
+  setting.n = face.normal.normalized();
+  setting.e1 = face.bounded ? face.along_u : setting.n.unitOrthogonal();
+  setting.e2 = setting.n.cross(setting.e1);
+  setting.g_n = -body.gravity.dot(setting.n);
+  setting.g_t = body.gravity + setting.g_n * setting.n;
+  setting.height = setting.n.dot(body.centre - face.point);
+  setting.foot = body.centre - setting.height * setting.n;
+  setting.reach = reachOf(body.shape);
+  if (settled) {
+    setting.band = std::max(kLastingBand, kLastingSettled * setting.reach);
+    setting.settled_speed =
+        std::max(kLastingStillSpeed, std::sqrt(2 * setting.g_n * kLastingSettled * setting.reach));
+  }
+  return setting;
+}
+
 Vec onFace(const Vec& x, const FlatFace& face, const Vec& n) {
   return x - n.dot(x - face.point) * n;
 }
@@ -424,6 +444,7 @@ Expected<std::vector<SupportForce>> supportForces(Support& support, const Settin
                     "g - a) is not strictly inside the support polygon");
     }
     f = polygonForces(q, p, total, true);
+    for (double& share : f) share = std::max(0.0, share);  // rounding's -1e-17 near an edge
   }
   std::vector<SupportForce> forces;
   for (std::size_t i = 0; i < f.size(); ++i) {
@@ -532,33 +553,13 @@ Expected<Plan> rollPlan(const LastingBody& body, const Support& support, const S
 
 }  // namespace
 
-Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& face) {
-  if (Status status = checkLasting(body, face); !status) return status.error();
-  const Eigen::Quaterniond orientation = body.orientation.normalized();
-  const Eigen::Matrix3d rotation = orientation.toRotationMatrix();
-  Setting setting;
-  setting.n = face.normal.normalized();
-  setting.e1 = face.bounded ? face.along_u : setting.n.unitOrthogonal();
-  setting.e2 = setting.n.cross(setting.e1);
-  setting.g_n = -body.gravity.dot(setting.n);
-  setting.g_t = body.gravity + setting.g_n * setting.n;
-  setting.height = setting.n.dot(body.centre - face.point);
-  setting.foot = body.centre - setting.height * setting.n;
-  setting.reach = reachOf(body.shape);
-  setting.band = std::max(kLastingBand, kLastingSettled * setting.reach);
-  setting.settled_speed =
-      std::max(kLastingStillSpeed, std::sqrt(2 * setting.g_n * kLastingSettled * setting.reach));
-  auto found = supportOf(body, rotation, face, setting);
-  if (!found) return found.error();
-  Support support = found.value();
+namespace {
 
-  // Its turning: none, a roll about a side's axis, or what is not modelled.
-  const Vec& v = body.velocity;
-  const Vec& w = body.angular_velocity;
-  const Vec in_face = v - v.dot(setting.n) * setting.n;
-  // A side keeps its turn about its axis (a roll); the rest of w is a spin about the normal,
-  // refused beyond kLastingStillSpeed, and a rocking turn about an axis in the face, refused
-  // beyond the settled speed and dropped within it (with it, energy: the axis is principal).
+/// The turn a side keeps about its axis (a roll; 0 for a body on a face or a cap), or the Error
+/// of a turning not modelled: a spin about the normal beyond kLastingStillSpeed, a rocking turn
+/// about an axis in the face beyond the settled speed (within it, dropped: with it, energy,
+/// since a side's axis is principal).
+Expected<double> keptSpin(const Support& support, const Setting& setting, const Vec& w) {
   const double spin = support.kind == SupportKind::kLine ? w.dot(support.axis) : 0.0;
   const Vec rest = support.kind == SupportKind::kLine ? Vec(w - spin * support.axis) : w;
   const double about_normal = rest.dot(setting.n);
@@ -568,15 +569,24 @@ Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& f
   if ((rest - about_normal * setting.n).norm() * setting.reach > setting.settled_speed) {
     return notYet("rocking: turning about an axis in the face that is not a side's own");
   }
-  // The manifold neither approaches nor leaves the face.
+  return spin;
+}
+
+/// The support's outline on the face: a cap's rim at its extremes along `along` and `across`,
+/// or the manifold's points.
+std::vector<Vec> outlineOf(const Support& support, const Vec& along, const Vec& across) {
+  if (support.kind != SupportKind::kDisc) return support.feet;
+  const Vec& c = support.centre;
   const double r = support.radius;
-  const std::vector<Vec> points =
-      support.kind == SupportKind::kDisc
-          ? std::vector<Vec>{support.centre + r * setting.e1, support.centre - r * setting.e1,
-                             support.centre + r * setting.e2, support.centre - r * setting.e2}
-          : support.feet;
-  for (const Vec& point : points) {
-    const double normal_speed = (v + w.cross(point - body.centre)).dot(setting.n);
+  return {c + r * along, c - r * along, c + r * across, c - r * across};
+}
+
+/// Neither approaching nor leaving the face (beyond the settled speed), nor off a bounded face.
+Status checkOnFace(const LastingBody& body, const FlatFace& face, const Support& support,
+                   const Setting& setting) {
+  for (const Vec& point : outlineOf(support, setting.e1, setting.e2)) {
+    const double normal_speed =
+        (body.velocity + body.angular_velocity.cross(point - body.centre)).dot(setting.n);
     if (std::abs(normal_speed) > setting.settled_speed) {
       return Error{"body.velocity", std::string("a point of the contact ") +
                                         (normal_speed < 0 ? "approaches" : "leaves") +
@@ -586,43 +596,65 @@ Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& f
                                         " m/s: an elastic rise of 1e-6 of the body's reach)"};
     }
   }
-  if (face.bounded) {
-    const std::vector<Vec> reaching =
-        support.kind == SupportKind::kDisc
-            ? std::vector<Vec>{support.centre + support.radius * face.along_u,
-                               support.centre - support.radius * face.along_u,
-                               support.centre + support.radius * face.along_v,
-                               support.centre - support.radius * face.along_v}
-            : support.feet;
-    for (const Vec& foot : reaching) {
-      const Vec offset = foot - face.point;
-      if (std::abs(offset.dot(face.along_u)) > face.half_extent.x() + kLastingBand ||
-          std::abs(offset.dot(face.along_v)) > face.half_extent.y() + kLastingBand) {
-        return notYet("the body overhangs the face's edge (a point of its support is off it)");
-      }
+  if (!face.bounded) return Ok{};
+  for (const Vec& point : outlineOf(support, face.along_u, face.along_v)) {
+    const Vec offset = point - face.point;
+    if (std::abs(offset.dot(face.along_u)) > face.half_extent.x() + kLastingBand ||
+        std::abs(offset.dot(face.along_v)) > face.half_extent.y() + kLastingBand) {
+      return notYet("the body overhangs the face's edge (a point of its support is off it)");
     }
   }
+  return Ok{};
+}
 
+const char* tippingOf(ContactState state) {
+  switch (state) {
+    case ContactState::kResting:
+      return "tipping over";
+    case ContactState::kSliding:
+      return "tipping while sliding";
+    case ContactState::kRolling:
+      return "tipping while rolling";
+  }
+  return "tipping";
+}
+
+}  // namespace
+
+Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& face) {
+  if (Status status = checkLasting(body, face); !status) return status.error();
+  const Eigen::Quaterniond orientation = body.orientation.normalized();
+  const Eigen::Matrix3d rotation = orientation.toRotationMatrix();
+  const Setting setting = settingOf(body, face, true);
+  auto found = supportOf(body, rotation, face, setting);
+  if (!found) return found.error();
+  Support support = found.value();
+  const auto spin = keptSpin(support, setting, body.angular_velocity);
+  if (!spin) return spin.error();
+  if (Status status = checkOnFace(body, face, support, setting); !status) return status.error();
+  // Outlines taken before supportForces chooses a cap's four points.
+  const std::vector<Vec> outline = outlineOf(support, face.along_u, face.along_v);
+
+  // The motion: the velocity's part in the face (its normal part settled), a roll kept.
+  const Vec in_face = body.velocity - body.velocity.dot(setting.n) * setting.n;
   const double mu = face.friction;
   Expected<Plan> planned = support.kind == SupportKind::kLine
-                               ? rollPlan(body, support, setting, mu, in_face, spin)
+                               ? rollPlan(body, support, setting, mu, in_face, spin.value())
                                : translationPlan(in_face, setting.g_t, setting.g_n, mu);
   if (!planned) return planned.error();
   const Plan& plan = planned.value();
 
   // The forces: N = m g_n, friction m (a - g_t), the centre of pressure h (g_t - a) / g_n from
-  // the centre's foot.
+  // the centre's foot. A side's centre of pressure is taken along its axis only: across it, the
+  // roll's J alpha balances the friction's moment. The friction's moment about the normal is 0
+  // there too: gravity has no part along the axis while the body rolls, none across it while it
+  // rests or slides (rollPlan's cases).
   const double total = body.mass * setting.g_n;
   const Vec friction_ratio = (plan.acceleration - setting.g_t) / setting.g_n;
   const Vec pressure =
       setting.foot + setting.height * (setting.g_t - plan.acceleration) / setting.g_n;
-  // A side's centre of pressure is taken along its axis only: across it, the roll's J alpha
-  // balances the friction's moment. The friction's moment about the normal is 0 there too:
-  // gravity has no part along the axis while the body rolls, none across it while it rests or
-  // slides (rollPlan's cases).
-  auto forces = supportForces(
-      support, setting, pressure, total, friction_ratio, rotation,
-      plan.state == ContactState::kResting ? "tipping over" : "tipping while sliding");
+  auto forces = supportForces(support, setting, pressure, total, friction_ratio, rotation,
+                              tippingOf(plan.state));
   if (!forces) return forces.error();
 
   LastingMotion motion;
@@ -635,7 +667,7 @@ Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& f
   motion.angular_acceleration = plan.angular_acceleration;
   motion.orientation0 = orientation;
   motion.forces = forces.value();
-  const double edge = edgeReached(support.feet, face, plan.track);
+  const double edge = edgeReached(outline, face, plan.track);
   double lasts = plan.lasts;
   motion.ends = plan.ends;
   if (edge < lasts) {
@@ -651,15 +683,7 @@ std::optional<double> flatBouncesEnd(const LastingBody& body, const FlatFace& fa
   if (!(std::isfinite(restitution) && restitution >= 0 && restitution < 1)) return std::nullopt;
   if (!checkLasting(body, face)) return std::nullopt;
   const Eigen::Matrix3d rotation = body.orientation.normalized().toRotationMatrix();
-  Setting setting;
-  setting.n = face.normal.normalized();
-  setting.e1 = setting.n.unitOrthogonal();
-  setting.e2 = setting.n.cross(setting.e1);
-  setting.g_n = -body.gravity.dot(setting.n);
-  setting.g_t = body.gravity + setting.g_n * setting.n;
-  setting.height = setting.n.dot(body.centre - face.point);
-  setting.foot = body.centre - setting.height * setting.n;
-  setting.reach = reachOf(body.shape);
+  const Setting setting = settingOf(body, face, false);
   auto found = supportOf(body, rotation, face, setting);
   if (!found) return std::nullopt;
   Support support = found.value();
