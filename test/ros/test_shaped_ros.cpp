@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <tf2/buffer_core.h>
 
+#include <algorithm>
 #include <cmath>
 #include <deque>
 #include <optional>
@@ -299,6 +300,57 @@ TEST(ShapedDiagnostics, AnUnmodelledContactIsNamedAndCounted) {
   diagnostics.report(status, cycle, 0);
   EXPECT_EQ(diagnosticValue(status, "contacts of shaped bodies not modelled yet (total)"), "1");
   EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::OK) << status.message;
+}
+
+// Item 4: the contacts topic carries a shaped body's lasting contact as a ball's, one Contact a
+// point: a box (0.1 x 0.08 x 0.06 m, 2 kg) given at rest flat on a floor rests on its four
+// corners, each carrying m g / 4 by symmetry (the four supports symmetric about the centre), the
+// normal from the box into the floor.
+TEST(ShapedContacts, ABoxRestingFlatIsPublishedAsOneContactACorner) {
+  core::Scene scene;
+  scene.effects.gravity = true;
+  scene.gravity = Eigen::Vector3d(0, 0, -9.81);
+  scene.materials.addMaterial("test_half", core::Material{0.5, std::nullopt}, "materials");
+  core::BodySpec box = bodyOf("block", core::BodyShape::kBox);
+  box.mass = 2.0;
+  box.size = Eigen::Vector3d(0.1, 0.08, 0.06);
+  box.material = "test_half";
+  scene.bodies = {box};
+  core::ObstacleSpec floor;
+  floor.id = "floor";
+  floor.material = "test_half";
+  scene.obstacles = {floor};
+  MonitorCycle cycle(scene, MonitorParams{});
+  tf2::BufferCore tf;
+  const ros::Time start(1000, 0);
+  std::deque<std::vector<BodyState>> inputs;
+  MonitorCycle::Update update;
+  for (int k = 0; k <= 2; ++k) {
+    BodyState state = stateOf("block", 0, 0, 0, 1);
+    state.header.stamp = start + ros::Duration(0.01 * k);
+    state.pose.position.x = 0.1;
+    state.pose.position.z = 0.03;
+    inputs.push_back({state});
+    update = cycle.process({&inputs.back(), "/body_states", "/source", ""}, start, false, tf);
+    EXPECT_TRUE(update.reports.empty()) << update.reports.front().text;
+  }
+  ASSERT_EQ(update.contacts.contacts.size(), 4u);
+  std::vector<std::pair<double, double>> corners;
+  for (const Contact& contact : update.contacts.contacts) {
+    EXPECT_EQ(contact.body_a, "block");
+    EXPECT_EQ(contact.body_b, "floor");
+    EXPECT_NEAR(contact.normal_force, 2.0 * 9.81 / 4, 1e-12);
+    EXPECT_NEAR(contact.normal.z, -1.0, 1e-15);
+    EXPECT_NEAR(contact.contact_point.z, 0.0, 1e-12);
+    corners.emplace_back(contact.contact_point.x, contact.contact_point.y);
+  }
+  std::sort(corners.begin(), corners.end());
+  const std::vector<std::pair<double, double>> expected = {
+      {0.05, -0.04}, {0.05, 0.04}, {0.15, -0.04}, {0.15, 0.04}};
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_NEAR(corners[k].first, expected[k].first, 1e-12);
+    EXPECT_NEAR(corners[k].second, expected[k].second, 1e-12);
+  }
 }
 
 }  // namespace
