@@ -11,7 +11,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <string>
+
+#include <Eigen/LU>
 
 #include "contact/shaped_lasting.h"
 
@@ -307,6 +310,86 @@ TEST(ShapedLasting, AnOffCentreBodyLeavesItsFarCornerUnloadedWhereTheLinearRuleW
   }
   expectBalance(body, floor, *motion, 1e-14);
   expectNeverBelowNorGaining(body, floor, *motion);
+}
+
+TEST(ShapedLasting, RandomBodiesRestOnTheLeastNonNegativeForcesOrTipWhereTheirCentreIsOff) {
+  // 600 hulls (a box's corners, its centre of mass anywhere over its base or a little beyond it)
+  // resting on random inclines (up to 0.5 rad, mu = 10), turned about the normal at random. The
+  // test's own criterion: the centre's projection along g onto the face, in the body's axes,
+  // strictly inside the base rectangle: then a rest whose forces balance (expectBalance), are
+  // >= 0, and whose squared norm no feasible move along the balance's free direction (the
+  // kernel of the 3x4 balance, by a full-pivot LU of the test's) lowers (1,000 steps over the
+  // feasible interval); outside, refused as tipping.
+  std::mt19937 random(20261206);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int rests = 0, unloaded = 0, tips = 0;
+  for (int k = 0; k < 600; ++k) {
+    const double a = 0.1 + 0.4 * unit(random), b = 0.1 + 0.4 * unit(random);
+    const double c = 0.05 + 0.3 * unit(random);
+    const double x0 = -2 * a * (-0.1 + 1.2 * unit(random));
+    const double y0 = -2 * b * (-0.1 + 1.2 * unit(random));
+    ConvexHull hull;
+    for (const double x : {x0, x0 + 2 * a}) {
+      for (const double y : {y0, y0 + 2 * b}) {
+        for (const double z : {-c, 0.1}) hull.vertices.emplace_back(x, y, z);
+      }
+    }
+    const double tilt = 0.5 * unit(random), azimuth = 2 * M_PI * unit(random);
+    const V n(std::sin(tilt) * std::cos(azimuth), std::sin(tilt) * std::sin(azimuth),
+              std::cos(tilt));
+    const Q turn =
+        Q(Eigen::AngleAxisd(2 * M_PI * unit(random), n)) * Q::FromTwoVectors(V::UnitZ(), n);
+    LastingBody body;
+    body.shape = hull;
+    body.mass = 1 + 2 * unit(random);
+    body.moments = V(0.1, 0.2, 0.3);
+    body.orientation = turn;
+    body.centre = c * n;
+    body.gravity = kDown;
+    const FlatFace face = plane(n, 10.0);
+    // The centre's projection along g onto the face n.x = 0, in the body's axes.
+    const V projected = body.centre + body.gravity * (n.dot(body.centre) / -body.gravity.dot(n));
+    const V local = turn.conjugate() * (projected - body.centre);
+    const double inside =
+        std::min({local.x() - x0, x0 + 2 * a - local.x(), local.y() - y0, y0 + 2 * b - local.y()});
+    if (std::abs(inside) < 1e-9) continue;
+    const auto motion = lastingOnFace(body, face);
+    if (inside < 0) {
+      ++tips;
+      ASSERT_FALSE(motion.ok()) << k;
+      EXPECT_NE(motion.error().reason.find("not yet: tipping over"), std::string::npos)
+          << motion.error().message();
+      continue;
+    }
+    ++rests;
+    ASSERT_TRUE(motion.ok()) << k << ": " << errorOf(motion);
+    EXPECT_EQ(motion->state, ContactState::kResting);
+    ASSERT_EQ(motion->forces.size(), 4u);
+    expectBalance(body, face, *motion, 1e-12);
+    const V e1 = turn * V::UnitX(), e2 = turn * V::UnitY();
+    Eigen::Matrix<double, 3, 4> balance;
+    Eigen::Vector4d f;
+    for (int i = 0; i < 4; ++i) {
+      const SupportForce& force = motion->forces[static_cast<std::size_t>(i)];
+      balance.col(i) = V(1, force.point.dot(e1), force.point.dot(e2));
+      f[i] = force.normal_force;
+      EXPECT_GE(f[i], 0.0);
+    }
+    if (f.minCoeff() < 1e-12 * body.mass * kG) ++unloaded;
+    const Eigen::Vector4d free = Eigen::FullPivLU<Eigen::Matrix<double, 3, 4>>(balance).kernel();
+    double lo = -INFINITY, hi = INFINITY;
+    for (int i = 0; i < 4; ++i) {
+      if (free[i] > 0) lo = std::max(lo, -f[i] / free[i]);
+      if (free[i] < 0) hi = std::min(hi, -f[i] / free[i]);
+    }
+    for (int step = 0; step <= 1000; ++step) {
+      const double t = lo + (hi - lo) * step / 1000.0;
+      EXPECT_GE((f + t * free).squaredNorm(), f.squaredNorm() * (1 - 1e-12)) << k;
+    }
+  }
+  EXPECT_GT(rests, 200);
+  EXPECT_GT(unloaded, 20);  // the least-norm shares >= 0 where the linear rule would pull
+  EXPECT_GT(tips, 20);
 }
 
 TEST(ShapedLasting, AStandingCylinderOnAnInclineLeansItsWeightTowardsItsLowerRim) {

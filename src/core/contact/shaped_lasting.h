@@ -92,10 +92,14 @@ struct LastingMotion {
   std::vector<SupportForce> forcesAt(double t) const;
 };
 
-/// The lasting motion that starts from `body` touching `face` (within the touching band, not
-/// approaching it), or an Error whose message says what is not modelled yet, for the caller to
-/// report (e.g. "not yet: tipping over an edge", "not yet: spin about the face's normal while
-/// sliding"). The body must not gain energy, and no point of it goes below the face.
+/// The lasting motion that starts from `body` touching `face` (its lowest point within
+/// kLastingBand of it, its normal motion settled: kLastingSettled), or an Error whose message
+/// says what is not modelled yet, for the caller to report (e.g. "not yet: tipping over an
+/// edge", "not yet: spin about the face's normal while sliding"), or which input is wrong
+/// (`body.mass`, `face.normal`, ...). The body does not gain energy (a settled normal motion is
+/// dropped), and no point of it goes below the face. The normal forces are the least-norm ones
+/// >= 0 that balance m (a - g) and the moment about the centre of mass; each point's friction is
+/// in proportion to its normal force (doc/model.md, "Lasting contact of a shaped body").
 Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& face);
 
 /// Bounces on one face that accumulate: a body landing flat on a face or a side (every point of
