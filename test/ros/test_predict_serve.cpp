@@ -456,6 +456,59 @@ TEST(PredictServe, ThePlayedServesImpactsComeWhereThePredictionSaid) {
   }
 }
 
+// A solid cylinder rolling down an incline over ROS (issue 42's "Done when"; the node on
+// test/ros/incline_roll.yaml, incline_roll.test): radius r = 0.05 m, length 0.1 m, 1 kg, its axis
+// along y across the slope of the plane n = (7, 0, 24)/25 (sin(theta) = 7/25, cos(theta) =
+// 24/25), released at rest touching it (its centre r n from the plane's point at the origin).
+// Rolling without slip (mu = 0.8 >= tan(theta) / 3 = 0.0972): a = g sin(theta) / (1 + J / (m
+// r^2)) with J = m r^2 / 2, a = 2/3 g sin(theta) down the slope d = (24, 0, -7)/25; after T:
+// the centre a T^2 / 2 along d, the velocity a T d, the spin n x v / r (no slip at the contact);
+// the contact's normal forces add up to m g cos(theta), its friction to m g sin(theta) / 3 up d.
+TEST(PredictRoll, ASolidCylinderRollsDownAnInclineAtTwoThirdsGSinTheta) {
+  ASSERT_TRUE(ros::service::waitForService("/collision_response/predict_impacts", 30000));
+  const double g = 9.81, r = 0.05, m = 1.0, sin_theta = 7.0 / 25.0, cos_theta = 24.0 / 25.0;
+  const Eigen::Vector3d n(7.0 / 25.0, 0.0, 24.0 / 25.0), down(24.0 / 25.0, 0.0, -7.0 / 25.0);
+  const double a = 2.0 / 3.0 * g * sin_theta, horizon = 0.5;
+  PredictImpacts call;
+  call.request.header.frame_id = "world";
+  call.request.header.stamp = ros::Time(100.0);
+  call.request.body.id = "can";
+  call.request.body.shape = "cylinder";
+  call.request.body.radius = r;
+  call.request.body.length = 0.1;
+  call.request.body.mass = m;
+  call.request.body.material = "rubber";
+  // The cylinder's axis (its z) along the world's y: a quarter turn about x.
+  const Eigen::Quaterniond axis_along_y(Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitX()));
+  call.request.body.orientation.x = axis_along_y.x();
+  call.request.body.orientation.w = axis_along_y.w();
+  call.request.body.position = point(r * n);
+  call.request.effects = {"gravity", "friction"};
+  call.request.horizon = horizon;
+  call.request.max_impacts = 1;
+  ASSERT_TRUE(callService(call));
+  ASSERT_TRUE(call.response.success) << call.response.message;
+  EXPECT_TRUE(call.response.impacts.empty()) << call.response.message;
+  const auto& end = call.response.final_state;
+  const Eigen::Vector3d v = a * horizon * down;
+  EXPECT_LT(distance(end.pose.position, r * n + 0.5 * a * horizon * horizon * down), 1e-12);
+  EXPECT_LT(distance(end.twist.linear, v), 1e-12);
+  EXPECT_LT(distance(end.twist.angular, n.cross(v) / r), 1e-11);
+  Eigen::Vector3d normal_force = Eigen::Vector3d::Zero(), friction = Eigen::Vector3d::Zero();
+  for (const collision_response::Contact& contact : call.response.final_contacts) {
+    EXPECT_EQ(contact.body_b, "incline");
+    EXPECT_EQ(contact.state, "rolling");
+    normal_force += contact.normal_force * n;
+    friction += Eigen::Vector3d(contact.friction_force.x, contact.friction_force.y,
+                                contact.friction_force.z);
+  }
+  EXPECT_FALSE(call.response.final_contacts.empty());
+  EXPECT_NEAR(normal_force.norm(), m * g * cos_theta, 1e-12);
+  // On the incline, against the body's motion: the force on the other side is down the slope.
+  EXPECT_NEAR(std::abs(friction.dot(down)), m * g * sin_theta / 3.0, 1e-12);
+  EXPECT_NEAR((friction - friction.dot(down) * down).norm(), 0.0, 1e-12);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
