@@ -752,6 +752,70 @@ TEST(ShapedLasting, ACylinderRollingOnATableTopEndsWhereItsSideReachesTheEdge) {
       << spins.error().message();
 }
 
+TEST(ShapedLasting, RandomSlidesAndRollsBalanceNeverGoBelowNorGainEnergy) {
+  // 300 boxes flat on random inclines (up to 0.6 rad, or level), turned about the normal, sliding
+  // along the slope (or any way on a level face) at up to 3 m/s either way, mu in [0, 1]; 300
+  // cylinders on their side across the slope (J from 0.3 to 1 m r^2), rolling or slipping either
+  // way. Each: its forces balance m (a - g) and the turning (1e-12), and over its span (or 1 s)
+  // no point below the face, no energy gained, no force < 0, friction within mu (the helper's
+  // sampling); a box may instead be refused as tipping, a side never.
+  std::mt19937 random(4242);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int slides = 0, tips = 0, rolls = 0, slips = 0;
+  for (int k = 0; k < 600; ++k) {
+    const bool level = k % 5 == 0;
+    const double tilt = level ? 0.0 : 0.6 * unit(random), azimuth = 2 * M_PI * unit(random);
+    const V n(std::sin(tilt) * std::cos(azimuth), std::sin(tilt) * std::sin(azimuth),
+              std::cos(tilt));
+    const V g_t = kDown - kDown.dot(n) * n;
+    V down = g_t.norm() > 0 ? V(g_t.normalized()) : V(n.unitOrthogonal());
+    if (level) down = Eigen::AngleAxisd(2 * M_PI * unit(random), n) * down;
+    const FlatFace face = plane(n, unit(random));
+    const double speed = 3 * (2 * unit(random) - 1);
+    if (k < 300) {
+      const V half(0.05 + 0.25 * unit(random), 0.05 + 0.25 * unit(random),
+                   0.05 + 0.25 * unit(random));
+      const Q turn =
+          Q(Eigen::AngleAxisd(2 * M_PI * unit(random), n)) * Q::FromTwoVectors(V::UnitZ(), n);
+      LastingBody body = box(half, 1 + unit(random), half.z() * n, turn);
+      body.velocity = speed * down;
+      const auto motion = lastingOnFace(body, face);
+      if (!motion.ok()) {
+        ++tips;
+        EXPECT_NE(motion.error().reason.find("not yet: tipping"), std::string::npos)
+            << k << ": " << motion.error().message();
+        continue;
+      }
+      ++slides;
+      expectBalance(body, face, *motion, 1e-12);
+      expectNeverBelowNorGaining(body, face, *motion, 1.0);
+      continue;
+    }
+    const double r = 0.05 + 0.2 * unit(random), m = 1 + unit(random);
+    const V axis = n.cross(down);
+    Eigen::Matrix3d frame;
+    frame.col(0) = n;
+    frame.col(1) = axis.cross(n);
+    frame.col(2) = axis;
+    LastingBody body = cylinder(r, 0.05 + 0.3 * unit(random), m,
+                                (0.3 + 0.7 * unit(random)) * m * r * r, r * n, Q(frame));
+    body.velocity = speed * down;
+    const double slip = unit(random) < 0.5 ? 0.0 : 2 * unit(random) - 1;
+    // The contact line's velocity v + w x (-r n) is slip along `down` for w = (speed - slip) / r
+    // about n x down (its axis): (n x down) x n = down.
+    body.angular_velocity = ((speed - slip) / r) * axis;
+    const auto motion = lastingOnFace(body, face);
+    ASSERT_TRUE(motion.ok()) << k << ": " << errorOf(motion);
+    (motion->state == ContactState::kRolling ? rolls : slips) += 1;
+    expectBalance(body, face, *motion, 1e-12);
+    expectNeverBelowNorGaining(body, face, *motion, 1.0);
+  }
+  EXPECT_GT(slides, 100);
+  EXPECT_GT(tips, 10);
+  EXPECT_GT(rolls, 50);
+  EXPECT_GT(slips, 50);
+}
+
 TEST(ShapedLasting, FlatBouncesEndAtTheGeometricSeriesSum) {
   // A box landing flat at u = 2 m/s, e = 1/2, g_n = g: 2 e u / (g (1 - e)) = 4 / g after it.
   LastingBody body = box(V(0.3, 0.2, 0.1), 1, V(0, 0, 0.1));
