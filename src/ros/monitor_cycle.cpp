@@ -391,11 +391,12 @@ void MonitorCycle::reportStep(const core::StepReport& step, Update& update) cons
     update.reports.push_back(
         {Reason::kUnmodelledContact,
          "the contact of " +
-             sides(monitor_, contact.body, contact.other, contact.other_is_obstacle) + " from " +
+             sides(monitor_, contact.body, contact.other, contact.other_is_obstacle) + ", begun " +
              core::formatNumber(monitor_.now() - contact.time) +
-             " s before this update's end is not modelled yet: " + contact.what +
-             " (a shaped body with an obstacle is held where it is, with a ball or another "
-             "shaped body not resolved; doc/model.md, \"Shaped bodies in the monitor\")"});
+             " s before this update's end: " + contact.what +
+             (contact.other_is_obstacle ? " (the body is held where it is until its next state)"
+                                        : "") +
+             " (doc/model.md, \"Shaped bodies in the monitor\")"});
   }
   for (const core::StalledFlight& flight : step.stalled) {
     update.reports.push_back(
