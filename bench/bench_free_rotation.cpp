@@ -1,8 +1,9 @@
 // What a tumbling body's exact free rotation costs per evaluation (geometry/free_rotation.h):
 // its construction, its body-frame angular velocity and its orientation at a time, for an
-// asymmetric body (Jacobi elliptic functions, the angle about L by one Gauss-Legendre piece),
-// near the separatrix (a long period: more pieces at construction) and for a cylinder (closed
-// form). Google Benchmark; built on demand: cmake --build .ws/build --target bench_free_rotation.
+// asymmetric body (Jacobi elliptic functions, the angle about L by Carlson's R_F and R_J), near
+// the separatrix (a long period) and for a cylinder (closed form); and the orientation 1,000 s
+// on (many whole periods: the same cost). Google Benchmark; built on demand: cmake --build
+// .ws/build --target bench_free_rotation.
 #include <benchmark/benchmark.h>
 
 #include "geometry/free_rotation.h"
@@ -48,10 +49,20 @@ void orientation(benchmark::State& state) {
   }
 }
 
+void orientationLate(benchmark::State& state) {
+  const FreeRotation r = body(static_cast<int>(state.range(0)));
+  double t = 1000.0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(r.orientation(t));
+    t += 0.001;
+  }
+}
+
 // 0: asymmetric, 1: near the separatrix, 2: axisymmetric.
 BENCHMARK(construct)->Arg(0)->Arg(1)->Arg(2);
 BENCHMARK(angularVelocity)->Arg(0)->Arg(1)->Arg(2);
 BENCHMARK(orientation)->Arg(0)->Arg(1)->Arg(2);
+BENCHMARK(orientationLate)->Arg(0)->Arg(1);
 
 }  // namespace
 }  // namespace collision_response::core
