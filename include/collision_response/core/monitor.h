@@ -140,7 +140,7 @@ struct StalledFlight {
 struct StepReport {
   std::vector<ImpactRecord> impacts;
   /// The lasting contacts at the step's time (with the gravity effect), in the order of their
-  /// pairs.
+  /// pairs; then each shaped body's, one record per point of its manifold.
   std::vector<ContactRecord> contacts;
   std::size_t stale_states = 0;  ///< states not newer than their body's last one: dropped
   /// States of shaped bodies whose motion cannot start from them (an orientation that is not a
@@ -200,7 +200,11 @@ struct StepReport {
 /// Watches the scene's bodies and obstacles and finds their impacts.
 ///
 /// Time is a line of doubles (s) chosen by the caller. Each body has a track: a state (time,
-/// position, velocity) from which its motion is predicted in a straight line. step(T, states)
+/// position, velocity) from which its motion is predicted in a straight line (a parabola under
+/// gravity). A shaped body (a box, cylinder or capsule) is moved by its own exact motion from its
+/// last state, orientation included, among the obstacles (doc/model.md, "Shaped bodies in the
+/// monitor"): its impacts with obstacles and its lasting contacts on one flat face are reported
+/// as a ball's, what the model does not carry yet in StepReport::unmodelled. step(T, states)
 /// looks for impacts over (now, T] along the predicted motion, resolves them (updating the
 /// tracks with the post-impact velocities), and then takes the states at T as the new tracks.
 ///

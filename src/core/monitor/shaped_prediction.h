@@ -1,10 +1,10 @@
 // The prediction of a shaped body (issue 42, build step 7, first part): a box, cylinder or
 // capsule (or a sphere given a tensor) predicted among the scene's obstacles by its exact flight
 // (its centre's parabola, its torque-free rotation: free_rotation.h), its certified first
-// contacts (tumbling_contact.h) and its impacts with rotation (rigid_impact.h), until it would
-// come into lasting contact, which is not modelled yet for a shaped body: the prediction ends
-// there and says so. The motion is the engine's (shaped_motion.h); the samples, the crossing and
-// the budgets are the prediction's.
+// contacts (tumbling_contact.h) and its impacts with rotation (rigid_impact.h), and where its
+// contact lasts on one flat face by lastingOnFace's closed forms (shaped_lasting.h); where the
+// contact lasts otherwise (not modelled yet) the prediction ends there and says so. The motion is
+// the engine's (shaped_motion.h); the samples, the crossing and the budgets are the prediction's.
 #pragma once
 
 #include <Eigen/Core>
