@@ -24,11 +24,16 @@
 // screw turns its velocity at |w_o|). The gap, a distance between the two sets, changes no faster
 // than the points move, so it has no root before s = 2 g / (V + sqrt(V^2 + 2 A g)). |w| of a
 // free rotation is bounded for all time by sqrt(2 E / J_min), E its kinetic energy (2 E = sum
-// J_i w_i^2 >= J_min |w|^2). The advancement stops where a step falls below `time_tolerance`
-// (1e-12 s by default, with the rounding of the instant) or g reaches 0: every instant before the
-// one returned is certified apart (never missed), and the gap there is >= 0 (never inside) and
-// at most V time_tolerance plus the GJK tolerance; the true first contact is after it by at most
-// that gap over the closing speed.
+// J_i w_i^2 >= J_min |w|^2). Against a plane a second bound, along its normal n, where that
+// steps further (planeStep in the source, proved there): the centre's height moves exactly on
+// its parabola, and how far the body reaches below its centre, h = R cos(theta) (R its reach),
+// rises only as theta falls, no faster than |n x w| (exactly where w is fixed, else bounded by
+// sqrt(2 E / J_min)): a body sliding along the plane or turning steadily about its normal, or a
+// corner straight below its centre, takes long steps. The advancement stops where a step falls
+// below `time_tolerance` (1e-12 s by default, with the rounding of the instant) or g reaches 0:
+// every instant before the one returned is certified apart (never missed), and the gap there is
+// >= 0 (never inside) and at most V time_tolerance plus the GJK tolerance; the true first contact
+// is after it by at most that gap over the closing speed.
 //
 // At the instant found, the contact manifold: the points of either side that may touch first
 // (contactCandidates: a box's corners, a hull's vertices, a cylinder's rim points, a capsule's
