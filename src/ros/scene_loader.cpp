@@ -129,6 +129,44 @@ core::Status readBodyInertia(const XmlRpc::XmlRpcValue& value, const std::string
   return core::Ok{};
 }
 
+/// `orientation: [x, y, z, w]`: a quaternion, not zero, normalised (an obstacle's shape's, a
+/// body's).
+template <class Spec>
+core::Status readOrientation(const XmlRpc::XmlRpcValue& value, const std::string& field,
+                             Spec& spec) {
+  if (value.getType() != XmlRpc::XmlRpcValue::TypeArray || value.size() != 4) {
+    return core::Error{field, "must be a list of four numbers [x, y, z, w] (a quaternion)"};
+  }
+  double q[4];
+  for (int i = 0; i < 4; ++i) {
+    const auto component = readDouble(value[i], indexKey(field, static_cast<std::size_t>(i)));
+    if (!component) return component.error();
+    if (!std::isfinite(*component)) {
+      return core::Error{indexKey(field, static_cast<std::size_t>(i)), "must be finite"};
+    }
+    q[i] = *component;
+  }
+  const Eigen::Quaterniond quaternion(q[3], q[0], q[1], q[2]);
+  if (!(quaternion.norm() > 1e-6)) {
+    return core::Error{field, "must not be zero (a rotation's quaternion has length 1)"};
+  }
+  spec.orientation = quaternion.normalized();
+  return core::Ok{};
+}
+
+/// `rpy: [roll, pitch, yaw]` (rad, about the fixed x, y, z in that order, as URDF's).
+template <class Spec>
+core::Status readRollPitchYaw(const XmlRpc::XmlRpcValue& value, const std::string& field,
+                              Spec& spec) {
+  const auto angles = readVector3(value, field);
+  if (!angles) return angles.error();
+  if (auto status = core::checkFinite(*angles, field); !status) return status;
+  spec.orientation = Eigen::AngleAxisd(angles->z(), Eigen::Vector3d::UnitZ()) *
+                     Eigen::AngleAxisd(angles->y(), Eigen::Vector3d::UnitY()) *
+                     Eigen::AngleAxisd(angles->x(), Eigen::Vector3d::UnitX());
+  return core::Ok{};
+}
+
 /// The keys every body has; `shape` was read first, to choose the table.
 KeyTable<BodySpec> commonBodyKeys() {
   return {
@@ -152,6 +190,8 @@ KeyTable<BodySpec> commonBodyKeys() {
       numberKey<BodySpec>("lift_coefficient",
                           [](BodySpec& b) -> double& { return b.lift_coefficient; }),
       {"inertia", false, readBodyInertia},
+      {"orientation", false, readOrientation<BodySpec>},
+      {"rpy", false, readRollPitchYaw<BodySpec>},
   };
 }
 
@@ -251,48 +291,13 @@ const KeyTable<ObstacleSpec>& sphereKeys() {
   return kKeys;
 }
 
-/// `orientation: [x, y, z, w]`: a quaternion, not zero, normalised.
-core::Status readOrientation(const XmlRpc::XmlRpcValue& value, const std::string& field,
-                             ObstacleSpec& obstacle) {
-  if (value.getType() != XmlRpc::XmlRpcValue::TypeArray || value.size() != 4) {
-    return core::Error{field, "must be a list of four numbers [x, y, z, w] (a quaternion)"};
-  }
-  double q[4];
-  for (int i = 0; i < 4; ++i) {
-    const auto component = readDouble(value[i], indexKey(field, static_cast<std::size_t>(i)));
-    if (!component) return component.error();
-    if (!std::isfinite(*component)) {
-      return core::Error{indexKey(field, static_cast<std::size_t>(i)), "must be finite"};
-    }
-    q[i] = *component;
-  }
-  const Eigen::Quaterniond quaternion(q[3], q[0], q[1], q[2]);
-  if (!(quaternion.norm() > 1e-6)) {
-    return core::Error{field, "must not be zero (a rotation's quaternion has length 1)"};
-  }
-  obstacle.orientation = quaternion.normalized();
-  return core::Ok{};
-}
-
-/// `rpy: [roll, pitch, yaw]` (rad, about the fixed x, y, z in that order, as URDF's).
-core::Status readRollPitchYaw(const XmlRpc::XmlRpcValue& value, const std::string& field,
-                              ObstacleSpec& obstacle) {
-  const auto angles = readVector3(value, field);
-  if (!angles) return angles.error();
-  if (auto status = core::checkFinite(*angles, field); !status) return status;
-  obstacle.orientation = Eigen::AngleAxisd(angles->z(), Eigen::Vector3d::UnitZ()) *
-                         Eigen::AngleAxisd(angles->y(), Eigen::Vector3d::UnitY()) *
-                         Eigen::AngleAxisd(angles->x(), Eigen::Vector3d::UnitX());
-  return core::Ok{};
-}
-
 /// The keys of a finite shape: where its centre is, how it is turned, and `size_keys`.
 KeyTable<ObstacleSpec> finiteShapeKeys(const KeyTable<ObstacleSpec>& size_keys) {
   KeyTable<ObstacleSpec> keys = commonObstacleKeys();
   keys.push_back(vectorKey<ObstacleSpec>(
       "position", [](ObstacleSpec& o) -> Eigen::Vector3d& { return o.position; }));
-  keys.push_back({"orientation", false, readOrientation});
-  keys.push_back({"rpy", false, readRollPitchYaw});
+  keys.push_back({"orientation", false, readOrientation<ObstacleSpec>});
+  keys.push_back({"rpy", false, readRollPitchYaw<ObstacleSpec>});
   keys.insert(keys.end(), size_keys.begin(), size_keys.end());
   return keys;
 }
@@ -547,6 +552,10 @@ core::Status readBody(const XmlRpc::XmlRpcValue& entry, const std::string& field
     const auto shape = core::parseBodyShape(*name, shape_field);
     if (!shape) return shape.error();
     body.shape = *shape;
+  }
+  if (entry.hasMember("orientation") && entry.hasMember("rpy")) {
+    return core::Error{joinKey(field, "rpy"),
+                       "give the orientation as `orientation` or as `rpy`, not both"};
   }
   return readKeys(entry, bodyKeysOf(body.shape), field, body);
 }

@@ -533,7 +533,14 @@ std::map<std::string, std::map<std::string, XmlRpc::XmlRpcValue>> examples() {
                         {"inertia", "hollow"},
                         {"drag_coefficient", 0.5},
                         {"lift_coefficient", 0.25},
-                        {"shape", "sphere"}};
+                        {"shape", "sphere"},
+                        {"rpy", list3(M_PI / 2, 0, 0)}};
+  XmlRpc::XmlRpcValue quarter_turn;  // about z: [0, 0, 2, 2], normalised on load
+  quarter_turn[0] = 0.0;
+  quarter_turn[1] = 0.0;
+  quarter_turn[2] = 2.0;
+  quarter_turn[3] = 2.0;
+  values["bodies[]"]["orientation"] = quarter_turn;
   XmlRpc::XmlRpcValue tensor;
   tensor["ixx"] = 1e-3;
   tensor["iyy"] = 2e-3;
@@ -663,6 +670,12 @@ TEST(SceneKeys, EveryDocumentedKeyLoadsWithItsValue) {
       for (const auto& [table, keys] : read) {
         if (table.rfind("bodies[] ", 0) != 0) continue;
         if (std::find(keys.begin(), keys.end(), key) == keys.end()) continue;
+        // An orientation is given one way or the other: the cylinder's as roll, pitch and yaw,
+        // the others' as a quaternion.
+        if ((table == "bodies[] cylinder, capsule") == (key == "orientation") &&
+            (key == "orientation" || key == "rpy")) {
+          continue;
+        }
         put(table == "bodies[] sphere" ? body : shaped_bodies[table], table, key);
       }
     }
@@ -725,6 +738,8 @@ TEST(SceneKeys, EveryDocumentedKeyLoadsWithItsValue) {
   EXPECT_EQ(ball.drag_coefficient, 0.5);
   EXPECT_EQ(ball.lift_coefficient, 0.25);
   EXPECT_EQ(ball.shape, core::BodyShape::kSphere);
+  EXPECT_NEAR((ball.orientation * Eigen::Vector3d::UnitX() - Eigen::Vector3d(0, 1, 0)).norm(), 0,
+              1e-15);  // the quarter turn about z, normalised
   // The other shapes' keys, each read into its body (a scene with one is refused, "not yet").
   core::BodySpec block, can, grip_body;
   ASSERT_TRUE(readBody(shaped_bodies["bodies[] box"], "b", block).ok());
@@ -740,6 +755,9 @@ TEST(SceneKeys, EveryDocumentedKeyLoadsWithItsValue) {
   EXPECT_EQ(can.shape, core::BodyShape::kCylinder);
   EXPECT_EQ(can.radius, 0.033);
   EXPECT_EQ(can.length, 0.12);
+  // Roll pi/2 about x: the can's axis z lies along -y.
+  EXPECT_NEAR((can.orientation * Eigen::Vector3d::UnitZ() - Eigen::Vector3d(0, -1, 0)).norm(), 0,
+              1e-15);
   ASSERT_TRUE(readBody(shaped_bodies["bodies[] mesh"], "b", grip_body).ok());
   EXPECT_EQ(grip_body.shape, core::BodyShape::kMesh);
   EXPECT_EQ(grip_body.resource, testMesh("grip.stl"));
@@ -921,6 +939,65 @@ TEST(SceneLoader, Issue42_ShapedBodiesAreReadCheckedAndNotYetMoved) {
             b["inertia"] = 7.0;
           }),
           at + "inertia", "a tensor");
+}
+
+// A body's orientation at the start (issue 42, step 2): `orientation: [x, y, z, w]` normalised,
+// or `rpy` as an obstacle's (roll about x, then pitch about y, then yaw about z, about the fixed
+// axes): rpy (0, 0, pi/2) is the quarter turn about z, q = (0, 0, sin(pi/4), cos(pi/4)); a zero
+// quaternion, a number that is not finite and both keys at once are refused by name.
+TEST(SceneLoader, ABodysOrientationIsReadAsAnObstaclesIs) {
+  const auto blockOf = [](const std::function<void(XmlRpc::XmlRpcValue&)>& turn_it) {
+    XmlRpc::XmlRpcValue scene = fullScene();
+    XmlRpc::XmlRpcValue body;
+    body["id"] = "block";
+    body["mass"] = 0.37;
+    body["material"] = "tennis_ball";
+    body["shape"] = "box";
+    body["size"] = list3(0.1, 0.2, 0.3);
+    turn_it(body);
+    scene["bodies"][2] = body;
+    return loadScene(scene, "~scene");
+  };
+  const auto orientationOf = [](const core::Expected<core::Scene>& loaded) {
+    EXPECT_TRUE(loaded.ok()) << loaded.error().message();
+    for (const core::BodySpec& b : loaded->bodies) {
+      if (b.id == "block") return b.orientation;
+    }
+    ADD_FAILURE() << "no block";
+    return Eigen::Quaterniond::Identity();
+  };
+  const double s = std::sqrt(0.5);
+  const Eigen::Quaterniond quarter(s, 0.0, 0.0, s);
+  const auto given = orientationOf(blockOf([](XmlRpc::XmlRpcValue& b) {
+    b["orientation"][0] = 0.0;
+    b["orientation"][1] = 0.0;
+    b["orientation"][2] = 2.0;  // normalised on load
+    b["orientation"][3] = 2.0;
+  }));
+  EXPECT_NEAR(given.angularDistance(quarter), 0.0, 1e-15);
+  EXPECT_NEAR(given.norm(), 1.0, 1e-15);
+  const auto rpy = orientationOf(
+      blockOf([](XmlRpc::XmlRpcValue& b) { b["rpy"] = list3(0.0, 0.0, 1.5707963267948966); }));
+  EXPECT_NEAR(rpy.angularDistance(quarter), 0.0, 1e-15);
+  EXPECT_EQ(orientationOf(blockOf([](XmlRpc::XmlRpcValue&) {})).coeffs(),
+            Eigen::Quaterniond::Identity().coeffs());
+  const auto refusal = [](const core::Expected<core::Scene>& loaded) {
+    return loaded.ok() ? std::string("taken") : loaded.error().message();
+  };
+  const std::string at = "~scene/bodies[2]/";
+  EXPECT_EQ(refusal(blockOf([](XmlRpc::XmlRpcValue& b) {
+              for (int i = 0; i < 4; ++i) b["orientation"][i] = 0.0;
+            })).rfind(at + "orientation: must not be zero", 0),
+            0u);
+  EXPECT_EQ(refusal(blockOf([](XmlRpc::XmlRpcValue& b) {
+              b["rpy"] = list3(0.0, std::numeric_limits<double>::infinity(), 0.0);
+            })).rfind(at + "rpy", 0),
+            0u);
+  EXPECT_EQ(refusal(blockOf([](XmlRpc::XmlRpcValue& b) {
+              b["rpy"] = list3(0.0, 0.0, 0.0);
+              b["orientation"] = list3(0.0, 0.0, 0.0);
+            })).rfind(at + "rpy: give the orientation as `orientation` or as `rpy`, not both", 0),
+            0u);
 }
 
 // Issue 13, item 7: a plane normal "of any length" is one, also 1e-200 and 1e200 long (where
