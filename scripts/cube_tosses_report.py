@@ -6,7 +6,8 @@ bench/cube_tosses/main.cpp (cube_tosses_peers) wrote. Run by scripts/cube_tosses
 
 RESULTS.json: the benchmark's output; OURS.json: our model's (bench/cube_tosses/ours.cpp,
 cube_tosses_ours), measured over the span its prediction covers and set beside each peer over
-the same span; TOSSES_DIR: the tosses (read again for the free flight's
+the same span, and at rest where its prediction reaches the recording's end, beside each peer
+on the same tosses; TOSSES_DIR: the tosses (read again for the free flight's
 floor, below); DOC_DIR: where the page and the plot go; VERSIONS: the peers' Debian packages, one
 line of text. Besides the peers' figures it measures, from the recording alone, the part of the
 error no contact model explains: each evaluation toss's free flight (its first samples, before
@@ -161,13 +162,57 @@ def over_span(series, covered):
     return float(np.mean(part)), part[-1]
 
 
+def reached(run):
+    """The tosses of a run whose prediction reaches the recording's end (the horizon)."""
+    return [t for t in predicted(run) if t["reached"]]
+
+
+def at_rest(run):
+    """The tosses of a run whose prediction reaches the recording's end at rest (resting)."""
+    return [t for t in predicted(run) if t["rested"]]
+
+
+def reasons(run):
+    """How a run's predictions end, (reason, count), the recording's end first, then by count."""
+    counts = {reason: len(names) for reason, names in run["ends"].items()}
+    return sorted(counts.items(), key=lambda rc: (not rc[0].startswith("reaches"), -rc[1], rc[0]))
+
+
+def at_rest_row(tosses, distance, angle):
+    """The figures over whole tosses: the centre's mean over the toss and at rest (widths), the
+    angle's (deg), the tosses over 1 width at rest; `distance`, `angle`: each toss's series."""
+    d = [distance(t) for t in tosses]
+    a = [angle(t) for t in tosses]
+    over = sum(1 for series in d if series[-1] > 1)
+    return (f"{pair([float(np.mean(x)) for x in d], 3)} | {pair([x[-1] for x in d], 3)} | "
+            f"{pair([float(np.mean(x)) for x in a], 1)} | {pair([x[-1] for x in a], 1)} | "
+            f"{over} of {len(tosses)}")
+
+
+def degenerate(ours, coarse):
+    """Whether the fit over the span picks the shortest span: its pair's median span no longer
+    than every coarse e's best pair's (the objective least where the span is shortest)."""
+    fitted = ours["runs"][0]
+    point = [g for g in ours["grid"]
+             if g[0] == fitted["restitution"] and g[1] == fitted["friction"]][0]
+    best = {}
+    for g in coarse:
+        if g[0] not in best or g[2] < best[g[0]][2]:
+            best[g[0]] = g
+    return point[3] <= min(g[3] for g in best.values()) + 1e-9, best
+
+
 def ours_section(add, ours, results):
-    """Our model's section: the span its prediction covers, its errors there, each peer's over
-    the same samples, the fit over the span and why it is degenerate, the checks, the refusals."""
+    """Our model's section: how far its prediction goes (to the recording's end, or the lasting
+    contact not modelled yet that ends it), its error at rest where it reaches the end beside
+    each peer's on the same tosses, its errors over the span it covers beside each peer's over
+    the same samples, the fit over the span and whether it is degenerate, the checks, the
+    refusals."""
     rate = results["sample_rate_hz"]
     peers = results["peers"]
     index = {name: i for i, name in enumerate(results["evaluation"])}
     fitted = ours["runs"][0]
+    total = len(ours["evaluation"])
     add("## Ours, as far as our model goes today")
     add("")
     add("Our core alone (`cube_tosses_ours`, `bench/cube_tosses/ours.cpp`): `predictImpacts` "
@@ -179,53 +224,123 @@ def ours_section(add, ours, results):
         "frame), the horizon the toss's recorded duration, `sample_period` 1/148 s. Its "
         "prediction flies the cube exactly, finds each contact with the table certified, resolves "
         "each impact with rotation (one corner: Chatterjee and Ruina's law with e and mu; several "
-        "corners at once: the joint rule, frictionless), and ends where the contact would last "
-        "(resting, sliding, rocking: not modelled yet; doc/model.md, \"Prediction of a shaped "
-        "body\"), saying so. So ours is measured over the span its prediction covers, from the "
-        "first sample to the last one before it ends, and each peer beside it over the same "
-        "samples of the same toss, at the peer's own fitted e and mu (the table above). "
-        "**What ours cannot give yet**: the error at rest, and the error over the whole toss: "
-        "our prediction stops at the cube's first lasting contact with the table.")
+        "corners at once: the joint rule, frictionless), and where the contact lasts on the "
+        "table's face goes on by that contact's closed forms (resting, sliding, rolling; "
+        "doc/model.md, \"Prediction of a shaped body\"). A lasting contact those forms do not "
+        "carry yet (tipping over an edge or a corner, rocking, spin about the face's normal while "
+        "sliding or resting) ends the prediction there, its message naming it. So ours is "
+        "measured over the span its prediction covers, from the first sample to the last one "
+        "before it ends, and each peer beside it over the same samples of the same toss, at the "
+        "peer's own fitted e and mu (the table above); where the prediction reaches the "
+        "recording's end resting on the table, its last sample is the error **at rest**, as "
+        "the peers'.")
     add("")
-    # The fit over the span, and why it is degenerate.
-    grid = ours["grid"]
-    coarse = [g for g in grid[:len(results["coarse_restitutions"]) *
-                              len(results["coarse_frictions"])]]
-    by_e = {}
-    for e, mu, objective, covered, refused in coarse:
-        if e not in by_e or objective < by_e[e][1]:
-            by_e[e] = (mu, objective, covered)
-    e0 = [g[2] for g in coarse if g[0] == min(by_e)]
+    # How far the predictions go, per run.
+    add("**How far the prediction goes**: per run, the evaluation tosses whose prediction "
+        "reaches the recording's end (and the contact's state there: `resting`, `sliding`, "
+        "`rolling`, or none, in flight), and the others by what ends them (the words of the "
+        "prediction's message; `cube_tosses_ours --toss NAME --contact E MU` replays one).")
+    add("")
+    all_reasons = []
+    for run in ours["runs"]:
+        for reason, _ in reasons(run):
+            if reason not in all_reasons:
+                all_reasons.append(reason)
+    all_reasons.sort(key=lambda r: (not r.startswith("reaches"),
+                                    -len(fitted["ends"].get(r, [])), r))
+    add("| how it ends | " + " | ".join(run_label(r) for r in ours["runs"]) + " |")
+    add("|---|" + "---|" * len(ours["runs"]))
+    for reason in all_reasons:
+        add(f"| {reason} | " +
+            " | ".join(str(len(r["ends"].get(reason, []))) for r in ours["runs"]) + " |")
+    for label, chosen in (("to the recording's end", reached), ("at rest there", at_rest)):
+        add(f"| **{label}, of {total}** | " +
+            " | ".join(f"**{len(chosen(r))}** ({100 * len(chosen(r)) / total:.0f} %)"
+                       for r in ours["runs"]) + " |")
+    add("")
+    # At rest, where the prediction reaches the end resting.
+    if not any(at_rest(run) for run in ours["runs"]):
+        add("**At rest**: not yet. In no run does any toss's prediction reach the recording's end "
+            "at rest on the table (resting), so our error at rest cannot be given yet, nor the "
+            "peers' beside it on the same tosses; a prediction that reaches the end still "
+            "bouncing (in flight, at the high e of the grid below) is counted as reaching the "
+            "end, not at rest. At the peers' fitted pairs the cube's first lasting contact "
+            "touches the "
+            "table at one corner or along one edge (a corner struck at low e keeps touching): "
+            "the tipping that lastingOnFace does not carry yet. So the spans are still those of "
+            "the first lasting contact, as before a box resting, sliding or rolling on a face "
+            "was carried (their median fractions in the table \"Over the span\" below); a run "
+            "whose predictions reach the end at rest would be reported here, beside the peers "
+            "on the same tosses.")
+        add("")
+    else:
+        add("**At rest**, over the tosses whose prediction reaches the recording's end at rest on "
+            "the table (each run its own: the count in the third column), ours and each peer on "
+            "the same tosses, the peer at its own fitted e and mu; median / 90th percentile. "
+            "These tosses are whole, so the mean over the toss is the peers' measure too; they "
+            "are the ones our model carries to rest, not a random share of the tosses (the "
+            "others end at a contact it does not model yet, above), and the peers' figures on "
+            "them differ from theirs over all tosses (the table at the top).")
+        add("")
+    if any(at_rest(run) for run in ours["runs"]):
+        add("| run | engine | tosses | centre, mean over the toss (widths) | centre at rest "
+            "(widths) | angle, mean over the toss (deg) | angle at rest (deg) | tosses over 1 "
+            "width at rest |")
+        add("|---|---|---|---|---|---|---|---|")
+    for run in ours["runs"]:
+        tosses = at_rest(run)
+        if not tosses:
+            continue
+        add(f"| {run_label(run)} | **ours** | {len(tosses)} | " +
+            at_rest_row(tosses, lambda t: t["distance"], lambda t: t["angle"]) + " |")
+        for p in peers:
+            add(f"| | {p['name']} | | " + at_rest_row(
+                tosses, lambda t: p["distance_series"][index[t["name"]]],
+                lambda t: p["angle_series"][index[t["name"]]]) + " |")
+    if any(at_rest(run) for run in ours["runs"]):
+        add("")
+    # The fit over the span, and whether it is degenerate.
+    coarse = ours["grid"][:len(results["coarse_restitutions"]) * len(results["coarse_frictions"])]
+    is_degenerate, best = degenerate(ours, coarse)
+    e0 = [g[2] for g in coarse if g[0] == min(best)]
     fit = fitted["fit"]
-    add(f"- **The fit over the span.** e and mu fitted on the same {len(ours['fitting'])} fitting "
-        "tosses by the same grid and the peers' objective (the mean over the tosses of each "
-        "toss's mean centre error), each toss's mean taken over its span: e = "
-        f"{fitted['restitution']:.2f}, mu = {fitted['friction']:.3f}, {fit['mean_distance']:.4f} "
-        f"widths ({fit['grid_points']} points, {fit['cpu_s']:.1f} s CPU; at most "
-        f"{ours['fit_refused']} fitting tosses refused at a point). This fit is degenerate: the "
-        "span itself depends on e and mu, and the objective is least where the span is "
-        "shortest. At each e of the coarse grid, its best mu's objective and the span it "
-        "covers (median fraction of the samples): " +
-        "; ".join(f"e {e:g}: {o:.4f} widths over {c:.2f}" for e, (mu, o, c) in sorted(by_e.items()))
-        + f". At e = {min(by_e):g} every mu gives {min(e0):.4f} to {max(e0):.4f} widths: "
-        "the struck corner stops on the table at the first impact, the contact lasts from the "
-        "first touch and the prediction ends there, so the span is the free flight and little "
-        "more, and what it measures is the flight's part of the error (\"What no parameter "
-        "explains\" above), not the contact's. The fair comparison of the contact models is "
-        "therefore ours at each peer's own fitted pair, beside that peer over the same span "
-        "(the rows \"at Bullet's ...\" below). Over a flight alone ours is the exact motion "
-        "under g = 9.81 m/s^2; the peers' steps are off it by up to about 2e-3 widths (\"Check "
-        "of the engines' start\" above), here towards the recording, whose flights fit "
-        "g = 9.61 m/s^2: hence their slightly smaller errors over the spans at e = 0.")
+    by_e = "; ".join(f"e {e:g}: {g[2]:.4f} widths at mu {g[1]:g}, over {g[3]:.2f} of the samples, "
+                     f"{100 * g[5]:.0f} % to the end, {100 * g[6]:.0f} % at rest there"
+                     for e, g in sorted(best.items()))
+    text = (f"- **The fit over the span.** e and mu fitted on the same {len(ours['fitting'])} "
+            "fitting tosses by the same grid and the peers' objective (the mean over the tosses "
+            "of each toss's mean centre error), each toss's mean taken over its span: e = "
+            f"{fitted['restitution']:.2f}, mu = {fitted['friction']:.3f}, "
+            f"{fit['mean_distance']:.4f} widths ({fit['grid_points']} points, "
+            f"{fit['cpu_s']:.1f} s CPU; at most {ours['fit_refused']} fitting tosses refused at a "
+            "point). At each e of the coarse grid, its best mu's objective, the span it covers "
+            "(median fraction of the samples) and the shares of the fitting tosses it carries to "
+            f"the end and to rest there: {by_e}. ")
+    if is_degenerate:
+        text += ("This fit is still degenerate: the span depends on e and mu, and the objective "
+                 "is least where the span is shortest, which the fit picks. At e = "
+                 f"{min(best):g} every mu gives {min(e0):.4f} to {max(e0):.4f} widths. The fair "
+                 "comparison of the contact models is therefore ours at each peer's own fitted "
+                 "pair, beside that peer over the same span or at rest on the same tosses (the "
+                 "rows \"at Bullet's ...\" above and below).")
+    else:
+        text += ("The fit no longer picks the shortest span (the pair's median span is longer "
+                 "than some e's best), but the span still depends on e and mu, so the objective "
+                 "is not the peers' over the same samples: ours at each peer's own fitted pair, "
+                 "beside that peer, remains the fair comparison.")
+    text += (" Over a flight alone ours is the exact motion under g = 9.81 m/s^2; the peers' "
+             "steps are off it by up to about 2e-3 widths (\"Check of the engines' start\" "
+             "above), here towards the recording, whose flights fit g = 9.61 m/s^2.")
+    add(text)
     add("")
-    add("Median / 90th percentile over the evaluation tosses our prediction answered; every row "
-        "of one run over that run's spans (toss by toss, the same samples). Span: the median "
-        "fraction of the toss's recorded duration and of its samples. Ended: the spans ended by "
-        "a lasting contact / by the toss's recorded end (the horizon) / refused. CPU: ours per "
-        "toss (its span) and per second predicted; the peers' per second played over the whole "
-        "toss (from the table above).")
+    add("**Over the span**: median / 90th percentile over the evaluation tosses our prediction "
+        "answered; every row of one run over that run's spans (toss by toss, the same samples). "
+        "Span: the median fraction of the toss's recorded duration and of its samples. Ended: "
+        "the spans ended before the recording's end (cut short at a lasting contact not modelled "
+        "yet) / at the recording's end / refused. CPU: ours per toss (its span) and per second "
+        "predicted; the peers' per second played over the whole toss (from the table above).")
     add("")
-    add("| run | engine | span: duration / samples | ended: lasting / horizon / refused | "
+    add("| run | engine | span: duration / samples | ended: early / at the end / refused | "
         "centre, mean over the span (widths) | centre at the span's end (widths) | angle, mean "
         "over the span (deg) | angle at the span's end (deg) | CPU per toss (ms) / per s "
         "predicted (ms) |")
@@ -234,7 +349,7 @@ def ours_section(add, ours, results):
     deepest, gained = float("inf"), -float("inf")
     for run in ours["runs"]:
         tosses = predicted(run)
-        lasting = sum(1 for t in tosses if t["lasting"])
+        lasting = sum(1 for t in tosses if not t["reached"])
         refused = [t for t in run["tosses"] if t["refused"] is not None]
         refusals += [(run_label(run), t["name"], t["refused"]) for t in refused]
         breaches += [(run_label(run), name) for name in run["breaches"]]
@@ -272,10 +387,6 @@ def ours_section(add, ours, results):
             "; ".join(f"{n} ({r}): {why}" for r, n, why in refusals) + ".")
     else:
         add("- **Refused**: none; every evaluation toss of every run was predicted.")
-    add("- **How the spans end**, per run: " + "; ".join(
-        f"{run_label(r)}: " + ", ".join(f"{len(names)} by {reason}"
-                                        for reason, names in r["ends"].items())
-        for r in ours["runs"]) + ".")
     add("")
 
 
@@ -372,10 +483,19 @@ def main():
         add("| **ours** | (not run) | | not run: `cube_tosses_ours` gave no results | | | | | |")
     else:
         fitted = ours["runs"][0]
-        add(f"| **ours** | {fitted['restitution']:.2f} (fitted over its span: degenerate, "
-            f"below) | {fitted['friction']:.3f} | not yet: only over the span its prediction "
-            "covers, [below](#ours-as-far-as-our-model-goes-today) | not yet: our prediction ends "
-            "at the first lasting contact | below | not yet | not yet | below |")
+        whole = at_rest(fitted)
+        cpu = 1000 * float(np.mean([t["cpu_s"] for t in predicted(fitted)]))
+        head = (f"| **ours** | {fitted['restitution']:.2f} (fitted over its span, "
+                f"[below](#ours-as-far-as-our-model-goes-today)) | {fitted['friction']:.3f} | ")
+        if whole:
+            add(head + f"only the {len(whole)} of {len(fitted['tosses'])} tosses its prediction "
+                "carries to rest (the peers on them below): " +
+                at_rest_row(whole, lambda t: t["distance"], lambda t: t["angle"]).replace(
+                    f" of {len(whole)}", f" of {len(whole)} (ours)") + f" | {cpu:.2f} |")
+        else:
+            add(head + "over the span its prediction covers only, "
+                "[below](#ours-as-far-as-our-model-goes-today) | not yet: no toss's prediction "
+                "reaches rest (below) | below | not yet | not yet | " f"{cpu:.2f} |")
     for p in peers:
         e = f"{p['fit']['restitution']:.2f}" if p["fits_restitution"] else "(none)"
         over_rest = sum(1 for v in p["rest_distance"] if v > 1)
@@ -448,7 +568,8 @@ def main():
     add("Each engine's median evaluation toss (by its mean centre error): " +
         "; ".join(f"{p['name']}: `{p['median_toss']['name']}`" for p in peers) +
         ("" if ours is None else
-         "; ours (dashed, over its span only; one run per e): each run's median toss by its mean "
+         "; ours (dashed, over its span: to the end where it reaches it; one run per e): each "
+         "run's median toss by its mean "
          "centre error over its span, " +
          "; ".join(f"{run_label(r)}: `{median_run_toss(r)['name']}`"
                    for r in plotted_runs(ours))) + ".")

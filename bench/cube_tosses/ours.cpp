@@ -1,20 +1,26 @@
 // Our model on the real cube tosses (issue 42, step 8; scripts/cube_tosses.sh writes
 // doc/cube_tosses.md from what this prints beside the peers' run, main.cpp). The core alone
 // (predictImpacts, include/collision_response/core/prediction.h), as far as it goes today: a
-// shaped body's prediction flies the cube exactly, finds its first contacts with the table
-// certified and resolves its impacts with rotation, and ENDS where its contact would last
-// (resting, sliding, rocking: not modelled yet, doc/model.md "Prediction of a shaped body"). So
-// each toss is measured over the span the prediction covers, the samples up to where it ends.
+// shaped body's prediction flies the cube exactly, finds its contacts with the table certified,
+// resolves its impacts with rotation, and where the contact lasts on the table's face goes on by
+// that contact's closed forms (resting, sliding, rolling: doc/model.md "Prediction of a shaped
+// body"); a lasting contact those forms do not carry yet (tipping over an edge or a corner,
+// rocking, spin about the face's normal while sliding or resting, ...) ENDS the prediction there,
+// its message naming it. So each toss is measured over the span the prediction covers, the
+// samples up to where it ends; where it reaches the recording's end (the horizon) resting on the
+// table, the last sample is the error at rest, as the peers' (main.cpp); one reaching the end
+// still bouncing (in flight) or sliding is counted so, not at rest.
 // 1. the tosses split as the peers' (tosses.h): every 4th by file name fits, the others evaluate;
 // 2. e and mu fitted on the fitting tosses by the peers' grid and objective (each toss's mean
 //    centre error in widths, averaged over the tosses), each toss's mean taken over its span,
-//    and each grid point's median span written beside its objective: the span depends on e and
-//    mu, and the objective is least where the span is shortest (at e = 0 the cube's contact lasts
-//    from its first touch), so this fit is degenerate, and the report says so;
+//    and each grid point's median span and shares of tosses reaching the end, and at rest there,
+//    written beside its
+//    objective: where the span depends on e and mu, the objective is least where the span is
+//    shortest, and the fit is degenerate (the report says whether it is);
 // 3. each evaluation toss predicted from its first recorded state at the fitted e and mu, horizon
 //    its recorded duration, sampled every 1/148 s; per toss the span covered (samples, s, why it
-//    ended), the centre's distance (widths) and the orientation's angle (deg) at every sample of
-//    the span, its impacts, the CPU;
+//    ended: reasonOf, the contact's state where it reached the end), the centre's distance
+//    (widths) and the orientation's angle (deg) at every sample of the span, its impacts, the CPU;
 // 4. every sample checked against what the model promises: no point of the cube below the table
 //    (by more than 1e-9 m) and no energy gained (kinetic, rotational and potential above the
 //    first state's by more than 1e-9 of it): any breach is counted and its toss named.
@@ -30,6 +36,7 @@
 #include <iostream>
 #include <map>
 #include <optional>
+#include <regex>
 
 #include "collision_response/core/prediction.h"
 #include "cube_tosses.h"
@@ -94,8 +101,13 @@ struct Played {
   std::optional<std::string> refused;  ///< the error's field and message: not predicted
   std::size_t covered = 0;             ///< samples of the span, the first one included
   double end_time = 0.0;               ///< s: where the prediction ends
-  bool lasting = false;                ///< it ended at a lasting contact (cut short)
-  std::string message;                 ///< the prediction's, as it is
+  bool lasting = false;                ///< it ended before the horizon (cut short)
+  bool reached = false;                ///< it covers every sample: the recording's end
+  bool rested = false;                 ///< reached, every contact there resting: at rest
+  /// The contact's state at the end (the prediction's contacts: "resting", "sliding",
+  /// "rolling", several joined by "+"), or "in flight" without any.
+  std::string end_motion;
+  std::string message;  ///< the prediction's, as it is
   std::size_t impacts = 0;
   std::vector<double> distance, angle;  ///< per sample of the span (widths, deg)
   double mean_distance = 0.0, end_distance = 0.0, mean_angle = 0.0, end_angle = 0.0;
@@ -128,6 +140,17 @@ Played play(const core::Scene& scene, const Toss& toss) {
   played.lasting = prediction->cut_short;
   played.message = prediction->message;
   played.impacts = prediction->impacts.size();
+  std::vector<std::string> motions;
+  for (const core::ContactRecord& contact : prediction->contacts) {
+    const std::string motion = core::toString(contact.state);
+    if (std::find(motions.begin(), motions.end(), motion) == motions.end()) {
+      motions.push_back(motion);
+    }
+  }
+  for (const std::string& motion : motions) {
+    played.end_motion += (played.end_motion.empty() ? "" : "+") + motion;
+  }
+  if (played.end_motion.empty()) played.end_motion = "in flight";
   played.first_energy = energy(request.state);
   for (std::size_t k = 0; k < prediction->samples.size() && k < n; ++k) {
     const core::BodyStateSample& sample = prediction->samples[k];
@@ -144,6 +167,8 @@ Played play(const core::Scene& scene, const Toss& toss) {
   }
   played.covered = played.distance.size();
   if (played.covered == 0) throw std::runtime_error(toss.name + ": no sample predicted");
+  played.reached = !played.lasting && played.covered == n;
+  played.rested = played.reached && played.end_motion == "resting";
   for (std::size_t k = 0; k < played.covered; ++k) {
     played.mean_distance += played.distance[k] / static_cast<double>(played.covered);
     played.mean_angle += played.angle[k] / static_cast<double>(played.covered);
@@ -155,19 +180,30 @@ Played play(const core::Scene& scene, const Toss& toss) {
   return played;
 }
 
+/// The median of `values` (the mean of the middle two of an even count; NaN if empty).
+double median(std::vector<double> values) {
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(values.begin(), values.end());
+  const std::size_t half = values.size() / 2;
+  return values.size() % 2 ? values[half] : 0.5 * (values[half - 1] + values[half]);
+}
+
 /// A grid point of the fit: the objective, the peers' over our span (the mean over the tosses
 /// predicted of each toss's mean centre error over its span, widths), the median over them of
-/// the fraction of its samples the span covers, and the tosses refused (not predicted).
+/// the fraction of its samples the span covers, the fraction of them whose prediction reaches
+/// the recording's end, and the tosses refused (not predicted).
 struct GridPoint {
   Contact contact;
   double objective = std::numeric_limits<double>::infinity();
   double median_covered = 0.0;
+  double reached = 0.0;
+  double rested = 0.0;
   std::size_t refused = 0;
 };
 
 GridPoint gridPoint(const Contact& contact, const std::vector<const Toss*>& tosses) {
   const core::Scene scene = cubeScene(contact);
-  GridPoint point{contact, 0.0, 0.0, 0};
+  GridPoint point{contact, 0.0, 0.0, 0.0, 0.0, 0};
   std::vector<double> covered;
   for (const Toss* toss : tosses) {
     const Played played = play(scene, *toss);
@@ -176,6 +212,8 @@ GridPoint gridPoint(const Contact& contact, const std::vector<const Toss*>& toss
       continue;
     }
     point.objective += played.mean_distance;
+    if (played.reached) point.reached += 1.0;
+    if (played.rested) point.rested += 1.0;
     covered.push_back(static_cast<double>(played.covered) /
                       static_cast<double>(toss->samples.size()));
   }
@@ -184,22 +222,46 @@ GridPoint gridPoint(const Contact& contact, const std::vector<const Toss*>& toss
     return point;
   }
   point.objective /= static_cast<double>(covered.size());
-  std::sort(covered.begin(), covered.end());
-  const std::size_t half = covered.size() / 2;
-  point.median_covered =
-      covered.size() % 2 ? covered[half] : 0.5 * (covered[half - 1] + covered[half]);
+  point.reached /= static_cast<double>(covered.size());
+  point.rested /= static_cast<double>(covered.size());
+  point.median_covered = median(covered);
   return point;
 }
 
-/// The reason a prediction ended, in a few words, for the counts: the horizon, a lasting
-/// contact, or the rest of its message.
-std::string endReason(const Played& played) {
+/// The reason a prediction ended, in a few words, for the counts: the recording's end (and the
+/// contact's state there), or what ended it before. A lasting contact not modelled yet is named
+/// by the words of its refusal (shaped_prediction.cpp's "... which is not yet modelled (WHY), and
+/// the prediction ends there", WHY "field: not yet: what: details"): `what`, its numbers left out.
+std::string reasonOf(const Played& played) {
   if (played.refused) return "refused: " + *played.refused;
-  if (!played.lasting) return "the horizon (the toss's recorded end)";
-  if (played.message.find("lasting contact") != std::string::npos) {
-    return "a lasting contact with the table (not yet modelled)";
+  if (played.reached) return "reaches the recording's end, " + played.end_motion;
+  if (!played.lasting) return "ends before the recording's end uncut (the samples stop)";
+  const std::string& message = played.message;
+  const std::string opening = "which is not yet modelled (";
+  const std::string closing = "), and the prediction ends there";
+  const auto from = message.find(opening);
+  const auto to = message.rfind(closing);
+  if (from != std::string::npos && to != std::string::npos && to > from) {
+    std::string why = message.substr(from + opening.size(), to - from - opening.size());
+    // The field ("contact: ", "body.velocity: ") and "not yet: " left out.
+    if (const auto field = why.find(": ");
+        field != std::string::npos && why.substr(0, field).find(' ') == std::string::npos) {
+      why = why.substr(field + 2);
+    }
+    if (why.rfind("not yet: ", 0) == 0) why = why.substr(9);
+    if (const auto detail = why.find(':'); detail != std::string::npos) why.resize(detail);
+    why = std::regex_replace(why, std::regex(" at [-+0-9.e]+ m/s"), "");
+    return "not modelled: " + why;
   }
-  return "cut short: " + played.message;
+  if (const auto ends = message.find("' ends at +"); ends != std::string::npos) {
+    // "the body's lasting contact with 'table' ends at +T s (WHY), which is not yet modelled"
+    const auto open = message.find('(', ends);
+    const auto close = message.find(')', open);
+    if (open != std::string::npos && close != std::string::npos) {
+      return "its lasting motion ends: " + message.substr(open + 1, close - open - 1);
+    }
+  }
+  return "cut short: " + message;
 }
 
 /// One toss, every sample of its span printed: a reproducer.
@@ -209,13 +271,14 @@ int printToss(const Contact& contact, const std::vector<Toss>& tosses, const std
   if (toss == tosses.end()) throw std::runtime_error("no toss named " + name);
   const Played played = play(cubeScene(contact), *toss);
   std::cout << toss->name << " at e " << contact.restitution << ", mu " << contact.friction << ": "
-            << endReason(played) << "\n";
+            << reasonOf(played) << "\n";
   if (played.refused) return 1;
   std::cout << "ends at +" << played.end_time << " s, " << played.covered << " of "
             << toss->samples.size() << " samples, " << played.impacts
             << " impacts; message: " << played.message << "\nlowest corner over the table (least) "
             << played.deepest << " m; energy gained (most) " << played.energy_gained << " J of "
-            << played.first_energy << " J\nk  distance (widths)  angle (deg)\n";
+            << played.first_energy << " J; at the end: " << played.end_motion
+            << "\nk  distance (widths)  angle (deg)\n";
   for (std::size_t k = 0; k < played.covered; ++k) {
     std::cout << k << "  " << played.distance[k] << "  " << played.angle[k] << "\n";
   }
@@ -237,13 +300,28 @@ std::string evaluate(const std::string& label, const Contact& contact, const Fit
   std::map<std::string, std::vector<std::string>> ends;  // reason -> tosses
   std::vector<std::string> breaches;
   for (std::size_t i = 0; i < played.size(); ++i) {
-    ends[endReason(played[i])].push_back(evaluation[i]->name);
+    ends[reasonOf(played[i])].push_back(evaluation[i]->name);
     if (played[i].breach) breaches.push_back(evaluation[i]->name);
   }
   std::cerr << "== ours, " << label << ": e " << contact.restitution << ", mu " << contact.friction
             << "\n";
   for (const auto& [reason, names] : ends) {
     std::cerr << "   ended by " << reason << ": " << names.size() << " tosses\n";
+  }
+  std::vector<double> rest_distance, rest_angle;
+  for (const Played& p : played) {
+    if (!p.rested) continue;
+    rest_distance.push_back(p.end_distance);
+    rest_angle.push_back(p.end_angle);
+  }
+  std::cerr << "   reaching the recording's end: "
+            << std::count_if(played.begin(), played.end(),
+                             [](const Played& p) { return p.reached; })
+            << " of " << played.size() << " tosses; at rest there: " << rest_distance.size()
+            << "\n";
+  if (!rest_distance.empty()) {
+    std::cerr << "   at rest: the centre " << median(rest_distance) << " widths, the angle "
+              << median(rest_angle) << " deg (median)\n";
   }
   std::cerr << "   inside the table or energy gained: " << breaches.size() << " tosses";
   for (const std::string& name : breaches) std::cerr << " " << name;
@@ -276,7 +354,11 @@ std::string evaluate(const std::string& label, const Contact& contact, const Fit
         << ", \"samples\": " << evaluation[i]->samples.size()
         << ", \"refused\": " << (p.refused ? jsonText(*p.refused) : "null")
         << ", \"covered\": " << p.covered << ", \"end_s\": " << json(p.end_time)
-        << ", \"lasting\": " << (p.lasting ? "true" : "false") << ", \"impacts\": " << p.impacts
+        << ", \"lasting\": " << (p.lasting ? "true" : "false")
+        << ", \"reached\": " << (p.reached ? "true" : "false")
+        << ", \"rested\": " << (p.rested ? "true" : "false")
+        << ", \"end_motion\": " << jsonText(p.end_motion)
+        << ",\n     \"reason\": " << jsonText(reasonOf(p)) << ", \"impacts\": " << p.impacts
         << ", \"cpu_s\": " << json(cpu[i]) << ", \"deepest_m\": " << json(p.deepest)
         << ", \"energy_gained_j\": " << json(p.energy_gained)
         << ", \"first_energy_j\": " << json(p.first_energy)
@@ -330,7 +412,8 @@ int run(int argc, char** argv) {
 
   std::vector<std::string> runs;
   std::size_t fit_refused = 0;
-  std::string grid_json = "[]";  // e, mu, objective, median fraction covered, refused
+  // e, mu, objective, median fraction covered, refused, fractions reaching the end and at rest
+  std::string grid_json = "[]";
   if (given_contact) {
     runs.push_back(evaluate("given", *given_contact, nullptr, evaluation));
   } else {
@@ -346,7 +429,8 @@ int run(int argc, char** argv) {
         [&](const Contact& contact, double objective) {
           std::cerr << "   e " << contact.restitution << ", mu " << contact.friction << ": "
                     << objective << " widths, the span " << grid.back().median_covered
-                    << " of the samples (median)\n";
+                    << " of the samples (median), " << grid.back().reached
+                    << " of the tosses to their end, " << grid.back().rested << " at rest there\n";
         });
     std::cerr << "   e " << fitted.best.restitution << ", mu " << fitted.best.friction
               << ", mean error over the span " << fitted.objective << " widths ("
@@ -356,7 +440,8 @@ int run(int argc, char** argv) {
     for (std::size_t i = 0; i < grid.size(); ++i) {
       grid_json += std::string(i ? ",\n  " : "") + "[" + json(grid[i].contact.restitution) + ", " +
                    json(grid[i].contact.friction) + ", " + json(grid[i].objective) + ", " +
-                   json(grid[i].median_covered) + ", " + std::to_string(grid[i].refused) + "]";
+                   json(grid[i].median_covered) + ", " + std::to_string(grid[i].refused) + ", " +
+                   json(grid[i].reached) + ", " + json(grid[i].rested) + "]";
     }
     grid_json += "]";
     runs.push_back(evaluate("fitted", fitted.best, &fitted, evaluation));
