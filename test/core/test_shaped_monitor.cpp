@@ -373,6 +373,44 @@ TEST(ShapedMonitor, ABoxBouncingFlatComesToRestAtTheSeriesEnd) {
   EXPECT_NEAR(predicted->first.z(), half.z(), 1e-9);
 }
 
+// A box bouncing flat to rest, played as the scene player plays it (Playback's states every 10 ms
+// into the monitor, its impacts applied back): the monitor reports the bounces and then the four
+// resting contacts, m g / 4 each, nothing unmodelled (a played state on the floor is touching it,
+// not inside), and the played box rests on the floor.
+TEST(ShapedMonitor, PlaybackAndTheMonitorBringABoxBouncingFlatToRest) {
+  const V half(0.05, 0.05, 0.05);
+  const double e = 0.5, m = 2.0, height = 0.3;
+  Scene scene = floorScene(e, half, m);
+  scene.bodies[0].position = V(0, 0, height);
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  Playback playback(scene, MonitorSettings{}.contact_tolerance, 0.0);
+  StepReport last;
+  std::size_t impacts = 0, unmodelled = 0;
+  for (int k = 0; k <= 100; ++k) {
+    const double t = 0.01 * k;
+    BodyStateSample state;
+    state.body = *monitor.bodyIndex("block");
+    state.time = t;
+    state.position = playback.position(0, t);
+    state.velocity = playback.velocity(0, t);
+    state.angular_velocity = playback.angularVelocity(0, t);
+    state.orientation = playback.orientation(0, t);
+    last = monitor.step(t, {state});
+    EXPECT_TRUE(playback.applyImpacts(monitor, last.impacts, true).empty());
+    impacts += last.impacts.size();
+    unmodelled += last.unmodelled.size();
+    for (const UnmodelledContact& contact : last.unmodelled) ADD_FAILURE() << contact.what;
+  }
+  EXPECT_GE(impacts, 12u);
+  EXPECT_EQ(unmodelled, 0u);
+  ASSERT_EQ(last.contacts.size(), 4u);
+  for (const ContactRecord& contact : last.contacts) {
+    EXPECT_NEAR(contact.normal_force, m * kG / 4, 1e-9);
+  }
+  EXPECT_NEAR(playback.position(0, 1.0).z(), half.z(), 1e-9);
+  EXPECT_EQ(playback.contacts(1.0).size(), 4u);
+}
+
 // A box given at rest on one of its edges would tip over it, which lastingOnFace does not model
 // yet: the monitor holds it where it is (never into the floor) and reports the contact once, with
 // lastingOnFace's words, though states of it keep coming.

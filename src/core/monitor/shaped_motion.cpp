@@ -287,7 +287,20 @@ std::vector<ShapedMotion::ObstacleContact> ShapedMotion::firstContacts(const Tum
   for (std::size_t slot = 0; slot < obstacles_.size(); ++slot) {
     const PlacedShape& placed = obstacles_[slot].placed.placed;
     const double start = obstacles_[slot].clear_from;
-    if (!(start < horizon) && !(through && start == horizon)) continue;
+    if (through && start == horizon) {
+      // A motion that starts at the step's end (a state given there): an obstacle within the
+      // touching band touches it from that instant (a played box resting 2e-15 m above the floor
+      // would otherwise be found only as it falls the 2e-15 m, after the step).
+      const SurfaceGap gap = gapAt(body, placed, horizon);
+      if (gap.overlapping || !(gap.gap_upper <= FirstContactOptions{}.manifold_band)) continue;
+      FirstContactOptions at_once;
+      at_once.time_tolerance = std::numeric_limits<double>::infinity();
+      const FirstContactResult result = firstContact(body, placed, horizon, 0.0, at_once);
+      if (result.contact)
+        found.push_back({obstacles_[slot].placed.obstacle, slot, *result.contact});
+      continue;
+    }
+    if (!(start < horizon)) continue;
     // The advancement's step budget may run out on a slow graze before the horizon: it goes
     // on from where it is known apart.
     for (double clear = start;;) {
