@@ -106,6 +106,38 @@ TEST(ShapedMonitor, ABoxDroppedFlatBouncesAtTheParabolasInstant) {
             1e-12);
 }
 
+// A shaped body's states are taken by the balls' rules: one not newer than its body's last is
+// stale; one after the landing that still falls at the parabola's speed lacks the impact the
+// monitor found (more than half its velocity change, (1 + e) v): reported as contradicting it, at
+// the impact's instant, and taken as the track.
+TEST(ShapedMonitor, StatesAreStaleOrContradictAnImpactAsABallsDo) {
+  const V half(0.05, 0.04, 0.03);
+  const double e = 0.5, height = 0.5;
+  const Scene scene = floorScene(e, half);
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  const Eigen::Quaterniond flat = Eigen::Quaterniond::Identity();
+  monitor.step(0.0, {fallingState(monitor, height, flat, 0.0)});
+  const StepReport stale = monitor.step(0.1, {fallingState(monitor, height, flat, 0.0)});
+  EXPECT_EQ(stale.stale_states, 1u);
+  const double fall = std::sqrt(2 * (height - half.z()) / kG), v = kG * fall;
+  // After the landing, a state still falling (a source that did not see it), 5 mm above the
+  // floor, at the parabola's velocity past the landing.
+  const double t = fall + 0.001;
+  BodyStateSample falling = fallingState(monitor, height, flat, t);
+  falling.position.z() = half.z() + 0.005;
+  const StepReport report = monitor.step(t, {falling});
+  ASSERT_EQ(report.impacts.size(), 4u);
+  ASSERT_EQ(report.contradicted.size(), 1u);
+  EXPECT_EQ(report.contradicted[0].body, *monitor.bodyIndex("block"));
+  EXPECT_NEAR(report.contradicted[0].impact_time, fall, 1e-11);
+  EXPECT_EQ(report.contradicted[0].state_time, t);
+  // It lacks the impact's change, (1 + e) v (both fell g 0.001 s since: that cancels).
+  EXPECT_NEAR(report.contradicted[0].missing, (1 + e) * v, 1e-9);
+  const auto predicted = monitor.predictedState(*monitor.bodyIndex("block"), t);
+  ASSERT_TRUE(predicted);
+  EXPECT_EQ(predicted->first, falling.position);  // the state is the track
+}
+
 // The box landing on an edge (shaped_scenes::EdgeLanding's closed form), over the monitor: two
 // corners at the parabola's instant, their impulses summing to J, v_z' and w_y' as it says, and
 // the monitor's orientation after it turning at w_y' (until its other edge lands, 11 ms later).
