@@ -1,6 +1,6 @@
 // A scene body's shape and mass (issue 42, build step 2): its shape in its own frame, the checks
-// of its shape and inertia keys, and its mass properties. Only spheres move yet: a scene with any
-// other body is refused by name (checkOnlySpheresMove, the last check of validateScene), so that
+// of its shape and inertia keys, and its mass properties. The monitor moves spheres, boxes,
+// cylinders and capsules; what it does not move yet is refused by name (validateScene), so that
 // nothing silently becomes a ball.
 #pragma once
 
@@ -57,9 +57,10 @@ BodySpec shapeSpecOf(const Body& body);
 /// ball (isBall), otherwise checkOrientation's.
 Status checkBodyShape(const Body& body, const std::string& prefix);
 
-/// For now (issue 42: the model moves spheres only), the first body that is not a sphere, or a
-/// sphere given a tensor, is refused, naming its `shape` (or `inertia`) key under `prefix` and
-/// the body: "not yet: only spheres move".
+/// Where only spheres may move (a ball's prediction holds the scene's other bodies as spheres:
+/// MovingShapes::kSpheresOnly), the first body that is not a sphere, or a sphere given a tensor,
+/// is refused, naming its `shape` (or `inertia`) key under `prefix` and the body: "not yet: only
+/// spheres move".
 Status checkOnlySpheresMove(const Scene& scene, const std::string& prefix);
 
 }  // namespace collision_response::core

@@ -1,7 +1,7 @@
 // A rigid body's rotation in flight, torque-free and exact (issue 42, build step 4): its angular
 // velocity and orientation at any time from its principal moments, its first orientation and
-// angular velocity. Not yet used by the monitor (only spheres move; shaped bodies are refused at
-// start-up).
+// angular velocity. A shaped body's flight in the monitor, the scene player and its prediction
+// (src/core/monitor/shaped_motion.h).
 //
 // In the body's principal frame Euler's equations J_1 w_1' = (J_2 - J_3) w_2 w_3 (cyclically)
 // keep the kinetic energy E = (1/2) sum J_i w_i^2 and |L|^2 = M^2 = sum J_i^2 w_i^2, and L is

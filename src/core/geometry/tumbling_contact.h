@@ -1,5 +1,6 @@
-// The first contact of a tumbling body, certified (issue 42, build step 5). Not yet used by the
-// monitor: only spheres move there.
+// The first contact of a tumbling body, certified (issue 42, build step 5): a shaped body's
+// impacts with obstacles in the monitor, the scene player and its prediction
+// (src/core/monitor/shaped_motion.h).
 //
 // A tumbling body is a convex shape (convex_distance.h: a sphere, box, cylinder, capsule or
 // convex hull) in its body frame, whose origin is the centre of mass and whose axes are the

@@ -164,11 +164,9 @@ Status checkOnlySpheresMove(const Scene& scene, const std::string& prefix) {
     const BodySpec& body = scene.bodies[i];
     const std::string where = prefix + "/bodies[" + std::to_string(i) + "]/";
     if (body.shape != BodyShape::kSphere) {
-      return Error{where + "shape",
-                   std::string("not yet: only spheres move (body '") + body.id + "' is a " +
-                       toString(body.shape) +
-                       "; its shape and mass are checked, and the model takes them with issue "
-                       "42's next steps)"};
+      return Error{where + "shape", std::string("not yet: only spheres move (body '") + body.id +
+                                        "' is a " + toString(body.shape) +
+                                        "; a ball's prediction holds the other bodies as spheres)"};
     }
     if (body.inertia_tensor) {
       return Error{where + "inertia", "not yet: only spheres of uniform mass move (body '" +
