@@ -77,6 +77,15 @@ Error notYet(const std::string& what) { return Error{"contact", "not yet: " + wh
 
 bool isUnit(const Vec& v) { return v.allFinite() && std::abs(v.norm() - 1.0) <= kLastingBand; }
 
+/// A cylinder's or a capsule's (`what`) radius and half length: finite and > 0.
+Status checkRound(const char* what, double radius, double half_length) {
+  if (std::isfinite(radius) && radius > 0 && std::isfinite(half_length) && half_length > 0) {
+    return Ok{};
+  }
+  return Error{"body.shape",
+               std::string("a ") + what + "'s radius and half length must be finite and > 0"};
+}
+
 Status checkLasting(const LastingBody& body, const FlatFace& face) {
   if (!(std::isfinite(body.mass) && body.mass > 0)) {
     return Error{"body.mass", "must be finite and > 0, got " + formatNumber(body.mass)};
@@ -131,21 +140,11 @@ Status checkLasting(const LastingBody& body, const FlatFace& face) {
               }
               return Ok{};
             },
-            [](const Cylinder& cylinder) -> Status {
-              if (!(std::isfinite(cylinder.radius) && cylinder.radius > 0 &&
-                    std::isfinite(cylinder.half_length) && cylinder.half_length > 0)) {
-                return Error{"body.shape",
-                             "a cylinder's radius and half length must be finite and > 0"};
-              }
-              return Ok{};
+            [](const Cylinder& cylinder) {
+              return checkRound("cylinder", cylinder.radius, cylinder.half_length);
             },
-            [](const Capsule& capsule) -> Status {
-              if (!(std::isfinite(capsule.radius) && capsule.radius > 0 &&
-                    std::isfinite(capsule.half_length) && capsule.half_length > 0)) {
-                return Error{"body.shape",
-                             "a capsule's radius and half length must be finite and > 0"};
-              }
-              return Ok{};
+            [](const Capsule& capsule) {
+              return checkRound("capsule", capsule.radius, capsule.half_length);
             },
             [](const ConvexHull& hull) -> Status {
               if (hull.vertices.size() < 4) {
