@@ -7,7 +7,9 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cmath>
+#include <vector>
 
+#include "collision_response/core/monitor.h"
 #include "collision_response/core/scene.h"
 #include "edge_landing.h"
 #include "scene_builders.h"
@@ -31,6 +33,23 @@ inline Scene floorScene(double e, const Eigen::Vector3d& half, double mass = 2.0
   scene.bodies = {body};
   scene.obstacles = {scene_builders::plane("floor", Eigen::Vector3d::UnitZ(), 0.0, "concrete")};
   return scene;
+}
+
+/// The edge landing's impacts at one instant against its closed form: at edge.fall() (1e-11 s,
+/// the first contact's certification), each leaving with v_z' and w_y' and no other spin (1e-9),
+/// their impulses adding up to J (1e-9).
+inline void expectTheEdgeLanding(const EdgeLanding& edge,
+                                 const std::vector<ImpactRecord>& impacts) {
+  double total = 0.0;
+  for (const ImpactRecord& impact : impacts) {
+    EXPECT_NEAR(impact.time, edge.fall(), 1e-11);
+    total += impact.impulse;
+    EXPECT_NEAR(impact.velocity_a_after.z(), edge.velocityAfter(), 1e-9);
+    EXPECT_NEAR(impact.angular_velocity_a_after.y(), edge.spinAfter(), 1e-9);
+    EXPECT_NEAR(impact.angular_velocity_a_after.x(), 0.0, 1e-9);
+    EXPECT_NEAR(impact.angular_velocity_a_after.z(), 0.0, 1e-9);
+  }
+  EXPECT_NEAR(total, edge.impulse(), 1e-9);
 }
 
 }  // namespace collision_response::core::shaped_scenes

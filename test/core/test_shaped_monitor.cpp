@@ -17,6 +17,18 @@
 namespace collision_response::core {
 namespace {
 
+/// The played body 0's state at `t`, as the scene player publishes it, for the monitor's `body`.
+BodyStateSample playedState(const Playback& playback, std::size_t body, double t) {
+  BodyStateSample state;
+  state.body = body;
+  state.time = t;
+  state.position = playback.position(0, t);
+  state.velocity = playback.velocity(0, t);
+  state.angular_velocity = playback.angularVelocity(0, t);
+  state.orientation = playback.orientation(0, t);
+  return state;
+}
+
 using V = Eigen::Vector3d;
 using shaped_scenes::EdgeLanding;
 using shaped_scenes::floorScene;
@@ -153,16 +165,7 @@ TEST(ShapedMonitor, ABoxLandingOnAnEdgeTurnsAsTheClosedFormSays) {
   ASSERT_FALSE(all.empty());
   const std::vector<ImpactRecord> impacts = firstInstant(all);
   ASSERT_EQ(impacts.size(), 2u);
-  double total = 0.0;
-  for (const ImpactRecord& impact : impacts) {
-    EXPECT_NEAR(impact.time, edge.fall(), 1e-11);
-    total += impact.impulse;
-    EXPECT_NEAR(impact.velocity_a_after.z(), edge.velocityAfter(), 1e-9);
-    EXPECT_NEAR(impact.angular_velocity_a_after.y(), edge.spinAfter(), 1e-9);
-    EXPECT_NEAR(impact.angular_velocity_a_after.x(), 0.0, 1e-9);
-    EXPECT_NEAR(impact.angular_velocity_a_after.z(), 0.0, 1e-9);
-  }
-  EXPECT_NEAR(total, edge.impulse(), 1e-9);
+  expectTheEdgeLanding(edge, impacts);
   // A cuboid's turn about its principal y is at a constant rate: theta + w_y' dt after it.
   const std::size_t block = *monitor.bodyIndex("block");
   const Eigen::Quaterniond expected(
@@ -187,13 +190,7 @@ TEST(ShapedMonitor, PlaybackAndTheMonitorGiveTheEdgeLandingsImpacts) {
   bool checked = false;
   for (int k = 0; k * dt <= edge.fall() + 0.05; ++k) {
     const double t = k * dt;
-    BodyStateSample state;
-    state.body = *monitor.bodyIndex("block");
-    state.time = t;
-    state.position = playback.position(0, t);
-    state.velocity = playback.velocity(0, t);
-    state.angular_velocity = playback.angularVelocity(0, t);
-    state.orientation = playback.orientation(0, t);
+    const BodyStateSample state = playedState(playback, *monitor.bodyIndex("block"), t);
     const StepReport report = monitor.step(t, {state});
     EXPECT_TRUE(playback.applyImpacts(monitor, report.impacts, true).empty());
     impacts.insert(impacts.end(), report.impacts.begin(), report.impacts.end());
@@ -420,13 +417,7 @@ TEST(ShapedMonitor, PlaybackAndTheMonitorBringABoxBouncingFlatToRest) {
   std::size_t impacts = 0, unmodelled = 0;
   for (int k = 0; k <= 100; ++k) {
     const double t = 0.01 * k;
-    BodyStateSample state;
-    state.body = *monitor.bodyIndex("block");
-    state.time = t;
-    state.position = playback.position(0, t);
-    state.velocity = playback.velocity(0, t);
-    state.angular_velocity = playback.angularVelocity(0, t);
-    state.orientation = playback.orientation(0, t);
+    const BodyStateSample state = playedState(playback, *monitor.bodyIndex("block"), t);
     last = monitor.step(t, {state});
     EXPECT_TRUE(playback.applyImpacts(monitor, last.impacts, true).empty());
     impacts += last.impacts.size();

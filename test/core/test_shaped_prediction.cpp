@@ -81,16 +81,7 @@ TEST(ShapedPrediction, BoxLandingOnAnEdgeTurnsAsTheClosedFormSays) {
   const auto prediction = predictImpacts(scene, nullptr, MonitorSettings{}, request);
   ASSERT_TRUE(prediction.ok()) << prediction.error().message();
   ASSERT_EQ(prediction->impacts.size(), 2u) << prediction->message;
-  double total = 0.0;
-  for (const ImpactRecord& impact : prediction->impacts) {
-    EXPECT_NEAR(impact.time, edge.fall(), 1e-11);
-    total += impact.impulse;
-    EXPECT_NEAR(impact.velocity_a_after.z(), edge.velocityAfter(), 1e-9);
-    EXPECT_NEAR(impact.angular_velocity_a_after.y(), edge.spinAfter(), 1e-9);
-    EXPECT_NEAR(impact.angular_velocity_a_after.x(), 0.0, 1e-9);
-    EXPECT_NEAR(impact.angular_velocity_a_after.z(), 0.0, 1e-9);
-  }
-  EXPECT_NEAR(total, edge.impulse(), 1e-9);
+  expectTheEdgeLanding(edge, prediction->impacts);
 }
 
 // A cube's inertia is isotropic, so its answer does not depend on how it is turned about the
