@@ -244,6 +244,25 @@ TEST(TumblingContact, ABoxSlidingAlongTheFloorSpinningAboutItsNormalIsClearInOne
   EXPECT_LE(r.steps, 1);
 }
 
+TEST(TumblingContact, AnEdgeSkimmingTheFloorWithinTheToleranceTouchesAtOnce) {
+  // A cube of half side a = 0.05 m, flat, its bottom face 1.5e-12 m above the floor, no gravity,
+  // turning steadily at w = 48 rad/s about x and rising at w a = 2.4 m/s: its edge y = z = -a
+  // moves along the floor at first (height 1.5e-12 + a (phi - sin phi) + a (1 - cos phi), phi =
+  // w t, its least at t = 0). Every point's speed bound (2.4 + 48 a sqrt(3) = 6.56 m/s) steps
+  // 2.3e-13 s there, below the 1e-12 s tolerance: touching (the gap within V time_tolerance).
+  // The plane's bound (closing -2.4 + w a sqrt(2) = 0.99 m/s) stepped 1.5e-12 s at a time from
+  // there, the gap rising by little a step: the step budget (65,536) ran out, the contact never
+  // found (a real cube toss at e = 0 took 3.5 million steps so, 0.7 s of CPU).
+  const double a = 0.05, w = 48.0;
+  const TumblingBody body = makeBody(Cuboid{V(a, a, a)}, V(1, 1, 1), V(0, 0, a + 1.5e-12),
+                                     V(0, 0, w * a), V::Zero(), Q::Identity(), V(w, 0, 0));
+  const FirstContactResult r = firstContact(body, floorAt(0.0), 0.0, 0.01);
+  ASSERT_TRUE(r.contact) << "clear until " << r.clear_until << " s after " << r.steps << " steps";
+  EXPECT_EQ(r.contact->time, 0.0);
+  EXPECT_LE(r.steps, 1);
+  EXPECT_LE(r.contact->closest.gap, 1.5e-12 + 1e-15);
+}
+
 TEST(ConvexDistance, BoxesCylindersCapsulesAndHullsAgainstTheirClosedForms) {
   // A box and a cylinder standing apart along x: the box's face x = 0.3 and the cylinder's side
   // x = 1 - 0.25: 0.45 apart.

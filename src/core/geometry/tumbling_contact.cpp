@@ -558,6 +558,14 @@ FirstContactResult advance(const TumblingBody& body, const Side& side, double fr
       return result;
     }
     const double speed = (body.velocityAt(t) - side.centreVelocity(t)).norm() + turning;
+    // Touching where every point's speed bound would step less than the tolerance (the gap
+    // within V time_tolerance: the header's comment), even where a plane's own bound steps
+    // further: a point gliding along it within that gap would otherwise creep on in steps of
+    // about the tolerance, millions of them.
+    if (firstRoot(g.gap, speed, acceleration) <= stop) {
+      contactAt(t);
+      return result;
+    }
     const double step = side.step(body, t, g.gap, speed, acceleration);
     if (step <= stop) {
       contactAt(t);
