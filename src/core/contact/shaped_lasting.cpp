@@ -331,6 +331,22 @@ double edgeReached(const std::vector<Vec>& feet, const FlatFace& face, const Tra
   return first;
 }
 
+/// The support's points and `point` in the face's coordinates (e1, e2) about the points'
+/// centroid: the polygon and the point whose inside and forces the 2-D rules read.
+std::pair<std::vector<Eigen::Vector2d>, Eigen::Vector2d> inFace(const Support& support,
+                                                                const Setting& setting,
+                                                                const Vec& point) {
+  Vec centroid = Vec::Zero();
+  for (const Vec& foot : support.feet) centroid += foot;
+  centroid /= static_cast<double>(support.feet.size());
+  std::vector<Eigen::Vector2d> q;
+  for (const Vec& foot : support.feet) {
+    q.emplace_back((foot - centroid).dot(setting.e1), (foot - centroid).dot(setting.e2));
+  }
+  return {q,
+          Eigen::Vector2d((point - centroid).dot(setting.e1), (point - centroid).dot(setting.e2))};
+}
+
 /// Whether the point p lies strictly inside the convex polygon of `corners` (2D, any order).
 bool strictlyInside(std::vector<Eigen::Vector2d> corners, const Eigen::Vector2d& p) {
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
@@ -428,15 +444,7 @@ Expected<std::vector<SupportForce>> supportForces(Support& support, const Settin
       support.feet = {support.centre + r * along, support.centre + r * across,
                       support.centre - r * along, support.centre - r * across};
     }
-    Vec centroid = Vec::Zero();
-    for (const Vec& foot : support.feet) centroid += foot;
-    centroid /= static_cast<double>(support.feet.size());
-    std::vector<Eigen::Vector2d> q;
-    for (const Vec& foot : support.feet) {
-      q.emplace_back((foot - centroid).dot(setting.e1), (foot - centroid).dot(setting.e2));
-    }
-    const Eigen::Vector2d p((pressure - centroid).dot(setting.e1),
-                            (pressure - centroid).dot(setting.e2));
+    const auto [q, p] = inFace(support, setting, pressure);
     if (support.kind == SupportKind::kPolygon && !strictlyInside(q, p)) {
       return notYet(tipping +
                     ": the centre of pressure (the centre of mass's projection along "
@@ -697,15 +705,7 @@ std::optional<double> flatBouncesEnd(const LastingBody& body, const FlatFace& fa
   // The joint frictionless rule sends every point back at e u without turning only where its
   // least-norm impulses, centred under the centre of mass, are >= 0 (none dropped).
   if (support.kind == SupportKind::kPolygon) {
-    Vec centroid = Vec::Zero();
-    for (const Vec& foot : support.feet) centroid += foot;
-    centroid /= static_cast<double>(support.feet.size());
-    std::vector<Eigen::Vector2d> q;
-    for (const Vec& foot : support.feet) {
-      q.emplace_back((foot - centroid).dot(setting.e1), (foot - centroid).dot(setting.e2));
-    }
-    const Eigen::Vector2d p((setting.foot - centroid).dot(setting.e1),
-                            (setting.foot - centroid).dot(setting.e2));
+    const auto [q, p] = inFace(support, setting, setting.foot);
     const std::vector<double> shares = polygonForces(q, p, 1.0, false);
     if (*std::min_element(shares.begin(), shares.end()) < 0) return std::nullopt;
   } else if (support.kind == SupportKind::kLine) {

@@ -79,8 +79,6 @@ Expected<PrincipalBody> principalBody(const BodySpec& body, const std::string& f
 
 namespace {
 
-/// A rebound lifting no point by more than this fraction of the body's reach: settled.
-constexpr double kSettled = 1e-6;
 /// Contacts this close to the earliest (relative to the instant, 1e-12) strike together.
 constexpr double kSimultaneous = 1e-12;
 
@@ -390,8 +388,9 @@ Expected<bool> ShapedMotion::resolve(const TumblingBody& body, SolverBody& movin
   if (!(fastest > 0)) return false;
   // Bounces that accumulate (a body settling, rocking from edge to edge) would go on for ever in
   // finitely many seconds: where even an elastic rebound could lift no point by more than
-  // kSettled of the body's reach, the contact is taken to last.
-  const double lift = body.acceleration().norm() * kSettled * body.reach();
+  // kLastingSettled of the body's reach, the contact is taken to last (lastingOnFace's own
+  // rule for a settled body: one constant for both).
+  const double lift = body.acceleration().norm() * kLastingSettled * body.reach();
   if (fastest * fastest <= 2 * lift) return false;
   const bool bounces = fastest >= scene_.restitution_threshold;
   if (!bounces) {
