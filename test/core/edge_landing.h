@@ -29,6 +29,36 @@ struct EdgeLanding {
   double impulse() const { return (1 + e) * speed() / (1 / m + x() * x() / inertia()); }
   double velocityAfter() const { return -speed() + impulse() / m; }  ///< v_z'
   double spinAfter() const { return -x() * impulse() / inertia(); }  ///< w_y'
+
+  /// The centre's height at tilt phi about y, on the edge of (a, +-b, -c): a sin phi + c cos phi.
+  double heightAt(double phi) const { return a * std::sin(phi) + c * std::cos(phi); }
+  /// Released at rest on that edge (tilt theta, the centre at low()) on a frictionless floor: the
+  /// floor's force is vertical, so the centre's x and y stay, and the energy gives
+  /// phi'^2 = 2 g (h(theta) - h(phi)) / (h'(phi)^2 + I_yy / m), h' = a cos phi - c sin phi, down
+  /// to phi = 0 where the face lands. Its instant is the integral of dphi / |phi'| over (0, theta):
+  /// with phi = theta - u^2 the integrand 2 u / |phi'| is smooth, by 5-point Gauss-Legendre over
+  /// 200 panels of u in (0, sqrt theta).
+  double tipInstant() const {
+    const auto rate = [&](double phi) {
+      const double slope = a * std::cos(phi) - c * std::sin(phi);
+      return std::sqrt(2 * kGravity * (heightAt(theta) - heightAt(phi)) /
+                       (slope * slope + inertia() / m));
+    };
+    const double x[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831,
+                         0.9061798459386640};
+    const double w[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889,
+                         0.4786286704993665, 0.2369268850561891};
+    const int panels = 200;
+    const double width = std::sqrt(theta) / panels;
+    double sum = 0.0;
+    for (int p = 0; p < panels; ++p) {
+      for (int i = 0; i < 5; ++i) {
+        const double u = (p + 0.5) * width + 0.5 * width * x[i];
+        sum += w[i] * 0.5 * width * 2 * u / rate(theta - u * u);
+      }
+    }
+    return sum;
+  }
 };
 
 }  // namespace collision_response::core::shaped_scenes

@@ -286,21 +286,28 @@ TEST(ShapedPrediction, ABoxRestingOnTheFloorRestsThere) {
 }
 
 // A box given at rest on one of its edges (turned by 0.3 rad about y, its lowest edge on the
-// floor) would tip over it, which lastingOnFace does not model yet: the prediction ends there,
-// cut short, saying so with lastingOnFace's words, never through the floor.
-TEST(ShapedPrediction, ABoxTippingOverAnEdgeEndsThePredictionSayingWhy) {
+// frictionless floor) tips over it: its centre falls straight down (the floor's force is
+// vertical), at the height h(phi) its tilt gives, and its face lands at the energy integral's
+// instant (EdgeLanding::tipInstant, 1e-8 s: the integration's tolerance 1e-9), never through the
+// floor. Before, the prediction ended there: tipping was not modelled.
+TEST(ShapedPrediction, ABoxTippingOverAFrictionlessEdgeLandsOnItsFaceAtTheEnergyIntegralsInstant) {
   const EdgeLanding edge;
   const Scene scene = floorScene(edge.e, V(edge.a, edge.b, edge.c), edge.m);
-  auto request = dropped(scene, V(0, 0, edge.low()), edge.turn(), 1.0, 10);
+  auto request = dropped(scene, V(0, 0, edge.low()), edge.turn(), 1.0, 1);
+  request.sample_period = 0.01;
   const auto prediction = predictImpacts(scene, nullptr, MonitorSettings{}, request);
   ASSERT_TRUE(prediction.ok()) << prediction.error().message();
-  EXPECT_TRUE(prediction->impacts.empty());
-  EXPECT_TRUE(prediction->cut_short);
-  EXPECT_NE(prediction->message.find("lasting contact with 'floor' at +0 s, which is not yet "
-                                     "modelled (contact: not yet"),
-            std::string::npos)
-      << prediction->message;
-  EXPECT_EQ(prediction->final_state.time, 0.0);
+  ASSERT_FALSE(prediction->impacts.empty()) << prediction->message;
+  const double landing = edge.tipInstant();
+  EXPECT_NEAR(prediction->impacts.front().time, landing, 1e-8);
+  for (const BodyStateSample& sample : prediction->samples) {
+    if (sample.time >= landing) break;
+    EXPECT_NEAR(sample.position.x(), 0.0, 1e-9) << sample.time;
+    EXPECT_NEAR(sample.position.y(), 0.0, 1e-12) << sample.time;
+    const Eigen::AngleAxisd tilt(sample.orientation);
+    const double phi = tilt.angle() * tilt.axis().y();
+    EXPECT_NEAR(sample.position.z(), edge.heightAt(phi), 1e-9) << sample.time;
+  }
 }
 
 TEST(ShapedPrediction, WhatIsNotModelledYetIsRefusedByName) {

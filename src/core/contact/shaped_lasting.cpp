@@ -29,23 +29,28 @@
 #include <Eigen/Dense>
 
 #include "collision_response/core/validation.h"
+#include "contact/shaped_pivot.h"
 
 namespace collision_response::core {
 
 Eigen::Vector3d LastingMotion::centreAt(double t) const {
+  if (pivot) return pivot->stateAt(t).centre;
   const double s = t - start;
   return centre0 + velocity0 * s + 0.5 * acceleration * s * s;
 }
 
 Eigen::Vector3d LastingMotion::velocityAt(double t) const {
+  if (pivot) return pivot->stateAt(t).velocity;
   return velocity0 + acceleration * (t - start);
 }
 
 Eigen::Vector3d LastingMotion::angularVelocityAt(double t) const {
+  if (pivot) return pivot->stateAt(t).angular_velocity;
   return angular_velocity0 + angular_acceleration * (t - start);
 }
 
 Eigen::Quaterniond LastingMotion::orientationAt(double t) const {
+  if (pivot) return pivot->stateAt(t).orientation;
   const double s = t - start;
   const Eigen::Vector3d turn = angular_velocity0 * s + 0.5 * angular_acceleration * s * s;
   const double angle = turn.norm();
@@ -54,12 +59,17 @@ Eigen::Quaterniond LastingMotion::orientationAt(double t) const {
 }
 
 std::vector<SupportForce> LastingMotion::forcesAt(double t) const {
+  if (pivot) return pivot->stateAt(t).forces;
   // The manifold's points stay under the body: they move with its centre (a body that does not
   // turn, or a round side turning about its axis), and the forces are constant.
   std::vector<SupportForce> moved = forces;
   const Eigen::Vector3d shift = centreAt(t) - centre0;
   for (SupportForce& force : moved) force.point += shift;
   return moved;
+}
+
+ContactState LastingMotion::stateAt(double t) const {
+  return pivot ? pivot->stateAt(t).state : state;
 }
 
 namespace {
@@ -165,6 +175,7 @@ enum class SupportKind {
   kPolygon,  ///< 3 or 4 corners (a box's face, a hull's)
   kDisc,     ///< a cylinder's cap: its rim
   kLine,     ///< a cylinder's or capsule's side: the two ends of its lowest line
+  kCorners,  ///< one corner or one edge's two: the body tips over them (pivotOnFace)
 };
 
 struct Support {
@@ -174,6 +185,7 @@ struct Support {
   Vec centre = Vec::Zero();   ///< a disc's centre, on the face
   double radius = 0.0;        ///< a disc's, or a side's (the roll's)
   double axial_moment = 0.0;  ///< a side's moment about its axis (the roll's J)
+  std::vector<Vec> corners;   ///< the feet's corners in the principal frame (kCorners)
 };
 
 /// The face's frame and what the body is there.
@@ -188,6 +200,7 @@ struct Setting {
   double band = kLastingBand;
   /// m/s: the normal speed a point may have and be settled (kLastingSettled).
   double settled_speed = kLastingStillSpeed;
+  bool settled = false;  ///< handed over as settled: its support's points move no faster
 };
 
 /// The face's frame and the body's place over it; `settled`: the bands of a body handed over as
@@ -202,6 +215,7 @@ Setting settingOf(const LastingBody& body, const FlatFace& face, bool settled) {
   setting.height = setting.n.dot(body.centre - face.point);
   setting.foot = body.centre - setting.height * setting.n;
   setting.reach = reachOf(body.shape);
+  setting.settled = settled;
   if (settled) {
     setting.band = std::max(kLastingBand, kLastingSettled * setting.reach);
     setting.settled_speed =
@@ -263,12 +277,27 @@ Expected<Support> supportOf(const LastingBody& body, const Eigen::Matrix3d& rota
   contactCandidates(body.shape, down, candidates);
   for (const Vec& corner : candidates) {
     const Vec point = body.centre + rotation * corner;
-    if (n.dot(point - face.point) - lowest <= setting.band) {
+    const double above = n.dot(point - face.point) - lowest;
+    // A point that approaches or leaves the face faster than a settled one does not rest on it:
+    // it strikes it (an impact, the caller's) or parts from it, as the others tip.
+    const double normal_speed =
+        n.dot(body.velocity + body.angular_velocity.cross(rotation * corner));
+    if (above <= setting.band &&
+        (!setting.settled || std::abs(normal_speed) <= setting.settled_speed)) {
       support.feet.push_back(onFace(point, face, n));
+      support.corners.push_back(corner);
     }
   }
+  if (support.feet.empty()) {
+    return Error{"body.velocity",
+                 "every point of the body near the face approaches or leaves it faster than " +
+                     formatNumber(setting.settled_speed) +
+                     " m/s: not a lasting contact (settled: an elastic rise of 1e-6 of its "
+                     "reach)"};
+  }
   if (support.feet.size() == 1) {
-    return notYet("tipping over a corner: the body touches the face at one point");
+    support.kind = SupportKind::kCorners;
+    return support;
   }
   if (support.feet.size() > 4) {
     return notYet("a face of more than four points on the face (a hull's)");
@@ -284,7 +313,11 @@ Expected<Support> supportOf(const LastingBody& body, const Eigen::Matrix3d& rota
     for (const Vec& foot : support.feet) size = std::max(size, (foot - support.feet[0]).norm());
     if (area > kLastingBand * size) return support;
   }
-  return notYet("tipping over an edge: the body touches the face along one edge");
+  if (support.feet.size() != 2) {
+    return notYet("tipping over an edge of more than two points (a hull's)");
+  }
+  support.kind = SupportKind::kCorners;
+  return support;
 }
 
 /// The smallest s > 0 with v s + a s^2 / 2 = target (target >= 0), or infinity: written
@@ -628,7 +661,8 @@ const char* tippingOf(ContactState state) {
 
 }  // namespace
 
-Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& face) {
+Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& face,
+                                      double tolerance) {
   if (Status status = checkLasting(body, face); !status) return status.error();
   const Eigen::Quaterniond orientation = body.orientation.normalized();
   const Eigen::Matrix3d rotation = orientation.toRotationMatrix();
@@ -636,9 +670,23 @@ Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& f
   auto found = supportOf(body, rotation, face, setting);
   if (!found) return found.error();
   Support support = found.value();
+  if (support.kind == SupportKind::kCorners) {
+    if (Status status = checkOnFace(body, face, support, setting); !status) {
+      return status.error();
+    }
+    return pivotOnFace(body, face, support.corners, tolerance);
+  }
+  // A box's (or a hull's) face whose turning the closed forms do not carry (a spin about the
+  // normal: each corner slides its own way, Coulomb's friction at each; a rocking turn) or whose
+  // centre of pressure leaves the support (it tips over an edge of it) moves as the tipping
+  // does, its corners each sticking, sliding or leaving (pivotOnFace).
+  const bool cornered = support.kind == SupportKind::kPolygon && !support.corners.empty();
   const auto spin = keptSpin(support, setting, body.angular_velocity);
-  if (!spin) return spin.error();
   if (Status status = checkOnFace(body, face, support, setting); !status) return status.error();
+  if (!spin) {
+    if (cornered) return pivotOnFace(body, face, support.corners, tolerance);
+    return spin.error();
+  }
   // Outlines taken before supportForces chooses a cap's four points.
   const std::vector<Vec> outline = outlineOf(support, face.along_u, face.along_v);
 
@@ -662,6 +710,7 @@ Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& f
       setting.foot + setting.height * (setting.g_t - plan.acceleration) / setting.g_n;
   auto forces = supportForces(support, setting, pressure, total, friction_ratio, rotation,
                               tippingOf(plan.state));
+  if (!forces && cornered) return pivotOnFace(body, face, support.corners, tolerance);
   if (!forces) return forces.error();
 
   LastingMotion motion;
@@ -694,6 +743,7 @@ std::optional<double> flatBouncesEnd(const LastingBody& body, const FlatFace& fa
   auto found = supportOf(body, rotation, face, setting);
   if (!found) return std::nullopt;
   Support support = found.value();
+  if (support.kind == SupportKind::kCorners) return std::nullopt;
   // Flat: approaching along the normal, no slip and no turning (every point of the manifold
   // approaches at u, to 1e-9 m/s).
   const double approach = -body.velocity.dot(setting.n);

@@ -1,13 +1,16 @@
 // A shaped body's lasting contact with one flat face (issue 42, build step 6): a box, cylinder or
 // capsule resting, sliding or rolling on a plane or on a face of a box obstacle, under gravity,
-// by closed forms. What is not modelled yet (tipping over an edge, rocking, spin about the
-// face's normal while the body slides, a cylinder rolling with its axis not across the slope) is
-// refused by name, so that the caller says so instead of moving the body through the face.
+// by closed forms; a box (or a hull) touching at one corner or along one edge, rocking or
+// spinning on a face, or whose centre of pressure leaves its face, by its tipping motion
+// (shaped_pivot.h). What is not modelled yet (a cylinder leaning on its rim, a capsule on one
+// end, a cylinder rolling with its axis not across the slope) is refused by name, so that the
+// caller says so instead of moving the body through the face.
 #pragma once
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -33,6 +36,8 @@ constexpr double kLastingSettled = 1e-6;
 /// Of |g_t| + g_n: gravity's part across a slide (or along a rolling side's axis, or across a
 /// resting side's) below it counts as none.
 constexpr double kLastingAcrossGravity = 1e-12;
+
+class PivotPath;
 
 /// The body at the instant its contact begins to last, in its principal frame (as
 /// PrincipalBody: its shape about its centre of mass along its principal axes).
@@ -84,23 +89,33 @@ struct LastingMotion {
   Eigen::Quaterniond orientation0 = Eigen::Quaterniond::Identity();  ///< world from principal
   /// The contact's points (the manifold) and their forces, at `start`; forcesAt gives them at t.
   std::vector<SupportForce> forces;
+  /// A body tipping over a corner or an edge (pivotOnFace): its integrated path, which the
+  /// state and the forces at t come from instead of the closed form.
+  std::shared_ptr<const PivotPath> pivot;
 
   Eigen::Vector3d centreAt(double t) const;
   Eigen::Vector3d velocityAt(double t) const;
   Eigen::Vector3d angularVelocityAt(double t) const;
   Eigen::Quaterniond orientationAt(double t) const;
   std::vector<SupportForce> forcesAt(double t) const;
+  /// Resting, sliding or rolling at t (a tipping body's points stick or slide as it goes).
+  ContactState stateAt(double t) const;
 };
 
 /// The lasting motion that starts from `body` touching `face` (its lowest point within
 /// kLastingBand of it, its normal motion settled: kLastingSettled), or an Error whose message
-/// says what is not modelled yet, for the caller to report (e.g. "not yet: tipping over an
-/// edge", "not yet: spin about the face's normal while sliding"), or which input is wrong
-/// (`body.mass`, `face.normal`, ...). The body does not gain energy (a settled normal motion is
+/// says what is not modelled yet, for the caller to report (e.g. "not yet: tipping: a cylinder
+/// leaning on its rim"), or which input is wrong (`body.mass`, `face.normal`, ...), or that the
+/// contact is no lasting one (field `body.velocity`: its points near the face approach or leave
+/// it faster than a settled body's). The body does not gain energy (a settled normal motion is
 /// dropped), and no point of it goes below the face. The normal forces are the least-norm ones
 /// >= 0 that balance m (a - g) and the moment about the centre of mass; each point's friction is
-/// in proportion to its normal force (doc/model.md, "Lasting contact of a shaped body").
-Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& face);
+/// in proportion to its normal force (doc/model.md, "Lasting contact of a shaped body"). A box
+/// or hull touching at one corner or along one edge, rocking or spinning on a face, or tipping
+/// off it, moves by pivotOnFace (integrated to `tolerance`). Points near the face that approach
+/// or leave it faster than a settled body's are not of the support (they strike or part).
+Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& face,
+                                      double tolerance = 1e-9);
 
 /// Bounces on one face that accumulate: a body landing flat on a face or a side (every point of
 /// its manifold approaching at the same speed u, no slip, no spin about the normal), which the

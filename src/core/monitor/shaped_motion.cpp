@@ -111,6 +111,25 @@ Expected<ShapedMotion> ShapedMotion::create(PrincipalBody principal,
   return motion;
 }
 
+Status ShapedMotion::restartFrom(const BodyStateSample& state) {
+  const Eigen::Quaterniond orientation =
+      state.orientation.normalized() * principal_.body_from_principal;
+  auto flight = TumblingBody::create(principal_.shape, principal_.moments, state.time,
+                                     state.position, state.velocity, scene_.acceleration,
+                                     orientation, state.angular_velocity);
+  if (!flight) return flight.error();
+  flight_ = std::move(flight.value());
+  time_ = state.time;
+  for (Watched& w : obstacles_) {
+    w.clear_from = state.time;
+    w.parted = false;
+  }
+  struck_.clear();
+  lasting_.clear();
+  landed_.reset();
+  return Ok{};
+}
+
 BodyStateSample ShapedMotion::stateOn(const TumblingBody& flight, double time) const {
   BodyStateSample state;
   state.body = scene_.body;
@@ -197,6 +216,32 @@ bool ShapedMotion::leave(double horizon) {
   }
   clearUntil(time_, struck_, *apart);
   return true;
+}
+
+bool ShapedMotion::part(double horizon) {
+  if (lasting_.empty()) return false;
+  const double time = lasting_time_;
+  const double speed =
+      flight_.velocityAt(time).norm() + flight_.angularSpeedBound() * flight_.reach();
+  const double acceleration = flight_.acceleration().norm();
+  const double band = FirstContactOptions{}.manifold_band;
+  double step = std::max(band / (speed + std::sqrt(speed * speed + acceleration * band)),
+                         4 * std::numeric_limits<double>::epsilon() * std::abs(time));
+  for (; step <= 1e-3; step *= 2) {
+    const double apart = time + step;
+    bool open = true;
+    for (const ObstacleContact& c : lasting_) {
+      const SurfaceGap gap =
+          gapAt(flight_, obstacles_[c.slot].placed.placed, std::min(apart, horizon));
+      open = open && !gap.overlapping && gap.gap > 0;
+    }
+    if (open || !(apart < horizon)) {
+      clearUntil(time, lasting_, apart);
+      lasting_.clear();
+      return true;
+    }
+  }
+  return false;
 }
 
 Expected<std::pair<LastingBody, FlatFace>> ShapedMotion::lastingFace() const {

@@ -56,6 +56,9 @@ struct ShapedScene {
   std::function<Expected<double>(std::size_t obstacle)> restitution;
   std::function<Expected<double>(std::size_t obstacle)> friction;
   std::size_t body = 0;  ///< the body index its impact records name
+  /// The tolerance a tipping body's motion is integrated to (pivotOnFace): the scene's
+  /// contact_integration_tolerance.
+  double integration_tolerance = 1e-9;
 };
 
 /// A shaped body moving among obstacles from a state, flight by flight. next() finds the next
@@ -79,6 +82,11 @@ class ShapedMotion {
   double time() const { return time_; }
   const PrincipalBody& principal() const { return principal_; }
   std::size_t body() const { return scene_.body; }
+  double integrationTolerance() const { return scene_.integration_tolerance; }
+
+  /// The body's events go on from `state` (a lasting motion that ends with "resumes": another
+  /// point reaches the face, or the body leaves it), every obstacle looked at from there.
+  Status restartFrom(const BodyStateSample& state);
 
   /// The body's state at `time` on `flight` (a flight of this body): its centre's, and the body
   /// frame's orientation.
@@ -95,6 +103,12 @@ class ShapedMotion {
   /// After an impact (next() said kImpact): whether the points struck leave their obstacles
   /// (they are looked at again from there); false: the contact lasts (lastingWith()).
   bool leave(double horizon);
+
+  /// A contact found to last that is none (lastingOnFace: its points near the face all leave or
+  /// approach it faster than a settled body's, Error field "body.velocity"): its obstacles are
+  /// looked at again from the first instant their gap is open, by doubling steps from the
+  /// separation's (up to 1 ms); false where it does not open (the caller holds the body).
+  bool part(double horizon);
 
   /// The obstacles (model indices) of the contact found to last, and its manifold.
   std::vector<std::size_t> lastingWith() const;

@@ -58,6 +58,7 @@ class ShapedRun {
     scene.restitution_threshold = scene_.restitution_threshold;
     scene.restitution = [this](std::size_t o) { return restitutionWith(o); };
     scene.friction = [this](std::size_t o) { return frictionWith(o); };
+    scene.integration_tolerance = scene_.contact_integration_tolerance;
     BodyStateSample state = request_.state;
     state.body = 0;
     state.time = 0.0;
@@ -89,8 +90,11 @@ class ShapedRun {
           return finish(motion, body, horizon_);
         case ShapedMotion::Event::kGrazed:
           continue;
-        case ShapedMotion::Event::kLasting:
-          return lastingFrom(motion, body, found->time, cut);
+        case ShapedMotion::Event::kLasting: {
+          auto ended = lastingFrom(motion, body, found->time, cut);
+          if (ended) return std::move(*ended);
+          continue;  // it resumes its events
+        }
         case ShapedMotion::Event::kImpact:
           break;
       }
@@ -100,7 +104,8 @@ class ShapedRun {
       }
       if (!motion.leave(horizon_)) {
         const TumblingBody after = motion.flight();
-        return lastingFrom(motion, after, motion.time(), cut);
+        auto ended = lastingFrom(motion, after, motion.time(), cut);
+        if (ended) return std::move(*ended);
       }
     }
   }
@@ -172,9 +177,10 @@ class ShapedRun {
   /// The contact the engine found to last at `time` (on `body`'s flight): where it is on one flat
   /// face, the body moves by lastingOnFace's motion (sampled; asked again where it `stops`) to
   /// the horizon or to where that motion ends; where it is not modelled, the prediction ends
-  /// there, saying why.
-  Expected<Prediction> lastingFrom(const ShapedMotion& motion, const TumblingBody& body,
-                                   double time, std::vector<std::string>& cut) {
+  /// there, saying why. Empty where the motion ends with "resumes" (a body that tips until
+  /// another corner reaches the face, or leaves it): its events go on from there.
+  std::optional<Expected<Prediction>> lastingFrom(ShapedMotion& motion, const TumblingBody& body,
+                                                  double time, std::vector<std::string>& cut) {
     const std::vector<std::size_t> with = motion.lastingWith();
     auto face = motion.lastingFace();
     if (!face) {
@@ -182,8 +188,11 @@ class ShapedRun {
       return finish(motion, body, time);
     }
     LastingBody on = face->first;
-    for (;;) {
-      auto lasting = lastingOnFace(on, face->second);
+    for (bool first = true;; first = false) {
+      auto lasting = lastingOnFace(on, face->second, motion.integrationTolerance());
+      if (!lasting && first && lasting.error().field == "body.velocity" && motion.part(horizon_)) {
+        return std::nullopt;  // no lasting contact: its points part from the face
+      }
       if (!lasting) {
         cut.push_back(lastingContact(with, on.time, lasting.error().message()));
         BodyStateSample state;
@@ -197,6 +206,15 @@ class ShapedRun {
       const LastingMotion& along = *lasting;
       const double until = std::min(along.until, horizon_);
       sampleUntil(on.time, until, [&](double t) { return stateOn(along, t); });
+      if (until < horizon_ && along.ends == "resumes" && until != resumed_at_) {
+        resumed_at_ = until;  // once at an instant: a tipping that ends again there is cut
+        const BodyStateSample there = stateOn(along, until);
+        if (Status status = motion.restartFrom(there); !status) {
+          return Expected<Prediction>(status.error());
+        }
+        rests_from_.reset();
+        return std::nullopt;
+      }
       if (until >= horizon_ || along.ends != "stops") {
         if (until < horizon_) {
           cut.push_back("the body's lasting contact with '" + model_.obstacle(with.front()).id +
@@ -212,7 +230,7 @@ class ShapedRun {
           record.normal = -face->second.normal;
           record.normal_force = force.normal_force;
           record.friction_force = -force.friction_force;
-          record.state = along.state;
+          record.state = along.stateAt(until);
           // After a flat landing whose bounces accumulate, the contact lasts from their end (as
           // a ball's: doc/model.md, "Coming to rest").
           record.since = rests_from_ ? *rests_from_ : time;
@@ -261,7 +279,7 @@ class ShapedRun {
   Expected<Prediction> finishWith(const ShapedMotion& motion, const BodyStateSample& state) {
     prediction_.final_state = state;
     if (const auto frictionless_at = motion.frictionlessAt()) {
-      extra_.push_back(
+      notes_.push_back(
           "friction at several points struck at once (a face or an edge landing, "
           "first at +" +
           formatNumber(*frictionless_at) +
@@ -271,7 +289,7 @@ class ShapedRun {
   }
 
  public:
-  std::vector<std::string> extra_;
+  std::vector<std::string> notes_;
 
  private:
   const PredictionRequest& request_;
@@ -284,6 +302,7 @@ class ShapedRun {
   double horizon_ = 0.0, period_ = 0.0;
   std::size_t max_impacts_ = 0;
   std::optional<double> rests_from_;  // the last impact's flat bounces accumulate then
+  double resumed_at_ = -std::numeric_limits<double>::infinity();  // a tipping's last "resumes"
 };
 
 }  // namespace
@@ -297,7 +316,11 @@ Expected<Prediction> runShapedPrediction(const PredictionStart& start,
   ShapedRun run(start, budget, began, *model, std::move(principal.value()));
   auto prediction = run.run(cut);
   if (!prediction) return prediction;
-  cut.insert(cut.end(), run.extra_.begin(), run.extra_.end());
+  // What the model simplified on the way (friction left out of impacts at several points) is
+  // said in the message; it does not cut the prediction short.
+  for (const std::string& note : run.notes_) {
+    prediction.value().message += (prediction.value().message.empty() ? "" : "; ") + note;
+  }
   prediction.value().model = std::move(model);
   return prediction;
 }

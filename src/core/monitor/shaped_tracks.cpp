@@ -31,6 +31,7 @@ ShapedScene shapedScene(const World& world, std::size_t body) {
   scene.acceleration = world.gravity;
   scene.restitution_threshold = world.restitution_threshold;
   scene.body = body;
+  scene.integration_tolerance = world.integration_tolerance;
   std::vector<double> restitution, friction;
   for (std::size_t o = 0; o < world.obstacles.size(); ++o) {
     const Pair pair{body, world.bodyCount() + o};
@@ -123,6 +124,24 @@ void ShapedTrack::advanceTo(double time, std::vector<ImpactRecord>& impacts,
         }
         continue;
       }
+      if (ends == "resumes") {
+        // Another point reaches the face, or the body leaves it: its events go on from there
+        // (once at an instant: a tipping that ends again where it resumed is held).
+        if (until == resumed_at_) {
+          hold(there, *against_, "its tipping ends where it starts", unmodelled);
+          return;
+        }
+        resumed_at_ = until;
+        if (Status status = motion_.restartFrom(there); !status) {
+          hold(there, *against_, status.error().message(), unmodelled);
+          return;
+        }
+        mode_ = Mode::kFlying;
+        lasting_.reset();
+        since_ = until;
+        rests_from_.reset();
+        continue;
+      }
       hold(there, *against_, ends, unmodelled);
       return;
     }
@@ -178,7 +197,11 @@ void ShapedTrack::enterLasting(double time, std::vector<UnmodelledContact>& unmo
 void ShapedTrack::startLasting(const LastingBody& body, const FlatFace& face,
                                std::vector<UnmodelledContact>& unmodelled) {
   const std::size_t obstacle = against_.value_or(0);
-  auto motion = lastingOnFace(body, face);
+  auto motion = lastingOnFace(body, face, motion_.integrationTolerance());
+  if (!motion && mode_ == Mode::kFlying && motion.error().field == "body.velocity" &&
+      motion_.part(kInfinity)) {
+    return;  // no lasting contact: its points part from the face, and the flight goes on
+  }
   if (!motion) {
     BodyStateSample state;
     state.body = motion_.body();
@@ -254,7 +277,7 @@ std::vector<ContactRecord> ShapedTrack::contacts(double time) const {
     record.normal = -face_.normal;  // from the body into the face
     record.normal_force = force.normal_force;
     record.friction_force = -force.friction_force;  // on the face
-    record.state = lasting_->state;
+    record.state = lasting_->stateAt(time);
     record.since = lasting_since_;
     records.push_back(record);
   }

@@ -1,0 +1,679 @@
+// A body tipping over one or two corners on a flat face (shaped_pivot.h).
+//
+// The body (mass m, inertia I = R diag(moments) R^T in the world) touches the face (normal n)
+// at points r_i from its centre. With forces f_i there,
+//   a = g + sum f_i / m,   I w' = sum r_i x f_i - w x I w,
+// and a point's acceleration is a + w' x r_i + w x (w x r_i). A sticking point's acceleration
+// is 0 (three conditions, its force three unknowns); a sliding point's normal acceleration is
+// 0, its force N_i (n - mu s_hat_i) (one unknown: Coulomb's law, against its slip s_i). The
+// conditions are linear in the unknowns; where they do not fix them (two sticking points: the
+// forces along the edge), the least-norm ones (doc/model.md, "Tipping over a corner or an
+// edge"). The state (orientation, w, centre, v) is integrated by the Dormand-Prince 5(4) pair
+// with dense output (Boost.Odeint); the events are found on the dense output by bisection.
+#include "contact/shaped_pivot.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <array>
+#include <boost/numeric/odeint.hpp>
+#include <cmath>
+#include <exception>
+#include <functional>
+#include <limits>
+#include <optional>
+#include <string>
+#include <variant>
+
+#include "collision_response/core/validation.h"
+#include "geometry/convex_distance.h"
+
+namespace collision_response::core {
+
+namespace {
+
+using Vec = Eigen::Vector3d;
+using State = std::array<double, 13>;  // orientation (w, x, y, z), w, centre, velocity
+using Stepper = boost::numeric::odeint::runge_kutta_dopri5<State>;
+using Dense = boost::numeric::odeint::result_of::make_dense_output<Stepper>::type;
+
+/// Steps one motion may take before it is asked again from where it is ("stops").
+constexpr std::size_t kMaxSteps = 1u << 14;
+constexpr double kSlipStops = kPivotSlipStops;
+/// Bisection of an event on the dense output: to this part of the instant (or of 1 s).
+constexpr double kEventResolution = 1e-13;
+
+Error notYet(const std::string& what) { return Error{"contact", "not yet: " + what}; }
+
+/// One point touching: a corner of the body (principal frame) and how it moves.
+struct Point {
+  Vec corner = Vec::Zero();
+  bool sliding = false;
+  /// Unit, in the face: the slip's direction while it is too slow to give one (its onset).
+  Vec direction = Vec::Zero();
+};
+
+/// The body and the face, fixed over the motion.
+struct Setting {
+  Vec moments = Vec::Ones();
+  double mass = 0.0;
+  Vec gravity = Vec::Zero();
+  FlatFace face;
+  Vec n, e1, e2;
+  double mu = 0.0;
+  std::vector<Vec> corners;  // every corner of the body (principal frame)
+};
+
+struct Kinematics {
+  Eigen::Quaterniond orientation;
+  Eigen::Matrix3d rotation;
+  Vec centre, velocity, spin;
+};
+
+Kinematics unpack(const State& y) {
+  Kinematics k;
+  k.orientation = Eigen::Quaterniond(y[0], y[1], y[2], y[3]).normalized();
+  k.rotation = k.orientation.toRotationMatrix();
+  k.spin = Vec(y[4], y[5], y[6]);
+  k.centre = Vec(y[7], y[8], y[9]);
+  k.velocity = Vec(y[10], y[11], y[12]);
+  return k;
+}
+
+State pack(const Kinematics& k) {
+  const Eigen::Quaterniond& q = k.orientation;
+  return {q.w(),          q.x(),          q.y(),         q.z(),        k.spin.x(),
+          k.spin.y(),     k.spin.z(),     k.centre.x(),  k.centre.y(), k.centre.z(),
+          k.velocity.x(), k.velocity.y(), k.velocity.z()};
+}
+
+/// A point's velocity's part in the face.
+Vec slipOf(const Setting& s, const Kinematics& k, const Point& p) {
+  const Vec u = k.velocity + k.spin.cross(k.rotation * p.corner);
+  return u - u.dot(s.n) * s.n;
+}
+
+/// The forces and accelerations of the body with its points as `points` say.
+struct Dynamics {
+  Vec acceleration = Vec::Zero();
+  Vec angular_acceleration = Vec::Zero();
+  std::vector<Vec> forces;
+};
+
+/// The unknowns' directions of the points (a sticking point's n, e1, e2; a sliding point's
+/// n - mu s_hat), each with its point's index.
+std::vector<std::pair<std::size_t, Vec>> columnsOf(const Setting& s, const Kinematics& k,
+                                                   const std::vector<Point>& points, double still) {
+  std::vector<std::pair<std::size_t, Vec>> columns;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (points[i].sliding) {
+      // The slip's direction; below `still`, turned continuously towards the point's given one
+      // (its onset's), which it is at 0.
+      const Vec slip = slipOf(s, k, points[i]);
+      const double speed = slip.norm();
+      const Vec towards = speed >= still ? slip : Vec(slip + (still - speed) * points[i].direction);
+      const double length = towards.norm();
+      const Vec direction = length > 0 ? Vec(towards / length) : points[i].direction;
+      columns.emplace_back(i, s.n - s.mu * direction);
+    } else {
+      columns.emplace_back(i, s.n);
+      columns.emplace_back(i, s.e1);
+      columns.emplace_back(i, s.e2);
+    }
+  }
+  return columns;
+}
+
+/// Rows of the conditions on the points (a sticking point's three, a sliding point's normal),
+/// given what each unknown (`columns`) does at a point per unit, and `free` per point (the
+/// points' acceleration or velocity without the forces): solved least-norm, the forces per point.
+std::vector<Vec> solveConditions(const Setting& s, const Kinematics& k,
+                                 const std::vector<Point>& points,
+                                 const std::vector<std::pair<std::size_t, Vec>>& columns,
+                                 const std::vector<Vec>& free,
+                                 const Eigen::Matrix3d& inverse_inertia) {
+  std::vector<Vec> levers;
+  for (const Point& p : points) levers.push_back(k.rotation * p.corner);
+  std::vector<std::pair<std::size_t, Vec>> rows;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    rows.emplace_back(i, s.n);
+    if (!points[i].sliding) {
+      rows.emplace_back(i, s.e1);
+      rows.emplace_back(i, s.e2);
+    }
+  }
+  Eigen::MatrixXd a(rows.size(), columns.size());
+  Eigen::VectorXd b(rows.size());
+  for (std::size_t c = 0; c < columns.size(); ++c) {
+    const auto& [j, force] = columns[c];
+    const Vec turn = inverse_inertia * levers[j].cross(force);
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      const auto& [i, along] = rows[r];
+      a(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) =
+          along.dot(force / s.mass + turn.cross(levers[i]));
+    }
+  }
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    b(static_cast<Eigen::Index>(r)) = -rows[r].second.dot(free[rows[r].first]);
+  }
+  const Eigen::VectorXd x = a.completeOrthogonalDecomposition().solve(b);
+  std::vector<Vec> forces(points.size(), Vec::Zero());
+  for (std::size_t c = 0; c < columns.size(); ++c) {
+    forces[columns[c].first] += x(static_cast<Eigen::Index>(c)) * columns[c].second;
+  }
+  return forces;
+}
+
+Dynamics dynamicsOf(const Setting& s, const Kinematics& k, const std::vector<Point>& points) {
+  const Eigen::Matrix3d inertia = k.rotation * s.moments.asDiagonal() * k.rotation.transpose();
+  const Eigen::Matrix3d inverse_inertia =
+      k.rotation * s.moments.cwiseInverse().asDiagonal() * k.rotation.transpose();
+  const Vec gyroscopic = -inverse_inertia * k.spin.cross(inertia * k.spin);
+  std::vector<Vec> free;
+  for (const Point& p : points) {
+    const Vec r = k.rotation * p.corner;
+    free.push_back(s.gravity + gyroscopic.cross(r) + k.spin.cross(k.spin.cross(r)));
+  }
+  Dynamics d;
+  d.forces =
+      solveConditions(s, k, points, columnsOf(s, k, points, kSlipStops), free, inverse_inertia);
+  Vec total = Vec::Zero(), moment = Vec::Zero();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    total += d.forces[i];
+    moment += (k.rotation * points[i].corner).cross(d.forces[i]);
+  }
+  d.acceleration = s.gravity + total / s.mass;
+  d.angular_acceleration = gyroscopic + inverse_inertia * moment;
+  return d;
+}
+
+void derivative(const Setting& s, const std::vector<Point>& points, const State& y, State& rate) {
+  const Kinematics k = unpack(y);
+  const Dynamics d = dynamicsOf(s, k, points);
+  const Eigen::Quaterniond q(y[0], y[1], y[2], y[3]);
+  // q' = (0, w) q / 2 (w in the world).
+  const Eigen::Quaterniond turn(0.0, 0.5 * k.spin.x(), 0.5 * k.spin.y(), 0.5 * k.spin.z());
+  const Eigen::Quaterniond q_rate = turn * q;
+  rate = {q_rate.w(),
+          q_rate.x(),
+          q_rate.y(),
+          q_rate.z(),
+          d.angular_acceleration.x(),
+          d.angular_acceleration.y(),
+          d.angular_acceleration.z(),
+          k.velocity.x(),
+          k.velocity.y(),
+          k.velocity.z(),
+          d.acceleration.x(),
+          d.acceleration.y(),
+          d.acceleration.z()};
+}
+
+/// The points' normal motion, and the slip of those that stick, taken out by one plastic
+/// impulse (least-norm where the conditions do not fix it).
+Kinematics settle(const Setting& s, Kinematics k, const std::vector<Point>& points) {
+  const Eigen::Matrix3d inverse_inertia =
+      k.rotation * s.moments.cwiseInverse().asDiagonal() * k.rotation.transpose();
+  std::vector<Vec> free;
+  for (const Point& p : points) {
+    free.push_back(k.velocity + k.spin.cross(k.rotation * p.corner));
+  }
+  std::vector<Point> frictionless = points;
+  Setting plain = s;
+  plain.mu = 0.0;  // a sliding point's impulse is along n: it takes out a settled normal motion
+  const std::vector<Vec> impulses =
+      solveConditions(plain, k, frictionless, columnsOf(plain, k, frictionless, kLastingStillSpeed),
+                      free, inverse_inertia);
+  Vec total = Vec::Zero(), moment = Vec::Zero();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    total += impulses[i];
+    moment += (k.rotation * points[i].corner).cross(impulses[i]);
+  }
+  k.velocity += total / s.mass;
+  k.spin += inverse_inertia * moment;
+  return k;
+}
+
+/// The height of the body's point `corner` above the face.
+double heightOf(const Setting& s, const Kinematics& k, const Vec& corner) {
+  return s.n.dot(k.centre + k.rotation * corner - s.face.point);
+}
+
+/// How far a sticking point's force is within its cone (mu N, to the solve's rounding): < 0
+/// outside. The sticking's event and the modes' choice both read it.
+double coneMargin(const Setting& s, const Vec& force) {
+  const double normal = force.dot(s.n);
+  const double across = (force - normal * s.n).norm();
+  return s.mu * normal + 1e-12 * std::abs(normal) - across;
+}
+
+/// The direction in the face a sticking point `which` starts to slip in: where its acceleration
+/// in the face, with friction mu N against it, is along it (Coulomb's law at the onset), found
+/// over the angle by bisection; empty where there is none.
+std::optional<Vec> slipOnset(const Setting& s, const Kinematics& k, std::vector<Point> points,
+                             std::size_t which) {
+  points[which].sliding = true;
+  const auto along = [&](double angle) {
+    points[which].direction = std::cos(angle) * s.e1 + std::sin(angle) * s.e2;
+    const Dynamics d = dynamicsOf(s, k, points);
+    const Vec r = k.rotation * points[which].corner;
+    const Vec a = d.acceleration + d.angular_acceleration.cross(r) + k.spin.cross(k.spin.cross(r));
+    const Vec in_face = a - a.dot(s.n) * s.n;
+    return std::make_pair(in_face.cross(points[which].direction).dot(s.n),
+                          in_face.dot(points[which].direction));
+  };
+  constexpr int kSamples = 72;
+  constexpr double kTurn = 6.283185307179586;
+  double previous_angle = 0.0;
+  auto previous = along(0.0);
+  for (int i = 1; i <= kSamples; ++i) {
+    const double angle = kTurn * i / kSamples;
+    const auto now = along(angle);
+    if ((previous.first <= 0) != (now.first <= 0)) {
+      double lo = previous_angle, hi = angle;
+      const bool rising = previous.first <= 0;
+      for (int b = 0; b < 60; ++b) {
+        const double mid = 0.5 * (lo + hi);
+        if ((along(mid).first <= 0) == rising) {
+          lo = mid;
+        } else {
+          hi = mid;
+        }
+      }
+      const double root = 0.5 * (lo + hi);
+      if (along(root).second > 0) return Vec(std::cos(root) * s.e1 + std::sin(root) * s.e2);
+    }
+    previous = now;
+    previous_angle = angle;
+  }
+  return std::nullopt;
+}
+
+/// The points' modes at a state, from what `points` say (sliding or not): a sticking point
+/// whose force is outside the cone slides from its onset direction, and a point whose normal
+/// force would be negative leaves (dropped). An Error where the onset has no direction.
+Expected<std::vector<Point>> modesAt(const Setting& s, const Kinematics& k,
+                                     std::vector<Point> points) {
+  // Each round drops a point or sets one sliding (none comes back): at most two per point.
+  const std::size_t rounds = 2 * points.size() + 1;
+  for (std::size_t round = 0; round < rounds; ++round) {
+    const Dynamics d = dynamicsOf(s, k, points);
+    bool changed = false;
+    for (std::size_t i = 0; i < points.size() && !changed; ++i) {
+      if (d.forces[i].dot(s.n) < 0) {
+        points.erase(points.begin() + static_cast<std::ptrdiff_t>(i));
+        changed = true;
+      } else if (!points[i].sliding && coneMargin(s, d.forces[i]) < 0) {
+        const auto onset = slipOnset(s, k, points, i);
+        if (!onset) return notYet("a corner starting to slip with no direction of onset");
+        points[i].sliding = true;
+        points[i].direction = *onset;
+        changed = true;
+      }
+    }
+    if (!changed || points.empty()) return points;
+  }
+  return notYet("a tipping whose corners' sticking and sliding do not settle");
+}
+
+}  // namespace
+
+/// The path's steps: each a copy of the dense stepper after it (its dense output covers it), with
+/// the points touching over it.
+struct PivotPath::Steps {
+  Setting setting;
+  double start = 0.0;
+  double until = 0.0;
+  Kinematics initial;
+  std::vector<Point> initial_points;
+  /// The state from `until` on where the motion ends at rest on a face (every corner sticking,
+  /// its last slip taken out): the closed forms take it from there.
+  std::optional<Kinematics> final;
+  struct Step {
+    Dense dense;
+    double to = 0.0;     // the step holds over (dense.previous_time(), to]
+    std::size_t points;  // into modes
+  };
+  std::vector<Step> steps;
+  std::vector<std::vector<Point>> modes;
+};
+
+PivotPath::PivotPath(std::unique_ptr<Steps> steps) : steps_(std::move(steps)) {}
+PivotPath::~PivotPath() = default;
+double PivotPath::start() const { return steps_->start; }
+double PivotPath::until() const { return steps_->until; }
+std::size_t PivotPath::steps() const { return steps_->steps.size(); }
+
+PivotState PivotPath::stateAt(double t) const {
+  const Steps& path = *steps_;
+  const double time = std::clamp(t, path.start, path.until);
+  Kinematics k = path.initial;
+  const std::vector<Point>* points = &path.initial_points;
+  if (path.final && time >= path.until) {
+    k = *path.final;
+    points = &path.modes.back();
+  }
+  const auto covering =
+      std::lower_bound(path.steps.begin(), path.steps.end(), time,
+                       [](const Steps::Step& step, double at) { return step.to < at; });
+  if (!path.steps.empty() && time > path.start && !(path.final && time >= path.until)) {
+    const Steps::Step& step = covering == path.steps.end() ? path.steps.back() : *covering;
+    State y;
+    step.dense.calc_state(std::clamp(time, step.dense.previous_time(), step.to), y);
+    k = unpack(y);
+    points = &path.modes[step.points];
+  }
+  const Setting& s = path.setting;
+  // The lowest corner exactly on the face: the integration's drift of the points' height (within
+  // its tolerance) is taken out along n, and no corner is below the face (one that reaches it
+  // ends the motion: its events take over from a body touching, never overlapping).
+  double lowest = std::numeric_limits<double>::infinity();
+  for (const Vec& corner : s.corners) lowest = std::min(lowest, heightOf(s, k, corner));
+  k.centre -= lowest * s.n;
+  PivotState state;
+  state.centre = k.centre;
+  state.velocity = k.velocity;
+  state.angular_velocity = k.spin;
+  state.orientation = k.orientation;
+  const Dynamics d = dynamicsOf(s, k, *points);
+  bool sliding = false;
+  for (std::size_t i = 0; i < points->size(); ++i) {
+    const Point& p = (*points)[i];
+    sliding = sliding || p.sliding;
+    SupportForce force;
+    const Vec at = k.centre + k.rotation * p.corner;
+    force.point = at - s.n.dot(at - s.face.point) * s.n;
+    force.normal_force = d.forces[i].dot(s.n);
+    force.friction_force = d.forces[i] - force.normal_force * s.n;
+    state.forces.push_back(force);
+  }
+  state.state = sliding ? ContactState::kSliding : ContactState::kRolling;
+  return state;
+}
+
+Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& face,
+                                    const std::vector<Eigen::Vector3d>& corners, double tolerance,
+                                    double horizon) {
+  if (corners.empty() || corners.size() > 4) {
+    return Error{"corners", "must be one to four of the body's corners, got " +
+                                std::to_string(corners.size())};
+  }
+  if (!(tolerance > 0 && std::isfinite(tolerance))) {
+    return Error{"tolerance", "must be finite and > 0, got " + formatNumber(tolerance)};
+  }
+  auto path = std::make_unique<PivotPath::Steps>();
+  Setting& s = path->setting;
+  s.moments = body.moments;
+  s.mass = body.mass;
+  s.gravity = body.gravity;
+  s.face = face;
+  s.n = face.normal.normalized();
+  s.e1 = s.n.unitOrthogonal();
+  s.e2 = s.n.cross(s.e1);
+  s.mu = face.friction;
+  std::vector<Vec> all;
+  contactCandidates(body.shape, -Vec::UnitZ(), all);
+  if (const auto* box = std::get_if<Cuboid>(&body.shape)) {
+    all.clear();
+    for (int c = 0; c < 8; ++c) {
+      all.push_back(Vec((c & 1) ? 1.0 : -1.0, (c & 2) ? 1.0 : -1.0, (c & 4) ? 1.0 : -1.0)
+                        .cwiseProduct(box->half_size));
+    }
+  } else if (const auto* hull = std::get_if<ConvexHull>(&body.shape)) {
+    all = hull->vertices;
+  } else {
+    return notYet("tipping of a body with no corners (a cylinder's rim, a capsule's end)");
+  }
+  s.corners = all;
+
+  std::vector<Point> points;
+  for (const Vec& corner : corners) points.push_back({corner, false, Vec::Zero()});
+  const auto slipping = [&s](const Kinematics& at, std::vector<Point>& touching) {
+    for (Point& p : touching) {
+      const Vec slip = slipOf(s, at, p);
+      p.sliding = s.mu == 0.0 || slip.norm() > kLastingStillSpeed;
+      p.direction = slip.norm() > kLastingStillSpeed ? Vec(slip.normalized()) : s.e1;
+    }
+  };
+  Kinematics k;
+  k.orientation = body.orientation.normalized();
+  k.rotation = k.orientation.toRotationMatrix();
+  k.centre = body.centre;
+  k.velocity = body.velocity;
+  k.spin = body.angular_velocity;
+  // A point slipping keeps its slip; the others' (below kLastingStillSpeed) is taken out.
+  slipping(k, points);
+  k = settle(s, k, points);
+  auto modes = modesAt(s, k, points);
+  if (!modes) return modes.error();
+  points = modes.value();
+  if (points.empty()) {
+    return notYet("the body leaves the face from the corner it touches (its normal force < 0)");
+  }
+  path->start = body.time;
+  path->initial = k;
+  path->initial_points = points;
+  path->modes.push_back(points);
+
+  LastingMotion motion;
+  motion.start = body.time;
+  const double end = body.time + horizon;
+  double t = body.time;
+  State y = pack(k);
+  std::size_t mode = 0;
+  std::string ends = "stops";
+  double until = end;
+  std::size_t taken = 0;
+  bool finished = false;
+  while (!finished) {
+    const std::vector<Point> current = path->modes[mode];
+    const auto system = [&s, &current](const State& x, State& rate, double) {
+      derivative(s, current, x, rate);
+    };
+    // Each corner's height over the lowest point touching (the one stateAt puts on the face):
+    // their drift is not a corner's approach. A corner below it at the segment's start (one that
+    // just left) reaches the face where it comes back 1e-12 m below where it was.
+    const auto above = [&s, &current](const Kinematics& x, const Vec& corner) {
+      double base = std::numeric_limits<double>::infinity();
+      for (const Point& p : current) base = std::min(base, heightOf(s, x, p.corner));
+      return heightOf(s, x, corner) - base;
+    };
+    std::vector<double> below;
+    for (const Vec& corner : s.corners) {
+      below.push_back(std::min(0.0, above(unpack(y), corner)));
+    }
+    Dense dense = boost::numeric::odeint::make_dense_output(tolerance, tolerance, Stepper());
+    dense.initialize(y, t, 1e-4);
+    for (;;) {
+      if (++taken > kMaxSteps) {
+        until = t;
+        finished = true;
+        break;
+      }
+      try {
+        dense.do_step(system);
+      } catch (const std::exception&) {
+        return Error{"contact", "the tipping motion could not be integrated past +" +
+                                    formatNumber(t - body.time) + " s"};
+      }
+      const double t0 = dense.previous_time();
+      const double t1 = std::min(dense.current_time(), end);
+      const auto at = [&](double time) {
+        State x;
+        dense.calc_state(time, x);
+        return unpack(x);
+      };
+      // The events: each a function of the state that reaches <= 0, and what it does.
+      enum class What { kCorner, kLeaves, kSlips, kSticks, kEdge };
+      struct Event {
+        What what;
+        std::size_t point;
+        std::function<double(const Kinematics&)> value;
+      };
+      std::vector<Event> events;
+      for (std::size_t c = 0; c < s.corners.size(); ++c) {
+        const Vec& corner = s.corners[c];
+        bool touching = false;
+        for (const Point& p : current) touching = touching || (p.corner - corner).norm() == 0.0;
+        if (touching) continue;
+        const double level = below[c] < 0 ? below[c] - 1e-12 : 0.0;
+        events.push_back({What::kCorner, 0, [&above, corner, level](const Kinematics& x) {
+                            return above(x, corner) - level;
+                          }});
+      }
+      for (std::size_t i = 0; i < current.size(); ++i) {
+        events.push_back({What::kLeaves, i, [&s, &current, i](const Kinematics& x) {
+                            return dynamicsOf(s, x, current).forces[i].dot(s.n);
+                          }});
+        if (!current[i].sliding) {
+          // Bisected to where the margin is < 0: there the modes' choice slides it.
+          events.push_back({What::kSlips, i, [&s, &current, i](const Kinematics& x) {
+                              const double margin =
+                                  coneMargin(s, dynamicsOf(s, x, current).forces[i]);
+                              return margin < 0 ? margin : std::max(margin, 1e-300);
+                            }});
+        } else if (s.mu > 0) {
+          // Its slip stops: it falls to kSlipStops (its direction would turn ever faster as it
+          // passes near 0); a slip just begun (slower at the step's start) stops where its part
+          // along the onset's direction falls below -kLastingStillSpeed.
+          const Vec before = slipOf(s, at(t0), current[i]);
+          if (before.norm() > kSlipStops) {
+            events.push_back({What::kSticks, i, [&s, &current, i](const Kinematics& x) {
+                                return slipOf(s, x, current[i]).norm() - kSlipStops;
+                              }});
+          } else {
+            const Vec reference = before.norm() > kLastingStillSpeed ? Vec(before.normalized())
+                                                                     : current[i].direction;
+            events.push_back({What::kSticks, i, [&s, &current, i, reference](const Kinematics& x) {
+                                return slipOf(s, x, current[i]).dot(reference) + kLastingStillSpeed;
+                              }});
+          }
+        }
+        if (face.bounded) {
+          events.push_back(
+              {What::kEdge, i, [&face, &current, i](const Kinematics& x) {
+                 const Vec offset = x.centre + x.rotation * current[i].corner - face.point;
+                 return std::min(
+                     face.half_extent.x() + kLastingBand - std::abs(offset.dot(face.along_u)),
+                     face.half_extent.y() + kLastingBand - std::abs(offset.dot(face.along_v)));
+               }});
+        }
+      }
+      std::optional<std::pair<double, std::size_t>> first;
+      for (std::size_t e = 0; e < events.size(); ++e) {
+        if (events[e].value(at(t1)) > 0) continue;
+        if (events[e].value(at(t0)) <= 0) {
+          // Already at its start (a point that left at once, a corner touching as it began).
+          first = std::make_pair(t0, e);
+          break;
+        }
+        double lo = t0, hi = t1;
+        while (hi - lo > kEventResolution * std::max(1.0, std::abs(hi))) {
+          const double mid = 0.5 * (lo + hi);
+          if (events[e].value(at(mid)) > 0) {
+            lo = mid;
+          } else {
+            hi = mid;
+          }
+        }
+        if (!first || hi < first->first) first = std::make_pair(hi, e);
+      }
+      path->steps.push_back({dense, first ? first->first : t1, mode});
+      if (!first) {
+        t = t1;
+        if (t1 >= end) {
+          until = end;
+          finished = true;
+          break;
+        }
+        continue;
+      }
+      const Event& event = events[first->second];
+      const double when = first->first;
+      Kinematics there = at(when);
+      until = when;
+      t = when;
+      if (event.what == What::kCorner) {
+        ends = "resumes";
+        finished = true;
+        break;
+      }
+      if (event.what == What::kEdge) {
+        ends = "a point of its support reaches the face's edge";
+        finished = true;
+        break;
+      }
+      if (when <= path->start && event.what != What::kSticks) {
+        return notYet("the tipping's contact changes at once where it starts");
+      }
+      std::vector<Point> next = current;
+      if (event.what == What::kLeaves) {
+        next.erase(next.begin() + static_cast<std::ptrdiff_t>(event.point));
+      } else if (event.what == What::kSticks) {
+        next[event.point].sliding = false;
+        // A face's corners (three or more) stop slipping together (Goyal, Ruina and
+        // Papadopoulos, Wear 143:307, 1991: a planar slide's translation and turning stop at the
+        // same instant): where every one slips slower than 100 kSlipStops, all stick.
+        double fastest = 0.0;
+        for (const Point& p : next) fastest = std::max(fastest, slipOf(s, there, p).norm());
+        if (next.size() >= 3 && fastest <= 100 * kSlipStops) {
+          for (Point& p : next) p.sliding = false;
+        }
+        there = settle(s, there, next);  // the slip's rounding left at its stop
+      } else {
+        auto onset = slipOnset(s, there, next, event.point);
+        if (!onset) {
+          ends = "a corner starting to slip with no direction of onset";
+          finished = true;
+          break;
+        }
+        next[event.point].sliding = true;
+        next[event.point].direction = *onset;
+      }
+      if (next.empty()) {
+        ends = "resumes";
+        finished = true;
+        break;
+      }
+      auto settled = modesAt(s, there, next);
+      if (!settled) {
+        ends = settled.error().reason;
+        finished = true;
+        break;
+      }
+      if (settled->empty()) {  // its last point leaves the face
+        ends = "resumes";
+        finished = true;
+        break;
+      }
+      if (settled->size() >= 3 && std::none_of(settled->begin(), settled->end(),
+                                               [](const Point& p) { return p.sliding; })) {
+        // A face whose every corner sticks: it rests, as the closed forms say (lastingOnFace),
+        // its last slip (within the event's resolution) taken out.
+        path->modes.push_back(settled.value());
+        path->final = settle(s, there, settled.value());
+        ends = "stops";
+        finished = true;
+        break;
+      }
+      path->modes.push_back(settled.value());
+      mode = path->modes.size() - 1;
+      y = pack(there);
+      break;
+    }
+  }
+  path->until = until;
+  auto pivot = std::make_shared<const PivotPath>(std::move(path));
+  const PivotState first_state = pivot->stateAt(body.time);
+  motion.state = first_state.state;
+  motion.until = until;
+  motion.ends = ends;
+  motion.centre0 = first_state.centre;
+  motion.velocity0 = first_state.velocity;
+  motion.angular_velocity0 = first_state.angular_velocity;
+  motion.orientation0 = first_state.orientation;
+  motion.forces = first_state.forces;
+  motion.pivot = pivot;
+  return motion;
+}
+
+}  // namespace collision_response::core

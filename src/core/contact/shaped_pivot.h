@@ -1,0 +1,71 @@
+// A shaped body tipping over one or two of its corners on one flat face (issue 42, build step 6):
+// a box (or a hull) that touches the face at one corner or along one edge, pivoting under gravity
+// until another corner reaches the face, it leaves the face, or a corner reaches a bounded face's
+// edge. Each point sticks (static friction within mu) or slides (Coulomb); the motion has no
+// closed form (a heavy top about a fixed point, a physical pendulum about an edge) and is
+// integrated to a stated tolerance (doc/model.md, "Tipping over a corner or an edge").
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <memory>
+#include <vector>
+
+#include "collision_response/core/expected.h"
+#include "collision_response/core/monitor.h"
+#include "contact/shaped_lasting.h"
+
+namespace collision_response::core {
+
+/// m/s: a point's slip that falls to it has stopped: the point sticks where its force is within
+/// the cone (the slip left taken out by a plastic impulse), else slips anew from Coulomb's onset
+/// direction. Near 0 the slip's direction, and the friction with it, turns at |a| / |slip|: the
+/// integration would crawl. Below it a slip just begun takes its friction's direction turned
+/// continuously from its onset's to its own (doc/model.md, "Tipping over a corner or an edge").
+constexpr double kPivotSlipStops = 1e-6;
+
+/// What the path gives at an instant of [start, until].
+struct PivotState {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< world from principal
+  ContactState state = ContactState::kRolling;  ///< every point sticking, or one sliding
+  std::vector<SupportForce> forces;             ///< at the points touching
+};
+
+/// The integrated path of a tipping body (pivotOnFace): dense output over [start, until].
+class PivotPath {
+ public:
+  struct Steps;
+  explicit PivotPath(std::unique_ptr<Steps> steps);
+  ~PivotPath();
+  PivotPath(const PivotPath&) = delete;
+  PivotPath& operator=(const PivotPath&) = delete;
+
+  /// The state at `t` (clamped to [start, until]); the points touching exactly on the face.
+  PivotState stateAt(double t) const;
+  double start() const;
+  double until() const;
+  /// The accepted steps of the integration (its cost).
+  std::size_t steps() const;
+
+ private:
+  std::unique_ptr<Steps> steps_;
+};
+
+/// The body touching `face` at `corners` (one, or two: an edge; in its principal frame, each
+/// within kLastingBand of the face) tipping under gravity, integrated with the Dormand-Prince
+/// pair to `tolerance` (absolute and relative). At its start the normal motion of the points
+/// (settled: kLastingSettled) and the slip of a point slower than kLastingStillSpeed are taken
+/// out by a plastic impulse (energy lost, never gained). Then each point sticks while the force
+/// that holds it is within mu of its normal force, and slides (friction mu N against its slip)
+/// otherwise; a point whose normal force reaches 0 leaves. The motion ends (`until`, `ends`)
+/// where another corner of the body reaches the face or the last point leaves it ("resumes":
+/// the body's events take over from the state there), where a point reaches a bounded face's
+/// edge (not modelled yet), or after `horizon` seconds ("stops": asked again from there).
+Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& face,
+                                    const std::vector<Eigen::Vector3d>& corners, double tolerance,
+                                    double horizon = 10.0);
+
+}  // namespace collision_response::core
