@@ -259,6 +259,38 @@ TEST(ShapedPivot, ABoxSpinningFlatStopsTurningAtOmegaOverAlpha) {
   expectSound(body, floor, *motion, 1e-9);
 }
 
+TEST(ShapedPivot, ACornerLiftedByItsTurningFliesItsParabolaUntilClearOfTheFace) {
+  // On one corner, its diagonal vertical (the centre d = h sqrt 3 above the corner), turning at
+  // 20 rad/s about x with the corner still: the centre's circle about the corner needs w^2 d =
+  // 34.6 m/s^2 towards the corner, more than g: the floor would have to pull, so the corner
+  // leaves at once and the body flies: its centre on the parabola c0 + v0 t + g t^2 / 2 and its
+  // spin kept (a cube's inertia is isotropic), no force, until its lowest corner is
+  // kPivotClearance of its reach (h sqrt 3) above the floor ("resumes": the certified first
+  // contact takes it from there).
+  const double half = 0.05, d = half * std::sqrt(3.0);
+  const Q diagonal_up = Q::FromTwoVectors(V(1, 1, 1).normalized(), V::UnitZ());
+  LastingBody body = cube(half, 0.4, V(0, 0, d), diagonal_up);
+  body.angular_velocity = V(20, 0, 0);
+  body.velocity = -body.angular_velocity.cross(V(0, 0, -d));  // the corner still
+  const FlatFace floor = floorWith(0.5);
+  const auto motion = lastingOnFace(body, floor, 1e-11);
+  ASSERT_TRUE(motion.ok()) << motion.error().message();
+  ASSERT_TRUE(motion->pivot);
+  EXPECT_EQ(motion->ends, "resumes");
+  for (int k = 0; k <= 50; ++k) {
+    const double t = motion->start + (motion->until - motion->start) * k / 50.0;
+    const double s = t - motion->start;
+    EXPECT_LE(
+        (motion->centreAt(t) - (body.centre + body.velocity * s + 0.5 * kDown * s * s)).norm(),
+        1e-10)
+        << "at t = " << t;
+    EXPECT_LE((motion->angularVelocityAt(t) - body.angular_velocity).norm(), 1e-8);
+    EXPECT_TRUE(motion->forcesAt(t).empty());
+  }
+  EXPECT_NEAR(lowestCorner(body, *motion, motion->until), kPivotClearance * d, 1e-12);
+  expectSound(body, floor, *motion, 1e-9);
+}
+
 TEST(ShapedPivot, RandomCubesOnCornersAndEdgesNeverGoBelowNorGainEnergy) {
   // 200 cubes on one corner or one edge at random (turned about the vertical, tilted up to
   // 0.4 rad from balance), moving at up to 1 m/s across the floor and turning at up to 5 rad/s

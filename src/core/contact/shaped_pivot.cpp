@@ -131,6 +131,7 @@ std::vector<Vec> solveConditions(const Setting& s, const Kinematics& k,
                                  const std::vector<std::pair<std::size_t, Vec>>& columns,
                                  const std::vector<Vec>& free,
                                  const Eigen::Matrix3d& inverse_inertia) {
+  if (points.empty()) return {};  // flying: no force
   std::vector<Vec> levers;
   for (const Point& p : points) levers.push_back(k.rotation * p.corner);
   std::vector<std::pair<std::size_t, Vec>> rows;
@@ -365,10 +366,11 @@ PivotState PivotPath::stateAt(double t) const {
   const Setting& s = path.setting;
   // The lowest corner exactly on the face: the integration's drift of the points' height (within
   // its tolerance) is taken out along n, and no corner is below the face (one that reaches it
-  // ends the motion: its events take over from a body touching, never overlapping).
+  // ends the motion: its events take over from a body touching, never overlapping). Lifted off
+  // (no point touching), only a corner below the face (by the event's 1e-12 m) is lifted.
   double lowest = std::numeric_limits<double>::infinity();
   for (const Vec& corner : s.corners) lowest = std::min(lowest, heightOf(s, k, corner));
-  k.centre -= lowest * s.n;
+  if (!points->empty() || lowest < 0) k.centre -= lowest * s.n;
   PivotState state;
   state.centre = k.centre;
   state.velocity = k.velocity;
@@ -424,6 +426,9 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
     return notYet("tipping of a body with no corners (a cylinder's rim, a capsule's end)");
   }
   s.corners = all;
+  double reach = 0.0;
+  for (const Vec& corner : all) reach = std::max(reach, corner.norm());
+  const double clearance = kPivotClearance * reach;
 
   std::vector<Point> points;
   for (const Vec& corner : corners) points.push_back({corner, false, Vec::Zero()});
@@ -446,9 +451,6 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
   auto modes = modesAt(s, k, points);
   if (!modes) return modes.error();
   points = modes.value();
-  if (points.empty()) {
-    return notYet("the body leaves the face from the corner it touches (its normal force < 0)");
-  }
   path->start = body.time;
   path->initial = k;
   path->initial_points = points;
@@ -473,7 +475,7 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
     // their drift is not a corner's approach. A corner below it at the segment's start (one that
     // just left) reaches the face where it comes back 1e-12 m below where it was.
     const auto above = [&s, &current](const Kinematics& x, const Vec& corner) {
-      double base = std::numeric_limits<double>::infinity();
+      double base = current.empty() ? 0.0 : std::numeric_limits<double>::infinity();
       for (const Point& p : current) base = std::min(base, heightOf(s, x, p.corner));
       return heightOf(s, x, corner) - base;
     };
@@ -503,7 +505,7 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
         return unpack(x);
       };
       // The events: each a function of the state that reaches <= 0, and what it does.
-      enum class What { kCorner, kLeaves, kSlips, kSticks, kEdge };
+      enum class What { kCorner, kLeaves, kSlips, kSticks, kEdge, kClear };
       struct Event {
         What what;
         std::size_t point;
@@ -518,6 +520,16 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
         const double level = below[c] < 0 ? below[c] - 1e-12 : 0.0;
         events.push_back({What::kCorner, 0, [&above, corner, level](const Kinematics& x) {
                             return above(x, corner) - level;
+                          }});
+      }
+      if (current.empty()) {
+        // Lifted off: flying until its lowest corner is kPivotClearance of its reach above the
+        // face (the certified first contact takes it from there) or a corner lands.
+        events.push_back({What::kClear, 0, [&s, clearance](const Kinematics& x) {
+                            double lowest = std::numeric_limits<double>::infinity();
+                            for (const Vec& c : s.corners)
+                              lowest = std::min(lowest, heightOf(s, x, c));
+                            return clearance - lowest;
                           }});
       }
       for (std::size_t i = 0; i < current.size(); ++i) {
@@ -592,7 +604,7 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
       Kinematics there = at(when);
       until = when;
       t = when;
-      if (event.what == What::kCorner) {
+      if (event.what == What::kCorner || event.what == What::kClear) {
         ends = "resumes";
         finished = true;
         break;
@@ -629,19 +641,9 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
         next[event.point].sliding = true;
         next[event.point].direction = *onset;
       }
-      if (next.empty()) {
-        ends = "resumes";
-        finished = true;
-        break;
-      }
       auto settled = modesAt(s, there, next);
       if (!settled) {
         ends = settled.error().reason;
-        finished = true;
-        break;
-      }
-      if (settled->empty()) {  // its last point leaves the face
-        ends = "resumes";
         finished = true;
         break;
       }

@@ -24,6 +24,11 @@ namespace collision_response::core {
 /// continuously from its onset's to its own (doc/model.md, "Tipping over a corner or an edge").
 constexpr double kPivotSlipStops = 1e-6;
 
+/// Of the body's reach: a body whose last point leaves the face flies on, integrated, until its
+/// lowest corner is this far above the face (or a corner lands): the certified first contact's
+/// advancement, bounded by the body's turning, would crawl from a gap that opens from 0.
+constexpr double kPivotClearance = 1e-5;
+
 /// What the path gives at an instant of [start, until].
 struct PivotState {
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
@@ -60,10 +65,12 @@ class PivotPath {
 /// (settled: kLastingSettled) and the slip of a point slower than kLastingStillSpeed are taken
 /// out by a plastic impulse (energy lost, never gained). Then each point sticks while the force
 /// that holds it is within mu of its normal force, and slides (friction mu N against its slip)
-/// otherwise; a point whose normal force reaches 0 leaves. The motion ends (`until`, `ends`)
-/// where another corner of the body reaches the face or the last point leaves it ("resumes":
-/// the body's events take over from the state there), where a point reaches a bounded face's
-/// edge (not modelled yet), or after `horizon` seconds ("stops": asked again from there).
+/// otherwise; a point whose normal force reaches 0 leaves (the last one too: the body flies on,
+/// integrated, until kPivotClearance). The motion ends (`until`, `ends`) where another corner of
+/// the body reaches the face or the flying body is clear of it ("resumes": the body's events
+/// take over from the state there), where a face's corners all stick ("stops": it rests), where
+/// a point reaches a bounded face's edge (not modelled yet), or after `horizon` seconds
+/// ("stops": asked again from there).
 Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& face,
                                     const std::vector<Eigen::Vector3d>& corners, double tolerance,
                                     double horizon = 10.0);
