@@ -267,6 +267,31 @@ TEST(ShapedLasting, ACubeThatSettledRestsWithItsResidualMotionDropped) {
   EXPECT_EQ(on_edge->forces.size(), 2u);
 }
 
+TEST(ShapedLasting, AFaceWhoseFourthCornerIsJustBeyondTheBandRestsOnAllFour) {
+  // A cube (h = 0.05 m) turned by e about x and about y (e small): its bottom corners' heights
+  // over the lowest, (h, -h), are 2 e h at (h, h) and (-h, -h) and 4 e h at (-h, h). With 2 e h =
+  // 0.8 of a settled body's band (1e-6 of its reach h sqrt 3), three corners are within it and
+  // the fourth at 1.6 of it: the face rests on all four (the fourth's height is the three's
+  // h1 + h3 - h2), not balanced on its diagonal; the forces are each near m g / 4.
+  const double half = 0.05, m = 0.4;
+  const double band = 1e-6 * half * std::sqrt(3.0), e = 0.4 * band / half;
+  const Q turn = Q(Eigen::AngleAxisd(e, V::UnitX())) * Q(Eigen::AngleAxisd(-e, V::UnitY()));
+  double lowest = 0;
+  for (const double x : {-half, half}) {
+    for (const double y : {-half, half}) lowest = std::min(lowest, (turn * V(x, y, -half)).z());
+  }
+  const LastingBody body = box(V(half, half, half), m, V(0, 0, -lowest), turn);
+  const FlatFace floor = plane(V::UnitZ(), 0.5);
+  const auto motion = lastingOnFace(body, floor);
+  ASSERT_TRUE(motion.ok()) << errorOf(motion);
+  EXPECT_FALSE(motion->pivot);
+  EXPECT_EQ(motion->state, ContactState::kResting);
+  ASSERT_EQ(motion->forces.size(), 4u);
+  for (const SupportForce& force : motion->forces) {
+    EXPECT_NEAR(force.normal_force, m * kG / 4, 1e-4 * m * kG);
+  }
+}
+
 TEST(ShapedLasting, ABoxRestingOnAnInclineWithinFrictionLeansItsWeightDownhill) {
   // Half sizes a = 0.5 up the slope, b = 0.3 across, c = 0.2 along the normal, 2 kg, on the
   // incline tan theta = 3/4 with mu = 0.8 >= 3/4: static friction holds it. N = m g cos theta;

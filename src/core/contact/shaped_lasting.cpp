@@ -288,6 +288,30 @@ Expected<Support> supportOf(const LastingBody& body, const Eigen::Matrix3d& rota
       support.corners.push_back(corner);
     }
   }
+  // Three corners of one face of a box on the face: its fourth is within twice the band (its
+  // height is the other three's h1 + h3 - h2) and the face rests on all four; taken alone, the
+  // three would balance the body on the face's diagonal, an edge it tips over only by rounding.
+  if (const auto* box = std::get_if<Cuboid>(&body.shape); box && support.corners.size() == 3) {
+    for (int axis = 0; axis < 3; ++axis) {
+      const double side = support.corners[0][axis];
+      if (support.corners[1][axis] != side || support.corners[2][axis] != side) continue;
+      Vec fourth = Vec::Zero();
+      fourth[axis] = side;
+      for (int other = 0; other < 3; ++other) {
+        if (other == axis) continue;
+        // The sign the three show once: the fourth has the other.
+        double sum = 0;
+        for (const Vec& c : support.corners) sum += c[other] > 0 ? 1.0 : -1.0;
+        fourth[other] = (sum > 0 ? -1.0 : 1.0) * box->half_size[other];
+      }
+      const Vec point = body.centre + rotation * fourth;
+      const double speed = n.dot(body.velocity + body.angular_velocity.cross(rotation * fourth));
+      if (setting.settled && std::abs(speed) > setting.settled_speed) break;
+      support.feet.push_back(onFace(point, face, n));
+      support.corners.push_back(fourth);
+      break;
+    }
+  }
   if (support.feet.empty()) {
     return Error{"body.velocity",
                  "every point of the body near the face approaches or leaves it faster than " +

@@ -558,6 +558,16 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
             events.push_back({What::kSticks, i, [&s, &current, i, reference](const Kinematics& x) {
                                 return slipOf(s, x, current[i]).dot(reference) + kLastingStillSpeed;
                               }});
+            // ... or where the force that would hold it comes back within its cone (a slip that
+            // began at the cone's edge and does not grow: it would hover below kSlipStops, its
+            // friction's direction turning ever faster).
+            std::vector<Point> held = current;
+            held[i].sliding = false;
+            events.push_back({What::kSticks, i, [&s, held, i](const Kinematics& x) {
+                                const double margin =
+                                    coneMargin(s, dynamicsOf(s, x, held).forces[i]);
+                                return margin >= 0 ? -std::max(margin, 1e-300) : -margin;
+                              }});
           }
         }
         if (face.bounded) {
