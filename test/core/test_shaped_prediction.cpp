@@ -310,6 +310,23 @@ TEST(ShapedPrediction, ABoxTippingOverAFrictionlessEdgeLandsOnItsFaceAtTheEnergy
   }
 }
 
+// The same tipping on a table top (a box obstacle, its distances by GJK to 1e-12 m) lands at the
+// same instant: the tipping hands the body over a hair above the top (1e-11 m), never
+// overlapping it by the distance's tolerance. Before, the body touching exactly was taken as
+// starting inside the top, its first contact never found, and it fell through (to z = -0.3 m).
+TEST(ShapedPrediction, ABoxTippingOnATableTopLandsOnItNeverThroughIt) {
+  const EdgeLanding edge;
+  Scene scene = floorScene(edge.e, V(edge.a, edge.b, edge.c), edge.m);
+  scene.obstacles = {
+      scene_builders::box("table", V(0, 0, 0.745), V(2.74, 1.525, 0.03), "concrete")};
+  auto request = dropped(scene, V(-1.0, 0, 0.76 + edge.low() + 1e-12), edge.turn(), 0.5, 1);
+  const auto prediction = predictImpacts(scene, nullptr, MonitorSettings{}, request);
+  ASSERT_TRUE(prediction.ok()) << prediction.error().message();
+  ASSERT_FALSE(prediction->impacts.empty()) << prediction->message;
+  EXPECT_NEAR(prediction->impacts.front().time, edge.tipInstant(), 1e-8);
+  EXPECT_NEAR(prediction->final_state.position.z(), 0.76 + edge.c, 1e-9);
+}
+
 TEST(ShapedPrediction, WhatIsNotModelledYetIsRefusedByName) {
   Scene scene = floorScene(0.5, V(0.05, 0.05, 0.05));
   auto request = dropped(scene, V(0, 0, 1), Eigen::Quaterniond::Identity(), 1.0, 10);

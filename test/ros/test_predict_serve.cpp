@@ -300,6 +300,48 @@ TEST(PredictServe, ABoxDroppedOnAnEdgeTurnsAsTheClosedFormSays) {
   EXPECT_NEAR(total, edge.impulse(), 1e-9);
 }
 
+// A box released at rest on one of its edges on the table (no friction asked: the table's force
+// is vertical) tips over it, its centre falling straight down, and its face lands at the energy
+// integral's instant (EdgeLanding::tipInstant, 1e-8 s: the integration's tolerance), as in the
+// core
+// (ShapedPrediction.ABoxTippingOverAFrictionlessEdgeLandsOnItsFaceAtTheEnergyIntegralsInstant).
+TEST(PredictServe, ABoxReleasedOnAnEdgeTipsOntoItsFaceAtTheEnergyIntegralsInstant) {
+  ASSERT_TRUE(ros::service::waitForService("/collision_response/predict_impacts", 30000));
+  collision_response::core::shaped_scenes::EdgeLanding edge;
+  PredictImpacts call;
+  call.request.header.frame_id = "world";
+  call.request.header.stamp = ros::Time(300.0);
+  call.request.body.id = "tipping";
+  call.request.body.shape = "box";
+  call.request.body.mass = edge.m;
+  call.request.body.material = "celluloid";
+  call.request.body.size.x = 2 * edge.a;
+  call.request.body.size.y = 2 * edge.b;
+  call.request.body.size.z = 2 * edge.c;
+  call.request.body.orientation.w = edge.turn().w();
+  call.request.body.orientation.y = edge.turn().y();
+  call.request.body.position.x = -1.0;
+  // 1e-12 m above the top (whose 0.76 m rounds either way): touching, within the 1e-9 m band.
+  call.request.body.position.z = 0.76 + edge.low() + 1e-12;
+  call.request.effects = {"gravity"};
+  call.request.horizon = 0.5;
+  call.request.max_impacts = 1;
+  call.request.sample_period = 0.01;
+  ASSERT_TRUE(callService(call));
+  ASSERT_TRUE(call.response.success) << call.response.message;
+  ASSERT_FALSE(call.response.impacts.empty()) << call.response.message;
+  const double landing = edge.tipInstant();
+  EXPECT_NEAR((call.response.impacts.front().header.stamp - ros::Time(300.0)).toSec(), landing,
+              1e-8)
+      << call.response.message;
+  ASSERT_FALSE(call.response.samples.empty());
+  for (const collision_response::BodyState& sample : call.response.samples) {
+    if ((sample.header.stamp - ros::Time(300.0)).toSec() >= landing) break;
+    EXPECT_NEAR(sample.pose.position.x, -1.0, 1e-9);
+    EXPECT_NEAR(sample.pose.position.y, 0.0, 1e-12);
+  }
+}
+
 // The intermediate axis's flip (Dzhanibekov's effect) over ROS: a box given the tensor J = (2, 3,
 // 4) kg m^2, far from everything without gravity, spun at w0 = (1e-6, 2, 1e-6) rad/s (body =
 // world at the start): Landau's solution gives w_2 = A_2 sn u, its zeros every 2K(m) / omega and

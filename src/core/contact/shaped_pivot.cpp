@@ -39,6 +39,9 @@ using Dense = boost::numeric::odeint::result_of::make_dense_output<Stepper>::typ
 /// Steps one motion may take before it is asked again from where it is ("stops").
 constexpr std::size_t kMaxSteps = 1u << 14;
 constexpr double kSlipStops = kPivotSlipStops;
+/// m: how far above the face the lowest corner is put (within the touching band, 1e-9 m, and
+/// beyond the first contact's distance tolerance against a box, 1e-12 m).
+constexpr double kPivotHair = 1e-11;
 /// Bisection of an event on the dense output: to this part of the instant (or of 1 s).
 constexpr double kEventResolution = 1e-13;
 
@@ -364,13 +367,14 @@ PivotState PivotPath::stateAt(double t) const {
     points = &path.modes[step.points];
   }
   const Setting& s = path.setting;
-  // The lowest corner exactly on the face: the integration's drift of the points' height (within
-  // its tolerance) is taken out along n, and no corner is below the face (one that reaches it
-  // ends the motion: its events take over from a body touching, never overlapping). Lifted off
-  // (no point touching), only a corner below the face (by the event's 1e-12 m) is lifted.
+  // The lowest corner a hair (kPivotHair) above the face: the integration's drift of the points'
+  // height (within its tolerance) is taken out along n, and no corner is below the face (one
+  // that reaches it ends the motion: its events take over from a body touching, never
+  // overlapping, even by the distance's tolerance against a box). Lifted off (no point
+  // touching), only a corner below the hair is lifted.
   double lowest = std::numeric_limits<double>::infinity();
   for (const Vec& corner : s.corners) lowest = std::min(lowest, heightOf(s, k, corner));
-  if (!points->empty() || lowest < 0) k.centre -= lowest * s.n;
+  if (!points->empty() || lowest < kPivotHair) k.centre += (kPivotHair - lowest) * s.n;
   PivotState state;
   state.centre = k.centre;
   state.velocity = k.velocity;

@@ -212,6 +212,10 @@ class ShapedRun {
         if (Status status = motion.restartFrom(there); !status) {
           return Expected<Prediction>(status.error());
         }
+        if (motion.insideAtStart()) {  // never through it
+          cut.push_back(lastingContact(with, until, "its tipping ends inside the obstacle"));
+          return finishWith(motion, there);
+        }
         rests_from_.reset();
         return std::nullopt;
       }

@@ -136,6 +136,10 @@ void ShapedTrack::advanceTo(double time, std::vector<ImpactRecord>& impacts,
           hold(there, *against_, status.error().message(), unmodelled);
           return;
         }
+        if (const auto inside = motion_.insideAtStart()) {  // never through it
+          hold(there, *inside, "its tipping ends inside the obstacle", unmodelled);
+          return;
+        }
         mode_ = Mode::kFlying;
         lasting_.reset();
         since_ = until;
