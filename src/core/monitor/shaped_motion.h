@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 #include <cstddef>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <string>
 #include <utility>
@@ -59,6 +60,33 @@ struct ShapedScene {
   /// The tolerance a tipping body's motion is integrated to (pivotOnFace): the scene's
   /// contact_integration_tolerance.
   double integration_tolerance = 1e-9;
+};
+
+/// The hand-overs of a body's tipping to its events ("resumes", shaped_pivot.h) its motion takes:
+/// one at an instant, and at most kMaxResumes within kResumeWindow seconds; more, it chatters
+/// between supports (a cube at the edge of tipping, mu h = w / 2), which is not modelled yet.
+class ResumeGuard {
+ public:
+  static constexpr int kMaxResumes = 50;
+  static constexpr double kResumeWindow = 1e-3;  ///< s
+  /// Empty where a hand-over at `time` may go on; else why not.
+  std::optional<std::string> refuse(double time) {
+    if (time == last_) return std::string("its tipping ends where it starts");
+    last_ = time;
+    if (!(time - window_start_ <= kResumeWindow)) {
+      window_start_ = time;
+      count_ = 0;
+    }
+    if (++count_ > kMaxResumes) {
+      return std::string("its tipping chatters between supports (over 50 hand-overs within 1 ms)");
+    }
+    return std::nullopt;
+  }
+
+ private:
+  double last_ = -std::numeric_limits<double>::infinity();
+  double window_start_ = -std::numeric_limits<double>::infinity();
+  int count_ = 0;
 };
 
 /// A shaped body moving among obstacles from a state, flight by flight. next() finds the next

@@ -206,9 +206,12 @@ class ShapedRun {
       const LastingMotion& along = *lasting;
       const double until = std::min(along.until, horizon_);
       sampleUntil(on.time, until, [&](double t) { return stateOn(along, t); });
-      if (until < horizon_ && along.ends == "resumes" && until != resumed_at_) {
-        resumed_at_ = until;  // once at an instant: a tipping that ends again there is cut
+      if (until < horizon_ && along.ends == "resumes") {
         const BodyStateSample there = stateOn(along, until);
+        if (const auto refused = resumes_.refuse(until)) {  // beyond its bounds: cut there
+          cut.push_back(lastingContact(with, until, *refused));
+          return finishWith(motion, there);
+        }
         if (Status status = motion.restartFrom(there); !status) {
           return Expected<Prediction>(status.error());
         }
@@ -306,7 +309,7 @@ class ShapedRun {
   double horizon_ = 0.0, period_ = 0.0;
   std::size_t max_impacts_ = 0;
   std::optional<double> rests_from_;  // the last impact's flat bounces accumulate then
-  double resumed_at_ = -std::numeric_limits<double>::infinity();  // a tipping's last "resumes"
+  ResumeGuard resumes_;               // a tipping's hand-overs to its events
 };
 
 }  // namespace

@@ -126,12 +126,11 @@ void ShapedTrack::advanceTo(double time, std::vector<ImpactRecord>& impacts,
       }
       if (ends == "resumes") {
         // Another point reaches the face, or the body leaves it: its events go on from there
-        // (once at an instant: a tipping that ends again where it resumed is held).
-        if (until == resumed_at_) {
-          hold(there, *against_, "its tipping ends where it starts", unmodelled);
+        // (within ResumeGuard's bounds; beyond them it is held).
+        if (const auto refused = resumes_.refuse(until)) {
+          hold(there, *against_, *refused, unmodelled);
           return;
         }
-        resumed_at_ = until;
         if (Status status = motion_.restartFrom(there); !status) {
           hold(there, *against_, status.error().message(), unmodelled);
           return;

@@ -79,7 +79,7 @@ class ShapedTrack {
   bool fresh_ = true;     // not advanced yet: whether it starts inside an obstacle is asked first
   bool leaving_ = false;  // after an impact: the struck points to part first (ShapedMotion::leave)
   std::optional<double> rests_from_;  // a flat landing's bounces accumulate then
-  double resumed_at_ = -std::numeric_limits<double>::infinity();  // a tipping's last "resumes"
+  ResumeGuard resumes_;               // a tipping's hand-overs to its events
   std::optional<LastingMotion> lasting_;
   FlatFace face_;
   double lasting_since_ = 0.0;
