@@ -11,6 +11,7 @@
 #include "collision_response/core/monitor.h"
 #include "collision_response/core/playback.h"
 #include "collision_response/core/validation.h"
+#include "monitor/shaped_motion.h"
 #include "scene_builders.h"
 #include "shaped_scenes.h"
 
@@ -432,6 +433,20 @@ TEST(ShapedMonitor, PlaybackAndTheMonitorBringABoxBouncingFlatToRest) {
   }
   EXPECT_NEAR(playback.position(0, 1.0).z(), half.z(), 1e-9);
   EXPECT_EQ(playback.contacts(1.0).size(), 4u);
+}
+
+// The tipping's hand-overs: one at an instant, at most 50 within 1 ms (the 51st refused, saying it
+// chatters), and counted afresh after the window.
+TEST(ShapedMonitor, ATippingsHandOversAreBoundedAsResumeGuardSays) {
+  ResumeGuard guard;
+  EXPECT_FALSE(guard.refuse(1.0));
+  ASSERT_TRUE(guard.refuse(1.0));
+  EXPECT_NE(guard.refuse(1.0)->find("ends where it starts"), std::string::npos);
+  for (int k = 1; k < 50; ++k) EXPECT_FALSE(guard.refuse(1.0 + 1e-5 * k)) << k;
+  const auto refused = guard.refuse(1.0 + 5e-4);
+  ASSERT_TRUE(refused);
+  EXPECT_NE(refused->find("chatters between supports"), std::string::npos);
+  EXPECT_FALSE(guard.refuse(1.0 + 2e-3));  // a new window
 }
 
 /// A solid cylinder (r = 0.05 m, length 0.2 m, 1 kg) leaning on its rim: its axis turned by
