@@ -255,6 +255,28 @@ TEST(PredictServe, ABoxDroppedFlatIsPredictedAsTheClosedFormSays) {
   EXPECT_EQ(refusal(call).rfind("body.size: must be 0", 0), 0u) << refusal(call);
 }
 
+/// The edge landing's box (gravity only: no friction) over the table at x = -1 m, its centre at
+/// height `z`, stamped 300 s in the world frame.
+PredictImpacts edgeBox(const collision_response::core::shaped_scenes::EdgeLanding& edge,
+                       const std::string& id, double z) {
+  PredictImpacts call;
+  call.request.header.frame_id = "world";
+  call.request.header.stamp = ros::Time(300.0);
+  call.request.body.id = id;
+  call.request.body.shape = "box";
+  call.request.body.mass = edge.m;
+  call.request.body.material = "celluloid";
+  call.request.body.size.x = 2 * edge.a;
+  call.request.body.size.y = 2 * edge.b;
+  call.request.body.size.z = 2 * edge.c;
+  call.request.body.orientation.w = edge.turn().w();
+  call.request.body.orientation.y = edge.turn().y();
+  call.request.body.position.x = -1.0;
+  call.request.body.position.z = z;
+  call.request.effects = {"gravity"};
+  return call;
+}
+
 // A box landing on an edge over ROS, as in the core (edge_landing.h, ShapedPrediction.
 // BoxLandingOnAnEdgeTurnsAsTheClosedFormSays): a 2 kg box of half edges (0.1, 0.05, 0.025) m turned
 // by 0.3 rad about y, dropped from rest with its centre 0.5 m above the table's top (z = 0.76 in
@@ -265,21 +287,7 @@ TEST(PredictServe, ABoxDroppedOnAnEdgeTurnsAsTheClosedFormSays) {
   ASSERT_TRUE(ros::service::waitForService("/collision_response/predict_impacts", 30000));
   collision_response::core::shaped_scenes::EdgeLanding edge;
   edge.e = 0.9;
-  PredictImpacts call;
-  call.request.header.frame_id = "world";
-  call.request.header.stamp = ros::Time(300.0);
-  call.request.body.id = "edge";
-  call.request.body.shape = "box";
-  call.request.body.mass = edge.m;
-  call.request.body.material = "celluloid";
-  call.request.body.size.x = 2 * edge.a;
-  call.request.body.size.y = 2 * edge.b;
-  call.request.body.size.z = 2 * edge.c;
-  call.request.body.orientation.w = edge.turn().w();
-  call.request.body.orientation.y = edge.turn().y();
-  call.request.body.position.x = -1.0;
-  call.request.body.position.z = 0.76 + edge.height;
-  call.request.effects = {"gravity"};
+  PredictImpacts call = edgeBox(edge, "edge", 0.76 + edge.height);
   call.request.horizon = 0.5;
   call.request.max_impacts = 2;
   ASSERT_TRUE(callService(call));
@@ -308,22 +316,8 @@ TEST(PredictServe, ABoxDroppedOnAnEdgeTurnsAsTheClosedFormSays) {
 TEST(PredictServe, ABoxReleasedOnAnEdgeTipsOntoItsFaceAtTheEnergyIntegralsInstant) {
   ASSERT_TRUE(ros::service::waitForService("/collision_response/predict_impacts", 30000));
   collision_response::core::shaped_scenes::EdgeLanding edge;
-  PredictImpacts call;
-  call.request.header.frame_id = "world";
-  call.request.header.stamp = ros::Time(300.0);
-  call.request.body.id = "tipping";
-  call.request.body.shape = "box";
-  call.request.body.mass = edge.m;
-  call.request.body.material = "celluloid";
-  call.request.body.size.x = 2 * edge.a;
-  call.request.body.size.y = 2 * edge.b;
-  call.request.body.size.z = 2 * edge.c;
-  call.request.body.orientation.w = edge.turn().w();
-  call.request.body.orientation.y = edge.turn().y();
-  call.request.body.position.x = -1.0;
   // 1e-12 m above the top (whose 0.76 m rounds either way): touching, within the 1e-9 m band.
-  call.request.body.position.z = 0.76 + edge.low() + 1e-12;
-  call.request.effects = {"gravity"};
+  PredictImpacts call = edgeBox(edge, "tipping", 0.76 + edge.low() + 1e-12);
   call.request.horizon = 0.5;
   call.request.max_impacts = 1;
   call.request.sample_period = 0.01;
