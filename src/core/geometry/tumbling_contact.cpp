@@ -334,6 +334,45 @@ double firstRoot(double gap, double speed, double acceleration) {
 /// gap >= h(t_0), clamped to [-R, R] (conservative: the bound rises with h_0). A body moving
 /// along the plane (n . v = 0) or spinning about its normal (n x w = 0) takes long steps, and a
 /// corner straight below the centre (theta_0 = 0) rises only by its turning, quadratically.
+/// s: no corner of a box or hull reaches the plane n.x = offset (n unit, moving at
+/// `plane_velocity`) before it; 0 for other shapes. Each corner's height h_i and its rate h_i' are
+/// exact at `time`, and |h_i''| <= |n.a| + |r_i| (|w'| + |w|^2) over any span (r_i from the centre:
+/// (R v_i)'' = w' x r_i + w x (w x r_i)), so h_i stays > 0 until h_i + h_i' s - A_i s^2 / 2 = 0.
+/// A corner just struck and leaving at e u keeps the step of order e u / A, where the body's
+/// speed bound alone (planeStep's others) would step its gap over its whole turning speed.
+double cornerStep(const TumblingBody& body, double time, const Eigen::Vector3d& n, double offset,
+                  const Eigen::Vector3d& plane_velocity) {
+  std::vector<Eigen::Vector3d> corners;
+  if (const auto* box = std::get_if<Cuboid>(&body.shape())) {
+    for (int c = 0; c < 8; ++c) {
+      corners.emplace_back((c & 1) ? box->half_size.x() : -box->half_size.x(),
+                           (c & 2) ? box->half_size.y() : -box->half_size.y(),
+                           (c & 4) ? box->half_size.z() : -box->half_size.z());
+    }
+  } else if (const auto* hull = std::get_if<ConvexHull>(&body.shape())) {
+    corners = hull->vertices;
+  } else {
+    return 0.0;
+  }
+  const Eigen::Matrix3d rotation = body.orientationAt(time).toRotationMatrix();
+  const Eigen::Vector3d centre = body.positionAt(time);
+  const Eigen::Vector3d velocity = body.velocityAt(time) - plane_velocity;
+  const Eigen::Vector3d spin = body.angularVelocityAt(time);
+  const double w = body.angularSpeedBound();
+  const double turning = body.angularAccelerationBound() + w * w;
+  const double pulled = std::abs(n.dot(body.acceleration()));
+  double step = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector3d& corner : corners) {
+    const Eigen::Vector3d r = rotation * corner;
+    const double height = n.dot(centre + r) - offset;
+    if (!(height > 0)) return 0.0;
+    const double closing = -n.dot(velocity + spin.cross(r));
+    const double bound = (pulled + r.norm() * turning) * (1 + 64 * kEps);
+    step = std::min(step, firstRoot(height, closing, bound));
+  }
+  return step;
+}
+
 double planeStep(const TumblingBody& body, double time, double gap, const Plane& plane,
                  const Eigen::Vector3d& plane_velocity) {
   const double length = plane.normal.norm();
@@ -349,7 +388,8 @@ double planeStep(const TumblingBody& body, double time, double gap, const Plane&
   const double taylor = firstRoot(gap, closing + across * spin, pulled + reach * spin * spin);
   const double lowest = gap - (reach - below);
   const double reached = lowest > 0 ? firstRoot(lowest, closing, pulled) : 0.0;
-  return std::max({lipschitz, taylor, reached});
+  return std::max({lipschitz, taylor, reached,
+                   cornerStep(body, time, n, plane.offset / length, plane_velocity)});
 }
 
 /// The other side of a first-contact query: what it is at an instant and how fast its points
@@ -611,6 +651,13 @@ Expected<TumblingBody> TumblingBody::create(const ConvexShape& shape,
   const FreeRotation::Kind kind = body.rotation_.kind();
   body.steady_spin_ =
       kind == FreeRotation::Kind::kResting || kind == FreeRotation::Kind::kIsotropic;
+  if (!body.steady_spin_) {
+    const Eigen::Vector3d& j = principal_moments;
+    const double spread = std::abs(j.y() - j.z()) / j.x() + std::abs(j.z() - j.x()) / j.y() +
+                          std::abs(j.x() - j.y()) / j.z();
+    body.angular_acceleration_bound_ =
+        0.5 * body.angular_speed_bound_ * body.angular_speed_bound_ * spread * (1 + 64 * kEps);
+  }
   body.angular_velocity_ = angular_velocity;
   return body;
 }

@@ -104,6 +104,10 @@ class TumblingBody {
     return steady_spin_ ? n.cross(angular_velocity_).norm() * (1 + 64 * 2.220446049250313e-16)
                         : angular_speed_bound_;
   }
+  /// rad/s^2: |w'| never exceeds it: 0 where w is fixed, else, by Euler's equations
+  /// (J_x w_x' = (J_y - J_z) w_y w_z, ...; |w_y w_z| <= |w|^2 / 2), angularSpeedBound()^2 / 2
+  /// times the sum of |J_y - J_z| / J_x and its turns (with a few ulps).
+  double angularAccelerationBound() const { return angular_acceleration_bound_; }
   /// m: the body's farthest point from its centre.
   double reach() const { return reach_; }
 
@@ -117,6 +121,7 @@ class TumblingBody {
   Eigen::Vector3d velocity_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d acceleration_ = Eigen::Vector3d::Zero();
   double angular_speed_bound_ = 0.0;
+  double angular_acceleration_bound_ = 0.0;
   bool steady_spin_ = false;                                    // w fixed in the world
   Eigen::Vector3d angular_velocity_ = Eigen::Vector3d::Zero();  // w at time_ (world)
   double reach_ = 0.0;
