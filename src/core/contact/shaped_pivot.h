@@ -1,9 +1,10 @@
-// A shaped body tipping over one or two of its corners on one flat face (issue 42, build step 6):
-// a box (or a hull) that touches the face at one corner or along one edge, pivoting under gravity
-// until another corner reaches the face, it leaves the face, or a corner reaches a bounded face's
-// edge. Each point sticks (static friction within mu) or slides (Coulomb); the motion has no
-// closed form (a heavy top about a fixed point, a physical pendulum about an edge) and is
-// integrated to a stated tolerance (doc/model.md, "Tipping over a corner or an edge").
+// A shaped body tipping over its corners on one flat face (issue 42, build step 6): a box (or a
+// hull) that touches the face at one corner or along one edge, or rocks or spins on a face,
+// pivoting under gravity until another corner reaches the face, it leaves the face and is clear
+// of it, its corners all stick on a face (it rests), or a corner reaches a bounded face's edge.
+// Each corner sticks (static friction within mu) or slides (Coulomb); the motion has no closed
+// form (a heavy top about a fixed point, a physical pendulum about an edge) and is integrated to
+// a stated tolerance (doc/model.md, "Tipping over a corner or an edge").
 #pragma once
 
 #include <Eigen/Core>
@@ -59,18 +60,18 @@ class PivotPath {
   std::unique_ptr<Steps> steps_;
 };
 
-/// The body touching `face` at `corners` (one, or two: an edge; in its principal frame, each
-/// within kLastingBand of the face) tipping under gravity, integrated with the Dormand-Prince
-/// pair to `tolerance` (absolute and relative). At its start the normal motion of the points
-/// (settled: kLastingSettled) and the slip of a point slower than kLastingStillSpeed are taken
-/// out by a plastic impulse (energy lost, never gained). Then each point sticks while the force
-/// that holds it is within mu of its normal force, and slides (friction mu N against its slip)
-/// otherwise; a point whose normal force reaches 0 leaves (the last one too: the body flies on,
-/// integrated, until kPivotClearance). The motion ends (`until`, `ends`) where another corner of
-/// the body reaches the face or the flying body is clear of it ("resumes": the body's events
-/// take over from the state there), where a face's corners all stick ("stops": it rests), where
-/// a point reaches a bounded face's edge (not modelled yet), or after `horizon` seconds
-/// ("stops": asked again from there).
+/// The body touching `face` at `corners` (one to four: a corner, an edge, a face; in its
+/// principal frame, each within the settled band of the face) tipping under gravity, integrated
+/// with the Dormand-Prince pair to `tolerance` (absolute and relative). At its start the normal
+/// motion of the points (settled: kLastingSettled) and the slip of a point slower than
+/// kLastingStillSpeed are taken out by a plastic impulse (energy lost, never gained). Then each
+/// point sticks while the force that holds it is within mu of its normal force, and slides
+/// (friction mu N against its slip) otherwise; a point whose normal force reaches 0 leaves (the
+/// last one too: the body flies on, integrated, until kPivotClearance). The motion ends (`until`,
+/// `ends`) where another corner of the body reaches the face or the flying body is clear of it
+/// ("resumes": the body's events take over from the state there), where a face's corners all
+/// stick ("stops": it rests), where a point reaches a bounded face's edge (not modelled yet), or
+/// after `horizon` seconds ("stops": asked again from there).
 Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& face,
                                     const std::vector<Eigen::Vector3d>& corners, double tolerance,
                                     double horizon = 10.0);
