@@ -8,8 +8,8 @@
 // is 0 (three conditions, its force three unknowns); a sliding point's normal acceleration is
 // 0, its force N_i (n - mu s_hat_i) (one unknown: Coulomb's law, against its slip s_i). The
 // conditions are linear in the unknowns; where they do not fix them (two sticking points: the
-// forces along the edge; a face's four), the least-norm ones (doc/model.md, "Tipping over a corner or an
-// edge"). The state (orientation, w, centre, v) is integrated by the Dormand-Prince 5(4) pair
+// forces along the edge; a face's four), the least-norm ones (doc/model.md, "Tipping over a corner
+// or an edge"). The state (orientation, w, centre, v) is integrated by the Dormand-Prince 5(4) pair
 // with dense output (Boost.Odeint); the events are found on the dense output by bisection.
 #include "contact/shaped_pivot.h"
 
