@@ -103,50 +103,8 @@ void ShapedTrack::advanceTo(double time, std::vector<ImpactRecord>& impacts,
     if (mode_ == Mode::kHeld) return;
     if (mode_ == Mode::kLasting) {
       if (time <= lasting_->until) return;
-      const double until = lasting_->until;
-      const std::string ends = lasting_->ends;
-      BodyStateSample there = stateAt(until);
-      if (ends == "stops") {
-        LastingBody body;
-        const PrincipalBody& principal = motion_.principal();
-        body.shape = principal.shape;
-        body.moments = principal.moments;
-        body.mass = principal.mass;
-        body.time = until;
-        body.centre = lasting_->centreAt(until);
-        body.velocity = lasting_->velocityAt(until);
-        body.angular_velocity = lasting_->angularVelocityAt(until);
-        body.orientation = lasting_->orientationAt(until);
-        body.gravity = motion_.flight().acceleration();
-        startLasting(body, face_, unmodelled);
-        if (mode_ == Mode::kLasting && !(lasting_->until > until)) {
-          hold(there, *against_, "its lasting contact ends where it starts", unmodelled);
-        }
-        continue;
-      }
-      if (ends == "resumes") {
-        // Another point reaches the face, or the body leaves it: its events go on from there
-        // (within ResumeGuard's bounds; beyond them it is held).
-        if (const auto refused = resumes_.refuse(until)) {
-          hold(there, *against_, *refused, unmodelled);
-          return;
-        }
-        if (Status status = motion_.restartFrom(there); !status) {
-          hold(there, *against_, status.error().message(), unmodelled);
-          return;
-        }
-        if (const auto inside = motion_.insideAtStart()) {  // never through it
-          hold(there, *inside, "its tipping ends inside the obstacle", unmodelled);
-          return;
-        }
-        mode_ = Mode::kFlying;
-        lasting_.reset();
-        since_ = until;
-        rests_from_.reset();
-        continue;
-      }
-      hold(there, *against_, ends, unmodelled);
-      return;
+      endLasting(unmodelled);
+      continue;
     }
     if (leaving_) {
       leaving_ = false;
@@ -183,6 +141,54 @@ void ShapedTrack::advanceTo(double time, std::vector<ImpactRecord>& impacts,
     }
     rests_from_ = motion_.flatBouncesEnd();
   }
+}
+
+/// Where its lasting motion ends (lasting_->until): asked again from there ("stops"), its events
+/// going on from there ("resumes", within ResumeGuard's bounds), or held, saying why.
+void ShapedTrack::endLasting(std::vector<UnmodelledContact>& unmodelled) {
+  const double until = lasting_->until;
+  const std::string ends = lasting_->ends;
+  BodyStateSample there = stateAt(until);
+  if (ends == "stops") {
+    LastingBody body;
+    const PrincipalBody& principal = motion_.principal();
+    body.shape = principal.shape;
+    body.moments = principal.moments;
+    body.mass = principal.mass;
+    body.time = until;
+    body.centre = lasting_->centreAt(until);
+    body.velocity = lasting_->velocityAt(until);
+    body.angular_velocity = lasting_->angularVelocityAt(until);
+    body.orientation = lasting_->orientationAt(until);
+    body.gravity = motion_.flight().acceleration();
+    startLasting(body, face_, unmodelled);
+    if (mode_ == Mode::kLasting && !(lasting_->until > until)) {
+      hold(there, *against_, "its lasting contact ends where it starts", unmodelled);
+    }
+    return;
+  }
+  if (ends == "resumes") {
+    // Another point reaches the face, or the body leaves it: its events go on from there
+    // (within ResumeGuard's bounds; beyond them it is held).
+    if (const auto refused = resumes_.refuse(until)) {
+      hold(there, *against_, *refused, unmodelled);
+      return;
+    }
+    if (Status status = motion_.restartFrom(there); !status) {
+      hold(there, *against_, status.error().message(), unmodelled);
+      return;
+    }
+    if (const auto inside = motion_.insideAtStart()) {  // never through it
+      hold(there, *inside, "its tipping ends inside the obstacle", unmodelled);
+      return;
+    }
+    mode_ = Mode::kFlying;
+    lasting_.reset();
+    since_ = until;
+    rests_from_.reset();
+    return;
+  }
+  hold(there, *against_, ends, unmodelled);
 }
 
 void ShapedTrack::enterLasting(double time, std::vector<UnmodelledContact>& unmodelled) {

@@ -66,6 +66,8 @@ class ShapedTrack {
  private:
   ShapedTrack(ShapedMotion motion, std::size_t revision)
       : motion_(std::move(motion)), since_(motion_.time()), revision_(revision) {}
+  /// Where its lasting motion ends: asked again, its events on from there, or held.
+  void endLasting(std::vector<UnmodelledContact>& unmodelled);
   /// The contact the engine found to last: on one flat face by lastingOnFace, or held.
   void enterLasting(double time, std::vector<UnmodelledContact>& unmodelled);
   void startLasting(const LastingBody& body, const FlatFace& face,
