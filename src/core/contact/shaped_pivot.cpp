@@ -320,6 +320,20 @@ Expected<std::vector<Point>> modesAt(const Setting& s, const Kinematics& k,
   return notYet("a tipping whose corners' sticking and sliding do not settle");
 }
 
+/// Every corner of a box or hull (principal frame); empty for a shape with none.
+std::optional<std::vector<Vec>> cornersOf(const ConvexShape& shape) {
+  if (const auto* box = std::get_if<Cuboid>(&shape)) {
+    std::vector<Vec> corners;
+    for (int c = 0; c < 8; ++c) {
+      corners.push_back(Vec((c & 1) ? 1.0 : -1.0, (c & 2) ? 1.0 : -1.0, (c & 4) ? 1.0 : -1.0)
+                            .cwiseProduct(box->half_size));
+    }
+    return corners;
+  }
+  if (const auto* hull = std::get_if<ConvexHull>(&shape)) return hull->vertices;
+  return std::nullopt;
+}
+
 }  // namespace
 
 /// The path's steps: each a copy of the dense stepper after it (its dense output covers it), with
@@ -417,22 +431,13 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
   s.e1 = s.n.unitOrthogonal();
   s.e2 = s.n.cross(s.e1);
   s.mu = face.friction;
-  std::vector<Vec> all;
-  contactCandidates(body.shape, -Vec::UnitZ(), all);
-  if (const auto* box = std::get_if<Cuboid>(&body.shape)) {
-    all.clear();
-    for (int c = 0; c < 8; ++c) {
-      all.push_back(Vec((c & 1) ? 1.0 : -1.0, (c & 2) ? 1.0 : -1.0, (c & 4) ? 1.0 : -1.0)
-                        .cwiseProduct(box->half_size));
-    }
-  } else if (const auto* hull = std::get_if<ConvexHull>(&body.shape)) {
-    all = hull->vertices;
-  } else {
+  auto all = cornersOf(body.shape);
+  if (!all) {
     return notYet("tipping of a body with no corners (a cylinder's rim, a capsule's end)");
   }
-  s.corners = all;
+  s.corners = *all;
   double reach = 0.0;
-  for (const Vec& corner : all) reach = std::max(reach, corner.norm());
+  for (const Vec& corner : s.corners) reach = std::max(reach, corner.norm());
   const double clearance = kPivotClearance * reach;
 
   std::vector<Point> points;
