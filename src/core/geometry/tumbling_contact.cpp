@@ -561,18 +561,61 @@ void BodySide::manifold(const TumblingBody& body, double time, const SurfaceGap&
   candidatesOfB(body, time, closest, band, tolerance, local, centre_b, out);
 }
 
-/// Conservative advancement (the header's comment) of `body` against `side`.
-template <class Side>
-FirstContactResult advance(const TumblingBody& body, const Side& side, double from, double horizon,
+/// The moving side a of the advancement in flight: exact at every instant, its own bounds.
+struct FlightSide {
+  const TumblingBody& body;
+  const TumblingBody* at(double) const { return &body; }
+  double turning() const { return body.angularSpeedBound() * body.reach(); }
+  /// m/s: the centres' relative speed at `time`, the other's centre moving at `other`.
+  double relativeSpeed(double time, const Eigen::Vector3d& other) const {
+    return (body.velocityAt(time) - other).norm();
+  }
+  template <class Side>
+  double accelerationBound(const Side& side, const TumblingBody&) const {
+    return side.accelerationBound(body);
+  }
+  template <class Side>
+  double step(const Side& side, double time, double gap, double speed, double acceleration) const {
+    return side.step(body, time, gap, speed, acceleration);
+  }
+};
+
+/// Side a of the advancement as a BoundedMotion: what it is at an instant (its state there, no
+/// acceleration), its points' speeds bounded over the whole query (no acceleration term for it).
+struct BoundedSide {
+  const BoundedMotion& motion;
+  mutable std::optional<TumblingBody> current;
+  const TumblingBody* at(double time) const {
+    current = motion.at(time);
+    return current ? &*current : nullptr;
+  }
+  double turning() const { return motion.angular_speed * motion.reach; }
+  double relativeSpeed(double, const Eigen::Vector3d& other) const {
+    return motion.centre_speed + other.norm();
+  }
+  /// The other side's alone: `at`'s state has none.
+  template <class Side>
+  double accelerationBound(const Side& side, const TumblingBody& at_from) const {
+    return side.accelerationBound(at_from);
+  }
+  template <class Side>
+  double step(const Side&, double, double gap, double speed, double acceleration) const {
+    return firstRoot(gap, speed, acceleration);
+  }
+};
+
+/// Conservative advancement (the header's comment) of side a (`moving`: FlightSide,
+/// BoundedSide) against `side`.
+template <class Moving, class Side>
+FirstContactResult advance(const Moving& moving, const Side& side, double from, double horizon,
                            const FirstContactOptions& options) {
   FirstContactResult result;
   result.clear_until = from;
   const double end = from + horizon;
-  const double turning = body.angularSpeedBound() * body.reach() + side.pointSpeedAboutCentre();
-  const double acceleration = side.accelerationBound(body);
+  const double turning = moving.turning() + side.pointSpeedAboutCentre();
   // The steps look at the gap alone; the contact found carries its approach speed too (the same
   // gap, computed once more with it).
-  const auto contactAt = [&](double t) {
+  const auto contactAt = [&](const TumblingBody& body, double t) {
     const SurfaceGap g = side.gap(body, t);
     TumblingContact contact;
     contact.time = t;
@@ -586,7 +629,10 @@ FirstContactResult advance(const TumblingBody& body, const Side& side, double fr
     result.clear_until = t;
   };
   double t = from;
-  SurfaceGap g = side.gap(body, t, Approach::kWithout);
+  const TumblingBody* body = moving.at(t);
+  if (body == nullptr) return result;
+  const double acceleration = moving.accelerationBound(side, *body);
+  SurfaceGap g = side.gap(*body, t, Approach::kWithout);
   if (g.overlapping || g.gap_upper < 0) {
     result.inside_at_start = true;
     return result;
@@ -594,27 +640,29 @@ FirstContactResult advance(const TumblingBody& body, const Side& side, double fr
   for (; result.steps < options.max_steps; ++result.steps) {
     const double stop = options.time_tolerance + 4 * kEps * std::abs(t);
     if (!(g.gap > 0)) {
-      contactAt(t);
+      contactAt(*body, t);
       return result;
     }
-    const double speed = (body.velocityAt(t) - side.centreVelocity(t)).norm() + turning;
+    const double speed = moving.relativeSpeed(t, side.centreVelocity(t)) + turning;
     // Touching where every point's speed bound would step less than the tolerance (the gap
     // within V time_tolerance: the header's comment), even where a plane's own bound steps
     // further: a point gliding along it within that gap would otherwise creep on in steps of
     // about the tolerance, millions of them.
     if (firstRoot(g.gap, speed, acceleration) <= stop) {
-      contactAt(t);
+      contactAt(*body, t);
       return result;
     }
-    const double step = side.step(body, t, g.gap, speed, acceleration);
+    const double step = moving.step(side, t, g.gap, speed, acceleration);
     if (step <= stop) {
-      contactAt(t);
+      contactAt(*body, t);
       return result;
     }
     result.clear_until = std::min(t + step, end);
     if (!(t + step <= end)) return result;  // apart until the horizon's end
     t += step;
-    g = side.gap(body, t, Approach::kWithout);
+    body = moving.at(t);
+    if (body == nullptr) return result;  // apart until t (its state there is refused)
+    g = side.gap(*body, t, Approach::kWithout);
   }
   return result;  // the step budget ran out: apart until clear_until
 }
@@ -674,12 +722,19 @@ SurfaceGap gapAt(const TumblingBody& a, const TumblingBody& b, double time,
 
 FirstContactResult firstContact(const TumblingBody& body, const PlacedShape& obstacle, double from,
                                 double horizon, const FirstContactOptions& options) {
-  return advance(body, ObstacleSide{obstacle, options.distance_tolerance}, from, horizon, options);
+  return advance(FlightSide{body}, ObstacleSide{obstacle, options.distance_tolerance}, from,
+                 horizon, options);
+}
+
+FirstContactResult firstContact(const BoundedMotion& body, const PlacedShape& obstacle, double from,
+                                double horizon, const FirstContactOptions& options) {
+  return advance(BoundedSide{body, std::nullopt},
+                 ObstacleSide{obstacle, options.distance_tolerance}, from, horizon, options);
 }
 
 FirstContactResult firstContact(const TumblingBody& a, const TumblingBody& b, double from,
                                 double horizon, const FirstContactOptions& options) {
-  return advance(a, BodySide{b, options.distance_tolerance}, from, horizon, options);
+  return advance(FlightSide{a}, BodySide{b, options.distance_tolerance}, from, horizon, options);
 }
 
 }  // namespace collision_response::core

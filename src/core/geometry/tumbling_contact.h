@@ -47,6 +47,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -177,6 +178,19 @@ struct FirstContactResult {
   int steps = 0;
 };
 
+/// A body whose motion is known at every instant but is no flight (a lasting contact's on a face,
+/// a tipping: shaped_lasting.h): what it is at an instant, and bounds on its points' speeds over
+/// the whole query, from which firstContact advances as for a flight (the header's comment, its
+/// own acceleration 0: the speeds bounded throughout).
+struct BoundedMotion {
+  /// The body at `time` (its state there, no acceleration); empty where none is made (the query
+  /// ends there, apart until then).
+  std::function<std::optional<TumblingBody>(double time)> at;
+  double centre_speed = 0.0;   ///< m/s: |v| of its centre never exceeds it in the query
+  double angular_speed = 0.0;  ///< rad/s: |w| never exceeds it in the query
+  double reach = 0.0;          ///< m: its farthest point from its centre
+};
+
 /// The gap between `body` and `obstacle` (moved to `time` by shapeAt) at `time`.
 SurfaceGap gapAt(const TumblingBody& body, const PlacedShape& obstacle, double time,
                  double distance_tolerance = 1e-12);
@@ -188,6 +202,9 @@ SurfaceGap gapAt(const TumblingBody& a, const TumblingBody& b, double time,
 /// the header's comment), and the contact there. Touching at `from` (within the tolerances) is
 /// a contact at `from` whatever its approach speed (given in the contact: the caller knows).
 FirstContactResult firstContact(const TumblingBody& body, const PlacedShape& obstacle, double from,
+                                double horizon, const FirstContactOptions& options = {});
+/// The same for a body moving as `body` says (BoundedMotion), certified by its bounds.
+FirstContactResult firstContact(const BoundedMotion& body, const PlacedShape& obstacle, double from,
                                 double horizon, const FirstContactOptions& options = {});
 /// The same between two tumbling bodies (a ball is a tumbling sphere).
 FirstContactResult firstContact(const TumblingBody& a, const TumblingBody& b, double from,
