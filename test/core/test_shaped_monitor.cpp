@@ -528,5 +528,53 @@ TEST(ShapedMonitor, ABoxTippingOverAnEdgeLandsOnItsFaceAtTheEnergyIntegralsInsta
   EXPECT_NEAR(impacts.front().time, edge.tipInstant(), 1e-8);
 }
 
+// A box at rest on the frictionless floor struck by a robot's link moving at v_o (a box obstacle
+// on a tf frame, its face against the box's back face, d behind it): its lasting rest watched the
+// floor alone, and the link went through it. Now the rest ends where the link reaches it, d / v_o
+// (1e-11 s), the four corners of its back face struck at once by an immovable body moving at v_o
+// (the joint frictionless rule): it leaves at (1 + e) v_o without turning, sliding on the floor
+// ahead of the link, its contacts with the floor again m g / 4 per corner.
+TEST(ShapedMonitor, ABoxAtRestStruckByAMovingLinkLeavesAtOnePlusETimesItsSpeed) {
+  const V half(0.05, 0.04, 0.03);
+  const double e = 0.5, m = 2.0, v_o = 0.8, d = 0.04;
+  Scene scene = floorScene(e, half, m);
+  scene.obstacles.push_back(
+      scene_builders::box("paddle", V::Zero(), V(0.02, 0.3, 0.2), "concrete"));
+  scene.obstacles.back().frame = "paddle_link";
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  const std::size_t block = *monitor.bodyIndex("block");
+  RigidPose link;
+  link.transform.translation() = V(-half.x() - d - 0.01, 0, half.z());
+  link.velocity = V(v_o, 0, 0);
+  monitor.setObstaclePose(1, link);
+  BodyStateSample state;
+  state.body = block;
+  state.position = V(0, 0, half.z());
+  std::vector<StepReport> reports{monitor.step(0.0, {state})};
+  for (int k = 1; k <= 10; ++k) reports.push_back(monitor.step(0.01 * k, {}));
+  for (const StepReport& report : reports) {
+    for (const UnmodelledContact& c : report.unmodelled) ADD_FAILURE() << c.what;
+  }
+  const std::vector<ImpactRecord> impacts = impactsOf(reports);
+  std::size_t by_link = 0;
+  for (const ImpactRecord& impact : impacts) {
+    EXPECT_NEAR(impact.time, d / v_o, 1e-11);
+    EXPECT_NEAR(impact.velocity_a_after.x(), (1 + e) * v_o, 1e-9);
+    EXPECT_NEAR(impact.velocity_a_after.z(), 0.0, 1e-9);
+    EXPECT_NEAR(impact.angular_velocity_a_after.norm(), 0.0, 1e-9);
+    if (impact.other_is_obstacle && impact.other == 1) ++by_link;
+  }
+  EXPECT_EQ(by_link, 4u);
+  const auto predicted = monitor.predictedState(block, 0.1);
+  ASSERT_TRUE(predicted);
+  EXPECT_NEAR(predicted->first.x(), (1 + e) * v_o * (0.1 - d / v_o), 1e-9);
+  EXPECT_NEAR(predicted->first.z(), half.z(), 1e-9);
+  ASSERT_EQ(reports.back().contacts.size(), 4u);
+  for (const ContactRecord& contact : reports.back().contacts) {
+    EXPECT_EQ(contact.other, 0u);
+    EXPECT_NEAR(contact.normal_force, m * kG / 4, 1e-9);
+  }
+}
+
 }  // namespace
 }  // namespace collision_response::core

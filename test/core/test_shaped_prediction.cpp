@@ -351,6 +351,45 @@ TEST(ShapedPrediction, ACylinderLeaningOnItsRimEndsThePredictionSayingWhy) {
   EXPECT_EQ(prediction->final_state.time, 0.0);
 }
 
+// A box sliding on the floor (mu 0.3, e 1/2) towards a wall d ahead of its front face: its slide
+// ends where the face reaches the wall, u t - mu g t^2 / 2 = d, t = 2 d / (u + u_s) with u_s =
+// sqrt(u^2 - 2 mu g d) the speed there; the four corners of the face strike at once (their joint
+// rule frictionless), sending it back at e u_s without turning, and it slides back to rest after
+// (e u_s)^2 / (2 mu g). Before, the lasting slide watched its face alone and went through the
+// wall.
+TEST(ShapedPrediction, ABoxSlidingIntoAWallStrikesItAndSlidesBackToRest) {
+  const V half(0.05, 0.04, 0.03);
+  const double e = 0.5, mu = 0.3, u = 1.5, d = 0.2, wall = 0.5;
+  Scene scene = floorScene(e, half);
+  ASSERT_TRUE(scene.materials.addMaterial("sliding", Material{e, mu}, "m").ok());
+  scene.bodies[0].material = "sliding";
+  scene.effects.friction = true;
+  scene.obstacles.push_back(plane("wall", -V::UnitX(), -wall, "concrete"));
+  const double x0 = wall - half.x() - d;
+  auto request = dropped(scene, V(x0, 0, half.z()), Eigen::Quaterniond::Identity(), 1.0, 10);
+  request.state.velocity = V(u, 0, 0);
+  const auto prediction = predictImpacts(scene, nullptr, MonitorSettings{}, request);
+  ASSERT_TRUE(prediction.ok()) << prediction.error().message();
+  EXPECT_FALSE(prediction->cut_short) << prediction->message;
+  const double u_s = std::sqrt(u * u - 2 * mu * kG * d);
+  const double strike = 2 * d / (u + u_s);
+  std::size_t on_wall = 0;
+  for (const ImpactRecord& impact : prediction->impacts) {
+    EXPECT_NEAR(impact.time, strike, 1e-11);
+    EXPECT_NEAR(impact.velocity_a_before.x(), u_s, 1e-9);
+    EXPECT_NEAR(impact.velocity_a_after.x(), -e * u_s, 1e-9);
+    EXPECT_NEAR(impact.velocity_a_after.z(), 0.0, 1e-9);
+    EXPECT_NEAR(impact.angular_velocity_a_after.norm(), 0.0, 1e-9);
+    if (impact.other_is_obstacle && impact.other == 1) ++on_wall;
+  }
+  EXPECT_EQ(on_wall, 4u);
+  const double back = e * u_s;
+  EXPECT_NEAR(prediction->final_state.position.x(), wall - half.x() - back * back / (2 * mu * kG),
+              1e-9);
+  EXPECT_NEAR(prediction->final_state.position.z(), half.z(), 1e-9);
+  EXPECT_EQ(prediction->final_state.velocity, V::Zero());
+}
+
 TEST(ShapedPrediction, WhatIsNotModelledYetIsRefusedByName) {
   Scene scene = floorScene(0.5, V(0.05, 0.05, 0.05));
   auto request = dropped(scene, V(0, 0, 1), Eigen::Quaterniond::Identity(), 1.0, 10);

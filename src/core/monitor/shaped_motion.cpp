@@ -130,6 +130,90 @@ Status ShapedMotion::restartFrom(const BodyStateSample& state) {
   return Ok{};
 }
 
+namespace {
+
+/// m/s and rad/s: bounds on a lasting motion's centre speed and turning speed over [from, until]
+/// (from < until). Its closed forms (a constant acceleration, a constant angular acceleration
+/// about a fixed axis) are affine in t, whose norms are convex: their largest is at an end. A
+/// tipping never gains energy: its kinetic energy K(t) <= K(from) + m g . (c(t) - c(from)) <=
+/// K(from) + m |g| V T over the span T, with V^2 = 2 K_max / m, so V <= |g| T + sqrt((|g| T)^2
+/// + 2 K(from) / m) (its integration's energy error taken in by a margin of 1e-6 of the
+/// energy), and |w| <= sqrt(2 K_max / J_min).
+std::pair<double, double> lastingSpeedBounds(const LastingMotion& lasting,
+                                             const PrincipalBody& principal,
+                                             const Eigen::Vector3d& gravity, double from,
+                                             double until) {
+  constexpr double kMargin = 1 + 1e-12;
+  if (!lasting.pivot) {
+    return {kMargin * std::max(lasting.velocityAt(from).norm(), lasting.velocityAt(until).norm()),
+            kMargin * std::max(lasting.angularVelocityAt(from).norm(),
+                               lasting.angularVelocityAt(until).norm())};
+  }
+  const Eigen::Vector3d v = lasting.velocityAt(from);
+  const Eigen::Vector3d w = lasting.angularVelocityAt(from);
+  const Eigen::Matrix3d turn = lasting.orientationAt(from).toRotationMatrix();
+  const Eigen::Vector3d w_principal = turn.transpose() * w;
+  const double kinetic = 0.5 * principal.mass * v.squaredNorm() +
+                         0.5 * w_principal.dot(principal.moments.cwiseProduct(w_principal));
+  const double g_span = gravity.norm() * (until - from);
+  const double speed =
+      g_span + std::sqrt(g_span * g_span + 2 * (1 + 1e-6) * kinetic / principal.mass + 1e-300);
+  const double kinetic_max = 0.5 * principal.mass * speed * speed;
+  return {kMargin * speed, kMargin * std::sqrt(2 * kinetic_max / principal.moments.minCoeff())};
+}
+
+}  // namespace
+
+std::optional<ShapedMotion::Strike> ShapedMotion::struckWhileLasting(const LastingMotion& lasting,
+                                                                     std::size_t resting_on,
+                                                                     double from,
+                                                                     double until) const {
+  if (!(from < until)) return std::nullopt;
+  BoundedMotion moving;
+  const auto [centre_speed, angular_speed] =
+      lastingSpeedBounds(lasting, principal_, scene_.acceleration, from, until);
+  moving.centre_speed = centre_speed;
+  moving.angular_speed = angular_speed;
+  moving.reach = flight_.reach();
+  moving.at = [&](double t) -> std::optional<TumblingBody> {
+    auto body = TumblingBody::create(principal_.shape, principal_.moments, t, lasting.centreAt(t),
+                                     lasting.velocityAt(t), Eigen::Vector3d::Zero(),
+                                     lasting.orientationAt(t), lasting.angularVelocityAt(t));
+    if (!body) return std::nullopt;
+    return std::move(body.value());
+  };
+  std::optional<Strike> first;
+  for (const Watched& w : obstacles_) {
+    if (w.placed.obstacle == resting_on) continue;
+    const double horizon = first ? first->time : until;
+    // Its step budget may run out on a slow approach: it goes on from where it is known apart
+    // (an obstacle just struck and parted from: from where it is apart).
+    for (double clear = std::max(from, w.clear_from); clear < horizon;) {
+      const FirstContactResult result =
+          firstContact(moving, w.placed.placed, clear, horizon - clear);
+      if (result.contact) {
+        const double closing = result.contact->closest.approach_speed;
+        if (!first || result.contact->time < first->time) {
+          first = Strike{result.contact->time, w.placed.obstacle, closing > kLastingSettled};
+        }
+        break;
+      }
+      if (result.inside_at_start) {
+        first = Strike{clear, w.placed.obstacle, false};
+        break;
+      }
+      if (!(result.clear_until > clear)) break;
+      clear = result.clear_until;
+    }
+  }
+  return first;
+}
+
+void ShapedMotion::placeObstacles(std::vector<ShapedObstacle> placed, double time) {
+  obstacles_.clear();
+  for (ShapedObstacle& obstacle : placed) obstacles_.push_back({std::move(obstacle), time, false});
+}
+
 BodyStateSample ShapedMotion::stateOn(const TumblingBody& flight, double time) const {
   BodyStateSample state;
   state.body = scene_.body;
@@ -209,13 +293,35 @@ bool ShapedMotion::leave(double horizon) {
   // The points just struck leave their obstacles: the next contact with those is looked for
   // once they are apart (separation), with every other obstacle from now.
   const auto apart = separation(flight_, time_, struck_, horizon);
-  if (!apart) {
-    lasting_ = struck_;
-    lasting_time_ = time_;
-    return false;
+  if (apart) {
+    clearUntil(time_, struck_, *apart);
+    return true;
   }
-  clearUntil(time_, struck_, *apart);
-  return true;
+  // Struck at several obstacles at once (a wall the body slides into, and the floor under it):
+  // those whose points part are looked at again once apart; the contact lasts with the others.
+  lasting_.clear();
+  lasting_time_ = time_;
+  std::vector<std::pair<std::size_t, double>> parted;
+  for (std::size_t slot = 0; slot < obstacles_.size(); ++slot) {
+    std::vector<ObstacleContact> with;
+    for (const ObstacleContact& c : struck_) {
+      if (c.slot == slot) with.push_back(c);
+    }
+    if (with.empty()) continue;
+    const auto own =
+        with.size() < struck_.size() ? separation(flight_, time_, with, horizon) : std::nullopt;
+    if (own) {
+      parted.emplace_back(slot, *own);
+    } else {
+      lasting_.insert(lasting_.end(), with.begin(), with.end());
+    }
+  }
+  clearUntil(time_, {}, time_);
+  for (const auto& [slot, from] : parted) {
+    obstacles_[slot].clear_from = from;
+    obstacles_[slot].parted = true;
+  }
+  return false;
 }
 
 bool ShapedMotion::part(double horizon) {

@@ -138,6 +138,25 @@ class ShapedMotion {
   /// separation's (up to 1 ms); false where it does not open (the caller holds the body).
   bool part(double horizon);
 
+  /// Another obstacle meeting the body in its lasting motion: when, which (its model index), and
+  /// whether it strikes (its gap closing faster than a settled body's, kLastingSettled) or only
+  /// touches.
+  struct Strike {
+    double time = 0.0;
+    std::size_t obstacle = 0;
+    bool closing = false;
+  };
+  /// A lasting motion (`lasting`, on the face of obstacle `resting_on`: shaped_lasting.h) watches
+  /// its face alone: the first instant in [from, until] at which another obstacle, fixed or
+  /// moving, touches the body moving so (certified as firstContact, by a BoundedMotion: its
+  /// centre's and its turn's speeds at either end of the span where they are closed forms, a
+  /// tipping's by its energy); empty where none does.
+  std::optional<Strike> struckWhileLasting(const LastingMotion& lasting, std::size_t resting_on,
+                                           double from, double until) const;
+  /// The obstacles as placed now (a tf frame's link moved: the monitor's revisions), looked at
+  /// from `time` on; the motion found so far is kept.
+  void placeObstacles(std::vector<ShapedObstacle> placed, double time);
+
   /// The obstacles (model indices) of the contact found to last, and its manifold.
   std::vector<std::size_t> lastingWith() const;
   /// The contact found to last as the body on one flat face there, for lastingOnFace: with one

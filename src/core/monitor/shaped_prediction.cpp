@@ -204,9 +204,18 @@ class ShapedRun {
         return finishWith(motion, state);
       }
       const LastingMotion& along = *lasting;
-      const double until = std::min(along.until, horizon_);
+      // Its lasting motion watches its face alone: another obstacle it meets ends it first.
+      const auto strike =
+          motion.struckWhileLasting(along, with.front(), on.time, std::min(along.until, horizon_));
+      const double until = strike ? strike->time : std::min(along.until, horizon_);
       sampleUntil(on.time, until, [&](double t) { return stateOn(along, t); });
-      if (until < horizon_ && along.ends == "resumes") {
+      if (strike && !strike->closing) {
+        cut.push_back(lastingContact({with.front(), strike->obstacle}, until,
+                                     "it meets a second obstacle without striking it (a body "
+                                     "against two obstacles at once)"));
+        return finishWith(motion, stateOn(along, until));
+      }
+      if (strike || (until < horizon_ && along.ends == "resumes")) {
         const BodyStateSample there = stateOn(along, until);
         if (const auto refused = resumes_.refuse(until)) {  // beyond its bounds: cut there
           cut.push_back(lastingContact(with, until, *refused));
@@ -220,7 +229,7 @@ class ShapedRun {
           return finishWith(motion, there);
         }
         rests_from_.reset();
-        return std::nullopt;
+        return std::nullopt;  // its events go on from there: a strike's impact first
       }
       if (until >= horizon_ || along.ends != "stops") {
         if (until < horizon_) {

@@ -102,6 +102,17 @@ void ShapedTrack::advanceTo(double time, std::vector<ImpactRecord>& impacts,
   for (;;) {
     if (mode_ == Mode::kHeld) return;
     if (mode_ == Mode::kLasting) {
+      // Its lasting motion watches its face alone: another obstacle (a wall it slides into, a
+      // robot's link swung at it) is looked for first.
+      const double watch_end = std::min(time, lasting_->until);
+      if (watched_until_ < watch_end) {
+        if (const auto strike =
+                motion_.struckWhileLasting(*lasting_, *against_, watched_until_, watch_end)) {
+          struck(*strike, unmodelled);
+          continue;
+        }
+        watched_until_ = watch_end;
+      }
       if (time <= lasting_->until) return;
       endLasting(unmodelled);
       continue;
@@ -191,6 +202,39 @@ void ShapedTrack::endLasting(std::vector<UnmodelledContact>& unmodelled) {
   hold(there, *against_, ends, unmodelled);
 }
 
+/// Another obstacle meets the body in its lasting motion: a strike ends the lasting motion there,
+/// its events going on from there (the impact with it, the face's points taking part); a touch
+/// that does not close (resting or sliding against two obstacles) is held, not modelled yet.
+void ShapedTrack::struck(const ShapedMotion::Strike& strike,
+                         std::vector<UnmodelledContact>& unmodelled) {
+  const BodyStateSample there = stateAt(strike.time);
+  if (!strike.closing) {
+    hold(there, strike.obstacle,
+         "its lasting contact meets a second obstacle without striking it (a body against two "
+         "obstacles at once)",
+         unmodelled);
+    return;
+  }
+  if (const auto refused = resumes_.refuse(strike.time)) {
+    hold(there, strike.obstacle, *refused, unmodelled);
+    return;
+  }
+  if (Status status = motion_.restartFrom(there); !status) {
+    hold(there, strike.obstacle, status.error().message(), unmodelled);
+    return;
+  }
+  mode_ = Mode::kFlying;
+  lasting_.reset();
+  since_ = strike.time;
+  rests_from_.reset();
+}
+
+void ShapedTrack::placeObstacles(std::vector<ShapedObstacle> placed, double time,
+                                 std::size_t revision) {
+  motion_.placeObstacles(std::move(placed), std::max(time, motion_.time()));
+  revision_ = revision;
+}
+
 void ShapedTrack::enterLasting(double time, std::vector<UnmodelledContact>& unmodelled) {
   const std::vector<std::size_t> with = motion_.lastingWith();
   const std::size_t obstacle = with.empty() ? 0 : with.front();
@@ -225,6 +269,7 @@ void ShapedTrack::startLasting(const LastingBody& body, const FlatFace& face,
   lasting_ = std::move(motion.value());
   face_ = face;
   since_ = body.time;
+  watched_until_ = body.time;
   against_ = obstacle;
   if (!resting_again) {
     // Where its last impact was a flat landing, whose bounces accumulate at rests_from_
@@ -332,8 +377,12 @@ namespace {
 void followRevisions(const World& world, ShapedRoom& room, double from) {
   for (std::size_t body = 0; body < room.tracks.size(); ++body) {
     std::optional<ShapedTrack>& track = room.tracks[body];
-    if (!track || track->revision() == room.revision ||
-        track->mode() != ShapedTrack::Mode::kFlying) {
+    if (!track || track->revision() == room.revision || track->mode() == ShapedTrack::Mode::kHeld) {
+      continue;
+    }
+    if (track->mode() == ShapedTrack::Mode::kLasting) {
+      // Its lasting motion goes on; the other obstacles it watches are as placed now.
+      track->placeObstacles(placedObstacles(world), from, room.revision);
       continue;
     }
     const double since = std::max(track->since(), from);

@@ -55,6 +55,9 @@ class ShapedTrack {
   std::vector<ContactRecord> contacts(double time) const;
   /// The obstacle it lasts on or is held against (kLasting, kHeld).
   std::optional<std::size_t> against() const { return against_; }
+  /// The obstacles as placed now (a revision of its room), looked at from `time` on, its motion
+  /// kept (a lasting one's).
+  void placeObstacles(std::vector<ShapedObstacle> placed, double time, std::size_t revision);
   /// The ShapedRoom::revision its motion was started with.
   std::size_t revision() const { return revision_; }
 
@@ -72,6 +75,7 @@ class ShapedTrack {
   void enterLasting(double time, std::vector<UnmodelledContact>& unmodelled);
   void startLasting(const LastingBody& body, const FlatFace& face,
                     std::vector<UnmodelledContact>& unmodelled);
+  void struck(const ShapedMotion::Strike& strike, std::vector<UnmodelledContact>& unmodelled);
   void hold(const BodyStateSample& state, std::size_t obstacle, const std::string& what,
             std::vector<UnmodelledContact>& unmodelled);
 
@@ -85,6 +89,7 @@ class ShapedTrack {
   std::optional<LastingMotion> lasting_;
   FlatFace face_;
   double lasting_since_ = 0.0;
+  double watched_until_ = 0.0;  // no other obstacle meets its lasting motion before it
   std::optional<std::size_t> against_;
   BodyStateSample held_;
   std::size_t revision_ = 0;
