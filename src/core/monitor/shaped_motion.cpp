@@ -30,6 +30,18 @@ ConvexHull boxCorners(const Cuboid& box, const Eigen::Matrix3d& principal_from_b
 
 }  // namespace
 
+SolverBody solverBodyOf(const PrincipalBody& principal, const TumblingBody& body, double time) {
+  SolverBody solver;
+  solver.inverse_mass = 1.0 / principal.mass;
+  solver.velocity = body.velocityAt(time);
+  solver.angular_velocity = body.angularVelocityAt(time);
+  solver.inertia_kind = InverseInertiaKind::kTensor;
+  const Eigen::Matrix3d rotation = body.orientationAt(time).toRotationMatrix();
+  solver.inverse_inertia =
+      rotation * principal.moments.cwiseInverse().asDiagonal() * rotation.transpose();
+  return solver;
+}
+
 Expected<PrincipalBody> principalBody(const BodySpec& body, const std::string& field) {
   if (body.shape == BodyShape::kMesh) {
     return Error{field + ".shape",
@@ -475,15 +487,7 @@ std::vector<ShapedMotion::ObstacleContact> ShapedMotion::firstContacts(const Tum
 
 /// The body as the impact's solver sees it at `time`.
 SolverBody ShapedMotion::solverBody(const TumblingBody& body, double time) const {
-  SolverBody solver;
-  solver.inverse_mass = 1.0 / principal_.mass;
-  solver.velocity = body.velocityAt(time);
-  solver.angular_velocity = body.angularVelocityAt(time);
-  solver.inertia_kind = InverseInertiaKind::kTensor;
-  const Eigen::Matrix3d rotation = body.orientationAt(time).toRotationMatrix();
-  solver.inverse_inertia =
-      rotation * principal_.moments.cwiseInverse().asDiagonal() * rotation.transpose();
-  return solver;
+  return solverBodyOf(principal_, body, time);
 }
 
 /// After an impact or a graze at `time` with `contacts`' obstacles, apart from them at `apart`:

@@ -43,6 +43,10 @@ struct PrincipalBody {
 /// refused (`field`.shape: not yet predicted).
 Expected<PrincipalBody> principalBody(const BodySpec& body, const std::string& field);
 
+/// The body `body` (a flight of `principal`) as the impact solvers see it at `time`: 1 / m, its
+/// inverse inertia tensor in the world (R J^-1 R^T), its velocities.
+SolverBody solverBodyOf(const PrincipalBody& principal, const TumblingBody& body, double time);
+
 /// An obstacle the shaped body may meet: the model's index and where it is placed.
 struct ShapedObstacle {
   std::size_t obstacle = 0;

@@ -8,6 +8,7 @@
 #include "collision_response/core/body_shape.h"
 #include "collision_response/core/validation.h"
 #include "geometry/narrow_phase.h"
+#include "monitor/shaped_pairs.h"
 
 namespace collision_response::core::monitor {
 
@@ -53,7 +54,8 @@ ShapedScene shapedScene(const World& world, std::size_t body) {
   return scene;
 }
 
-/// The shaped body of `room` at `time` as a tumbling body (for its gap to another body).
+}  // namespace
+
 std::optional<TumblingBody> tumblingAt(const ShapedRoom& room, std::size_t body, double time) {
   const PrincipalBody& principal = *room.principal[body];
   const BodyStateSample state = room.tracks[body]->stateAt(time);
@@ -65,12 +67,9 @@ std::optional<TumblingBody> tumblingAt(const ShapedRoom& room, std::size_t body,
   return std::move(created.value());
 }
 
-/// Touching: overlapping, or apart by no more than the manifold's band.
 bool touching(const SurfaceGap& gap) {
   return gap.overlapping || gap.gap <= FirstContactOptions{}.manifold_band;
 }
-
-}  // namespace
 
 Expected<ShapedTrack> ShapedTrack::start(const PrincipalBody& principal,
                                          std::vector<ShapedObstacle> obstacles,
@@ -229,6 +228,16 @@ void ShapedTrack::struck(const ShapedMotion::Strike& strike,
   rests_from_.reset();
 }
 
+void ShapedTrack::holdTouching(double time) {
+  held_ = stateAt(time);
+  held_.velocity.setZero();
+  held_.angular_velocity.setZero();
+  mode_ = Mode::kHeld;
+  since_ = time;
+  against_.reset();
+  lasting_.reset();
+}
+
 void ShapedTrack::placeObstacles(std::vector<ShapedObstacle> placed, double time,
                                  std::size_t revision) {
   motion_.placeObstacles(std::move(placed), std::max(time, motion_.time()));
@@ -295,6 +304,24 @@ void ShapedTrack::hold(const BodyStateSample& state, std::size_t obstacle, const
   contact.time = state.time;
   contact.what = what;
   unmodelled.push_back(contact);
+}
+
+double ShapedTrack::quietUntil(double horizon) const {
+  if (mode_ == Mode::kHeld || still(horizon)) return horizon;
+  if (mode_ == Mode::kLasting || fresh_) return since_;
+  ShapedMotion peek = motion_;
+  if (leaving_ && !peek.leave(kInfinity)) return peek.time();
+  std::vector<ImpactRecord> impacts;
+  const auto found = peek.next(horizon, impacts, true);
+  if (!found) return peek.time();
+  return found->event == ShapedMotion::Event::kFree ? horizon : found->time;
+}
+
+bool ShapedTrack::still(double horizon) const {
+  if (mode_ == Mode::kHeld) return true;
+  if (mode_ != Mode::kLasting || lasting_->pivot || !(lasting_->until >= horizon)) return false;
+  return lasting_->velocity0.isZero(0.0) && lasting_->acceleration.isZero(0.0) &&
+         lasting_->angular_velocity0.isZero(0.0) && lasting_->angular_acceleration.isZero(0.0);
 }
 
 BodyStateSample ShapedTrack::stateAt(double time) const {
@@ -459,7 +486,7 @@ void reportUnmodelled(const World& world, ShapedRoom& room, double time,
   std::vector<UnmodelledContact> found;
   for (std::size_t body = 0; body < room.tracks.size(); ++body) {
     const std::optional<ShapedTrack>& track = room.tracks[body];
-    if (!track || track->mode() != ShapedTrack::Mode::kHeld) continue;
+    if (!track || track->mode() != ShapedTrack::Mode::kHeld || !track->against()) continue;
     const auto key = std::make_tuple(body, *track->against(), true);
     if (!now.insert(key).second) continue;
     UnmodelledContact contact{body, *track->against(), true, track->since(),
@@ -497,12 +524,18 @@ void reportUnmodelled(const World& world, ShapedRoom& room, double time,
         gap = gapAt(*tumbling, sphere, time);
       }
       if (!touching(*gap)) continue;
+      // A pair of shaped bodies just struck is parting (shaped_pairs.h), not in lasting contact.
+      if (room.shaped(other) && room.parting.count({body, other})) continue;
       const auto key = std::make_tuple(body, other, false);
       now.insert(key);
       found.push_back({body, other, false, time,
-                       std::string("a shaped body touching ") +
-                           (room.shaped(other) ? "another shaped body" : "a ball") +
-                           " is not modelled yet: it is not resolved (no impulse, no force)"});
+                       room.shaped(other)
+                           ? std::string("two shaped bodies in lasting contact (at rest on each "
+                                         "other, pushing) are not modelled yet: both are held "
+                                         "where they are until their next states (their impacts "
+                                         "are resolved)")
+                           : std::string("a shaped body touching a ball is not modelled yet: it "
+                                         "is not resolved (no impulse, no force)")});
     }
   }
   for (const UnmodelledContact& contact : found) {
@@ -543,9 +576,7 @@ void stepShaped(const World& world, ShapedRoom& room, double from, double time,
   forgetStale(world, room, time);
   followRevisions(world, room, from);
   std::vector<UnmodelledContact> held;
-  for (std::optional<ShapedTrack>& track : room.tracks) {
-    if (track) track->advanceTo(time, report.impacts, held);
-  }
+  advanceShapedTogether(world, room, from, time, report.impacts, held);
   takeStates(world, room, time, states, held, report);
   finishStep(world, room, time, held, balls, ball_impacts, report);
 }
@@ -557,9 +588,14 @@ void advanceShaped(const World& world, ShapedRoom& room, double from, double tim
   forgetStale(world, room, time);
   followRevisions(world, room, from);
   std::vector<UnmodelledContact> held;
+  double now = from;
   for (const BodyStateSample& state : imposed) {
     std::optional<ShapedTrack>& track = room.tracks[state.body];
     if (!room.shaped(state.body) || !track) continue;
+    if (state.time > now) {
+      advanceShapedTogether(world, room, now, state.time, report.impacts, held);
+      now = state.time;
+    }
     track->advanceTo(state.time, report.impacts, held);
     // The motion just after an impact, which turns no body at its instant: the orientation the
     // track has there is kept.
@@ -573,9 +609,7 @@ void advanceShaped(const World& world, ShapedRoom& room, double from, double tim
     room.tracks[state.body]->last_impact_time = state.time;
     room.tracks[state.body]->impact_change.setZero();
   }
-  for (std::optional<ShapedTrack>& track : room.tracks) {
-    if (track) track->advanceTo(time, report.impacts, held);
-  }
+  advanceShapedTogether(world, room, std::max(now, from), time, report.impacts, held);
   finishStep(world, room, time, held, balls, ball_impacts, report);
 }
 

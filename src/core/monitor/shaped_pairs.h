@@ -1,0 +1,40 @@
+// Impacts between the monitor's shaped bodies (issue 42, step 6: "their impacts are found and
+// resolved"): every known shaped track advanced over a step together, each pair of shaped bodies
+// watched for its first contact, and the impact there resolved on both.
+//
+// The watch is conservative advancement (tumbling_contact.h) on the pair's certified gap g at t:
+// no point of either body moves faster than its bound over the step's rest T, so they do not
+// touch before t + g / (V_a + V_b). A body's bound holds through its own events with fixed
+// obstacles (impacts and lasting contact never gain energy): its kinetic energy K(s) <= K(t) +
+// m g . (c(s) - c(t)) <= K(t) + m |g| V T, so its centre's speed V <= |g| T + sqrt((|g| T)^2 +
+// 2 K(t) / m) and its turning |w| <= sqrt(2 K_max / J_min), every point within V + |w| R (R its
+// reach). A body struck by a moving obstacle in the step may gain energy past it: a pair found
+// overlapping after a step is reported (not modelled: never a silent pass-through).
+//
+// Where a pair touches closing (faster than a settled body's rebound, as an obstacle's impact:
+// ShapedMotion), the impact is resolved at that instant: one point by Chatterjee and Ruina's law
+// with the pair's friction, several at once by the joint frictionless rule (rigid_impact.h), both
+// tracks going on from their states after it; the pair is then left to part (ShapedRoom::parting)
+// before it may touch again. A pair that touches without closing lasts, which is not modelled yet
+// (two shaped bodies at rest on each other, pushing): it is not watched for the rest of the step
+// and is reported at the step's end (stepShaped).
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "collision_response/core/monitor.h"
+#include "model/monitor_world.h"
+#include "monitor/shaped_tracks.h"
+
+namespace collision_response::core::monitor {
+
+/// Every known shaped track of `room` advanced from `from` to `time`, their impacts with obstacles
+/// and with each other appended to `impacts` (time order is the caller's), the contacts whose
+/// model is missing (a track held, a pair of shaped bodies found inside each other) to
+/// `unmodelled`.
+void advanceShapedTogether(const World& world, ShapedRoom& room, double from, double time,
+                           std::vector<ImpactRecord>& impacts,
+                           std::vector<UnmodelledContact>& unmodelled);
+
+}  // namespace collision_response::core::monitor
