@@ -1,0 +1,97 @@
+// Two boxes sliding into each other, then one into a wall, played through demo.launch over real
+// topics (config/scenes/box_collide.yaml): cubes of 0.1 m on a frictionless floor, 'left' (0.5
+// kg) from x = -0.3 m at +1 m/s, 'right' (1 kg) from x = +0.3 m at -0.5 m/s, e = 1/2 for every
+// pair, a wall at x = 0.4 m. Closed forms:
+//  - the faces meet at t1 = (0.6 - 0.1) / 1.5 = 1/3 s, four corners at once; along the line of
+//    impact (no lever arm about any axis: the corners are symmetric about the line of centres)
+//    v_l' = (m_l v_l + m_r v_r - m_r e (v_l - v_r)) / (m_l + m_r) = -0.5 m/s and v_r' = v_l' +
+//    e (v_l - v_r) = 0.25 m/s, without turning;
+//  - 'right', sliding on at 0.25 m/s from x = 0.3 - 0.5 t1, reaches the wall at t2 = t1 + (0.35
+//    - 0.3 + 0.5 t1) / 0.25 = 1.2 s and leaves at -0.125 m/s.
+// The instants are read from the stamps (the node's impacts against the player's first state):
+// ROS stamps are whole nanoseconds, and the player applies the node's impact from its stamp, so
+// the wall's instant is off by up to 0.5e-9 s times 0.5 / 0.25 (held to 1e-8 s).
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "collision_response/BodyStateArray.h"
+#include "collision_response/ImpactArray.h"
+
+namespace {
+
+constexpr double kE = 0.5, kHalf = 0.05, kWall = 0.4;
+
+TEST(BoxCollide, TheNodesImpactsAreTheClosedFormsAndNoBoxEntersAnother) {
+  ros::NodeHandle node;
+  std::vector<collision_response::Impact> impacts;
+  ros::Time start;
+  double last_time = 0, worst_overlap = -INFINITY, worst_wall = -INFINITY, worst_floor = 0;
+  double largest_spin = 0;
+  ros::Subscriber impact_subscriber = node.subscribe<collision_response::ImpactArray>(
+      "impacts", 100, [&](const collision_response::ImpactArray::ConstPtr& array) {
+        impacts.insert(impacts.end(), array->impacts.begin(), array->impacts.end());
+      });
+  ros::Subscriber states = node.subscribe<collision_response::BodyStateArray>(
+      "body_states", 1000, [&](const collision_response::BodyStateArray::ConstPtr& array) {
+        if (start.isZero()) start = array->header.stamp;
+        std::map<std::string, double> x;
+        for (const auto& state : array->states) {
+          x[state.id] = state.pose.position.x;
+          const auto& w = state.twist.angular;
+          largest_spin = std::max(largest_spin, std::sqrt(w.x * w.x + w.y * w.y + w.z * w.z));
+          worst_floor = std::max(worst_floor, std::abs(state.pose.position.z - kHalf));
+        }
+        if (x.count("left") && x.count("right")) {
+          worst_overlap = std::max(worst_overlap, (x["left"] + kHalf) - (x["right"] - kHalf));
+          worst_wall = std::max(worst_wall, x["right"] + kHalf - kWall);
+        }
+        last_time = (array->header.stamp - start).toSec();
+      });
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(40.0);
+  while (ros::ok() && ros::WallTime::now() < end && last_time < 1.45) {
+    ros::spinOnce();
+    ros::WallDuration(0.01).sleep();
+  }
+  std::vector<collision_response::Impact> pair, wall;
+  for (const auto& impact : impacts) {
+    if (impact.body_b == "right") pair.push_back(impact);
+    if (impact.body_b == "wall") wall.push_back(impact);
+  }
+  ASSERT_EQ(pair.size(), 4u) << "the faces' four corners at once";
+  for (const auto& impact : pair) {
+    EXPECT_EQ(impact.body_a, "left");
+    EXPECT_NEAR((impact.header.stamp - start).toSec(), 1.0 / 3.0, 2e-9);
+    EXPECT_NEAR(impact.velocity_a_before.linear.x, 1.0, 1e-12);
+    EXPECT_NEAR(impact.velocity_b_before.linear.x, -0.5, 1e-12);
+    EXPECT_NEAR(impact.velocity_a_after.linear.x, -0.5, 1e-12);
+    EXPECT_NEAR(impact.velocity_b_after.linear.x, 0.25, 1e-12);
+    EXPECT_NEAR(std::abs(impact.velocity_a_after.linear.z), 0, 1e-12);
+    EXPECT_NEAR(std::abs(impact.normal.x), 1.0, 1e-15);
+  }
+  ASSERT_EQ(wall.size(), 4u) << "the face's four corners at once";
+  for (const auto& impact : wall) {
+    EXPECT_EQ(impact.body_a, "right");
+    EXPECT_NEAR((impact.header.stamp - start).toSec(), 1.2, 1e-8);
+    EXPECT_NEAR(impact.velocity_a_before.linear.x, 0.25, 1e-9);
+    EXPECT_NEAR(impact.velocity_a_after.linear.x, -kE * 0.25, 1e-9);
+  }
+  EXPECT_LT(largest_spin, 1e-12) << "no box turns";
+  EXPECT_LE(worst_overlap, 1e-9) << "a played 'left' inside 'right'";
+  EXPECT_LE(worst_wall, 1e-9) << "a played 'right' inside the wall";
+  EXPECT_LT(worst_floor, 1e-9) << "both slide on the floor";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "box_collide_test");
+  ros::NodeHandle node;
+  return RUN_ALL_TESTS();
+}
