@@ -1,6 +1,6 @@
 // A scene body's shape and inertia (body_shape.h): each bad value named at its scene key by
-// validateScene, before the refusals that stand for now ("not yet": a mesh body or an immovable
-// shaped body in the monitor, any shaped body in a ball's prediction), which name the body; a
+// validateScene, before the refusals that stand for now ("not yet": an immovable shaped body in
+// the monitor, any shaped body in a ball's prediction), which name the body; a
 // ball's scene as before; each shape's mass properties its closed form's.
 #include <gtest/gtest.h>
 
@@ -50,11 +50,12 @@ TEST(BodyShape, BallsAreAsBefore) {
       << validateScene(scene, "scene").error().message();
 }
 
-// The monitor moves a box, a cylinder, a capsule and a sphere given a tensor (validateScene's
-// default, MovingShapes::kMonitored); a mesh body and an immovable shaped body not yet, saying so.
+// The monitor moves a box, a cylinder, a capsule, a mesh (its convex hull) and a sphere given a
+// tensor (validateScene's default, MovingShapes::kMonitored); an immovable shaped body not yet,
+// saying so.
 // A ball's prediction (kSpheresOnly), whose other bodies are held as spheres, still refuses every
 // shaped body by name: nothing silently becomes a ball.
-TEST(BodyShape, TheMonitorMovesShapedBodiesButAMeshOrAnImmovableOneNotYet) {
+TEST(BodyShape, TheMonitorMovesShapedBodiesButAnImmovableOneNotYet) {
   for (const auto& [shape, name] :
        {std::pair{BodyShape::kBox, "box"}, std::pair{BodyShape::kCylinder, "cylinder"},
         std::pair{BodyShape::kCapsule, "capsule"}, std::pair{BodyShape::kMesh, "mesh"}}) {
@@ -66,13 +67,8 @@ TEST(BodyShape, TheMonitorMovesShapedBodiesButAMeshOrAnImmovableOneNotYet) {
           shape_kind == BodyShape::kCylinder || shape_kind == BodyShape::kCapsule ? 0.1 : 0.0;
       body.mesh = scene_builders::cubeMesh(V(0.05, 0.05, 0.05));
     });
-    if (shape == BodyShape::kMesh) {
-      expectRefused(validateScene(scene, "~scene"), "~scene/bodies[1]/shape",
-                    "not yet: a mesh body does not move yet (body 'block' is a mesh");
-    } else {
-      EXPECT_TRUE(validateScene(scene, "~scene").ok())
-          << validateScene(scene, "~scene").error().message();
-    }
+    EXPECT_TRUE(validateScene(scene, "~scene").ok())
+        << validateScene(scene, "~scene").error().message();
     expectRefused(validateScene(scene, "~scene", MovingShapes::kSpheresOnly),
                   "~scene/bodies[1]/shape",
                   std::string("not yet: only spheres move (body 'block' is a ") + name);

@@ -134,6 +134,50 @@ TEST(ShapedPairs, ABoxDroppedOnABoxRestingOnTheFloorLandsOnItAtTheParabolasInsta
   EXPECT_NE(unmodelled[0].what.find("lasting contact"), std::string::npos) << unmodelled[0].what;
 }
 
+// config/scenes/box_collide.yaml in the core: two 0.125 m cubes (0.5 kg, and 1 kg given as a
+// mesh: the cube's 12 triangles, its hull) sliding on a frictionless floor into each other, e =
+// 1/2, then the heavier into a wall at x = 0.425: the faces meet at t1 = (0.6 - 0.125) / 1.5 s
+// (1e-11 s), leaving at -0.5 and 0.25 m/s (the line of impact's closed form, 1e-12), and the
+// wall is struck at t1 + (0.425 - 0.0625 - 0.3 + 0.5 t1) / 0.25 = 1.2 s (1e-10 s), the mesh
+// leaving it at -0.125 m/s.
+TEST(ShapedPairs, TwoBoxesSlidingIntoEachOtherThenAWallAsTheSceneSays) {
+  const V half(0.0625, 0.0625, 0.0625);
+  Scene scene = twoBoxes(half, 0.5, half, 1.0, 0.5);
+  scene.effects.gravity = true;
+  scene.gravity = V(0, 0, -9.81);
+  scene.bodies[1].shape = BodyShape::kMesh;
+  scene.bodies[1].size = V::Zero();
+  scene.bodies[1].mesh = scene_builders::cubeMesh(half);
+  scene.obstacles = {scene_builders::plane("floor", V::UnitZ(), 0.0, "concrete"),
+                     scene_builders::plane("wall", -V::UnitX(), -0.425, "concrete")};
+  MonitorSettings settings;
+  settings.body_timeout = 10.0;  // one state each, followed for 1.5 s
+  ImpactMonitor monitor(scene, settings);
+  monitor.step(0.0, {stateOf(monitor, "a", V(-0.3, 0, 0.0625), V(1.0, 0, 0)),
+                     stateOf(monitor, "b", V(0.3, 0, 0.0625), V(-0.5, 0, 0))});
+  std::vector<ImpactRecord> pair, wall;
+  for (int k = 1; k <= 150; ++k) {
+    const StepReport report = monitor.step(0.01 * k, {});
+    for (const UnmodelledContact& c : report.unmodelled) ADD_FAILURE() << c.what;
+    for (const ImpactRecord& impact : report.impacts) {
+      if (!impact.other_is_obstacle) pair.push_back(impact);
+      if (impact.other_is_obstacle && impact.other == 1) wall.push_back(impact);
+    }
+  }
+  ASSERT_EQ(pair.size(), 4u);
+  for (const ImpactRecord& impact : pair) {
+    EXPECT_NEAR(impact.time, 0.475 / 1.5, 1e-11);
+    EXPECT_NEAR(impact.velocity_a_after.x(), -0.5, 1e-12);
+    EXPECT_NEAR(impact.velocity_b_after.x(), 0.25, 1e-12);
+  }
+  ASSERT_EQ(wall.size(), 4u);
+  for (const ImpactRecord& impact : wall) {
+    EXPECT_EQ(impact.other, 1u);
+    EXPECT_NEAR(impact.time, 1.2, 1e-10);
+    EXPECT_NEAR(impact.velocity_a_after.x(), -0.125, 1e-12);
+  }
+}
+
 /// kg m/s and kg m^2/s: the linear momentum and the angular momentum about the origin of the
 /// monitor's shaped bodies at `time`, and their kinetic energy (J).
 struct Momenta {

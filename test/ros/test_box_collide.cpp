@@ -1,13 +1,13 @@
 // Two boxes sliding into each other, then one into a wall, played through demo.launch over real
-// topics (config/scenes/box_collide.yaml): cubes of 0.1 m on a frictionless floor, 'left' (0.5
-// kg) from x = -0.3 m at +1 m/s, 'right' (1 kg) from x = +0.3 m at -0.5 m/s, e = 1/2 for every
-// pair, a wall at x = 0.4 m. Closed forms:
-//  - the faces meet at t1 = (0.6 - 0.1) / 1.5 = 1/3 s, four corners at once; along the line of
+// topics (config/scenes/box_collide.yaml): cubes of 0.125 m on a frictionless floor, 'left' (0.5
+// kg) from x = -0.3 m at +1 m/s, 'right' (1 kg, a mesh body: meshes/cube.stl, its hull the cube)
+// from x = +0.3 m at -0.5 m/s, e = 1/2 for every pair, a wall at x = 0.425 m. Closed forms:
+//  - the faces meet at t1 = (0.6 - 0.125) / 1.5 s, four corners at once; along the line of
 //    impact (no lever arm about any axis: the corners are symmetric about the line of centres)
 //    v_l' = (m_l v_l + m_r v_r - m_r e (v_l - v_r)) / (m_l + m_r) = -0.5 m/s and v_r' = v_l' +
 //    e (v_l - v_r) = 0.25 m/s, without turning;
-//  - 'right', sliding on at 0.25 m/s from x = 0.3 - 0.5 t1, reaches the wall at t2 = t1 + (0.35
-//    - 0.3 + 0.5 t1) / 0.25 = 1.2 s and leaves at -0.125 m/s.
+//  - 'right', sliding on at 0.25 m/s from x = 0.3 - 0.5 t1, reaches the wall at t2 = t1 + (0.425
+//    - 0.0625 - 0.3 + 0.5 t1) / 0.25 = 1.2 s and leaves at -0.125 m/s.
 // The instants are read from the stamps (the node's impacts against the player's first state):
 // ROS stamps are whole nanoseconds, and the player applies the node's impact from its stamp, so
 // the wall's instant is off by up to 0.5e-9 s times 0.5 / 0.25 (held to 1e-8 s).
@@ -25,7 +25,7 @@
 
 namespace {
 
-constexpr double kE = 0.5, kHalf = 0.05, kWall = 0.4;
+constexpr double kE = 0.5, kHalf = 0.0625, kWall = 0.425;
 
 TEST(BoxCollide, TheNodesImpactsAreTheClosedFormsAndNoBoxEntersAnother) {
   ros::NodeHandle node;
@@ -66,7 +66,7 @@ TEST(BoxCollide, TheNodesImpactsAreTheClosedFormsAndNoBoxEntersAnother) {
   ASSERT_EQ(pair.size(), 4u) << "the faces' four corners at once";
   for (const auto& impact : pair) {
     EXPECT_EQ(impact.body_a, "left");
-    EXPECT_NEAR((impact.header.stamp - start).toSec(), 1.0 / 3.0, 2e-9);
+    EXPECT_NEAR((impact.header.stamp - start).toSec(), 0.475 / 1.5, 2e-9);
     EXPECT_NEAR(impact.velocity_a_before.linear.x, 1.0, 1e-12);
     EXPECT_NEAR(impact.velocity_b_before.linear.x, -0.5, 1e-12);
     EXPECT_NEAR(impact.velocity_a_after.linear.x, -0.5, 1e-12);

@@ -810,9 +810,9 @@ TEST(SceneKeys, EveryDocumentedKeyLoadsWithItsValue) {
 // Issue 42, build step 2: a body's shape keys. Each bad value is named at its key; a good box,
 // cylinder or capsule body (or a sphere given its tensor) is read, checked and taken, as the
 // monitor moves it (issue 42, step 7; it was refused "not yet: only spheres move" until the
-// monitor took shaped bodies); a mesh body is read and checked, then refused at load naming the
-// body, as it does not move yet (nothing silently becomes a ball).
-TEST(SceneLoader, Issue42_ShapedBodiesAreReadCheckedAndNotYetMoved) {
+// monitor took shaped bodies), and so is a mesh body (its convex hull; refused "not yet" until
+// the monitor moved one).
+TEST(SceneLoader, Issue42_ShapedBodiesAreReadCheckedAndTaken) {
   const auto withBody = [](const std::function<void(XmlRpc::XmlRpcValue&)>& shape_it) {
     XmlRpc::XmlRpcValue scene = fullScene();
     XmlRpc::XmlRpcValue body;
@@ -839,7 +839,7 @@ TEST(SceneLoader, Issue42_ShapedBodiesAreReadCheckedAndNotYetMoved) {
     ASSERT_NE(block, loaded->bodies.end());
     EXPECT_EQ(block->shape, shape);
   };
-  // Good shapes: read, checked and taken; a mesh body read and checked, then "not yet".
+  // Good shapes: read, checked and taken.
   taken(withBody([](XmlRpc::XmlRpcValue& b) {
           b["shape"] = "box";
           b["size"] = list3(0.1, 0.2, 0.3);
@@ -851,11 +851,11 @@ TEST(SceneLoader, Issue42_ShapedBodiesAreReadCheckedAndNotYetMoved) {
           b["length"] = 0.0;
         }),
         core::BodyShape::kCapsule);
-  refused(withBody([](XmlRpc::XmlRpcValue& b) {
-            b["shape"] = "mesh";
-            b["resource"] = testMesh("grip.stl");
-          }),
-          at + "shape", "not yet: a mesh body does not move yet (body 'block' is a mesh");
+  taken(withBody([](XmlRpc::XmlRpcValue& b) {
+          b["shape"] = "mesh";
+          b["resource"] = testMesh("grip.stl");
+        }),
+        core::BodyShape::kMesh);
   // A ball given a tensor: a shaped body of a sphere's shape.
   taken(withBody([](XmlRpc::XmlRpcValue& b) {
           b["radius"] = 0.05;

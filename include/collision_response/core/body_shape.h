@@ -1,7 +1,7 @@
 // A scene body's shape and mass (issue 42, build step 2): its shape in its own frame, the checks
 // of its shape and inertia keys, and its mass properties. The monitor moves spheres, boxes,
-// cylinders and capsules; what it does not move yet is refused by name (validateScene), so that
-// nothing silently becomes a ball.
+// cylinders, capsules and meshes (their convex hulls); what it does not move yet is refused by
+// name (validateScene), so that nothing silently becomes a ball.
 #pragma once
 
 #include <functional>

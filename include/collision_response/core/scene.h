@@ -76,7 +76,7 @@ struct BodySpec {
   /// Its shape: a sphere of `radius` by default; a box of edges `size`, a cylinder or a capsule
   /// of `radius` and `length` (between the caps; of the capsule's segment), or the convex hull of
   /// `mesh` (loaded from `resource`, scaled by `scale`, as an obstacle's). The monitor moves a
-  /// box, cylinder or capsule (validateScene refuses a mesh body: "not yet").
+  /// box, cylinder, capsule or mesh (its hull).
   BodyShape shape = BodyShape::kSphere;
   Eigen::Vector3d size = Eigen::Vector3d::Zero();  ///< box: edge lengths, m
   double length = 0.0;                             ///< cylinder, capsule: m
@@ -147,8 +147,8 @@ struct Scene {
 
 /// Which bodies a scene may move: spheres only (a ball's prediction, whose other bodies are held
 /// as spheres), any shape (a shaped body's prediction: src/core/monitor/shaped_prediction.h), or
-/// the monitor's: spheres, and boxes, cylinders and capsules of finite mass under gravity alone
-/// (a mesh body, an immovable shaped body, drag or magnus with a shaped body: "not yet").
+/// the monitor's: spheres, and boxes, cylinders, capsules and meshes of finite mass under gravity
+/// alone (an immovable shaped body, drag or magnus with a shaped body: "not yet").
 enum class MovingShapes { kSpheresOnly, kAny, kMonitored };
 
 /// Every value and cross-reference of a scene: ids unique among bodies and obstacles, masses,

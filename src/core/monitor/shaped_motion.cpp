@@ -7,7 +7,9 @@
 #include <utility>
 
 #include "collision_response/core/body_shape.h"
+#include "collision_response/core/mass_properties.h"
 #include "collision_response/core/rigid_impact.h"
+#include "collision_response/core/triangle_mesh.h"
 #include "geometry/narrow_phase.h"
 
 namespace collision_response::core {
@@ -43,10 +45,6 @@ SolverBody solverBodyOf(const PrincipalBody& principal, const TumblingBody& body
 }
 
 Expected<PrincipalBody> principalBody(const BodySpec& body, const std::string& field) {
-  if (body.shape == BodyShape::kMesh) {
-    return Error{field + ".shape",
-                 "not yet: a mesh body is not predicted (a box, cylinder, capsule or sphere is)"};
-  }
   auto properties = bodyMassProperties(body, field + ".inertia");
   if (!properties) return properties.error();
   PrincipalBody principal;
@@ -77,6 +75,16 @@ Expected<PrincipalBody> principalBody(const BodySpec& body, const std::string& f
     } else {
       principal.shape = *box;
     }
+  } else if (const auto* mesh = std::get_if<Mesh>(&shape)) {
+    // A mesh body is the convex hull of its vertices (its mass properties are the hull's).
+    if (mesh->triangles == nullptr) return Error{field + ".resource", "has no loaded mesh"};
+    const auto hull = convexHull(mesh->triangles->vertices(), field + ".resource");
+    if (!hull) return hull.error();
+    ConvexHull corners;
+    for (const Eigen::Vector3d& vertex : hull->vertices) {
+      corners.vertices.push_back(principal_from_body * (vertex - principal.centre_of_mass));
+    }
+    principal.shape = std::move(corners);
   } else if (moved) {
     return Error{field + ".inertia",
                  "not yet: a cylinder's or a capsule's tensor must have no products of inertia "

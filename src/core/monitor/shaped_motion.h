@@ -39,8 +39,9 @@ struct PrincipalBody {
 
 /// A shaped body's principal frame from its shape and mass (bodyMassProperties). A tensor with
 /// products of inertia turns the frame: a box then becomes the hull of its corners; a cylinder
-/// or a capsule given such a tensor is refused (`field`.inertia: not yet). A mesh body is
-/// refused (`field`.shape: not yet predicted).
+/// or a capsule given such a tensor is refused (`field`.inertia: not yet). A mesh body is the
+/// convex hull of its vertices (convexHull; `field`.resource names a mesh not loaded or of no
+/// volume).
 Expected<PrincipalBody> principalBody(const BodySpec& body, const std::string& field);
 
 /// The body `body` (a flight of `principal`) as the impact solvers see it at `time`: 1 / m, its

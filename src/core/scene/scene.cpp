@@ -325,18 +325,14 @@ Status checkEveryPairHasRestitution(const Scene& scene, const std::string& prefi
 }
 
 /// The shaped bodies the monitor moves (doc/model.md, "Shaped bodies in the monitor"): a box, a
-/// cylinder, a capsule, or a sphere given a tensor, of finite mass, by gravity alone; a mesh body,
-/// an immovable shaped body, drag or magnus with a shaped body, and what principalBody refuses
-/// (a cylinder's or capsule's tensor with products of inertia) are refused: "not yet".
+/// cylinder, a capsule, a mesh (its convex hull), or a sphere given a tensor, of finite mass, by
+/// gravity alone; an immovable shaped body, drag or magnus with a shaped body, and what
+/// principalBody refuses (a cylinder's or capsule's tensor with products of inertia) are refused:
+/// "not yet".
 Status checkMonitoredShapes(const Scene& scene, const std::string& prefix) {
   for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
     const BodySpec& body = scene.bodies[i];
     if (!isShapedBody(body)) continue;
-    if (body.shape == BodyShape::kMesh) {
-      return Error{item(prefix, "bodies", i, "shape"),
-                   "not yet: a mesh body does not move yet (body '" + body.id +
-                       "' is a mesh; a sphere, box, cylinder or capsule does)"};
-    }
     if (!std::isfinite(body.mass)) {
       return Error{item(prefix, "bodies", i, "mass"),
                    "not yet: an immovable shaped body (body '" + body.id + "' is a " +
