@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -128,6 +129,14 @@ TEST(ShapedPairs, ABoxDroppedOnABoxRestingOnTheFloorLandsOnItAtTheParabolasInsta
     EXPECT_EQ(impacts[k].body_a, upper);
     EXPECT_EQ(impacts[k].other, lower);
   }
+  // The lower box, struck down onto the floor it rests on, strikes it at that instant (its
+  // records reported as any impact's).
+  const auto on_floor = std::find_if(impacts.begin(), impacts.end(), [&](const ImpactRecord& i) {
+    return i.body_a == lower && i.other_is_obstacle;
+  });
+  ASSERT_NE(on_floor, impacts.end());
+  EXPECT_NEAR(on_floor->time, std::sqrt(2 * h / 9.81), 1e-11);
+  EXPECT_LT(on_floor->velocity_a_before.z(), 0.0);
   ASSERT_EQ(unmodelled.size(), 1u);
   EXPECT_EQ(unmodelled[0].body, upper);
   EXPECT_EQ(unmodelled[0].other, lower);

@@ -66,11 +66,12 @@ class PairWatch {
             std::vector<UnmodelledContact>& unmodelled)
       : world_(world), room_(room), impacts_(impacts), unmodelled_(unmodelled) {}
 
-  /// s: how far from `time` the pair (a < b) may go on untouched, up to `end`, where `quiet_a`
-  /// and `quiet_b` are when the two tracks' present motions end (ShapedTrack::quietUntil); an
-  /// impact where it touches closing is resolved (0: look again at `time`); a lasting touch
-  /// leaves it unwatched for the rest of the step.
-  double step(const Pair& pair, double time, double end, double quiet_a, double quiet_b) {
+  /// s: how far from `time` the pair (a < b) may go on untouched, up to `end`, where `quiet(i)`
+  /// is when track i's present motion ends (ShapedTrack::quietUntil, asked only where both fly or
+  /// are still); an impact where it touches closing is resolved (0: look again at `time`); a
+  /// lasting touch leaves it unwatched for the rest of the step.
+  template <class Quiet>
+  double step(const Pair& pair, double time, double end, const Quiet& quiet) {
     if (unwatched_.count(pair)) return end - time;
     const ShapedTrack& track_a = *room_.tracks[pair.first];
     const ShapedTrack& track_b = *room_.tracks[pair.second];
@@ -100,7 +101,7 @@ class PairWatch {
     if (exact) {
       // Both are flights (or still) until the earlier of their own next events: the pair's own
       // certified advancement (tumbling_contact.h: their relative motion) up to there.
-      const double until = std::min({quiet_a, quiet_b, end});
+      const double until = std::min({quiet(pair.first), quiet(pair.second), end});
       if (!(until > time)) return stop;
       const FirstContactResult found = firstContact(*a, *b, time, until - time);
       if (found.inside_at_start) {
@@ -260,8 +261,9 @@ class PairWatch {
       track.last_orientation = orientation;
       track.last_impact_time = time;
       track.impact_change = bodies[side].velocity - before[side].velocity;
-      std::vector<ImpactRecord> none;
-      track.advanceTo(time, none, unmodelled_);  // whether it starts inside an obstacle
+      // Whether it starts inside an obstacle, and its impacts at this instant (a box struck down
+      // onto the floor it rests on strikes the floor now).
+      track.advanceTo(time, impacts_, unmodelled_);
     }
     room_.parting[pair] = time;  // touching as they part: looked at by touch() from here
   }
@@ -294,7 +296,11 @@ void advanceShapedTogether(const World& world, ShapedRoom& room, double from, do
   PairWatch watch(world, room, impacts, unmodelled);
   double t = from;
   advanceAll(t);
-  std::vector<double> quiet(room.tracks.size(), time);
+  std::vector<std::optional<double>> quiet(room.tracks.size());  // this pass's, where asked
+  const auto quietOf = [&](std::size_t body) {
+    if (!quiet[body]) quiet[body] = room.tracks[body]->quietUntil(time);
+    return *quiet[body];
+  };
   for (int pass = 0; t < time; ++pass) {
     if (pass == kMaxPasses) {
       for (std::size_t i = 0; i < known.size(); ++i) {
@@ -303,16 +309,14 @@ void advanceShapedTogether(const World& world, ShapedRoom& room, double from, do
         }
       }
     }
-    for (const std::size_t body : known) {
-      if (room.tracks[body]) quiet[body] = room.tracks[body]->quietUntil(time);
-    }
+    std::fill(quiet.begin(), quiet.end(), std::nullopt);
     double next = time;
     bool struck = false;
     for (std::size_t i = 0; i < known.size() && !struck; ++i) {
       for (std::size_t j = i + 1; j < known.size(); ++j) {
         const std::size_t a = known[i], b = known[j];
         if (!room.tracks[a] || !room.tracks[b]) continue;
-        const double step = watch.step({a, b}, t, time, quiet[a], quiet[b]);
+        const double step = watch.step({a, b}, t, time, quietOf);
         if (step == 0.0) {
           struck = true;  // an impact: every pair looked at again from here
           break;
