@@ -341,7 +341,7 @@ bool ShapedMotion::leave(double horizon) {
     obstacles_[slot].clear_from = from;
     obstacles_[slot].parted = true;
   }
-  return false;
+  return lasting_.empty();  // each obstacle's points part on their own: apart
 }
 
 bool ShapedMotion::part(double horizon) {

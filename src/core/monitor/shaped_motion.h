@@ -134,7 +134,9 @@ class ShapedMotion {
   /// up to it is looked at from there on (kFree), not from its older instant again.
   Expected<Found> next(double horizon, std::vector<ImpactRecord>& impacts, bool through = false);
   /// After an impact (next() said kImpact): whether the points struck leave their obstacles
-  /// (they are looked at again from there); false: the contact lasts (lastingWith()).
+  /// (they are looked at again from there); false: the contact lasts (lastingWith()). Struck at
+  /// several obstacles at once, those whose points part on their own are looked at again once
+  /// apart, and the contact lasts with the others.
   bool leave(double horizon);
 
   /// A contact found to last that is none (lastingOnFace: its points near the face all leave or
