@@ -334,6 +334,181 @@ std::optional<std::vector<Vec>> cornersOf(const ConvexShape& shape) {
   return std::nullopt;
 }
 
+/// What ends a segment of the motion: each a function of the state that reaches <= 0.
+enum class What { kCorner, kLeaves, kSlips, kSticks, kEdge, kClear };
+struct Event {
+  What what;
+  std::size_t point;
+  std::function<double(const Kinematics&)> value;
+};
+
+/// Each corner's height over the lowest point touching (the one stateAt puts on the face): their
+/// drift is not a corner's approach.
+struct Above {
+  const Setting& s;
+  const std::vector<Point>& current;
+  double operator()(const Kinematics& x, const Vec& corner) const {
+    double base = current.empty() ? 0.0 : std::numeric_limits<double>::infinity();
+    for (const Point& p : current) base = std::min(base, heightOf(s, x, p.corner));
+    return heightOf(s, x, corner) - base;
+  }
+};
+
+/// The events of a step of the segment with `current` touching, from `start` (the state at the
+/// step's start): another corner reaching the face (one below it as the segment began, one that
+/// just left, where it comes back 1e-12 m below where it was: `below`), a point leaving (its
+/// normal force 0), a sticking point leaving its cone, a sliding one's slip stopping, a point
+/// reaching a bounded face's edge, and, lifted off, the lowest corner `clearance` above the face.
+std::vector<Event> eventsOf(const Setting& s, const std::vector<Point>& current, const Above& above,
+                            const std::vector<double>& below, double clearance,
+                            const Kinematics& start) {
+  std::vector<Event> events;
+  for (std::size_t c = 0; c < s.corners.size(); ++c) {
+    const Vec& corner = s.corners[c];
+    bool touching = false;
+    for (const Point& p : current) touching = touching || (p.corner - corner).norm() == 0.0;
+    if (touching) continue;
+    const double level = below[c] < 0 ? below[c] - 1e-12 : 0.0;
+    events.push_back({What::kCorner, 0, [&above, corner, level](const Kinematics& x) {
+                        return above(x, corner) - level;
+                      }});
+  }
+  if (current.empty()) {
+    // Lifted off: flying until its lowest corner is kPivotClearance of its reach above the
+    // face (the certified first contact takes it from there) or a corner lands.
+    events.push_back({What::kClear, 0, [&s, clearance](const Kinematics& x) {
+                        double lowest = std::numeric_limits<double>::infinity();
+                        for (const Vec& c : s.corners) lowest = std::min(lowest, heightOf(s, x, c));
+                        return clearance - lowest;
+                      }});
+  }
+  for (std::size_t i = 0; i < current.size(); ++i) {
+    events.push_back({What::kLeaves, i, [&s, &current, i](const Kinematics& x) {
+                        return dynamicsOf(s, x, current).forces[i].dot(s.n);
+                      }});
+    if (!current[i].sliding) {
+      // Bisected to where the margin is < 0: there the modes' choice slides it.
+      events.push_back({What::kSlips, i, [&s, &current, i](const Kinematics& x) {
+                          const double margin = coneMargin(s, dynamicsOf(s, x, current).forces[i]);
+                          return margin < 0 ? margin : std::max(margin, 1e-300);
+                        }});
+    } else if (s.mu > 0) {
+      // Its slip stops: it falls to kSlipStops (its direction would turn ever faster as it
+      // passes near 0); a slip just begun (slower at the step's start) stops where its part
+      // along the onset's direction falls below -kLastingStillSpeed.
+      const Vec before = slipOf(s, start, current[i]);
+      if (before.norm() > kSlipStops) {
+        events.push_back({What::kSticks, i, [&s, &current, i](const Kinematics& x) {
+                            return slipOf(s, x, current[i]).norm() - kSlipStops;
+                          }});
+      } else {
+        const Vec reference =
+            before.norm() > kLastingStillSpeed ? Vec(before.normalized()) : current[i].direction;
+        events.push_back({What::kSticks, i, [&s, &current, i, reference](const Kinematics& x) {
+                            return slipOf(s, x, current[i]).dot(reference) + kLastingStillSpeed;
+                          }});
+        // ... or where the force that would hold it comes back within its cone (a slip that
+        // began at the cone's edge and does not grow: it would hover below kSlipStops, its
+        // friction's direction turning ever faster).
+        std::vector<Point> held = current;
+        held[i].sliding = false;
+        events.push_back({What::kSticks, i, [&s, held, i](const Kinematics& x) {
+                            const double margin = coneMargin(s, dynamicsOf(s, x, held).forces[i]);
+                            return margin >= 0 ? -std::max(margin, 1e-300) : -margin;
+                          }});
+      }
+    }
+    if (s.face.bounded) {
+      events.push_back(
+          {What::kEdge, i, [&s, &current, i](const Kinematics& x) {
+             const FlatFace& face = s.face;
+             const Vec offset = x.centre + x.rotation * current[i].corner - face.point;
+             return std::min(
+                 face.half_extent.x() + kLastingBand - std::abs(offset.dot(face.along_u)),
+                 face.half_extent.y() + kLastingBand - std::abs(offset.dot(face.along_v)));
+           }});
+    }
+  }
+  return events;
+}
+
+/// The first event over a step (t0, t1] of the dense output `at`, bisected to kEventResolution
+/// (the instant and the event's index); one already at its start is taken at t0. Empty: none.
+template <class At>
+std::optional<std::pair<double, std::size_t>> firstEvent(const std::vector<Event>& events,
+                                                         const At& at, double t0, double t1) {
+  std::optional<std::pair<double, std::size_t>> first;
+  for (std::size_t e = 0; e < events.size(); ++e) {
+    if (events[e].value(at(t1)) > 0) continue;
+    if (events[e].value(at(t0)) <= 0) {
+      // Already at its start (a point that left at once, a corner touching as it began).
+      return std::make_pair(t0, e);
+    }
+    double lo = t0, hi = t1;
+    while (hi - lo > kEventResolution * std::max(1.0, std::abs(hi))) {
+      const double mid = 0.5 * (lo + hi);
+      if (events[e].value(at(mid)) > 0) {
+        lo = mid;
+      } else {
+        hi = mid;
+      }
+    }
+    if (!first || hi < first->first) first = std::make_pair(hi, e);
+  }
+  return first;
+}
+
+/// What a point's event (it leaves, sticks or slips) does at its instant: the points touching
+/// after it and the state there (a stop's slip taken out), or why the motion ends (`ends`), or
+/// that it rests (a face whose every corner sticks).
+struct Change {
+  std::string ends;    // empty: the motion goes on with `points` from `there`
+  bool rests = false;  // at rest from `there` (the closed forms take it from there)
+  std::vector<Point> points;
+  Kinematics there;
+};
+
+Change changeAt(const Setting& s, const std::vector<Point>& current, const Event& event,
+                Kinematics there) {
+  Change change;
+  std::vector<Point> next = current;
+  if (event.what == What::kLeaves) {
+    next.erase(next.begin() + static_cast<std::ptrdiff_t>(event.point));
+  } else if (event.what == What::kSticks) {
+    next[event.point].sliding = false;
+    // A face's corners (three or more) stop slipping together (Goyal, Ruina and
+    // Papadopoulos, Wear 143:307, 1991: a planar slide's translation and turning stop at the
+    // same instant): where every one slips slower than 100 kSlipStops, all stick.
+    double fastest = 0.0;
+    for (const Point& p : next) fastest = std::max(fastest, slipOf(s, there, p).norm());
+    if (next.size() >= 3 && fastest <= 100 * kSlipStops) {
+      for (Point& p : next) p.sliding = false;
+    }
+    there = settle(s, there, next);  // the slip's rounding left at its stop
+  } else {
+    auto onset = slipOnset(s, there, next, event.point);
+    if (!onset) {
+      change.ends = "a corner starting to slip with no direction of onset";
+      return change;
+    }
+    next[event.point].sliding = true;
+    next[event.point].direction = *onset;
+  }
+  auto settled = modesAt(s, there, next);
+  if (!settled) {
+    change.ends = settled.error().reason;
+    return change;
+  }
+  change.points = std::move(settled.value());
+  // A face whose every corner sticks: it rests, as the closed forms say (lastingOnFace), its last
+  // slip (within the event's resolution) taken out.
+  change.rests =
+      change.points.size() >= 3 && std::none_of(change.points.begin(), change.points.end(),
+                                                [](const Point& p) { return p.sliding; });
+  change.there = change.rests ? settle(s, there, change.points) : there;
+  return change;
+}
+
 }  // namespace
 
 /// The path's steps: each a copy of the dense stepper after it (its dense output covers it), with
@@ -481,14 +656,9 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
     const auto system = [&s, &current](const State& x, State& rate, double) {
       derivative(s, current, x, rate);
     };
-    // Each corner's height over the lowest point touching (the one stateAt puts on the face):
-    // their drift is not a corner's approach. A corner below it at the segment's start (one that
-    // just left) reaches the face where it comes back 1e-12 m below where it was.
-    const auto above = [&s, &current](const Kinematics& x, const Vec& corner) {
-      double base = current.empty() ? 0.0 : std::numeric_limits<double>::infinity();
-      for (const Point& p : current) base = std::min(base, heightOf(s, x, p.corner));
-      return heightOf(s, x, corner) - base;
-    };
+    const Above above{s, current};
+    // A corner below the lowest point touching at the segment's start (one that just left)
+    // reaches the face where it comes back 1e-12 m below where it was.
     std::vector<double> below;
     for (const Vec& corner : s.corners) {
       below.push_back(std::min(0.0, above(unpack(y), corner)));
@@ -514,101 +684,8 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
         dense.calc_state(time, x);
         return unpack(x);
       };
-      // The events: each a function of the state that reaches <= 0, and what it does.
-      enum class What { kCorner, kLeaves, kSlips, kSticks, kEdge, kClear };
-      struct Event {
-        What what;
-        std::size_t point;
-        std::function<double(const Kinematics&)> value;
-      };
-      std::vector<Event> events;
-      for (std::size_t c = 0; c < s.corners.size(); ++c) {
-        const Vec& corner = s.corners[c];
-        bool touching = false;
-        for (const Point& p : current) touching = touching || (p.corner - corner).norm() == 0.0;
-        if (touching) continue;
-        const double level = below[c] < 0 ? below[c] - 1e-12 : 0.0;
-        events.push_back({What::kCorner, 0, [&above, corner, level](const Kinematics& x) {
-                            return above(x, corner) - level;
-                          }});
-      }
-      if (current.empty()) {
-        // Lifted off: flying until its lowest corner is kPivotClearance of its reach above the
-        // face (the certified first contact takes it from there) or a corner lands.
-        events.push_back({What::kClear, 0, [&s, clearance](const Kinematics& x) {
-                            double lowest = std::numeric_limits<double>::infinity();
-                            for (const Vec& c : s.corners)
-                              lowest = std::min(lowest, heightOf(s, x, c));
-                            return clearance - lowest;
-                          }});
-      }
-      for (std::size_t i = 0; i < current.size(); ++i) {
-        events.push_back({What::kLeaves, i, [&s, &current, i](const Kinematics& x) {
-                            return dynamicsOf(s, x, current).forces[i].dot(s.n);
-                          }});
-        if (!current[i].sliding) {
-          // Bisected to where the margin is < 0: there the modes' choice slides it.
-          events.push_back({What::kSlips, i, [&s, &current, i](const Kinematics& x) {
-                              const double margin =
-                                  coneMargin(s, dynamicsOf(s, x, current).forces[i]);
-                              return margin < 0 ? margin : std::max(margin, 1e-300);
-                            }});
-        } else if (s.mu > 0) {
-          // Its slip stops: it falls to kSlipStops (its direction would turn ever faster as it
-          // passes near 0); a slip just begun (slower at the step's start) stops where its part
-          // along the onset's direction falls below -kLastingStillSpeed.
-          const Vec before = slipOf(s, at(t0), current[i]);
-          if (before.norm() > kSlipStops) {
-            events.push_back({What::kSticks, i, [&s, &current, i](const Kinematics& x) {
-                                return slipOf(s, x, current[i]).norm() - kSlipStops;
-                              }});
-          } else {
-            const Vec reference = before.norm() > kLastingStillSpeed ? Vec(before.normalized())
-                                                                     : current[i].direction;
-            events.push_back({What::kSticks, i, [&s, &current, i, reference](const Kinematics& x) {
-                                return slipOf(s, x, current[i]).dot(reference) + kLastingStillSpeed;
-                              }});
-            // ... or where the force that would hold it comes back within its cone (a slip that
-            // began at the cone's edge and does not grow: it would hover below kSlipStops, its
-            // friction's direction turning ever faster).
-            std::vector<Point> held = current;
-            held[i].sliding = false;
-            events.push_back({What::kSticks, i, [&s, held, i](const Kinematics& x) {
-                                const double margin =
-                                    coneMargin(s, dynamicsOf(s, x, held).forces[i]);
-                                return margin >= 0 ? -std::max(margin, 1e-300) : -margin;
-                              }});
-          }
-        }
-        if (face.bounded) {
-          events.push_back(
-              {What::kEdge, i, [&face, &current, i](const Kinematics& x) {
-                 const Vec offset = x.centre + x.rotation * current[i].corner - face.point;
-                 return std::min(
-                     face.half_extent.x() + kLastingBand - std::abs(offset.dot(face.along_u)),
-                     face.half_extent.y() + kLastingBand - std::abs(offset.dot(face.along_v)));
-               }});
-        }
-      }
-      std::optional<std::pair<double, std::size_t>> first;
-      for (std::size_t e = 0; e < events.size(); ++e) {
-        if (events[e].value(at(t1)) > 0) continue;
-        if (events[e].value(at(t0)) <= 0) {
-          // Already at its start (a point that left at once, a corner touching as it began).
-          first = std::make_pair(t0, e);
-          break;
-        }
-        double lo = t0, hi = t1;
-        while (hi - lo > kEventResolution * std::max(1.0, std::abs(hi))) {
-          const double mid = 0.5 * (lo + hi);
-          if (events[e].value(at(mid)) > 0) {
-            lo = mid;
-          } else {
-            hi = mid;
-          }
-        }
-        if (!first || hi < first->first) first = std::make_pair(hi, e);
-      }
+      const std::vector<Event> events = eventsOf(s, current, above, below, clearance, at(t0));
+      const auto first = firstEvent(events, at, t0, t1);
       path->steps.push_back({dense, first ? first->first : t1, mode});
       if (!first) {
         t = t1;
@@ -621,7 +698,6 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
       }
       const Event& event = events[first->second];
       const double when = first->first;
-      Kinematics there = at(when);
       until = when;
       t = when;
       if (event.what == What::kCorner || event.what == What::kClear) {
@@ -637,49 +713,21 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
       if (when <= path->start && event.what != What::kSticks) {
         return notYet("the tipping's contact changes at once where it starts");
       }
-      std::vector<Point> next = current;
-      if (event.what == What::kLeaves) {
-        next.erase(next.begin() + static_cast<std::ptrdiff_t>(event.point));
-      } else if (event.what == What::kSticks) {
-        next[event.point].sliding = false;
-        // A face's corners (three or more) stop slipping together (Goyal, Ruina and
-        // Papadopoulos, Wear 143:307, 1991: a planar slide's translation and turning stop at the
-        // same instant): where every one slips slower than 100 kSlipStops, all stick.
-        double fastest = 0.0;
-        for (const Point& p : next) fastest = std::max(fastest, slipOf(s, there, p).norm());
-        if (next.size() >= 3 && fastest <= 100 * kSlipStops) {
-          for (Point& p : next) p.sliding = false;
-        }
-        there = settle(s, there, next);  // the slip's rounding left at its stop
-      } else {
-        auto onset = slipOnset(s, there, next, event.point);
-        if (!onset) {
-          ends = "a corner starting to slip with no direction of onset";
-          finished = true;
-          break;
-        }
-        next[event.point].sliding = true;
-        next[event.point].direction = *onset;
-      }
-      auto settled = modesAt(s, there, next);
-      if (!settled) {
-        ends = settled.error().reason;
+      Change change = changeAt(s, current, event, at(when));
+      if (!change.ends.empty()) {
+        ends = change.ends;
         finished = true;
         break;
       }
-      if (settled->size() >= 3 && std::none_of(settled->begin(), settled->end(),
-                                               [](const Point& p) { return p.sliding; })) {
-        // A face whose every corner sticks: it rests, as the closed forms say (lastingOnFace),
-        // its last slip (within the event's resolution) taken out.
-        path->modes.push_back(settled.value());
-        path->final = settle(s, there, settled.value());
+      path->modes.push_back(change.points);
+      if (change.rests) {
+        path->final = change.there;
         ends = "stops";
         finished = true;
         break;
       }
-      path->modes.push_back(settled.value());
       mode = path->modes.size() - 1;
-      y = pack(there);
+      y = pack(change.there);
       break;
     }
   }
