@@ -228,97 +228,68 @@ Vec onFace(const Vec& x, const FlatFace& face, const Vec& n) {
   return x - n.dot(x - face.point) * n;
 }
 
-Expected<Support> supportOf(const LastingBody& body, const Eigen::Matrix3d& rotation,
-                            const FlatFace& face, const Setting& setting) {
+/// A cylinder's or capsule's support (`radius`, `half_length` along its axis, rotation's z): on
+/// its side, the lowest line's two ends; a cylinder on its cap, the cap's disc; else, leaning on
+/// its rim or one end, not modelled yet.
+Expected<Support> roundSupport(const LastingBody& body, const Eigen::Matrix3d& rotation,
+                               const FlatFace& face, const Setting& setting, double radius,
+                               double half_length, bool cylinder) {
   const Vec& n = setting.n;
-  const Vec down = rotation.transpose() * (-n);
-  const double lowest = n.dot(body.centre + rotation * coreSupport(body.shape, down) - face.point) -
-                        marginOf(body.shape);
-  if (lowest > kLastingBand) {
-    return Error{"body.centre", "the body does not touch the face: its lowest point is " +
-                                    formatNumber(lowest) +
-                                    " m above it (the touching band is 1e-9 m)"};
-  }
-  if (lowest < -kLastingBand) {
-    return Error{"body.centre", "the body is " + formatNumber(-lowest) +
-                                    " m inside the face (more than the touching band, 1e-9 m)"};
-  }
   Support support;
-  const auto round = [&](double radius, double half_length, bool cylinder) -> Expected<Support> {
-    const Vec axis = rotation.col(2);
-    const double rise = 2 * half_length * std::abs(axis.dot(n));
-    if (rise <= setting.band) {  // on its side: the lowest line's two ends
-      support.kind = SupportKind::kLine;
-      support.axis = (axis - axis.dot(n) * n).normalized();
-      const Vec below = body.centre - radius * n;
-      support.feet = {onFace(below - half_length * support.axis, face, n),
-                      onFace(below + half_length * support.axis, face, n)};
-      support.radius = radius;
-      support.axial_moment = body.moments.z();
-      return support;
+  const Vec axis = rotation.col(2);
+  const double rise = 2 * half_length * std::abs(axis.dot(n));
+  if (rise <= setting.band) {  // on its side: the lowest line's two ends
+    support.kind = SupportKind::kLine;
+    support.axis = (axis - axis.dot(n) * n).normalized();
+    const Vec below = body.centre - radius * n;
+    support.feet = {onFace(below - half_length * support.axis, face, n),
+                    onFace(below + half_length * support.axis, face, n)};
+    support.radius = radius;
+    support.axial_moment = body.moments.z();
+    return support;
+  }
+  if (cylinder && 2 * radius * axis.cross(n).norm() <= setting.band) {  // on its cap
+    support.kind = SupportKind::kDisc;
+    const double side = axis.dot(n) > 0 ? -1.0 : 1.0;  // the cap nearer the face
+    support.centre = onFace(body.centre + side * half_length * axis, face, n);
+    support.radius = radius;
+    return support;
+  }
+  return notYet(cylinder ? "tipping: a cylinder leaning on its rim (one point of it touches)"
+                         : "tipping: a capsule leaning on one end (one point of it touches)");
+}
+
+/// Three corners of one face of a box on the face: its fourth is within twice the band (its
+/// height is the other three's h1 + h3 - h2) and the face rests on all four; taken alone, the
+/// three would balance the body on the face's diagonal, an edge it tips over only by rounding.
+/// The fourth is added to `support` (unless, settled, it moves faster than a settled point).
+void addFourthCorner(const LastingBody& body, const Cuboid& box, const Eigen::Matrix3d& rotation,
+                     const FlatFace& face, const Setting& setting, Support& support) {
+  const Vec& n = setting.n;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double side = support.corners[0][axis];
+    if (support.corners[1][axis] != side || support.corners[2][axis] != side) continue;
+    Vec fourth = Vec::Zero();
+    fourth[axis] = side;
+    for (int other = 0; other < 3; ++other) {
+      if (other == axis) continue;
+      // The sign the three show once: the fourth has the other.
+      double sum = 0;
+      for (const Vec& c : support.corners) sum += c[other] > 0 ? 1.0 : -1.0;
+      fourth[other] = (sum > 0 ? -1.0 : 1.0) * box.half_size[other];
     }
-    if (cylinder && 2 * radius * axis.cross(n).norm() <= setting.band) {  // on its cap
-      support.kind = SupportKind::kDisc;
-      const double side = axis.dot(n) > 0 ? -1.0 : 1.0;  // the cap nearer the face
-      support.centre = onFace(body.centre + side * half_length * axis, face, n);
-      support.radius = radius;
-      return support;
-    }
-    return notYet(cylinder ? "tipping: a cylinder leaning on its rim (one point of it touches)"
-                           : "tipping: a capsule leaning on one end (one point of it touches)");
-  };
-  if (const auto* cylinder = std::get_if<Cylinder>(&body.shape)) {
-    return round(cylinder->radius, cylinder->half_length, true);
+    const Vec point = body.centre + rotation * fourth;
+    const double speed = n.dot(body.velocity + body.angular_velocity.cross(rotation * fourth));
+    if (setting.settled && std::abs(speed) > setting.settled_speed) return;
+    support.feet.push_back(onFace(point, face, n));
+    support.corners.push_back(fourth);
+    return;
   }
-  if (const auto* capsule = std::get_if<Capsule>(&body.shape)) {
-    return round(capsule->radius, capsule->half_length, false);
-  }
-  std::vector<Vec> candidates;
-  contactCandidates(body.shape, down, candidates);
-  for (const Vec& corner : candidates) {
-    const Vec point = body.centre + rotation * corner;
-    const double above = n.dot(point - face.point) - lowest;
-    // A point that approaches or leaves the face faster than a settled one does not rest on it:
-    // it strikes it (an impact, the caller's) or parts from it, as the others tip.
-    const double normal_speed =
-        n.dot(body.velocity + body.angular_velocity.cross(rotation * corner));
-    if (above <= setting.band &&
-        (!setting.settled || std::abs(normal_speed) <= setting.settled_speed)) {
-      support.feet.push_back(onFace(point, face, n));
-      support.corners.push_back(corner);
-    }
-  }
-  // Three corners of one face of a box on the face: its fourth is within twice the band (its
-  // height is the other three's h1 + h3 - h2) and the face rests on all four; taken alone, the
-  // three would balance the body on the face's diagonal, an edge it tips over only by rounding.
-  if (const auto* box = std::get_if<Cuboid>(&body.shape); box && support.corners.size() == 3) {
-    for (int axis = 0; axis < 3; ++axis) {
-      const double side = support.corners[0][axis];
-      if (support.corners[1][axis] != side || support.corners[2][axis] != side) continue;
-      Vec fourth = Vec::Zero();
-      fourth[axis] = side;
-      for (int other = 0; other < 3; ++other) {
-        if (other == axis) continue;
-        // The sign the three show once: the fourth has the other.
-        double sum = 0;
-        for (const Vec& c : support.corners) sum += c[other] > 0 ? 1.0 : -1.0;
-        fourth[other] = (sum > 0 ? -1.0 : 1.0) * box->half_size[other];
-      }
-      const Vec point = body.centre + rotation * fourth;
-      const double speed = n.dot(body.velocity + body.angular_velocity.cross(rotation * fourth));
-      if (setting.settled && std::abs(speed) > setting.settled_speed) break;
-      support.feet.push_back(onFace(point, face, n));
-      support.corners.push_back(fourth);
-      break;
-    }
-  }
-  if (support.feet.empty()) {
-    return Error{"body.velocity",
-                 "every point of the body near the face approaches or leaves it faster than " +
-                     formatNumber(setting.settled_speed) +
-                     " m/s: not a lasting contact (settled: an elastic rise of 1e-6 of its "
-                     "reach)"};
-  }
+}
+
+/// A box's or hull's support from its points on the face: one corner, an edge (two, or more
+/// collinear), or a polygon of three or four; more are not modelled yet.
+Expected<Support> cornersSupport(Support support) {
   if (support.feet.size() == 1) {
     support.kind = SupportKind::kCorners;
     return support;
@@ -342,6 +313,58 @@ Expected<Support> supportOf(const LastingBody& body, const Eigen::Matrix3d& rota
   }
   support.kind = SupportKind::kCorners;
   return support;
+}
+
+Expected<Support> supportOf(const LastingBody& body, const Eigen::Matrix3d& rotation,
+                            const FlatFace& face, const Setting& setting) {
+  const Vec& n = setting.n;
+  const Vec down = rotation.transpose() * (-n);
+  const double lowest = n.dot(body.centre + rotation * coreSupport(body.shape, down) - face.point) -
+                        marginOf(body.shape);
+  if (lowest > kLastingBand) {
+    return Error{"body.centre", "the body does not touch the face: its lowest point is " +
+                                    formatNumber(lowest) +
+                                    " m above it (the touching band is 1e-9 m)"};
+  }
+  if (lowest < -kLastingBand) {
+    return Error{"body.centre", "the body is " + formatNumber(-lowest) +
+                                    " m inside the face (more than the touching band, 1e-9 m)"};
+  }
+  if (const auto* cylinder = std::get_if<Cylinder>(&body.shape)) {
+    return roundSupport(body, rotation, face, setting, cylinder->radius, cylinder->half_length,
+                        true);
+  }
+  if (const auto* capsule = std::get_if<Capsule>(&body.shape)) {
+    return roundSupport(body, rotation, face, setting, capsule->radius, capsule->half_length,
+                        false);
+  }
+  Support support;
+  std::vector<Vec> candidates;
+  contactCandidates(body.shape, down, candidates);
+  for (const Vec& corner : candidates) {
+    const Vec point = body.centre + rotation * corner;
+    const double above = n.dot(point - face.point) - lowest;
+    // A point that approaches or leaves the face faster than a settled one does not rest on it:
+    // it strikes it (an impact, the caller's) or parts from it, as the others tip.
+    const double normal_speed =
+        n.dot(body.velocity + body.angular_velocity.cross(rotation * corner));
+    if (above <= setting.band &&
+        (!setting.settled || std::abs(normal_speed) <= setting.settled_speed)) {
+      support.feet.push_back(onFace(point, face, n));
+      support.corners.push_back(corner);
+    }
+  }
+  if (const auto* box = std::get_if<Cuboid>(&body.shape); box && support.corners.size() == 3) {
+    addFourthCorner(body, *box, rotation, face, setting, support);
+  }
+  if (support.feet.empty()) {
+    return Error{"body.velocity",
+                 "every point of the body near the face approaches or leaves it faster than " +
+                     formatNumber(setting.settled_speed) +
+                     " m/s: not a lasting contact (settled: an elastic rise of 1e-6 of its "
+                     "reach)"};
+  }
+  return cornersSupport(std::move(support));
 }
 
 /// The smallest s > 0 with v s + a s^2 / 2 = target (target >= 0), or infinity: written
