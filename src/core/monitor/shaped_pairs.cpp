@@ -69,7 +69,7 @@ class PairWatch {
   /// s: how far from `time` the pair (a < b) may go on untouched, up to `end`, where `quiet(i)`
   /// is when track i's present motion ends (ShapedTrack::quietUntil, asked only where both fly or
   /// are still); an impact where it touches closing is resolved (0: look again at `time`); a
-  /// lasting touch leaves it unwatched for the rest of the step.
+  /// lasting touch holds both and leaves the pair unwatched for the rest of the step.
   template <class Quiet>
   double step(const Pair& pair, double time, double end, const Quiet& quiet) {
     if (unwatched_.count(pair)) return end - time;
@@ -137,7 +137,8 @@ class PairWatch {
   /// (ShapedMotion's rule), an impact (0: look again from `time`); not closing (just struck, or a
   /// graze), apart again, looked at from the first instant its gap is open (doubling steps from
   /// the band's passage, up to 1 ms, as ShapedMotion::part); else its contact lasts, which is not
-  /// modelled yet: unwatched for the rest of the step (reported at the step's end).
+  /// modelled yet: both held where they are, the pair unwatched for the rest of the step
+  /// (reported at the step's end).
   double touch(const Pair& pair, const TumblingBody& a, const TumblingBody& b,
                const SurfaceGap& gap, double time, double end) {
     const double lift = world_.gravity.norm() * kLastingSettled * std::max(a.reach(), b.reach());
