@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <optional>
 #include <set>
 #include <string>
@@ -87,8 +88,22 @@ class PairWatch {
     }
     const auto parting = room_.parting.find(pair);
     if (parting != room_.parting.end() && parting->second > time) return parting->second - time;
+    // The contact the pair's advancement found ahead, now reached with both motions as they were:
+    // taken as found (its gap, normal, approach and manifold), not looked for again (face to face,
+    // GJK may see the touching pair as overlapping by its tolerance).
+    if (const auto ahead = pending_.find(pair); ahead != pending_.end()) {
+      const Pending found = ahead->second;
+      pending_.erase(ahead);
+      // (t + (t_c - t) is t_c to the instant's rounding.)
+      if (std::abs(found.contact.time - time) <= 4 * kEps * std::abs(time) &&
+          found.since_a == track_a.since() && found.since_b == track_b.since()) {
+        return touch(pair, *a, *b, found.contact, time, end);
+      }
+    }
     const SurfaceGap gap = gapAt(*a, *b, time);
     if (gap.overlapping) {
+      // Just struck, face to face, GJK may see the pair overlap by its tolerance: it parts.
+      if (parting != room_.parting.end()) return partOrHold(pair, *a, *b, time, end);
       unwatch(pair, time,
               "found inside each other (an impact missed: a body struck by a moving "
               "obstacle may pass its speed bound)");
@@ -104,18 +119,18 @@ class PairWatch {
       const double until = std::min({quiet(pair.first), quiet(pair.second), end});
       if (!(until > time)) return stop;
       const FirstContactResult found = firstContact(*a, *b, time, until - time);
-      if (found.inside_at_start) {
-        unwatch(pair, time, "found inside each other");
-        return end - time;
-      }
+      if (found.inside_at_start) return touchingNow(pair, *a, *b, time, end);
       if (!found.contact) return std::max(found.clear_until - time, stop);
-      if (found.contact->time > time) return found.contact->time - time;
-      return touch(pair, *a, *b, gap, time, end);
+      if (found.contact->time > time) {
+        pending_[pair] = Pending{*found.contact, track_a.since(), track_b.since()};
+        return found.contact->time - time;
+      }
+      return touch(pair, *a, *b, *found.contact, time, end);
     }
     // A body moving in lasting contact: every point's speed bounded by its energy.
     const double ahead = gap.gap / speed;
     if (gap.gap > 0 && ahead > stop) return ahead;
-    return touch(pair, *a, *b, gap, time, end);
+    return touchingNow(pair, *a, *b, time, end);
   }
 
   void unwatch(const Pair& pair, double time, const std::string& why) {
@@ -140,48 +155,67 @@ class PairWatch {
   /// modelled yet: both held where they are, the pair unwatched for the rest of the step
   /// (reported at the step's end).
   double touch(const Pair& pair, const TumblingBody& a, const TumblingBody& b,
-               const SurfaceGap& gap, double time, double end) {
+               const TumblingContact& contact, double time, double end) {
     const double lift = world_.gravity.norm() * kLastingSettled * std::max(a.reach(), b.reach());
-    const double closing = gap.approach_speed;
+    const double closing = contact.closest.approach_speed;
     if (closing > 0 && closing * closing > 2 * lift) {
-      resolve(pair, a, b, time);
+      resolve(pair, a, b, contact, time);
       return 0.0;
     }
-    if (!(closing > 0)) {
-      const double speed = (a.velocityAt(time) - b.velocityAt(time)).norm() +
-                           a.angularSpeedBound() * a.reach() + b.angularSpeedBound() * b.reach();
-      const double band = FirstContactOptions{}.manifold_band;
-      for (double step = std::max(band / speed, 1e-12 + 4 * kEps * std::abs(time)); step <= 1e-3;
-           step *= 2) {
-        // On the two motions as they are at `time` (past the step's end too: the watch of the
-        // next step starts from the instant found).
-        const SurfaceGap later = gapAt(a, b, time + step);
-        if (!later.overlapping && !touching(later)) {
-          room_.parting[pair] = time + step;
-          return std::min(step, end - time);
-        }
+    if (!(closing > 0)) return partOrHold(pair, a, b, time, end);
+    hold(pair, time);
+    return end - time;
+  }
+
+  /// A pair touching without closing (just struck, a graze): looked at again from the first
+  /// instant its gap is past the touching band (doubling steps from the band's passage, up to
+  /// 1 ms, as ShapedMotion::part); where it does not open, its contact lasts (hold).
+  double partOrHold(const Pair& pair, const TumblingBody& a, const TumblingBody& b, double time,
+                    double end) {
+    const double speed = (a.velocityAt(time) - b.velocityAt(time)).norm() +
+                         a.angularSpeedBound() * a.reach() + b.angularSpeedBound() * b.reach();
+    const double band = FirstContactOptions{}.manifold_band;
+    for (double step = std::max(band / speed, 1e-12 + 4 * kEps * std::abs(time)); step <= 1e-3;
+         step *= 2) {
+      // On the two motions as they are at `time` (past the step's end too: the watch of the
+      // next step starts from the instant found).
+      const SurfaceGap later = gapAt(a, b, time + step);
+      if (!later.overlapping && !touching(later)) {
+        room_.parting[pair] = time + step;
+        return std::min(step, end - time);
       }
     }
-    // A lasting contact: both held where they are (never into each other), reported at the
-    // step's end.
+    hold(pair, time);
+    return end - time;
+  }
+
+  /// A lasting contact: both held where they are (never into each other), the pair unwatched
+  /// for the rest of the step, reported at the step's end.
+  void hold(const Pair& pair, double time) {
     room_.tracks[pair.first]->holdTouching(time);
     room_.tracks[pair.second]->holdTouching(time);
     room_.parting.erase(pair);
     unwatch(pair, time, "");
-    return end - time;
   }
 
-  /// The impact of the pair at `time`: its manifold, one point by Chatterjee and Ruina's law with
-  /// the pair's friction, several by the joint frictionless rule; both tracks restarted after.
-  void resolve(const Pair& pair, const TumblingBody& a, const TumblingBody& b, double time) {
+  /// The pair touching at `time`, found so by its gap rather than by an advancement to it: its
+  /// contact there (touch), or, overlapping by more than the distance's tolerance, reported.
+  double touchingNow(const Pair& pair, const TumblingBody& a, const TumblingBody& b, double time,
+                     double end) {
     FirstContactOptions at_once;
     at_once.time_tolerance = std::numeric_limits<double>::infinity();
     const FirstContactResult found = firstContact(a, b, time, 0.0, at_once);
     if (!found.contact) {
-      unwatch(pair, time, "touch where no contact is found");
-      return;
+      unwatch(pair, time, "found inside each other");
+      return end - time;
     }
-    const TumblingContact& contact = *found.contact;
+    return touch(pair, a, b, *found.contact, time, end);
+  }
+
+  /// The impact of the pair at `time` at `contact`: one point by Chatterjee and Ruina's law with
+  /// the pair's friction, several by the joint frictionless rule; both tracks restarted after.
+  void resolve(const Pair& pair, const TumblingBody& a, const TumblingBody& b,
+               const TumblingContact& contact, double time) {
     std::vector<SolverBody> bodies{solverBodyOf(*room_.principal[pair.first], a, time),
                                    solverBodyOf(*room_.principal[pair.second], b, time)};
     const std::vector<SolverBody> before = bodies;
@@ -274,6 +308,14 @@ class PairWatch {
   std::vector<ImpactRecord>& impacts_;
   std::vector<UnmodelledContact>& unmodelled_;
   std::set<Pair> unwatched_;  // lasting or not resolved: not watched for the rest of the step
+  /// A contact found ahead by a pair's advancement, and the instants the two motions it was found
+  /// on hold from (ShapedTrack::since): valid at its instant while they are unchanged.
+  struct Pending {
+    TumblingContact contact;
+    double since_a = 0.0;
+    double since_b = 0.0;
+  };
+  std::map<Pair, Pending> pending_;
 };
 
 }  // namespace

@@ -475,8 +475,9 @@ void takeStates(const World& world, ShapedRoom& room, double time,
   }
 }
 
-/// The contacts not modelled at `time`: each held track's with its obstacle, and each shaped body
-/// touching a ball or another shaped body (its gap at `time`, overlapping or within the band);
+/// The contacts not modelled at `time`: each held track's with its obstacle, each pair the watch
+/// of shaped pairs could not resolve, and each shaped body touching a ball or another shaped body
+/// (its gap at `time`, overlapping or within the band);
 /// those that did not hold at the last step's end are reported, beginning at `time` (a held
 /// track's when it was held).
 void reportUnmodelled(const World& world, ShapedRoom& room, double time,
@@ -495,6 +496,12 @@ void reportUnmodelled(const World& world, ShapedRoom& room, double time,
       if (h.body == body && h.other == contact.other) contact = h;
     }
     found.push_back(contact);
+  }
+  // What the watch of shaped pairs could not resolve (a pair found inside each other, an impact
+  // the solver refused): reported as it comes.
+  for (const UnmodelledContact& h : held) {
+    if (h.other_is_obstacle) continue;
+    if (now.insert(std::make_tuple(h.body, h.other, false)).second) found.push_back(h);
   }
   for (std::size_t body = 0; body < room.tracks.size(); ++body) {
     if (!room.tracks[body]) continue;
@@ -527,7 +534,7 @@ void reportUnmodelled(const World& world, ShapedRoom& room, double time,
       // A pair of shaped bodies just struck is parting (shaped_pairs.h), not in lasting contact.
       if (room.shaped(other) && room.parting.count({body, other})) continue;
       const auto key = std::make_tuple(body, other, false);
-      now.insert(key);
+      if (!now.insert(key).second) continue;  // said above, by the watch of shaped pairs
       found.push_back({body, other, false, time,
                        room.shaped(other)
                            ? std::string("two shaped bodies in lasting contact (at rest on each "
