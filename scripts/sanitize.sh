@@ -31,7 +31,7 @@ fi
 # bodies: the tipping runs in ShapedPivot's closed-form tests). Their code runs in the other tests
 # under the sanitizers, and their answers are checked in the main build.
 declare -A filters=(
-  [core_tests]="-Trace.*:Monitor.BroadphaseGivesTheSameImpactsAsEveryPair:Calibration.NinetyFivePercentIntervalsCoverTheTruth*:Calibration.AStuckBounceIsNotReadAsSliding:EdgeScan.*:ClusterFriction.EnergyNeverIncreases:ShapedPivot.Random*:ShapedLasting.Random*"
+  [core_tests]="-Trace.*:Monitor.BroadphaseGivesTheSameImpactsAsEveryPair:Calibration.NinetyFivePercentIntervalsCoverTheTruth*:Calibration.AStuckBounceIsNotReadAsSliding:EdgeScan.*:ClusterFriction.EnergyNeverIncreases:ShapedPivot.Random*:ShapedLasting.Random*:TumblingContact.Fuzz*:SteppedClusters.APileSettlesInABox*"
 )
 # Each program in two shards side by side (gtest's GTEST_TOTAL_SHARDS): the two cores.
 run_shard() {
