@@ -72,8 +72,12 @@ rm -f "$ws/first-lane.status" "$ws/second-lane.status"
 (
   trap 'echo "$?" >"$ws/second-lane.status"' EXIT
   renice -n 10 -p "$BASHPID" >/dev/null
-  # The checks of a few seconds first: the sanitizer build is the run's long pole, and they no
-  # longer wait behind it.
+  bash "$repo/scripts/sanitize.sh" || true
+  if [ "$mode" = long ]; then
+    bash "$repo/scripts/fuzz.sh" "${FUZZ_SECONDS:-600}" || true
+  else
+    bash "$repo/scripts/fuzz.sh" --replay || true
+  fi
   # catkin_lint on the package (warnings count as failures): one counted case.
   # Not in collision_response/: run_tests empties that folder when it starts.
   echo "== catkin_lint --strict"
@@ -138,12 +142,6 @@ rm -f "$ws/first-lane.status" "$ws/second-lane.status"
     printf '<testsuite><testcase classname="docs" name="API documentation"><failure message="%s"/></testcase></testsuite>\n' \
       "$(grep -E 'warning|missing' <<<"$docs" | head -5 | sed 's/[<>&"]/_/g' | tr '\n' ' ')" \
       >"$ws/build/test_results/lint/api_docs.xml"
-  fi
-  bash "$repo/scripts/sanitize.sh" || true
-  if [ "$mode" = long ]; then
-    bash "$repo/scripts/fuzz.sh" "${FUZZ_SECONDS:-600}" || true
-  else
-    bash "$repo/scripts/fuzz.sh" --replay || true
   fi
   echo "== second lane done"
 ) >"$lane" 2>&1 &
