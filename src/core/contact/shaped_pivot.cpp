@@ -468,14 +468,14 @@ struct Change {
   Kinematics there;
 };
 
-Change changeAt(const Setting& s, const std::vector<Point>& current, const Event& event,
+Change changeAt(const Setting& s, const std::vector<Point>& current, What what, std::size_t point,
                 Kinematics there) {
   Change change;
   std::vector<Point> next = current;
-  if (event.what == What::kLeaves) {
-    next.erase(next.begin() + static_cast<std::ptrdiff_t>(event.point));
-  } else if (event.what == What::kSticks) {
-    next[event.point].sliding = false;
+  if (what == What::kLeaves) {
+    next.erase(next.begin() + static_cast<std::ptrdiff_t>(point));
+  } else if (what == What::kSticks) {
+    next[point].sliding = false;
     // A face's corners (three or more) stop slipping together (Goyal, Ruina and
     // Papadopoulos, Wear 143:307, 1991: a planar slide's translation and turning stop at the
     // same instant): where every one slips slower than 100 kSlipStops, all stick.
@@ -486,13 +486,13 @@ Change changeAt(const Setting& s, const std::vector<Point>& current, const Event
     }
     there = settle(s, there, next);  // the slip's rounding left at its stop
   } else {
-    auto onset = slipOnset(s, there, next, event.point);
+    auto onset = slipOnset(s, there, next, point);
     if (!onset) {
       change.ends = "a corner starting to slip with no direction of onset";
       return change;
     }
-    next[event.point].sliding = true;
-    next[event.point].direction = *onset;
+    next[point].sliding = true;
+    next[point].direction = *onset;
   }
   auto settled = modesAt(s, there, next);
   if (!settled) {
@@ -586,6 +586,84 @@ PivotState PivotPath::stateAt(double t) const {
   return state;
 }
 
+namespace {
+
+/// The motion's start: the body's state as `k`, the points of `corners` touching, each sliding
+/// where it slips (faster than kLastingStillSpeed, or the face is frictionless) and sticking
+/// with its slip taken out otherwise (settle), then the modes the forces there allow (modesAt).
+Expected<std::vector<Point>> startOf(const Setting& s, const LastingBody& body,
+                                     const std::vector<Vec>& corners, Kinematics& k) {
+  k.orientation = body.orientation.normalized();
+  k.rotation = k.orientation.toRotationMatrix();
+  k.centre = body.centre;
+  k.velocity = body.velocity;
+  k.spin = body.angular_velocity;
+  std::vector<Point> points;
+  for (const Vec& corner : corners) {
+    Point p{corner, false, Vec::Zero()};
+    const Vec slip = slipOf(s, k, p);
+    p.sliding = s.mu == 0.0 || slip.norm() > kLastingStillSpeed;
+    p.direction = slip.norm() > kLastingStillSpeed ? Vec(slip.normalized()) : s.e1;
+    points.push_back(p);
+  }
+  k = settle(s, k, points);
+  return modesAt(s, k, points);
+}
+
+/// How a segment of the motion (one set of points touching) ended: at `until`, by an event
+/// (`what`, of point `point`, the state there), at the horizon, or where the steps ran out.
+struct SegmentEnd {
+  double until = 0.0;
+  std::optional<What> what;
+  std::size_t point = 0;
+  std::optional<Kinematics> there;  // with `what`
+};
+
+/// Integrates the segment of `path`'s mode `mode` from `y` at `t` to its first event, `end` or
+/// kMaxSteps (counted in `taken`), each step's dense output kept in `path`.
+Expected<SegmentEnd> integrateSegment(const Setting& s, PivotPath::Steps& path, std::size_t mode,
+                                      const State& y, double t, double end, double tolerance,
+                                      double clearance, std::size_t& taken) {
+  const std::vector<Point> current = path.modes[mode];
+  const auto system = [&s, &current](const State& x, State& rate, double) {
+    derivative(s, current, x, rate);
+  };
+  const Above above{s, current};
+  // A corner below the lowest point touching at the segment's start (one that just left)
+  // reaches the face where it comes back 1e-12 m below where it was.
+  std::vector<double> below;
+  for (const Vec& corner : s.corners) below.push_back(std::min(0.0, above(unpack(y), corner)));
+  Dense dense = boost::numeric::odeint::make_dense_output(tolerance, tolerance, Stepper());
+  dense.initialize(y, t, 1e-4);
+  for (;;) {
+    if (++taken > kMaxSteps) return SegmentEnd{t, std::nullopt, 0, std::nullopt};
+    try {
+      dense.do_step(system);
+    } catch (const std::exception&) {
+      return Error{"contact", "the tipping motion could not be integrated past +" +
+                                  formatNumber(t - path.start) + " s"};
+    }
+    const double t0 = dense.previous_time();
+    const double t1 = std::min(dense.current_time(), end);
+    const auto at = [&](double time) {
+      State x;
+      dense.calc_state(time, x);
+      return unpack(x);
+    };
+    const std::vector<Event> events = eventsOf(s, current, above, below, clearance, at(t0));
+    const auto first = firstEvent(events, at, t0, t1);
+    path.steps.push_back({dense, first ? first->first : t1, mode});
+    if (first) {
+      const Event& event = events[first->second];
+      return SegmentEnd{first->first, event.what, event.point, at(first->first)};
+    }
+    t = t1;
+    if (t1 >= end) return SegmentEnd{end, std::nullopt, 0, std::nullopt};
+  }
+}
+
+}  // namespace
+
 Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& face,
                                     const std::vector<Eigen::Vector3d>& corners, double tolerance,
                                     double horizon) {
@@ -615,27 +693,10 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
   for (const Vec& corner : s.corners) reach = std::max(reach, corner.norm());
   const double clearance = kPivotClearance * reach;
 
-  std::vector<Point> points;
-  for (const Vec& corner : corners) points.push_back({corner, false, Vec::Zero()});
-  const auto slipping = [&s](const Kinematics& at, std::vector<Point>& touching) {
-    for (Point& p : touching) {
-      const Vec slip = slipOf(s, at, p);
-      p.sliding = s.mu == 0.0 || slip.norm() > kLastingStillSpeed;
-      p.direction = slip.norm() > kLastingStillSpeed ? Vec(slip.normalized()) : s.e1;
-    }
-  };
   Kinematics k;
-  k.orientation = body.orientation.normalized();
-  k.rotation = k.orientation.toRotationMatrix();
-  k.centre = body.centre;
-  k.velocity = body.velocity;
-  k.spin = body.angular_velocity;
-  // A point slipping keeps its slip; the others' (below kLastingStillSpeed) is taken out.
-  slipping(k, points);
-  k = settle(s, k, points);
-  auto modes = modesAt(s, k, points);
-  if (!modes) return modes.error();
-  points = modes.value();
+  auto start = startOf(s, body, corners, k);
+  if (!start) return start.error();
+  const std::vector<Point> points = std::move(start.value());
   path->start = body.time;
   path->initial = k;
   path->initial_points = points;
@@ -650,86 +711,35 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
   std::string ends = "stops";
   double until = end;
   std::size_t taken = 0;
-  bool finished = false;
-  while (!finished) {
-    const std::vector<Point> current = path->modes[mode];
-    const auto system = [&s, &current](const State& x, State& rate, double) {
-      derivative(s, current, x, rate);
-    };
-    const Above above{s, current};
-    // A corner below the lowest point touching at the segment's start (one that just left)
-    // reaches the face where it comes back 1e-12 m below where it was.
-    std::vector<double> below;
-    for (const Vec& corner : s.corners) {
-      below.push_back(std::min(0.0, above(unpack(y), corner)));
-    }
-    Dense dense = boost::numeric::odeint::make_dense_output(tolerance, tolerance, Stepper());
-    dense.initialize(y, t, 1e-4);
-    for (;;) {
-      if (++taken > kMaxSteps) {
-        until = t;
-        finished = true;
-        break;
-      }
-      try {
-        dense.do_step(system);
-      } catch (const std::exception&) {
-        return Error{"contact", "the tipping motion could not be integrated past +" +
-                                    formatNumber(t - body.time) + " s"};
-      }
-      const double t0 = dense.previous_time();
-      const double t1 = std::min(dense.current_time(), end);
-      const auto at = [&](double time) {
-        State x;
-        dense.calc_state(time, x);
-        return unpack(x);
-      };
-      const std::vector<Event> events = eventsOf(s, current, above, below, clearance, at(t0));
-      const auto first = firstEvent(events, at, t0, t1);
-      path->steps.push_back({dense, first ? first->first : t1, mode});
-      if (!first) {
-        t = t1;
-        if (t1 >= end) {
-          until = end;
-          finished = true;
-          break;
-        }
-        continue;
-      }
-      const Event& event = events[first->second];
-      const double when = first->first;
-      until = when;
-      t = when;
-      if (event.what == What::kCorner || event.what == What::kClear) {
-        ends = "resumes";
-        finished = true;
-        break;
-      }
-      if (event.what == What::kEdge) {
-        ends = "a point of its support reaches the face's edge";
-        finished = true;
-        break;
-      }
-      if (when <= path->start && event.what != What::kSticks) {
-        return notYet("the tipping's contact changes at once where it starts");
-      }
-      Change change = changeAt(s, current, event, at(when));
-      if (!change.ends.empty()) {
-        ends = change.ends;
-        finished = true;
-        break;
-      }
-      path->modes.push_back(change.points);
-      if (change.rests) {
-        path->final = change.there;
-        ends = "stops";
-        finished = true;
-        break;
-      }
-      mode = path->modes.size() - 1;
-      y = pack(change.there);
+  for (;;) {
+    auto segment = integrateSegment(s, *path, mode, y, t, end, tolerance, clearance, taken);
+    if (!segment) return segment.error();
+    until = t = segment->until;
+    if (!segment->what) break;  // the horizon, or the steps ran out: asked again from there
+    const What what = *segment->what;
+    if (what == What::kCorner || what == What::kClear) {
+      ends = "resumes";
       break;
     }
+    if (what == What::kEdge) {
+      ends = "a point of its support reaches the face's edge";
+      break;
+    }
+    if (until <= path->start && what != What::kSticks) {
+      return notYet("the tipping's contact changes at once where it starts");
+    }
+    Change change = changeAt(s, path->modes[mode], what, segment->point, *segment->there);
+    if (!change.ends.empty()) {
+      ends = change.ends;
+      break;
+    }
+    path->modes.push_back(change.points);
+    if (change.rests) {
+      path->final = change.there;
+      break;
+    }
+    mode = path->modes.size() - 1;
+    y = pack(change.there);
   }
   path->until = until;
   auto pivot = std::make_shared<const PivotPath>(std::move(path));
