@@ -169,20 +169,27 @@ std::pair<double, double> lastingSpeedBounds(const LastingMotion& lasting,
             kMargin * std::max(lasting.angularVelocityAt(from).norm(),
                                lasting.angularVelocityAt(until).norm())};
   }
-  const Eigen::Vector3d v = lasting.velocityAt(from);
-  const Eigen::Vector3d w = lasting.angularVelocityAt(from);
-  const Eigen::Matrix3d turn = lasting.orientationAt(from).toRotationMatrix();
-  const Eigen::Vector3d w_principal = turn.transpose() * w;
-  const double kinetic = 0.5 * principal.mass * v.squaredNorm() +
-                         0.5 * w_principal.dot(principal.moments.cwiseProduct(w_principal));
-  const double g_span = gravity.norm() * (until - from);
+  return energySpeedBounds(principal, lasting.velocityAt(from), lasting.angularVelocityAt(from),
+                           lasting.orientationAt(from), gravity, until - from);
+}
+
+}  // namespace
+
+std::pair<double, double> energySpeedBounds(const PrincipalBody& principal,
+                                            const Eigen::Vector3d& velocity,
+                                            const Eigen::Vector3d& angular_velocity,
+                                            const Eigen::Quaterniond& orientation,
+                                            const Eigen::Vector3d& gravity, double span) {
+  constexpr double kMargin = 1 + 1e-12;
+  const Eigen::Vector3d w = orientation.toRotationMatrix().transpose() * angular_velocity;
+  const double kinetic = 0.5 * principal.mass * velocity.squaredNorm() +
+                         0.5 * w.dot(principal.moments.cwiseProduct(w));
+  const double g_span = gravity.norm() * span;
   const double speed =
       g_span + std::sqrt(g_span * g_span + 2 * (1 + 1e-6) * kinetic / principal.mass + 1e-300);
   const double kinetic_max = 0.5 * principal.mass * speed * speed;
   return {kMargin * speed, kMargin * std::sqrt(2 * kinetic_max / principal.moments.minCoeff())};
 }
-
-}  // namespace
 
 std::optional<ShapedMotion::Strike> ShapedMotion::struckWhileLasting(const LastingMotion& lasting,
                                                                      std::size_t resting_on,

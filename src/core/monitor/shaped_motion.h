@@ -48,6 +48,17 @@ Expected<PrincipalBody> principalBody(const BodySpec& body, const std::string& f
 /// inverse inertia tensor in the world (R J^-1 R^T), its velocities.
 SolverBody solverBodyOf(const PrincipalBody& principal, const TumblingBody& body, double time);
 
+/// m/s and rad/s: bounds on the centre's speed and the turning speed, over `span` seconds from
+/// a state (`velocity`; `angular_velocity` in the world; `orientation` world from principal), of
+/// a body that gains no energy but gravity's (impacts and lasting contact with fixed obstacles):
+/// its kinetic energy K(s) <= K + m |g| V span, so V <= |g| span + sqrt((|g| span)^2 + 2 K / m),
+/// and |w| <= sqrt(2 K_max / J_min) (a margin of 1e-6 of the energy for a tipping's integration).
+std::pair<double, double> energySpeedBounds(const PrincipalBody& principal,
+                                            const Eigen::Vector3d& velocity,
+                                            const Eigen::Vector3d& angular_velocity,
+                                            const Eigen::Quaterniond& orientation,
+                                            const Eigen::Vector3d& gravity, double span);
+
 /// An obstacle the shaped body may meet: the model's index and where it is placed.
 struct ShapedObstacle {
   std::size_t obstacle = 0;

@@ -25,21 +25,14 @@ constexpr int kMaxPasses = 1 << 16;
 
 using Pair = std::pair<std::size_t, std::size_t>;
 
-/// m/s: no point of `body`'s track moves faster over a span of `span` seconds from `state` (the
-/// header's energy bound, with a margin of 1e-6 of the energy for a tipping's integration); 0
-/// for a held one.
+/// m/s: no point of `body`'s track moves faster over a span of `span` seconds from `time`
+/// (energySpeedBounds: the centre's speed plus the turning speed times the reach).
 double pointSpeedBound(const PrincipalBody& principal, const TumblingBody& body,
                        const Eigen::Vector3d& gravity, double time, double span) {
-  const Eigen::Vector3d v = body.velocityAt(time);
-  const Eigen::Matrix3d turn = body.orientationAt(time).toRotationMatrix();
-  const Eigen::Vector3d w = turn.transpose() * body.angularVelocityAt(time);
-  const double kinetic =
-      0.5 * principal.mass * v.squaredNorm() + 0.5 * w.dot(principal.moments.cwiseProduct(w));
-  const double g_span = gravity.norm() * span;
-  const double speed =
-      g_span + std::sqrt(g_span * g_span + 2 * (1 + 1e-6) * kinetic / principal.mass);
-  const double turning = speed * std::sqrt(principal.mass / principal.moments.minCoeff());
-  return (1 + 1e-12) * (speed + turning * body.reach());
+  const auto [centre, turning] =
+      energySpeedBounds(principal, body.velocityAt(time), body.angularVelocityAt(time),
+                        body.orientationAt(time), gravity, span);
+  return centre + turning * body.reach();
 }
 
 /// Track `body` as a tumbling body at `time`: its flight itself where it flies (no rotation made
