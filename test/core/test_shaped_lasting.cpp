@@ -630,6 +630,45 @@ TEST(ShapedLasting, ASolidCylinderRollsDownAnInclineAtTwoThirdsGSinTheta) {
   }
 }
 
+// A solid ball (r = 0.1, 2 kg, I = 2/5 m r^2) at rest on the incline: with mu = 0.5 it rolls at a
+// = g sin / (1 + I / (m r^2)) = 5/7 g sin down the slope, w' = a / r, its one point carrying m g
+// cos and the friction m g sin 2/7 up the slope (within mu m g cos); with mu = 0.05 (below 2/7
+// tan) it slides at g (sin - mu cos), turning at w' = mu m g cos r / I, the slip growing.
+TEST(ShapedLasting, ABallRollsDownAnInclineAtFiveSeventhsGSinThetaOrSlidesBelowItsFriction) {
+  const double r = 0.1, m = 2;
+  LastingBody ball;
+  ball.shape = Sphere{V::Zero(), r};
+  ball.mass = m;
+  ball.moments = V::Constant(0.4 * m * r * r);
+  ball.centre = r * kInclineNormal;
+  ball.gravity = kDown;
+  const auto rolling = lastingOnFace(ball, plane(kInclineNormal, 0.5));
+  ASSERT_TRUE(rolling.ok()) << errorOf(rolling);
+  EXPECT_EQ(rolling->state, ContactState::kRolling);
+  EXPECT_LE((rolling->acceleration + 5.0 / 7 * kG * kSin * kUphill).norm(), 1e-14 * kG);
+  EXPECT_LE(
+      (rolling->angular_acceleration - kInclineNormal.cross(-5.0 / 7 * kG * kSin * kUphill) / r)
+          .norm(),
+      1e-14 * kG / r);
+  ASSERT_EQ(rolling->forces.size(), 1u);
+  EXPECT_NEAR(rolling->forces[0].normal_force, m * kG * kCos, 1e-14 * m * kG);
+  EXPECT_LE((rolling->forces[0].friction_force - m * kG * kSin * 2 / 7 * kUphill).norm(),
+            1e-14 * m * kG);
+  for (const double t : {0.5, 1.0}) {
+    const V slip =
+        rolling->velocityAt(t) + rolling->angularVelocityAt(t).cross(-r * kInclineNormal);
+    EXPECT_LE(slip.norm(), 1e-14 * kG * t);
+  }
+  const double mu = 0.05;
+  const auto sliding = lastingOnFace(ball, plane(kInclineNormal, mu));
+  ASSERT_TRUE(sliding.ok()) << errorOf(sliding);
+  EXPECT_EQ(sliding->state, ContactState::kSliding);
+  EXPECT_TRUE(std::isinf(sliding->until));
+  EXPECT_LE((sliding->acceleration + kG * (kSin - mu * kCos) * kUphill).norm(), 1e-14 * kG);
+  EXPECT_NEAR(sliding->angular_acceleration.norm(), mu * m * kG * kCos * r / (0.4 * m * r * r),
+              1e-12);
+}
+
 TEST(ShapedLasting, ACylinderOfAGivenAxialMomentRollsAtItsOwnRate) {
   // J = 0.8 m r^2 (a hollow-ish tensor): a = g sin / 1.8 = g / 3; the friction it needs,
   // m g sin 0.8 / 1.8 = m g 4/15 = 0.267 m g, within mu m g cos = 0.4 m g.
@@ -925,7 +964,7 @@ TEST(ShapedLasting, BadInputIsNamed) {
   body.velocity = V(0, 0, -0.5);  // approaching: an impact
   EXPECT_EQ(fieldOf(lastingOnFace(body, floor)), "body.velocity");
   body = good;
-  body.shape = Sphere{V::Zero(), 0.1};
+  body.shape = Sphere{V::Zero(), -0.1};
   EXPECT_EQ(fieldOf(lastingOnFace(body, floor)), "body.shape");
   body = good;
   body.moments.y() = -1;

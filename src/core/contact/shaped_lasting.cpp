@@ -139,10 +139,11 @@ Status checkLasting(const LastingBody& body, const FlatFace& face) {
                      formatNumber(pressing) + " m/s^2): no lasting contact"};
   }
   return std::visit(
-      Visit{[](const Sphere&) -> Status {
-              return Error{"body.shape",
-                           "not yet: a sphere's lasting contact is a ball's (the monitor's), "
-                           "not a shaped body's"};
+      Visit{[](const Sphere& sphere) -> Status {
+              if (!(std::isfinite(sphere.radius) && sphere.radius > 0)) {
+                return Error{"body.shape", "a sphere's radius must be finite and > 0"};
+              }
+              return Ok{};
             },
             [](const Cuboid& box) -> Status {
               if (!(box.half_size.allFinite() && box.half_size.minCoeff() > 0)) {
@@ -226,6 +227,20 @@ Setting settingOf(const LastingBody& body, const FlatFace& face, bool settled) {
 
 Vec onFace(const Vec& x, const FlatFace& face, const Vec& n) {
   return x - n.dot(x - face.point) * n;
+}
+
+/// Whether a body whose lowest point is `lowest` above the face touches it (within the band).
+Status touchesFace(double lowest) {
+  if (lowest > kLastingBand) {
+    return Error{"body.centre", "the body does not touch the face: its lowest point is " +
+                                    formatNumber(lowest) +
+                                    " m above it (the touching band is 1e-9 m)"};
+  }
+  if (lowest < -kLastingBand) {
+    return Error{"body.centre", "the body is " + formatNumber(-lowest) +
+                                    " m inside the face (more than the touching band, 1e-9 m)"};
+  }
+  return Ok{};
 }
 
 /// A cylinder's or capsule's support (`radius`, `half_length` along its axis, rotation's z): on
@@ -321,15 +336,7 @@ Expected<Support> supportOf(const LastingBody& body, const Eigen::Matrix3d& rota
   const Vec down = rotation.transpose() * (-n);
   const double lowest = n.dot(body.centre + rotation * coreSupport(body.shape, down) - face.point) -
                         marginOf(body.shape);
-  if (lowest > kLastingBand) {
-    return Error{"body.centre", "the body does not touch the face: its lowest point is " +
-                                    formatNumber(lowest) +
-                                    " m above it (the touching band is 1e-9 m)"};
-  }
-  if (lowest < -kLastingBand) {
-    return Error{"body.centre", "the body is " + formatNumber(-lowest) +
-                                    " m inside the face (more than the touching band, 1e-9 m)"};
-  }
+  if (Status status = touchesFace(lowest); !status) return status.error();
   if (const auto* cylinder = std::get_if<Cylinder>(&body.shape)) {
     return roundSupport(body, rotation, face, setting, cylinder->radius, cylinder->half_length,
                         true);
@@ -708,9 +715,124 @@ const char* tippingOf(ContactState state) {
 
 }  // namespace
 
+namespace {
+
+/// The first instant (after the start) a point moving by x0 + v s + a s^2 / 2 in a bounded face
+/// reaches its edge (+inf on an unbounded face).
+double pointReachesEdge(const Vec& x0, const Vec& v, const Vec& a, const FlatFace& face) {
+  double first = std::numeric_limits<double>::infinity();
+  if (!face.bounded) return first;
+  const std::array<Vec, 2> axes{face.along_u, face.along_v};
+  for (std::size_t k = 0; k < 2; ++k) {
+    const double u = (x0 - face.point).dot(axes[k]), bound = face.half_extent[static_cast<int>(k)];
+    const double v_k = v.dot(axes[k]), a_k = a.dot(axes[k]);
+    first = std::min({first, firstReach(v_k, a_k, bound - u), firstReach(-v_k, -a_k, u + bound)});
+  }
+  return first;
+}
+
+/// A sphere (its moment I about any axis) touching a face at one point, its normal motion
+/// settled: the closed forms of a ball on a plane (doc/model.md, "Balls among shaped bodies").
+/// The contact point's slip is u = v - r w x n; with k = 1 + m r^2 / I:
+///  - no slip, and friction enough (|g_t| I / (I + m r^2) <= mu g_n): it rolls, a = g_t / (1 + I
+///    / (m r^2)), alpha = n x a / r; with no velocity and no slope it rests;
+///  - else it slides, friction mu m g_n against the slip u^ (along g_t from no slip): a = g_t -
+///    mu g_n u^, alpha = mu m g_n r (n x u^) / I, the slip changing at g_t.u^ - mu g_n k, so
+///    stopping (then it rolls: asked again) where that is < 0.
+/// A point contact has no torque about the normal: a spin about it is kept. The orientation is
+/// the closed form's only where w stays about one axis: a turn about another axis while alpha
+/// is not 0, or a slide across the slope (the slip's direction turns), is not yet.
+Expected<LastingMotion> ballOnFace(const LastingBody& body, const FlatFace& face, double radius) {
+  const Setting setting = settingOf(body, face, true);
+  const Vec& n = setting.n;
+  const double lowest = setting.height - radius;
+  if (Status status = touchesFace(lowest); !status) return status.error();
+  const double normal_speed = body.velocity.dot(n);
+  if (std::abs(normal_speed) > setting.settled_speed) {
+    return Error{"body.velocity", std::string("its point of contact ") +
+                                      (normal_speed < 0 ? "approaches" : "leaves") +
+                                      " the face at " + formatNumber(std::abs(normal_speed)) +
+                                      " m/s: not a lasting contact"};
+  }
+  const Vec point = setting.foot;
+  if (face.bounded &&
+      (std::abs((point - face.point).dot(face.along_u)) > face.half_extent.x() + kLastingBand ||
+       std::abs((point - face.point).dot(face.along_v)) > face.half_extent.y() + kLastingBand)) {
+    return notYet("the body overhangs the face's edge (its point of contact is off it)");
+  }
+  const double m = body.mass, r = radius, I = body.moments.x(), mu = face.friction;
+  const double g_n = setting.g_n, still = kLastingStillSpeed;
+  const Vec& g_t = setting.g_t;
+  const Vec v = body.velocity - normal_speed * n;
+  const Vec& w = body.angular_velocity;
+  const Vec slip = v - r * w.cross(n);
+  const Vec rolling = g_t / (1 + I / (m * r * r));
+  LastingMotion motion;
+  motion.start = body.time;
+  motion.centre0 = body.centre;
+  motion.orientation0 = body.orientation.normalized();
+  motion.velocity0 = v;
+  motion.angular_velocity0 = w;
+  Vec slip_direction = Vec::Zero();
+  if (slip.norm() <= still && (g_t - rolling).norm() <= mu * g_n) {
+    const bool level = g_t.norm() <= kLastingAcrossGravity * (g_t.norm() + g_n);
+    motion.state = level && v.norm() <= still ? ContactState::kResting : ContactState::kRolling;
+    if (motion.state == ContactState::kResting) {
+      motion.velocity0.setZero();
+      motion.angular_velocity0 = w.dot(n) * n;  // a spin about the normal is kept
+    } else if (!level) {
+      motion.acceleration = rolling;
+      motion.angular_acceleration = n.cross(rolling) / r;
+    }
+  } else {
+    // Sliding: from no slip, the way gravity drives it (friction cannot hold the roll).
+    slip_direction = slip.norm() > still ? Vec(slip.normalized()) : Vec(g_t.normalized());
+    const double downhill = g_t.dot(slip_direction);
+    if ((g_t - downhill * slip_direction).norm() > kLastingAcrossGravity * (g_t.norm() + g_n)) {
+      return notYet(
+          "a ball sliding across the slope (gravity's part in the face not along its slip: the "
+          "slide turns)");
+    }
+    motion.state = ContactState::kSliding;
+    motion.acceleration = g_t - mu * g_n * slip_direction;
+    motion.angular_acceleration = (mu * m * g_n * r / I) * n.cross(slip_direction);
+    const double slip_rate = downhill - mu * g_n * (1 + m * r * r / I);
+    if (slip.norm() > still && slip_rate < 0) {
+      motion.until = body.time + slip.norm() / -slip_rate;
+      motion.ends = "stops";
+    }
+  }
+  const double alpha = motion.angular_acceleration.norm();
+  if (alpha > 0) {
+    const Vec axis = motion.angular_acceleration / alpha;
+    const Vec& w0 = motion.angular_velocity0;
+    if ((w0 - w0.dot(axis) * axis).norm() * r > still) {
+      return notYet(
+          "a ball turning about an axis other than its roll's while it slides or rolls down a "
+          "slope (its orientation has no closed form here)");
+    }
+  }
+  SupportForce force;
+  force.point = point;
+  force.normal_force = m * g_n;
+  force.friction_force = m * (motion.acceleration - g_t);
+  motion.forces = {force};
+  const double edge = pointReachesEdge(point, motion.velocity0, motion.acceleration, face);
+  if (body.time + edge < motion.until) {
+    motion.until = body.time + edge;
+    motion.ends = "a point of its support reaches the face's edge";
+  }
+  return motion;
+}
+
+}  // namespace
+
 Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& face,
                                       double tolerance) {
   if (Status status = checkLasting(body, face); !status) return status.error();
+  if (const auto* sphere = std::get_if<Sphere>(&body.shape)) {
+    return ballOnFace(body, face, sphere->radius);
+  }
   const Eigen::Quaterniond orientation = body.orientation.normalized();
   const Eigen::Matrix3d rotation = orientation.toRotationMatrix();
   const Setting setting = settingOf(body, face, true);
@@ -785,12 +907,7 @@ std::optional<double> flatBouncesEnd(const LastingBody& body, const FlatFace& fa
                                      double restitution) {
   if (!(std::isfinite(restitution) && restitution >= 0 && restitution < 1)) return std::nullopt;
   if (!checkLasting(body, face)) return std::nullopt;
-  const Eigen::Matrix3d rotation = body.orientation.normalized().toRotationMatrix();
   const Setting setting = settingOf(body, face, false);
-  auto found = supportOf(body, rotation, face, setting);
-  if (!found) return std::nullopt;
-  Support support = found.value();
-  if (support.kind == SupportKind::kCorners) return std::nullopt;
   // Flat: approaching along the normal, no slip and no turning (every point of the manifold
   // approaches at u, to 1e-9 m/s).
   const double approach = -body.velocity.dot(setting.n);
@@ -799,16 +916,24 @@ std::optional<double> flatBouncesEnd(const LastingBody& body, const FlatFace& fa
       body.angular_velocity.norm() * setting.reach > kLastingStillSpeed) {
     return std::nullopt;
   }
-  // The joint frictionless rule sends every point back at e u without turning only where its
-  // least-norm impulses, centred under the centre of mass, are >= 0 (none dropped).
-  if (support.kind == SupportKind::kPolygon) {
-    const auto [q, p] = inFace(support, setting, setting.foot);
-    const std::vector<double> shares = polygonForces(q, p, 1.0, false);
-    if (*std::min_element(shares.begin(), shares.end()) < 0) return std::nullopt;
-  } else if (support.kind == SupportKind::kLine) {
-    const double l1 = (support.feet[0] - setting.foot).dot(support.axis);
-    const double l2 = (support.feet[1] - setting.foot).dot(support.axis);
-    if (!(l1 <= 0 && 0 <= l2)) return std::nullopt;
+  // A ball's one point is under its centre: the impact sends it back at e u. A body of corners
+  // or sides: the joint frictionless rule sends every point back at e u without turning only
+  // where its least-norm impulses, centred under the centre of mass, are >= 0 (none dropped).
+  if (!std::holds_alternative<Sphere>(body.shape)) {
+    const Eigen::Matrix3d rotation = body.orientation.normalized().toRotationMatrix();
+    auto found = supportOf(body, rotation, face, setting);
+    if (!found) return std::nullopt;
+    Support support = found.value();
+    if (support.kind == SupportKind::kCorners) return std::nullopt;
+    if (support.kind == SupportKind::kPolygon) {
+      const auto [q, p] = inFace(support, setting, setting.foot);
+      const std::vector<double> shares = polygonForces(q, p, 1.0, false);
+      if (*std::min_element(shares.begin(), shares.end()) < 0) return std::nullopt;
+    } else if (support.kind == SupportKind::kLine) {
+      const double l1 = (support.feet[0] - setting.foot).dot(support.axis);
+      const double l2 = (support.feet[1] - setting.foot).dot(support.axis);
+      if (!(l1 <= 0 && 0 <= l2)) return std::nullopt;
+    }
   }
   // The k-th bounce leaves at e^k e u and lands 2 e^k e u / g_n later: the sum
   // 2 e u / (g_n (1 - e)) (doc/model.md, "Coming to rest (Zeno)").
