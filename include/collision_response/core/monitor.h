@@ -295,7 +295,7 @@ class ImpactMonitor {
   /// ball's is its last state's (a ball's does not matter).
   Eigen::Quaterniond predictedOrientation(std::size_t body, double time) const;
   /// Whether the body is moved as a shaped body (issue 42; doc/model.md, "Shaped bodies in the
-  /// monitor").
+  /// monitor"): a shaped body, or a ball among shaped bodies ("Balls among shaped bodies").
   bool shaped(std::size_t body) const;
 
  private:

@@ -170,10 +170,11 @@ bool Playback::applyImpact(const ImpactMonitor& monitor, const ImpactRecord& imp
                          const Eigen::Vector3d& angular_after) {
     const auto body = bodyIndex(monitor.body(monitor_body).id);
     if (!body) return true;  // not one of this scene's bodies: nothing to move
-    // A ball's centre from the contact (its radius along the normal); a shaped body's where its
-    // motion has it at the instant (its centre is no radius from the contact).
+    // A ball's centre from the contact (its radius along the normal); a body the monitor moves
+    // as a rigid body (a shaped body, or a ball among shaped bodies) where its motion has it at
+    // the instant (a shaped body's centre is no radius from the contact).
     const double radius = scene_.bodies[*body].radius;
-    const bool from_contact = exact_contact && !isShapedBody(scene_.bodies[*body]);
+    const bool from_contact = exact_contact && !monitor.shaped(monitor_body);
     const Eigen::Vector3d centre =
         from_contact ? Eigen::Vector3d(impact.contact_point + side * radius * impact.normal)
                      : position(*body, impact.time);

@@ -370,12 +370,20 @@ bool ShapedRoom::any() const {
                      [](const auto& p) { return p.has_value(); });
 }
 
+bool ballsMoveAsShaped(const World& world) {
+  const bool any = std::any_of(world.bodies.begin(), world.bodies.end(),
+                               [](const BodySpec& body) { return isShapedBody(body); });
+  return any && (world.effects.spin || !world.effects.friction);
+}
+
 ShapedRoom shapedRoomOf(const World& world) {
   ShapedRoom room;
   room.principal.resize(world.bodies.size());
   room.tracks.resize(world.bodies.size());
+  const bool balls_too = ballsMoveAsShaped(world);
   for (std::size_t body = 0; body < world.bodies.size(); ++body) {
-    if (!isShapedBody(world.bodies[body])) continue;
+    const BodySpec& spec = world.bodies[body];
+    if (!isShapedBody(spec) && !(balls_too && std::isfinite(spec.mass))) continue;
     auto principal = principalBody(world.bodies[body], "body");
     if (principal) room.principal[body] = std::move(principal.value());
   }

@@ -138,7 +138,13 @@ std::optional<TumblingBody> tumblingAt(const ShapedRoom& room, std::size_t body,
 /// Touching: overlapping, or apart by no more than the manifold's band.
 bool touching(const SurfaceGap& gap);
 
-/// The shaped bodies of `world`'s scene (validateScene took them: principalBody holds).
+/// Whether `world`'s balls move as rigid spheres among its shaped bodies (doc/model.md, "Balls
+/// among shaped bodies"): where the scene has a shaped body, and spin is on or friction off (a
+/// shaped body turns; validateScene refuses drag and Magnus with one).
+bool ballsMoveAsShaped(const World& world);
+
+/// The shaped bodies of `world`'s scene (validateScene took them: principalBody holds), and
+/// where ballsMoveAsShaped, its movable balls, as rigid spheres of their inertia.
 ShapedRoom shapedRoomOf(const World& world);
 
 /// A shaped body's track starts again from `state` (the obstacles as placed in `world`).
