@@ -497,6 +497,98 @@ TEST(RigidImpact, ABoxLandingFlatOnFourCornersLeavesStraightAndLosesItsClosedFor
   }
 }
 
+/// The box's kinetic energy (its moments' inverse in `body`).
+double kineticEnergy(const SolverBody& body) {
+  const Eigen::Matrix3d inertia = body.inverse_inertia.inverse();
+  return 0.5 * body.velocity.squaredNorm() / body.inverse_mass +
+         0.5 * body.angular_velocity.dot(inertia * body.angular_velocity);
+}
+
+// The box (1 x 2 x 3 m, 2 kg, half c = 1.5 below its centre, I_yy = m (a^2 + c^2) / 3 = 5/3)
+// landing flat at v_n = 3 m/s while sliding at 4 m/s along x, e = 1/2: the joint rule's normal
+// impulses J = (1 + e) m v_n = 9 N s, a quarter at each corner, then friction of maximal
+// dissipation given them. With mu = 0.1 every corner slides (the slip left, 4 - mu J (1/m + c^2 /
+// I_yy) = 2.335 m/s, stays ahead): T = mu J against the slip, v_x' = 4 - mu J / m = 3.55, w_y' =
+// c mu J / I_yy = 0.81 rad/s, the friction losing mu J (u + u') / 2 = 0.9 (4 + 2.335) / 2. With
+// mu = 1 the slip stops (T = 4 / (1/m + c^2 / I_yy) = 4 / 1.85 <= mu J): v_x' = 4 - T / m, w_y' =
+// c T / I_yy. Either way the box leaves at e v_n upwards, the front corners leaving too (e v_n -
+// a w_y' > 0), and all 24 orders of the corners give the same bits. Before, such a landing was
+// frictionless.
+TEST(RigidImpact, ABoxLandingFlatWhileSlidingTakesFrictionOfMaximalDissipation) {
+  const Eigen::Vector3d half(0.5, 1.0, 1.5);
+  const double m = 2.0, e = 0.5, v_n = 3.0, u = 4.0, c = 1.5, I_yy = 5.0 / 3, J = 9.0;
+  for (const double mu : {0.1, 1.0}) {
+    FlatBox box = flatBox(m, half, Eigen::Vector3d(u, 0, -v_n), e);
+    const double before = kineticEnergy(box.bodies[1]);
+    const auto outcome = resolveRigidSimultaneous(box.bodies, box.contacts, {mu, mu, mu, mu});
+    ASSERT_TRUE(outcome.ok()) << outcome.error().message();
+    const double T = mu == 0.1 ? mu * J : u / (1 / m + c * c / I_yy);
+    const SolverBody& landed = box.bodies[1];
+    EXPECT_NEAR((landed.velocity - Eigen::Vector3d(u - T / m, 0, e * v_n)).norm(), 0.0,
+                16 * kEps * u)
+        << "mu " << mu;
+    EXPECT_NEAR((landed.angular_velocity - Eigen::Vector3d(0, c * T / I_yy, 0)).norm(), 0.0,
+                16 * kEps * u)
+        << "mu " << mu;
+    EXPECT_GT(e * v_n - half.x() * landed.angular_velocity.y(), 0.0);
+    double friction = 0.0, lost = 0.0;
+    for (const FrictionalOutcome& corner : *outcome) {
+      EXPECT_NEAR(corner.normal.impulse, J / 4, 16 * kEps * J);
+      EXPECT_LE(corner.friction_impulse, mu * corner.normal.impulse * (1 + 1e-12));
+      friction += corner.friction_impulse;
+      lost += corner.normal.energy_lost + corner.friction_energy_lost;
+    }
+    EXPECT_NEAR(friction, T, 16 * kEps * J);
+    EXPECT_NEAR(lost, before - kineticEnergy(landed), 64 * kEps * before);
+    if (mu == 0.1) {
+      EXPECT_NEAR(lost, 0.5 * m * (1 - e * e) * v_n * v_n + T * (u + 2.335) / 2, 1e-12);
+    }
+    std::vector<std::size_t> order = {0, 1, 2, 3};
+    while (std::next_permutation(order.begin(), order.end())) {
+      FlatBox shuffled = flatBox(m, half, Eigen::Vector3d(u, 0, -v_n), e);
+      std::vector<ClusterContact> contacts;
+      for (const std::size_t k : order) contacts.push_back(shuffled.contacts[k]);
+      ASSERT_TRUE(resolveRigidSimultaneous(shuffled.bodies, contacts, {mu, mu, mu, mu}).ok());
+      EXPECT_EQ(shuffled.bodies[1].velocity, landed.velocity);
+      EXPECT_EQ(shuffled.bodies[1].angular_velocity, landed.angular_velocity);
+    }
+  }
+}
+
+// 2,000 random boxes (edges 0.1 to 2 m, masses, tilts, slides and spins) landing on their four
+// bottom corners with e in [0, 1] and mu in [0, 2]: friction never adds energy (1e-12 of the
+// energy before), each corner's friction within its cone (mu J_k), the energies lost adding up to
+// the change.
+TEST(RigidImpact, RandomFrictionalFlatLandingsNeverGainEnergy) {
+  std::mt19937_64 random(11);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int trial = 0; trial < 2000; ++trial) {
+    const Eigen::Vector3d half = Eigen::Vector3d(0.05, 0.05, 0.05) +
+                                 0.95 * Eigen::Vector3d(unit(random), unit(random), unit(random));
+    const Eigen::Vector3d velocity(4 * unit(random) - 2, 4 * unit(random) - 2,
+                                   -0.1 - 3 * unit(random));
+    FlatBox box = flatBox(0.1 + 5 * unit(random), half, velocity, unit(random));
+    box.bodies[1].angular_velocity =
+        Eigen::Vector3d(unit(random) - 0.5, unit(random) - 0.5, 4 * unit(random) - 2);
+    const double mu = 2 * unit(random);
+    const double before = kineticEnergy(box.bodies[1]);
+    const auto outcome = resolveRigidSimultaneous(box.bodies, box.contacts, {mu, mu, mu, mu});
+    if (!outcome.ok()) {
+      ADD_FAILURE() << trial << ": " << outcome.error().message();
+      continue;
+    }
+    const double after = kineticEnergy(box.bodies[1]);
+    EXPECT_LE(after, before * (1 + 1e-12)) << trial;
+    double lost = 0.0;
+    for (const FrictionalOutcome& corner : *outcome) {
+      EXPECT_LE(corner.friction_impulse, mu * corner.normal.impulse * (1 + 1e-12) + 1e-300)
+          << trial;
+      lost += corner.normal.energy_lost + corner.friction_energy_lost;
+    }
+    EXPECT_NEAR(lost, before - after, 1e-12 * before) << trial;
+  }
+}
+
 // The same box landing flat while drifting and turning about z (the floor frictionless, the
 // corners approaching alike): only the normal velocity changes, v_z' = -e v_z; in any order of
 // the corners, the same bits; and on a floor turned by a rotation R (the whole problem turned)

@@ -88,9 +88,8 @@ RigidImpactOutcome resolveRigidImpactByLaw(SolverBody& a, SolverBody& b,
 
 /// Resolves contacts of shaped bodies that all strike at one instant (a box landing flat touches
 /// the floor at four corners), frictionless, updating the bodies' velocities and angular
-/// velocities; outcomes in the order of `contacts`. Friction at several contacts at once of a
-/// shaped body is not here yet (a body given by its tensor with friction: one contact at a time,
-/// resolveRigidImpact).
+/// velocities; outcomes in the order of `contacts`. With friction: resolveRigidSimultaneous
+/// taking the contacts' coefficients, below.
 ///
 /// The rule: Newton's joint rule of resolveSimultaneous (simultaneous.h) with the lever arms:
 /// impulses J_k >= 0 such that every contact that receives one leaves with d_k' = -e_k d_k, d_k
@@ -111,5 +110,27 @@ RigidImpactOutcome resolveRigidImpactByLaw(SolverBody& a, SolverBody& b,
 /// body index out of range or both sides one body.
 Expected<std::vector<ContactOutcome>> resolveRigidSimultaneous(
     std::vector<SolverBody>& bodies, const std::vector<ClusterContact>& contacts);
+
+/// One contact's share of a frictional joint impact.
+struct FrictionalOutcome {
+  ContactOutcome normal;              ///< the joint rule's, its energy_lost the normal impulse's
+  double friction_impulse = 0.0;      ///< N s, |T|, <= mu J
+  double friction_energy_lost = 0.0;  ///< J, >= 0 in sum: -T.(u + u') / 2, u, u' its slips
+};
+
+/// Contacts that all strike at one instant, each with Coulomb's coefficient `friction[k]` >= 0
+/// (doc/model.md, "One impact of a shaped body"): the joint rule's normal impulses J_k (the
+/// frictionless resolveRigidSimultaneous above), then friction of maximal dissipation given
+/// them, jointly over the contacts (solveFrictionImpulses, src/core/solver/friction_impulses.h):
+/// tangential impulses |T_k| <= mu_k J_k that leave the least kinetic energy, which stop every
+/// slip they can and act at mu_k J_k against the slip left where they cannot, so that friction
+/// never reverses a slip nor adds energy, and nothing depends on the order of the contacts. A
+/// box landing flat while it slides, no point sticking, leaves at v_t - mu (1 + e) v_n and turns
+/// at c mu (1 + e) m v_n / I about the axis across the slide (c the centre's height). All
+/// coefficients 0: the frictionless rule itself. Bad input as resolveRigidSimultaneous, and
+/// `friction` of another length or a coefficient not finite or < 0.
+Expected<std::vector<FrictionalOutcome>> resolveRigidSimultaneous(
+    std::vector<SolverBody>& bodies, const std::vector<ClusterContact>& contacts,
+    const std::vector<double>& friction);
 
 }  // namespace collision_response::core

@@ -13,6 +13,7 @@
 #include "collision_response/core/impact.h"
 #include "collision_response/core/validation.h"
 #include "solver/effective_mass.h"
+#include "solver/friction_impulses.h"
 #include "solver/impulse_response.h"
 #include "solver/order_free.h"
 
@@ -471,6 +472,57 @@ Expected<std::vector<ContactOutcome>> resolveRigidSimultaneous(
   const JointSystem system = jointSystem(bodies, contacts, order);
   const std::vector<double> impulses = jointImpulses(system.delassus, system.target);
   return applyJointImpulses(bodies, contacts, order, system, impulses);
+}
+
+Expected<std::vector<FrictionalOutcome>> resolveRigidSimultaneous(
+    std::vector<SolverBody>& bodies, const std::vector<ClusterContact>& contacts,
+    const std::vector<double>& friction) {
+  if (friction.size() != contacts.size()) {
+    return Error{"friction", "must give one coefficient per contact (" +
+                                 std::to_string(contacts.size()) + "), not " +
+                                 std::to_string(friction.size())};
+  }
+  for (std::size_t k = 0; k < friction.size(); ++k) {
+    if (!(std::isfinite(friction[k]) && friction[k] >= 0)) {
+      return Error{"friction[" + std::to_string(k) + "]", "must be finite and >= 0"};
+    }
+  }
+  auto normal = resolveRigidSimultaneous(bodies, contacts);
+  if (!normal) return normal.error();
+  std::vector<FrictionalOutcome> outcomes(contacts.size());
+  for (std::size_t k = 0; k < contacts.size(); ++k) outcomes[k].normal = (*normal)[k];
+  if (std::all_of(friction.begin(), friction.end(), [](double mu) { return mu == 0.0; })) {
+    return outcomes;
+  }
+  // Friction given the normal impulses, on the velocities after them, the contacts in the
+  // canonical order (so that their order given changes no bit of the long double sums).
+  std::vector<ForceBody> force_bodies;
+  for (const SolverBody& body : bodies) force_bodies.push_back(ForceBody{body});
+  const std::vector<std::size_t> order = canonicalOrder(contacts);
+  std::vector<ForceContact> force_contacts;
+  std::vector<double> normal_impulses;
+  for (const std::size_t k : order) {
+    ForceContact contact{contacts[k]};
+    contact.friction = friction[k];
+    force_contacts.push_back(contact);
+    normal_impulses.push_back(outcomes[k].normal.impulse);
+  }
+  const ContactForceSolution solution =
+      solveFrictionImpulses(force_bodies, force_contacts, normal_impulses);
+  for (std::size_t place = 0; place < order.size(); ++place) {
+    const std::size_t k = order[place];
+    const ContactForce& applied = solution.contacts[place];
+    outcomes[k].friction_impulse = applied.tangential.norm();
+    // -T.(u + u') / 2 with u' = u + du (du in slip_acceleration), as the balls' clusters.
+    outcomes[k].friction_energy_lost =
+        -0.5 * applied.tangential.dot(2 * applied.slip + applied.slip_acceleration);
+  }
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    if (bodies[i].inverse_mass == 0.0) continue;
+    bodies[i].velocity += solution.acceleration[i];
+    bodies[i].angular_velocity += solution.angular_acceleration[i];
+  }
+  return outcomes;
 }
 
 }  // namespace collision_response::core

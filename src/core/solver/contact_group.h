@@ -50,7 +50,8 @@ class Group {
       const V3 across = relative - relative.dot(normal) * normal;
       const V3 turning =
           (Real(a.radius) * widen(a.angular_velocity) + Real(b.radius) * widen(b.angular_velocity));
-      const V3 slip_full = relative - turning.cross(normal);
+      const V3 slip_full = relative - turningOf(contact, normal, widen(a.angular_velocity),
+                                                widen(b.angular_velocity));
       slip_.push_back(slip_full - slip_full.dot(normal) * normal);
       const Real curvature = contact.curvature;
       if (contact.turning_axis.isZero()) {
@@ -109,9 +110,8 @@ class Group {
         const V3 relative = local(contact.b, acceleration) - local(contact.a, acceleration);
         const Real gap = normal_[k].dot(relative);
         const V3 slip =
-            relative - (Real(bodies_[contact.a].radius) * local(contact.a, angular_acceleration) +
-                        Real(bodies_[contact.b].radius) * local(contact.b, angular_acceleration))
-                           .cross(normal_[k]);
+            relative - turningOf(contact, normal_[k], local(contact.a, angular_acceleration),
+                                 local(contact.b, angular_acceleration));
         visit(k, gap, V3(slip - slip.dot(normal_[k]) * normal_[k]));
       }
     }
@@ -144,9 +144,8 @@ class Group {
       const ForceContact& contact = contacts_[k];
       const V3 relative = r.acceleration[contact.b] - r.acceleration[contact.a];
       Real gap = normal_[k].dot(relative);
-      V3 slip = relative - (Real(bodies_[contact.a].radius) * r.angular_acceleration[contact.a] +
-                            Real(bodies_[contact.b].radius) * r.angular_acceleration[contact.b])
-                               .cross(normal_[k]);
+      V3 slip = relative - turningOf(contact, normal_[k], r.angular_acceleration[contact.a],
+                                     r.angular_acceleration[contact.b]);
       if (free) {
         gap += centripetal_[k];
         slip += turning_term_[k];
@@ -158,6 +157,27 @@ class Group {
   }
 
  private:
+  /// The part of the slip at `contact` (normal `normal`) that its bodies' angular velocities
+  /// (or accelerations) `w_a` and `w_b` make, subtracted from the relative velocity: w_a x r_a -
+  /// w_b x r_b. Two balls: (R_a w_a + R_b w_b) x n, as the ball solvers always have (r_a = R_a
+  /// n, r_b = -R_b n); where a side is given by its tensor, from the contact's lever arms.
+  V3 turningOf(const ForceContact& contact, const V3& normal, const V3& w_a, const V3& w_b) const {
+    const ForceBody& a = bodies_[contact.a];
+    const ForceBody& b = bodies_[contact.b];
+    if (a.inertia_kind == InverseInertiaKind::kIsotropic &&
+        b.inertia_kind == InverseInertiaKind::kIsotropic) {
+      return (Real(a.radius) * w_a + Real(b.radius) * w_b).cross(normal);
+    }
+    const auto side = [&](const ForceBody& body, const V3& w, const Eigen::Vector3d& lever,
+                          const V3& outward) -> V3 {
+      if (body.inertia_kind == InverseInertiaKind::kIsotropic) {
+        return w.cross(Real(body.radius) * outward);
+      }
+      return w.cross(widen(lever));
+    };
+    return side(a, w_a, contact.lever_a, normal) - side(b, w_b, contact.lever_b, -normal);
+  }
+
   /// Force `force` on body `i` at its contact point, `arm` from its centre (its lever arm; a
   /// ball's is r `outward`, outward +n for a, -n for b).
   void push(Response& r, std::size_t i, const V3& force, const V3& outward,
