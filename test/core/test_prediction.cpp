@@ -2,6 +2,7 @@
 // the bit and the closed forms; budgets and every bad request named.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
 
@@ -172,6 +173,36 @@ TEST(Prediction, OtherBodiesAreHeldWhereTheLiveMonitorHasThem) {
   ASSERT_EQ(prediction->impacts.size(), 1u);
   EXPECT_EQ(prediction->model->obstacle(prediction->impacts[0].other).id, "target");
   EXPECT_NEAR(prediction->impacts[0].time, 0.4, 4 * kEps);
+}
+
+// A ball predicted in a scene with a box body (0.2 x 0.4 x 0.2 m, turned a quarter about z) that
+// the live monitor has at rest at x = 1: the box is held as an immovable box at its pose, its
+// half extent along x 0.2 m (its y edge, turned), so the ball thrown along x at 2 m/s from the
+// origin (r = 0.1, no gravity, e = 1/2) meets its face when its centre is at 1 - 0.2 - 0.1, at
+// t = 0.35 s, and leaves at -e 2 m/s. Before, the box was held as a sphere of its radius (0).
+TEST(Prediction, AShapedBodyIsHeldAsItsShapeAtItsPose) {
+  Scene scene;
+  ASSERT_TRUE(scene.materials.addMaterial("hard", Material{0.5, {}}, "m").ok());
+  BodySpec crate;
+  crate.id = "crate";
+  crate.mass = 2.0;
+  crate.material = "hard";
+  crate.shape = BodyShape::kBox;
+  crate.size = V(0.2, 0.4, 0.2);
+  scene.bodies = {ball("ball", 1, 0.1, "hard"), crate};
+  ImpactMonitor live(scene, MonitorSettings{});
+  BodyStateSample at_rest;
+  at_rest.body = *live.bodyIndex("crate");
+  at_rest.position = V(1, 0, 0);
+  at_rest.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, V::UnitZ()));
+  live.step(0.0, {at_rest});
+  auto request = requestFor(scene, V::Zero(), V(2, 0, 0), 1.0, 1);
+  const auto prediction = predictImpacts(scene, &live, MonitorSettings{}, request);
+  ASSERT_TRUE(prediction.ok()) << prediction.error().message();
+  ASSERT_EQ(prediction->impacts.size(), 1u);
+  EXPECT_EQ(prediction->model->obstacle(prediction->impacts[0].other).id, "crate");
+  EXPECT_NEAR(prediction->impacts[0].time, 0.35, 1e-12);
+  EXPECT_NEAR((prediction->impacts[0].velocity_a_after - V(-1, 0, 0)).norm(), 0.0, 1e-12);
 }
 
 /// The serve's reference (bench/accuracy/reference/serve_reference.py, 40-digit mpmath).

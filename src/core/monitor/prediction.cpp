@@ -5,8 +5,12 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
+#include <utility>
 
 #include "collision_response/core/body_shape.h"
+#include "collision_response/core/mass_properties.h"
+#include "collision_response/core/triangle_mesh.h"
 #include "collision_response/core/validation.h"
 #include "geometry/narrow_phase.h"
 #include "monitor/crossing.h"
@@ -87,8 +91,50 @@ Status checkRequest(const Scene& scene, const PredictionRequest& request) {
   return checkAirCoefficient(body.lift_coefficient, "lift_coefficient");
 }
 
+/// Another body of the scene held where it is, as an immovable obstacle of its shape at its
+/// position and orientation `at`: a ball a sphere, a box, cylinder or capsule that shape, a
+/// mesh body the convex hull of its vertices (as the monitor moves it); empty where the hull
+/// cannot be made (the scene's checks refuse such a body first).
+std::optional<ObstacleSpec> heldAsObstacle(const BodySpec& body, const Eigen::Vector3d& position,
+                                           const Eigen::Quaterniond& orientation) {
+  ObstacleSpec held;
+  held.id = body.id;
+  held.material = body.material;
+  held.position = position;
+  held.orientation = orientation;
+  held.radius = body.radius;
+  held.size = body.size;
+  held.length = body.length;
+  switch (body.shape) {
+    case BodyShape::kSphere:
+      held.shape = ObstacleShape::kSphere;
+      break;
+    case BodyShape::kBox:
+      held.shape = ObstacleShape::kBox;
+      break;
+    case BodyShape::kCylinder:
+      held.shape = ObstacleShape::kCylinder;
+      break;
+    case BodyShape::kCapsule:
+      held.shape = ObstacleShape::kCapsule;
+      break;
+    case BodyShape::kMesh: {
+      if (!body.mesh) return std::nullopt;
+      const auto hull = convexHull(body.mesh->vertices(), "mesh");
+      if (!hull) return std::nullopt;
+      auto triangles = TriangleMesh::build(hull->vertices, hull->triangles, "mesh");
+      if (!triangles) return std::nullopt;
+      held.shape = ObstacleShape::kMesh;
+      held.mesh = std::move(triangles.value());
+      held.resource = body.resource;
+      break;
+    }
+  }
+  return held;
+}
+
 /// The scene the prediction runs: the body alone among the scene's obstacles and, held where
-/// `live` has them at `time`, the other bodies as immovable spheres.
+/// `live` has them at `time`, the other bodies as immovable obstacles of their shapes.
 Scene sceneAhead(const Scene& scene, const ImpactMonitor* live, const PredictionRequest& request) {
   Scene ahead = scene;
   ahead.detection = Detection::kContinuous;
@@ -104,13 +150,9 @@ Scene sceneAhead(const Scene& scene, const ImpactMonitor* live, const Prediction
     const auto index = live->bodyIndex(other.id);
     const auto state = index ? live->predictedState(*index, request.state.time) : std::nullopt;
     if (!state) continue;  // not tracked: nowhere known
-    ObstacleSpec held;
-    held.id = other.id;
-    held.shape = ObstacleShape::kSphere;
-    held.material = other.material;
-    held.position = state->first;
-    held.radius = other.radius;
-    ahead.obstacles.push_back(held);
+    auto held =
+        heldAsObstacle(other, state->first, live->predictedOrientation(*index, request.state.time));
+    if (held) ahead.obstacles.push_back(std::move(*held));
   }
   return ahead;
 }
