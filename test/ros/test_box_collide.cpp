@@ -28,6 +28,7 @@
 
 #include "collision_response/BodyStateArray.h"
 #include "collision_response/ImpactArray.h"
+#include "collision_response/PredictImpacts.h"
 
 namespace {
 
@@ -109,6 +110,33 @@ TEST(BoxCollide, TheNodesImpactsAreTheClosedFormsAndNoBodyEntersAnother) {
   EXPECT_LE(worst_overlap, 1e-9) << "a played 'left' inside 'right'";
   EXPECT_LE(worst_wall, 1e-9) << "a played 'right' inside the wall";
   EXPECT_LT(worst_floor, 1e-9) << "all slide on the floor";
+
+  // A prediction holds the other bodies where the node has them, each of its shape: at 1.45 s
+  // 'right' (a mesh body, its hull the cube) slides at -0.125 m/s from the wall, its centre at
+  // 0.425 - 0.0625 - 0.125 (1.45 - 1.2) = 0.33125 m. A probe ball (r = 0.0625 m) on the
+  // frictionless floor at y = 0.5 m over that x, sliding at -1 m/s along y, meets its face y =
+  // 0.0625 when its centre is at y = 0.125, at 0.375 s, and leaves at +e 1 m/s (the held box is
+  // immovable). Held as a sphere of its radius (0), as before, it would meet it at 0.4375 s.
+  collision_response::PredictImpacts probe;
+  probe.request.header.frame_id = "world";
+  probe.request.header.stamp = start + ros::Duration(1.45);
+  probe.request.body.id = "probe";
+  probe.request.body.mass = 0.1;
+  probe.request.body.radius = kRadius;
+  probe.request.body.material = "block";
+  probe.request.body.position.x = 0.33125;
+  probe.request.body.position.y = 0.5;
+  probe.request.body.position.z = kRadius;
+  probe.request.body.velocity.y = -1.0;
+  probe.request.horizon = 1.0;
+  probe.request.max_impacts = 1;
+  ASSERT_TRUE(ros::service::call("/collision_response/predict_impacts", probe));
+  ASSERT_TRUE(probe.response.success) << probe.response.message;
+  ASSERT_EQ(probe.response.impacts.size(), 1u) << probe.response.message;
+  const collision_response::Impact& held = probe.response.impacts[0];
+  EXPECT_EQ(held.body_b, "right");
+  EXPECT_NEAR((held.header.stamp - probe.request.header.stamp).toSec(), 0.375, 1e-8);
+  EXPECT_NEAR(held.velocity_a_after.linear.y, kE * 1.0, 1e-9);
 }
 
 }  // namespace
