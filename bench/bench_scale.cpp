@@ -252,6 +252,63 @@ BENCHMARK(BM_PileUpdate)
     ->Unit(benchmark::kMillisecond)
     ->MinTime(1.0);
 
+/// Balls among shaped bodies (doc/model.md, "Balls among shaped bodies"): `range(0)` balls
+/// (radius 0.05 m, 0.1 kg, e = 0.5, frictionless) dropped from rest 0.3 to 0.6 m above a floor, a
+/// grid 0.3 m apart (never touching each other), bouncing until they rest, for 1 s at 100 Hz on
+/// the monitor's own motion; with `range(1)` 1, a box (0.1 m cube) at rest on the floor beside
+/// them, so that the balls move as rigid spheres by the shaped bodies' engine; with 0, by the
+/// balls' own. The ratio of the two is what a shaped body costs the balls of its scene.
+void BM_BallsAmongShapes(benchmark::State& state) {
+  const int balls = static_cast<int>(state.range(0));
+  const bool with_box = state.range(1) != 0;
+  core::Scene scene;
+  scene.effects.gravity = true;
+  (void)scene.materials.addMaterial("bouncy", core::Material{0.5, {}}, "m");
+  const int side = static_cast<int>(std::ceil(std::sqrt(balls)));
+  for (int i = 0; i < balls; ++i) {
+    core::BodySpec ball;
+    ball.id = "ball_" + std::to_string(i);
+    ball.mass = 0.1;
+    ball.radius = 0.05;
+    ball.material = "bouncy";
+    ball.position = V(0.3 * (i % side), 0.3 * (i / side), 0.35 + 0.3 * (i % 7) / 6.0);
+    scene.bodies.push_back(ball);
+  }
+  if (with_box) {
+    core::BodySpec box;
+    box.id = "box";
+    box.mass = 1.0;
+    box.material = "bouncy";
+    box.shape = core::BodyShape::kBox;
+    box.size = V(0.1, 0.1, 0.1);
+    box.position = V(-0.3, -0.3, 0.05);
+    scene.bodies.push_back(box);
+  }
+  core::ObstacleSpec floor;
+  floor.id = "floor";
+  floor.material = "bouncy";
+  scene.obstacles.push_back(floor);
+  core::MonitorSettings settings;
+  settings.body_timeout = INFINITY;  // no states after the first: the monitor's own motion
+  std::size_t impacts = 0;
+  for (auto _ : state) {
+    core::ImpactMonitor monitor(scene, settings);
+    std::vector<core::BodyStateSample> states;
+    for (const core::BodySpec& body : scene.bodies) {
+      core::BodyStateSample sample;
+      sample.body = *monitor.bodyIndex(body.id);
+      sample.position = body.position;
+      states.push_back(sample);
+    }
+    monitor.step(0.0, states);
+    impacts = 0;
+    for (int k = 1; k <= 100; ++k) impacts += monitor.step(0.01 * k, {}).impacts.size();
+  }
+  state.counters["impacts"] = static_cast<double>(impacts);
+  state.counters["balls"] = static_cast<double>(balls);
+}
+BENCHMARK(BM_BallsAmongShapes)->ArgsProduct({{8, 32}, {0, 1}})->Unit(benchmark::kMillisecond);
+
 /// A frictional cluster: side^3 touching balls (radius 0.05 m, 0.1 kg, solid: I = 2/5 m r^2) on
 /// a cubic lattice, closing on its centre at 1 m/s per m, swirling about z at 1 rad/s and each
 /// spinning at up to 10 rad/s about an axis of its own; e = 0.5 and mu = 0.3 on every contact.
