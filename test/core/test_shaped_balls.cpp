@@ -88,6 +88,32 @@ TEST(ShapedBalls, ABallMeetsABoxHeadOnAsTheLineOfImpactSays) {
   EXPECT_NEAR(box_at->first.x(), (1 + e) * m * v / (m + M) * 0.3, 1e-11);
 }
 
+// Two balls in a scene with a box (so both move as rigid spheres), meeting head on in free space
+// far from it, e = 1/2: m_1 = 1 kg at +1 m/s, m_2 = 3 kg at -1 m/s, radii 0.05 and 0.1, 0.6 m
+// apart: they touch at (0.6 - 0.15) / 2 = 0.225 s and leave by the line of impact, v_1' = (m_1 v_1
+// + m_2 v_2 - m_2 e (v_1 - v_2)) / (m_1 + m_2) = -1.25 m/s, v_2' = v_1' + e (v_1 - v_2) = -0.25
+// m/s, neither turning: the balls' own closed form (a ball world gives the same).
+TEST(ShapedBalls, TwoBallsBesideABoxMeetAsTheLineOfImpactSays) {
+  Scene scene = boxAndBall(V(0.1, 0.1, 0.1), 2.0, 1.0, 0.05, 0.5, false);
+  scene.bodies.push_back(scene_builders::ball("other", 3.0, 0.1, "block"));
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  const std::size_t first = *monitor.bodyIndex("ball");
+  monitor.step(0.0, {stateOf(monitor, "block", V(0, 0, 5), V::Zero()),
+                     stateOf(monitor, "ball", V(-0.3, 0, 1), V(1, 0, 0)),
+                     stateOf(monitor, "other", V(0.3, 0, 1), V(-1, 0, 0))});
+  const std::vector<ImpactRecord> impacts = impactsUpTo(monitor, 0.5);
+  ASSERT_EQ(impacts.size(), 1u);
+  EXPECT_NEAR(impacts[0].time, 0.225, 1e-11);
+  const bool first_is_a = impacts[0].body_a == first;
+  const V one = first_is_a ? impacts[0].velocity_a_after : impacts[0].velocity_b_after;
+  const V two = first_is_a ? impacts[0].velocity_b_after : impacts[0].velocity_a_after;
+  EXPECT_NEAR((one - V(-1.25, 0, 0)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((two - V(-0.25, 0, 0)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR(
+      impacts[0].angular_velocity_a_after.norm() + impacts[0].angular_velocity_b_after.norm(), 0.0,
+      1e-12);
+}
+
 // The ball strikes the box's face x = a off its centre, at y = d (no gravity, e = 1/2): along the
 // normal x the pair's effective mass is 1 / (1/m + 1/M + d^2 / I_zz) (the box's lever (a, d, 0)
 // crossed with x; the ball's lever is along the normal), I_zz = M (a^2 + b^2) / 3 for half edges

@@ -760,6 +760,9 @@ Expected<LastingMotion> ballOnFace(const LastingBody& body, const FlatFace& face
        std::abs((point - face.point).dot(face.along_v)) > face.half_extent.y() + kLastingBand)) {
     return notYet("the body overhangs the face's edge (its point of contact is off it)");
   }
+  if (body.moments.maxCoeff() - body.moments.minCoeff() > 1e-12 * body.moments.maxCoeff()) {
+    return notYet("a sphere whose moments of inertia differ (a given tensor) in lasting contact");
+  }
   const double m = body.mass, r = radius, I = body.moments.x(), mu = face.friction;
   const double g_n = setting.g_n, still = kLastingStillSpeed;
   const Vec& g_t = setting.g_t;
