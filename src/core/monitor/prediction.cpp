@@ -97,39 +97,22 @@ Status checkRequest(const Scene& scene, const PredictionRequest& request) {
 /// cannot be made (the scene's checks refuse such a body first).
 std::optional<ObstacleSpec> heldAsObstacle(const BodySpec& body, const Eigen::Vector3d& position,
                                            const Eigen::Quaterniond& orientation) {
+  Shape shape = shapeOf(body);
+  if (body.shape == BodyShape::kMesh) {
+    if (!body.mesh) return std::nullopt;
+    const auto hull = convexHull(body.mesh->vertices(), "mesh");
+    if (!hull) return std::nullopt;
+    auto triangles = TriangleMesh::build(hull->vertices, hull->triangles, "mesh");
+    if (!triangles) return std::nullopt;
+    shape = Mesh{std::move(triangles.value())};
+  }
   ObstacleSpec held;
   held.id = body.id;
   held.material = body.material;
-  held.position = position;
+  held.resource = body.resource;
+  setShape(held, shape);
+  held.position = position;  // after setShape: a sphere's centre is the body's, not its origin
   held.orientation = orientation;
-  held.radius = body.radius;
-  held.size = body.size;
-  held.length = body.length;
-  switch (body.shape) {
-    case BodyShape::kSphere:
-      held.shape = ObstacleShape::kSphere;
-      break;
-    case BodyShape::kBox:
-      held.shape = ObstacleShape::kBox;
-      break;
-    case BodyShape::kCylinder:
-      held.shape = ObstacleShape::kCylinder;
-      break;
-    case BodyShape::kCapsule:
-      held.shape = ObstacleShape::kCapsule;
-      break;
-    case BodyShape::kMesh: {
-      if (!body.mesh) return std::nullopt;
-      const auto hull = convexHull(body.mesh->vertices(), "mesh");
-      if (!hull) return std::nullopt;
-      auto triangles = TriangleMesh::build(hull->vertices, hull->triangles, "mesh");
-      if (!triangles) return std::nullopt;
-      held.shape = ObstacleShape::kMesh;
-      held.mesh = std::move(triangles.value());
-      held.resource = body.resource;
-      break;
-    }
-  }
   return held;
 }
 
