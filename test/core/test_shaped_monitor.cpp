@@ -578,6 +578,46 @@ TEST(ShapedMonitor, ABoxAtRestStruckByAMovingLinkLeavesAtOnePlusETimesItsSpeed) 
   }
 }
 
+// A box set flush on a table's top (a box obstacle): the distance of the two flush faces rounds
+// below 0, and its state was refused as inside the table. Touching within the manifold's band
+// (1e-9 m) is touching: it rests there, m g / 4 on each corner (1e-9 N), where it was set. Set
+// 1e-6 m into the table, it is inside, named and held.
+TEST(ShapedMonitor, ABoxSetFlushOnATablesTopRestsThereAndOneSetInsideIsNamed) {
+  const V half(0.05, 0.04, 0.03);
+  const double m = 2.0;
+  Scene scene = floorScene(0.5, half, m);
+  scene.obstacles.push_back(
+      scene_builders::box("table", V(0.1, 0.2, 0.35), V(1.0, 1.0, 0.1), "concrete"));
+  for (const double sunk : {0.0, 1e-6}) {
+    ImpactMonitor monitor(scene, MonitorSettings{});
+    const std::size_t block = *monitor.bodyIndex("block");
+    BodyStateSample state;
+    state.body = block;
+    state.position = V(0.3, 0.1, 0.4 + half.z() - sunk);
+    StepReport report = monitor.step(0.0, {state});
+    for (int k = 1; k <= 10; ++k) {
+      const StepReport later = monitor.step(0.01 * k, {});
+      report.unmodelled.insert(report.unmodelled.end(), later.unmodelled.begin(),
+                               later.unmodelled.end());
+      report.contacts = later.contacts;
+    }
+    if (sunk > 0) {
+      ASSERT_EQ(report.unmodelled.size(), 1u);
+      EXPECT_NE(report.unmodelled.front().what.find("inside the obstacle"), std::string::npos);
+      continue;
+    }
+    for (const UnmodelledContact& c : report.unmodelled) ADD_FAILURE() << c.what;
+    const auto at = monitor.predictedState(block, 0.1);
+    ASSERT_TRUE(at);
+    EXPECT_NEAR((at->first - state.position).norm(), 0.0, 1e-9);
+    ASSERT_EQ(report.contacts.size(), 4u);
+    for (const ContactRecord& contact : report.contacts) {
+      EXPECT_EQ(contact.other, 1u);
+      EXPECT_NEAR(contact.normal_force, m * kG / 4, 1e-9);
+    }
+  }
+}
+
 // A mesh body is the convex hull of its vertices: a 0.1 m cube's 12 triangles with one face pushed
 // in to a pyramid's dent (a vertex 0.03 m inside its top face's centre: the mesh is not convex)
 // moves as the cube, its hull. Of e = 1/2, dropped flat from rest, frictionless, it strikes the

@@ -634,7 +634,16 @@ FirstContactResult advance(const Moving& moving, const Side& side, double from, 
   const double acceleration = moving.accelerationBound(side, *body);
   SurfaceGap g = side.gap(*body, t, Approach::kWithout);
   if (g.overlapping || g.gap_upper < 0) {
-    result.inside_at_start = true;
+    // Touching within the manifold's band (a box set flush on a table's top, where the distance
+    // of the flush faces rounds below 0): the contact there, its normal and points those of the
+    // body shrunk by the band, which is apart. Deeper, it is inside.
+    const TumblingBody shrunk = body->shrunkBy(options.manifold_band);
+    const SurfaceGap within = side.gap(shrunk, t, Approach::kWithout);
+    if (within.overlapping || within.gap_upper < 0) {
+      result.inside_at_start = true;
+      return result;
+    }
+    contactAt(shrunk, t);
     return result;
   }
   for (; result.steps < options.max_steps; ++result.steps) {
@@ -708,6 +717,29 @@ Expected<TumblingBody> TumblingBody::create(const ConvexShape& shape,
   }
   body.angular_velocity_ = angular_velocity;
   return body;
+}
+
+TumblingBody TumblingBody::shrunkBy(double distance) const {
+  TumblingBody shrunk = *this;
+  // Each size less `distance`, but never below half of itself (a body smaller than the band).
+  const auto less = [distance](double size) { return std::max(size - distance, 0.5 * size); };
+  std::visit(
+      [&](auto& shape) {
+        using Kind = std::decay_t<decltype(shape)>;
+        if constexpr (std::is_same_v<Kind, Sphere>) {
+          shape.radius = less(shape.radius);
+        } else if constexpr (std::is_same_v<Kind, Cuboid>) {
+          shape.half_size = shape.half_size.unaryExpr(less);
+        } else if constexpr (std::is_same_v<Kind, Cylinder> || std::is_same_v<Kind, Capsule>) {
+          shape.radius = less(shape.radius);
+          shape.half_length = less(shape.half_length);
+        } else {
+          const double scale = less(reach_) / reach_;
+          for (Eigen::Vector3d& vertex : shape.vertices) vertex *= scale;
+        }
+      },
+      shrunk.shape_);
+  return shrunk;
 }
 
 SurfaceGap gapAt(const TumblingBody& body, const PlacedShape& obstacle, double time,

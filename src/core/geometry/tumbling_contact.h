@@ -111,6 +111,11 @@ class TumblingBody {
   double angularAccelerationBound() const { return angular_acceleration_bound_; }
   /// m: the body's farthest point from its centre.
   double reach() const { return reach_; }
+  /// The same motion of its shape shrunk by `distance` (>= 0) towards its centre: a sphere's,
+  /// box's, cylinder's and capsule's sizes less `distance`, a hull's vertices scaled about the
+  /// centre by 1 - distance / reach (never below half a size). No surface point moves in by more
+  /// than `distance`: what overlaps an obstacle shrunk is inside it by more than that.
+  TumblingBody shrunkBy(double distance) const;
 
  private:
   TumblingBody(const ConvexShape& shape, const FreeRotation& rotation)

@@ -136,7 +136,8 @@ class ShapedMotion {
   /// frame's orientation.
   BodyStateSample stateOn(const TumblingBody& flight, double time) const;
 
-  /// The first obstacle (model index) the body overlaps or touches from inside at its start.
+  /// The first obstacle (model index) the body is inside at its start, by more than the touching
+  /// band (kLastingBand: a box set flush on a table is not).
   std::optional<std::size_t> insideAtStart() const;
 
   /// The next event up to `horizon`: the impacts' records appended to `impacts`. `through`: the
