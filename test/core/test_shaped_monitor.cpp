@@ -618,6 +618,70 @@ TEST(ShapedMonitor, ABoxSetFlushOnATablesTopRestsThereAndOneSetInsideIsNamed) {
   }
 }
 
+// A box sliding off a table's edge (frictionless): before, the monitor held it where its support
+// reached the edge, "not yet". Now it slides on until its centre is over the edge, at
+// (0.5 - 0.25) / 0.5 = 0.5 s (its path the straight line to then, 1e-9 m), tips over the edge and
+// falls to the floor, its energy kept until it strikes it (frictionless: within the tipping's
+// integration, 1e-7 of m g h), never inside the table (its corners, 1e-9 m), nothing unmodelled.
+TEST(ShapedMonitor, ABoxSlidingOffATablesEdgeTipsOverItAndFallsToTheFloor) {
+  const V half(0.0625, 0.0625, 0.0625);
+  const double m = 2.0, v = 0.5;
+  Scene scene = floorScene(0.5, half, m);
+  scene.obstacles.push_back(
+      scene_builders::box("table", V(0, 0, 0.25), V(1.0, 1.0, 0.5), "concrete"));
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  const std::size_t block = *monitor.bodyIndex("block");
+  BodyStateSample state;
+  state.body = block;
+  state.position = V(0.25, 0, 0.5 + half.z());
+  state.velocity = V(v, 0, 0);
+  // Its energy (1/2) m v^2 + (1/2) I w^2 + m g z, I = m (2 a)^2 / 6 for a cube, at each step.
+  const double inertia = m * 4 * half.x() * half.x() / 6;
+  const auto energy = [&](const V& centre, const V& velocity, const V& w) {
+    return 0.5 * m * velocity.squaredNorm() + 0.5 * inertia * w.squaredNorm() + m * kG * centre.z();
+  };
+  const double start = energy(state.position, state.velocity, V::Zero());
+  std::vector<std::pair<double, double>> energies;
+  std::vector<StepReport> reports{monitor.step(0.0, {state})};
+  for (int k = 1; k <= 200; ++k) {
+    const double t = 0.005 * k;
+    reports.push_back(monitor.step(t, {}));
+    const auto at = monitor.predictedState(block, t);
+    ASSERT_TRUE(at);
+    energies.emplace_back(
+        t, energy(at->first, at->second, monitor.predictedAngularVelocity(block, t)));
+    if (t <= 0.5) {
+      EXPECT_NEAR((at->first - V(0.25 + v * t, 0, 0.5625)).norm(), 0.0, 1e-9) << t;
+    }
+    const Eigen::Matrix3d r = monitor.predictedOrientation(block, t).toRotationMatrix();
+    for (int i = 0; i < 8; ++i) {
+      const V corner =
+          at->first +
+          r * V((i & 1) ? 1 : -1, (i & 2) ? 1 : -1, (i & 4) ? 1 : -1).cwiseProduct(half);
+      EXPECT_GE(std::max(corner.x() - 0.5, corner.z() - 0.5), -1e-9)
+          << "corner " << i << " inside the table at " << t;
+      EXPECT_GE(corner.z(), -1e-9) << "corner " << i << " below the floor at " << t;
+    }
+  }
+  for (const StepReport& report : reports) {
+    for (const UnmodelledContact& c : report.unmodelled) ADD_FAILURE() << c.what;
+  }
+  const std::vector<ImpactRecord> impacts = impactsOf(reports);
+  ASSERT_FALSE(impacts.empty());
+  const ImpactRecord& first = impacts.front();
+  EXPECT_TRUE(first.other_is_obstacle);
+  EXPECT_EQ(first.other, 0u);  // the floor
+  EXPECT_GT(first.time, 0.5);
+  EXPECT_NEAR(first.contact_point.z(), 0.0, 1e-9);
+  std::size_t flying = 0;
+  for (const auto& [t, e] : energies) {
+    if (t >= first.time) break;
+    EXPECT_NEAR(e, start, 1e-7 * m * kG * 0.5625) << t;
+    if (t > 0.5) ++flying;
+  }
+  EXPECT_GT(flying, 10u);
+}
+
 // A mesh body is the convex hull of its vertices: a 0.1 m cube's 12 triangles with one face pushed
 // in to a pyramid's dent (a vertex 0.03 m inside its top face's centre: the mesh is not convex)
 // moves as the cube, its hull. Of e = 1/2, dropped flat from rest, frictionless, it strikes the

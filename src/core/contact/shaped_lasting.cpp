@@ -29,6 +29,7 @@
 #include <Eigen/Dense>
 
 #include "collision_response/core/validation.h"
+#include "contact/shaped_edge_tip.h"
 #include "contact/shaped_pivot.h"
 
 namespace collision_response::core {
@@ -60,6 +61,7 @@ Eigen::Quaterniond LastingMotion::orientationAt(double t) const {
 
 std::vector<SupportForce> LastingMotion::forcesAt(double t) const {
   if (pivot) return pivot->stateAt(t).forces;
+  if (forces_over) return forces_over(t);
   // The manifold's points stay under the body: they move with its centre (a body that does not
   // turn, or a round side turning about its axis), and the forces are constant.
   std::vector<SupportForce> moved = forces;
@@ -398,7 +400,10 @@ struct Track {
 };
 
 /// The first instant (after the start) a point of the manifold reaches a bounded face's edge.
-double edgeReached(const std::vector<Vec>& feet, const FlatFace& face, const Track& track) {
+/// (`skip`: the edge a support overhangs, its axis 0 or 1 and side -1 or 1, which its points
+/// crossing do not end the motion: the support is cut there anew, overhangMotion.)
+double edgeReached(const std::vector<Vec>& feet, const FlatFace& face, const Track& track,
+                   std::optional<std::pair<int, double>> skip = std::nullopt) {
   double first = std::numeric_limits<double>::infinity();
   if (!face.bounded || track.direction.isZero(0.0)) return first;
   const std::array<Vec, 2> axes{face.along_u, face.along_v};
@@ -406,13 +411,18 @@ double edgeReached(const std::vector<Vec>& feet, const FlatFace& face, const Tra
     const double along = track.direction.dot(axes[static_cast<std::size_t>(k)]);
     if (along == 0) continue;
     const double bound = face.half_extent[k];
+    const bool skip_ahead = skip && skip->first == k && (skip->second > 0) == (along > 0);
+    const bool skip_behind = skip && skip->first == k && !skip_ahead;
     for (const Vec& foot : feet) {
       const double u = (foot - face.point).dot(axes[static_cast<std::size_t>(k)]);
       // u + along x = +-bound: forward where the direction goes, backward the other way.
       const double forward = along > 0 ? (bound - u) / along : (-bound - u) / along;
       const double backward = along > 0 ? (u + bound) / along : (u - bound) / along;
-      first = std::min({first, firstReach(track.speed, track.acceleration, forward),
-                        firstReach(-track.speed, -track.acceleration, backward)});
+      if (!skip_ahead)
+        first = std::min(first, firstReach(track.speed, track.acceleration, forward));
+      if (!skip_behind) {
+        first = std::min(first, firstReach(-track.speed, -track.acceleration, backward));
+      }
     }
   }
   return first;
@@ -690,7 +700,11 @@ Status checkOnFace(const LastingBody& body, const FlatFace& face, const Support&
                                         " m/s: an elastic rise of 1e-6 of the body's reach)"};
     }
   }
-  if (!face.bounded) return Ok{};
+  // A face or a cap over a bounded face's edge: overhangMotion's.
+  if (!face.bounded || support.kind == SupportKind::kPolygon ||
+      support.kind == SupportKind::kDisc) {
+    return Ok{};
+  }
   for (const Vec& point : outlineOf(support, face.along_u, face.along_v)) {
     const Vec offset = point - face.point;
     if (std::abs(offset.dot(face.along_u)) > face.half_extent.x() + kLastingBand ||
@@ -828,6 +842,201 @@ Expected<LastingMotion> ballOnFace(const LastingBody& body, const FlatFace& face
   return motion;
 }
 
+/// A support past a bounded face's edge: the edge and which of the face's bounds it is.
+struct Overhang {
+  FaceEdge edge;
+  std::pair<int, double> bound;  ///< the face's axis (0: along_u, 1: along_v) and side (-1, 1)
+};
+
+/// The face's edge the support's outline is past or at (within the touching band); none on an
+/// unbounded face or where nothing is; not modelled where it is past two (the face's corner).
+Expected<std::optional<Overhang>> overhangOf(const std::vector<Vec>& outline,
+                                             const FlatFace& face) {
+  std::optional<Overhang> found;
+  if (!face.bounded) return found;
+  const std::array<Vec, 2> axes{face.along_u, face.along_v};
+  for (int k = 0; k < 2; ++k) {
+    const Vec& axis = axes[static_cast<std::size_t>(k)];
+    for (const double side : {-1.0, 1.0}) {
+      // At the edge within the band counts: a support that reached it goes on over it.
+      const bool past = std::any_of(outline.begin(), outline.end(), [&](const Vec& point) {
+        return side * (point - face.point).dot(axis) > face.half_extent[k] - kLastingBand;
+      });
+      if (!past) continue;
+      if (found) return notYet("the body overhangs two of the face's edges (its corner)");
+      Overhang overhang;
+      overhang.edge.out = side * axis;
+      overhang.edge.along = axes[static_cast<std::size_t>(1 - k)];
+      overhang.edge.point = face.point + side * face.half_extent[k] * axis;
+      overhang.bound = {k, side};
+      found = overhang;
+    }
+  }
+  return found;
+}
+
+/// The weights of p in the triangle (a, b, c) of the face (in its frame e1, e2).
+std::array<double, 3> barycentric(const Setting& setting, const Vec& a, const Vec& b, const Vec& c,
+                                  const Vec& p) {
+  const auto flat = [&](const Vec& x) {
+    return Eigen::Vector2d((x - a).dot(setting.e1), (x - a).dot(setting.e2));
+  };
+  Eigen::Matrix2d basis;
+  basis << flat(b), flat(c);
+  const Eigen::Vector2d l = basis.partialPivLu().solve(flat(p));
+  return {1 - l.x() - l.y(), l.x(), l.y()};
+}
+
+/// The normal forces of a support cut by the face's edge, with its centre of pressure
+/// `pressure` strictly inside the part on the face: a face's polygon cut by the edge's line
+/// (Sutherland and Hodgman's clipping), the least-norm forces >= 0 on up to four points
+/// (polygonForces) or, on five, the fan triangle from its first point that holds the centre of
+/// pressure; a cap's disc cut to a segment, its chord's two ends and the rim's point on the ray
+/// from the chord's middle through the centre of pressure, which hold it in their triangle. One
+/// documented choice among the statically indeterminate distributions, as the whole face's.
+Expected<std::vector<SupportForce>> overhangForces(const Support& support, const Setting& setting,
+                                                   const FaceEdge& edge, const Vec& pressure,
+                                                   double total, const Vec& friction_ratio) {
+  const auto past = [&](const Vec& x) { return edge.out.dot(x - edge.point); };
+  std::vector<Vec> points;
+  std::vector<double> f;
+  if (support.kind == SupportKind::kDisc) {
+    const Vec& c = support.centre;
+    const double r = support.radius, d = past(c);
+    const Vec middle = c - d * edge.out;
+    const double half = std::sqrt(std::max(0.0, r * r - d * d));
+    const Vec ray = pressure - middle;
+    if (!((pressure - c).norm() < r && past(pressure) < 0 && ray.norm() > 0)) {
+      return notYet("tipping: the centre of pressure leaves the cap's part on the face");
+    }
+    const Vec dir = ray.normalized();
+    const double b = dir.dot(middle - c);
+    const double reach = -b + std::sqrt(b * b - ((middle - c).squaredNorm() - r * r));
+    const double l = ray.norm() / reach;
+    points = {middle - half * edge.along, middle + half * edge.along, middle + reach * dir};
+    f = {total * (1 - l) / 2, total * (1 - l) / 2, total * l};
+  } else {
+    // The polygon in order about its centroid, then cut by the edge's line.
+    std::vector<Vec> ring = support.feet;
+    Vec centroid = Vec::Zero();
+    for (const Vec& foot : ring) centroid += foot;
+    centroid /= static_cast<double>(ring.size());
+    std::sort(ring.begin(), ring.end(), [&](const Vec& a, const Vec& b) {
+      return std::atan2((a - centroid).dot(setting.e2), (a - centroid).dot(setting.e1)) <
+             std::atan2((b - centroid).dot(setting.e2), (b - centroid).dot(setting.e1));
+    });
+    for (std::size_t i = 0; i < ring.size(); ++i) {
+      const Vec& p = ring[i];
+      const Vec& q = ring[(i + 1) % ring.size()];
+      const double dp = past(p), dq = past(q);
+      if (dp <= 0) points.push_back(p);
+      if ((dp < 0 && dq > 0) || (dp > 0 && dq < 0))
+        points.push_back(p + (q - p) * (dp / (dp - dq)));
+    }
+    Support cut = support;
+    cut.feet = points;
+    const auto [q, p] = inFace(cut, setting, pressure);
+    if (points.size() < 3 || !strictlyInside(q, p)) {
+      return notYet("tipping: the centre of pressure leaves the face's part on the face");
+    }
+    if (points.size() <= 4) f = polygonForces(q, p, total, true);
+    if (f.empty() || *std::min_element(f.begin(), f.end()) < -1e-12 * total) {
+      f.assign(points.size(), 0.0);
+      for (std::size_t i = 1; i + 1 < points.size(); ++i) {
+        const auto w = barycentric(setting, points[0], points[i], points[i + 1], pressure);
+        if (*std::min_element(w.begin(), w.end()) < -1e-12) continue;
+        f[0] = total * w[0], f[i] = total * w[1], f[i + 1] = total * w[2];
+        break;
+      }
+    }
+  }
+  std::vector<SupportForce> forces;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const double share = std::max(0.0, f[i]);
+    forces.push_back({points[i], share, share * friction_ratio});
+  }
+  return forces;
+}
+
+/// The body's face (a polygon's corners in order, a cap's disc) about the centre's foot, in the
+/// edge's coordinates: x along its out, y along it.
+FootPrint footPrintOf(const Support& support, const Setting& setting, const FaceEdge& edge) {
+  const auto flat = [&](const Vec& x) {
+    return Eigen::Vector2d((x - setting.foot).dot(edge.out), (x - setting.foot).dot(edge.along));
+  };
+  FootPrint print;
+  if (support.kind == SupportKind::kDisc) {
+    print.centre = flat(support.centre);
+    print.radius = support.radius;
+    return print;
+  }
+  for (const Vec& foot : support.feet) print.polygon.push_back(flat(foot));
+  std::sort(print.polygon.begin(), print.polygon.end(),
+            [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+              return std::atan2(a.y(), a.x()) < std::atan2(b.y(), b.x());
+            });
+  return print;
+}
+
+/// A face or a cap past a bounded face's edge (`overhang`), moving by `plan` (resting or
+/// sliding, without turning) with its centre of pressure `pressure`: where that is past the
+/// edge's line (within the touching band), the body tips over the edge (tipOverFaceEdge); else
+/// it rests or slides on by the closed form, its support the part on the face (overhangForces,
+/// cut anew at each instant: forces_over), until its centre of pressure reaches the edge's line
+/// ("stops": asked again there, it tips), a point reaches another of the face's edges, or the
+/// plan's own end.
+Expected<LastingMotion> overhangMotion(const LastingBody& body, const FlatFace& face,
+                                       const Support& support, const Setting& setting,
+                                       const Overhang& overhang, const Plan& plan,
+                                       const Vec& pressure, double total, const Vec& friction_ratio,
+                                       double tolerance) {
+  const FaceEdge& edge = overhang.edge;
+  if (support.kind != SupportKind::kPolygon && support.kind != SupportKind::kDisc) {
+    return notYet("the body overhangs the face's edge (a point of its support is off it)");
+  }
+  const double behind = -edge.out.dot(pressure - edge.point);
+  if (behind <= kLastingBand) {
+    return tipOverFaceEdge(body, face, edge, footPrintOf(support, setting, edge), tolerance);
+  }
+  auto forces = overhangForces(support, setting, edge, pressure, total, friction_ratio);
+  if (!forces) return forces.error();
+  LastingMotion motion;
+  motion.state = plan.state;
+  motion.start = body.time;
+  motion.centre0 = body.centre;
+  motion.velocity0 = plan.velocity;
+  motion.acceleration = plan.acceleration;
+  motion.orientation0 = body.orientation.normalized();
+  motion.forces = forces.value();
+  motion.forces_over = [support, setting, edge, pressure, total, friction_ratio, start = body.time,
+                        v = plan.velocity, a = plan.acceleration](double t) {
+    const double s = t - start;
+    const Vec shift = v * s + 0.5 * a * s * s;
+    Support moved = support;
+    for (Vec& foot : moved.feet) foot += shift;
+    moved.centre += shift;
+    auto at = overhangForces(moved, setting, edge, pressure + shift, total, friction_ratio);
+    return at ? at.value() : std::vector<SupportForce>{};
+  };
+  const Track& track = plan.track;
+  const double toward = track.direction.dot(edge.out);
+  const double tips = firstReach(toward * track.speed, toward * track.acceleration, behind);
+  const double edge_reached =
+      edgeReached(outlineOf(support, face.along_u, face.along_v), face, track, overhang.bound);
+  double lasts = plan.lasts;
+  motion.ends = plan.ends;
+  if (tips < lasts) {
+    lasts = tips;
+    motion.ends = "stops";  // asked again there: it tips over the edge
+  }
+  if (edge_reached < lasts) {
+    lasts = edge_reached;
+    motion.ends = "a point of its support reaches the face's edge";
+  }
+  if (std::isfinite(lasts)) motion.until = body.time + lasts;
+  return motion;
+}
+
 }  // namespace
 
 Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& face,
@@ -855,12 +1064,14 @@ Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& f
   const bool cornered = support.kind == SupportKind::kPolygon && !support.corners.empty();
   const auto spin = keptSpin(support, setting, body.angular_velocity);
   if (Status status = checkOnFace(body, face, support, setting); !status) return status.error();
-  if (!spin) {
-    if (cornered) return pivotOnFace(body, face, support.corners, tolerance);
-    return spin.error();
-  }
   // Outlines taken before supportForces chooses a cap's four points.
   const std::vector<Vec> outline = outlineOf(support, face.along_u, face.along_v);
+  const auto overhang = overhangOf(outline, face);
+  if (!overhang) return overhang.error();
+  if (!spin) {
+    if (cornered && !overhang.value()) return pivotOnFace(body, face, support.corners, tolerance);
+    return spin.error();
+  }
 
   // The motion: the velocity's part in the face (its normal part settled), a roll kept.
   const Vec in_face = body.velocity - body.velocity.dot(setting.n) * setting.n;
@@ -880,6 +1091,10 @@ Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& f
   const Vec friction_ratio = (plan.acceleration - setting.g_t) / setting.g_n;
   const Vec pressure =
       setting.foot + setting.height * (setting.g_t - plan.acceleration) / setting.g_n;
+  if (overhang.value()) {
+    return overhangMotion(body, face, support, setting, *overhang.value(), plan, pressure, total,
+                          friction_ratio, tolerance);
+  }
   auto forces = supportForces(support, setting, pressure, total, friction_ratio, rotation,
                               tippingOf(plan.state));
   if (!forces && cornered) return pivotOnFace(body, face, support.corners, tolerance);
@@ -900,7 +1115,11 @@ Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& f
   motion.ends = plan.ends;
   if (edge < lasts) {
     lasts = edge;
-    motion.ends = "a point of its support reaches the face's edge";
+    // A face or a cap goes on over the edge (asked again there: overhangMotion); a side
+    // rolling off it is not modelled yet.
+    motion.ends = support.kind == SupportKind::kLine
+                      ? "a point of its support reaches the face's edge"
+                      : "stops";
   }
   if (std::isfinite(lasts)) motion.until = body.time + lasts;
   return motion;

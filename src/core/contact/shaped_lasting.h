@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -36,8 +37,6 @@ constexpr double kLastingSettled = 1e-6;
 /// Of |g_t| + g_n: gravity's part across a slide (or along a rolling side's axis, or across a
 /// resting side's) below it counts as none.
 constexpr double kLastingAcrossGravity = 1e-12;
-
-class PivotPath;
 
 /// The body at the instant its contact begins to last, in its principal frame (as
 /// PrincipalBody: its shape about its centre of mass along its principal axes).
@@ -70,6 +69,32 @@ struct SupportForce {
   Eigen::Vector3d point = Eigen::Vector3d::Zero();           ///< on the face, world
   double normal_force = 0.0;                                 ///< N, >= 0, on the body along n
   Eigen::Vector3d friction_force = Eigen::Vector3d::Zero();  ///< N, on the body, in the face
+  /// Unit, towards the body, where the contact's normal is not the face's (the body's own face
+  /// on the face's edge: normal_force along it, friction_force at right angles to it); zero: n.
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+};
+
+/// What an integrated lasting motion (LastingPath) gives at an instant.
+struct PathState {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< world from principal
+  ContactState state = ContactState::kRolling;  ///< every point sticking, or one sliding
+  std::vector<SupportForce> forces;             ///< at the points touching
+};
+
+/// A lasting motion with no closed form, integrated to a stated tolerance with dense output:
+/// a body tipping over its corners (pivotOnFace) or over the face's edge (tipOverFaceEdge).
+class LastingPath {
+ public:
+  virtual ~LastingPath() = default;
+  /// The state at `t` (clamped to [start, until]); the points touching exactly on the face.
+  virtual PathState stateAt(double t) const = 0;
+  virtual double start() const = 0;
+  virtual double until() const = 0;
+  /// The accepted steps of the integration (its cost).
+  virtual std::size_t steps() const = 0;
 };
 
 /// A lasting motion on one face, in closed form over [start, until].
@@ -89,9 +114,13 @@ struct LastingMotion {
   Eigen::Quaterniond orientation0 = Eigen::Quaterniond::Identity();  ///< world from principal
   /// The contact's points (the manifold) and their forces, at `start`; forcesAt gives them at t.
   std::vector<SupportForce> forces;
-  /// A body tipping over a corner or an edge (pivotOnFace): its integrated path, which the
-  /// state and the forces at t come from instead of the closed form.
-  std::shared_ptr<const PivotPath> pivot;
+  /// A body tipping over a corner or an edge of its own (pivotOnFace) or over the face's edge
+  /// (tipOverFaceEdge): its integrated path, which the state and the forces at t come from
+  /// instead of the closed form.
+  std::shared_ptr<const LastingPath> pivot;
+  /// A closed-form motion whose manifold changes as it goes (a support cut by the face's edge):
+  /// its points and forces at t; empty where they move with the centre.
+  std::function<std::vector<SupportForce>(double)> forces_over;
 
   Eigen::Vector3d centreAt(double t) const;
   Eigen::Vector3d velocityAt(double t) const;

@@ -537,7 +537,7 @@ double PivotPath::start() const { return steps_->start; }
 double PivotPath::until() const { return steps_->until; }
 std::size_t PivotPath::steps() const { return steps_->steps.size(); }
 
-PivotState PivotPath::stateAt(double t) const {
+PathState PivotPath::stateAt(double t) const {
   const Steps& path = *steps_;
   const double time = std::clamp(t, path.start, path.until);
   Kinematics k = path.initial;
@@ -565,7 +565,7 @@ PivotState PivotPath::stateAt(double t) const {
   double lowest = std::numeric_limits<double>::infinity();
   for (const Vec& corner : s.corners) lowest = std::min(lowest, heightOf(s, k, corner));
   if (!points->empty() || lowest < kPivotHair) k.centre += (kPivotHair - lowest) * s.n;
-  PivotState state;
+  PathState state;
   state.centre = k.centre;
   state.velocity = k.velocity;
   state.angular_velocity = k.spin;
@@ -743,7 +743,7 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
   }
   path->until = until;
   auto pivot = std::make_shared<const PivotPath>(std::move(path));
-  const PivotState first_state = pivot->stateAt(body.time);
+  const PathState first_state = pivot->stateAt(body.time);
   motion.state = first_state.state;
   motion.until = until;
   motion.ends = ends;

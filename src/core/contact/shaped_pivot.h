@@ -30,31 +30,20 @@ constexpr double kPivotSlipStops = 1e-6;
 /// advancement, bounded by the body's turning, would crawl from a gap that opens from 0.
 constexpr double kPivotClearance = 1e-5;
 
-/// What the path gives at an instant of [start, until].
-struct PivotState {
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
-  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();
-  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< world from principal
-  ContactState state = ContactState::kRolling;  ///< every point sticking, or one sliding
-  std::vector<SupportForce> forces;             ///< at the points touching
-};
-
 /// The integrated path of a tipping body (pivotOnFace): dense output over [start, until].
-class PivotPath {
+class PivotPath : public LastingPath {
  public:
   struct Steps;
   explicit PivotPath(std::unique_ptr<Steps> steps);
-  ~PivotPath();
+  ~PivotPath() override;
   PivotPath(const PivotPath&) = delete;
   PivotPath& operator=(const PivotPath&) = delete;
 
   /// The state at `t` (clamped to [start, until]); the points touching exactly on the face.
-  PivotState stateAt(double t) const;
-  double start() const;
-  double until() const;
-  /// The accepted steps of the integration (its cost).
-  std::size_t steps() const;
+  PathState stateAt(double t) const override;
+  double start() const override;
+  double until() const override;
+  std::size_t steps() const override;
 
  private:
   std::unique_ptr<Steps> steps_;

@@ -243,7 +243,8 @@ class ShapedRun {
           record.other = with.front();
           record.other_is_obstacle = true;
           record.contact_point = force.point;
-          record.normal = -face->second.normal;
+          record.normal = force.normal.isZero(0.0) ? Eigen::Vector3d(-face->second.normal)
+                                                   : Eigen::Vector3d(-force.normal);
           record.normal_force = force.normal_force;
           record.friction_force = -force.friction_force;
           record.state = along.stateAt(until);

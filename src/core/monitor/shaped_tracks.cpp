@@ -355,7 +355,9 @@ std::vector<ContactRecord> ShapedTrack::contacts(double time) const {
     record.other = against_.value_or(0);
     record.other_is_obstacle = true;
     record.contact_point = force.point;
-    record.normal = -face_.normal;  // from the body into the face
+    // From the body into the face (or into the face's edge, along the body's own face).
+    record.normal =
+        force.normal.isZero(0.0) ? Eigen::Vector3d(-face_.normal) : Eigen::Vector3d(-force.normal);
     record.normal_force = force.normal_force;
     record.friction_force = -force.friction_force;  // on the face
     record.state = lasting_->stateAt(time);

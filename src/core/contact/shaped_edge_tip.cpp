@@ -1,0 +1,458 @@
+// A shaped body tipping over a bounded face's edge (shaped_edge_tip.h).
+//
+// In the plane at right angles to the edge (n the face's normal, o = the edge's `out`, a = n x o
+// the axis of the turn): the body's face, turned by phi about a, has the normal
+// u = cos phi n + sin phi o and the direction w = cos phi o - sin phi n; the edge's point E lies
+// on it, s behind the centre's foot, so the centre is c = E + h u + s w (h: the centre's height
+// above its own face). The contact force N u + F w acts at E; with I the moment about a through
+// the centre and G_u = g.u, G_w = g.w:
+//   m (s'' + h phi'' - s phi'^2) = m G_w + F,   -m (2 s' phi' + h phi'^2 + s phi'') = m G_u + N,
+//   I phi'' = s N - h F,
+// and the body's point at E slips at s' along w. Sliding, F = -sigma mu N (sigma the sign of
+// s'): phi'' = -m (s + sigma mu h) (G_u + 2 s' phi' + h phi'^2) / (I + m s (s + sigma mu h));
+// sticking (s' = 0): the pendulum about E, (I + m (s^2 + h^2)) phi'' = m (h G_w - s G_u). The
+// state (s, phi, s', phi') is integrated by the Dormand-Prince 5(4) pair with dense output
+// (Boost.Odeint); the events (N = 0, a stop or onset of slip, the edge leaving the footprint's
+// chord) are found on the dense output by bisection.
+#include "contact/shaped_edge_tip.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <boost/numeric/odeint.hpp>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "collision_response/core/validation.h"
+#include "contact/shaped_pivot.h"
+#include "geometry/convex_distance.h"
+
+namespace collision_response::core {
+
+namespace {
+
+using Vec = Eigen::Vector3d;
+using Vec2 = Eigen::Vector2d;
+using State = std::array<double, 4>;  // s, phi, s', phi'
+using Stepper = boost::numeric::odeint::runge_kutta_dopri5<State>;
+using Dense = boost::numeric::odeint::result_of::make_dense_output<Stepper>::type;
+
+constexpr double kPi = 3.14159265358979323846;
+/// Steps one motion may take before it is asked again from where it is ("stops").
+constexpr std::size_t kMaxSteps = 1u << 14;
+/// Bisection of an event on the dense output: to this part of the instant (or of 1 s).
+constexpr double kEventResolution = 1e-13;
+/// m: how far the body's face is kept from the edge's line (as the corners' tipping keeps its
+/// lowest corner above the face: within the touching band, beyond the distance's tolerance).
+constexpr double kEdgeHair = 1e-11;
+
+Error notYet(const std::string& what) { return Error{"contact", "not yet: " + what}; }
+
+/// How the edge moves on the body's face.
+enum class Mode { kSliding, kSticking };
+
+/// The body, the edge and the footprint, fixed over the motion.
+struct Setting {
+  double mass = 0.0;
+  double moment = 0.0;  ///< about the axis a through the centre
+  double height = 0.0;  ///< h: the centre above its own face
+  double mu = 0.0;
+  Vec gravity = Vec::Zero();
+  Vec n, out, axis;  ///< the face's normal, the edge's out, a = n x out
+  Vec edge_point;    ///< E: the edge's point in the centre's plane
+  Eigen::Quaterniond orientation0;
+  FootPrint print;
+};
+
+/// N, F and the accelerations in a mode (sliding: sigma the slip's sign).
+struct Forces {
+  double normal = 0.0, friction = 0.0, s_rate = 0.0, phi_rate = 0.0;
+  bool paradox = false;  ///< Painleve's: sliding has no solution with N >= 0
+};
+
+Forces forcesOf(const Setting& k, const State& y, Mode mode, double sigma) {
+  const double s = y[0], phi = y[1], sd = y[2], pd = y[3];
+  const Vec u = std::cos(phi) * k.n + std::sin(phi) * k.out;
+  const Vec w = std::cos(phi) * k.out - std::sin(phi) * k.n;
+  const double g_u = k.gravity.dot(u), g_w = k.gravity.dot(w);
+  const double m = k.mass, h = k.height, I = k.moment;
+  Forces f;
+  if (mode == Mode::kSticking) {
+    f.phi_rate = m * (h * g_w - s * g_u) / (I + m * (s * s + h * h));
+    f.normal = -m * (g_u + h * pd * pd + s * f.phi_rate);
+    f.friction = m * (h * f.phi_rate - s * pd * pd - g_w);
+    f.s_rate = 0.0;
+    return f;
+  }
+  const double lever = s + sigma * k.mu * h;
+  const double d = I + m * s * lever;
+  if (!(d > 0)) {
+    f.paradox = true;
+    return f;
+  }
+  f.phi_rate = -m * lever * (g_u + 2 * sd * pd + h * pd * pd) / d;
+  f.normal = -m * (g_u + 2 * sd * pd + h * pd * pd + s * f.phi_rate);
+  f.friction = -sigma * k.mu * f.normal;
+  f.s_rate = g_w + f.friction / m - h * f.phi_rate + s * pd * pd;
+  return f;
+}
+
+/// The footprint's chord at x (its extent along y), or none where x is off it.
+std::optional<std::pair<double, double>> chordAt(const FootPrint& print, double x) {
+  if (print.radius > 0) {
+    const double dx = x - print.centre.x();
+    const double half2 = print.radius * print.radius - dx * dx;
+    if (!(half2 > 0)) return std::nullopt;
+    const double half = std::sqrt(half2);
+    return std::make_pair(print.centre.y() - half, print.centre.y() + half);
+  }
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  const std::size_t count = print.polygon.size();
+  for (std::size_t i = 0; i < count; ++i) {
+    const Vec2& p = print.polygon[i];
+    const Vec2& q = print.polygon[(i + 1) % count];
+    if ((p.x() - x) * (q.x() - x) > 0 || p.x() == q.x()) continue;
+    const double y = p.y() + (q.y() - p.y()) * (x - p.x()) / (q.x() - p.x());
+    lo = std::min(lo, y);
+    hi = std::max(hi, y);
+  }
+  if (!(lo < hi)) return std::nullopt;
+  return std::make_pair(lo, hi);
+}
+
+/// The body at (s, phi, s', phi'): centre, velocity, turning, orientation; the face kEdgeHair
+/// clear of the edge.
+PathState placed(const Setting& k, const State& y) {
+  const double s = y[0], phi = y[1], sd = y[2], pd = y[3];
+  const Vec u = std::cos(phi) * k.n + std::sin(phi) * k.out;
+  const Vec w = std::cos(phi) * k.out - std::sin(phi) * k.n;
+  PathState state;
+  state.centre = k.edge_point + (k.height + kEdgeHair) * u + s * w;
+  state.velocity = (sd + k.height * pd) * w - s * pd * u;
+  state.angular_velocity = pd * k.axis;
+  state.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(phi, k.axis)) * k.orientation0;
+  return state;
+}
+
+/// One integrated stretch of the motion in one mode.
+struct Stretch {
+  Dense dense;
+  double to = 0.0;
+  Mode mode = Mode::kSliding;
+  double sigma = 1.0;
+};
+
+/// The free flight after the body leaves the edge: from `from` (its state there) to `until`.
+struct Flight {
+  double from = 0.0;
+  PathState there;
+};
+
+class EdgeTipPath : public LastingPath {
+ public:
+  Setting setting;
+  double start_time = 0.0, until_time = 0.0;
+  State initial{};
+  Mode initial_mode = Mode::kSliding;
+  double initial_sigma = 1.0;
+  std::vector<Stretch> stretches;
+  std::optional<Flight> flight;
+
+  PathState stateAt(double t) const override {
+    const double time = std::clamp(t, start_time, until_time);
+    if (flight && time >= flight->from) {
+      const double tau = time - flight->from;
+      PathState state = flight->there;
+      state.centre += flight->there.velocity * tau + 0.5 * setting.gravity * tau * tau;
+      state.velocity += setting.gravity * tau;
+      const double turn = flight->there.angular_velocity.norm() * tau;
+      if (turn > 0) {
+        state.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(
+                                turn, flight->there.angular_velocity.normalized())) *
+                            flight->there.orientation;
+      }
+      state.state = ContactState::kSliding;
+      state.forces.clear();
+      return state;
+    }
+    State y = initial;
+    Mode mode = initial_mode;
+    double sigma = initial_sigma;
+    const auto covering =
+        std::lower_bound(stretches.begin(), stretches.end(), time,
+                         [](const Stretch& stretch, double at) { return stretch.to < at; });
+    if (!stretches.empty() && time > start_time) {
+      const Stretch& stretch = covering == stretches.end() ? stretches.back() : *covering;
+      stretch.dense.calc_state(std::clamp(time, stretch.dense.previous_time(), stretch.to), y);
+      mode = stretch.mode;
+      sigma = stretch.sigma;
+    }
+    return withForces(y, mode, sigma);
+  }
+
+  /// The state at y with the edge's force shared by the chord's two ends.
+  PathState withForces(const State& y, Mode mode, double sigma) const {
+    PathState state = placed(setting, y);
+    const Forces f = forcesOf(setting, y, mode, sigma);
+    state.state = mode == Mode::kSticking ? ContactState::kRolling : ContactState::kSliding;
+    const auto chord = chordAt(setting.print, -y[0]);
+    if (!chord || f.paradox) return state;
+    const auto [lo, hi] = *chord;
+    const Vec along = setting.axis;  // the edge's line, at right angles to the plane
+    const Vec u = std::cos(y[1]) * setting.n + std::sin(y[1]) * setting.out;
+    const Vec w = std::cos(y[1]) * setting.out - std::sin(y[1]) * setting.n;
+    const double normal = std::max(0.0, f.normal);
+    // Shares with no moment about the centre's plane: f_lo lo + f_hi hi = 0.
+    const std::array<std::pair<double, double>, 2> ends{std::make_pair(lo, hi / (hi - lo)),
+                                                        std::make_pair(hi, -lo / (hi - lo))};
+    for (const auto& [y_at, share] : ends) {
+      SupportForce force;
+      force.point = setting.edge_point + y_at * along;
+      force.normal_force = share * normal;
+      force.friction_force = share * f.friction * w;
+      force.normal = u;
+      state.forces.push_back(force);
+    }
+    return state;
+  }
+
+  double start() const override { return start_time; }
+  double until() const override { return until_time; }
+  std::size_t steps() const override { return stretches.size(); }
+};
+
+/// Why a stretch ended.
+enum class What { kLeaves, kSlipStops, kSlips, kPassesFace, kOutOfPlane, kFlat, kUpright };
+
+/// The events of a mode as functions > 0 while it lasts.
+double eventValue(const Setting& k, const State& y, Mode mode, double sigma, What what) {
+  const Forces f = forcesOf(k, y, mode, sigma);
+  switch (what) {
+    case What::kLeaves:
+      return f.paradox ? 1.0 : f.normal;
+    case What::kSlipStops:
+      return mode == Mode::kSliding && k.mu > 0 ? sigma * y[2] : 1.0;
+    case What::kSlips:
+      return mode == Mode::kSticking ? k.mu * f.normal - std::abs(f.friction) : 1.0;
+    case What::kPassesFace: {
+      const auto chord = chordAt(k.print, -y[0]);
+      return chord ? 1.0 : -1.0;
+    }
+    case What::kOutOfPlane: {
+      // The centre's plane's place in the chord, 0 to 1 (a disc's chord shrinking about it to
+      // the rim does not take it out).
+      const auto chord = chordAt(k.print, -y[0]);
+      if (!chord) return 1.0;
+      const double at = -chord->first / (chord->second - chord->first);
+      return std::min(at, 1 - at);
+    }
+    case What::kFlat:
+      return y[1] > 0 || y[3] >= 0 ? 1.0 : -1.0;
+    case What::kUpright:
+      return 0.5 * kPi - y[1];
+  }
+  return 1.0;
+}
+
+constexpr std::array<What, 7> kEvents{What::kLeaves,     What::kSlipStops,  What::kSlips,
+                                      What::kPassesFace, What::kOutOfPlane, What::kFlat,
+                                      What::kUpright};
+
+/// The clearance flight's end: the first of doubling spans from the instant it leaves at which
+/// the body is `clearance` from the edge's line (its part within the body's reach of E), with no
+/// return to it on the way (checked at 64 instants of the span); empty where it comes back.
+std::optional<double> clearAfter(const Setting& k, const ConvexShape& shape, const PathState& there,
+                                 double clearance) {
+  const double reach = reachOf(shape);
+  const TriangleSupport line(k.edge_point - reach * k.axis, k.edge_point + reach * k.axis,
+                             k.edge_point + reach * k.axis);
+  const auto gap = [&](double tau) {
+    const double turn = there.angular_velocity.norm() * tau;
+    Eigen::Quaterniond q = there.orientation;
+    if (turn > 0) q = Eigen::AngleAxisd(turn, there.angular_velocity.normalized()) * q;
+    const Vec c = there.centre + there.velocity * tau + 0.5 * k.gravity * tau * tau;
+    return convexDistance(PlacedConvex(shape, q.toRotationMatrix(), c), line, 1e-13).lower;
+  };
+  for (double tau = 1e-6; tau < 10.0; tau *= 2) {
+    if (gap(tau) < clearance) continue;
+    for (int i = 1; i < 64; ++i) {
+      if (!(gap(tau * i / 64.0) > 0)) return std::nullopt;
+    }
+    return tau;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+Expected<LastingMotion> tipOverFaceEdge(const LastingBody& body, const FlatFace& face,
+                                        const FaceEdge& edge, const FootPrint& print,
+                                        double tolerance, double horizon) {
+  if (!(tolerance > 0 && std::isfinite(tolerance))) {
+    return Error{"tolerance", "must be finite and > 0, got " + formatNumber(tolerance)};
+  }
+  auto path = std::make_shared<EdgeTipPath>();
+  Setting& k = path->setting;
+  k.mass = body.mass;
+  k.mu = face.friction;
+  k.gravity = body.gravity;
+  k.n = face.normal.normalized();
+  k.out = edge.out.normalized();
+  k.axis = k.n.cross(k.out);
+  k.print = print;
+  k.orientation0 = body.orientation.normalized();
+  const Eigen::Matrix3d rotation = k.orientation0.toRotationMatrix();
+  const Eigen::Matrix3d inertia = rotation * body.moments.asDiagonal() * rotation.transpose();
+  k.moment = k.axis.dot(inertia * k.axis);
+  const double scale = body.gravity.norm();
+  if ((inertia * k.axis - k.moment * k.axis).norm() > 1e-12 * body.moments.maxCoeff()) {
+    return notYet(
+        "tipping over the face's edge about an axis that is not a principal one of the body");
+  }
+  if (std::abs(body.gravity.dot(k.axis)) > kLastingAcrossGravity * scale) {
+    return notYet("tipping over the face's edge with gravity along it");
+  }
+  if (std::abs(body.velocity.dot(k.axis)) > kLastingStillSpeed) {
+    return notYet("sliding off the face's edge along it too (not at right angles to it)");
+  }
+  const double spin = body.angular_velocity.dot(k.axis);
+  if ((body.angular_velocity - spin * k.axis).norm() * reachOf(body.shape) > kLastingStillSpeed) {
+    return notYet("tipping over the face's edge while turning about another axis");
+  }
+  k.height = k.n.dot(body.centre - face.point);
+  const Vec foot = body.centre - k.height * k.n;
+  k.edge_point = edge.point + edge.along.dot(foot - edge.point) * edge.along;
+  const double s0 = k.out.dot(foot - k.edge_point);
+  // The body's face on the face: its velocity's normal part (settled) and the turn's, dropped.
+  State y{s0, 0.0, body.velocity.dot(k.out), spin};
+  Mode mode = Mode::kSliding;
+  double sigma = y[2] >= 0 ? 1.0 : -1.0;
+  if (k.mu > 0 && std::abs(y[2]) <= kLastingStillSpeed) {
+    y[2] = 0;
+    const Forces stick = forcesOf(k, y, Mode::kSticking, 1.0);
+    if (std::abs(stick.friction) <= k.mu * stick.normal) {
+      mode = Mode::kSticking;
+    } else {
+      sigma = stick.friction > 0 ? -1.0 : 1.0;
+    }
+  }
+  if (eventValue(k, y, mode, sigma, What::kOutOfPlane) <= 0) {
+    return notYet(
+        "tipping over the face's edge with the centre of mass past an end of the edge's contact");
+  }
+  path->start_time = body.time;
+  path->initial = y;
+  path->initial_mode = mode;
+  path->initial_sigma = sigma;
+
+  std::string ends = "stops";
+  double t = body.time, until = body.time + horizon;
+  std::size_t taken = 0;
+  std::optional<What> ended;
+  while (!ended) {
+    const auto system = [&k, mode, sigma](const State& x, State& rate, double) {
+      const Forces f = forcesOf(k, x, mode, sigma);
+      rate = {x[2], x[3], f.s_rate, f.phi_rate};
+    };
+    if (forcesOf(k, y, mode, sigma).paradox) {
+      return notYet("Painleve's paradox: sliding over the face's edge has no force that holds it");
+    }
+    Dense dense = boost::numeric::odeint::make_dense_output(tolerance, tolerance, Stepper());
+    dense.initialize(y, t, 1e-4);
+    std::optional<std::pair<double, What>> event;
+    for (;;) {
+      if (++taken > kMaxSteps) break;
+      try {
+        dense.do_step(system);
+      } catch (const std::exception&) {
+        return Error{"contact", "the tipping over the face's edge could not be integrated past +" +
+                                    formatNumber(t - body.time) + " s"};
+      }
+      const double t0 = dense.previous_time(), t1 = std::min(dense.current_time(), until);
+      const auto at = [&](double time) {
+        State x;
+        dense.calc_state(time, x);
+        return x;
+      };
+      for (const What what : kEvents) {
+        const auto value = [&](double time) { return eventValue(k, at(time), mode, sigma, what); };
+        if (value(t1) > 0) continue;
+        double lo = t0, hi = t1;
+        if (value(t0) <= 0) hi = t0;
+        while (hi - lo > kEventResolution * std::max(1.0, std::abs(hi))) {
+          const double mid = 0.5 * (lo + hi);
+          (value(mid) > 0 ? lo : hi) = mid;
+        }
+        if (!event || hi < event->first) event = std::make_pair(hi, what);
+      }
+      path->stretches.push_back({dense, event ? event->first : t1, mode, sigma});
+      t = path->stretches.back().to;
+      if (event || t >= until) break;
+    }
+    if (!event) {
+      until = t;  // the horizon, or the steps ran out: asked again from there
+      break;
+    }
+    dense.calc_state(event->first, y);
+    if (event->second == What::kSlipStops || event->second == What::kSlips) {
+      // A stop: it sticks where the friction holding it is within the cone, else slips back.
+      y[2] = event->second == What::kSlipStops ? 0.0 : y[2];
+      const Forces stick = forcesOf(k, y, Mode::kSticking, 1.0);
+      if (event->second == What::kSlipStops && std::abs(stick.friction) <= k.mu * stick.normal) {
+        mode = Mode::kSticking;
+      } else {
+        mode = Mode::kSliding;
+        sigma = stick.friction > 0 ? -1.0 : 1.0;
+      }
+      if (t <= body.time && event->second == What::kSlips && mode == Mode::kSliding &&
+          path->stretches.size() > 2 * kEvents.size()) {
+        return notYet("the edge's stick and slip change at once where it starts");
+      }
+      continue;
+    }
+    ended = event->second;
+    until = event->first;
+  }
+  const double reach = reachOf(body.shape);
+  if (ended == What::kOutOfPlane || ended == What::kUpright) {
+    ends = ended == What::kOutOfPlane
+               ? "tipping over the face's edge with the centre of mass past an end of the "
+                 "edge's contact (it turns out of its plane)"
+               : "tipping over the face's edge past upright";
+  } else if (ended == What::kFlat) {
+    ends = "resumes";
+  } else if (ended == What::kLeaves || ended == What::kPassesFace) {
+    // It flies on (closed form) until its face is clear of the edge, then its events take over.
+    Flight flight;
+    flight.from = until;
+    flight.there = placed(k, y);
+    const auto clear = clearAfter(k, body.shape, flight.there, kPivotClearance * reach);
+    if (!clear) {
+      ends = "its flight off the face's edge comes back to the edge";
+    } else {
+      path->flight = flight;
+      until += *clear;
+      ends = "resumes";
+    }
+  }
+  path->until_time = until;
+  LastingMotion motion;
+  const PathState first = path->stateAt(body.time);
+  motion.state = first.state;
+  motion.start = body.time;
+  motion.until = until;
+  motion.ends = ends;
+  motion.centre0 = first.centre;
+  motion.velocity0 = first.velocity;
+  motion.angular_velocity0 = first.angular_velocity;
+  motion.orientation0 = first.orientation;
+  motion.forces = first.forces;
+  motion.pivot = path;
+  return motion;
+}
+
+}  // namespace collision_response::core

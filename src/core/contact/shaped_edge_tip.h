@@ -1,0 +1,50 @@
+// A shaped body tipping over a bounded face's edge (issue 42, build step 6): a box or a can that
+// slides or rests on a table with its centre of pressure at the table's edge turns over that
+// edge, its own face pivoting on the edge's line, sticking there or sliding along its face
+// (Coulomb), until it leaves the edge or its face passes it. The motion is planar (the edge's
+// line a principal axis of the body, no motion along it) and integrated to a stated tolerance
+// (doc/model.md, "Tipping over the face's edge").
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "collision_response/core/expected.h"
+#include "contact/shaped_lasting.h"
+
+namespace collision_response::core {
+
+/// A bounded face's edge: the line through `point` along `along` (unit); `out` (unit, in the
+/// face, at right angles to `along`) points off the face.
+struct FaceEdge {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d along = Eigen::Vector3d::UnitY();
+  Eigen::Vector3d out = Eigen::Vector3d::UnitX();
+};
+
+/// The body's own face lying on the face, in 2-D coordinates about the centre of mass's foot
+/// (x along the edge's `out`, y along its `along`): a convex polygon (its corners, in order), or
+/// a disc (a cylinder's cap) where `radius` > 0.
+struct FootPrint {
+  std::vector<Eigen::Vector2d> polygon;
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  double radius = 0.0;
+};
+
+/// The body, lying flat on `face` with the footprint `print`, its centre of pressure at or past
+/// `edge`, turning over the edge under gravity: its face pivots on the edge's line at
+/// s = the centre's foot's distance past the line along its face, the edge's two ends of
+/// contact (the chord of its footprint) sharing the force. The edge sticks while the friction it
+/// needs is within mu of the normal force and slides (Coulomb) otherwise; integrated with the
+/// Dormand-Prince pair to `tolerance` (absolute and relative). Ends (`until`, `ends`): the body
+/// leaves the edge (its normal force reaches 0; it flies on, in closed form, until its face is
+/// kPivotClearance of its reach clear of the edge) or its face passes the edge, or its face
+/// turns back flat onto the face ("resumes": its events take over), or `horizon` ("stops").
+/// Refused by name (`contact: not yet: ...`): motion along the edge, gravity along it, a turn
+/// about another axis, the edge's line not a principal axis of the body, the centre of mass
+/// past an end of the chord (the body would turn out of its plane), Painleve's paradox.
+Expected<LastingMotion> tipOverFaceEdge(const LastingBody& body, const FlatFace& face,
+                                        const FaceEdge& edge, const FootPrint& print,
+                                        double tolerance, double horizon = 10.0);
+
+}  // namespace collision_response::core
