@@ -191,6 +191,24 @@ std::pair<double, double> energySpeedBounds(const PrincipalBody& principal,
   return {kMargin * speed, kMargin * std::sqrt(2 * kinetic_max / principal.moments.minCoeff())};
 }
 
+namespace {
+
+/// The first of doubling spans from `from` (1e-9 s on) within `until` at which `moving` is more
+/// than the manifold's band from `obstacle`; empty where there is none.
+std::optional<double> apartFrom(const BoundedMotion& moving, const PlacedShape& obstacle,
+                                double from, double until) {
+  const double band = FirstContactOptions{}.manifold_band;
+  for (double span = 1e-9; from + span < until; span *= 2) {
+    const auto body = moving.at(from + span);
+    if (!body) return std::nullopt;
+    const SurfaceGap gap = gapAt(*body, obstacle, from + span);
+    if (!gap.overlapping && gap.gap > band) return from + span;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 std::optional<ShapedMotion::Strike> ShapedMotion::struckWhileLasting(const LastingMotion& lasting,
                                                                      std::size_t resting_on,
                                                                      double from,
@@ -220,6 +238,14 @@ std::optional<ShapedMotion::Strike> ShapedMotion::struckWhileLasting(const Lasti
           firstContact(moving, w.placed.placed, clear, horizon - clear);
       if (result.contact) {
         const double closing = result.contact->closest.approach_speed;
+        if (closing < -kLastingStillSpeed && result.contact->time <= clear) {
+          // Touching where it starts and parting (a link that has just struck it, left behind):
+          // looked at again from where it is apart.
+          if (const auto apart = apartFrom(moving, w.placed.placed, clear, horizon)) {
+            clear = *apart;
+            continue;
+          }
+        }
         if (!first || result.contact->time < first->time) {
           first = Strike{result.contact->time, w.placed.obstacle, closing > kLastingSettled};
         }
