@@ -178,6 +178,36 @@ TEST(ShapedEdgeTip, ACubeAtRestPastTheEdgeTurnsAboutItAsAPendulumUntilItsFrictio
   }
   expectSound(cube, *tips, 1e-8);
   EXPECT_EQ(tips->ends, "resumes");
+
+  // Given halfway (as a tracker sees it: turned over the edge, its face below the table's plane
+  // past the edge), the motion goes on from there: the energy integral and rho again, and the
+  // same slip onset.
+  LastingBody halfway = cube;
+  halfway.time = 0.5 * (tips->start + before);
+  halfway.centre = tips->centreAt(halfway.time);
+  halfway.velocity = tips->velocityAt(halfway.time);
+  halfway.angular_velocity = tips->angularVelocityAt(halfway.time);
+  halfway.orientation = tips->orientationAt(halfway.time);
+  const auto goes_on = lastingOnFace(halfway, table);
+  ASSERT_TRUE(goes_on.ok()) << errorOf(goes_on);
+  ASSERT_TRUE(goes_on->pivot);
+  const auto turned = [&](double t) {
+    return Eigen::AngleAxisd(goes_on->orientationAt(t) * cube.orientation.conjugate()).angle();
+  };
+  for (int k = 0; k <= 20; ++k) {
+    const double t = halfway.time + (before - halfway.time) * k / 21.0;
+    const double rate = goes_on->angularVelocityAt(t).norm();
+    EXPECT_NEAR(rate * rate, static_cast<double>(rate2(turned(t))),
+                1e-8 * static_cast<double>(rate2(onset)))
+        << t;
+    EXPECT_NEAR((goes_on->centreAt(t) - V(1, 0, 0.7)).norm(), static_cast<double>(rho), 1e-10);
+  }
+  double again = halfway.time, later = goes_on->until;
+  for (int i = 0; i < 100; ++i) {
+    const double mid = 0.5 * (again + later);
+    (goes_on->stateAt(mid) == ContactState::kRolling ? again : later) = mid;
+  }
+  EXPECT_NEAR(turned(again), onset, 1e-7);
 }
 
 TEST(ShapedEdgeTip, ACanSlidingOffTheEdgeTipsOverItAndKeepsItsEnergyFrictionless) {

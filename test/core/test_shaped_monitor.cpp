@@ -682,6 +682,57 @@ TEST(ShapedMonitor, ABoxSlidingOffATablesEdgeTipsOverItAndFallsToTheFloor) {
   EXPECT_GT(flying, 10u);
 }
 
+// A state given halfway over a table's edge (as a tracker sees a box turning over it, its face a
+// hair above the edge and below the table's plane past it): the monitor goes on turning it over
+// the edge from there, nothing unmodelled, its path that of the monitor that slid it there
+// (1e-8 m, the tipping's integration). Before, the hair above the edge was taken for a graze
+// and the flight crawled back to the edge in steps of 1e-11 s (0.4 s of CPU an update).
+TEST(ShapedMonitor, AStateHalfwayOverATablesEdgeGoesOnTurningOverIt) {
+  const V half(0.0625, 0.0625, 0.0625);
+  Scene scene = floorScene(0.5, half, 2.0);
+  scene.obstacles.push_back(
+      scene_builders::box("table", V(0, 0, 0.25), V(1.0, 1.0, 0.5), "concrete"));
+  ImpactMonitor slid(scene, MonitorSettings{}), given(scene, MonitorSettings{});
+  BodyStateSample state;
+  state.body = 0;
+  state.position = V(0.25, 0, 0.5 + half.z());
+  state.velocity = V(0.5, 0, 0);
+  slid.step(0.0, {state});
+  const double halfway = 0.52;
+  slid.step(halfway, {});
+  BodyStateSample there;
+  there.body = 0;
+  there.time = halfway;
+  const auto at = slid.predictedState(0, halfway);
+  ASSERT_TRUE(at);
+  there.position = at->first;
+  there.velocity = at->second;
+  there.angular_velocity = slid.predictedAngularVelocity(0, halfway);
+  there.orientation = slid.predictedOrientation(0, halfway);
+  EXPECT_GT(Eigen::AngleAxisd(there.orientation).angle(), 1e-3) << "turned over the edge";
+  const StepReport first = given.step(halfway, {there});
+  EXPECT_TRUE(first.unmodelled.empty());
+  // In lasting contact at once: the chord's two ends on the edge (x = 0.5, z = 0.5), along the
+  // cube's own face's normal (turned about y), sharing its weight's part along it.
+  ASSERT_EQ(first.contacts.size(), 2u);
+  const V up = there.orientation * V::UnitZ();
+  for (const ContactRecord& contact : first.contacts) {
+    EXPECT_NEAR(contact.contact_point.x(), 0.5, 1e-12);
+    EXPECT_NEAR(contact.contact_point.z(), 0.5, 1e-12);
+    EXPECT_NEAR((contact.normal + up).norm(), 0.0, 1e-9);
+    EXPECT_GT(contact.normal_force, 0.0);
+  }
+  for (int k = 1; k <= 10; ++k) {
+    const double t = halfway + 0.005 * k;
+    const StepReport report = given.step(t, {});
+    slid.step(t, {});
+    for (const UnmodelledContact& c : report.unmodelled) ADD_FAILURE() << c.what;
+    EXPECT_NEAR((given.predictedState(0, t)->first - slid.predictedState(0, t)->first).norm(), 0.0,
+                1e-8)
+        << t;
+  }
+}
+
 // A can (r 0.033 m, 0.12 m tall, 0.35 kg) standing flush on a table (a box, mu 0.3) struck by a
 // link moving at v_o = 1 m/s (a box on a tf frame, placed every 1 ms as the node does, its face
 // d = 0.045 m behind the can's side; frictionless, e = 1/2), as config/scenes/can_knock.yaml.

@@ -52,6 +52,15 @@ constexpr double kEdgeHair = 1e-11;
 
 Error notYet(const std::string& what) { return Error{"contact", "not yet: " + what}; }
 
+/// The body's own face on the edge, in 2-D coordinates about the centre of mass's foot on it (x
+/// along w, y along the turn's axis a): a convex polygon (its corners, in order), or a disc (a
+/// cylinder's cap) where `radius` > 0.
+struct FootPrint {
+  std::vector<Vec2> polygon;
+  Vec2 centre = Vec2::Zero();
+  double radius = 0.0;
+};
+
 /// How the edge moves on the body's face.
 enum class Mode { kSliding, kSticking };
 
@@ -287,10 +296,53 @@ std::optional<double> clearAfter(const Setting& k, const ConvexShape& shape, con
   return std::nullopt;
 }
 
+/// The body's own flat face whose outward normal is -up, in the plane's coordinates (x along
+/// `w`, y along `a`) about the centre's foot on it, and h, the centre's height above it: a
+/// cylinder's cap (a disc), a box's or a hull's face (its corners in order). Empty where there is
+/// no flat face there (a sphere, a capsule, a cylinder's side, a box's edge).
+std::optional<std::pair<FootPrint, double>> ownFace(const LastingBody& body,
+                                                    const Eigen::Quaterniond& orientation,
+                                                    const Vec& up, const Vec& w, const Vec& a) {
+  const Eigen::Matrix3d r = orientation.toRotationMatrix();
+  const Vec down = r.transpose() * (-up);  // the body's frame
+  const double reach = reachOf(body.shape);
+  const double h = down.dot(coreSupport(body.shape, down)) + marginOf(body.shape);
+  const Vec foot = body.centre - h * up;
+  const auto flat = [&](const Vec& point) {
+    return Vec2((point - foot).dot(w), (point - foot).dot(a));
+  };
+  FootPrint print;
+  if (const auto* can = std::get_if<Cylinder>(&body.shape)) {
+    if (!(std::abs(std::abs(down.z()) - 1) <= 1e-12)) return std::nullopt;
+    print.centre = flat(body.centre + r * Vec(0, 0, down.z() * can->half_length));
+    print.radius = can->radius;
+    return std::make_pair(print, h);
+  }
+  if (!std::holds_alternative<Cuboid>(body.shape) &&
+      !std::holds_alternative<ConvexHull>(body.shape)) {
+    return std::nullopt;
+  }
+  std::vector<Vec> candidates;
+  contactCandidates(body.shape, down, candidates);
+  Vec2 mean = Vec2::Zero();
+  for (const Vec& corner : candidates) {
+    if (down.dot(corner) < h - kLastingBand * std::max(1.0, reach)) continue;
+    print.polygon.push_back(flat(body.centre + r * corner));
+    mean += print.polygon.back();
+  }
+  if (print.polygon.size() < 3) return std::nullopt;
+  mean /= static_cast<double>(print.polygon.size());
+  std::sort(print.polygon.begin(), print.polygon.end(), [&](const Vec2& p, const Vec2& q) {
+    return std::atan2(p.y() - mean.y(), p.x() - mean.x()) <
+           std::atan2(q.y() - mean.y(), q.x() - mean.x());
+  });
+  return std::make_pair(print, h);
+}
+
 }  // namespace
 
 Expected<LastingMotion> tipOverFaceEdge(const LastingBody& body, const FlatFace& face,
-                                        const FaceEdge& edge, const FootPrint& print,
+                                        const FaceEdge& edge, const Eigen::Vector3d& up,
                                         double tolerance, double horizon) {
   if (!(tolerance > 0 && std::isfinite(tolerance))) {
     return Error{"tolerance", "must be finite and > 0, got " + formatNumber(tolerance)};
@@ -303,9 +355,8 @@ Expected<LastingMotion> tipOverFaceEdge(const LastingBody& body, const FlatFace&
   k.n = face.normal.normalized();
   k.out = edge.out.normalized();
   k.axis = k.n.cross(k.out);
-  k.print = print;
-  k.orientation0 = body.orientation.normalized();
-  const Eigen::Matrix3d rotation = k.orientation0.toRotationMatrix();
+  const Eigen::Quaterniond orientation = body.orientation.normalized();
+  const Eigen::Matrix3d rotation = orientation.toRotationMatrix();
   const Eigen::Matrix3d inertia = rotation * body.moments.asDiagonal() * rotation.transpose();
   k.moment = k.axis.dot(inertia * k.axis);
   const double scale = body.gravity.norm();
@@ -320,15 +371,24 @@ Expected<LastingMotion> tipOverFaceEdge(const LastingBody& body, const FlatFace&
     return notYet("sliding off the face's edge along it too (not at right angles to it)");
   }
   const double spin = body.angular_velocity.dot(k.axis);
-  if ((body.angular_velocity - spin * k.axis).norm() * reachOf(body.shape) > kLastingStillSpeed) {
+  const double reach = reachOf(body.shape);
+  if ((body.angular_velocity - spin * k.axis).norm() * reach > kLastingStillSpeed ||
+      std::abs(up.dot(k.axis)) > kLastingBand) {
     return notYet("tipping over the face's edge while turning about another axis");
   }
-  k.height = k.n.dot(body.centre - face.point);
-  const Vec foot = body.centre - k.height * k.n;
-  k.edge_point = edge.point + edge.along.dot(foot - edge.point) * edge.along;
-  const double s0 = k.out.dot(foot - k.edge_point);
+  // Its face turned by phi0 about the edge (0: flat on the face), the path's reference
+  // orientation the body's turned back by phi0.
+  const double phi0 = std::atan2(up.dot(k.out), up.dot(k.n));
+  const Vec w0 = std::cos(phi0) * k.out - std::sin(phi0) * k.n;
+  k.orientation0 = Eigen::Quaterniond(Eigen::AngleAxisd(-phi0, k.axis)) * orientation;
+  const auto own = ownFace(body, orientation, up, w0, k.axis);
+  if (!own) return notYet("tipping over the face's edge on a part of the body that is not flat");
+  k.print = own->first;
+  k.height = own->second;
+  k.edge_point = edge.point + edge.along.dot(body.centre - edge.point) * edge.along;
+  const double s0 = w0.dot(body.centre - k.edge_point);
   // The body's face on the face: its velocity's normal part (settled) and the turn's, dropped.
-  State y{s0, 0.0, body.velocity.dot(k.out), spin};
+  State y{s0, phi0, body.velocity.dot(w0) - k.height * spin, spin};
   Mode mode = Mode::kSliding;
   double sigma = y[2] >= 0 ? 1.0 : -1.0;
   if (k.mu > 0 && std::abs(y[2]) <= kLastingStillSpeed) {
@@ -417,7 +477,6 @@ Expected<LastingMotion> tipOverFaceEdge(const LastingBody& body, const FlatFace&
     ended = event->second;
     until = event->first;
   }
-  const double reach = reachOf(body.shape);
   if (ended == What::kOutOfPlane || ended == What::kUpright) {
     ends = ended == What::kOutOfPlane
                ? "tipping over the face's edge with the centre of mass past an end of the "
@@ -453,6 +512,39 @@ Expected<LastingMotion> tipOverFaceEdge(const LastingBody& body, const FlatFace&
   motion.forces = first.forces;
   motion.pivot = path;
   return motion;
+}
+
+std::optional<std::pair<FaceEdge, Eigen::Vector3d>> tiltedOverEdge(const LastingBody& body,
+                                                                   const FlatFace& face) {
+  if (!face.bounded) return std::nullopt;
+  const Vec n = face.normal.normalized();
+  const Eigen::Matrix3d r = body.orientation.normalized().toRotationMatrix();
+  // The body's flat faces' inward normals: a box's six, a cylinder's two caps.
+  std::vector<Vec> ups;
+  if (std::holds_alternative<Cuboid>(body.shape)) {
+    for (int i = 0; i < 3; ++i) ups.insert(ups.end(), {Vec(r.col(i)), Vec(-r.col(i))});
+  } else if (std::holds_alternative<Cylinder>(body.shape)) {
+    ups = {Vec(r.col(2)), Vec(-r.col(2))};
+  }
+  const std::array<Vec, 2> axes{face.along_u, face.along_v};
+  for (int k = 0; k < 2; ++k) {
+    for (const double side : {-1.0, 1.0}) {
+      FaceEdge edge;
+      edge.out = side * axes[static_cast<std::size_t>(k)];
+      edge.along = axes[static_cast<std::size_t>(1 - k)];
+      edge.point = face.point + side * face.half_extent[k] * axes[static_cast<std::size_t>(k)];
+      const Vec a = n.cross(edge.out);
+      const Vec e = edge.point + edge.along.dot(body.centre - edge.point) * edge.along;
+      for (const Vec& up : ups) {
+        const double phi = std::atan2(up.dot(edge.out), up.dot(n));
+        if (std::abs(up.dot(a)) > kLastingBand || !(phi > 0 && phi < 0.5 * kPi)) continue;
+        const Vec down = r.transpose() * (-up);
+        const double h = down.dot(coreSupport(body.shape, down)) + marginOf(body.shape);
+        if (std::abs(up.dot(body.centre - e) - h) <= kLastingBand) return std::make_pair(edge, up);
+      }
+    }
+  }
+  return std::nullopt;
 }
 
 }  // namespace collision_response::core

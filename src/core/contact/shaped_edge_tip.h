@@ -7,6 +7,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include "collision_response/core/expected.h"
@@ -22,29 +24,28 @@ struct FaceEdge {
   Eigen::Vector3d out = Eigen::Vector3d::UnitX();
 };
 
-/// The body's own face lying on the face, in 2-D coordinates about the centre of mass's foot
-/// (x along the edge's `out`, y along its `along`): a convex polygon (its corners, in order), or
-/// a disc (a cylinder's cap) where `radius` > 0.
-struct FootPrint {
-  std::vector<Eigen::Vector2d> polygon;
-  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
-  double radius = 0.0;
-};
-
-/// The body, lying flat on `face` with the footprint `print`, its centre of pressure at or past
-/// `edge`, turning over the edge under gravity: its face pivots on the edge's line at
-/// s = the centre's foot's distance past the line along its face, the edge's two ends of
-/// contact (the chord of its footprint) sharing the force. The edge sticks while the friction it
-/// needs is within mu of the normal force and slides (Coulomb) otherwise; integrated with the
-/// Dormand-Prince pair to `tolerance` (absolute and relative). Ends (`until`, `ends`): the body
-/// leaves the edge (its normal force reaches 0; it flies on, in closed form, until its face is
-/// kPivotClearance of its reach clear of the edge) or its face passes the edge, or its face
-/// turns back flat onto the face ("resumes": its events take over), or `horizon` ("stops").
-/// Refused by name (`contact: not yet: ...`): motion along the edge, gravity along it, a turn
-/// about another axis, the edge's line not a principal axis of the body, the centre of mass
-/// past an end of the chord (the body would turn out of its plane), Painleve's paradox.
+/// The body, its own flat face (its outward normal -`up`: a box's or a hull's face, a
+/// cylinder's cap) on `edge` of `face`, flat on the face with its centre of pressure at or past the
+/// edge or already turned over it, turning over the edge under gravity: its face pivots on the
+/// edge's line at s = the centre's foot's distance past the line along its face, the chord of
+/// its face on the line sharing the force. The edge sticks while the friction it needs is within
+/// mu of the normal force and slides (Coulomb) otherwise; integrated with the Dormand-Prince
+/// pair to `tolerance` (absolute and relative). Ends (`until`, `ends`): the body leaves the edge
+/// (its normal force reaches 0; it flies on, in closed form, until it is kPivotClearance of its
+/// reach clear of the edge) or its face passes the edge, or its face turns back flat onto the
+/// face ("resumes": its events take over), or `horizon` ("stops"). Refused by name (`contact:
+/// not yet: ...`): motion along the edge, gravity along it, a turn about another axis, the
+/// edge's line not a principal axis of the body, the centre of mass past an end of the chord
+/// (the body would turn out of its plane), Painleve's paradox.
 Expected<LastingMotion> tipOverFaceEdge(const LastingBody& body, const FlatFace& face,
-                                        const FaceEdge& edge, const FootPrint& print,
+                                        const FaceEdge& edge, const Eigen::Vector3d& up,
                                         double tolerance, double horizon = 10.0);
+
+/// The edge of the bounded `face` that `body` is turned over, its own flat face (a box's or a
+/// hull's face, a cylinder's cap) on the edge's line within the touching band and turned past
+/// the face's plane towards the edge's out (as a tracker sees a box halfway over a table's
+/// edge), with that face's inward normal: what tipOverFaceEdge takes. Empty where it is not so.
+std::optional<std::pair<FaceEdge, Eigen::Vector3d>> tiltedOverEdge(const LastingBody& body,
+                                                                   const FlatFace& face);
 
 }  // namespace collision_response::core

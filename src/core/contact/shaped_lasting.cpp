@@ -958,26 +958,6 @@ Expected<std::vector<SupportForce>> overhangForces(const Support& support, const
   return forces;
 }
 
-/// The body's face (a polygon's corners in order, a cap's disc) about the centre's foot, in the
-/// edge's coordinates: x along its out, y along it.
-FootPrint footPrintOf(const Support& support, const Setting& setting, const FaceEdge& edge) {
-  const auto flat = [&](const Vec& x) {
-    return Eigen::Vector2d((x - setting.foot).dot(edge.out), (x - setting.foot).dot(edge.along));
-  };
-  FootPrint print;
-  if (support.kind == SupportKind::kDisc) {
-    print.centre = flat(support.centre);
-    print.radius = support.radius;
-    return print;
-  }
-  for (const Vec& foot : support.feet) print.polygon.push_back(flat(foot));
-  std::sort(print.polygon.begin(), print.polygon.end(),
-            [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-              return std::atan2(a.y(), a.x()) < std::atan2(b.y(), b.x());
-            });
-  return print;
-}
-
 /// A face or a cap past a bounded face's edge (`overhang`), moving by `plan` (resting or
 /// sliding, without turning) with its centre of pressure `pressure`: where that is past the
 /// edge's line (within the touching band), the body tips over the edge (tipOverFaceEdge); else
@@ -996,7 +976,7 @@ Expected<LastingMotion> overhangMotion(const LastingBody& body, const FlatFace& 
   }
   const double behind = -edge.out.dot(pressure - edge.point);
   if (behind <= kLastingBand) {
-    return tipOverFaceEdge(body, face, edge, footPrintOf(support, setting, edge), tolerance);
+    return tipOverFaceEdge(body, face, edge, setting.n, tolerance);
   }
   auto forces = overhangForces(support, setting, edge, pressure, total, friction_ratio);
   if (!forces) return forces.error();
@@ -1049,6 +1029,12 @@ Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& f
   const Eigen::Matrix3d rotation = orientation.toRotationMatrix();
   const Setting setting = settingOf(body, face, true);
   auto found = supportOf(body, rotation, face, setting);
+  if (!found && found.error().field == "body.centre") {
+    // Below the face's plane past its edge: turned over the edge (a state halfway over it).
+    if (const auto tilted = tiltedOverEdge(body, face)) {
+      return tipOverFaceEdge(body, face, tilted->first, tilted->second, tolerance);
+    }
+  }
   if (!found) return found.error();
   Support support = found.value();
   if (support.kind == SupportKind::kCorners) {

@@ -682,8 +682,12 @@ std::optional<double> ShapedMotion::separation(const TumblingBody& body, double 
   const double apart = time + step;
   if (!(apart < horizon)) return apart;
   for (const ObstacleContact& c : left) {
+    // Apart: the gap opened over the step (a body handed over a hair above a face's edge it
+    // turns over, its face sliding along the edge, keeps the hair: it lasts).
+    const SurfaceGap now = gapAt(body, obstacles_[c.slot].placed.placed, time);
     const SurfaceGap gap = gapAt(body, obstacles_[c.slot].placed.placed, apart);
-    if (gap.overlapping || !(gap.gap > 0)) return std::nullopt;
+    const double opened = now.gap > 0 ? now.gap + FirstContactOptions{}.distance_tolerance : 0.0;
+    if (gap.overlapping || !(gap.gap > opened)) return std::nullopt;
   }
   return apart;
 }
