@@ -339,16 +339,16 @@ std::optional<std::pair<FootPrint, double>> ownFace(const LastingBody& body,
   return std::make_pair(print, h);
 }
 
-}  // namespace
+/// The tipping's setting from the body on the edge (`k`, filled) and its start: (s, phi, s',
+/// phi'), the edge sticking or sliding (sigma). Refused by name where it is not modelled.
+struct Start {
+  State y{};
+  Mode mode = Mode::kSliding;
+  double sigma = 1.0;
+};
 
-Expected<LastingMotion> tipOverFaceEdge(const LastingBody& body, const FlatFace& face,
-                                        const FaceEdge& edge, const Eigen::Vector3d& up,
-                                        double tolerance, double horizon) {
-  if (!(tolerance > 0 && std::isfinite(tolerance))) {
-    return Error{"tolerance", "must be finite and > 0, got " + formatNumber(tolerance)};
-  }
-  auto path = std::make_shared<EdgeTipPath>();
-  Setting& k = path->setting;
+Expected<Start> startOf(const LastingBody& body, const FlatFace& face, const FaceEdge& edge,
+                        const Vec& up, Setting& k) {
   k.mass = body.mass;
   k.mu = face.friction;
   k.gravity = body.gravity;
@@ -359,20 +359,18 @@ Expected<LastingMotion> tipOverFaceEdge(const LastingBody& body, const FlatFace&
   const Eigen::Matrix3d rotation = orientation.toRotationMatrix();
   const Eigen::Matrix3d inertia = rotation * body.moments.asDiagonal() * rotation.transpose();
   k.moment = k.axis.dot(inertia * k.axis);
-  const double scale = body.gravity.norm();
   if ((inertia * k.axis - k.moment * k.axis).norm() > 1e-12 * body.moments.maxCoeff()) {
     return notYet(
         "tipping over the face's edge about an axis that is not a principal one of the body");
   }
-  if (std::abs(body.gravity.dot(k.axis)) > kLastingAcrossGravity * scale) {
+  if (std::abs(body.gravity.dot(k.axis)) > kLastingAcrossGravity * body.gravity.norm()) {
     return notYet("tipping over the face's edge with gravity along it");
   }
   if (std::abs(body.velocity.dot(k.axis)) > kLastingStillSpeed) {
     return notYet("sliding off the face's edge along it too (not at right angles to it)");
   }
   const double spin = body.angular_velocity.dot(k.axis);
-  const double reach = reachOf(body.shape);
-  if ((body.angular_velocity - spin * k.axis).norm() * reach > kLastingStillSpeed ||
+  if ((body.angular_velocity - spin * k.axis).norm() * reachOf(body.shape) > kLastingStillSpeed ||
       std::abs(up.dot(k.axis)) > kLastingBand) {
     return notYet("tipping over the face's edge while turning about another axis");
   }
@@ -386,121 +384,145 @@ Expected<LastingMotion> tipOverFaceEdge(const LastingBody& body, const FlatFace&
   k.print = own->first;
   k.height = own->second;
   k.edge_point = edge.point + edge.along.dot(body.centre - edge.point) * edge.along;
-  const double s0 = w0.dot(body.centre - k.edge_point);
-  // The body's face on the face: its velocity's normal part (settled) and the turn's, dropped.
-  State y{s0, phi0, body.velocity.dot(w0) - k.height * spin, spin};
-  Mode mode = Mode::kSliding;
-  double sigma = y[2] >= 0 ? 1.0 : -1.0;
-  if (k.mu > 0 && std::abs(y[2]) <= kLastingStillSpeed) {
-    y[2] = 0;
-    const Forces stick = forcesOf(k, y, Mode::kSticking, 1.0);
+  // The state's part along the face's normal (settled) is dropped: v = (s' + h phi') w - s phi' u.
+  Start start;
+  start.y = {w0.dot(body.centre - k.edge_point), phi0, body.velocity.dot(w0) - k.height * spin,
+             spin};
+  start.sigma = start.y[2] >= 0 ? 1.0 : -1.0;
+  if (k.mu > 0 && std::abs(start.y[2]) <= kLastingStillSpeed) {
+    start.y[2] = 0;
+    const Forces stick = forcesOf(k, start.y, Mode::kSticking, 1.0);
     if (std::abs(stick.friction) <= k.mu * stick.normal) {
-      mode = Mode::kSticking;
+      start.mode = Mode::kSticking;
     } else {
-      sigma = stick.friction > 0 ? -1.0 : 1.0;
+      start.sigma = stick.friction > 0 ? -1.0 : 1.0;
     }
   }
-  if (eventValue(k, y, mode, sigma, What::kOutOfPlane) <= 0) {
+  if (eventValue(k, start.y, start.mode, start.sigma, What::kOutOfPlane) <= 0) {
     return notYet(
         "tipping over the face's edge with the centre of mass past an end of the edge's contact");
   }
+  return start;
+}
+
+/// Integrates one mode from `y` at `t` to its first event (its instant and kind; `y` the state
+/// there), or to `until` or the step budget (`taken`) with none, each step kept in `path`.
+Expected<std::optional<std::pair<double, What>>> integrateMode(EdgeTipPath& path, State& y,
+                                                               double& t, double until, Mode mode,
+                                                               double sigma, double tolerance,
+                                                               std::size_t& taken) {
+  const Setting& k = path.setting;
+  const auto system = [&k, mode, sigma](const State& x, State& rate, double) {
+    const Forces f = forcesOf(k, x, mode, sigma);
+    rate = {x[2], x[3], f.s_rate, f.phi_rate};
+  };
+  Dense dense = boost::numeric::odeint::make_dense_output(tolerance, tolerance, Stepper());
+  dense.initialize(y, t, 1e-4);
+  std::optional<std::pair<double, What>> event;
+  while (++taken <= kMaxSteps) {
+    try {
+      dense.do_step(system);
+    } catch (const std::exception&) {
+      return Error{"contact", "the tipping over the face's edge could not be integrated past +" +
+                                  formatNumber(t - path.start_time) + " s"};
+    }
+    const double t0 = dense.previous_time(), t1 = std::min(dense.current_time(), until);
+    const auto value = [&](double time, What what) {
+      State x;
+      dense.calc_state(time, x);
+      return eventValue(k, x, mode, sigma, what);
+    };
+    for (const What what : kEvents) {
+      if (value(t1, what) > 0) continue;
+      double lo = t0, hi = value(t0, what) <= 0 ? t0 : t1;
+      while (hi - lo > kEventResolution * std::max(1.0, std::abs(hi))) {
+        const double mid = 0.5 * (lo + hi);
+        (value(mid, what) > 0 ? lo : hi) = mid;
+      }
+      if (!event || hi < event->first) event = std::make_pair(hi, what);
+    }
+    path.stretches.push_back({dense, event ? event->first : t1, mode, sigma});
+    t = path.stretches.back().to;
+    if (event || t >= until) break;
+  }
+  dense.calc_state(t, y);
+  return event;
+}
+
+}  // namespace
+
+Expected<LastingMotion> tipOverFaceEdge(const LastingBody& body, const FlatFace& face,
+                                        const FaceEdge& edge, const Eigen::Vector3d& up,
+                                        double tolerance, double horizon) {
+  if (!(tolerance > 0 && std::isfinite(tolerance))) {
+    return Error{"tolerance", "must be finite and > 0, got " + formatNumber(tolerance)};
+  }
+  auto path = std::make_shared<EdgeTipPath>();
+  Setting& k = path->setting;
+  const auto start = startOf(body, face, edge, up, k);
+  if (!start) return start.error();
+  State y = start->y;
+  Mode mode = start->mode;
+  double sigma = start->sigma;
   path->start_time = body.time;
   path->initial = y;
   path->initial_mode = mode;
   path->initial_sigma = sigma;
 
-  std::string ends = "stops";
-  double t = body.time, until = body.time + horizon;
-  std::size_t taken = 0;
+  double t = body.time, until = body.time + horizon, last_change = -1;
+  std::size_t taken = 0, changes_at_once = 0;
   std::optional<What> ended;
   while (!ended) {
-    const auto system = [&k, mode, sigma](const State& x, State& rate, double) {
-      const Forces f = forcesOf(k, x, mode, sigma);
-      rate = {x[2], x[3], f.s_rate, f.phi_rate};
-    };
     if (forcesOf(k, y, mode, sigma).paradox) {
       return notYet("Painleve's paradox: sliding over the face's edge has no force that holds it");
     }
-    Dense dense = boost::numeric::odeint::make_dense_output(tolerance, tolerance, Stepper());
-    dense.initialize(y, t, 1e-4);
-    std::optional<std::pair<double, What>> event;
-    for (;;) {
-      if (++taken > kMaxSteps) break;
-      try {
-        dense.do_step(system);
-      } catch (const std::exception&) {
-        return Error{"contact", "the tipping over the face's edge could not be integrated past +" +
-                                    formatNumber(t - body.time) + " s"};
-      }
-      const double t0 = dense.previous_time(), t1 = std::min(dense.current_time(), until);
-      const auto at = [&](double time) {
-        State x;
-        dense.calc_state(time, x);
-        return x;
-      };
-      for (const What what : kEvents) {
-        const auto value = [&](double time) { return eventValue(k, at(time), mode, sigma, what); };
-        if (value(t1) > 0) continue;
-        double lo = t0, hi = t1;
-        if (value(t0) <= 0) hi = t0;
-        while (hi - lo > kEventResolution * std::max(1.0, std::abs(hi))) {
-          const double mid = 0.5 * (lo + hi);
-          (value(mid) > 0 ? lo : hi) = mid;
-        }
-        if (!event || hi < event->first) event = std::make_pair(hi, what);
-      }
-      path->stretches.push_back({dense, event ? event->first : t1, mode, sigma});
-      t = path->stretches.back().to;
-      if (event || t >= until) break;
-    }
-    if (!event) {
+    auto event = integrateMode(*path, y, t, until, mode, sigma, tolerance, taken);
+    if (!event) return event.error();
+    if (!event.value()) {
       until = t;  // the horizon, or the steps ran out: asked again from there
       break;
     }
-    dense.calc_state(event->first, y);
-    if (event->second == What::kSlipStops || event->second == What::kSlips) {
-      // A stop: it sticks where the friction holding it is within the cone, else slips back.
-      y[2] = event->second == What::kSlipStops ? 0.0 : y[2];
-      const Forces stick = forcesOf(k, y, Mode::kSticking, 1.0);
-      if (event->second == What::kSlipStops && std::abs(stick.friction) <= k.mu * stick.normal) {
-        mode = Mode::kSticking;
-      } else {
-        mode = Mode::kSliding;
-        sigma = stick.friction > 0 ? -1.0 : 1.0;
-      }
-      if (t <= body.time && event->second == What::kSlips && mode == Mode::kSliding &&
-          path->stretches.size() > 2 * kEvents.size()) {
-        return notYet("the edge's stick and slip change at once where it starts");
-      }
-      continue;
+    const auto [at, what] = *event.value();
+    if (what != What::kSlipStops && what != What::kSlips) {
+      ended = what;
+      until = at;
+      break;
     }
-    ended = event->second;
-    until = event->first;
+    // A stop: it sticks where the friction holding it is within the cone, else slips back; an
+    // onset: it slips against the friction it needed.
+    changes_at_once = at == last_change ? changes_at_once + 1 : 0;
+    last_change = at;
+    if (changes_at_once > 2) return notYet("the edge's stick and slip change at once, again");
+    if (what == What::kSlipStops) y[2] = 0.0;
+    const Forces stick = forcesOf(k, y, Mode::kSticking, 1.0);
+    mode = what == What::kSlipStops && std::abs(stick.friction) <= k.mu * stick.normal
+               ? Mode::kSticking
+               : Mode::kSliding;
+    if (mode == Mode::kSliding) sigma = stick.friction > 0 ? -1.0 : 1.0;
   }
-  if (ended == What::kOutOfPlane || ended == What::kUpright) {
-    ends = ended == What::kOutOfPlane
-               ? "tipping over the face's edge with the centre of mass past an end of the "
-                 "edge's contact (it turns out of its plane)"
-               : "tipping over the face's edge past upright";
+  std::string ends = "stops";
+  if (ended == What::kOutOfPlane) {
+    ends =
+        "tipping over the face's edge with the centre of mass past an end of the edge's "
+        "contact (it turns out of its plane)";
+  } else if (ended == What::kUpright) {
+    ends = "tipping over the face's edge past upright";
   } else if (ended == What::kFlat) {
     ends = "resumes";
   } else if (ended == What::kLeaves || ended == What::kPassesFace) {
-    // It flies on (closed form) until its face is clear of the edge, then its events take over.
-    Flight flight;
-    flight.from = until;
-    flight.there = placed(k, y);
-    const auto clear = clearAfter(k, body.shape, flight.there, kPivotClearance * reach);
-    if (!clear) {
-      ends = "its flight off the face's edge comes back to the edge";
-    } else {
+    // It flies on (closed form) until it is clear of the edge, then its events take over.
+    Flight flight{until, placed(k, y)};
+    const auto clear =
+        clearAfter(k, body.shape, flight.there, kPivotClearance * reachOf(body.shape));
+    ends = clear ? "resumes" : "its flight off the face's edge comes back to the edge";
+    if (clear) {
       path->flight = flight;
       until += *clear;
-      ends = "resumes";
     }
   }
   path->until_time = until;
-  LastingMotion motion;
   const PathState first = path->stateAt(body.time);
+  LastingMotion motion;
   motion.state = first.state;
   motion.start = body.time;
   motion.until = until;
