@@ -1,0 +1,151 @@
+// A can knocked off a table by a robot's link, played through demo.launch over real topics
+// (config/scenes/can_knock.yaml): a can (r = 0.033 m, 0.12 m tall, 0.35 kg) standing on a table
+// (its top at 0.75 m, its edge at x = 1 m) 0.2 m from the edge; a flat paddle on the tf frame
+// paddle_link moving at v_o = 1 m/s along x, its face d = 0.045 m behind the can. Closed forms:
+// - the paddle strikes the can's side at d / v_o = 0.045 s (frictionless, e = 1/2): the can
+//   leaves at (1 + e) v_o = 1.5 m/s without turning;
+// - it slides (mu 0.3): x = 0.8 + 1.5 tau - mu g tau^2 / 2 (tau = t - 0.045), upright, its cap on
+//   the table, until its centre of pressure, h mu = 0.018 m ahead of its centre, reaches the
+//   edge: tau = (1.5 - sqrt(1.5^2 - 2 mu g 0.182)) / (mu g), t = 0.18577 s. Before, a can
+//   whose support reached a table's edge was held there;
+// - from there it turns over the edge (tilted at the next state), leaves it and flies: its
+//   energy (1/2) m v^2 + (1/2) I w^2 + m g z kept (I = m (3 r^2 + L^2) / 12 about the turn's
+//   axis), until it strikes the floor, its first impact after the strike.
+// No played state of the can is ever inside the table. Held to 1e-6 (s, m/s, m) where the tf
+// link's velocity enters (test_box_strike.cpp says why), to 1e-9 otherwise.
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "collision_response/BodyStateArray.h"
+#include "collision_response/ImpactArray.h"
+
+namespace {
+
+constexpr double kG = 9.81, kMu = 0.3, kE = 0.5, kSpeed = 1.0, kGap = 0.045;
+constexpr double kRadius = 0.033, kHalfLength = 0.06, kMass = 0.35, kX0 = 0.8, kZ0 = 0.81;
+
+/// How deep the can's rims (64 points each) are inside the table (x in [0, 1], |y| <= 0.4,
+/// z in [0.70, 0.75]): > 0 inside.
+double insideTable(const collision_response::BodyState& state) {
+  const auto& p = state.pose.position;
+  const auto& q = state.pose.orientation;
+  const double w = q.w, x = q.x, y = q.y, z = q.z;
+  double deepest = -1.0;
+  for (int i = 0; i < 64; ++i) {
+    const double a = 2 * M_PI * i / 64;
+    for (const double h : {-kHalfLength, kHalfLength}) {
+      const double lx = kRadius * std::cos(a), ly = kRadius * std::sin(a), lz = h;
+      // The point turned by q: v + 2 w (u x v) + 2 u x (u x v), u = (x, y, z).
+      const double cx = y * lz - z * ly, cy = z * lx - x * lz, cz = x * ly - y * lx;
+      const double px = p.x + lx + 2 * (w * cx + y * cz - z * cy);
+      const double py = p.y + ly + 2 * (w * cy + z * cx - x * cz);
+      const double pz = p.z + lz + 2 * (w * cz + x * cy - y * cx);
+      deepest =
+          std::max(deepest, std::min({px, 1.0 - px, 0.4 - std::abs(py), 0.75 - pz, pz - 0.70}));
+    }
+  }
+  return deepest;
+}
+
+double tilt(const collision_response::BodyState& state) {
+  const auto& q = state.pose.orientation;
+  return 2 * std::asin(std::min(1.0, std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z)));
+}
+
+struct Played {
+  double time;
+  collision_response::BodyState state;
+};
+
+TEST(CanKnock, TheCanIsStruckSlidesToTheEdgeTurnsOverItAndFallsAsTheClosedFormsSay) {
+  ros::NodeHandle node;
+  std::vector<collision_response::Impact> impacts;
+  std::vector<Played> played;
+  ros::Time start;
+  double last_time = 0;
+  ros::Subscriber impact_subscriber = node.subscribe<collision_response::ImpactArray>(
+      "impacts", 100, [&](const collision_response::ImpactArray::ConstPtr& array) {
+        impacts.insert(impacts.end(), array->impacts.begin(), array->impacts.end());
+      });
+  ros::Subscriber states = node.subscribe<collision_response::BodyStateArray>(
+      "body_states", 1000, [&](const collision_response::BodyStateArray::ConstPtr& array) {
+        if (start.isZero()) start = array->header.stamp;
+        last_time = (array->header.stamp - start).toSec();
+        for (const auto& state : array->states) {
+          if (state.id == "can") played.push_back({last_time, state});
+        }
+      });
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(40.0);
+  while (ros::ok() && ros::WallTime::now() < end && last_time < 0.85) {
+    ros::spinOnce();
+    ros::WallDuration(0.01).sleep();
+  }
+  const double strike = kGap / kSpeed, a = kMu * kG;
+  const double tips = strike + (1.5 - std::sqrt(1.5 * 1.5 - 2 * a * 0.182)) / a;
+
+  // The strike, and the first impact after it: the floor's.
+  std::size_t by_paddle = 0;
+  const collision_response::Impact* landing = nullptr;
+  for (const auto& impact : impacts) {
+    const double t = (impact.header.stamp - start).toSec();
+    if (impact.body_b == "paddle") {
+      ++by_paddle;
+      EXPECT_NEAR(t, strike, 1e-6);
+      EXPECT_NEAR(impact.velocity_a_after.linear.x, (1 + kE) * kSpeed, 1e-6);
+      const auto& w = impact.velocity_a_after.angular;
+      EXPECT_NEAR(std::sqrt(w.x * w.x + w.y * w.y + w.z * w.z), 0, 1e-9) << "no spin";
+    } else if (t > strike + 1e-3 && landing == nullptr) {
+      landing = &impact;
+      EXPECT_EQ(impact.body_b, "floor") << "at " << t;
+      EXPECT_GT(t, tips);
+    }
+  }
+  EXPECT_GE(by_paddle, 2u) << "the side's line struck";
+  ASSERT_NE(landing, nullptr) << "the can reached the floor";
+  const double lands = (landing->header.stamp - start).toSec();
+
+  // The played path: the slide's closed form, the turn over the edge, the flight's energy.
+  const double inertia = kMass * (3 * kRadius * kRadius + 4 * kHalfLength * kHalfLength) / 12;
+  std::size_t sliding = 0, flying = 0;
+  double flight_energy = NAN;
+  bool tilted_after = false;
+  for (const Played& p : played) {
+    const auto& s = p.state;
+    EXPECT_LE(insideTable(s), 1e-6) << "a played state of the can inside the table at " << p.time;
+    if (s.twist.linear.x > 0 && p.time < tips) {  // the player has applied the node's strike
+      const double tau = p.time - strike;
+      EXPECT_NEAR(s.pose.position.x, kX0 + 1.5 * tau - 0.5 * a * tau * tau, 1e-6) << p.time;
+      EXPECT_NEAR(s.pose.position.z, kZ0, 1e-9) << p.time;
+      EXPECT_LT(tilt(s), 1e-9) << p.time;
+      ++sliding;
+    }
+    if (p.time > tips && p.time < tips + 0.0101) tilted_after = tilt(s) > 1e-6;
+    if (p.time > 0.3 && p.time < lands - 1e-3) {
+      const auto& v = s.twist.linear;
+      const auto& w = s.twist.angular;
+      const double energy = 0.5 * kMass * (v.x * v.x + v.y * v.y + v.z * v.z) +
+                            0.5 * inertia * (w.x * w.x + w.y * w.y + w.z * w.z) +
+                            kMass * kG * s.pose.position.z;
+      if (std::isnan(flight_energy)) flight_energy = energy;
+      EXPECT_NEAR(energy, flight_energy, 1e-9 * flight_energy) << p.time;
+      ++flying;
+    }
+  }
+  EXPECT_GE(sliding, 5u);
+  EXPECT_TRUE(tilted_after) << "it turns over the edge from " << tips << " s";
+  EXPECT_GE(flying, 20u);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "can_knock_test");
+  ros::NodeHandle node;
+  return RUN_ALL_TESTS();
+}
