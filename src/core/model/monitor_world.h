@@ -37,6 +37,10 @@ inline constexpr double kNever = -std::numeric_limits<double>::infinity();
 /// resolved impact leaves behind by rounding (e = 0 gives d' = 0 only up to a few ulps) must not
 /// count as a new approach.
 inline constexpr double kApproachTolerance = 64 * kEps;
+/// s: a state stamped this little after an impact is at the impact's instant (ROS stamps are
+/// whole nanoseconds): one that lacks the impact there keeps the monitor's motion after it (taken,
+/// the pair would strike again there and the impact be published twice).
+inline constexpr double kSameInstant = 1e-9;
 
 /// What the monitor knows of a body: a state from which its motion is predicted.
 struct Track {

@@ -133,8 +133,8 @@ void applyStates(World& world, const std::vector<BodyStateSample>& states, StepR
       const double missing = -(state.velocity - predicted).dot(track.impact_change) / change;
       if (missing > 0.5 * change) {
         // At the impact's very instant the motion before it is as true as the one after: the
-        // monitor's after is kept (taken, the pair would strike again there).
-        if (state.time == track.last_impact_time) continue;
+        // monitor's after is kept (kSameInstant).
+        if (state.time - track.last_impact_time <= monitor::kSameInstant) continue;
         report.contradicted.push_back({state.body, track.last_impact_time, state.time, missing});
       }
     }

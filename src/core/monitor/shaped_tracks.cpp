@@ -475,7 +475,7 @@ void takeStates(const World& world, ShapedRoom& room, double time,
       const double change = track->impact_change.norm();
       const double missing = -(state.velocity - predicted).dot(track->impact_change) / change;
       if (missing > 0.5 * change) {
-        if (state.time == track->last_impact_time) continue;
+        if (state.time - track->last_impact_time <= kSameInstant) continue;
         report.contradicted.push_back({state.body, track->last_impact_time, state.time, missing});
       }
     }
