@@ -521,19 +521,7 @@ Expected<LastingMotion> tipOverFaceEdge(const LastingBody& body, const FlatFace&
     }
   }
   path->until_time = until;
-  const PathState first = path->stateAt(body.time);
-  LastingMotion motion;
-  motion.state = first.state;
-  motion.start = body.time;
-  motion.until = until;
-  motion.ends = ends;
-  motion.centre0 = first.centre;
-  motion.velocity0 = first.velocity;
-  motion.angular_velocity0 = first.angular_velocity;
-  motion.orientation0 = first.orientation;
-  motion.forces = first.forces;
-  motion.pivot = path;
-  return motion;
+  return LastingMotion::integrated(path, until, ends);
 }
 
 std::optional<std::pair<FaceEdge, Eigen::Vector3d>> tiltedOverEdge(const LastingBody& body,

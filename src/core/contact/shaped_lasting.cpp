@@ -59,6 +59,23 @@ Eigen::Quaterniond LastingMotion::orientationAt(double t) const {
   return Eigen::Quaterniond(Eigen::AngleAxisd(angle, turn / angle)) * orientation0;
 }
 
+LastingMotion LastingMotion::integrated(std::shared_ptr<const LastingPath> path, double until,
+                                        std::string ends) {
+  const PathState first = path->stateAt(path->start());
+  LastingMotion motion;
+  motion.state = first.state;
+  motion.start = path->start();
+  motion.until = until;
+  motion.ends = std::move(ends);
+  motion.centre0 = first.centre;
+  motion.velocity0 = first.velocity;
+  motion.angular_velocity0 = first.angular_velocity;
+  motion.orientation0 = first.orientation;
+  motion.forces = first.forces;
+  motion.pivot = std::move(path);
+  return motion;
+}
+
 std::vector<SupportForce> LastingMotion::forcesAt(double t) const {
   if (pivot) return pivot->stateAt(t).forces;
   if (forces_over) return forces_over(t);
@@ -958,6 +975,24 @@ Expected<std::vector<SupportForce>> overhangForces(const Support& support, const
   return forces;
 }
 
+/// The closed-form motion `plan` from `body` (its orientation `orientation`), its manifold
+/// `forces` at the start.
+LastingMotion plannedMotion(const LastingBody& body, const Plan& plan,
+                            const Eigen::Quaterniond& orientation,
+                            std::vector<SupportForce> forces) {
+  LastingMotion motion;
+  motion.state = plan.state;
+  motion.start = body.time;
+  motion.centre0 = body.centre;
+  motion.velocity0 = plan.velocity;
+  motion.acceleration = plan.acceleration;
+  motion.angular_velocity0 = plan.angular_velocity;
+  motion.angular_acceleration = plan.angular_acceleration;
+  motion.orientation0 = orientation;
+  motion.forces = std::move(forces);
+  return motion;
+}
+
 /// A face or a cap past a bounded face's edge (`overhang`), moving by `plan` (resting or
 /// sliding, without turning) with its centre of pressure `pressure`: where that is past the
 /// edge's line (within the touching band), the body tips over the edge (tipOverFaceEdge); else
@@ -980,14 +1015,8 @@ Expected<LastingMotion> overhangMotion(const LastingBody& body, const FlatFace& 
   }
   auto forces = overhangForces(support, setting, edge, pressure, total, friction_ratio);
   if (!forces) return forces.error();
-  LastingMotion motion;
-  motion.state = plan.state;
-  motion.start = body.time;
-  motion.centre0 = body.centre;
-  motion.velocity0 = plan.velocity;
-  motion.acceleration = plan.acceleration;
-  motion.orientation0 = body.orientation.normalized();
-  motion.forces = forces.value();
+  LastingMotion motion =
+      plannedMotion(body, plan, body.orientation.normalized(), std::move(forces.value()));
   motion.forces_over = [support, setting, edge, pressure, total, friction_ratio, start = body.time,
                         v = plan.velocity, a = plan.acceleration](double t) {
     const double s = t - start;
@@ -1086,16 +1115,7 @@ Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& f
   if (!forces && cornered) return pivotOnFace(body, face, support.corners, tolerance);
   if (!forces) return forces.error();
 
-  LastingMotion motion;
-  motion.state = plan.state;
-  motion.start = body.time;
-  motion.centre0 = body.centre;
-  motion.velocity0 = plan.velocity;
-  motion.acceleration = plan.acceleration;
-  motion.angular_velocity0 = plan.angular_velocity;
-  motion.angular_acceleration = plan.angular_acceleration;
-  motion.orientation0 = orientation;
-  motion.forces = forces.value();
+  LastingMotion motion = plannedMotion(body, plan, orientation, std::move(forces.value()));
   const double edge = edgeReached(outline, face, plan.track);
   double lasts = plan.lasts;
   motion.ends = plan.ends;

@@ -122,6 +122,10 @@ struct LastingMotion {
   /// its points and forces at t; empty where they move with the centre.
   std::function<std::vector<SupportForce>(double)> forces_over;
 
+  /// The motion along an integrated `path` from its start to `until`, ending as `ends` says.
+  static LastingMotion integrated(std::shared_ptr<const LastingPath> path, double until,
+                                  std::string ends);
+
   Eigen::Vector3d centreAt(double t) const;
   Eigen::Vector3d velocityAt(double t) const;
   Eigen::Vector3d angularVelocityAt(double t) const;

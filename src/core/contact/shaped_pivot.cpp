@@ -702,8 +702,6 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
   path->initial_points = points;
   path->modes.push_back(points);
 
-  LastingMotion motion;
-  motion.start = body.time;
   const double end = body.time + horizon;
   double t = body.time;
   State y = pack(k);
@@ -742,18 +740,7 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
     y = pack(change.there);
   }
   path->until = until;
-  auto pivot = std::make_shared<const PivotPath>(std::move(path));
-  const PathState first_state = pivot->stateAt(body.time);
-  motion.state = first_state.state;
-  motion.until = until;
-  motion.ends = ends;
-  motion.centre0 = first_state.centre;
-  motion.velocity0 = first_state.velocity;
-  motion.angular_velocity0 = first_state.angular_velocity;
-  motion.orientation0 = first_state.orientation;
-  motion.forces = first_state.forces;
-  motion.pivot = pivot;
-  return motion;
+  return LastingMotion::integrated(std::make_shared<const PivotPath>(std::move(path)), until, ends);
 }
 
 }  // namespace collision_response::core
