@@ -264,6 +264,16 @@ TEST(ShapedEdgeTip, WhatIsNotModelledIsRefusedByName) {
   LastingBody block =
       box(V(0.1, 0.05, 0.03), 1, V(1.0, 0, 0.73), Q(Eigen::AngleAxisd(0.3, V::UnitZ())));
   refused(lastingOnFace(block, smooth), "not yet: tipping over the face's edge about an axis");
+  // A can on its side, its end just at the edge (within the band), rests: a side over the edge
+  // is refused only once it is past it.
+  LastingBody lying =
+      cylinder(0.033, 0.06, 0.35, 0.35 * 0.033 * 0.033 / 2, V(1.0 - 0.06 + 5e-10, 0, 0.733),
+               Q(Eigen::AngleAxisd(M_PI / 2, V::UnitY())));
+  const auto rests = lastingOnFace(lying, table);
+  ASSERT_TRUE(rests.ok()) << errorOf(rests);
+  EXPECT_EQ(rests->state, ContactState::kResting);
+  lying.centre.x() += 1e-6;
+  refused(lastingOnFace(lying, table), "not yet: the body overhangs the face's edge");
 }
 
 }  // namespace

@@ -260,7 +260,7 @@ double eventValue(const Setting& k, const State& y, Mode mode, double sigma, Wha
       return std::min(at, 1 - at);
     }
     case What::kFlat:
-      return y[1] > 0 || y[3] >= 0 ? 1.0 : -1.0;
+      return y[1] >= 0 || y[3] >= 0 ? 1.0 : -1.0;  // turned back below flat, still turning back
     case What::kUpright:
       return 0.5 * kPi - y[1];
   }

@@ -1081,7 +1081,10 @@ Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& f
   if (Status status = checkOnFace(body, face, support, setting); !status) return status.error();
   // Outlines taken before supportForces chooses a cap's four points.
   const std::vector<Vec> outline = outlineOf(support, face.along_u, face.along_v);
-  const auto overhang = overhangOf(outline, face);
+  // A side's line over the edge is checkOnFace's (not modelled yet); a face or a cap goes on.
+  const auto overhang = support.kind == SupportKind::kLine
+                            ? Expected<std::optional<Overhang>>(std::optional<Overhang>{})
+                            : overhangOf(outline, face);
   if (!overhang) return overhang.error();
   if (!spin) {
     if (cornered && !overhang.value()) return pivotOnFace(body, face, support.corners, tolerance);
