@@ -111,9 +111,8 @@ TEST(CanKnock, TheCanIsStruckSlidesToTheEdgeTurnsOverItAndFallsAsTheClosedFormsS
 
   // The played path: the slide's closed form, the turn over the edge, the flight's energy.
   const double inertia = kMass * (3 * kRadius * kRadius + 4 * kHalfLength * kHalfLength) / 12;
-  std::size_t sliding = 0, flying = 0;
+  std::size_t sliding = 0, flying = 0, tilted_after = 0, upright_after = 0;
   double flight_energy = NAN;
-  bool tilted_after = false;
   for (const Played& p : played) {
     const auto& s = p.state;
     EXPECT_LE(insideTable(s), 1e-6) << "a played state of the can inside the table at " << p.time;
@@ -124,7 +123,11 @@ TEST(CanKnock, TheCanIsStruckSlidesToTheEdgeTurnsOverItAndFallsAsTheClosedFormsS
       EXPECT_LT(tilt(s), 1e-9) << p.time;
       ++sliding;
     }
-    if (p.time > tips && p.time < tips + 0.0101) tilted_after = tilt(s) > 1e-6;
+    // After the tipping's instant every state the player sent once it heard the strike (moved
+    // off its start) is turned over the edge.
+    if (p.time > tips + 1e-3 && s.pose.position.x > kX0 + 1e-9) {
+      ++(tilt(s) > 1e-6 ? tilted_after : upright_after);
+    }
     if (p.time > 0.3 && p.time < lands - 1e-3) {
       const auto& v = s.twist.linear;
       const auto& w = s.twist.angular;
@@ -136,8 +139,11 @@ TEST(CanKnock, TheCanIsStruckSlidesToTheEdgeTurnsOverItAndFallsAsTheClosedFormsS
       ++flying;
     }
   }
-  EXPECT_GE(sliding, 5u);
-  EXPECT_TRUE(tilted_after) << "it turns over the edge from " << tips << " s";
+  // The player hears the strike some tens of ms late (its states lack it until then): the slide's
+  // states are those after it heard, before the tipping.
+  EXPECT_GE(sliding, 1u);
+  EXPECT_GE(tilted_after, 1u);
+  EXPECT_EQ(upright_after, 0u) << "it turns over the edge from " << tips << " s";
   EXPECT_GE(flying, 20u);
 }
 
