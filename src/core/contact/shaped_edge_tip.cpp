@@ -524,6 +524,22 @@ Expected<LastingMotion> tipOverFaceEdge(const LastingBody& body, const FlatFace&
   return LastingMotion::integrated(path, until, ends);
 }
 
+std::array<BoundEdge, 4> edgesOf(const FlatFace& face) {
+  const std::array<Vec, 2> axes{face.along_u, face.along_v};
+  std::array<BoundEdge, 4> edges;
+  for (int k = 0; k < 2; ++k) {
+    for (int s = 0; s < 2; ++s) {
+      BoundEdge& bound = edges[static_cast<std::size_t>(2 * k + s)];
+      bound.axis = k;
+      bound.side = s == 0 ? -1.0 : 1.0;
+      bound.edge.out = bound.side * axes[static_cast<std::size_t>(k)];
+      bound.edge.along = axes[static_cast<std::size_t>(1 - k)];
+      bound.edge.point = face.point + face.half_extent[k] * bound.edge.out;
+    }
+  }
+  return edges;
+}
+
 std::optional<std::pair<FaceEdge, Eigen::Vector3d>> tiltedOverEdge(const LastingBody& body,
                                                                    const FlatFace& face) {
   if (!face.bounded) return std::nullopt;
@@ -536,22 +552,16 @@ std::optional<std::pair<FaceEdge, Eigen::Vector3d>> tiltedOverEdge(const Lasting
   } else if (std::holds_alternative<Cylinder>(body.shape)) {
     ups = {Vec(r.col(2)), Vec(-r.col(2))};
   }
-  const std::array<Vec, 2> axes{face.along_u, face.along_v};
-  for (int k = 0; k < 2; ++k) {
-    for (const double side : {-1.0, 1.0}) {
-      FaceEdge edge;
-      edge.out = side * axes[static_cast<std::size_t>(k)];
-      edge.along = axes[static_cast<std::size_t>(1 - k)];
-      edge.point = face.point + side * face.half_extent[k] * axes[static_cast<std::size_t>(k)];
-      const Vec a = n.cross(edge.out);
-      const Vec e = edge.point + edge.along.dot(body.centre - edge.point) * edge.along;
-      for (const Vec& up : ups) {
-        const double phi = std::atan2(up.dot(edge.out), up.dot(n));
-        if (std::abs(up.dot(a)) > kLastingBand || !(phi > 0 && phi < 0.5 * kPi)) continue;
-        const Vec down = r.transpose() * (-up);
-        const double h = down.dot(coreSupport(body.shape, down)) + marginOf(body.shape);
-        if (std::abs(up.dot(body.centre - e) - h) <= kLastingBand) return std::make_pair(edge, up);
-      }
+  for (const BoundEdge& bound : edgesOf(face)) {
+    const FaceEdge& edge = bound.edge;
+    const Vec a = n.cross(edge.out);
+    const Vec e = edge.point + edge.along.dot(body.centre - edge.point) * edge.along;
+    for (const Vec& up : ups) {
+      const double phi = std::atan2(up.dot(edge.out), up.dot(n));
+      if (std::abs(up.dot(a)) > kLastingBand || !(phi > 0 && phi < 0.5 * kPi)) continue;
+      const Vec down = r.transpose() * (-up);
+      const double h = down.dot(coreSupport(body.shape, down)) + marginOf(body.shape);
+      if (std::abs(up.dot(body.centre - e) - h) <= kLastingBand) return std::make_pair(edge, up);
     }
   }
   return std::nullopt;

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -23,6 +24,15 @@ struct FaceEdge {
   Eigen::Vector3d along = Eigen::Vector3d::UnitY();
   Eigen::Vector3d out = Eigen::Vector3d::UnitX();
 };
+
+/// A bounded face's four edges, each with the bound it is: the face's axis (0: along_u, 1:
+/// along_v) and side (-1, 1).
+struct BoundEdge {
+  FaceEdge edge;
+  int axis = 0;
+  double side = 1.0;
+};
+std::array<BoundEdge, 4> edgesOf(const FlatFace& face);
 
 /// The body, its own flat face (its outward normal -`up`: a box's or a hull's face, a
 /// cylinder's cap) on `edge` of `face`, flat on the face with its centre of pressure at or past the

@@ -871,23 +871,14 @@ Expected<std::optional<Overhang>> overhangOf(const std::vector<Vec>& outline,
                                              const FlatFace& face) {
   std::optional<Overhang> found;
   if (!face.bounded) return found;
-  const std::array<Vec, 2> axes{face.along_u, face.along_v};
-  for (int k = 0; k < 2; ++k) {
-    const Vec& axis = axes[static_cast<std::size_t>(k)];
-    for (const double side : {-1.0, 1.0}) {
-      // At the edge within the band counts: a support that reached it goes on over it.
-      const bool past = std::any_of(outline.begin(), outline.end(), [&](const Vec& point) {
-        return side * (point - face.point).dot(axis) > face.half_extent[k] - kLastingBand;
-      });
-      if (!past) continue;
-      if (found) return notYet("the body overhangs two of the face's edges (its corner)");
-      Overhang overhang;
-      overhang.edge.out = side * axis;
-      overhang.edge.along = axes[static_cast<std::size_t>(1 - k)];
-      overhang.edge.point = face.point + side * face.half_extent[k] * axis;
-      overhang.bound = {k, side};
-      found = overhang;
-    }
+  for (const BoundEdge& bound : edgesOf(face)) {
+    // At the edge within the band counts: a support that reached it goes on over it.
+    const bool past = std::any_of(outline.begin(), outline.end(), [&](const Vec& point) {
+      return bound.edge.out.dot(point - face.point) > face.half_extent[bound.axis] - kLastingBand;
+    });
+    if (!past) continue;
+    if (found) return notYet("the body overhangs two of the face's edges (its corner)");
+    found = Overhang{bound.edge, {bound.axis, bound.side}};
   }
   return found;
 }

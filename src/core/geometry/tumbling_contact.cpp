@@ -604,6 +604,18 @@ struct BoundedSide {
   }
 };
 
+/// `body`, found overlapping `side` at `time`, shrunk by `band` (TumblingBody::shrunkBy) where
+/// that is apart: it touches within the band (a box set flush on a table's top, where the
+/// distance of the flush faces rounds below 0). Empty: deeper, it is inside.
+template <class Side>
+std::optional<TumblingBody> shrunkWhereTouching(const Side& side, const TumblingBody& body,
+                                                double time, double band) {
+  TumblingBody shrunk = body.shrunkBy(band);
+  const SurfaceGap within = side.gap(shrunk, time, Approach::kWithout);
+  if (within.overlapping || within.gap_upper < 0) return std::nullopt;
+  return shrunk;
+}
+
 /// Conservative advancement (the header's comment) of side a (`moving`: FlightSide,
 /// BoundedSide) against `side`.
 template <class Moving, class Side>
@@ -634,16 +646,13 @@ FirstContactResult advance(const Moving& moving, const Side& side, double from, 
   const double acceleration = moving.accelerationBound(side, *body);
   SurfaceGap g = side.gap(*body, t, Approach::kWithout);
   if (g.overlapping || g.gap_upper < 0) {
-    // Touching within the manifold's band (a box set flush on a table's top, where the distance
-    // of the flush faces rounds below 0): the contact there, its normal and points those of the
-    // body shrunk by the band, which is apart. Deeper, it is inside.
-    const TumblingBody shrunk = body->shrunkBy(options.manifold_band);
-    const SurfaceGap within = side.gap(shrunk, t, Approach::kWithout);
-    if (within.overlapping || within.gap_upper < 0) {
+    // Touching within the band: the contact there, its normal and points the shrunk body's.
+    const auto touching = shrunkWhereTouching(side, *body, t, options.manifold_band);
+    if (!touching) {
       result.inside_at_start = true;
       return result;
     }
-    contactAt(shrunk, t);
+    contactAt(*touching, t);
     return result;
   }
   for (; result.steps < options.max_steps; ++result.steps) {
@@ -745,6 +754,12 @@ TumblingBody TumblingBody::shrunkBy(double distance) const {
 SurfaceGap gapAt(const TumblingBody& body, const PlacedShape& obstacle, double time,
                  double distance_tolerance) {
   return obstacleGap(body, time, shapeAt(obstacle, time), distance_tolerance);
+}
+
+bool insideBeyond(const TumblingBody& body, const PlacedShape& obstacle, double time, double band) {
+  const ObstacleSide side{obstacle, FirstContactOptions{}.distance_tolerance};
+  const SurfaceGap gap = side.gap(body, time, Approach::kWithout);
+  return (gap.overlapping || gap.gap_upper < 0) && !shrunkWhereTouching(side, body, time, band);
 }
 
 SurfaceGap gapAt(const TumblingBody& a, const TumblingBody& b, double time,

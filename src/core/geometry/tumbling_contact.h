@@ -199,6 +199,11 @@ struct BoundedMotion {
 /// The gap between `body` and `obstacle` (moved to `time` by shapeAt) at `time`.
 SurfaceGap gapAt(const TumblingBody& body, const PlacedShape& obstacle, double time,
                  double distance_tolerance = 1e-12);
+/// Whether `body` is inside `obstacle` at `time` by more than `band`: overlapping it, and still
+/// so shrunk by `band` (TumblingBody::shrunkBy; flush faces whose distance rounds below 0 touch).
+/// The first contact (firstContact) counts such a start inside (inside_at_start), a touching one
+/// its contact.
+bool insideBeyond(const TumblingBody& body, const PlacedShape& obstacle, double time, double band);
 /// The gap between two tumbling bodies at `time`.
 SurfaceGap gapAt(const TumblingBody& a, const TumblingBody& b, double time,
                  double distance_tolerance = 1e-12);

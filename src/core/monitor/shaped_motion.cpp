@@ -280,11 +280,7 @@ BodyStateSample ShapedMotion::stateOn(const TumblingBody& flight, double time) c
 
 std::optional<std::size_t> ShapedMotion::insideAtStart() const {
   for (const Watched& w : obstacles_) {
-    const SurfaceGap gap = gapAt(flight_, w.placed.placed, time_);
-    if (!(gap.overlapping || gap.gap_upper < 0)) continue;
-    // Touching within the band (a box set on a table's top, its faces flush) is not inside.
-    const SurfaceGap within = gapAt(flight_.shrunkBy(kLastingBand), w.placed.placed, time_);
-    if (within.overlapping || within.gap_upper < 0) return w.placed.obstacle;
+    if (insideBeyond(flight_, w.placed.placed, time_, kLastingBand)) return w.placed.obstacle;
   }
   return std::nullopt;
 }
