@@ -48,12 +48,24 @@ constexpr double kEventResolution = 1e-13;
 
 Error notYet(const std::string& what) { return Error{"contact", "not yet: " + what}; }
 
-/// One point touching: a corner of the body (principal frame) and how it moves.
+/// A part of the body that can touch the face, in its principal frame: a corner (`radius` 0), a
+/// capsule's end (a ball about `centre`: `axis` zero) or a cylinder's rim (the circle of
+/// `radius` about `centre` across `axis`, the cap's unit normal out of the body).
+struct Feature {
+  Vec centre = Vec::Zero();
+  Vec axis = Vec::Zero();
+  double radius = 0.0;
+};
+
+/// One point touching: which feature of the body, and how it moves.
 struct Point {
-  Vec corner = Vec::Zero();
+  std::size_t feature = 0;
   bool sliding = false;
   /// Unit, in the face: the slip's direction while it is too slow to give one (its onset).
   Vec direction = Vec::Zero();
+  /// A rim's: unit, in its plane (principal frame), the direction of its point touching where
+  /// that plane is along the face (the cap flat: every point of the rim equally low).
+  Vec lean = Vec::Zero();
 };
 
 /// The body and the face, fixed over the motion.
@@ -64,7 +76,7 @@ struct Setting {
   FlatFace face;
   Vec n, e1, e2;
   double mu = 0.0;
-  std::vector<Vec> corners;  // every corner of the body (principal frame)
+  std::vector<Feature> features;  // every corner, end or rim of the body
 };
 
 struct Kinematics {
@@ -90,9 +102,37 @@ State pack(const Kinematics& k) {
           k.velocity.x(), k.velocity.y(), k.velocity.z()};
 }
 
-/// A point's velocity's part in the face.
+/// Below this |n x a|, a rim's plane is along the face: its point touching is its `lean`'s.
+constexpr double kRimFlat = 1e-12;
+
+/// Where a point touches: its lever from the centre of mass (world) and the rate at which it
+/// moves over the body (`over`, world: 0 at a corner). A ball's lowest point is c - rho n, which
+/// moves over it at rho w x n; a rim's is c + rho d with d the unit -(n - (n.a) a) in its plane
+/// (a its axis), which moves over it at rho (d' - w x d), d' from a' = w x a.
+struct Contact {
+  Vec lever = Vec::Zero();
+  Vec over = Vec::Zero();
+};
+
+Contact contactOf(const Setting& s, const Kinematics& k, const Point& p) {
+  const Feature& f = s.features[p.feature];
+  const Vec centre = k.rotation * f.centre;
+  if (f.radius == 0.0) return {centre, Vec::Zero()};
+  if (f.axis.isZero()) return {centre - f.radius * s.n, f.radius * k.spin.cross(s.n)};
+  const Vec a = k.rotation * f.axis;
+  const Vec across = a.cross(s.n.cross(a));  // n - (n.a) a, without its cancellation
+  const double tilt = across.norm();
+  if (tilt <= kRimFlat) return {centre + f.radius * (k.rotation * p.lean), Vec::Zero()};
+  const Vec d = -across / tilt;
+  const Vec a_rate = k.spin.cross(a);
+  const Vec across_rate = -s.n.dot(a_rate) * a - s.n.dot(a) * a_rate;
+  const Vec d_rate = (d * d.dot(across_rate) - across_rate) / tilt;
+  return {centre + f.radius * d, f.radius * (d_rate - k.spin.cross(d))};
+}
+
+/// A point's velocity's part in the face (of the body's point there).
 Vec slipOf(const Setting& s, const Kinematics& k, const Point& p) {
-  const Vec u = k.velocity + k.spin.cross(k.rotation * p.corner);
+  const Vec u = k.velocity + k.spin.cross(contactOf(s, k, p).lever);
   return u - u.dot(s.n) * s.n;
 }
 
@@ -137,7 +177,7 @@ std::vector<Vec> solveConditions(const Setting& s, const Kinematics& k,
                                  const Eigen::Matrix3d& inverse_inertia) {
   if (points.empty()) return {};  // flying: no force
   std::vector<Vec> levers;
-  for (const Point& p : points) levers.push_back(k.rotation * p.corner);
+  for (const Point& p : points) levers.push_back(contactOf(s, k, p).lever);
   std::vector<std::pair<std::size_t, Vec>> rows;
   for (std::size_t i = 0; i < points.size(); ++i) {
     rows.emplace_back(i, s.n);
@@ -173,10 +213,13 @@ Dynamics dynamicsOf(const Setting& s, const Kinematics& k, const std::vector<Poi
   const Eigen::Matrix3d inverse_inertia =
       k.rotation * s.moments.cwiseInverse().asDiagonal() * k.rotation.transpose();
   const Vec gyroscopic = -inverse_inertia * k.spin.cross(inertia * k.spin);
+  // A point's acceleration without the forces; where it moves over the body (a ball's, a rim's)
+  // the body's point there changes at w x (its rate over the body) besides.
   std::vector<Vec> free;
   for (const Point& p : points) {
-    const Vec r = k.rotation * p.corner;
-    free.push_back(s.gravity + gyroscopic.cross(r) + k.spin.cross(k.spin.cross(r)));
+    const Contact c = contactOf(s, k, p);
+    free.push_back(s.gravity + gyroscopic.cross(c.lever) +
+                   k.spin.cross(k.spin.cross(c.lever) + c.over));
   }
   Dynamics d;
   d.forces =
@@ -184,7 +227,7 @@ Dynamics dynamicsOf(const Setting& s, const Kinematics& k, const std::vector<Poi
   Vec total = Vec::Zero(), moment = Vec::Zero();
   for (std::size_t i = 0; i < points.size(); ++i) {
     total += d.forces[i];
-    moment += (k.rotation * points[i].corner).cross(d.forces[i]);
+    moment += contactOf(s, k, points[i]).lever.cross(d.forces[i]);
   }
   d.acceleration = s.gravity + total / s.mass;
   d.angular_acceleration = gyroscopic + inverse_inertia * moment;
@@ -220,7 +263,7 @@ Kinematics settle(const Setting& s, Kinematics k, const std::vector<Point>& poin
       k.rotation * s.moments.cwiseInverse().asDiagonal() * k.rotation.transpose();
   std::vector<Vec> free;
   for (const Point& p : points) {
-    free.push_back(k.velocity + k.spin.cross(k.rotation * p.corner));
+    free.push_back(k.velocity + k.spin.cross(contactOf(s, k, p).lever));
   }
   std::vector<Point> frictionless = points;
   Setting plain = s;
@@ -231,16 +274,19 @@ Kinematics settle(const Setting& s, Kinematics k, const std::vector<Point>& poin
   Vec total = Vec::Zero(), moment = Vec::Zero();
   for (std::size_t i = 0; i < points.size(); ++i) {
     total += impulses[i];
-    moment += (k.rotation * points[i].corner).cross(impulses[i]);
+    moment += contactOf(s, k, points[i]).lever.cross(impulses[i]);
   }
   k.velocity += total / s.mass;
   k.spin += inverse_inertia * moment;
   return k;
 }
 
-/// The height of the body's point `corner` above the face.
-double heightOf(const Setting& s, const Kinematics& k, const Vec& corner) {
-  return s.n.dot(k.centre + k.rotation * corner - s.face.point);
+/// The height of a feature's lowest point above the face (a rim's: its centre's less rho |n x a|).
+double heightOf(const Setting& s, const Kinematics& k, const Feature& f) {
+  const double centre = s.n.dot(k.centre + k.rotation * f.centre - s.face.point);
+  if (f.radius == 0.0) return centre;
+  if (f.axis.isZero()) return centre - f.radius;
+  return centre - f.radius * s.n.cross(k.rotation * f.axis).norm();
 }
 
 /// How far a sticking point's force is within its cone (mu N, to the solve's rounding): < 0
@@ -260,8 +306,9 @@ std::optional<Vec> slipOnset(const Setting& s, const Kinematics& k, std::vector<
   const auto along = [&](double angle) {
     points[which].direction = std::cos(angle) * s.e1 + std::sin(angle) * s.e2;
     const Dynamics d = dynamicsOf(s, k, points);
-    const Vec r = k.rotation * points[which].corner;
-    const Vec a = d.acceleration + d.angular_acceleration.cross(r) + k.spin.cross(k.spin.cross(r));
+    const Contact c = contactOf(s, k, points[which]);
+    const Vec a = d.acceleration + d.angular_acceleration.cross(c.lever) +
+                  k.spin.cross(k.spin.cross(c.lever) + c.over);
     const Vec in_face = a - a.dot(s.n) * s.n;
     return std::make_pair(in_face.cross(points[which].direction).dot(s.n),
                           in_face.dot(points[which].direction));
@@ -320,18 +367,29 @@ Expected<std::vector<Point>> modesAt(const Setting& s, const Kinematics& k,
   return notYet("a tipping whose corners' sticking and sliding do not settle");
 }
 
-/// Every corner of a box or hull (principal frame); empty for a shape with none.
-std::optional<std::vector<Vec>> cornersOf(const ConvexShape& shape) {
+/// Every feature of the body that can touch a face: a box's or hull's corners, a cylinder's two
+/// rims, a capsule's two ends (its axis z; the end at -half_length first); empty for a ball.
+std::vector<Feature> featuresOf(const ConvexShape& shape) {
+  std::vector<Feature> features;
   if (const auto* box = std::get_if<Cuboid>(&shape)) {
-    std::vector<Vec> corners;
     for (int c = 0; c < 8; ++c) {
-      corners.push_back(Vec((c & 1) ? 1.0 : -1.0, (c & 2) ? 1.0 : -1.0, (c & 4) ? 1.0 : -1.0)
-                            .cwiseProduct(box->half_size));
+      features.push_back({Vec((c & 1) ? 1.0 : -1.0, (c & 2) ? 1.0 : -1.0, (c & 4) ? 1.0 : -1.0)
+                              .cwiseProduct(box->half_size)});
     }
-    return corners;
+  } else if (const auto* hull = std::get_if<ConvexHull>(&shape)) {
+    for (const Vec& vertex : hull->vertices) features.push_back({vertex});
+  } else if (const auto* cylinder = std::get_if<Cylinder>(&shape)) {
+    for (const double side : {-1.0, 1.0}) {
+      features.push_back(
+          {side * cylinder->half_length * Vec::UnitZ(), side * Vec::UnitZ(), cylinder->radius});
+    }
+  } else if (const auto* capsule = std::get_if<Capsule>(&shape)) {
+    for (const double side : {-1.0, 1.0}) {
+      features.push_back(
+          {side * capsule->half_length * Vec::UnitZ(), Vec::Zero(), capsule->radius});
+    }
   }
-  if (const auto* hull = std::get_if<ConvexHull>(&shape)) return hull->vertices;
-  return std::nullopt;
+  return features;
 }
 
 /// What ends a segment of the motion: each a function of the state that reaches <= 0.
@@ -342,43 +400,73 @@ struct Event {
   std::function<double(const Kinematics&)> value;
 };
 
-/// Each corner's height over the lowest point touching (the one stateAt puts on the face): their
-/// drift is not a corner's approach.
+/// Each feature's height over the lowest point touching (the one stateAt puts on the face):
+/// their drift is not a feature's approach.
 struct Above {
   const Setting& s;
   const std::vector<Point>& current;
-  double operator()(const Kinematics& x, const Vec& corner) const {
+  double operator()(const Kinematics& x, const Feature& feature) const {
     double base = current.empty() ? 0.0 : std::numeric_limits<double>::infinity();
-    for (const Point& p : current) base = std::min(base, heightOf(s, x, p.corner));
-    return heightOf(s, x, corner) - base;
+    for (const Point& p : current) base = std::min(base, heightOf(s, x, s.features[p.feature]));
+    return heightOf(s, x, feature) - base;
   }
 };
 
+/// How far a touching rim's cap is from lying flat on the face, signed along `towards` (in the
+/// face: where its point touching was at the step's start, so that the rim's turning about the
+/// normal does not move it): rho (the cap's normal out of the body . -towards), which passes 0
+/// where the cap lands flat.
+double capTilt(const Kinematics& x, const Feature& rim, const Vec& towards) {
+  return -rim.radius * towards.dot(x.rotation * rim.axis);
+}
+
+/// Where a touching rim's point is, in the face (unit), at `k`; zero for a corner or an end.
+Vec rimTowards(const Setting& s, const Kinematics& k, const Point& p) {
+  const Feature& f = s.features[p.feature];
+  if (f.radius == 0.0 || f.axis.isZero()) return Vec::Zero();
+  const Vec lever = contactOf(s, k, p).lever - k.rotation * f.centre;
+  const Vec in_face = lever - lever.dot(s.n) * s.n;
+  return in_face.norm() > 0 ? Vec(in_face.normalized()) : Vec::Zero();
+}
+
 /// The events of a step of the segment with `current` touching, from `start` (the state at the
-/// step's start): another corner reaching the face (one below it as the segment began, one that
-/// just left, where it comes back 1e-12 m below where it was: `below`), a point leaving (its
-/// normal force 0), a sticking point leaving its cone, a sliding one's slip stopping, a point
-/// reaching a bounded face's edge, and, lifted off, the lowest corner `clearance` above the face.
+/// step's start): another feature reaching the face (one below it as the segment began, one
+/// that just left, where it comes back 1e-12 m below where it was: `below`), a touching rim's cap
+/// landing flat (where its tilt, signed along where its point touched at the step's start,
+/// passes `flat`: 0, or 1e-12 m below a segment's start flat), a point leaving (its normal force
+/// 0), a sticking point leaving its cone, a sliding one's slip stopping, a point reaching a bounded
+/// face's edge, and, lifted off, the lowest feature `clearance` above the face.
 std::vector<Event> eventsOf(const Setting& s, const std::vector<Point>& current, const Above& above,
-                            const std::vector<double>& below, double clearance,
-                            const Kinematics& start) {
+                            const std::vector<double>& below, const std::vector<double>& flat,
+                            double clearance, const Kinematics& start) {
   std::vector<Event> events;
-  for (std::size_t c = 0; c < s.corners.size(); ++c) {
-    const Vec& corner = s.corners[c];
+  for (std::size_t c = 0; c < s.features.size(); ++c) {
     bool touching = false;
-    for (const Point& p : current) touching = touching || (p.corner - corner).norm() == 0.0;
+    for (const Point& p : current) touching = touching || p.feature == c;
     if (touching) continue;
     const double level = below[c] < 0 ? below[c] - 1e-12 : 0.0;
-    events.push_back({What::kCorner, 0, [&above, corner, level](const Kinematics& x) {
-                        return above(x, corner) - level;
+    events.push_back(
+        {What::kCorner, 0, [&above, &feature = s.features[c], level](const Kinematics& x) {
+           return above(x, feature) - level;
+         }});
+  }
+  for (std::size_t i = 0; i < current.size(); ++i) {
+    const Vec towards = rimTowards(s, start, current[i]);
+    const double level = flat[i];
+    if (towards.isZero()) continue;
+    events.push_back({What::kCorner, 0,
+                      [&rim = s.features[current[i].feature], towards, level](const Kinematics& x) {
+                        return capTilt(x, rim, towards) - level;
                       }});
   }
   if (current.empty()) {
-    // Lifted off: flying until its lowest corner is kPivotClearance of its reach above the
-    // face (the certified first contact takes it from there) or a corner lands.
+    // Lifted off: flying until its lowest feature is kPivotClearance of its reach above the
+    // face (the certified first contact takes it from there) or one lands.
     events.push_back({What::kClear, 0, [&s, clearance](const Kinematics& x) {
                         double lowest = std::numeric_limits<double>::infinity();
-                        for (const Vec& c : s.corners) lowest = std::min(lowest, heightOf(s, x, c));
+                        for (const Feature& f : s.features) {
+                          lowest = std::min(lowest, heightOf(s, x, f));
+                        }
                         return clearance - lowest;
                       }});
   }
@@ -422,7 +510,7 @@ std::vector<Event> eventsOf(const Setting& s, const std::vector<Point>& current,
       events.push_back(
           {What::kEdge, i, [&s, &current, i](const Kinematics& x) {
              const FlatFace& face = s.face;
-             const Vec offset = x.centre + x.rotation * current[i].corner - face.point;
+             const Vec offset = x.centre + contactOf(s, x, current[i]).lever - face.point;
              return std::min(
                  face.half_extent.x() + kLastingBand - std::abs(offset.dot(face.along_u)),
                  face.half_extent.y() + kLastingBand - std::abs(offset.dot(face.along_v)));
@@ -557,13 +645,13 @@ PathState PivotPath::stateAt(double t) const {
     points = &path.modes[step.points];
   }
   const Setting& s = path.setting;
-  // The lowest corner a hair (kPivotHair) above the face: the integration's drift of the points'
-  // height (within its tolerance) is taken out along n, and no corner is below the face (one
-  // that reaches it ends the motion: its events take over from a body touching, never
+  // The lowest feature a hair (kPivotHair) above the face: the integration's drift of the
+  // points' height (within its tolerance) is taken out along n, and no feature is below the face
+  // (one that reaches it ends the motion: its events take over from a body touching, never
   // overlapping, even by the distance's tolerance against a box). Lifted off (no point
-  // touching), only a corner below the hair is lifted.
+  // touching), only a feature below the hair is lifted.
   double lowest = std::numeric_limits<double>::infinity();
-  for (const Vec& corner : s.corners) lowest = std::min(lowest, heightOf(s, k, corner));
+  for (const Feature& f : s.features) lowest = std::min(lowest, heightOf(s, k, f));
   if (!points->empty() || lowest < kPivotHair) k.centre += (kPivotHair - lowest) * s.n;
   PathState state;
   state.centre = k.centre;
@@ -576,7 +664,7 @@ PathState PivotPath::stateAt(double t) const {
     const Point& p = (*points)[i];
     sliding = sliding || p.sliding;
     SupportForce force;
-    const Vec at = k.centre + k.rotation * p.corner;
+    const Vec at = k.centre + contactOf(s, k, p).lever;
     force.point = at - s.n.dot(at - s.face.point) * s.n;
     force.normal_force = d.forces[i].dot(s.n);
     force.friction_force = d.forces[i] - force.normal_force * s.n;
@@ -588,19 +676,18 @@ PathState PivotPath::stateAt(double t) const {
 
 namespace {
 
-/// The motion's start: the body's state as `k`, the points of `corners` touching, each sliding
-/// where it slips (faster than kLastingStillSpeed, or the face is frictionless) and sticking
-/// with its slip taken out otherwise (settle), then the modes the forces there allow (modesAt).
+/// The motion's start: the body's state as `k`, `touching` touching, each sliding where it slips
+/// (faster than kLastingStillSpeed, or the face is frictionless) and sticking with its slip
+/// taken out otherwise (settle), then the modes the forces there allow (modesAt).
 Expected<std::vector<Point>> startOf(const Setting& s, const LastingBody& body,
-                                     const std::vector<Vec>& corners, Kinematics& k) {
+                                     std::vector<Point> touching, Kinematics& k) {
   k.orientation = body.orientation.normalized();
   k.rotation = k.orientation.toRotationMatrix();
   k.centre = body.centre;
   k.velocity = body.velocity;
   k.spin = body.angular_velocity;
   std::vector<Point> points;
-  for (const Vec& corner : corners) {
-    Point p{corner, false, Vec::Zero()};
+  for (Point p : touching) {
     const Vec slip = slipOf(s, k, p);
     p.sliding = s.mu == 0.0 || slip.norm() > kLastingStillSpeed;
     p.direction = slip.norm() > kLastingStillSpeed ? Vec(slip.normalized()) : s.e1;
@@ -629,10 +716,18 @@ Expected<SegmentEnd> integrateSegment(const Setting& s, PivotPath::Steps& path, 
     derivative(s, current, x, rate);
   };
   const Above above{s, current};
-  // A corner below the lowest point touching at the segment's start (one that just left)
-  // reaches the face where it comes back 1e-12 m below where it was.
+  // A feature below the lowest point touching at the segment's start (one that just left)
+  // reaches the face where it comes back 1e-12 m below where it was; a touching rim's cap lands
+  // where its tilt passes 0, or 1e-12 m below where it began if flat or past.
+  const Kinematics initial = unpack(y);
   std::vector<double> below;
-  for (const Vec& corner : s.corners) below.push_back(std::min(0.0, above(unpack(y), corner)));
+  for (const Feature& f : s.features) below.push_back(std::min(0.0, above(initial, f)));
+  std::vector<double> flat;
+  for (const Point& p : current) {
+    const Vec towards = rimTowards(s, initial, p);
+    const double tilt = towards.isZero() ? 0.0 : capTilt(initial, s.features[p.feature], towards);
+    flat.push_back(tilt <= 1e-12 ? tilt - 1e-12 : 0.0);
+  }
   Dense dense = boost::numeric::odeint::make_dense_output(tolerance, tolerance, Stepper());
   dense.initialize(y, t, 1e-4);
   for (;;) {
@@ -650,7 +745,7 @@ Expected<SegmentEnd> integrateSegment(const Setting& s, PivotPath::Steps& path, 
       dense.calc_state(time, x);
       return unpack(x);
     };
-    const std::vector<Event> events = eventsOf(s, current, above, below, clearance, at(t0));
+    const std::vector<Event> events = eventsOf(s, current, above, below, flat, clearance, at(t0));
     const auto first = firstEvent(events, at, t0, t1);
     path.steps.push_back({dense, first ? first->first : t1, mode});
     if (first) {
@@ -662,18 +757,8 @@ Expected<SegmentEnd> integrateSegment(const Setting& s, PivotPath::Steps& path, 
   }
 }
 
-}  // namespace
-
-Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& face,
-                                    const std::vector<Eigen::Vector3d>& corners, double tolerance,
-                                    double horizon) {
-  if (corners.empty() || corners.size() > 4) {
-    return Error{"corners", "must be one to four of the body's corners, got " +
-                                std::to_string(corners.size())};
-  }
-  if (!(tolerance > 0 && std::isfinite(tolerance))) {
-    return Error{"tolerance", "must be finite and > 0, got " + formatNumber(tolerance)};
-  }
+/// The body and the face as the motion sees them: its features (featuresOf), none for a ball.
+std::unique_ptr<PivotPath::Steps> pathFor(const LastingBody& body, const FlatFace& face) {
   auto path = std::make_unique<PivotPath::Steps>();
   Setting& s = path->setting;
   s.moments = body.moments;
@@ -684,17 +769,24 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
   s.e1 = s.n.unitOrthogonal();
   s.e2 = s.n.cross(s.e1);
   s.mu = face.friction;
-  auto all = cornersOf(body.shape);
-  if (!all) {
-    return notYet("tipping of a body with no corners (a cylinder's rim, a capsule's end)");
+  s.features = featuresOf(body.shape);
+  return path;
+}
+
+/// The motion of the body of `path` (pathFor) from `touching` touching the face.
+Expected<LastingMotion> pivotFrom(const LastingBody& body, std::unique_ptr<PivotPath::Steps> path,
+                                  const std::vector<Point>& touching, double tolerance,
+                                  double horizon) {
+  if (!(tolerance > 0 && std::isfinite(tolerance))) {
+    return Error{"tolerance", "must be finite and > 0, got " + formatNumber(tolerance)};
   }
-  s.corners = *all;
+  const Setting& s = path->setting;
   double reach = 0.0;
-  for (const Vec& corner : s.corners) reach = std::max(reach, corner.norm());
+  for (const Feature& f : s.features) reach = std::max(reach, f.centre.norm() + f.radius);
   const double clearance = kPivotClearance * reach;
 
   Kinematics k;
-  auto start = startOf(s, body, corners, k);
+  auto start = startOf(s, body, touching, k);
   if (!start) return start.error();
   const std::vector<Point> points = std::move(start.value());
   path->start = body.time;
@@ -741,6 +833,60 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
   }
   path->until = until;
   return LastingMotion::integrated(std::make_shared<const PivotPath>(std::move(path)), until, ends);
+}
+
+}  // namespace
+
+Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& face,
+                                    const std::vector<Eigen::Vector3d>& corners, double tolerance,
+                                    double horizon) {
+  if (corners.empty() || corners.size() > 4) {
+    return Error{"corners", "must be one to four of the body's corners, got " +
+                                std::to_string(corners.size())};
+  }
+  if (!std::holds_alternative<Cuboid>(body.shape) &&
+      !std::holds_alternative<ConvexHull>(body.shape)) {
+    return Error{"body.shape", "corners are a box's or a hull's (a round body: pivotOnRound)"};
+  }
+  auto path = pathFor(body, face);
+  std::vector<Point> touching;
+  for (const Vec& corner : corners) {
+    const auto& features = path->setting.features;
+    const auto found = std::find_if(features.begin(), features.end(), [&](const Feature& f) {
+      return (f.centre - corner).norm() == 0.0;
+    });
+    if (found == features.end()) {
+      return Error{"corners", "each must be one of the body's corners"};
+    }
+    touching.push_back({static_cast<std::size_t>(found - features.begin())});
+  }
+  return pivotFrom(body, std::move(path), touching, tolerance, horizon);
+}
+
+Expected<LastingMotion> pivotOnRound(const LastingBody& body, const FlatFace& face,
+                                     const std::vector<int>& ends, const Eigen::Vector3d& lean,
+                                     double tolerance, double horizon) {
+  if (!std::holds_alternative<Cylinder>(body.shape) &&
+      !std::holds_alternative<Capsule>(body.shape)) {
+    return Error{"body.shape", "rims and ends are a cylinder's or a capsule's"};
+  }
+  if (ends.empty() || ends.size() > 2) {
+    return Error{"ends",
+                 "must be one or both of the body's ends, got " + std::to_string(ends.size())};
+  }
+  const Vec in_plane(lean.x(), lean.y(), 0.0);
+  auto path = pathFor(body, face);
+  std::vector<Point> touching;
+  for (const int end : ends) {
+    if (end != -1 && end != 1) {
+      return Error{"ends", "each must be -1 or 1 (the end at -half_length or +half_length)"};
+    }
+    Point p;
+    p.feature = end < 0 ? 0 : 1;
+    p.lean = in_plane.norm() > 0 ? Vec(in_plane.normalized()) : Vec::UnitX();
+    touching.push_back(p);
+  }
+  return pivotFrom(body, std::move(path), touching, tolerance, horizon);
 }
 
 }  // namespace collision_response::core

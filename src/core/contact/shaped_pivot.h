@@ -4,7 +4,8 @@
 // of it, its corners all stick on a face (it rests), or a corner reaches a bounded face's edge.
 // Each corner sticks (static friction within mu) or slides (Coulomb); the motion has no closed
 // form (a heavy top about a fixed point, a physical pendulum about an edge) and is integrated to
-// a stated tolerance (doc/model.md, "Tipping over a corner or an edge").
+// a stated tolerance (doc/model.md, "Tipping over a corner or an edge"). A cylinder on its rim or a
+// capsule on one end moves by the same law, its point touching moving over the body.
 #pragma once
 
 #include <Eigen/Core>
@@ -64,5 +65,17 @@ class PivotPath : public LastingPath {
 Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& face,
                                     const std::vector<Eigen::Vector3d>& corners, double tolerance,
                                     double horizon = 10.0);
+
+/// A cylinder leaning on a point of its rim, or a capsule on a point of one end, tipping, rolling
+/// or sliding on `face` as pivotOnFace's corners do (the same law, events and ends), where the
+/// point touching moves over the body: a rim's lowest point, an end's point under its centre.
+/// `ends` says which touch (-1: the rim or end at -half_length along the body's z; 1: at
+/// +half_length; both: a side's two ends); `lean` (principal frame, its part across z) is the
+/// direction from a rim's centre to its point touching where the cap is flat on the face (a cap
+/// tipping over its rim). It ends as pivotOnFace's, "resumes" where another rim or end reaches
+/// the face or a touching rim's cap lands flat.
+Expected<LastingMotion> pivotOnRound(const LastingBody& body, const FlatFace& face,
+                                     const std::vector<int>& ends, const Eigen::Vector3d& lean,
+                                     double tolerance, double horizon = 10.0);
 
 }  // namespace collision_response::core
