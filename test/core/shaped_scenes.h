@@ -35,6 +35,55 @@ inline Scene floorScene(double e, const Eigen::Vector3d& half, double mass = 2.0
   return scene;
 }
 
+/// A solid cylinder (r = 0.05 m, 0.2 m long, 1 kg) over the frictionless floor of floorScene,
+/// given at rest leaning on its rim: its axis turned by `tilt` about x, its rim's lowest point
+/// on the floor. Its centre falls straight down (no force along the floor), at the height
+/// z = r sin theta + h cos theta, and m z'^2 theta'^2 / 2 + I_x theta'^2 / 2 + m g z is kept
+/// (I_x = m (3 r^2 + L^2) / 12): below atan(r / h) it falls back onto its cap at theta = 0,
+/// the integral of dtheta / theta' later (landing()).
+struct RimFall {
+  double r = 0.05, h = 0.1, m = 1.0, tilt = 0.3;
+
+  Scene scene() const {
+    Scene made = floorScene(0.5, Eigen::Vector3d(0.05, 0.05, 0.05), m);
+    made.bodies[0].shape = BodyShape::kCylinder;
+    made.bodies[0].size = Eigen::Vector3d::Zero();
+    made.bodies[0].radius = r;
+    made.bodies[0].length = 2 * h;
+    return made;
+  }
+  Eigen::Vector3d centre() const {
+    return Eigen::Vector3d(0, 0, r * std::sin(tilt) + h * std::cos(tilt));
+  }
+  Eigen::Quaterniond orientation() const {
+    return Eigen::Quaterniond(Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitX()));
+  }
+  /// From rest at tilt to 0: with theta = tilt - s^2 the integrand 2 s / theta' is smooth at
+  /// s = 0; 5-point Gauss-Legendre over 400 panels of s in [0, sqrt(tilt)].
+  double landing() const {
+    const double ix = m * (3 * r * r + 4 * h * h) / 12;
+    const auto z = [&](double q) { return r * std::sin(q) + h * std::cos(q); };
+    const auto dz = [&](double q) { return r * std::cos(q) - h * std::sin(q); };
+    const auto rate = [&](double q) {
+      return std::sqrt(2 * m * kG * (z(tilt) - z(q)) / (m * dz(q) * dz(q) + ix));
+    };
+    const double x[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831,
+                         0.9061798459386640};
+    const double w[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889,
+                         0.4786286704993665, 0.2369268850561891};
+    const int panels = 400;
+    const double width = std::sqrt(tilt) / panels;
+    double sum = 0.0;
+    for (int p = 0; p < panels; ++p) {
+      for (int i = 0; i < 5; ++i) {
+        const double s = (p + 0.5 + 0.5 * x[i]) * width;
+        sum += w[i] * 0.5 * width * 2 * s / rate(tilt - s * s);
+      }
+    }
+    return sum;
+  }
+};
+
 /// The edge landing's impacts at one instant against its closed form: at edge.fall() (1e-11 s,
 /// the first contact's certification), each leaving with v_z' and w_y' and no other spin (1e-9),
 /// their impulses adding up to J (1e-9).

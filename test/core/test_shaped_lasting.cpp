@@ -410,9 +410,13 @@ TEST(ShapedLasting, AStandingCylinderOnAnInclineLeansItsWeightTowardsItsLowerRim
   }
   expectBalance(body, incline, *motion, 1e-14);
   expectNeverBelowNorGaining(body, incline, *motion);
-  // Taller (h = 0.3): h tan theta = 0.225 > r, it would tip over its lower rim: refused.
+  // Taller (h = 0.3): h tan theta = 0.225 > r, it tips over its lower rim's point, which alone
+  // carries it (pivotOnRound): sound over its motion.
   const LastingBody tall = cylinder(r, 0.3, m, m * r * r / 2, 0.3 * kInclineNormal, onIncline());
-  expectNotYet(lastingOnFace(tall, incline), "not yet: tipping over");
+  const auto tips = lastingOnFace(tall, incline);
+  expectTips(tall, incline, tips);
+  ASSERT_EQ(tips->forcesAt(tips->start).size(), 1u);
+  EXPECT_LT(tips->forcesAt(tips->start)[0].point.dot(kUphill), -0.1) << "its lower rim";
 }
 
 TEST(ShapedLasting, ABoxSlidingOnAFloorStopsAfterVOverMuGAtVSquaredOverTwoMuG) {
@@ -783,9 +787,10 @@ TEST(ShapedLasting, ACylinderRollingOnATableTopEndsWhereItsSideReachesTheEdge) {
   EXPECT_NEAR(motion->until, 1.5, 1e-15);
   EXPECT_EQ(motion->acceleration, V::Zero());
   expectNeverBelowNorGaining(body, table, *motion);
-  // Turning about the vertical as well: spin about the normal, refused by name.
+  // Turning about the vertical as well: each end of its side slides its own way (Coulomb's
+  // friction at each), which the tipping on its two rims carries (pivotOnRound): sound.
   body.angular_velocity.z() = 0.5;
-  expectNotYet(lastingOnFace(body, table), "not yet: spin about the face's normal");
+  expectTips(body, table, lastingOnFace(body, table));
 }
 
 TEST(ShapedLasting, RandomSlidesAndRollsBalanceNeverGoBelowNorGainEnergy) {

@@ -196,6 +196,7 @@ enum class SupportKind {
   kDisc,     ///< a cylinder's cap: its rim
   kLine,     ///< a cylinder's or capsule's side: the two ends of its lowest line
   kCorners,  ///< one corner or one edge's two: the body tips over them (pivotOnFace)
+  kRound,    ///< one point of a cylinder's rim or a capsule's end: it tips (pivotOnRound)
 };
 
 struct Support {
@@ -206,6 +207,7 @@ struct Support {
   double radius = 0.0;        ///< a disc's, or a side's (the roll's)
   double axial_moment = 0.0;  ///< a side's moment about its axis (the roll's J)
   std::vector<Vec> corners;   ///< the feet's corners in the principal frame (kCorners)
+  int end = 0;                ///< a cap's, or a rim's or end's touching (kRound): -1 or 1 along z
 };
 
 /// The face's frame and what the body is there.
@@ -264,7 +266,7 @@ Status touchesFace(double lowest) {
 
 /// A cylinder's or capsule's support (`radius`, `half_length` along its axis, rotation's z): on
 /// its side, the lowest line's two ends; a cylinder on its cap, the cap's disc; else, leaning on
-/// its rim or one end, not modelled yet.
+/// its rim or one end, the one point touching (kRound: it tips, pivotOnRound).
 Expected<Support> roundSupport(const LastingBody& body, const Eigen::Matrix3d& rotation,
                                const FlatFace& face, const Setting& setting, double radius,
                                double half_length, bool cylinder) {
@@ -282,15 +284,23 @@ Expected<Support> roundSupport(const LastingBody& body, const Eigen::Matrix3d& r
     support.axial_moment = body.moments.z();
     return support;
   }
-  if (cylinder && 2 * radius * axis.cross(n).norm() <= setting.band) {  // on its cap
+  const double side = axis.dot(n) > 0 ? -1.0 : 1.0;  // the cap or end nearer the face
+  support.end = static_cast<int>(side);
+  support.radius = radius;
+  const Vec end = body.centre + side * half_length * axis;
+  const double tilt = axis.cross(n).norm();
+  if (cylinder && 2 * radius * tilt <= setting.band) {  // on its cap
     support.kind = SupportKind::kDisc;
-    const double side = axis.dot(n) > 0 ? -1.0 : 1.0;  // the cap nearer the face
-    support.centre = onFace(body.centre + side * half_length * axis, face, n);
-    support.radius = radius;
+    support.centre = onFace(end, face, n);
     return support;
   }
-  return notYet(cylinder ? "tipping: a cylinder leaning on its rim (one point of it touches)"
-                         : "tipping: a capsule leaning on one end (one point of it touches)");
+  // Leaning on its rim (its lowest point, radius along -(n - (n.a) a)) or on one end (under its
+  // centre): that one point touches, and the body tips.
+  support.kind = SupportKind::kRound;
+  const Vec lowest =
+      cylinder ? Vec(end - radius * axis.cross(n.cross(axis)) / tilt) : Vec(end - radius * n);
+  support.feet = {onFace(lowest, face, n)};
+  return support;
 }
 
 /// Three corners of one face of a box on the face: its fourth is within twice the band (its
@@ -1063,11 +1073,26 @@ Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& f
     }
     return pivotOnFace(body, face, support.corners, tolerance);
   }
+  if (support.kind == SupportKind::kRound) {
+    if (Status status = checkOnFace(body, face, support, setting); !status) {
+      return status.error();
+    }
+    return pivotOnRound(body, face, {support.end}, Vec::Zero(), tolerance);
+  }
   // A box's (or a hull's) face whose turning the closed forms do not carry (a spin about the
   // normal: each corner slides its own way, Coulomb's friction at each; a rocking turn) or whose
   // centre of pressure leaves the support (it tips over an edge of it) moves as the tipping
-  // does, its corners each sticking, sliding or leaving (pivotOnFace).
+  // does, its corners each sticking, sliding or leaving (pivotOnFace); a side that rocks, spins
+  // or tips over an end, and a cap that rocks or tips over its rim, as the tipping on its rims
+  // or ends does (pivotOn).
   const bool cornered = support.kind == SupportKind::kPolygon && !support.corners.empty();
+  const auto pivotOn = [&](const Vec& lean) -> Expected<LastingMotion> {
+    if (cornered) return pivotOnFace(body, face, support.corners, tolerance);
+    if (support.kind == SupportKind::kLine) {
+      return pivotOnRound(body, face, {-1, 1}, Vec::Zero(), tolerance);
+    }
+    return pivotOnRound(body, face, {support.end}, rotation.transpose() * lean, tolerance);
+  };
   const auto spin = keptSpin(support, setting, body.angular_velocity);
   if (Status status = checkOnFace(body, face, support, setting); !status) return status.error();
   // Outlines taken before supportForces chooses a cap's four points.
@@ -1078,7 +1103,13 @@ Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& f
                             : overhangOf(outline, face);
   if (!overhang) return overhang.error();
   if (!spin) {
-    if (cornered && !overhang.value()) return pivotOnFace(body, face, support.corners, tolerance);
+    // A cap rocks over the rim's point its turning lowers fastest (w x n); spinning about the
+    // normal alone, its whole rim slides (not modelled yet).
+    const Vec lowered = body.angular_velocity.cross(setting.n);
+    const bool pivots =
+        cornered || support.kind == SupportKind::kLine ||
+        (support.kind == SupportKind::kDisc && lowered.norm() * setting.reach > kLastingStillSpeed);
+    if (pivots && !overhang.value()) return pivotOn(lowered);
     return spin.error();
   }
 
@@ -1106,7 +1137,9 @@ Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& f
   }
   auto forces = supportForces(support, setting, pressure, total, friction_ratio, rotation,
                               tippingOf(plan.state));
-  if (!forces && cornered) return pivotOnFace(body, face, support.corners, tolerance);
+  // Tipping: a cap over its rim's point towards the centre of pressure.
+  if (!forces && support.kind != SupportKind::kPolygon) return pivotOn(pressure - support.centre);
+  if (!forces && cornered) return pivotOn(Vec::Zero());
   if (!forces) return forces.error();
 
   LastingMotion motion = plannedMotion(body, plan, orientation, std::move(forces.value()));
@@ -1146,7 +1179,9 @@ std::optional<double> flatBouncesEnd(const LastingBody& body, const FlatFace& fa
     auto found = supportOf(body, rotation, face, setting);
     if (!found) return std::nullopt;
     Support support = found.value();
-    if (support.kind == SupportKind::kCorners) return std::nullopt;
+    if (support.kind == SupportKind::kCorners || support.kind == SupportKind::kRound) {
+      return std::nullopt;
+    }
     if (support.kind == SupportKind::kPolygon) {
       const auto [q, p] = inFace(support, setting, setting.foot);
       const std::vector<double> shares = polygonForces(q, p, 1.0, false);
