@@ -874,7 +874,16 @@ Expected<LastingMotion> pivotOnRound(const LastingBody& body, const FlatFace& fa
     return Error{"ends",
                  "must be one or both of the body's ends, got " + std::to_string(ends.size())};
   }
-  const Vec in_plane(lean.x(), lean.y(), 0.0);
+  // No lean given: the rim's point touching as the body is (its lowest; its direction kept
+  // where the cap lands flat, the motion's end).
+  Vec in_plane(lean.x(), lean.y(), 0.0);
+  const Eigen::Matrix3d rotation = body.orientation.normalized().toRotationMatrix();
+  const Vec n = face.normal.normalized(), axis = rotation.col(2);
+  const Vec across = axis.cross(n.cross(axis));
+  if (in_plane.isZero() && across.norm() > kRimFlat) {
+    const Vec down = rotation.transpose() * (-across);
+    in_plane = Vec(down.x(), down.y(), 0.0);
+  }
   auto path = pathFor(body, face);
   std::vector<Point> touching;
   for (const int end : ends) {
