@@ -6,6 +6,8 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "quadrature.h"
+
 namespace collision_response::core::shaped_scenes {
 
 /// A box of half edges (a, b, c) and mass m, turned by theta about y, dropped from rest with its
@@ -44,20 +46,7 @@ struct EdgeLanding {
       return std::sqrt(2 * kGravity * (heightAt(theta) - heightAt(phi)) /
                        (slope * slope + inertia() / m));
     };
-    const double x[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831,
-                         0.9061798459386640};
-    const double w[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889,
-                         0.4786286704993665, 0.2369268850561891};
-    const int panels = 200;
-    const double width = std::sqrt(theta) / panels;
-    double sum = 0.0;
-    for (int p = 0; p < panels; ++p) {
-      for (int i = 0; i < 5; ++i) {
-        const double u = (p + 0.5) * width + 0.5 * width * x[i];
-        sum += w[i] * 0.5 * width * 2 * u / rate(theta - u * u);
-      }
-    }
-    return sum;
+    return quadrature::fromRest(rate, theta, 0.0, 200);
   }
 };
 

@@ -1,6 +1,6 @@
 // Bodies and faces for the lasting-contact tests (test_shaped_lasting.cpp,
-// test_shaped_edge_tip.cpp): a box's and a cylinder's moments in closed form, the energy a
-// motion has at an instant.
+// test_shaped_edge_tip.cpp, test_shaped_pivot.cpp, test_shaped_rim.cpp): a box's and a
+// cylinder's moments in closed form, the energy a motion has at an instant.
 #pragma once
 
 #include <Eigen/Core>

@@ -12,6 +12,7 @@
 #include "collision_response/core/monitor.h"
 #include "collision_response/core/scene.h"
 #include "edge_landing.h"
+#include "quadrature.h"
 #include "scene_builders.h"
 
 namespace collision_response::core::shaped_scenes {
@@ -67,20 +68,7 @@ struct RimFall {
     const auto rate = [&](double q) {
       return std::sqrt(2 * m * kG * (z(tilt) - z(q)) / (m * dz(q) * dz(q) + ix));
     };
-    const double x[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831,
-                         0.9061798459386640};
-    const double w[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889,
-                         0.4786286704993665, 0.2369268850561891};
-    const int panels = 400;
-    const double width = std::sqrt(tilt) / panels;
-    double sum = 0.0;
-    for (int p = 0; p < panels; ++p) {
-      for (int i = 0; i < 5; ++i) {
-        const double s = (p + 0.5 + 0.5 * x[i]) * width;
-        sum += w[i] * 0.5 * width * 2 * s / rate(tilt - s * s);
-      }
-    }
-    return sum;
+    return quadrature::fromRest(rate, tilt, 0.0, 400);
   }
 };
 

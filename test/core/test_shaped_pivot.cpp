@@ -14,15 +14,20 @@
 
 #include "contact/shaped_lasting.h"
 #include "contact/shaped_pivot.h"
+#include "lasting_bodies.h"
+#include "quadrature.h"
 
 namespace collision_response::core {
 namespace {
 
 using V = Eigen::Vector3d;
 using Q = Eigen::Quaterniond;
+using lasting_bodies::energy;
 
-constexpr double kG = 9.81;
-const V kDown(0, 0, -kG);
+FlatFace floorOf(double mu) { return lasting_bodies::plane(V::UnitZ(), mu); }
+
+using lasting_bodies::kDown;
+using lasting_bodies::kG;
 
 LastingBody cube(double half, double mass, const V& centre, const Q& orientation) {
   LastingBody body;
@@ -33,21 +38,6 @@ LastingBody cube(double half, double mass, const V& centre, const Q& orientation
   body.orientation = orientation;
   body.gravity = kDown;
   return body;
-}
-
-FlatFace floorWith(double mu) {
-  FlatFace face;
-  face.normal = V::UnitZ();
-  face.friction = mu;
-  return face;
-}
-
-double energyAt(const LastingBody& body, const LastingMotion& motion, double t) {
-  const Eigen::Matrix3d r = motion.orientationAt(t).toRotationMatrix();
-  const V w = r.transpose() * motion.angularVelocityAt(t);
-  return 0.5 * body.mass * motion.velocityAt(t).squaredNorm() +
-         0.5 * w.dot(body.moments.cwiseProduct(w)) -
-         body.mass * body.gravity.dot(motion.centreAt(t));
 }
 
 double lowestCorner(const LastingBody& body, const LastingMotion& motion, double t) {
@@ -68,13 +58,13 @@ double lowestCorner(const LastingBody& body, const LastingMotion& motion, double
 void expectSound(const LastingBody& body, const FlatFace& face, const LastingMotion& motion,
                  double tolerance) {
   const double reach = std::get<Cuboid>(body.shape).half_size.norm();
-  const double scale = body.mass * kG * reach + energyAt(body, motion, motion.start) -
+  const double scale = body.mass * kG * reach + energy(body, motion, motion.start) -
                        body.mass * kG * motion.centreAt(motion.start).z();
-  const double start = energyAt(body, motion, motion.start);
+  const double start = energy(body, motion, motion.start);
   for (int k = 0; k <= 100; ++k) {
     const double t = motion.start + (motion.until - motion.start) * k / 100.0;
     EXPECT_GE(lowestCorner(body, motion, t), 0.0) << "at t = " << t;
-    EXPECT_LE(energyAt(body, motion, t), start + tolerance * scale) << "at t = " << t;
+    EXPECT_LE(energy(body, motion, t), start + tolerance * scale) << "at t = " << t;
     for (const SupportForce& force : motion.forcesAt(t)) {
       EXPECT_GE(force.normal_force, 0.0) << "at t = " << t;
       EXPECT_LE(force.friction_force.norm(),
@@ -107,18 +97,7 @@ double pendulumInstant(double half, double psi0, double rate0, double psi1) {
     return std::sqrt(rate0 * rate0 +
                      2 * kG * d * (std::cos(psi0) - std::cos(psi)) / inertia_per_mass);
   };
-  const double x[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831,
-                       0.9061798459386640};
-  const double w[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889,
-                       0.4786286704993665, 0.2369268850561891};
-  const int panels = 400;
-  const double width = (psi1 - psi0) / panels;
-  double sum = 0.0;
-  for (int p = 0; p < panels; ++p) {
-    const double mid = psi0 + (p + 0.5) * width;
-    for (int i = 0; i < 5; ++i) sum += w[i] * 0.5 * width / rate(mid + 0.5 * width * x[i]);
-  }
-  return sum;
+  return quadrature::gaussLegendre([&](double psi) { return 1 / rate(psi); }, psi0, psi1, 400);
 }
 
 }  // namespace
@@ -130,7 +109,7 @@ TEST(ShapedPivot, ACubeTippingOverAStickingEdgeLandsOnItsFaceAtThePendulumsInsta
   // psi = pi/4, at the quadrature's instant (the motion ends there: the impact is the caller's).
   const double half = 0.0524, m = 0.37, psi0 = 0.1, rate0 = 0.5;
   const LastingBody body = onEdge(half, m, psi0, rate0);
-  const FlatFace floor = floorWith(5.0);
+  const FlatFace floor = floorOf(5.0);
   const auto motion = lastingOnFace(body, floor, 1e-11);
   ASSERT_TRUE(motion.ok()) << motion.error().message();
   ASSERT_TRUE(motion->pivot);
@@ -159,17 +138,17 @@ TEST(ShapedPivot, AFrictionlessEdgeSlidesWithTheCentreFallingStraightDown) {
   // mu = 0: no force across the floor, so the centre's x and y stay where they are (it starts
   // with no velocity across), and the energy stays what it was (no friction to take it).
   const LastingBody body = onEdge(0.05, 1.0, 0.2, 0.0);
-  const FlatFace floor = floorWith(0.0);
+  const FlatFace floor = floorOf(0.0);
   const auto motion = lastingOnFace(body, floor, 1e-11);
   ASSERT_TRUE(motion.ok()) << motion.error().message();
   ASSERT_TRUE(motion->pivot);
   EXPECT_EQ(motion->ends, "resumes");
-  const double start = energyAt(body, *motion, motion->start);
+  const double start = energy(body, *motion, motion->start);
   for (int k = 0; k <= 50; ++k) {
     const double t = motion->start + (motion->until - motion->start) * k / 50.0;
     EXPECT_NEAR(motion->centreAt(t).x(), body.centre.x(), 1e-10) << "at t = " << t;
     EXPECT_NEAR(motion->centreAt(t).y(), 0.0, 1e-12);
-    EXPECT_NEAR(energyAt(body, *motion, t), start, 1e-9 * start);
+    EXPECT_NEAR(energy(body, *motion, t), start, 1e-9 * start);
     EXPECT_EQ(motion->stateAt(t), ContactState::kSliding);
   }
   expectSound(body, floor, *motion, 1e-9);
@@ -189,7 +168,7 @@ TEST(ShapedPivot, ACubeOnAStickingCornerKeepsItsEnergyAndItsSpinAboutTheVertical
   LastingBody body = cube(half, m, centre, turn);
   body.angular_velocity = V(0, 0, 3);
   body.velocity = body.angular_velocity.cross(centre);
-  const FlatFace floor = floorWith(5.0);
+  const FlatFace floor = floorOf(5.0);
   const auto motion = lastingOnFace(body, floor, 1e-11);
   ASSERT_TRUE(motion.ok()) << motion.error().message();
   ASSERT_TRUE(motion->pivot);
@@ -201,11 +180,11 @@ TEST(ShapedPivot, ACubeOnAStickingCornerKeepsItsEnergyAndItsSpinAboutTheVertical
                 m * c.cross(motion->velocityAt(t));  // about the corner at the origin
     return l.z();
   };
-  const double l0 = spinAbout(motion->start), e0 = energyAt(body, *motion, motion->start);
+  const double l0 = spinAbout(motion->start), e0 = energy(body, *motion, motion->start);
   for (int k = 0; k <= 50; ++k) {
     const double t = motion->start + (motion->until - motion->start) * k / 50.0;
     EXPECT_NEAR(spinAbout(t), l0, 1e-9 * std::abs(l0)) << "at t = " << t;
-    EXPECT_NEAR(energyAt(body, *motion, t), e0, 1e-9 * e0) << "at t = " << t;
+    EXPECT_NEAR(energy(body, *motion, t), e0, 1e-9 * e0) << "at t = " << t;
     const auto forces = motion->forcesAt(t);
     ASSERT_EQ(forces.size(), 1u);
     EXPECT_LE(forces.front().point.norm(), 1e-9) << "at t = " << t;
@@ -226,7 +205,7 @@ TEST(ShapedPivot, ABoxSpinningFlatStopsTurningAtOmegaOverAlpha) {
   body.centre = V(0, 0, 0.05);
   body.gravity = kDown;
   body.angular_velocity = V(0, 0, 1);
-  const FlatFace floor = floorWith(0.5);
+  const FlatFace floor = floorOf(0.5);
   const auto motion = lastingOnFace(body, floor, 1e-11);
   ASSERT_TRUE(motion.ok()) << motion.error().message();
   ASSERT_TRUE(motion->pivot);
@@ -272,7 +251,7 @@ TEST(ShapedPivot, ACornerLiftedByItsTurningFliesItsParabolaUntilClearOfTheFace) 
   LastingBody body = cube(half, 0.4, V(0, 0, d), diagonal_up);
   body.angular_velocity = V(20, 0, 0);
   body.velocity = -body.angular_velocity.cross(V(0, 0, -d));  // the corner still
-  const FlatFace floor = floorWith(0.5);
+  const FlatFace floor = floorOf(0.5);
   const auto motion = lastingOnFace(body, floor, 1e-11);
   ASSERT_TRUE(motion.ok()) << motion.error().message();
   ASSERT_TRUE(motion->pivot);
@@ -317,7 +296,7 @@ TEST(ShapedPivot, RandomCubesOnCornersAndEdgesNeverGoBelowNorGainEnergy) {
     // The lowest corner neither approaching nor leaving the floor.
     body.velocity = V(2 * unit(random) - 1, 2 * unit(random) - 1, 0);
     body.velocity.z() = -body.angular_velocity.cross(low).z();
-    const FlatFace floor = floorWith(unit(random));
+    const FlatFace floor = floorOf(unit(random));
     const auto motion = lastingOnFace(body, floor);
     if (!motion.ok()) {
       // Where its lowest points approach or leave faster than a settled body's: no lasting

@@ -15,6 +15,8 @@
 
 #include "contact/shaped_lasting.h"
 #include "contact/shaped_pivot.h"
+#include "lasting_bodies.h"
+#include "quadrature.h"
 
 namespace collision_response::core {
 namespace {
@@ -22,34 +24,16 @@ namespace {
 using V = Eigen::Vector3d;
 using Q = Eigen::Quaterniond;
 
-constexpr double kG = 9.81;
+using lasting_bodies::energy;
+using lasting_bodies::kG;
 
-/// A solid cylinder of radius r and half length h (axis z), or a capsule of the same, moments
-/// given, turned by `tilt` about x; its centre and velocity set by the caller.
+/// A solid cylinder of radius r and half length h (axis z), its centre and motion set by the
+/// caller.
 LastingBody cylinder(double r, double h, double m) {
-  LastingBody body;
-  body.shape = Cylinder{r, h};
-  body.mass = m;
-  const double side = m * (3 * r * r + 4 * h * h) / 12;
-  body.moments = V(side, side, m * r * r / 2);
-  body.gravity = V(0, 0, -kG);
-  return body;
+  return lasting_bodies::cylinder(r, h, m, m * r * r / 2, V::Zero(), Q::Identity());
 }
 
-FlatFace floorWith(double mu) {
-  FlatFace face;
-  face.normal = V::UnitZ();
-  face.friction = mu;
-  return face;
-}
-
-double energyAt(const LastingBody& body, const LastingMotion& motion, double t) {
-  const Eigen::Matrix3d r = motion.orientationAt(t).toRotationMatrix();
-  const V w = r.transpose() * motion.angularVelocityAt(t);
-  return 0.5 * body.mass * motion.velocityAt(t).squaredNorm() +
-         0.5 * w.dot(body.moments.cwiseProduct(w)) -
-         body.mass * body.gravity.dot(motion.centreAt(t));
-}
+FlatFace floorOf(double mu) { return lasting_bodies::plane(V::UnitZ(), mu); }
 
 /// The body's lowest height at t: a rim's lowest point is its centre's height less
 /// r sqrt(1 - a_z^2) (a its axis), an end's its centre's less r.
@@ -71,21 +55,10 @@ double lowestAt(const LastingBody& body, const LastingMotion& motion, double t) 
   return lowest;
 }
 
-/// The integral of dtheta / rate(theta) from theta0 to theta1 (rate > 0 over it), 5-point
-/// Gauss-Legendre over 400 panels.
+/// The integral of dtheta / rate(theta) from theta0 to theta1 (rate > 0 over it).
 double instant(const std::function<double(double)>& rate, double theta0, double theta1) {
-  const double x[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831,
-                       0.9061798459386640};
-  const double w[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889,
-                       0.4786286704993665, 0.2369268850561891};
-  const int panels = 400;
-  const double width = (theta1 - theta0) / panels;
-  double sum = 0.0;
-  for (int p = 0; p < panels; ++p) {
-    const double mid = theta0 + (p + 0.5) * width;
-    for (int i = 0; i < 5; ++i) sum += w[i] * 0.5 * width / rate(mid + 0.5 * width * x[i]);
-  }
-  return std::abs(sum);
+  return std::abs(
+      quadrature::gaussLegendre([&](double q) { return 1 / rate(q); }, theta0, theta1, 400));
 }
 
 /// Over [start, until] at 201 instants: no point below the floor (1e-12 m), the energy never
@@ -95,13 +68,13 @@ double instant(const std::function<double(double)>& rate, double theta0, double 
 void expectSound(const LastingBody& body, const FlatFace& face, const LastingMotion& motion,
                  double gain, bool kept) {
   const double reach = 0.2;
-  const double start = energyAt(body, motion, motion.start);
+  const double start = energy(body, motion, motion.start);
   const double scale =
       body.mass * kG * reach + start - body.mass * kG * motion.centreAt(motion.start).z();
   for (int k = 0; k <= 200; ++k) {
     const double t = motion.start + (motion.until - motion.start) * k / 200.0;
     EXPECT_GE(lowestAt(body, motion, t), -1e-12) << "at t = " << t;
-    const double now = energyAt(body, motion, t);
+    const double now = energy(body, motion, t);
     EXPECT_LE(now, start + gain * scale) << "at t = " << t;
     if (kept) {
       EXPECT_GE(now, start - gain * scale) << "at t = " << t;
@@ -139,7 +112,7 @@ TEST(ShapedRim, ACanLeaningOnAStickingRimFallsBackOntoItsCapAtThePendulumsInstan
   // the psi its centre shows (1e-8 rad/s), the point touching stays where it was (1e-9 m).
   const double r = 0.05, h = 0.1, m = 1.0, tilt = 0.3, rate0 = 0.5;
   const LastingBody body = leaning(r, h, m, tilt, -rate0);
-  const FlatFace floor = floorWith(5.0);
+  const FlatFace floor = floorOf(5.0);
   const auto motion = lastingOnFace(body, floor, 1e-11);
   ASSERT_TRUE(motion.ok()) << motion.error().message();
   ASSERT_TRUE(motion->pivot);
@@ -176,7 +149,7 @@ TEST(ShapedRim, AFrictionlessRimSlidesItsCentreFallingStraightDownUntilTheSideLa
   LastingBody body = leaning(r, h, m, tilt, rate0);
   // Its centre moving straight down: z' theta', its rim's point sliding along y.
   body.velocity = V(0, 0, (r * std::cos(tilt) - h * std::sin(tilt)) * rate0);
-  const FlatFace floor = floorWith(0.0);
+  const FlatFace floor = floorOf(0.0);
   const auto motion = lastingOnFace(body, floor, 1e-11);
   ASSERT_TRUE(motion.ok()) << motion.error().message();
   ASSERT_TRUE(motion->pivot);
@@ -214,7 +187,7 @@ TEST(ShapedRim, ACapsuleOnOneEndFallsOntoItsSideAtTheEnergyIntegralsInstant) {
   body.centre = V(0, -h * std::sin(tilt), r + h * std::cos(tilt));
   body.angular_velocity = V(rate0, 0, 0);
   body.velocity = V(0, 0, -h * std::sin(tilt) * rate0);
-  const FlatFace floor = floorWith(0.0);
+  const FlatFace floor = floorOf(0.0);
   const auto motion = lastingOnFace(body, floor, 1e-11);
   ASSERT_TRUE(motion.ok()) << motion.error().message();
   ASSERT_TRUE(motion->pivot);
@@ -274,7 +247,7 @@ TEST(ShapedRim, RandomCansAndCapsulesOnARimOrAnEndKeepTheirEnergyWhereNothingSli
     if (trial % 3 != 0) v += 0.5 * V(unit(random) - 0.5, unit(random) - 0.5, 0);
     body.velocity = v;
     const double mu = trial % 3 == 0 ? 5.0 : (trial % 3 == 1 ? 0.0 : 0.3);
-    const FlatFace floor = floorWith(mu);
+    const FlatFace floor = floorOf(mu);
     const auto motion = pivotOnRound(body, floor, {-1}, V::UnitX(), 1e-10, 1.0);
     ASSERT_TRUE(motion.ok()) << trial << ": " << motion.error().message();
     bool slid = false, touched = true;
@@ -302,7 +275,7 @@ TEST(ShapedRim, ATallCanSlidingOnItsCapTipsOverItsFrontRim) {
   LastingBody body = cylinder(r, h, m);
   body.centre = V(0, 0, h);
   body.velocity = V(2, 0, 0);
-  const FlatFace floor = floorWith(0.5);
+  const FlatFace floor = floorOf(0.5);
   const auto motion = lastingOnFace(body, floor, 1e-10);
   ASSERT_TRUE(motion.ok()) << motion.error().message();
   ASSERT_TRUE(motion->pivot);
