@@ -27,6 +27,7 @@ namespace {
 using V = Eigen::Vector3d;
 using scene_builders::plane;
 
+using shaped_scenes::AcrossSlope;
 using shaped_scenes::EdgeLanding;
 using shaped_scenes::floorScene;
 using shaped_scenes::kG;
@@ -346,22 +347,44 @@ TEST(ShapedPrediction, ACanLeaningOnItsRimFallsBackOntoItsCapAtTheEnergyIntegral
   EXPECT_NEAR(prediction->final_state.position.y(), 0.0, 1e-10) << "straight down";
 }
 
-// A can spinning on its cap (its whole rim sliding: pivoting friction) is not modelled yet: the
-// prediction ends there, cut short, saying so with lastingOnFace's words, never through the
-// floor.
-TEST(ShapedPrediction, ACanSpinningOnItsCapEndsThePredictionSayingWhy) {
-  const Scene scene = RimFall{}.scene();
-  auto request = dropped(scene, V(0, 0, 0.1), Eigen::Quaterniond::Identity(), 1.0, 10);
-  request.state.angular_velocity = V(0, 0, 2.0);
+// A cube sliding across an incline (its slide's direction turns: no closed form) is not modelled
+// yet: the prediction ends there, cut short, saying so with lastingOnFace's words, never through
+// the incline.
+TEST(ShapedPrediction, ACubeSlidingAcrossAnInclineEndsThePredictionSayingWhy) {
+  const AcrossSlope slope;
+  const Scene scene = slope.scene();
+  const BodyStateSample state = slope.state(0, 0.0);
+  auto request = dropped(scene, state.position, state.orientation, 1.0, 10);
+  request.state.velocity = state.velocity;
   const auto prediction = predictImpacts(scene, nullptr, MonitorSettings{}, request);
   ASSERT_TRUE(prediction.ok()) << prediction.error().message();
   EXPECT_TRUE(prediction->impacts.empty());
   EXPECT_TRUE(prediction->cut_short);
-  EXPECT_NE(prediction->message.find("lasting contact with 'floor' at +0 s, which is not yet "
-                                     "modelled (contact: not yet: spin about the face's normal"),
+  EXPECT_NE(prediction->message.find("lasting contact with 'incline' at +0 s, which is not yet "
+                                     "modelled (contact: not yet: sliding across the slope"),
             std::string::npos)
       << prediction->message;
   EXPECT_EQ(prediction->final_state.time, 0.0);
+}
+
+// A can standing on its cap on a floor of mu 0.5, spinning at 3 rad/s about the vertical: its
+// four rim points' friction stops it at (w0 - 1e-6 / r) r / (2 mu g) (ShapedRim's closed form),
+// where it rests: at the horizon it is where it stood, still. Before, the prediction ended at
+// once, saying a can spinning on its cap was not modelled.
+TEST(ShapedPrediction, ACanSpinningOnItsCapStopsWhereItStands) {
+  Scene scene = RimFall{}.scene();
+  ASSERT_TRUE(scene.materials.addMaterial("rough", Material{0.5, 0.5}, "m").ok());
+  scene.bodies[0].material = "rough";
+  scene.effects.friction = true;
+  auto request = dropped(scene, V(0.2, -0.1, 0.1), Eigen::Quaterniond::Identity(), 1.0, 10);
+  request.state.angular_velocity = V(0, 0, 3.0);
+  const auto prediction = predictImpacts(scene, nullptr, MonitorSettings{}, request);
+  ASSERT_TRUE(prediction.ok()) << prediction.error().message();
+  EXPECT_FALSE(prediction->cut_short) << prediction->message;
+  EXPECT_TRUE(prediction->impacts.empty());
+  EXPECT_NEAR((prediction->final_state.position - V(0.2, -0.1, 0.1)).norm(), 0.0, 1e-9);
+  EXPECT_EQ(prediction->final_state.angular_velocity, V::Zero());
+  EXPECT_EQ(prediction->final_state.velocity, V::Zero());
 }
 
 // A box sliding on the floor (mu 0.3, e 1/2) towards a wall d ahead of its front face: its slide

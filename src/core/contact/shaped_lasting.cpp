@@ -1104,12 +1104,16 @@ Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& f
   if (!overhang) return overhang.error();
   if (!spin) {
     // A cap rocks over the rim's point its turning lowers fastest (w x n); spinning about the
-    // normal alone, its whole rim slides (not modelled yet).
+    // normal alone, it turns on four points of its rim (spinOnCap).
     const Vec lowered = body.angular_velocity.cross(setting.n);
     const bool pivots =
         cornered || support.kind == SupportKind::kLine ||
         (support.kind == SupportKind::kDisc && lowered.norm() * setting.reach > kLastingStillSpeed);
     if (pivots && !overhang.value()) return pivotOn(lowered);
+    // A cap spinning about the normal alone: its four rim points slide, each its own way.
+    if (support.kind == SupportKind::kDisc && !overhang.value()) {
+      return spinOnCap(body, face, support.end, tolerance);
+    }
     return spin.error();
   }
 

@@ -66,6 +66,9 @@ struct Point {
   /// A rim's: unit, in its plane (principal frame), the direction of its point touching where
   /// that plane is along the face (the cap flat: every point of the rim equally low).
   Vec lean = Vec::Zero();
+  /// A rim's point fixed in the body at `lean` (a flat cap's four, carried as a face's corners
+  /// are), not its lowest.
+  bool fixed = false;
 };
 
 /// The body and the face, fixed over the motion.
@@ -119,6 +122,7 @@ Contact contactOf(const Setting& s, const Kinematics& k, const Point& p) {
   const Vec centre = k.rotation * f.centre;
   if (f.radius == 0.0) return {centre, Vec::Zero()};
   if (f.axis.isZero()) return {centre - f.radius * s.n, f.radius * k.spin.cross(s.n)};
+  if (p.fixed) return {centre + f.radius * (k.rotation * p.lean), Vec::Zero()};
   const Vec a = k.rotation * f.axis;
   const Vec across = a.cross(s.n.cross(a));  // n - (n.a) a, without its cancellation
   const double tilt = across.norm();
@@ -340,6 +344,40 @@ std::optional<Vec> slipOnset(const Setting& s, const Kinematics& k, std::vector<
   return std::nullopt;
 }
 
+/// A flat cap's fixed points once fewer than three are left (the others lifted): the cap tips
+/// over its rim, whose lowest point (non-fixed) replaces them, at first where they were (their
+/// mean's direction; two opposite ones: the lower). Other points as they are.
+std::vector<Point> liftedCap(const Setting& s, const Kinematics& k, std::vector<Point> points) {
+  std::vector<Point> fixed;
+  for (const Point& p : points) {
+    if (p.fixed) fixed.push_back(p);
+  }
+  if (fixed.empty() || fixed.size() >= 3) return points;
+  points.erase(std::remove_if(points.begin(), points.end(), [](const Point& p) { return p.fixed; }),
+               points.end());
+  Vec mean = Vec::Zero();
+  for (const Point& p : fixed) mean += p.lean;
+  mean /= static_cast<double>(fixed.size());
+  Point rim = fixed.front();
+  if (mean.norm() > 0.5) {
+    rim.lean = mean.normalized();
+  } else {
+    for (const Point& p : fixed) {
+      const Feature& f = s.features[p.feature];
+      const auto height = [&](const Point& q) {
+        return s.n.dot(k.rotation * (f.centre + f.radius * q.lean));
+      };
+      if (height(p) < height(rim)) rim = p;
+    }
+  }
+  rim.fixed = false;
+  const Vec slip = slipOf(s, k, rim);
+  rim.sliding = s.mu == 0.0 || slip.norm() > kLastingStillSpeed;
+  rim.direction = slip.norm() > kLastingStillSpeed ? Vec(slip.normalized()) : s.e1;
+  points.push_back(rim);
+  return points;
+}
+
 /// The points' modes at a state, from what `points` say (sliding or not): a sticking point
 /// whose force is outside the cone slides from its onset direction, and a point whose normal
 /// force would be negative leaves (dropped). An Error where the onset has no direction.
@@ -353,6 +391,7 @@ Expected<std::vector<Point>> modesAt(const Setting& s, const Kinematics& k,
     for (std::size_t i = 0; i < points.size() && !changed; ++i) {
       if (d.forces[i].dot(s.n) < 0) {
         points.erase(points.begin() + static_cast<std::ptrdiff_t>(i));
+        points = liftedCap(s, k, std::move(points));
         changed = true;
       } else if (!points[i].sliding && coneMargin(s, d.forces[i]) < 0) {
         const auto onset = slipOnset(s, k, points, i);
@@ -420,10 +459,11 @@ double capTilt(const Kinematics& x, const Feature& rim, const Vec& towards) {
   return -rim.radius * towards.dot(x.rotation * rim.axis);
 }
 
-/// Where a touching rim's point is, in the face (unit), at `k`; zero for a corner or an end.
+/// Where a touching rim's point is, in the face (unit), at `k`; zero for a corner, an end or a
+/// flat cap's fixed point (its cap is flat while it touches).
 Vec rimTowards(const Setting& s, const Kinematics& k, const Point& p) {
   const Feature& f = s.features[p.feature];
-  if (f.radius == 0.0 || f.axis.isZero()) return Vec::Zero();
+  if (f.radius == 0.0 || f.axis.isZero() || p.fixed) return Vec::Zero();
   const Vec lever = contactOf(s, k, p).lever - k.rotation * f.centre;
   const Vec in_face = lever - lever.dot(s.n) * s.n;
   return in_face.norm() > 0 ? Vec(in_face.normalized()) : Vec::Zero();
@@ -562,6 +602,7 @@ Change changeAt(const Setting& s, const std::vector<Point>& current, What what, 
   std::vector<Point> next = current;
   if (what == What::kLeaves) {
     next.erase(next.begin() + static_cast<std::ptrdiff_t>(point));
+    next = liftedCap(s, there, std::move(next));
   } else if (what == What::kSticks) {
     next[point].sliding = false;
     // A face's corners (three or more) stop slipping together (Goyal, Ruina and
@@ -859,6 +900,26 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
       return Error{"corners", "each must be one of the body's corners"};
     }
     touching.push_back({static_cast<std::size_t>(found - features.begin())});
+  }
+  return pivotFrom(body, std::move(path), touching, tolerance, horizon);
+}
+
+Expected<LastingMotion> spinOnCap(const LastingBody& body, const FlatFace& face, int end,
+                                  double tolerance, double horizon) {
+  if (!std::holds_alternative<Cylinder>(body.shape)) {
+    return Error{"body.shape", "a cap is a cylinder's"};
+  }
+  if (end != -1 && end != 1) {
+    return Error{"end", "must be -1 or 1 (the cap at -half_length or +half_length)"};
+  }
+  auto path = pathFor(body, face);
+  std::vector<Point> touching;
+  for (const Vec& lean : {Vec(1, 0, 0), Vec(0, 1, 0), Vec(-1, 0, 0), Vec(0, -1, 0)}) {
+    Point p;
+    p.feature = end < 0 ? 0 : 1;
+    p.lean = lean;
+    p.fixed = true;
+    touching.push_back(p);
   }
   return pivotFrom(body, std::move(path), touching, tolerance, horizon);
 }

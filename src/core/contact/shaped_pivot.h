@@ -78,4 +78,14 @@ Expected<LastingMotion> pivotOnRound(const LastingBody& body, const FlatFace& fa
                                      const std::vector<int>& ends, const Eigen::Vector3d& lean,
                                      double tolerance, double horizon = 10.0);
 
+/// A cylinder standing on its cap (`end`: -1 or 1, as pivotOnRound's) that spins about the
+/// face's normal: its whole rim would slide, each point its own way. The cap's load is carried
+/// at four points of its rim fixed in the body (along its x and y axes, the square the closed
+/// forms' forces use), each sticking or sliding as pivotOnFace's corners; where fewer than three
+/// are left, the cap tips over its rim (its lowest point, as pivotOnRound's), and where all stick
+/// it rests ("stops": the closed forms take it). One documented choice where the pressure over a
+/// cap is statically indeterminate (a drinks can stands on a ring).
+Expected<LastingMotion> spinOnCap(const LastingBody& body, const FlatFace& face, int end,
+                                  double tolerance, double horizon = 10.0);
+
 }  // namespace collision_response::core
