@@ -61,6 +61,17 @@ inline double energy(const LastingBody& body, const LastingMotion& motion, doubl
          body.mass * body.gravity.dot(motion.centreAt(t));
 }
 
+/// The body as `motion` has it at `t`: to ask lastingOnFace again from there.
+inline LastingBody bodyAt(const LastingBody& body, const LastingMotion& motion, double t) {
+  LastingBody there = body;
+  there.time = t;
+  there.centre = motion.centreAt(t);
+  there.velocity = motion.velocityAt(t);
+  there.angular_velocity = motion.angularVelocityAt(t);
+  there.orientation = motion.orientationAt(t);
+  return there;
+}
+
 inline std::string errorOf(const Expected<LastingMotion>& motion) {
   return motion.ok() ? std::string("(no error)") : motion.error().message();
 }

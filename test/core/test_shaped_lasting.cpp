@@ -677,12 +677,7 @@ TEST(ShapedLasting, ACylinderThatSlipsThenRollsAtTheClosedFormInstant) {
     EXPECT_NEAR(force.normal_force, m * kG / 2, 1e-14 * m * kG);
     EXPECT_NEAR(std::abs(force.point.y()), 0.2, 1e-15);
   }
-  LastingBody rolling = body;
-  rolling.time = motion->until;
-  rolling.centre = motion->centreAt(motion->until);
-  rolling.velocity = motion->velocityAt(motion->until);
-  rolling.angular_velocity = motion->angularVelocityAt(motion->until);
-  rolling.orientation = motion->orientationAt(motion->until);
+  const LastingBody rolling = bodyAt(body, *motion, motion->until);
   const auto then = lastingOnFace(rolling, floor);
   ASSERT_TRUE(then.ok()) << errorOf(then);
   EXPECT_EQ(then->state, ContactState::kRolling);

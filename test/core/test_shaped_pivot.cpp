@@ -226,12 +226,7 @@ TEST(ShapedPivot, ABoxSpinningFlatStopsTurningAtOmegaOverAlpha) {
     }
   }
   // Asked again where it stops: at rest by the closed forms.
-  LastingBody there = body;
-  there.time = motion->until;
-  there.centre = motion->centreAt(motion->until);
-  there.velocity = motion->velocityAt(motion->until);
-  there.angular_velocity = motion->angularVelocityAt(motion->until);
-  there.orientation = motion->orientationAt(motion->until);
+  const LastingBody there = lasting_bodies::bodyAt(body, *motion, motion->until);
   const auto rest = lastingOnFace(there, floor);
   ASSERT_TRUE(rest.ok()) << rest.error().message();
   EXPECT_EQ(rest->state, ContactState::kResting);
