@@ -277,6 +277,96 @@ TEST(ShapedLasting, ABoxRestingOnAnInclineWithinFrictionLeansItsWeightDownhill) 
   EXPECT_LE((slides->acceleration + kG * (kSin - 0.7 * kCos) * kUphill).norm(), 1e-14 * kG);
 }
 
+/// A hexagonal prism hull (a tool's flat side: a regular hexagon of circumradius r, corners at
+/// angles k pi / 3, 2 h thick) whose centre of mass is `offset` along x from the hexagon's centre.
+LastingBody hexagonalPrism(double r, double h, double offset) {
+  LastingBody body;
+  ConvexHull hull;
+  for (const double z : {-h, h}) {
+    for (int k = 0; k < 6; ++k) {
+      hull.vertices.emplace_back(r * std::cos(k * M_PI / 3) - offset, r * std::sin(k * M_PI / 3),
+                                 z);
+    }
+  }
+  body.shape = hull;
+  body.mass = 0.8;
+  body.moments = V(0.004, 0.004, 0.006);
+  body.centre = V(0, 0, h);
+  body.gravity = kDown;
+  return body;
+}
+
+TEST(ShapedLasting, AHexagonalToolRestsOnItsSixCornersByTheLeastNormRule) {
+  // A hexagon's six corners q_k = r (cos, sin)(k pi / 3), the centre of pressure p = (p_x, 0)
+  // from its centre. The least-norm shares are f = l0 + l1 x + l2 y with sum 1 = 6, sum x = 0,
+  // sum x^2 = 3 r^2: f_k = N (1/6 + p_x x_k / (3 r^2)). At p_x = 0.3 r: N (1/6 + 0.1 cos). At
+  // p_x = 0.6 r that gives the corner at x = -r N (1/6 - 0.2) < 0: the least-norm f >= 0 leaves it
+  // out; on the other five, sum 1 = 5, sum x = r, sum x^2 = 2 r^2: 5 l0 + r l1 = N,
+  // r l0 + 2 r^2 l1 = N p_x, so l0 = N (2 r - p_x) / (9 r), l1 = N (5 p_x - r) / (9 r^2): the
+  // corner at x = r 6.8 N / 18, those at r / 2 4.8 N / 18, those at -r / 2 0.8 N / 18, and
+  // l0 - l1 r = N (3 r - 6 p_x) / (9 r) <= 0 where the sixth is left out (its optimality). Before,
+  // a face of more than four points was refused (`not yet`). Past the hexagon (p_x = 1.2 r) it
+  // tips over its two corners at x = r / 2... r.
+  const double r = 0.06, h = 0.01, N = 0.8 * kG;
+  const FlatFace floor = plane(V::UnitZ(), 0.0);
+  for (const double p : {0.0, 0.3, 0.6}) {
+    const LastingBody body = hexagonalPrism(r, h, p * r);
+    const auto motion = lastingOnFace(body, floor);
+    ASSERT_TRUE(motion.ok()) << errorOf(motion);
+    EXPECT_EQ(motion->state, ContactState::kResting);
+    ASSERT_EQ(motion->forces.size(), 6u) << p;
+    for (const SupportForce& force : motion->forces) {
+      const double x = (force.point.x() + p * r) / r;  // the corner's x / r about the hexagon
+      double expected = N * (1.0 / 6 + p * x / 3);
+      if (p == 0.6) {
+        expected = x > 0.9 ? 6.8 : (x > 0 ? 4.8 : (x > -0.9 ? 0.8 : 0.0));
+        expected *= N / 18;
+      }
+      EXPECT_NEAR(force.normal_force, expected, 1e-13 * N) << "p " << p << " x " << x;
+    }
+    expectBalance(body, floor, *motion, 1e-14);
+  }
+  const LastingBody past = hexagonalPrism(r, h, 1.2 * r);
+  expectTips(past, floor, lastingOnFace(past, floor));
+  // 200 centres of mass anywhere within the hexagon (0.95 of its inradius), any way: the forces
+  // are >= 0, balance (1e-13 N), and are the least in norm: optimality's certificate, that some
+  // l gives f_k = l . (1, x_k, y_k) on the corners that carry and l . (1, x_k, y_k) <= 0 on those
+  // that do not (the l fitted here to the carrying ones, 1e-12 N).
+  std::mt19937 random(61);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    const double rho = 0.95 * std::sqrt(3.0) / 2 * r * std::sqrt(unit(random));
+    const double angle = 2 * M_PI * unit(random);
+    LastingBody body = hexagonalPrism(r, h, 0.0);
+    for (V& vertex : std::get<ConvexHull>(body.shape).vertices) {
+      vertex -= V(rho * std::cos(angle), rho * std::sin(angle), 0);
+    }
+    const auto motion = lastingOnFace(body, floor);
+    ASSERT_TRUE(motion.ok()) << errorOf(motion);
+    ASSERT_EQ(motion->forces.size(), 6u);
+    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+    V moment = V::Zero();
+    for (const SupportForce& force : motion->forces) {
+      EXPECT_GE(force.normal_force, 0.0);
+      const V b(1, force.point.x(), force.point.y());
+      if (force.normal_force > 1e-12 * N) {
+        normal += b * b.transpose();
+        moment += force.normal_force * b;
+      }
+    }
+    const V l = normal.fullPivLu().solve(moment);
+    for (const SupportForce& force : motion->forces) {
+      const double linear = l.dot(V(1, force.point.x(), force.point.y()));
+      if (force.normal_force > 1e-12 * N) {
+        EXPECT_NEAR(force.normal_force, linear, 1e-12 * N) << trial;
+      } else {
+        EXPECT_LE(linear, 1e-12 * N) << trial;
+      }
+    }
+    expectBalance(body, floor, *motion, 1e-13);
+  }
+}
+
 TEST(ShapedLasting, AnOffCentreBodyLeavesItsFarCornerUnloadedWhereTheLinearRuleWouldPull) {
   // A hull (a box's corners) whose centre of mass is off its face's centre: x, y in {-0.2, 0.8},
   // on a floor, the centre of pressure at the centre's foot, (-0.3, -0.3) from the face's centre,

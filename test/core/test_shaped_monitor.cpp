@@ -861,5 +861,55 @@ TEST(ShapedMonitor, AMeshBodyMovesAsItsConvexHull) {
   }
 }
 
+// A tool's flat hexagonal side (a mesh body: a hexagonal prism, circumradius 0.06 m, 0.02 m
+// thick, 0.8 kg, e = 1/2) dropped flat from rest, frictionless: its six bottom corners strike at
+// once at sqrt(2 (z0 - h) / g) (1e-11 s), its bounces accumulate, and it rests on the six,
+// m g / 6 each (1e-9 N), by the closed forms, nothing held or reported. Before, a face of more
+// than four points was not modelled: the body was held where its bounces ended.
+TEST(ShapedMonitor, AHexagonalToolDroppedFlatRestsOnItsSixCorners) {
+  const double r = 0.06, h = 0.01, height = 0.2, m = 0.8;
+  std::vector<V> vertices;
+  for (const double z : {-h, h}) {
+    for (int k = 0; k < 6; ++k) {
+      vertices.push_back(V(r * std::cos(k * M_PI / 3), r * std::sin(k * M_PI / 3), z));
+    }
+  }
+  std::vector<TriangleMesh::Triangle> triangles;
+  for (unsigned k = 1; k + 1 < 6; ++k) {
+    triangles.push_back({0, k, k + 1});
+    triangles.push_back({6, 6 + k, 6 + k + 1});
+  }
+  for (unsigned k = 0; k < 6; ++k) {
+    const unsigned next = (k + 1) % 6;
+    triangles.push_back({k, next, 6 + k});
+    triangles.push_back({next, 6 + next, 6 + k});
+  }
+  Scene scene = floorScene(0.5, V(0.05, 0.05, 0.05), m);
+  scene.bodies[0].shape = BodyShape::kMesh;
+  scene.bodies[0].size = V::Zero();
+  scene.bodies[0].mesh = scene_builders::facingOut(vertices, triangles, V::Zero());
+  ASSERT_TRUE(validateScene(scene, "s").ok()) << validateScene(scene, "s").error().message();
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  const Eigen::Quaterniond flat = Eigen::Quaterniond::Identity();
+  // Until 0.9 s: a body 1 s past its last state is forgotten.
+  const std::vector<StepReport> reports =
+      run(monitor, {fallingState(monitor, height, flat, 0.0)}, 0.05, 0.9);
+  const std::vector<ImpactRecord> impacts = firstInstant(impactsOf(reports));
+  EXPECT_EQ(impacts.size(), 4u) << "the manifold's four of the six";
+  for (const ImpactRecord& impact : impacts) {
+    EXPECT_NEAR(impact.time, std::sqrt(2 * (height - h) / kG), 1e-11);
+  }
+  for (const StepReport& report : reports) {
+    EXPECT_TRUE(report.unmodelled.empty()) << report.unmodelled.front().what;
+  }
+  const std::vector<ContactRecord>& contacts = reports.back().contacts;
+  ASSERT_EQ(contacts.size(), 6u);
+  for (const ContactRecord& contact : contacts) {
+    EXPECT_EQ(contact.state, ContactState::kResting);
+    EXPECT_NEAR(contact.normal_force, m * kG / 6, 1e-9);
+    EXPECT_NEAR(contact.contact_point.z(), 0.0, 1e-9);
+  }
+}
+
 }  // namespace
 }  // namespace collision_response::core

@@ -331,15 +331,12 @@ void addFourthCorner(const LastingBody& body, const Cuboid& box, const Eigen::Ma
   }
 }
 
-/// A box's or hull's support from its points on the face: one corner, an edge (two, or more
-/// collinear), or a polygon of three or four; more are not modelled yet.
+/// A box's or hull's support from its points on the face: one corner, an edge (two, or the two
+/// extreme ones of more collinear), or a polygon of three or more.
 Expected<Support> cornersSupport(Support support) {
   if (support.feet.size() == 1) {
     support.kind = SupportKind::kCorners;
     return support;
-  }
-  if (support.feet.size() > 4) {
-    return notYet("a face of more than four points on the face (a hull's)");
   }
   if (support.feet.size() >= 3) {
     // Collinear corners are an edge: the polygon's area against its size.
@@ -352,8 +349,17 @@ Expected<Support> cornersSupport(Support support) {
     for (const Vec& foot : support.feet) size = std::max(size, (foot - support.feet[0]).norm());
     if (area > kLastingBand * size) return support;
   }
-  if (support.feet.size() != 2) {
-    return notYet("tipping over an edge of more than two points (a hull's)");
+  if (support.feet.size() > 2) {
+    // Collinear: the edge's two extreme points carry it (the ones between add no support).
+    const Vec along = support.feet[1] - support.feet[0];
+    std::size_t low = 0, high = 0;
+    for (std::size_t i = 0; i < support.feet.size(); ++i) {
+      const double at = along.dot(support.feet[i] - support.feet[0]);
+      if (at < along.dot(support.feet[low] - support.feet[0])) low = i;
+      if (at > along.dot(support.feet[high] - support.feet[0])) high = i;
+    }
+    support.feet = {support.feet[low], support.feet[high]};
+    support.corners = {support.corners[low], support.corners[high]};
   }
   support.kind = SupportKind::kCorners;
   return support;
@@ -488,12 +494,45 @@ bool strictlyInside(std::vector<Eigen::Vector2d> corners, const Eigen::Vector2d&
   return true;
 }
 
-/// The normal forces on 3 or 4 points q_i of the face (coordinates about their centroid) that
+/// The least-norm f >= 0 with balance f = target (3 rows, k > 4 columns), by its dual: f_i =
+/// max(0, (B^T l)_i) where B max(0, B^T l) = target, solved by Newton's method on l over the
+/// points that carry (the semismooth Newton step is the least-norm solve on them), from the
+/// linear rule's l; empty where it does not settle in 64 steps or the points that carry do not
+/// span the face (the caller takes a triangle).
+std::vector<double> leastNonNegative(const Eigen::Matrix<double, 3, Eigen::Dynamic>& balance,
+                                     const Vec& target, Vec l) {
+  const Eigen::Index k = balance.cols();
+  std::vector<bool> carries(static_cast<std::size_t>(k), true);
+  for (int step = 0; step < 64; ++step) {
+    const Eigen::VectorXd linear = balance.transpose() * l;
+    std::vector<bool> now(static_cast<std::size_t>(k));
+    for (Eigen::Index i = 0; i < k; ++i) now[static_cast<std::size_t>(i)] = linear(i) > 0;
+    if (step > 0 && now == carries) {
+      std::vector<double> f(static_cast<std::size_t>(k));
+      for (Eigen::Index i = 0; i < k; ++i)
+        f[static_cast<std::size_t>(i)] = std::max(0.0, linear(i));
+      return f;
+    }
+    carries = now;
+    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+    for (Eigen::Index i = 0; i < k; ++i) {
+      if (carries[static_cast<std::size_t>(i)])
+        normal += balance.col(i) * balance.col(i).transpose();
+    }
+    const auto solver = normal.fullPivLu();
+    if (solver.rank() < 3) return {};
+    l = solver.solve(target);
+  }
+  return {};
+}
+
+/// The normal forces on 3 or more points q_i of the face (coordinates about their centroid) that
 /// carry N with their centre of pressure at p: the least-norm f with sum f_i = N and
 /// sum f_i q_i = N p (f_i = l0 + l1 x_i + l2 y_i, a 3x3 solve), and where that has a negative
-/// share (4 points, p inside the polygon but outside the region the linear rule reaches), the
-/// least-norm f >= 0 along the one null direction of the balance (its closed form: the share
-/// that went negative is 0).
+/// share (p inside the polygon but outside the region the linear rule reaches), the least-norm
+/// f >= 0: for 4 points along the one null direction of the balance (its closed form: the share
+/// that went negative is 0), for more by leastNonNegative (else the fan triangle from the first
+/// point that holds p: one documented choice).
 std::vector<double> polygonForces(const std::vector<Eigen::Vector2d>& q, const Eigen::Vector2d& p,
                                   double total, bool nonnegative) {
   const std::size_t k = q.size();
@@ -506,7 +545,22 @@ std::vector<double> polygonForces(const std::vector<Eigen::Vector2d>& q, const E
   const Vec l = normal.partialPivLu().solve(target);
   const Eigen::VectorXd least = balance.transpose() * l;
   std::vector<double> f(least.data(), least.data() + k);
-  if (!nonnegative || k != 4 || *std::min_element(f.begin(), f.end()) >= 0) return f;
+  if (!nonnegative || k < 4 || *std::min_element(f.begin(), f.end()) >= 0) return f;
+  if (k > 4) {
+    std::vector<double> shares = leastNonNegative(balance, target, l);
+    if (!shares.empty()) return shares;
+    shares.assign(k, 0.0);
+    for (std::size_t i = 1; i + 1 < k; ++i) {
+      // p's weights in the triangle (q_0, q_i, q_i+1).
+      Eigen::Matrix2d basis;
+      basis << q[i] - q[0], q[i + 1] - q[0];
+      const Eigen::Vector2d w = basis.partialPivLu().solve(p - q[0]);
+      if (w.minCoeff() < -1e-12 || w.sum() > 1 + 1e-12) continue;
+      shares[0] = total * (1 - w.sum()), shares[i] = total * w.x(), shares[i + 1] = total * w.y();
+      break;
+    }
+    return shares;
+  }
   // The null direction of the 3x4 balance: its signed 3x3 minors.
   std::array<double, 4> null{};
   for (int i = 0; i < 4; ++i) {

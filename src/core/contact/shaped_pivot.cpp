@@ -881,9 +881,9 @@ Expected<LastingMotion> pivotFrom(const LastingBody& body, std::unique_ptr<Pivot
 Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& face,
                                     const std::vector<Eigen::Vector3d>& corners, double tolerance,
                                     double horizon) {
-  if (corners.empty() || corners.size() > 4) {
-    return Error{"corners", "must be one to four of the body's corners, got " +
-                                std::to_string(corners.size())};
+  if (corners.empty() || corners.size() > kPivotMaxPoints) {
+    return Error{"corners", "must be one to " + std::to_string(kPivotMaxPoints) +
+                                " of the body's corners, got " + std::to_string(corners.size())};
   }
   if (!std::holds_alternative<Cuboid>(body.shape) &&
       !std::holds_alternative<ConvexHull>(body.shape)) {

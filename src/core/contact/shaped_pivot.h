@@ -31,6 +31,10 @@ constexpr double kPivotSlipStops = 1e-6;
 /// advancement, bounded by the body's turning, would crawl from a gap that opens from 0.
 constexpr double kPivotClearance = 1e-5;
 
+/// The most points a tipping may start on (a hull's face of many corners: each sticks, slides or
+/// leaves as a box's four do).
+constexpr std::size_t kPivotMaxPoints = 32;
+
 /// The integrated path of a tipping body (pivotOnFace): dense output over [start, until].
 class PivotPath : public LastingPath {
  public:
@@ -50,7 +54,7 @@ class PivotPath : public LastingPath {
   std::unique_ptr<Steps> steps_;
 };
 
-/// The body touching `face` at `corners` (one to four: a corner, an edge, a face; in its
+/// The body touching `face` at `corners` (one to kPivotMaxPoints: a corner, an edge, a face; in its
 /// principal frame, each within the settled band of the face) tipping under gravity, integrated
 /// with the Dormand-Prince pair to `tolerance` (absolute and relative). At its start the normal
 /// motion of the points (settled: kLastingSettled) and the slip of a point slower than
