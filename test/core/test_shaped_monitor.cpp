@@ -63,6 +63,16 @@ std::vector<StepReport> run(ImpactMonitor& monitor, const std::vector<BodyStateS
   return reports;
 }
 
+/// floorScene's body (e = 1/2, `mass`) as a mesh body of `vertices` and `triangles` (its hull).
+Scene meshScene(const std::vector<V>& vertices,
+                const std::vector<TriangleMesh::Triangle>& triangles, double mass) {
+  Scene scene = floorScene(0.5, V(0.05, 0.05, 0.05), mass);
+  scene.bodies[0].shape = BodyShape::kMesh;
+  scene.bodies[0].size = V::Zero();
+  scene.bodies[0].mesh = scene_builders::facingOut(vertices, triangles, V::Zero());
+  return scene;
+}
+
 /// The impacts at the first instant of impact (the box's landing; its other edge lands later).
 std::vector<ImpactRecord> firstInstant(const std::vector<ImpactRecord>& impacts) {
   std::vector<ImpactRecord> first;
@@ -838,10 +848,7 @@ TEST(ShapedMonitor, AMeshBodyMovesAsItsConvexHull) {
       {4, 5, 8}, {5, 7, 8}, {7, 6, 8}, {6, 4, 8},   // the dented top
       {0, 1, 5}, {0, 5, 4}, {2, 3, 7}, {2, 7, 6},   // y sides
       {0, 2, 6}, {0, 6, 4}, {1, 3, 7}, {1, 7, 5}};  // x sides
-  Scene scene = floorScene(0.5, V(a, a, a));
-  scene.bodies[0].shape = BodyShape::kMesh;
-  scene.bodies[0].size = V::Zero();
-  scene.bodies[0].mesh = scene_builders::facingOut(vertices, triangles, V::Zero());
+  const Scene scene = meshScene(vertices, triangles, 2.0);
   ASSERT_TRUE(validateScene(scene, "s").ok()) << validateScene(scene, "s").error().message();
   ImpactMonitor monitor(scene, MonitorSettings{});
   const Eigen::Quaterniond flat = Eigen::Quaterniond::Identity();
@@ -884,10 +891,7 @@ TEST(ShapedMonitor, AHexagonalToolDroppedFlatRestsOnItsSixCorners) {
     triangles.push_back({k, next, 6 + k});
     triangles.push_back({next, 6 + next, 6 + k});
   }
-  Scene scene = floorScene(0.5, V(0.05, 0.05, 0.05), m);
-  scene.bodies[0].shape = BodyShape::kMesh;
-  scene.bodies[0].size = V::Zero();
-  scene.bodies[0].mesh = scene_builders::facingOut(vertices, triangles, V::Zero());
+  const Scene scene = meshScene(vertices, triangles, m);
   ASSERT_TRUE(validateScene(scene, "s").ok()) << validateScene(scene, "s").error().message();
   ImpactMonitor monitor(scene, MonitorSettings{});
   const Eigen::Quaterniond flat = Eigen::Quaterniond::Identity();
