@@ -915,5 +915,62 @@ TEST(ShapedMonitor, AHexagonalToolDroppedFlatRestsOnItsSixCorners) {
   }
 }
 
+// A can (r = 0.04 m, 0.2 m long, 0.4 kg) hanging still without gravity, struck head-on by a disc
+// (a robot's paddle: a cylinder of radius 0.08 m, 1 cm thick, its axis along the arm) turning at
+// a constant 1.2 rad/s about the vertical through (0, 0, 0.5), its centre 0.7 m out: the disc's
+// leading rim reaches the can's side at psi = 0.3 rad, the can's axis 0.7 u + 0.12 v from the
+// turning axis (u, v the radial and tangential directions at psi). Two cylinders' sides touch on
+// their axes' common perpendicular: the normal is v = z x u exactly, through the can's axis at its
+// middle's height, and the rim's point there moves at 1.2 (0.7 v - 0.08 u): frictionless with
+// e = 1/2 the can leaves at 1.5 x 0.84 v = 1.26 v m/s, without turning. Before, GJK's normal
+// between the two curved surfaces a hair apart (2.6e-5 rad off) and a contact point off its
+// line gave the can 1.7e-3 rad/s about its axis.
+TEST(ShapedMonitor, ATurningDiscsRimStrikesACansSideAlongTheirAxesCommonPerpendicular) {
+  Scene scene;
+  ASSERT_TRUE(scene.materials.addMaterial("aluminium", Material{0.5, 0.0}, "m").ok());
+  BodySpec can;
+  can.id = "can";
+  can.mass = 0.4;
+  can.material = "aluminium";
+  can.shape = BodyShape::kCylinder;
+  can.radius = 0.04;
+  can.length = 0.2;
+  scene.bodies = {can};
+  ObstacleSpec disc;
+  disc.id = "paddle";
+  disc.shape = ObstacleShape::kCylinder;
+  disc.radius = 0.08;
+  disc.length = 0.01;
+  disc.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, V::UnitY()));
+  disc.material = "aluminium";
+  disc.frame = "paddle_link";
+  scene.obstacles = {disc};
+  const double rate = 1.2, psi = 0.3, strike = 0.05;
+  const V u(std::cos(psi), std::sin(psi), 0), v(-std::sin(psi), std::cos(psi), 0);
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  RigidPose link;  // the disc's frame at t = 0, turning on at a constant rate
+  link.transform = Eigen::Translation3d(0, 0, 0.5) *
+                   Eigen::AngleAxisd(psi - rate * strike, V::UnitZ()) *
+                   Eigen::Translation3d(0.7, 0, 0);
+  link.angular_velocity = V(0, 0, rate);
+  link.velocity = link.angular_velocity.cross(link.transform.translation() - V(0, 0, 0.5));
+  monitor.setObstaclePose(0, link);
+  BodyStateSample state;
+  state.body = 0;
+  state.position = 0.7 * u + 0.12 * v + V(0, 0, 0.5);
+  std::vector<StepReport> reports{monitor.step(0.0, {state})};
+  reports.push_back(monitor.step(0.1, {}));
+  const std::vector<ImpactRecord> impacts = impactsOf(reports);
+  ASSERT_EQ(impacts.size(), 1u);
+  const ImpactRecord& impact = impacts.front();
+  // Found up to 1e-10 s before the touch (the gap left over the closing speed, 0.84 m/s), where
+  // the common perpendicular is turned by the rate times that: the normal (from the can into the
+  // disc) and the velocity to 1e-10; no turn at all, to 1e-12 rad/s.
+  EXPECT_NEAR(impact.time, strike, 1e-10);
+  EXPECT_NEAR((impact.normal + v).norm(), 0.0, 1e-10) << impact.normal.transpose();
+  EXPECT_NEAR((impact.velocity_a_after - 1.5 * rate * 0.7 * v).norm(), 0.0, 1e-10);
+  EXPECT_NEAR(impact.angular_velocity_a_after.norm(), 0.0, 1e-12);
+}
+
 }  // namespace
 }  // namespace collision_response::core
