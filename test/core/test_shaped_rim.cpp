@@ -4,8 +4,9 @@
 // centre falls straight down, its side landing at the instant the energy integral gives; random
 // cans and capsules rolling and sliding on a rim or an end, whose energy a sticking or frictionless
 // contact keeps and a sliding one never raises; a can on its cap that tips over its rim where
-// its centre of pressure leaves the cap. Each instant is the test's own quadrature of dtheta /
-// theta' (5-point Gauss-Legendre, 400 panels), never the code's.
+// its centre of pressure leaves the cap; a can spinning on its cap, whose four rim points'
+// friction stops it at w0 r / (2 mu g) (spinOnCap). Each instant is the test's own quadrature of
+// dtheta / theta' (5-point Gauss-Legendre, 400 panels), never the code's.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
