@@ -1101,6 +1101,99 @@ Expected<LastingMotion> overhangMotion(const LastingBody& body, const FlatFace& 
   return motion;
 }
 
+/// The tipping motion of a support the closed forms do not carry: a box's (or a hull's) corners
+/// (one, an edge's two, a face's), each sticking, sliding or leaving (pivotOnFace); a side's two
+/// rims' or ends' lowest points; one point of a rim or an end, or a cap's rim point towards
+/// `lean` (world, in the cap's plane: where it tips or rocks) (pivotOnRound).
+Expected<LastingMotion> pivotOnSupport(const LastingBody& body, const FlatFace& face,
+                                       const Support& support, const Eigen::Matrix3d& rotation,
+                                       const Vec& lean, double tolerance) {
+  if (!support.corners.empty()) return pivotOnFace(body, face, support.corners, tolerance);
+  if (support.kind == SupportKind::kLine) {
+    return pivotOnRound(body, face, {-1, 1}, Vec::Zero(), tolerance);
+  }
+  return pivotOnRound(body, face, {support.end}, rotation.transpose() * lean, tolerance);
+}
+
+/// A support whose turning the closed forms do not carry (keptSpin's `refused`): a face's
+/// corners and a side that spin or rock tip (pivotOnSupport); a cap rocks over the rim's point
+/// its turning lowers fastest (w x n), and spinning about the normal alone turns on four points
+/// of its rim (spinOnCap); over a table's edge, or a shape without such a motion, refused.
+Expected<LastingMotion> turningOnFace(const LastingBody& body, const FlatFace& face,
+                                      const Support& support, const Setting& setting,
+                                      const Eigen::Matrix3d& rotation, bool overhanging,
+                                      const Error& refused, double tolerance) {
+  if (overhanging) return refused;
+  const Vec lowered = body.angular_velocity.cross(setting.n);
+  const bool rocks = lowered.norm() * setting.reach > kLastingStillSpeed;
+  if (support.kind == SupportKind::kDisc) {
+    if (rocks) return pivotOnSupport(body, face, support, rotation, lowered, tolerance);
+    return spinOnCap(body, face, support.end, tolerance);
+  }
+  if (support.kind == SupportKind::kLine || !support.corners.empty()) {
+    return pivotOnSupport(body, face, support, rotation, lowered, tolerance);
+  }
+  return refused;
+}
+
+/// The closed forms on a face or a cap, a side or a face's polygon: the plan (resting, sliding
+/// or rolling), the centre of pressure and the forces it puts on the support's points, until the
+/// plan's end or the support reaching the face's edge; over an edge, overhangMotion; where the
+/// centre of pressure leaves the support, the tipping (pivotOnSupport, towards it).
+Expected<LastingMotion> plannedOnFace(const LastingBody& body, const FlatFace& face,
+                                      Support support, const Setting& setting,
+                                      const Eigen::Quaterniond& orientation,
+                                      const std::vector<Vec>& outline,
+                                      const std::optional<Overhang>& overhang, double roll,
+                                      double tolerance) {
+  const Eigen::Matrix3d rotation = orientation.toRotationMatrix();
+  // The motion: the velocity's part in the face (its normal part settled), a roll kept.
+  const Vec in_face = body.velocity - body.velocity.dot(setting.n) * setting.n;
+  const double mu = face.friction;
+  Expected<Plan> planned = support.kind == SupportKind::kLine
+                               ? rollPlan(body, support, setting, mu, in_face, roll)
+                               : translationPlan(in_face, setting.g_t, setting.g_n, mu);
+  if (!planned) return planned.error();
+  const Plan& plan = planned.value();
+
+  // The forces: N = m g_n, friction m (a - g_t), the centre of pressure h (g_t - a) / g_n from
+  // the centre's foot. A side's centre of pressure is taken along its axis only: across it, the
+  // roll's J alpha balances the friction's moment. The friction's moment about the normal is 0
+  // there too: gravity has no part along the axis while the body rolls, none across it while it
+  // rests or slides (rollPlan's cases).
+  const double total = body.mass * setting.g_n;
+  const Vec friction_ratio = (plan.acceleration - setting.g_t) / setting.g_n;
+  const Vec pressure =
+      setting.foot + setting.height * (setting.g_t - plan.acceleration) / setting.g_n;
+  if (overhang) {
+    return overhangMotion(body, face, support, setting, *overhang, plan, pressure, total,
+                          friction_ratio, tolerance);
+  }
+  auto forces = supportForces(support, setting, pressure, total, friction_ratio, rotation,
+                              tippingOf(plan.state));
+  if (!forces && (support.kind != SupportKind::kPolygon || !support.corners.empty())) {
+    // Tipping: a face over its corners, a side over an end, a cap over its rim's point towards
+    // the centre of pressure.
+    return pivotOnSupport(body, face, support, rotation, pressure - support.centre, tolerance);
+  }
+  if (!forces) return forces.error();
+
+  LastingMotion motion = plannedMotion(body, plan, orientation, std::move(forces.value()));
+  const double edge = edgeReached(outline, face, plan.track);
+  double lasts = plan.lasts;
+  motion.ends = plan.ends;
+  if (edge < lasts) {
+    lasts = edge;
+    // A face or a cap goes on over the edge (asked again there: overhangMotion); a side
+    // rolling off it is not modelled yet.
+    motion.ends = support.kind == SupportKind::kLine
+                      ? "a point of its support reaches the face's edge"
+                      : "stops";
+  }
+  if (std::isfinite(lasts)) motion.until = body.time + lasts;
+  return motion;
+}
+
 }  // namespace
 
 Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& face,
@@ -1120,100 +1213,26 @@ Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& f
     }
   }
   if (!found) return found.error();
-  Support support = found.value();
-  if (support.kind == SupportKind::kCorners) {
-    if (Status status = checkOnFace(body, face, support, setting); !status) {
-      return status.error();
-    }
-    return pivotOnFace(body, face, support.corners, tolerance);
-  }
-  if (support.kind == SupportKind::kRound) {
-    if (Status status = checkOnFace(body, face, support, setting); !status) {
-      return status.error();
-    }
-    return pivotOnRound(body, face, {support.end}, Vec::Zero(), tolerance);
-  }
-  // A box's (or a hull's) face whose turning the closed forms do not carry (a spin about the
-  // normal: each corner slides its own way, Coulomb's friction at each; a rocking turn) or whose
-  // centre of pressure leaves the support (it tips over an edge of it) moves as the tipping
-  // does, its corners each sticking, sliding or leaving (pivotOnFace); a side that rocks, spins
-  // or tips over an end, and a cap that rocks or tips over its rim, as the tipping on its rims
-  // or ends does (pivotOn).
-  const bool cornered = support.kind == SupportKind::kPolygon && !support.corners.empty();
-  const auto pivotOn = [&](const Vec& lean) -> Expected<LastingMotion> {
-    if (cornered) return pivotOnFace(body, face, support.corners, tolerance);
-    if (support.kind == SupportKind::kLine) {
-      return pivotOnRound(body, face, {-1, 1}, Vec::Zero(), tolerance);
-    }
-    return pivotOnRound(body, face, {support.end}, rotation.transpose() * lean, tolerance);
-  };
-  const auto spin = keptSpin(support, setting, body.angular_velocity);
+  const Support& support = found.value();
   if (Status status = checkOnFace(body, face, support, setting); !status) return status.error();
-  // Outlines taken before supportForces chooses a cap's four points.
+  // One corner, an edge, one point of a rim or an end: it tips.
+  if (support.kind == SupportKind::kCorners || support.kind == SupportKind::kRound) {
+    return pivotOnSupport(body, face, support, rotation, Vec::Zero(), tolerance);
+  }
+  // Outlines taken before supportForces chooses a cap's four points. A side's line over the
+  // edge is checkOnFace's (not modelled yet); a face or a cap goes on over it.
   const std::vector<Vec> outline = outlineOf(support, face.along_u, face.along_v);
-  // A side's line over the edge is checkOnFace's (not modelled yet); a face or a cap goes on.
   const auto overhang = support.kind == SupportKind::kLine
                             ? Expected<std::optional<Overhang>>(std::optional<Overhang>{})
                             : overhangOf(outline, face);
   if (!overhang) return overhang.error();
+  const auto spin = keptSpin(support, setting, body.angular_velocity);
   if (!spin) {
-    // A cap rocks over the rim's point its turning lowers fastest (w x n); spinning about the
-    // normal alone, it turns on four points of its rim (spinOnCap).
-    const Vec lowered = body.angular_velocity.cross(setting.n);
-    const bool pivots =
-        cornered || support.kind == SupportKind::kLine ||
-        (support.kind == SupportKind::kDisc && lowered.norm() * setting.reach > kLastingStillSpeed);
-    if (pivots && !overhang.value()) return pivotOn(lowered);
-    // A cap spinning about the normal alone: its four rim points slide, each its own way.
-    if (support.kind == SupportKind::kDisc && !overhang.value()) {
-      return spinOnCap(body, face, support.end, tolerance);
-    }
-    return spin.error();
+    return turningOnFace(body, face, support, setting, rotation, overhang.value().has_value(),
+                         spin.error(), tolerance);
   }
-
-  // The motion: the velocity's part in the face (its normal part settled), a roll kept.
-  const Vec in_face = body.velocity - body.velocity.dot(setting.n) * setting.n;
-  const double mu = face.friction;
-  Expected<Plan> planned = support.kind == SupportKind::kLine
-                               ? rollPlan(body, support, setting, mu, in_face, spin.value())
-                               : translationPlan(in_face, setting.g_t, setting.g_n, mu);
-  if (!planned) return planned.error();
-  const Plan& plan = planned.value();
-
-  // The forces: N = m g_n, friction m (a - g_t), the centre of pressure h (g_t - a) / g_n from
-  // the centre's foot. A side's centre of pressure is taken along its axis only: across it, the
-  // roll's J alpha balances the friction's moment. The friction's moment about the normal is 0
-  // there too: gravity has no part along the axis while the body rolls, none across it while it
-  // rests or slides (rollPlan's cases).
-  const double total = body.mass * setting.g_n;
-  const Vec friction_ratio = (plan.acceleration - setting.g_t) / setting.g_n;
-  const Vec pressure =
-      setting.foot + setting.height * (setting.g_t - plan.acceleration) / setting.g_n;
-  if (overhang.value()) {
-    return overhangMotion(body, face, support, setting, *overhang.value(), plan, pressure, total,
-                          friction_ratio, tolerance);
-  }
-  auto forces = supportForces(support, setting, pressure, total, friction_ratio, rotation,
-                              tippingOf(plan.state));
-  // Tipping: a cap over its rim's point towards the centre of pressure.
-  if (!forces && support.kind != SupportKind::kPolygon) return pivotOn(pressure - support.centre);
-  if (!forces && cornered) return pivotOn(Vec::Zero());
-  if (!forces) return forces.error();
-
-  LastingMotion motion = plannedMotion(body, plan, orientation, std::move(forces.value()));
-  const double edge = edgeReached(outline, face, plan.track);
-  double lasts = plan.lasts;
-  motion.ends = plan.ends;
-  if (edge < lasts) {
-    lasts = edge;
-    // A face or a cap goes on over the edge (asked again there: overhangMotion); a side
-    // rolling off it is not modelled yet.
-    motion.ends = support.kind == SupportKind::kLine
-                      ? "a point of its support reaches the face's edge"
-                      : "stops";
-  }
-  if (std::isfinite(lasts)) motion.until = body.time + lasts;
-  return motion;
+  return plannedOnFace(body, face, support, setting, orientation, outline, overhang.value(),
+                       spin.value(), tolerance);
 }
 
 std::optional<double> flatBouncesEnd(const LastingBody& body, const FlatFace& face,
