@@ -262,8 +262,9 @@ SurfaceGap meshGap(const TumblingBody& body, double time, const Mesh& mesh, cons
   return g;
 }
 
-/// Whether a gap carries its approach speed: the advancement looks at the gap alone, and the
-/// approach speed costs the body's orientation and angular velocity once more.
+/// Whether a gap carries its approach speed and its normal made exact (exactWhereSmooth): the
+/// advancement looks at the gap alone, and those cost the body's orientation and angular
+/// velocity once more.
 enum class Approach { kWith, kWithout };
 
 /// The body against `obstacle` already moved to `time`.
@@ -293,8 +294,10 @@ SurfaceGap obstacleGap(const TumblingBody& body, double time, const PlacedShape&
     const ConvexDistance d = convexDistance(
         placedBody(body, time), PointSupport(sphere->centre, sphere->radius), tolerance);
     g = fromDistance(d, centre, sphere->centre);
-    exactWhereSmooth(g, body.shape(), body.orientationAt(time).toRotationMatrix(), centre, nullptr,
-                     Eigen::Matrix3d::Identity(), sphere->centre);
+    if (approach == Approach::kWith) {
+      exactWhereSmooth(g, body.shape(), body.orientationAt(time).toRotationMatrix(), centre,
+                       nullptr, Eigen::Matrix3d::Identity(), sphere->centre);
+    }
   } else if (const auto* mesh = std::get_if<Mesh>(&moved.shape)) {
     g = meshGap(body, time, *mesh, moved.pose, tolerance, near_triangles);
   } else {
@@ -311,8 +314,10 @@ SurfaceGap obstacleGap(const TumblingBody& body, double time, const PlacedShape&
         moved.shape);
     const PlacedConvex other(shape, moved.pose.transform.linear(), origin);
     g = fromDistance(convexDistance(placedBody(body, time), other, tolerance), centre, origin);
-    exactWhereSmooth(g, body.shape(), body.orientationAt(time).toRotationMatrix(), centre, &shape,
-                     moved.pose.transform.linear(), origin);
+    if (approach == Approach::kWith) {
+      exactWhereSmooth(g, body.shape(), body.orientationAt(time).toRotationMatrix(), centre, &shape,
+                       moved.pose.transform.linear(), origin);
+    }
   }
   if (approach == Approach::kWithout) return g;
   const Eigen::Vector3d surface =
@@ -325,9 +330,9 @@ SurfaceGap bodiesGap(const TumblingBody& a, const TumblingBody& b, double time, 
                      Approach approach = Approach::kWith) {
   SurfaceGap g = fromDistance(convexDistance(placedBody(a, time), placedBody(b, time), tolerance),
                               a.positionAt(time), b.positionAt(time));
+  if (approach == Approach::kWithout) return g;  // the advancement's steps: the distance alone
   exactWhereSmooth(g, a.shape(), a.orientationAt(time).toRotationMatrix(), a.positionAt(time),
                    &b.shape(), b.orientationAt(time).toRotationMatrix(), b.positionAt(time));
-  if (approach == Approach::kWithout) return g;
   g.approach_speed =
       g.normal.dot(a.pointVelocityAt(time, g.point_a) - b.pointVelocityAt(time, g.point_b));
   return g;
