@@ -73,6 +73,18 @@ Scene meshScene(const std::vector<V>& vertices,
   return scene;
 }
 
+/// A can: a cylinder body "can" of aluminium (the scene's material of that name).
+BodySpec canOf(double mass, double radius, double length) {
+  BodySpec can;
+  can.id = "can";
+  can.mass = mass;
+  can.material = "aluminium";
+  can.shape = BodyShape::kCylinder;
+  can.radius = radius;
+  can.length = length;
+  return can;
+}
+
 /// The impacts at the first instant of impact (the box's landing; its other edge lands later).
 std::vector<ImpactRecord> firstInstant(const std::vector<ImpactRecord>& impacts) {
   std::vector<ImpactRecord> first;
@@ -769,14 +781,7 @@ TEST(ShapedMonitor, ACanStruckOnATableByAMovingLinkSlidesToTheEdgeAndFallsOffIt)
   scene.gravity = V(0, 0, -kG);
   ASSERT_TRUE(scene.materials.addMaterial("aluminium", Material{e, mu}, "m").ok());
   ASSERT_TRUE(scene.materials.addMaterial("paddle_face", Material{e, 0.0}, "m").ok());
-  BodySpec can;
-  can.id = "can";
-  can.mass = 0.35;
-  can.material = "aluminium";
-  can.shape = BodyShape::kCylinder;
-  can.radius = 0.033;
-  can.length = 0.12;
-  scene.bodies = {can};
+  scene.bodies = {canOf(0.35, 0.033, 0.12)};
   scene.obstacles = {
       scene_builders::plane("floor", V::UnitZ(), 0.0, "aluminium"),
       scene_builders::box("paddle", V::Zero(), V(0.02, 0.3, 0.2), "paddle_face"),
@@ -928,14 +933,7 @@ TEST(ShapedMonitor, AHexagonalToolDroppedFlatRestsOnItsSixCorners) {
 TEST(ShapedMonitor, ATurningDiscsRimStrikesACansSideAlongTheirAxesCommonPerpendicular) {
   Scene scene;
   ASSERT_TRUE(scene.materials.addMaterial("aluminium", Material{0.5, 0.0}, "m").ok());
-  BodySpec can;
-  can.id = "can";
-  can.mass = 0.4;
-  can.material = "aluminium";
-  can.shape = BodyShape::kCylinder;
-  can.radius = 0.04;
-  can.length = 0.2;
-  scene.bodies = {can};
+  scene.bodies = {canOf(0.4, 0.04, 0.2)};
   ObstacleSpec disc;
   disc.id = "paddle";
   disc.shape = ObstacleShape::kCylinder;
