@@ -76,6 +76,17 @@ struct Polyhedron {
 Expected<Polyhedron> convexHull(const std::vector<Eigen::Vector3d>& points,
                                 const std::string& field);
 
+/// m^2: the total area of the polyhedron's triangles.
+double surfaceArea(const Polyhedron& polyhedron);
+
+/// m^2: a shape's mean cross-section, the area of its shadow averaged over every orientation: for
+/// a convex body a quarter of its surface (Cauchy's surface-area formula; Santalo, "Integral
+/// Geometry and Geometric Probability", 1976): pi r^2 for a sphere, 2 (x y + y z + z x)
+/// for a box of half sizes x, y, z, pi r (r + 2 h) / 2 for a cylinder and pi r (r + h) for a
+/// capsule of half length h, a mesh's convex hull's surface / 4. 0 for a plane, a mesh with no
+/// triangles or one whose hull is refused (convexHull).
+double meanCrossSection(const Shape& shape);
+
 /// A uniform solid polyhedron of `mass` (finite, > 0) bounded by closed, outward-wound triangles:
 /// its volume, centroid and inertia tensor by the divergence theorem, each volume integral of
 /// 1, x, y, z, x^2, ..., zx turned into sums over the triangles (Mirtich, "Fast and accurate

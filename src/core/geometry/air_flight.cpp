@@ -8,6 +8,9 @@
 #include <exception>
 #include <limits>
 
+#include "collision_response/core/body_shape.h"
+#include "collision_response/core/mass_properties.h"
+
 namespace collision_response::core {
 namespace {
 
@@ -31,6 +34,23 @@ AirFactors airFactors(double density, double radius, double inverse_mass, double
   return AirFactors{per_coefficient * drag_coefficient, per_coefficient * lift_coefficient};
 }
 
+AirFactors airFactorsOfSection(double density, double section, double inverse_mass,
+                               double drag_coefficient, double lift_coefficient) {
+  const double per_coefficient = 0.5 * density * section * inverse_mass;
+  return AirFactors{per_coefficient * drag_coefficient, per_coefficient * lift_coefficient};
+}
+
+AirFactors bodyAirFactors(const BodySpec& body, double density, bool drag, bool magnus) {
+  const double drag_coefficient = drag ? body.drag_coefficient : 0.0;
+  const double lift_coefficient = magnus ? body.lift_coefficient : 0.0;
+  if (!isShapedBody(body)) {
+    return airFactors(density, body.radius, inverseMass(body.mass), drag_coefficient,
+                      lift_coefficient);
+  }
+  return airFactorsOfSection(density, meanCrossSection(shapeOf(body)), inverseMass(body.mass),
+                             drag_coefficient, lift_coefficient);
+}
+
 Eigen::Vector3d airAcceleration(const Eigen::Vector3d& gravity, const AirFactors& air,
                                 const Eigen::Vector3d& velocity,
                                 const Eigen::Vector3d& angular_velocity) {
@@ -47,6 +67,7 @@ struct AirFlight::Integration {
   Eigen::Vector3d gravity;
   AirFactors air;
   Eigen::Vector3d spin;
+  std::function<Eigen::Vector3d(double)> spin_at;  ///< empty: `spin` throughout
   Dense dense;
   /// The stepper after each step taken: its dense output covers that step.
   std::vector<Dense> steps;
@@ -58,9 +79,10 @@ struct AirFlight::Integration {
   Integration(double tolerance)
       : dense(boost::numeric::odeint::make_dense_output(tolerance, tolerance, Stepper())) {}
 
-  void derivative(const State& x, State& rate) const {
+  void derivative(const State& x, State& rate, double time) const {
     const Eigen::Vector3d velocity(x[3], x[4], x[5]);
-    const Eigen::Vector3d acceleration = airAcceleration(gravity, air, velocity, spin);
+    const Eigen::Vector3d acceleration =
+        airAcceleration(gravity, air, velocity, spin_at ? spin_at(time) : spin);
     for (int i = 0; i < 3; ++i) {
       rate[static_cast<std::size_t>(i)] = x[static_cast<std::size_t>(i) + 3];
       rate[static_cast<std::size_t>(i) + 3] = acceleration[i];
@@ -87,14 +109,21 @@ AirFlight::AirFlight(double start, const Eigen::Vector3d& position, const Eigen:
   integration.dense.initialize(initial, start, 1e-3);
 }
 
+AirFlight::AirFlight(double start, const Eigen::Vector3d& position, const Eigen::Vector3d& velocity,
+                     std::function<Eigen::Vector3d(double)> spin_at, const Eigen::Vector3d& gravity,
+                     const AirFactors& air, double tolerance)
+    : AirFlight(start, position, velocity, spin_at(start), gravity, air, tolerance) {
+  integration_->spin_at = std::move(spin_at);
+}
+
 AirFlight::~AirFlight() = default;
 
 const Vector6& AirFlight::stateAt(double time) const {
   Integration& integration = *integration_;
   if (!(time > start_)) return integration.initial;
   if (time == integration.queried_time) return integration.queried;
-  const auto system = [&integration](const State& x, State& rate, double) {
-    integration.derivative(x, rate);
+  const auto system = [&integration](const State& x, State& rate, double t) {
+    integration.derivative(x, rate, t);
   };
   while (!integration.stalled &&
          (integration.steps.empty() || integration.steps.back().current_time() < time)) {
@@ -141,13 +170,17 @@ Eigen::Vector3d AirFlight::velocity(std::size_t, double time) const {
 double AirFlight::end() const { return std::numeric_limits<double>::infinity(); }
 
 double AirFlight::accelerationBound(std::size_t, double gravity, double from, double to) const {
+  return gravity + airAccelerationBound(gravity, from, to);
+}
+
+double AirFlight::airAccelerationBound(double gravity, double from, double to) const {
   const AirFactors& air = integration_->air;
   const double speed = velocity(0, from).norm();
   const double fastest =
       air.drag > 0 ? std::max(speed, std::sqrt(gravity / air.drag)) : speed + gravity * (to - from);
   // 1 % over: the integrated speed is the true one only to the integrator's tolerance.
   const double bound = 1.01 * fastest;
-  return gravity + (air.drag + air.lift) * bound * bound;
+  return (air.drag + air.lift) * bound * bound;
 }
 
 std::size_t AirFlight::steps() const { return integration_->steps.size(); }

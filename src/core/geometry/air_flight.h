@@ -4,9 +4,11 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <memory>
 #include <vector>
 
+#include "collision_response/core/scene.h"
 #include "geometry/integrated_motion.h"
 
 namespace collision_response::core {
@@ -21,6 +23,16 @@ struct AirFactors {
 /// The factors of a sphere of `radius` and inverse mass `inverse_mass` in air of `density`.
 AirFactors airFactors(double density, double radius, double inverse_mass, double drag_coefficient,
                       double lift_coefficient);
+/// The factors of a body of cross-section `section` (m^2) and inverse mass `inverse_mass`: the same
+/// rho C A / (2 m) with A given (a shaped body's mean cross-section, meanCrossSection).
+AirFactors airFactorsOfSection(double density, double section, double inverse_mass,
+                               double drag_coefficient, double lift_coefficient);
+
+/// The factors of a scene's body in air of `density`, drag's where `drag`, lift's where `magnus`
+/// (0 otherwise): a ball's by its radius (airFactors), a shaped body's (a box, cylinder, capsule,
+/// mesh, or a sphere given a tensor) by its mean cross-section (meanCrossSection: the drag of a
+/// body tumbling through every orientation alike).
+AirFactors bodyAirFactors(const BodySpec& body, double density, bool drag, bool magnus);
 
 /// The acceleration of a body moving at `velocity` and spinning at `angular_velocity` in air:
 /// g - drag |v| v + lift |v| (w/|w| x v). Quadratic drag, F = -1/2 rho C_d A |v| v, and the
@@ -32,13 +44,18 @@ Eigen::Vector3d airAcceleration(const Eigen::Vector3d& gravity, const AirFactors
                                 const Eigen::Vector3d& angular_velocity);
 
 /// One body's flight from its state at `start`: its centre and velocity integrated, its spin
-/// constant (no torque of the air). Integrated on demand, as far as it is looked at; a query
-/// between the steps taken reads the stepper's dense output (its 4th-order interpolant, to the
-/// step's error). The steps are those one integration would take, however it is asked.
+/// constant (no torque of the air), or, for a body whose turning is its own torque-free
+/// rotation (a tumbling shaped body), the angular velocity `spin_at(t)` that rotation gives.
+/// Integrated on demand, as far as it is looked at; a query between the steps taken reads the
+/// stepper's dense output (its 4th-order interpolant, to the step's error). The steps are those one
+/// integration would take, however it is asked.
 class AirFlight final : public IntegratedMotion {
  public:
   AirFlight(double start, const Eigen::Vector3d& position, const Eigen::Vector3d& velocity,
             const Eigen::Vector3d& angular_velocity, const Eigen::Vector3d& gravity,
+            const AirFactors& air, double tolerance);
+  AirFlight(double start, const Eigen::Vector3d& position, const Eigen::Vector3d& velocity,
+            std::function<Eigen::Vector3d(double)> spin_at, const Eigen::Vector3d& gravity,
             const AirFactors& air, double tolerance);
   ~AirFlight() override;
 
@@ -50,6 +67,8 @@ class AirFlight final : public IntegratedMotion {
   /// terminal speed sqrt(|g| / drag) (drag never lets it grow past both; Magnus does no work), or
   /// without drag by its start plus |g| (to - from).
   double accelerationBound(std::size_t slot, double gravity, double from, double to) const override;
+  /// m/s^2: the air's part of that bound (drag's and lift's), |g| aside.
+  double airAccelerationBound(double gravity, double from, double to) const;
   bool free() const override { return true; }
   /// Where the integrator could not go on (a step it could not take, a state past the doubles,
   /// or kMaxSteps taken), the flight holds its last state reached from then on.

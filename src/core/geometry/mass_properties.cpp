@@ -304,6 +304,34 @@ Expected<MassProperties> polyhedronMassProperties(const Polyhedron& polyhedron, 
   return properties;
 }
 
+double surfaceArea(const Polyhedron& polyhedron) {
+  double twice = 0.0;
+  for (const auto& t : polyhedron.triangles) {
+    const Eigen::Vector3d& a = polyhedron.vertices[t[0]];
+    twice += (polyhedron.vertices[t[1]] - a).cross(polyhedron.vertices[t[2]] - a).norm();
+  }
+  return 0.5 * twice;
+}
+
+double meanCrossSection(const Shape& shape) {
+  return std::visit(
+      Dispatch{
+          [](const Plane&) { return 0.0; },
+          [](const Sphere& sphere) { return kPi * sphere.radius * sphere.radius; },
+          [](const Cuboid& box) {
+            const Eigen::Vector3d& h = box.half_size;
+            return 2.0 * (h.x() * h.y() + h.y() * h.z() + h.z() * h.x());
+          },
+          [](const Cylinder& c) { return 0.5 * kPi * c.radius * (c.radius + 2 * c.half_length); },
+          [](const Capsule& c) { return kPi * c.radius * (c.radius + c.half_length); },
+          [](const Mesh& mesh) {
+            if (mesh.triangles == nullptr) return 0.0;
+            const auto hull = convexHull(mesh.triangles->vertices(), "mesh");
+            return hull ? 0.25 * surfaceArea(*hull) : 0.0;
+          }},
+      shape);
+}
+
 Expected<MassProperties> uniformMassProperties(const Shape& shape, double mass,
                                                Inertia sphere_inertia, const std::string& field) {
   if (!std::isfinite(mass) || !(mass > 0)) {

@@ -433,6 +433,8 @@ double firstRoot(double gap, double speed, double acceleration) {
 /// gap >= h(t_0), clamped to [-R, R] (conservative: the bound rises with h_0). A body moving
 /// along the plane (n . v = 0) or spinning about its normal (n x w = 0) takes long steps, and a
 /// corner straight below the centre (theta_0 = 0) rises only by its turning, quadratically.
+/// Through air (TumblingBody::throughAir) the centre's height accelerates within `air` (the air's
+/// bound over the query) of gravity's n . a, which the bounds then take as theirs.
 /// s: no corner of a box or hull reaches the plane n.x = offset (n unit, moving at
 /// `plane_velocity`) before it; 0 for other shapes. Each corner's height h_i and its rate h_i' are
 /// exact at `time`, and |h_i''| <= |n.a| + |r_i| (|w'| + |w|^2) over any span (r_i from the centre:
@@ -440,7 +442,7 @@ double firstRoot(double gap, double speed, double acceleration) {
 /// A corner just struck and leaving at e u keeps the step of order e u / A, where the body's
 /// speed bound alone (planeStep's others) would step its gap over its whole turning speed.
 double cornerStep(const TumblingBody& body, double time, const Eigen::Vector3d& n, double offset,
-                  const Eigen::Vector3d& plane_velocity) {
+                  const Eigen::Vector3d& plane_velocity, double air) {
   std::vector<Eigen::Vector3d> corners;
   if (const auto* box = std::get_if<Cuboid>(&body.shape())) {
     for (int c = 0; c < 8; ++c) {
@@ -459,7 +461,7 @@ double cornerStep(const TumblingBody& body, double time, const Eigen::Vector3d& 
   const Eigen::Vector3d spin = body.angularVelocityAt(time);
   const double w = body.angularSpeedBound();
   const double turning = body.angularAccelerationBound() + w * w;
-  const double pulled = std::abs(n.dot(body.acceleration()));
+  const double pulled = std::abs(n.dot(body.acceleration())) + air;
   double step = std::numeric_limits<double>::infinity();
   for (const Eigen::Vector3d& corner : corners) {
     const Eigen::Vector3d r = rotation * corner;
@@ -473,13 +475,13 @@ double cornerStep(const TumblingBody& body, double time, const Eigen::Vector3d& 
 }
 
 double planeStep(const TumblingBody& body, double time, double gap, const Plane& plane,
-                 const Eigen::Vector3d& plane_velocity) {
+                 const Eigen::Vector3d& plane_velocity, double air) {
   const double length = plane.normal.norm();
   const Eigen::Vector3d n = plane.normal / length;
   const double reach = body.reach() * (1 + 64 * kEps);
   const double spin = body.spinAcrossBound(n);
   const double closing = -n.dot(body.velocityAt(time) - plane_velocity);
-  const double pulled = -n.dot(body.acceleration());
+  const double pulled = -n.dot(body.acceleration()) + air;
   const double centre_height = (plane.normal.dot(body.positionAt(time)) - plane.offset) / length;
   const double below = std::clamp(centre_height - gap, -reach, reach);  // h_0, at least h(t_0)
   const double across = std::sqrt((reach - below) * (reach + below));   // R sin(theta_0)
@@ -488,7 +490,7 @@ double planeStep(const TumblingBody& body, double time, double gap, const Plane&
   const double lowest = gap - (reach - below);
   const double reached = lowest > 0 ? firstRoot(lowest, closing, pulled) : 0.0;
   return std::max({lipschitz, taylor, reached,
-                   cornerStep(body, time, n, plane.offset / length, plane_velocity)});
+                   cornerStep(body, time, n, plane.offset / length, plane_velocity, air)});
 }
 
 /// The other side of a first-contact query: what it is at an instant and how fast its points
@@ -504,13 +506,13 @@ struct ObstacleSide {
   /// s: no contact before it from `time`, where the gap is at least `gap`: the bound on every
   /// point's speed (`speed`, `acceleration`: the header's comment), or a plane's own (planeStep)
   /// where that is longer.
-  double step(const TumblingBody& body, double time, double gap, double speed,
-              double acceleration) const {
+  double step(const TumblingBody& body, double time, double gap, double speed, double acceleration,
+              double air) const {
     const double any = firstRoot(gap, speed, acceleration);
     if (std::holds_alternative<Plane>(placed.shape)) {
       const PlacedShape moved = at(time);
       return std::max(
-          any, planeStep(body, time, gap, std::get<Plane>(moved.shape), placed.pose.velocity));
+          any, planeStep(body, time, gap, std::get<Plane>(moved.shape), placed.pose.velocity, air));
     }
     return any;
   }
@@ -518,8 +520,8 @@ struct ObstacleSide {
     return turns(placed.shape) ? placed.pose.angular_velocity.norm() : 0.0;
   }
   double pointSpeedAboutCentre() const { return angularSpeed() * turningReach(placed.shape); }
-  double accelerationBound(const TumblingBody& body) const {
-    return body.acceleration().norm() + angularSpeed() * placed.pose.velocity.norm();
+  double accelerationBound(const TumblingBody& body, double from, double to) const {
+    return body.accelerationBound(from, to) + angularSpeed() * placed.pose.velocity.norm();
   }
   void manifold(const TumblingBody& body, double time, const SurfaceGap& closest, double band,
                 std::vector<ManifoldPoint>& out) const;
@@ -532,12 +534,14 @@ struct BodySide {
     return bodiesGap(body, other, time, tolerance, approach);
   }
   Eigen::Vector3d centreVelocity(double time) const { return other.velocityAt(time); }
-  double step(const TumblingBody&, double, double gap, double speed, double acceleration) const {
+  double step(const TumblingBody&, double, double gap, double speed, double acceleration,
+              double) const {
     return firstRoot(gap, speed, acceleration);
   }
   double pointSpeedAboutCentre() const { return other.angularSpeedBound() * other.reach(); }
-  double accelerationBound(const TumblingBody& body) const {
-    return (body.acceleration() - other.acceleration()).norm();
+  double accelerationBound(const TumblingBody& body, double from, double to) const {
+    return (body.acceleration() - other.acceleration()).norm() +
+           body.airAccelerationBound(from, to) + other.airAccelerationBound(from, to);
   }
   void manifold(const TumblingBody& body, double time, const SurfaceGap& closest, double band,
                 std::vector<ManifoldPoint>& out) const;
@@ -660,9 +664,11 @@ void BodySide::manifold(const TumblingBody& body, double time, const SurfaceGap&
   candidatesOfB(body, time, closest, band, tolerance, local, centre_b, out);
 }
 
-/// The moving side a of the advancement in flight: exact at every instant, its own bounds.
+/// The moving side a of the advancement in flight: exact at every instant, its own bounds (`air`:
+/// the air's part of its acceleration's over the query).
 struct FlightSide {
   const TumblingBody& body;
+  double air = 0.0;
   const TumblingBody* at(double) const { return &body; }
   double turning() const { return body.angularSpeedBound() * body.reach(); }
   /// m/s: the centres' relative speed at `time`, the other's centre moving at `other`.
@@ -670,12 +676,12 @@ struct FlightSide {
     return (body.velocityAt(time) - other).norm();
   }
   template <class Side>
-  double accelerationBound(const Side& side, const TumblingBody&) const {
-    return side.accelerationBound(body);
+  double accelerationBound(const Side& side, const TumblingBody&, double from, double to) const {
+    return side.accelerationBound(body, from, to);
   }
   template <class Side>
   double step(const Side& side, double time, double gap, double speed, double acceleration) const {
-    return side.step(body, time, gap, speed, acceleration);
+    return side.step(body, time, gap, speed, acceleration, air);
   }
 };
 
@@ -694,8 +700,9 @@ struct BoundedSide {
   }
   /// The other side's alone: `at`'s state has none.
   template <class Side>
-  double accelerationBound(const Side& side, const TumblingBody& at_from) const {
-    return side.accelerationBound(at_from);
+  double accelerationBound(const Side& side, const TumblingBody& at_from, double from,
+                           double to) const {
+    return side.accelerationBound(at_from, from, to);
   }
   template <class Side>
   double step(const Side&, double, double gap, double speed, double acceleration) const {
@@ -742,7 +749,7 @@ FirstContactResult advance(const Moving& moving, const Side& side, double from, 
   double t = from;
   const TumblingBody* body = moving.at(t);
   if (body == nullptr) return result;
-  const double acceleration = moving.accelerationBound(side, *body);
+  const double acceleration = moving.accelerationBound(side, *body, from, end);
   SurfaceGap g = side.gap(*body, t, Approach::kWithout);
   if (g.overlapping || g.gap_upper < 0) {
     // Touching within the band: the contact there, its normal and points the shrunk body's.
@@ -827,6 +834,24 @@ Expected<TumblingBody> TumblingBody::create(const ConvexShape& shape,
   return body;
 }
 
+TumblingBody TumblingBody::throughAir(const AirFactors& air, double tolerance) const {
+  if (air.drag == 0.0 && air.lift == 0.0) return *this;
+  TumblingBody through = *this;
+  // A steady turn (at rest, an isotropic body) is a constant w, as a ball's flight takes it.
+  if (steady_spin_) {
+    through.air_ = std::make_shared<const AirFlight>(time_, position_, velocity_, angular_velocity_,
+                                                     acceleration_, air, tolerance);
+  } else {
+    through.air_ = std::make_shared<const AirFlight>(
+        time_, position_, velocity_,
+        [rotation = rotation_, start = time_](double t) {
+          return rotation.angularVelocity(t - start);
+        },
+        acceleration_, air, tolerance);
+  }
+  return through;
+}
+
 TumblingBody TumblingBody::shrunkBy(double distance) const {
   TumblingBody shrunk = *this;
   // Each size less `distance`, but never below half of itself (a body smaller than the band).
@@ -868,8 +893,8 @@ SurfaceGap gapAt(const TumblingBody& a, const TumblingBody& b, double time,
 
 FirstContactResult firstContact(const TumblingBody& body, const PlacedShape& obstacle, double from,
                                 double horizon, const FirstContactOptions& options) {
-  return advance(FlightSide{body}, ObstacleSide{obstacle, options.distance_tolerance}, from,
-                 horizon, options);
+  return advance(FlightSide{body, body.airAccelerationBound(from, from + horizon)},
+                 ObstacleSide{obstacle, options.distance_tolerance}, from, horizon, options);
 }
 
 FirstContactResult firstContact(const BoundedMotion& body, const PlacedShape& obstacle, double from,
@@ -880,7 +905,8 @@ FirstContactResult firstContact(const BoundedMotion& body, const PlacedShape& ob
 
 FirstContactResult firstContact(const TumblingBody& a, const TumblingBody& b, double from,
                                 double horizon, const FirstContactOptions& options) {
-  return advance(FlightSide{a}, BodySide{b, options.distance_tolerance}, from, horizon, options);
+  return advance(FlightSide{a, a.airAccelerationBound(from, from + horizon)},
+                 BodySide{b, options.distance_tolerance}, from, horizon, options);
 }
 
 }  // namespace collision_response::core

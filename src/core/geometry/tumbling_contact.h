@@ -22,10 +22,11 @@
 // than V s + A s^2 / 2, with V = |v_a(t) - v_b(t)| + Omega_a rho_a + Omega_b rho_b (the centres'
 // relative velocity, and each side's bound on |w| times its farthest point from its centre) and
 // A = |a_a - a_b| + |w_o| |v_o| (the centres' relative acceleration; an obstacle's origin on its
-// screw turns its velocity at |w_o|). The gap, a distance between the two sets, changes no faster
-// than the points move, so it has no root before s = 2 g / (V + sqrt(V^2 + 2 A g)). |w| of a
-// free rotation is bounded for all time by sqrt(2 E / J_min), E its kinetic energy (2 E = sum
-// J_i w_i^2 >= J_min |w|^2). Against a plane a second bound, along its normal n, where that
+// screw turns its velocity at |w_o|; a body flying through air adds the air's bound, drag and
+// lift times its speed bound squared, air_flight.h). The gap, a distance between the two sets,
+// changes no faster than the points move, so it has no root before s = 2 g / (V + sqrt(V^2 + 2 A
+// g)). |w| of a free rotation is bounded for all time by sqrt(2 E / J_min), E its kinetic energy (2
+// E = sum J_i w_i^2 >= J_min |w|^2). Against a plane a second bound, along its normal n, where that
 // steps further (planeStep in the source, proved there): the centre's height moves exactly on
 // its parabola, and how far the body reaches below its centre, h = R cos(theta) (R its reach),
 // rises only as theta falls, no faster than |n x w| (exactly where w is fixed, else bounded by
@@ -48,17 +49,21 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <functional>
+#include <limits>
+#include <memory>
 #include <optional>
 #include <vector>
 
 #include "collision_response/core/expected.h"
 #include "collision_response/core/shape.h"
+#include "geometry/air_flight.h"
 #include "geometry/convex_distance.h"
 #include "geometry/free_rotation.h"
 
 namespace collision_response::core {
 
-/// A convex body in flight: its centre on a parabola and its exact free rotation.
+/// A convex body in flight: its centre on a parabola (or flying through air: throughAir) and its
+/// exact free rotation.
 class TumblingBody {
  public:
   /// `shape` in the body frame (the principal axes about the centre of mass, the moments
@@ -77,15 +82,38 @@ class TumblingBody {
                                        const Eigen::Quaterniond& orientation,
                                        const Eigen::Vector3d& angular_velocity);
 
+  /// The same body flying through air (the drag and magnus effects, doc/model.md, "Effects in
+  /// detail"): its centre's flight integrated (AirFlight, to `tolerance`) under its acceleration
+  /// as gravity, drag and the Magnus force of its own turning, w(t) of its free rotation; the air
+  /// puts no torque on it (its rotation stays torque-free). Itself where both factors are 0.
+  TumblingBody throughAir(const AirFactors& air, double tolerance) const;
+
   const ConvexShape& shape() const { return shape_; }
   Eigen::Vector3d positionAt(double time) const {
+    if (air_) return air_->position(0, time);
     const double dt = time - time_;
     return position_ + dt * (velocity_ + (0.5 * dt) * acceleration_);
   }
   Eigen::Vector3d velocityAt(double time) const {
+    if (air_) return air_->velocity(0, time);
     return velocity_ + (time - time_) * acceleration_;
   }
+  /// m/s^2: gravity (its parabola's acceleration; through air, the part besides the air's).
   const Eigen::Vector3d& acceleration() const { return acceleration_; }
+  /// m/s^2: the air's part of its centre's acceleration never exceeds it over [from, to]
+  /// (AirFlight::airAccelerationBound); 0 on a parabola.
+  double airAccelerationBound(double from, double to) const {
+    return air_ ? air_->airAccelerationBound(acceleration_.norm(), from, to) : 0.0;
+  }
+  /// m/s^2: |a(t)| of its centre never exceeds it over [from, to].
+  double accelerationBound(double from, double to) const {
+    return acceleration_.norm() + airAccelerationBound(from, to);
+  }
+  /// s: where its flight through air stalled (AirFlight::stalledAt: held from there); infinite
+  /// where it did not, or on a parabola.
+  double stalledAt() const {
+    return air_ ? air_->stalledAt() : std::numeric_limits<double>::infinity();
+  }
   Eigen::Quaterniond orientationAt(double time) const {
     return rotation_.orientation(time - time_);
   }
@@ -131,6 +159,7 @@ class TumblingBody {
   bool steady_spin_ = false;                                    // w fixed in the world
   Eigen::Vector3d angular_velocity_ = Eigen::Vector3d::Zero();  // w at time_ (world)
   double reach_ = 0.0;
+  std::shared_ptr<const AirFlight> air_;  // through air: the centre's flight
 };
 
 /// The gap between a tumbling body (side a) and another side b at one instant.
