@@ -24,11 +24,12 @@
 // A = |a_a - a_b| + |w_o| |v_o| (the centres' relative acceleration; an obstacle's origin on its
 // screw turns its velocity at |w_o|; a body flying through air adds the air's bound, drag and
 // lift times its speed bound squared, air_flight.h). The gap, a distance between the two sets,
-// changes no faster than the points move, so it has no root before s = 2 g / (V + sqrt(V^2 + 2 A
-// g)). |w| of a free rotation is bounded for all time by sqrt(2 E / J_min), E its kinetic energy (2
-// E = sum J_i w_i^2 >= J_min |w|^2). Against a plane a second bound, along its normal n, where that
-// steps further (planeStep in the source, proved there): the centre's height moves exactly on
-// its parabola, and how far the body reaches below its centre, h = R cos(theta) (R its reach),
+// changes no faster than the points move, so it has no root before
+// s = 2 g / (V + sqrt(V^2 + 2 A g)). |w| of a free rotation is bounded for all time by
+// sqrt(2 E / J_min), E its kinetic energy (2 E = sum J_i w_i^2 >= J_min |w|^2). Against a plane
+// a second bound, along its normal n, where that steps further (planeStep in the source, proved
+// there): the centre's height moves exactly on its parabola (through air, within the air's
+// bound of it), and how far the body reaches below its centre, h = R cos(theta) (R its reach),
 // rises only as theta falls, no faster than |n x w| (exactly where w is fixed, else bounded by
 // sqrt(2 E / J_min)): a body sliding along the plane or turning steadily about its normal, or a
 // corner straight below its centre, takes long steps. The advancement stops where a step falls

@@ -785,9 +785,8 @@ ImpactMonitor::ImpactMonitor(const Scene& scene, const MonitorSettings& settings
                            : 0.0);
     world.material.push_back(material_index(body.material));
     if (world.effects.air()) {
-      world.air.push_back(airFactors(scene.air_density, body.radius, world.inverse_mass.back(),
-                                     world.effects.drag ? body.drag_coefficient : 0.0,
-                                     world.effects.magnus ? body.lift_coefficient : 0.0));
+      world.air.push_back(
+          bodyAirFactors(body, scene.air_density, world.effects.drag, world.effects.magnus));
     }
   }
   for (const ObstacleSpec& obstacle : world.obstacles) {

@@ -273,10 +273,7 @@ class PredictionRun {
     }
     if (truncated) cut.push_back("the monitor's guard on impacts at one instant ran out");
     if (stalled_at < INFINITY) {
-      cut.push_back("the flight through air stalled at +" + formatNumber(stalled_at) +
-                    " s (its integrator could take no further step: a speed or an air factor "
-                    "too large for it); the body is held where it got to from there, its state "
-                    "at the horizon too");
+      cut.push_back(stalledFlightCut(stalled_at));
     }
     if (spent) {
       prediction.out_of_budget = true;

@@ -101,6 +101,10 @@ namespace {
 
 /// Contacts this close to the earliest (relative to the instant, 1e-12) strike together.
 constexpr double kSimultaneous = 1e-12;
+/// s: the longest step separation takes (a body's points part within far less).
+constexpr double kSeparationSpan = 1.0;
+/// s: a flight through air that stalls within this of its start is held still (holdIfStalled).
+constexpr double kStallProbe = 1e-3;
 
 /// An obstacle as the solver sees it at `time`: immovable, moving on as it moves.
 SolverBody obstacleBody(const PlacedShape& placed, double time) {
@@ -112,6 +116,19 @@ SolverBody obstacleBody(const PlacedShape& placed, double time) {
   return solver;
 }
 
+/// The body's flight from a state (`orientation`: world from principal): its parabola, or through
+/// the scene's air.
+Expected<TumblingBody> flightFrom(const PrincipalBody& principal, const ShapedScene& scene,
+                                  double time, const Eigen::Vector3d& position,
+                                  const Eigen::Vector3d& velocity,
+                                  const Eigen::Quaterniond& orientation,
+                                  const Eigen::Vector3d& angular_velocity) {
+  auto flight = TumblingBody::create(principal.shape, principal.moments, time, position, velocity,
+                                     scene.acceleration, orientation, angular_velocity);
+  if (!flight) return flight.error();
+  return flight->throughAir(scene.air, scene.flight_tolerance);
+}
+
 }  // namespace
 
 Expected<ShapedMotion> ShapedMotion::create(PrincipalBody principal,
@@ -119,12 +136,12 @@ Expected<ShapedMotion> ShapedMotion::create(PrincipalBody principal,
                                             const BodyStateSample& state) {
   const Eigen::Quaterniond orientation =
       state.orientation.normalized() * principal.body_from_principal;
-  auto flight =
-      TumblingBody::create(principal.shape, principal.moments, state.time, state.position,
-                           state.velocity, scene.acceleration, orientation, state.angular_velocity);
+  auto flight = flightFrom(principal, scene, state.time, state.position, state.velocity,
+                           orientation, state.angular_velocity);
   if (!flight) return flight.error();
   ShapedMotion motion(std::move(principal), std::move(scene), std::move(flight.value()),
                       state.time);
+  motion.holdIfStalled(state.time);
   for (ShapedObstacle& obstacle : placed) {
     motion.obstacles_.push_back({std::move(obstacle), state.time, false});
   }
@@ -134,12 +151,12 @@ Expected<ShapedMotion> ShapedMotion::create(PrincipalBody principal,
 Status ShapedMotion::restartFrom(const BodyStateSample& state) {
   const Eigen::Quaterniond orientation =
       state.orientation.normalized() * principal_.body_from_principal;
-  auto flight = TumblingBody::create(principal_.shape, principal_.moments, state.time,
-                                     state.position, state.velocity, scene_.acceleration,
-                                     orientation, state.angular_velocity);
+  auto flight = flightFrom(principal_, scene_, state.time, state.position, state.velocity,
+                           orientation, state.angular_velocity);
   if (!flight) return flight.error();
   flight_ = std::move(flight.value());
   time_ = state.time;
+  holdIfStalled(state.time);
   for (Watched& w : obstacles_) {
     w.clear_from = state.time;
     w.parted = false;
@@ -330,16 +347,32 @@ Expected<ShapedMotion::Found> ShapedMotion::next(double horizon, std::vector<Imp
     clearUntil(at, contacts, *apart);
     return Found{Event::kGrazed, at};
   }
-  auto after = TumblingBody::create(principal_.shape, principal_.moments, at,
-                                    flight_.positionAt(at), moving.velocity, flight_.acceleration(),
-                                    flight_.orientationAt(at), moving.angular_velocity);
+  auto after = flightFrom(principal_, scene_, at, flight_.positionAt(at), moving.velocity,
+                          flight_.orientationAt(at), moving.angular_velocity);
   if (!after) return after.error();
   landed_ = flight_;
   flight_ = std::move(after.value());
   time_ = at;
+  holdIfStalled(at);
   struck_ = contacts;
   return Found{Event::kImpact, at};
 }
+
+void ShapedMotion::holdIfStalled(double time) {
+  stalled_at_.reset();
+  if (scene_.air.drag == 0.0 && scene_.air.lift == 0.0) return;
+  flight_.positionAt(time + kStallProbe);  // its first steps, which any query takes
+  const double stalled = flight_.stalledAt();
+  if (!(stalled <= time + kStallProbe)) return;
+  auto still = TumblingBody::create(principal_.shape, principal_.moments, stalled,
+                                    flight_.positionAt(stalled), Eigen::Vector3d::Zero(),
+                                    Eigen::Vector3d::Zero(), flight_.orientationAt(stalled),
+                                    Eigen::Vector3d::Zero());
+  if (still) flight_ = std::move(still.value());
+  stalled_at_ = stalled;
+}
+
+double ShapedMotion::stalledAt() const { return stalled_at_.value_or(flight_.stalledAt()); }
 
 bool ShapedMotion::leave(double horizon) {
   // The points just struck leave their obstacles: the next contact with those is looked for
@@ -381,7 +414,7 @@ bool ShapedMotion::part(double horizon) {
   const double time = lasting_time_;
   const double speed =
       flight_.velocityAt(time).norm() + flight_.angularSpeedBound() * flight_.reach();
-  const double acceleration = flight_.acceleration().norm();
+  const double acceleration = flight_.accelerationBound(time, time + 1e-3);  // its steps' span
   const double band = FirstContactOptions{}.manifold_band;
   double step = std::max(band / (speed + std::sqrt(speed * speed + acceleration * band)),
                          4 * std::numeric_limits<double>::epsilon() * std::abs(time));
@@ -407,6 +440,9 @@ Expected<std::pair<LastingBody, FlatFace>> ShapedMotion::lastingFace() const {
 }
 
 std::optional<double> ShapedMotion::flatBouncesEnd() const {
+  // The series' closed form is the parabola's: through air the bounces are flown one by one
+  // until they settle (resolve's rule).
+  if (scene_.air.drag != 0.0 || scene_.air.lift != 0.0) return std::nullopt;
   if (!landed_ || struck_.empty()) return std::nullopt;
   const auto face = faceOf(struck_, *landed_, time_);
   if (!face) return std::nullopt;
@@ -662,7 +698,8 @@ std::optional<double> ShapedMotion::separation(const TumblingBody& body, double 
                                                const std::vector<ObstacleContact>& left,
                                                double horizon) const {
   double speed = body.velocityAt(time).norm() + body.angularSpeedBound() * body.reach();
-  double acceleration = body.acceleration().norm();
+  // Its step is at most kSeparationSpan (below), over which the air's part is bounded.
+  double acceleration = body.accelerationBound(time, time + kSeparationSpan);
   for (const ObstacleContact& c : left) {
     const PlacedShape now = shapeAt(obstacles_[c.slot].placed.placed, time);
     const double turning = now.pose.angular_velocity.norm();
@@ -673,8 +710,9 @@ std::optional<double> ShapedMotion::separation(const TumblingBody& body, double 
   }
   if (!(speed > 0) && !(acceleration > 0)) return std::nullopt;  // at rest, touching
   const double band = FirstContactOptions{}.manifold_band;
-  const double step = std::max(band / (speed + std::sqrt(speed * speed + acceleration * band)),
-                               4 * std::numeric_limits<double>::epsilon() * std::abs(time));
+  const double step = std::min(
+      kSeparationSpan, std::max(band / (speed + std::sqrt(speed * speed + acceleration * band)),
+                                4 * std::numeric_limits<double>::epsilon() * std::abs(time)));
   const double apart = time + step;
   if (!(apart < horizon)) return apart;
   for (const ObstacleContact& c : left) {

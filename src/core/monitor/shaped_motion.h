@@ -76,6 +76,11 @@ struct ShapedScene {
   /// The tolerance a tipping body's motion is integrated to (pivotOnFace): the scene's
   /// contact_integration_tolerance.
   double integration_tolerance = 1e-9;
+  /// What the air does to the body in flight (drag, magnus: bodyAirFactors, on its mean
+  /// cross-section; zero where the scene has neither), integrated to `flight_tolerance` (the
+  /// scene's flight_integration_tolerance). Lasting contact moves without air, as a ball's.
+  AirFactors air;
+  double flight_tolerance = 1e-9;
 };
 
 /// The hand-overs of a body's tipping to its events ("resumes", shaped_pivot.h) its motion takes:
@@ -183,12 +188,20 @@ class ShapedMotion {
   /// Error naming what is not modelled yet.
   Expected<std::pair<LastingBody, FlatFace>> lastingFace() const;
   /// After an impact (kImpact): the instant a flat landing's bounces accumulate on the face
-  /// struck (flatBouncesEnd, from the body as it landed), if they do.
+  /// struck (flatBouncesEnd, from the body as it landed), if they do; none through air (its
+  /// closed form is the parabola's).
   std::optional<double> flatBouncesEnd() const;
 
   /// The instant friction at several points struck at once was first left out (their joint rule
   /// is frictionless), if ever.
   std::optional<double> frictionlessAt() const { return frictionless_at_; }
+
+  /// s: where its present flight through air stalled (its integrator could go no further: a
+  /// speed or an air factor too large for it), the body held where it got to from there; infinite
+  /// where it has not (so far as it was integrated). A flight that stalls within its first
+  /// millisecond (a throw at 1e50 m/s) is held still there at once: its speed would bound its
+  /// first contact's steps to nothing.
+  double stalledAt() const;
 
  private:
   /// A contact of the body with one obstacle at an instant.
@@ -215,6 +228,8 @@ class ShapedMotion {
                                              bool through) const;
   SolverBody solverBody(const TumblingBody& body, double time) const;
   void clearUntil(double time, const std::vector<ObstacleContact>& contacts, double apart);
+  /// The flight just started at `time` held still where it stalls within kStallProbe (stalledAt).
+  void holdIfStalled(double time);
   Expected<bool> resolve(const TumblingBody& body, SolverBody& moving,
                          const std::vector<ObstacleContact>& contacts, double time,
                          std::vector<ImpactRecord>& impacts);
@@ -235,6 +250,7 @@ class ShapedMotion {
   double lasting_time_ = 0.0;             // and when
   std::optional<TumblingBody> landed_;    // the flight the last impact ended
   std::optional<double> frictionless_at_;
+  std::optional<double> stalled_at_;  // the flight that stalled at once, held still (stalledAt)
 };
 
 }  // namespace collision_response::core

@@ -14,12 +14,13 @@
 
 namespace collision_response::core {
 
+std::string stalledFlightCut(double stalled) {
+  return "the flight through air stalled at +" + formatNumber(stalled) +
+         " s (its integrator could take no further step: a speed or an air factor too large for "
+         "it); the body is held where it got to from there, its state at the horizon too";
+}
+
 Status checkShapedRequest(const PredictionRequest& request) {
-  if (request.effects.air()) {
-    return Error{"effects",
-                 "names drag or magnus: not yet modelled for a shaped body (a box, cylinder or "
-                 "capsule flies by gravity alone); leave them out"};
-  }
   if (!std::isfinite(request.body.mass)) {
     return Error{"body.mass", "must be finite: an immovable body is not predicted"};
   }
@@ -59,6 +60,9 @@ class ShapedRun {
     scene.restitution = [this](std::size_t o) { return restitutionWith(o); };
     scene.friction = [this](std::size_t o) { return frictionWith(o); };
     scene.integration_tolerance = scene_.contact_integration_tolerance;
+    scene.air = bodyAirFactors(request_.body, scene_.air_density, scene_.effects.drag,
+                               scene_.effects.magnus);
+    scene.flight_tolerance = scene_.flight_integration_tolerance;
     BodyStateSample state = request_.state;
     state.body = 0;
     state.time = 0.0;
@@ -85,6 +89,10 @@ class ShapedRun {
       const auto found = motion.next(horizon_, prediction_.impacts);
       if (!found) return found.error();
       flightUntil(motion, body, time, found->time);
+      if (const double stalled = motion.stalledAt(); stalled <= found->time) {
+        cut.push_back(stalledFlightCut(stalled));
+        return finish(motion, body, horizon_);
+      }
       switch (found->event) {
         case ShapedMotion::Event::kFree:
           return finish(motion, body, horizon_);

@@ -18,9 +18,13 @@
 
 namespace collision_response::core {
 
-/// The request's checks that only a shaped body has: drag and magnus are not yet modelled for
-/// it (`effects`); its shape and tensor (checkBodyShape, principalBody); its orientation.
+/// The request's checks that only a shaped body has: its mass finite, its shape and tensor
+/// (checkBodyShape, principalBody), its orientation.
 Status checkShapedRequest(const PredictionRequest& request);
+
+/// Why a prediction was cut short where its flight through air stalled at `stalled` (a ball's or a
+/// shaped body's).
+std::string stalledFlightCut(double stalled);
 
 /// The prediction of a shaped body: `model` holds the scene ahead (the obstacles where they
 /// are placed, the ids of the answer); `began` the budget's clock at the start. The reasons it

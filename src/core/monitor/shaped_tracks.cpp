@@ -33,6 +33,10 @@ ShapedScene shapedScene(const World& world, std::size_t body) {
   scene.restitution_threshold = world.restitution_threshold;
   scene.body = body;
   scene.integration_tolerance = world.integration_tolerance;
+  if (world.effects.air()) {
+    scene.air = world.air[body];
+    scene.flight_tolerance = world.flight_tolerance;
+  }
   std::vector<double> restitution, friction;
   for (std::size_t o = 0; o < world.obstacles.size(); ++o) {
     const Pair pair{body, world.bodyCount() + o};
@@ -568,6 +572,13 @@ void finishStep(const World& world, ShapedRoom& room, double time,
   reportUnmodelled(world, room, time, held, balls, report);
   for (std::size_t body = 0; body < room.tracks.size(); ++body) {
     if (!room.tracks[body]) continue;
+    // A flight through air that stalled (held where it got to: AirFlight), said once.
+    ShapedTrack& track = *room.tracks[body];
+    if (const double stalled = track.stalledAt();
+        stalled <= time && stalled != track.stall_reported) {
+      track.stall_reported = stalled;
+      report.stalled.push_back({body, stalled});
+    }
     const std::vector<ContactRecord> contacts = room.tracks[body]->contacts(time);
     report.contacts.insert(report.contacts.end(), contacts.begin(), contacts.end());
   }

@@ -64,6 +64,10 @@ class ShapedTrack {
   const TumblingBody* flight() const {
     return mode_ == Mode::kFlying ? &motion_.flight() : nullptr;
   }
+  /// s: where its flight through air stalled (ShapedMotion::stalledAt; kFlying), else infinite.
+  double stalledAt() const {
+    return mode_ == Mode::kFlying ? motion_.stalledAt() : std::numeric_limits<double>::infinity();
+  }
   /// Its lasting contacts at `time`, one record per point of the manifold (kLasting).
   std::vector<ContactRecord> contacts(double time) const;
   /// The obstacle it lasts on or is held against (kLasting, kHeld; none where it is held
@@ -82,6 +86,8 @@ class ShapedTrack {
   double last_impact_time = -std::numeric_limits<double>::infinity();
   Eigen::Vector3d impact_change = Eigen::Vector3d::Zero();  ///< m/s, the latest impact's
   Eigen::Quaterniond last_orientation = Eigen::Quaterniond::Identity();  ///< its last state's
+  /// s: the instant its flight through air stalled that was last reported (StepReport::stalled).
+  double stall_reported = std::numeric_limits<double>::quiet_NaN();
 
  private:
   ShapedTrack(ShapedMotion motion, std::size_t revision)
@@ -140,7 +146,7 @@ bool touching(const SurfaceGap& gap);
 
 /// Whether `world`'s balls move as rigid spheres among its shaped bodies (doc/model.md, "Balls
 /// among shaped bodies"): where the scene has a shaped body, and spin is on or friction off (a
-/// shaped body turns; validateScene refuses drag and Magnus with one).
+/// shaped body turns).
 bool ballsMoveAsShaped(const World& world);
 
 /// The shaped bodies of `world`'s scene (validateScene took them: principalBody holds), and

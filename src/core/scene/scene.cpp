@@ -11,6 +11,7 @@
 #include <variant>
 
 #include "collision_response/core/body_shape.h"
+#include "collision_response/core/mass_properties.h"
 #include "collision_response/core/validation.h"
 #include "geometry/air_flight.h"
 #include "geometry/finite_shapes.h"
@@ -102,18 +103,21 @@ Status checkAir(const Scene& scene, const std::string& prefix) {
 Status checkAirFactors(const Scene& scene, const BodySpec& body, const std::string& prefix,
                        std::size_t i) {
   if (!scene.effects.air()) return Ok{};
-  const AirFactors air = airFactors(scene.air_density, body.radius, inverseMass(body.mass),
-                                    scene.effects.drag ? body.drag_coefficient : 0.0,
-                                    scene.effects.magnus ? body.lift_coefficient : 0.0);
+  const AirFactors air =
+      bodyAirFactors(body, scene.air_density, scene.effects.drag, scene.effects.magnus);
   for (const auto& [factor, key, symbol] : {std::make_tuple(air.drag, "drag_coefficient", "C_d"),
                                             std::make_tuple(air.lift, "lift_coefficient", "C_L")}) {
     if (factor <= kMaxAirFactor) continue;
+    const bool shaped = isShapedBody(body);
+    char section[32];  // six figures: an area to read, not to parse
+    std::snprintf(section, sizeof section, "%.6g", meanCrossSection(shapeOf(body)));
+    const std::string area = shaped ? "mean cross-section " + std::string(section) + " m^2"
+                                    : "radius " + formatNumber(body.radius) + " m";
     return Error{item(prefix, "bodies", i, key),
-                 std::string("with air_density ") + formatNumber(scene.air_density) +
-                     " kg/m^3, radius " + formatNumber(body.radius) + " m and mass " +
-                     formatNumber(body.mass) + " kg, the air factor rho " + symbol +
-                     " pi r^2 / (2 m) is " + formatNumber(factor) + " 1/m, above " +
-                     formatNumber(kMaxAirFactor) +
+                 std::string("with air_density ") + formatNumber(scene.air_density) + " kg/m^3, " +
+                     area + " and mass " + formatNumber(body.mass) + " kg, the air factor rho " +
+                     symbol + (shaped ? " A" : " pi r^2") + " / (2 m) is " + formatNumber(factor) +
+                     " 1/m, above " + formatNumber(kMaxAirFactor) +
                      " 1/m: a flight that stiff could not be integrated (it would stall, the "
                      "body held still); lower " +
                      symbol + " or the density, or raise the mass"};
@@ -326,8 +330,8 @@ Status checkEveryPairHasRestitution(const Scene& scene, const std::string& prefi
 
 /// The shaped bodies the monitor moves (doc/model.md, "Shaped bodies in the monitor"): a box, a
 /// cylinder, a capsule, a mesh (its convex hull), or a sphere given a tensor, of finite mass, by
-/// gravity alone; an immovable shaped body, drag or magnus with a shaped body, and what
-/// principalBody refuses (a cylinder's or capsule's tensor with products of inertia) are refused:
+/// gravity (and the air where the scene asks); an immovable shaped body and what principalBody
+/// refuses (a cylinder's or capsule's tensor with products of inertia) are refused:
 /// "not yet".
 Status checkMonitoredShapes(const Scene& scene, const std::string& prefix) {
   for (std::size_t i = 0; i < scene.bodies.size(); ++i) {
@@ -337,11 +341,6 @@ Status checkMonitoredShapes(const Scene& scene, const std::string& prefix) {
       return Error{item(prefix, "bodies", i, "mass"),
                    "not yet: an immovable shaped body (body '" + body.id + "' is a " +
                        toString(body.shape) + "); give it a finite mass"};
-    }
-    if (scene.effects.air()) {
-      return Error{prefix + "/effects",
-                   "names drag or magnus: not yet modelled for a shaped body (body '" + body.id +
-                       "' is a " + toString(body.shape) + ", which flies by gravity alone)"};
     }
     // Its initial orientation is where the scene player's motion of it starts.
     if (auto status = checkOrientation(body.orientation, item(prefix, "bodies", i, "orientation"));
