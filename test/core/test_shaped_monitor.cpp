@@ -13,6 +13,7 @@
 #include "collision_response/core/triangle_mesh.h"
 #include "collision_response/core/validation.h"
 #include "monitor/shaped_motion.h"
+#include "quadrature.h"
 #include "scene_builders.h"
 #include "shaped_scenes.h"
 
@@ -708,6 +709,67 @@ TEST(ShapedMonitor, ABoxSlidingOffATablesEdgeTipsOverItAndFallsToTheFloor) {
     if (t > 0.5) ++flying;
   }
   EXPECT_GT(flying, 10u);
+}
+
+// A can on its side sliding off a frictionless table's edge, its axis along the edge: before, the
+// monitor held it where its side reached the edge, "not yet". Now it slides there at 0.5 s, turns
+// over the edge on its side, its centre on the circle of radius r about the edge's line until
+// N = m (g cos theta - r theta'^2) = 0 at cos theta = (2 g r + v^2) / (3 g r), at the integral of
+// dtheta / theta' (r theta'^2 = v^2 / r + 2 g (1 - cos theta)), then flies from there at
+// sqrt(g r cos theta) along the circle's tangent and lands on its side on the floor where its
+// centre is r above it: the parabola's instant (1e-8 s, the roll's integration), never inside the
+// table, nothing unmodelled.
+TEST(ShapedMonitor, ACanRollingOnItsSideOffATablesEdgeLandsOnTheFloorAtTheClosedFormsInstant) {
+  const double r = 0.05, half_length = 0.1, m = 0.5, v = 0.5, top = 0.5;
+  Scene scene = floorScene(0.5, V(0.05, 0.05, 0.05), m);
+  scene.bodies[0].shape = BodyShape::kCylinder;
+  scene.bodies[0].size = V::Zero();
+  scene.bodies[0].radius = r;
+  scene.bodies[0].length = 2 * half_length;
+  scene.obstacles.push_back(
+      scene_builders::box("table", V(0, 0, 0.25), V(1.0, 1.0, 0.5), "concrete"));
+  MonitorSettings settings;
+  settings.body_timeout = INFINITY;
+  ImpactMonitor monitor(scene, settings);
+  const std::size_t can = *monitor.bodyIndex("block");
+  BodyStateSample state;
+  state.body = can;
+  state.position = V(0.25, 0, top + r);
+  state.velocity = V(v, 0, 0);
+  state.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(-M_PI / 2, V::UnitX()));
+  const double leaves = std::acos((2 * kG * r + v * v) / (3 * kG * r));
+  const double turning =
+      0.5 + quadrature::gaussLegendre(
+                [&](double theta) {
+                  return 1 / std::sqrt(v * v / (r * r) + 2 * kG * (1 - std::cos(theta)) / r);
+                },
+                0.0, leaves, 400);
+  const double speed = std::sqrt(kG * r * std::cos(leaves));
+  const double height = top + r * std::cos(leaves) - r, down = speed * std::sin(leaves);
+  const double lands = turning + (-down + std::sqrt(down * down + 2 * kG * height)) / kG;
+  std::vector<StepReport> reports{monitor.step(0.0, {state})};
+  for (int k = 1; k <= 200; ++k) {
+    const double t = 0.005 * k;
+    reports.push_back(monitor.step(t, {}));
+    const auto at = monitor.predictedState(can, t);
+    ASSERT_TRUE(at);
+    // Its side (its axis along y, level) never inside the table (x <= 0.5, z <= top) nor the
+    // floor: the axis at least r from both.
+    const V c = at->first;
+    const double out = std::max(c.x() - 0.5, 0.0), up = std::max(c.z() - top, 0.0);
+    EXPECT_GE(std::hypot(out, up), r - 1e-9) << "inside the table at " << t;
+    EXPECT_GE(c.z(), r - 1e-9) << "inside the floor at " << t;
+  }
+  for (const StepReport& report : reports) {
+    for (const UnmodelledContact& c : report.unmodelled) ADD_FAILURE() << c.what;
+  }
+  const std::vector<ImpactRecord> impacts = impactsOf(reports);
+  ASSERT_FALSE(impacts.empty());
+  EXPECT_EQ(impacts.front().other, 0u);  // the floor
+  EXPECT_NEAR(impacts.front().time, lands, 1e-8);
+  EXPECT_NEAR(impacts.front().velocity_a_before.x(), speed * std::cos(leaves), 1e-8);
+  EXPECT_NEAR(impacts.front().velocity_a_before.z(), -std::sqrt(down * down + 2 * kG * height),
+              1e-8);
 }
 
 // A state given halfway over a table's edge (as a tracker sees a box turning over it, its face a

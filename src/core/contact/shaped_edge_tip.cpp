@@ -174,19 +174,7 @@ class EdgeTipPath : public LastingPath {
   PathState stateAt(double t) const override {
     const double time = std::clamp(t, start_time, until_time);
     if (flight && time >= flight->from) {
-      const double tau = time - flight->from;
-      PathState state = flight->there;
-      state.centre += flight->there.velocity * tau + 0.5 * setting.gravity * tau * tau;
-      state.velocity += setting.gravity * tau;
-      const double turn = flight->there.angular_velocity.norm() * tau;
-      if (turn > 0) {
-        state.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(
-                                turn, flight->there.angular_velocity.normalized())) *
-                            flight->there.orientation;
-      }
-      state.state = ContactState::kSliding;
-      state.forces.clear();
-      return state;
+      return flownFrom(flight->there, setting.gravity, time - flight->from);
     }
     State y = initial;
     Mode mode = initial_mode;
@@ -270,31 +258,6 @@ double eventValue(const Setting& k, const State& y, Mode mode, double sigma, Wha
 constexpr std::array<What, 7> kEvents{What::kLeaves,     What::kSlipStops,  What::kSlips,
                                       What::kPassesFace, What::kOutOfPlane, What::kFlat,
                                       What::kUpright};
-
-/// The clearance flight's end: the first of doubling spans from the instant it leaves at which
-/// the body is `clearance` from the edge's line (its part within the body's reach of E), with no
-/// return to it on the way (checked at 64 instants of the span); empty where it comes back.
-std::optional<double> clearAfter(const Setting& k, const ConvexShape& shape, const PathState& there,
-                                 double clearance) {
-  const double reach = reachOf(shape);
-  const TriangleSupport line(k.edge_point - reach * k.axis, k.edge_point + reach * k.axis,
-                             k.edge_point + reach * k.axis);
-  const auto gap = [&](double tau) {
-    const double turn = there.angular_velocity.norm() * tau;
-    Eigen::Quaterniond q = there.orientation;
-    if (turn > 0) q = Eigen::AngleAxisd(turn, there.angular_velocity.normalized()) * q;
-    const Vec c = there.centre + there.velocity * tau + 0.5 * k.gravity * tau * tau;
-    return convexDistance(PlacedConvex(shape, q.toRotationMatrix(), c), line, 1e-13).lower;
-  };
-  for (double tau = 1e-6; tau < 10.0; tau *= 2) {
-    if (gap(tau) < clearance) continue;
-    for (int i = 1; i < 64; ++i) {
-      if (!(gap(tau * i / 64.0) > 0)) return std::nullopt;
-    }
-    return tau;
-  }
-  return std::nullopt;
-}
 
 /// The body's own flat face whose outward normal is -up, in the plane's coordinates (x along
 /// `w`, y along `a`) about the centre's foot on it, and h, the centre's height above it: a
@@ -512,8 +475,11 @@ Expected<LastingMotion> tipOverFaceEdge(const LastingBody& body, const FlatFace&
   } else if (ended == What::kLeaves || ended == What::kPassesFace) {
     // It flies on (closed form) until it is clear of the edge, then its events take over.
     Flight flight{until, placed(k, y)};
-    const auto clear =
-        clearAfter(k, body.shape, flight.there, kPivotClearance * reachOf(body.shape));
+    const auto clear = clearAfter(
+        [&](double tau) {
+          return gapToEdge(body.shape, k.edge_point, k.axis, k.gravity, flight.there, tau);
+        },
+        kPivotClearance * reachOf(body.shape));
     ends = clear ? "resumes" : "its flight off the face's edge comes back to the edge";
     if (clear) {
       path->flight = flight;
@@ -522,6 +488,43 @@ Expected<LastingMotion> tipOverFaceEdge(const LastingBody& body, const FlatFace&
   }
   path->until_time = until;
   return LastingMotion::integrated(path, until, ends);
+}
+
+PathState flownFrom(const PathState& there, const Eigen::Vector3d& gravity, double tau) {
+  PathState state = there;
+  state.centre += there.velocity * tau + 0.5 * gravity * tau * tau;
+  state.velocity += gravity * tau;
+  const double turn = there.angular_velocity.norm() * tau;
+  if (turn > 0) {
+    state.orientation =
+        Eigen::Quaterniond(Eigen::AngleAxisd(turn, there.angular_velocity.normalized())) *
+        there.orientation;
+  }
+  state.state = ContactState::kSliding;
+  state.forces.clear();
+  return state;
+}
+
+double gapToEdge(const ConvexShape& shape, const Eigen::Vector3d& point,
+                 const Eigen::Vector3d& along, const Eigen::Vector3d& gravity,
+                 const PathState& there, double tau) {
+  const double reach = reachOf(shape);
+  const TriangleSupport line(point - reach * along, point + reach * along, point + reach * along);
+  const PathState flown = flownFrom(there, gravity, tau);
+  return convexDistance(PlacedConvex(shape, flown.orientation.toRotationMatrix(), flown.centre),
+                        line, 1e-13)
+      .lower;
+}
+
+std::optional<double> clearAfter(const std::function<double(double)>& gap, double clearance) {
+  for (double tau = 1e-6; tau < 10.0; tau *= 2) {
+    if (gap(tau) < clearance) continue;
+    for (int i = 1; i < 64; ++i) {
+      if (!(gap(tau * i / 64.0) > 0)) return std::nullopt;
+    }
+    return tau;
+  }
+  return std::nullopt;
 }
 
 std::array<BoundEdge, 4> edgesOf(const FlatFace& face) {

@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <functional>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -57,5 +58,22 @@ Expected<LastingMotion> tipOverFaceEdge(const LastingBody& body, const FlatFace&
 /// edge), with that face's inward normal: what tipOverFaceEdge takes. Empty where it is not so.
 std::optional<std::pair<FaceEdge, Eigen::Vector3d>> tiltedOverEdge(const LastingBody& body,
                                                                    const FlatFace& face);
+
+/// The body `tau` seconds after `there` in free flight under `gravity`: its centre's parabola,
+/// its turn at its constant w (a turn about a principal axis, as a body leaving an edge has),
+/// sliding, no forces.
+PathState flownFrom(const PathState& there, const Eigen::Vector3d& gravity, double tau);
+
+/// s: where a body flying off an edge is first `clearance` from it, `gap(tau)` its distance
+/// `tau` seconds on: the first of doubling spans from 1e-6 s at which the gap is `clearance`,
+/// with no return to the edge on the way (the gap > 0 at 64 instants of the span); empty where
+/// it comes back.
+std::optional<double> clearAfter(const std::function<double(double)>& gap, double clearance);
+
+/// The distance of a body (`shape`) flying from `there` (flownFrom, under `gravity`) to the edge's
+/// line through `point` along `along` (its part within the body's reach), `tau` seconds on (GJK).
+double gapToEdge(const ConvexShape& shape, const Eigen::Vector3d& point,
+                 const Eigen::Vector3d& along, const Eigen::Vector3d& gravity,
+                 const PathState& there, double tau);
 
 }  // namespace collision_response::core

@@ -29,6 +29,7 @@
 #include <Eigen/Dense>
 
 #include "collision_response/core/validation.h"
+#include "contact/shaped_edge_roll.h"
 #include "contact/shaped_edge_tip.h"
 #include "contact/shaped_pivot.h"
 
@@ -1136,6 +1137,16 @@ Expected<LastingMotion> turningOnFace(const LastingBody& body, const FlatFace& f
   return refused;
 }
 
+/// Whether a side (a cylinder's or a capsule's, its axis the principal z) moving along `track`
+/// reaches a bounded face's edge all along its line: its axis along one of the face's sides and
+/// its track square to the axis (each within kSideAlongEdge).
+bool acrossEdges(const LastingBody& body, const FlatFace& face, const Track& track) {
+  const Vec axis = body.orientation.normalized() * Vec::UnitZ();
+  return (axis.cross(face.along_u).norm() <= kSideAlongEdge ||
+          axis.cross(face.along_v).norm() <= kSideAlongEdge) &&
+         std::abs(track.direction.dot(axis)) <= kSideAlongEdge;
+}
+
 /// The closed forms on a face or a cap, a side or a face's polygon: the plan (resting, sliding
 /// or rolling), the centre of pressure and the forces it puts on the support's points, until the
 /// plan's end or the support reaching the face's edge; over an edge, overhangMotion; where the
@@ -1184,9 +1195,10 @@ Expected<LastingMotion> plannedOnFace(const LastingBody& body, const FlatFace& f
   motion.ends = plan.ends;
   if (edge < lasts) {
     lasts = edge;
-    // A face or a cap goes on over the edge (asked again there: overhangMotion); a side
-    // rolling off it is not modelled yet.
-    motion.ends = support.kind == SupportKind::kLine
+    // A face or a cap goes on over the edge (asked again there: overhangMotion), and a side
+    // whose line reaches it all along, rolling across it (rollOverFaceEdge); a side reaching it
+    // at one end is not modelled yet.
+    motion.ends = support.kind == SupportKind::kLine && !acrossEdges(body, face, plan.track)
                       ? "a point of its support reaches the face's edge"
                       : "stops";
   }
@@ -1207,14 +1219,24 @@ Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& f
   const Setting setting = settingOf(body, face, true);
   auto found = supportOf(body, rotation, face, setting);
   if (!found && found.error().field == "body.centre") {
-    // Below the face's plane past its edge: turned over the edge (a state halfway over it).
+    // Below the face's plane past its edge: turned over the edge (a state halfway over it), or a
+    // side rolling over it.
     if (const auto tilted = tiltedOverEdge(body, face)) {
       return tipOverFaceEdge(body, face, tilted->first, tilted->second, tolerance);
+    }
+    if (const auto edge = sideOnEdge(body, face)) {
+      return rollOverFaceEdge(body, face, *edge, tolerance);
     }
   }
   if (!found) return found.error();
   const Support& support = found.value();
   if (Status status = checkOnFace(body, face, support, setting); !status) return status.error();
+  // A side whose line lies on the face's edge, going over it: it rolls over the edge.
+  if (support.kind == SupportKind::kLine) {
+    if (const auto edge = sideOnEdge(body, face)) {
+      return rollOverFaceEdge(body, face, *edge, tolerance);
+    }
+  }
   // One corner, an edge, one point of a rim or an end: it tips.
   if (support.kind == SupportKind::kCorners || support.kind == SupportKind::kRound) {
     return pivotOnSupport(body, face, support, rotation, Vec::Zero(), tolerance);
