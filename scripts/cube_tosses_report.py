@@ -224,7 +224,7 @@ def ours_section(add, ours, results):
         "frame), the horizon the toss's recorded duration, `sample_period` 1/148 s. Its "
         "prediction flies the cube exactly, finds each contact with the table certified, resolves "
         "each impact with rotation (one corner: Chatterjee and Ruina's law with e and mu; several "
-        "corners at once: the joint rule, frictionless), and where the contact lasts on the "
+        "corners at once: the same law over all of them), and where the contact lasts on the "
         "table's face goes on by that contact's closed forms (resting, sliding, rolling; "
         "doc/model.md, \"Prediction of a shaped body\"), or where the cube touches at one corner "
         "or along one edge, rocks or spins on a face, by its tipping motion, each corner sticking "

@@ -504,45 +504,46 @@ double kineticEnergy(const SolverBody& body) {
          0.5 * body.angular_velocity.dot(inertia * body.angular_velocity);
 }
 
-// The box (1 x 2 x 3 m, 2 kg, half c = 1.5 below its centre, I_yy = m (a^2 + c^2) / 3 = 5/3)
-// landing flat at v_n = 3 m/s while sliding at 4 m/s along x, e = 1/2: the joint rule's normal
-// impulses J = (1 + e) m v_n = 9 N s, a quarter at each corner, then friction of maximal
-// dissipation given them. With mu = 0.1 every corner slides (the slip left, 4 - mu J (1/m + c^2 /
-// I_yy) = 2.335 m/s, stays ahead): T = mu J against the slip, v_x' = 4 - mu J / m = 3.55, w_y' =
-// c mu J / I_yy = 0.81 rad/s, the friction losing mu J (u + u') / 2 = 0.9 (4 + 2.335) / 2. With
-// mu = 1 the slip stops (T = 4 / (1/m + c^2 / I_yy) = 4 / 1.85 <= mu J): v_x' = 4 - T / m, w_y' =
-// c T / I_yy. Either way the box leaves at e v_n upwards, the front corners leaving too (e v_n -
-// a w_y' > 0), and all 24 orders of the corners give the same bits. Before, such a landing was
-// frictionless.
-TEST(RigidImpact, ABoxLandingFlatWhileSlidingTakesFrictionOfMaximalDissipation) {
+// The box (1 x 2 x 3 m, 2 kg, a = 0.5 ahead of its centre, c = 1.5 below it) landing flat at
+// v_n = 3 m/s while sliding at u = 4 m/s along x, e = 1/2, by the joint law (Chatterjee and
+// Ruina's over the four corners): P_I = m v_n / 4 = 1.5 N s at each corner; the sticking
+// impulses that stop the box without turning it carry -m u / 4 = -2 N s along x each, and to
+// hold the moment c m u of that friction about the centre, normal impulses m v_n / 4 + c m u x /
+// (4 a^2) = 1.5 +- 6 N s (the front corners more); so D = (-2, 0, +-6) and, on the rear corners'
+// cone kappa 2 = mu (2.25 - 6 kappa), kappa = 2.25 mu / (2 + 6 mu) (the front ones' is wider):
+// 0.0865 at mu = 0.1, 0.28125 at mu = 1, 0.3629 at mu = 10 (the rear corners' normal impulse
+// nearly spent: no flat landing this fast sticks). The box leaves at (u (1 - kappa), 0, e v_n)
+// without turning (friction's moment is held by the corners' normal impulses, as a real box's
+// shift forward: the two-stage rule before turned it over its front edge, w_y' = c mu J / I), each
+// corner's normal impulse 2.25 +- 6 kappa and friction 2 kappa, the energy lost
+// (1 - e^2) m v_n^2 / 2 + kappa (2 - kappa) m u^2 / 2; all 24 orders of the corners give the same
+// bits.
+TEST(RigidImpact, ABoxLandingFlatWhileSlidingTakesTheJointLawsFrictionWithoutTurning) {
   const Eigen::Vector3d half(0.5, 1.0, 1.5);
-  const double m = 2.0, e = 0.5, v_n = 3.0, u = 4.0, c = 1.5, I_yy = 5.0 / 3, J = 9.0;
-  for (const double mu : {0.1, 1.0}) {
+  const double m = 2.0, e = 0.5, v_n = 3.0, u = 4.0;
+  for (const double mu : {0.1, 1.0, 10.0}) {
+    SCOPED_TRACE("mu " + std::to_string(mu));
+    const double kappa = 2.25 * mu / (2 + 6 * mu);
     FlatBox box = flatBox(m, half, Eigen::Vector3d(u, 0, -v_n), e);
     const double before = kineticEnergy(box.bodies[1]);
     const auto outcome = resolveRigidSimultaneous(box.bodies, box.contacts, {mu, mu, mu, mu});
     ASSERT_TRUE(outcome.ok()) << outcome.error().message();
-    const double T = mu == 0.1 ? mu * J : u / (1 / m + c * c / I_yy);
     const SolverBody& landed = box.bodies[1];
-    EXPECT_NEAR((landed.velocity - Eigen::Vector3d(u - T / m, 0, e * v_n)).norm(), 0.0,
-                16 * kEps * u)
-        << "mu " << mu;
-    EXPECT_NEAR((landed.angular_velocity - Eigen::Vector3d(0, c * T / I_yy, 0)).norm(), 0.0,
-                16 * kEps * u)
-        << "mu " << mu;
-    EXPECT_GT(e * v_n - half.x() * landed.angular_velocity.y(), 0.0);
-    double friction = 0.0, lost = 0.0;
-    for (const FrictionalOutcome& corner : *outcome) {
-      EXPECT_NEAR(corner.normal.impulse, J / 4, 16 * kEps * J);
+    EXPECT_NEAR((landed.velocity - Eigen::Vector3d(u * (1 - kappa), 0, e * v_n)).norm(), 0.0,
+                16 * kEps * u);
+    EXPECT_NEAR(landed.angular_velocity.norm(), 0.0, 16 * kEps * u);
+    double lost = 0.0;
+    for (std::size_t k = 0; k < 4; ++k) {
+      const FrictionalOutcome& corner = (*outcome)[k];
+      const double ahead = box.contacts[k].lever_b.x() > 0 ? 1.0 : -1.0;
+      EXPECT_NEAR(corner.normal.impulse, 2.25 + ahead * 6 * kappa, 64 * kEps * 9);
+      EXPECT_NEAR(corner.friction_impulse, 2 * kappa, 64 * kEps * 9);
       EXPECT_LE(corner.friction_impulse, mu * corner.normal.impulse * (1 + 1e-12));
-      friction += corner.friction_impulse;
       lost += corner.normal.energy_lost + corner.friction_energy_lost;
     }
-    EXPECT_NEAR(friction, T, 16 * kEps * J);
-    EXPECT_NEAR(lost, before - kineticEnergy(landed), 64 * kEps * before);
-    if (mu == 0.1) {
-      EXPECT_NEAR(lost, 0.5 * m * (1 - e * e) * v_n * v_n + T * (u + 2.335) / 2, 1e-12);
-    }
+    const double closed = 0.5 * (1 - e * e) * m * v_n * v_n + 0.5 * kappa * (2 - kappa) * m * u * u;
+    EXPECT_NEAR(lost, closed, 64 * kEps * before);
+    EXPECT_NEAR(before - kineticEnergy(landed), closed, 64 * kEps * before);
     std::vector<std::size_t> order = {0, 1, 2, 3};
     while (std::next_permutation(order.begin(), order.end())) {
       FlatBox shuffled = flatBox(m, half, Eigen::Vector3d(u, 0, -v_n), e);
@@ -555,13 +556,50 @@ TEST(RigidImpact, ABoxLandingFlatWhileSlidingTakesFrictionOfMaximalDissipation) 
   }
 }
 
+// One contact struck alone: the joint law is Chatterjee and Ruina's (resolveRigidImpactByLaw),
+// to 1e-12 of the speeds (that law's n.K.n is rounded to doubles first), over 2,000 random
+// bodies, lever arms, normals, e and mu.
+TEST(RigidImpact, TheJointLawOnOneContactIsChatterjeeAndRuinas) {
+  std::mt19937_64 random(17);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const auto vector = [&](double scale) -> Eigen::Vector3d {
+    return Eigen::Vector3d(unit(random) - 0.5, unit(random) - 0.5, unit(random) - 0.5) * scale;
+  };
+  for (int trial = 0; trial < 2000; ++trial) {
+    const Eigen::Vector3d half = Eigen::Vector3d(0.1, 0.1, 0.1) + vector(1.0).cwiseAbs();
+    FlatBox box = flatBox(0.1 + 5 * unit(random), half, vector(4.0), unit(random));
+    box.bodies[1].angular_velocity = vector(4.0);
+    ClusterContact contact = box.contacts[0];
+    contact.normal = (Eigen::Vector3d::UnitZ() + vector(1.0)).normalized();
+    contact.lever_b = vector(2.0);
+    const double mu = 2 * unit(random);
+    std::vector<SolverBody> law = box.bodies;
+    const RigidImpactOutcome single =
+        resolveRigidImpactByLaw(law[0], law[1], contact, contact.restitution, mu, 0.0);
+    std::vector<SolverBody> joint = box.bodies;
+    const auto outcome = resolveRigidSimultaneous(joint, {contact}, {mu});
+    ASSERT_TRUE(outcome.ok()) << outcome.error().message();
+    const double scale = box.bodies[1].velocity.norm() +
+                         box.bodies[1].angular_velocity.norm() * contact.lever_b.norm() + 1;
+    EXPECT_NEAR((joint[1].velocity - law[1].velocity).norm(), 0.0, 1e-12 * scale) << trial;
+    EXPECT_NEAR(
+        (joint[1].angular_velocity - law[1].angular_velocity).norm() * contact.lever_b.norm(), 0.0,
+        1e-12 * scale)
+        << trial;
+    EXPECT_NEAR((*outcome)[0].normal.impulse, single.normal_impulse,
+                1e-12 * (single.impulse.norm() + 1e-300))
+        << trial;
+  }
+}
+
 // 2,000 random boxes (edges 0.1 to 2 m, masses, tilts, slides and spins) landing on their four
-// bottom corners with e in [0, 1] and mu in [0, 2]: friction never adds energy (1e-12 of the
-// energy before), each corner's friction within its cone (mu J_k), the energies lost adding up to
-// the change.
+// bottom corners with e in [0, 1] and mu in [0, 2]: the joint law never adds energy (1e-12 of the
+// energy before), each corner's friction within its cone (mu J_k), every corner that approached
+// and is pressed leaving, the energies lost adding up to the change.
 TEST(RigidImpact, RandomFrictionalFlatLandingsNeverGainEnergy) {
   std::mt19937_64 random(11);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int frictionless = 0;  // landings the law leaves to the frictionless joint rule
   for (int trial = 0; trial < 2000; ++trial) {
     const Eigen::Vector3d half = Eigen::Vector3d(0.05, 0.05, 0.05) +
                                  0.95 * Eigen::Vector3d(unit(random), unit(random), unit(random));
@@ -579,6 +617,18 @@ TEST(RigidImpact, RandomFrictionalFlatLandingsNeverGainEnergy) {
     }
     const double after = kineticEnergy(box.bodies[1]);
     EXPECT_LE(after, before * (1 + 1e-12)) << trial;
+    bool frictional = false;
+    for (std::size_t k = 0; k < 4; ++k) {
+      const ClusterContact& corner = box.contacts[k];
+      const SolverBody& landed = box.bodies[1];
+      const double leaving =
+          (landed.velocity + landed.angular_velocity.cross(corner.lever_b)).dot(corner.normal);
+      if ((*outcome)[k].normal.impulse > 0 && (*outcome)[k].normal.approach_speed > 0) {
+        EXPECT_GE(leaving, -1e-12 * velocity.norm()) << trial;
+      }
+      frictional = frictional || (*outcome)[k].friction_impulse > 0;
+    }
+    if (mu > 0 && !frictional) ++frictionless;
     double lost = 0.0;
     for (const FrictionalOutcome& corner : *outcome) {
       EXPECT_LE(corner.friction_impulse, mu * corner.normal.impulse * (1 + 1e-12) + 1e-300)
@@ -587,6 +637,10 @@ TEST(RigidImpact, RandomFrictionalFlatLandingsNeverGainEnergy) {
     }
     EXPECT_NEAR(lost, before - after, 1e-12 * before) << trial;
   }
+  // A corner the frictionless joint rule leaves apart but D would press (the rule's active set
+  // is Newton's, not a complementarity solve's): there the law gives the frictionless rule.
+  std::printf("frictionless joint rule in %d of 2000 landings\n", frictionless);
+  EXPECT_LT(frictionless, 400);
 }
 
 // The same box landing flat while drifting and turning about z (the floor frictionless, the

@@ -113,22 +113,42 @@ Expected<std::vector<ContactOutcome>> resolveRigidSimultaneous(
 
 /// One contact's share of a frictional joint impact.
 struct FrictionalOutcome {
-  ContactOutcome normal;              ///< the joint rule's, its energy_lost the normal impulse's
-  double friction_impulse = 0.0;      ///< N s, |T|, <= mu J
-  double friction_energy_lost = 0.0;  ///< J, >= 0 in sum: -T.(u + u') / 2, u, u' its slips
+  /// The impulse's part along the normal; its energy_lost (1 - e^2) J_k (-d_k) / 2, J_k the
+  /// plastic frictionless impulse.
+  ContactOutcome normal;
+  double friction_impulse = 0.0;      ///< N s, the part across the normal, <= mu times the normal
+  double friction_energy_lost = 0.0;  ///< J, >= 0 in sum: the law's kappa (2 - kappa) D.A.D / 2
+  /// The law did not apply and the frictionless joint rule was taken (friction left out).
+  bool frictionless_rule = false;
 };
 
 /// Contacts that all strike at one instant, each with Coulomb's coefficient `friction[k]` >= 0
-/// (doc/model.md, "One impact of a shaped body"): the joint rule's normal impulses J_k (the
-/// frictionless resolveRigidSimultaneous above), then friction of maximal dissipation given
-/// them, jointly over the contacts (solveFrictionImpulses, src/core/solver/friction_impulses.h):
-/// tangential impulses |T_k| <= mu_k J_k that leave the least kinetic energy, which stop every
-/// slip they can and act at mu_k J_k against the slip left where they cannot, so that friction
-/// never reverses a slip nor adds energy, and nothing depends on the order of the contacts. A
-/// box landing flat while it slides, no point sticking, leaves at v_t - mu (1 + e) v_n and turns
-/// at c mu (1 + e) m v_n / I about the axis across the slide (c the centre's height). All
-/// coefficients 0: the frictionless rule itself. Bad input as resolveRigidSimultaneous, and
-/// `friction` of another length or a coefficient not finite or < 0.
+/// (doc/model.md, "One impact of a shaped body"): Chatterjee and Ruina's law over all of them at
+/// once, normal and tangential impulses together. With A the contacts' full Delassus matrix (3x3
+/// blocks s_i s_j (w - [r_i]x I^-1 [r_j]x) summed over the bodies two contacts share) and u the
+/// contact points' relative velocities:
+///
+///   P_I  the plastic frictionless joint impulses (the joint rule above with e = 0), J_k n_k;
+///   P_II the least-norm sticking impulses of the contacts P_I presses: A P_II = -u there;
+///   D = P_II - P_I;  P = (1 + e) P_I + kappa D,
+///
+/// kappa the largest in [0, 1] that keeps every contact's impulse in its cone
+/// (kappa |D_t,k| <= mu_k ((1 + e) J_k + kappa D_k.n_k)). What it guarantees, as the law for one
+/// contact: A D has no part along the normals the plastic impulses press (P_I.A.D = 0), so each of
+/// them leaves at -e times its approach whatever mu, and the energy changes by
+/// -(1 - e^2) P_I.A.P_I / 2 - kappa (2 - kappa) D.A.D / 2 <= 0; each impulse is in its cone. One
+/// contact: Chatterjee and Ruina's law itself (to 1e-12). The sticking impulses hold the moment
+/// of the friction about the body by shifting normal impulse forward, so a box landing flat while
+/// it slides at u (half length a ahead of its centre, c above its face) leaves without turning at
+/// u (1 - kappa), kappa = mu (1 + e) v_n / (u (1 + mu c / a)) where its rear corners' cones bind.
+/// One kappa for all: the first cone reached sets how much of the sticking impulse is taken
+/// everywhere (a documented choice: it keeps the energy's closed form). In the canonical order of
+/// the contacts (the same bits in any order). The frictionless joint rule is taken (each
+/// outcome's frictionless_rule) where the law does not apply: the contacts' e differ, no impulse
+/// stops every slip (a moving obstacle's points no twist of the body follows), or a contact the
+/// plastic impulses leave apart would approach after P. All coefficients 0: the frictionless
+/// rule itself. Bad input as resolveRigidSimultaneous, and `friction` of another length or a
+/// coefficient not finite or < 0.
 Expected<std::vector<FrictionalOutcome>> resolveRigidSimultaneous(
     std::vector<SolverBody>& bodies, const std::vector<ClusterContact>& contacts,
     const std::vector<double>& friction);

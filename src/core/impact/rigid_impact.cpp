@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -13,7 +14,6 @@
 #include "collision_response/core/impact.h"
 #include "collision_response/core/validation.h"
 #include "solver/effective_mass.h"
-#include "solver/friction_impulses.h"
 #include "solver/impulse_response.h"
 #include "solver/order_free.h"
 
@@ -398,26 +398,21 @@ JointSystem jointSystem(const std::vector<SolverBody>& bodies,
   return system;
 }
 
-/// The impulses applied: each body's velocity changes summed free of order, every result checked
-/// representable; the bodies updated in place only where all is (references to them stay
-/// valid), the outcomes in the order of `contacts`.
-Expected<std::vector<ContactOutcome>> applyJointImpulses(
-    std::vector<SolverBody>& bodies, const std::vector<ClusterContact>& contacts,
-    const std::vector<std::size_t>& order, const JointSystem& system,
-    const std::vector<double>& impulses) {
-  const auto count = static_cast<Eigen::Index>(contacts.size());
-  const std::vector<Matrix3L>& inverse_inertia = system.inverse_inertia;
-  const VectorL& approach = system.approach;
-  std::vector<ContactOutcome> outcomes(contacts.size());
+/// Impulses (each on b, its opposite on a; `impulses[i]` at the contact order[i]) applied: each
+/// body's velocity changes summed free of order, every result checked representable; the bodies
+/// updated in place only where all is (references to them stay valid).
+Status applyImpulses(std::vector<SolverBody>& bodies, const std::vector<ClusterContact>& contacts,
+                     const std::vector<std::size_t>& order,
+                     const std::vector<Matrix3L>& inverse_inertia,
+                     const std::vector<Vector3L>& impulses) {
   std::vector<std::array<std::vector<RealL>, 6>> changes(bodies.size());  // dv, dw per axis
-  for (Eigen::Index i = 0; i < count; ++i) {
-    const std::size_t k = order[static_cast<std::size_t>(i)];
-    const ClusterContact& contact = contacts[k];
-    const RealL impulse = impulses[static_cast<std::size_t>(i)];
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const ClusterContact& contact = contacts[order[i]];
+    if (impulses[i].isZero(0)) continue;
     for (const ContactSideL& side : sidesOf(contact)) {
       const SolverBody& body = bodies[side.body];
-      if (body.inverse_mass == 0.0 || impulse == 0) continue;
-      const Vector3L force = side.sign * impulse * contact.normal.cast<RealL>();
+      if (body.inverse_mass == 0.0) continue;
+      const Vector3L force = side.sign * impulses[i];
       const Vector3L dv = RealL(body.inverse_mass) * force;
       const Vector3L dw = inverse_inertia[side.body] * side.lever.cross(force);
       for (int axis = 0; axis < 3; ++axis) {
@@ -425,10 +420,6 @@ Expected<std::vector<ContactOutcome>> applyJointImpulses(
         changes[side.body][static_cast<std::size_t>(axis) + 3].push_back(dw[axis]);
       }
     }
-    outcomes[k].impulse = impulses[static_cast<std::size_t>(i)];
-    outcomes[k].approach_speed = static_cast<double>(approach[i]);
-    outcomes[k].energy_lost = static_cast<double>(
-        RealL(0.5) * impulse * (RealL(1) - RealL(contact.restitution)) * approach[i]);
   }
   std::vector<SolverBody> after = bodies;
   for (std::size_t b = 0; b < bodies.size(); ++b) {
@@ -448,13 +439,164 @@ Expected<std::vector<ContactOutcome>> applyJointImpulses(
                    status.error().reason};
     }
   }
-  for (const ContactOutcome& outcome : outcomes) {
+  std::copy(after.begin(), after.end(), bodies.begin());  // in place: references to them stay valid
+  return Ok{};
+}
+
+/// The joint rule's impulses along the normals applied, and each contact's outcome in the order
+/// of `contacts`.
+Expected<std::vector<ContactOutcome>> applyJointImpulses(
+    std::vector<SolverBody>& bodies, const std::vector<ClusterContact>& contacts,
+    const std::vector<std::size_t>& order, const JointSystem& system,
+    const std::vector<double>& impulses) {
+  std::vector<ContactOutcome> outcomes(contacts.size());
+  std::vector<Vector3L> along(order.size());
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const ClusterContact& contact = contacts[order[i]];
+    const RealL impulse = impulses[i];
+    const auto row = static_cast<Eigen::Index>(i);
+    along[i] = impulse * contact.normal.cast<RealL>();
+    ContactOutcome& outcome = outcomes[order[i]];
+    outcome.impulse = impulses[i];
+    outcome.approach_speed = static_cast<double>(system.approach[row]);
+    outcome.energy_lost = static_cast<double>(
+        RealL(0.5) * impulse * (RealL(1) - RealL(contact.restitution)) * system.approach[row]);
     if (!std::isfinite(outcome.impulse) || !std::isfinite(outcome.energy_lost)) {
       return Error{"impulse", kBeyondDoubles};
     }
   }
-  std::copy(after.begin(), after.end(), bodies.begin());  // in place: references to them stay valid
+  if (auto status = applyImpulses(bodies, contacts, order, system.inverse_inertia, along);
+      !status) {
+    return status.error();
+  }
   return outcomes;
+}
+
+/// The 3x3 block of the contacts' Delassus matrix between contacts i and j: the change of the
+/// relative velocity at i's points per unit impulse at j's, summed over the bodies they share,
+/// s_i s_j (w - [r_i]x I^-1 [r_j]x).
+Matrix3L blockOf(const std::vector<SolverBody>& bodies,
+                 const std::vector<Matrix3L>& inverse_inertia, const ClusterContact& ci,
+                 const ClusterContact& cj) {
+  const auto cross = [](const Vector3L& r) {
+    Matrix3L m;
+    m << 0, -r.z(), r.y(), r.z(), 0, -r.x(), -r.y(), r.x(), 0;
+    return m;
+  };
+  Matrix3L block = Matrix3L::Zero();
+  for (const ContactSideL& si : sidesOf(ci)) {
+    for (const ContactSideL& sj : sidesOf(cj)) {
+      if (si.body != sj.body || bodies[si.body].inverse_mass == 0.0) continue;
+      block += si.sign * sj.sign *
+               (RealL(bodies[si.body].inverse_mass) * Matrix3L::Identity() -
+                cross(si.lever) * inverse_inertia[si.body] * cross(sj.lever));
+    }
+  }
+  return block;
+}
+
+using MaybeOutcomes = std::optional<std::vector<FrictionalOutcome>>;
+
+/// Chatterjee and Ruina's law (resolveRigidImpactByLaw) over contacts struck at once (the header's
+/// comment): P = (1 + e) P_I + kappa D, P_I the plastic frictionless joint impulses, D = P_II - P_I
+/// with P_II the least-norm sticking impulses of the contacts P_I presses, kappa the largest in
+/// [0, 1] within every contact's cone. The bodies updated and the outcomes; none (the caller
+/// takes the frictionless joint rule) where the contacts' e differ, the sticking impulses do not
+/// stop every slip (no such impulse exists: a moving obstacle's points no twist of the body
+/// follows), or a contact P_I leaves approaches after P.
+Expected<MaybeOutcomes> jointLaw(std::vector<SolverBody>& bodies,
+                                 const std::vector<ClusterContact>& contacts,
+                                 const std::vector<double>& friction) {
+  const std::vector<std::size_t> order = canonicalOrder(contacts);
+  const JointSystem system = jointSystem(bodies, contacts, order);
+  const RealL e = contacts.front().restitution;
+  for (const ClusterContact& contact : contacts) {
+    if (contact.restitution != contacts.front().restitution) return MaybeOutcomes{};
+  }
+  const std::vector<double> plastic = jointImpulses(system.delassus, system.approach);
+  std::vector<std::size_t> pressed;  // places in `order`
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    if (plastic[i] > 0) pressed.push_back(i);
+  }
+  if (pressed.empty()) return MaybeOutcomes{};
+  const auto size = static_cast<Eigen::Index>(3 * pressed.size());
+  MatrixL delassus(size, size);
+  VectorL slip(size);  // the relative velocities u_k, which P_II stops
+  for (std::size_t i = 0; i < pressed.size(); ++i) {
+    const ClusterContact& ci = contacts[order[pressed[i]]];
+    slip.segment<3>(static_cast<Eigen::Index>(3 * i)) =
+        pointVelocity(bodies[ci.b], ci.lever_b) - pointVelocity(bodies[ci.a], ci.lever_a);
+    for (std::size_t j = 0; j < pressed.size(); ++j) {
+      delassus.block<3, 3>(static_cast<Eigen::Index>(3 * i), static_cast<Eigen::Index>(3 * j)) =
+          blockOf(bodies, system.inverse_inertia, ci, contacts[order[pressed[j]]]);
+    }
+  }
+  Eigen::CompleteOrthogonalDecomposition<MatrixL> decomposition(size, size);
+  decomposition.setThreshold(kRedundantContacts);
+  const VectorL sticking = decomposition.compute(delassus).solve(-slip);
+  if (!((delassus * sticking + slip).norm() <= 1e-9L * slip.norm())) return MaybeOutcomes{};
+  // D, and kappa: on each contact's cone kappa |D_t| = mu ((1 + e) J + kappa D.n).
+  std::vector<Vector3L> d(pressed.size());
+  RealL kappa = 1;
+  for (std::size_t i = 0; i < pressed.size(); ++i) {
+    const ClusterContact& contact = contacts[order[pressed[i]]];
+    const Vector3L n = contact.normal.cast<RealL>();
+    d[i] = sticking.segment<3>(static_cast<Eigen::Index>(3 * i)) - RealL(plastic[pressed[i]]) * n;
+    const RealL d_normal = d[i].dot(n), d_tangential = (d[i] - d_normal * n).norm();
+    const RealL mu = friction[order[pressed[i]]];
+    const RealL pressing = (1 + e) * RealL(plastic[pressed[i]]);
+    if (d_tangential <= mu * (pressing + d_normal)) continue;  // P^ within this cone
+    const RealL denominator = d_tangential - mu * d_normal;
+    kappa = std::min(kappa,
+                     denominator > 0 ? std::max(mu * pressing / denominator, RealL(0)) : RealL(0));
+  }
+  std::vector<Vector3L> impulses(order.size(), Vector3L::Zero());
+  VectorL stacked_d(size);
+  for (std::size_t i = 0; i < pressed.size(); ++i) {
+    const Vector3L n = contacts[order[pressed[i]]].normal.cast<RealL>();
+    impulses[pressed[i]] = (1 + e) * RealL(plastic[pressed[i]]) * n + kappa * d[i];
+    stacked_d.segment<3>(static_cast<Eigen::Index>(3 * i)) = d[i];
+  }
+  const VectorL d_response = delassus * stacked_d;
+  const std::vector<SolverBody> before = bodies;
+  if (auto status = applyImpulses(bodies, contacts, order, system.inverse_inertia, impulses);
+      !status) {
+    return status.error();
+  }
+  // Every contact P_I left apart stays apart (D may press it).
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    if (plastic[i] > 0) continue;
+    const ClusterContact& c = contacts[order[i]];
+    const RealL after =
+        (pointVelocity(bodies[c.b], c.lever_b) - pointVelocity(bodies[c.a], c.lever_a))
+            .dot(c.normal.cast<RealL>());
+    if (after < -1e-12L * slip.norm()) {
+      std::copy(before.begin(), before.end(), bodies.begin());
+      return MaybeOutcomes{};
+    }
+  }
+  std::vector<FrictionalOutcome> outcomes(contacts.size());
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const ClusterContact& contact = contacts[order[i]];
+    const Vector3L n = contact.normal.cast<RealL>();
+    const RealL along = impulses[i].dot(n);
+    FrictionalOutcome& outcome = outcomes[order[i]];
+    outcome.normal.impulse = static_cast<double>(along);
+    outcome.normal.approach_speed =
+        static_cast<double>(system.approach[static_cast<Eigen::Index>(i)]);
+    outcome.friction_impulse = static_cast<double>((impulses[i] - along * n).norm());
+  }
+  // The energy lost, (1 - e^2) P_I.A.P_I / 2 + kappa (2 - kappa) D.A.D / 2, each contact's share.
+  for (std::size_t i = 0; i < pressed.size(); ++i) {
+    FrictionalOutcome& outcome = outcomes[order[pressed[i]]];
+    outcome.normal.energy_lost =
+        static_cast<double>(RealL(0.5) * (1 - e) * (1 + e) * RealL(plastic[pressed[i]]) *
+                            system.approach[static_cast<Eigen::Index>(pressed[i])]);
+    outcome.friction_energy_lost =
+        static_cast<double>(RealL(0.5) * kappa * (2 - kappa) *
+                            d[i].dot(d_response.segment<3>(static_cast<Eigen::Index>(3 * i))));
+  }
+  return MaybeOutcomes(std::move(outcomes));
 }
 
 }  // namespace
@@ -487,40 +629,25 @@ Expected<std::vector<FrictionalOutcome>> resolveRigidSimultaneous(
       return Error{"friction[" + std::to_string(k) + "]", "must be finite and >= 0"};
     }
   }
+  if (auto status = checkSimultaneous(bodies, contacts); !status) return status.error();
+  const bool frictionless =
+      std::all_of(friction.begin(), friction.end(), [](double mu) { return mu == 0.0; });
+  if (!frictionless && !contacts.empty()) {
+    std::vector<SolverBody> tried = bodies;
+    auto joint = jointLaw(tried, contacts, friction);
+    if (!joint) return joint.error();
+    if (joint.value()) {
+      std::copy(tried.begin(), tried.end(), bodies.begin());
+      return std::move(*joint.value());
+    }
+  }
+  // Frictionless, or where the law does not apply (jointLaw): the joint rule along the normals.
   auto normal = resolveRigidSimultaneous(bodies, contacts);
   if (!normal) return normal.error();
   std::vector<FrictionalOutcome> outcomes(contacts.size());
-  for (std::size_t k = 0; k < contacts.size(); ++k) outcomes[k].normal = (*normal)[k];
-  if (std::all_of(friction.begin(), friction.end(), [](double mu) { return mu == 0.0; })) {
-    return outcomes;
-  }
-  // Friction given the normal impulses, on the velocities after them, the contacts in the
-  // canonical order (so that their order given changes no bit of the long double sums).
-  std::vector<ForceBody> force_bodies;
-  for (const SolverBody& body : bodies) force_bodies.push_back(ForceBody{body});
-  const std::vector<std::size_t> order = canonicalOrder(contacts);
-  std::vector<ForceContact> force_contacts;
-  std::vector<double> normal_impulses;
-  for (const std::size_t k : order) {
-    ForceContact contact{contacts[k]};
-    contact.friction = friction[k];
-    force_contacts.push_back(contact);
-    normal_impulses.push_back(outcomes[k].normal.impulse);
-  }
-  const ContactForceSolution solution =
-      solveFrictionImpulses(force_bodies, force_contacts, normal_impulses);
-  for (std::size_t place = 0; place < order.size(); ++place) {
-    const std::size_t k = order[place];
-    const ContactForce& applied = solution.contacts[place];
-    outcomes[k].friction_impulse = applied.tangential.norm();
-    // -T.(u + u') / 2 with u' = u + du (du in slip_acceleration), as the balls' clusters.
-    outcomes[k].friction_energy_lost =
-        -0.5 * applied.tangential.dot(2 * applied.slip + applied.slip_acceleration);
-  }
-  for (std::size_t i = 0; i < bodies.size(); ++i) {
-    if (bodies[i].inverse_mass == 0.0) continue;
-    bodies[i].velocity += solution.acceleration[i];
-    bodies[i].angular_velocity += solution.angular_acceleration[i];
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    outcomes[k].normal = (*normal)[k];
+    outcomes[k].frictionless_rule = !frictionless;
   }
   return outcomes;
 }

@@ -585,8 +585,9 @@ void ShapedMotion::clearUntil(double time, const std::vector<ObstacleContact>& c
 }
 
 /// Resolves the impact at `time` of `moving` (updated) with the contacts' points: one point by
-/// Chatterjee and Ruina's law with the pair's friction, several at once by the joint frictionless
-/// rule (rigid_impact.h). False where no point approaches (a lasting contact).
+/// Chatterjee and Ruina's law with the pair's friction, several at once by the same law over all
+/// of them (resolveRigidSimultaneous with friction, rigid_impact.h). False where no point
+/// approaches (a lasting contact).
 Expected<bool> ShapedMotion::resolve(const TumblingBody& body, SolverBody& moving,
                                      const std::vector<ObstacleContact>& contacts, double time,
                                      std::vector<ImpactRecord>& impacts) {
@@ -642,19 +643,21 @@ Expected<bool> ShapedMotion::resolve(const TumblingBody& body, SolverBody& movin
     record.energy_lost = outcome->energy_lost;
     records.push_back(record);
   } else {
-    bool frictional = false;
+    std::vector<double> frictions;
     for (const std::size_t o : point_obstacle) {
       const auto friction = scene_.friction(o);
       if (!friction) return friction.error();
-      frictional = frictional || *friction > 0;
+      frictions.push_back(*friction);
     }
-    if (frictional && !frictionless_at_) frictionless_at_ = time;
-    auto outcomes = resolveRigidSimultaneous(bodies, points);
+    auto outcomes = resolveRigidSimultaneous(bodies, points, frictions);
     if (!outcomes) return outcomes.error();
     for (std::size_t k = 0; k < points.size(); ++k) {
+      const FrictionalOutcome& outcome = (*outcomes)[k];
+      if (outcome.frictionless_rule && !frictionless_at_) frictionless_at_ = time;
       ImpactRecord record = recordOf(points[k], point_obstacle[k], time, bodies[points[k].b]);
-      record.impulse = (*outcomes)[k].impulse;
-      record.energy_lost = (*outcomes)[k].energy_lost;
+      record.impulse = outcome.normal.impulse;
+      record.friction_impulse = outcome.friction_impulse;
+      record.energy_lost = outcome.normal.energy_lost + outcome.friction_energy_lost;
       records.push_back(record);
     }
   }

@@ -192,8 +192,8 @@ class ShapedMotion {
   /// closed form is the parabola's).
   std::optional<double> flatBouncesEnd() const;
 
-  /// The instant friction at several points struck at once was first left out (their joint rule
-  /// is frictionless), if ever.
+  /// The instant friction at several points struck at once was first left out (where the joint
+  /// law does not apply: resolveRigidSimultaneous's frictionless_rule), if ever.
   std::optional<double> frictionlessAt() const { return frictionless_at_; }
 
   /// s: where its present flight through air stalled (its integrator could go no further: a

@@ -206,7 +206,7 @@ class PairWatch {
   }
 
   /// The impact of the pair at `time` at `contact`: one point by Chatterjee and Ruina's law with
-  /// the pair's friction, several by the joint frictionless rule; both tracks restarted after.
+  /// the pair's friction, several by the same law over all of them; both tracks restarted after.
   void resolve(const Pair& pair, const TumblingBody& a, const TumblingBody& b,
                const TumblingContact& contact, double time) {
     std::vector<SolverBody> bodies{solverBodyOf(*room_.principal[pair.first], a, time),
@@ -253,14 +253,17 @@ class PairWatch {
       r.energy_lost = outcome->energy_lost;
       records.push_back(r);
     } else {
-      auto outcomes = resolveRigidSimultaneous(bodies, points);
+      auto outcomes =
+          resolveRigidSimultaneous(bodies, points, std::vector<double>(points.size(), friction));
       if (!outcomes) {
         unwatch(pair, time, "not resolved (" + outcomes.error().message() + ")");
         return;
       }
       for (std::size_t k = 0; k < points.size(); ++k) {
-        ImpactRecord r = record(points[k], (*outcomes)[k].impulse);
-        r.energy_lost = (*outcomes)[k].energy_lost;
+        const FrictionalOutcome& outcome = (*outcomes)[k];
+        ImpactRecord r = record(points[k], outcome.normal.impulse);
+        r.friction_impulse = outcome.friction_impulse;
+        r.energy_lost = outcome.normal.energy_lost + outcome.friction_energy_lost;
         records.push_back(r);
       }
     }

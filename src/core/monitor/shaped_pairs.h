@@ -17,7 +17,7 @@
 //
 // Where a pair touches closing (faster than a settled body's rebound, as an obstacle's impact:
 // ShapedMotion), the impact is resolved at that instant: one point by Chatterjee and Ruina's law
-// with the pair's friction, several at once by the joint frictionless rule (rigid_impact.h), both
+// with the pair's friction, several at once by the same law over all of them (rigid_impact.h), both
 // tracks going on from their states after it (their impacts with obstacles at that instant
 // reported). Touching without closing (just struck, a graze), the pair is looked at again from
 // the first instant its gap is past the touching band (ShapedRoom::parting; doubling steps, up to

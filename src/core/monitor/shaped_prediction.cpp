@@ -305,8 +305,8 @@ class ShapedRun {
     prediction_.final_state = state;
     if (const auto frictionless_at = motion.frictionlessAt()) {
       notes_.push_back(
-          "friction at several points struck at once (a face or an edge landing, "
-          "first at +" +
+          "friction at several points struck at once where the joint law does not apply "
+          "(their e differ, or a point left apart would approach; first at +" +
           formatNumber(*frictionless_at) +
           " s) is not yet modelled: those impacts were frictionless");
     }
