@@ -14,7 +14,6 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
-#include <boost/numeric/odeint.hpp>
 #include <cmath>
 #include <exception>
 #include <memory>
@@ -23,6 +22,7 @@
 #include <vector>
 
 #include "collision_response/core/validation.h"
+#include "contact/planar_stretches.h"
 #include "contact/shaped_pivot.h"
 #include "geometry/convex_distance.h"
 
@@ -31,14 +31,8 @@ namespace collision_response::core {
 namespace {
 
 using Vec = Eigen::Vector3d;
-using State = std::array<double, 4>;  // theta, psi, theta', psi'
-using Stepper = boost::numeric::odeint::runge_kutta_dopri5<State>;
-using Dense = boost::numeric::odeint::result_of::make_dense_output<Stepper>::type;
-
-/// Steps one motion may take before it is asked again from where it is ("stops").
-constexpr std::size_t kMaxSteps = 1u << 14;
-/// Bisection of an event on the dense output: to this part of the instant (or of 1 s).
-constexpr double kEventResolution = 1e-13;
+using State = planar::State;  // theta, psi, theta', psi'
+using Mode = planar::Grip;    // how the edge holds the side's point: sliding, or rolling
 /// m: how far the side is kept from the edge's line (as the tipping over an edge keeps its face).
 constexpr double kEdgeHair = 1e-11;
 
@@ -55,8 +49,6 @@ struct Roll {
   Eigen::Quaterniond orientation0;
 };
 
-enum class Mode { kSliding, kRolling };
-
 struct Forces {
   double normal = 0.0, friction = 0.0, theta_rate = 0.0, psi_rate = 0.0;
 };
@@ -69,7 +61,7 @@ Forces forcesOf(const Roll& k, const State& y, Mode mode, double sigma) {
   const double m = k.mass, r = k.radius;
   Forces f;
   f.normal = -m * (g_u + r * td * td);
-  if (mode == Mode::kRolling) {
+  if (mode == Mode::kHolding) {
     f.theta_rate = m * r * g_t / (k.moment + m * r * r);
     f.psi_rate = f.theta_rate;
     f.friction = m * r * f.theta_rate - m * g_t;
@@ -93,40 +85,19 @@ PathState placed(const Roll& k, const State& y) {
   return state;
 }
 
-struct Stretch {
-  Dense dense;
-  double to = 0.0;
-  Mode mode = Mode::kSliding;
-  double sigma = 1.0;
-};
-
 class EdgeRollPath : public LastingPath {
  public:
   Roll roll;
-  double start_time = 0.0, until_time = 0.0;
-  State initial{};
-  Mode initial_mode = Mode::kSliding;
-  double initial_sigma = 1.0;
-  std::vector<Stretch> stretches;
+  double until_time = 0.0;
+  planar::Stretches stretches;
   std::optional<std::pair<double, PathState>> flight;  // from when, and its state there
 
   PathState stateAt(double t) const override {
-    const double time = std::clamp(t, start_time, until_time);
+    const double time = std::clamp(t, stretches.start, until_time);
     if (flight && time >= flight->first) {
       return flownFrom(flight->second, roll.gravity, time - flight->first);
     }
-    State y = initial;
-    Mode mode = initial_mode;
-    double sigma = initial_sigma;
-    const auto covering =
-        std::lower_bound(stretches.begin(), stretches.end(), time,
-                         [](const Stretch& stretch, double at) { return stretch.to < at; });
-    if (!stretches.empty() && time > start_time) {
-      const Stretch& stretch = covering == stretches.end() ? stretches.back() : *covering;
-      stretch.dense.calc_state(std::clamp(time, stretch.dense.previous_time(), stretch.to), y);
-      mode = stretch.mode;
-      sigma = stretch.sigma;
-    }
+    const auto [y, mode, sigma] = stretches.at(time);
     return withForces(y, mode, sigma);
   }
 
@@ -134,7 +105,7 @@ class EdgeRollPath : public LastingPath {
   /// about the centre's plane.
   PathState withForces(const State& y, Mode mode, double sigma) const {
     PathState state = placed(roll, y);
-    state.state = mode == Mode::kRolling ? ContactState::kRolling : ContactState::kSliding;
+    state.state = mode == Mode::kHolding ? ContactState::kRolling : ContactState::kSliding;
     const Forces f = forcesOf(roll, y, mode, sigma);
     const double lo = std::max(-roll.half_side, roll.edge_from);
     const double hi = std::min(roll.half_side, roll.edge_to);
@@ -154,9 +125,9 @@ class EdgeRollPath : public LastingPath {
     return state;
   }
 
-  double start() const override { return start_time; }
+  double start() const override { return stretches.start; }
   double until() const override { return until_time; }
-  std::size_t steps() const override { return stretches.size(); }
+  std::size_t steps() const override { return stretches.list.size(); }
 };
 
 enum class What { kLeaves, kSlipStops, kSlips, kBack };
@@ -170,7 +141,7 @@ double eventValue(const Roll& k, const State& y, Mode mode, double sigma, What w
     case What::kSlipStops:
       return mode == Mode::kSliding && k.mu > 0 ? sigma * (y[2] - y[3]) : 1.0;
     case What::kSlips:
-      return mode == Mode::kRolling ? k.mu * f.normal - std::abs(f.friction) : 1.0;
+      return mode == Mode::kHolding ? k.mu * f.normal - std::abs(f.friction) : 1.0;
     case What::kBack:
       return y[0] >= 0 || y[2] >= 0 ? 1.0 : -1.0;  // back over the face, still rolling back
   }
@@ -242,50 +213,28 @@ Expected<std::optional<std::pair<double, What>>> integrateMode(EdgeRollPath& pat
                                                                double sigma, double tolerance,
                                                                std::size_t& taken) {
   const Roll& k = path.roll;
-  const auto system = [&k, mode, sigma](const State& x, State& rate, double) {
+  const auto rate = [&k, mode, sigma](const State& x) {
     const Forces f = forcesOf(k, x, mode, sigma);
-    rate = {x[2], x[3], f.theta_rate, f.psi_rate};
+    return State{x[2], x[3], f.theta_rate, f.psi_rate};
   };
-  Dense dense = boost::numeric::odeint::make_dense_output(tolerance, tolerance, Stepper());
-  dense.initialize(y, t, 1e-4);
-  std::optional<std::pair<double, What>> event;
-  while (++taken <= kMaxSteps) {
-    try {
-      dense.do_step(system);
-    } catch (const std::exception&) {
-      return Error{"contact", "the roll over the face's edge could not be integrated past +" +
-                                  formatNumber(t - path.start_time) + " s"};
-    }
-    const double t0 = dense.previous_time(), t1 = std::min(dense.current_time(), until);
-    const auto value = [&](double time, What what) {
-      State x;
-      dense.calc_state(time, x);
-      return eventValue(k, x, mode, sigma, what);
-    };
-    for (const What what : kEvents) {
-      if (value(t1, what) > 0) continue;
-      double lo = t0, hi = value(t0, what) <= 0 ? t0 : t1;
-      while (hi - lo > kEventResolution * std::max(1.0, std::abs(hi))) {
-        const double mid = 0.5 * (lo + hi);
-        (value(mid, what) > 0 ? lo : hi) = mid;
-      }
-      if (!event || hi < event->first) event = std::make_pair(hi, what);
-    }
-    path.stretches.push_back({dense, event ? event->first : t1, mode, sigma});
-    t = path.stretches.back().to;
-    if (event || t >= until) break;
-  }
-  dense.calc_state(t, y);
-  return event;
+  const auto value = [&k, mode, sigma](const State& x, std::size_t e) {
+    return eventValue(k, x, mode, sigma, kEvents[e]);
+  };
+  auto event = planar::integrateGrip(path.stretches, y, t, until, mode, sigma, tolerance, taken,
+                                     kEvents.size(), rate, value, "the roll over the face's edge");
+  if (!event) return event.error();
+  if (!event.value()) return std::optional<std::pair<double, What>>{};
+  return std::optional<std::pair<double, What>>(
+      std::make_pair(event.value()->first, kEvents[event.value()->second]));
 }
 
 /// The mode at a stop or onset of slip: rolling where the friction it needs is within the cone,
 /// else sliding against it.
 std::pair<Mode, double> modeAt(const Roll& k, State& y, What what) {
   if (what == What::kSlipStops) y[3] = y[2];
-  const Forces rolling = forcesOf(k, y, Mode::kRolling, 1.0);
+  const Forces rolling = forcesOf(k, y, Mode::kHolding, 1.0);
   if (what == What::kSlipStops && std::abs(rolling.friction) <= k.mu * rolling.normal) {
-    return {Mode::kRolling, 1.0};
+    return {Mode::kHolding, 1.0};
   }
   // Sliding with the friction the roll needed: the slip grows against it.
   return {Mode::kSliding, rolling.friction > 0 ? -1.0 : 1.0};
@@ -309,10 +258,10 @@ Expected<LastingMotion> rollOverFaceEdge(const LastingBody& body, const FlatFace
   if (k.mu > 0 && std::abs(slip) * k.radius <= kLastingStillSpeed) {
     std::tie(mode, sigma) = modeAt(k, y, What::kSlipStops);
   }
-  path->start_time = body.time;
-  path->initial = y;
-  path->initial_mode = mode;
-  path->initial_sigma = sigma;
+  path->stretches.start = body.time;
+  path->stretches.initial = y;
+  path->stretches.initial_grip = mode;
+  path->stretches.initial_sigma = sigma;
 
   double t = body.time, until = body.time + horizon, last_change = -1;
   std::size_t taken = 0, changes_at_once = 0;

@@ -19,7 +19,6 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
-#include <boost/numeric/odeint.hpp>
 #include <cmath>
 #include <exception>
 #include <limits>
@@ -28,6 +27,7 @@
 #include <string>
 
 #include "collision_response/core/validation.h"
+#include "contact/planar_stretches.h"
 #include "contact/shaped_pivot.h"
 #include "geometry/convex_distance.h"
 
@@ -37,15 +37,10 @@ namespace {
 
 using Vec = Eigen::Vector3d;
 using Vec2 = Eigen::Vector2d;
-using State = std::array<double, 4>;  // s, phi, s', phi'
-using Stepper = boost::numeric::odeint::runge_kutta_dopri5<State>;
-using Dense = boost::numeric::odeint::result_of::make_dense_output<Stepper>::type;
+using State = planar::State;  // s, phi, s', phi'
+using Mode = planar::Grip;    // how the edge holds the body's face: sliding, or sticking
 
 constexpr double kPi = 3.14159265358979323846;
-/// Steps one motion may take before it is asked again from where it is ("stops").
-constexpr std::size_t kMaxSteps = 1u << 14;
-/// Bisection of an event on the dense output: to this part of the instant (or of 1 s).
-constexpr double kEventResolution = 1e-13;
 /// m: how far the body's face is kept from the edge's line (as the corners' tipping keeps its
 /// lowest corner above the face: within the touching band, beyond the distance's tolerance).
 constexpr double kEdgeHair = 1e-11;
@@ -60,9 +55,6 @@ struct FootPrint {
   Vec2 centre = Vec2::Zero();
   double radius = 0.0;
 };
-
-/// How the edge moves on the body's face.
-enum class Mode { kSliding, kSticking };
 
 /// The body, the edge and the footprint, fixed over the motion.
 struct Setting {
@@ -90,7 +82,7 @@ Forces forcesOf(const Setting& k, const State& y, Mode mode, double sigma) {
   const double g_u = k.gravity.dot(u), g_w = k.gravity.dot(w);
   const double m = k.mass, h = k.height, I = k.moment;
   Forces f;
-  if (mode == Mode::kSticking) {
+  if (mode == Mode::kHolding) {
     f.phi_rate = m * (h * g_w - s * g_u) / (I + m * (s * s + h * h));
     f.normal = -m * (g_u + h * pd * pd + s * f.phi_rate);
     f.friction = m * (h * f.phi_rate - s * pd * pd - g_w);
@@ -147,14 +139,6 @@ PathState placed(const Setting& k, const State& y) {
   return state;
 }
 
-/// One integrated stretch of the motion in one mode.
-struct Stretch {
-  Dense dense;
-  double to = 0.0;
-  Mode mode = Mode::kSliding;
-  double sigma = 1.0;
-};
-
 /// The free flight after the body leaves the edge: from `from` (its state there) to `until`.
 struct Flight {
   double from = 0.0;
@@ -164,30 +148,16 @@ struct Flight {
 class EdgeTipPath : public LastingPath {
  public:
   Setting setting;
-  double start_time = 0.0, until_time = 0.0;
-  State initial{};
-  Mode initial_mode = Mode::kSliding;
-  double initial_sigma = 1.0;
-  std::vector<Stretch> stretches;
+  double until_time = 0.0;
+  planar::Stretches stretches;
   std::optional<Flight> flight;
 
   PathState stateAt(double t) const override {
-    const double time = std::clamp(t, start_time, until_time);
+    const double time = std::clamp(t, stretches.start, until_time);
     if (flight && time >= flight->from) {
       return flownFrom(flight->there, setting.gravity, time - flight->from);
     }
-    State y = initial;
-    Mode mode = initial_mode;
-    double sigma = initial_sigma;
-    const auto covering =
-        std::lower_bound(stretches.begin(), stretches.end(), time,
-                         [](const Stretch& stretch, double at) { return stretch.to < at; });
-    if (!stretches.empty() && time > start_time) {
-      const Stretch& stretch = covering == stretches.end() ? stretches.back() : *covering;
-      stretch.dense.calc_state(std::clamp(time, stretch.dense.previous_time(), stretch.to), y);
-      mode = stretch.mode;
-      sigma = stretch.sigma;
-    }
+    const auto [y, mode, sigma] = stretches.at(time);
     return withForces(y, mode, sigma);
   }
 
@@ -195,7 +165,7 @@ class EdgeTipPath : public LastingPath {
   PathState withForces(const State& y, Mode mode, double sigma) const {
     PathState state = placed(setting, y);
     const Forces f = forcesOf(setting, y, mode, sigma);
-    state.state = mode == Mode::kSticking ? ContactState::kRolling : ContactState::kSliding;
+    state.state = mode == Mode::kHolding ? ContactState::kRolling : ContactState::kSliding;
     const auto chord = chordAt(setting.print, -y[0]);
     if (!chord || f.paradox) return state;
     const auto [lo, hi] = *chord;
@@ -217,9 +187,9 @@ class EdgeTipPath : public LastingPath {
     return state;
   }
 
-  double start() const override { return start_time; }
+  double start() const override { return stretches.start; }
   double until() const override { return until_time; }
-  std::size_t steps() const override { return stretches.size(); }
+  std::size_t steps() const override { return stretches.list.size(); }
 };
 
 /// Why a stretch ended.
@@ -234,7 +204,7 @@ double eventValue(const Setting& k, const State& y, Mode mode, double sigma, Wha
     case What::kSlipStops:
       return mode == Mode::kSliding && k.mu > 0 ? sigma * y[2] : 1.0;
     case What::kSlips:
-      return mode == Mode::kSticking ? k.mu * f.normal - std::abs(f.friction) : 1.0;
+      return mode == Mode::kHolding ? k.mu * f.normal - std::abs(f.friction) : 1.0;
     case What::kPassesFace: {
       const auto chord = chordAt(k.print, -y[0]);
       return chord ? 1.0 : -1.0;
@@ -354,9 +324,9 @@ Expected<Start> startOf(const LastingBody& body, const FlatFace& face, const Fac
   start.sigma = start.y[2] >= 0 ? 1.0 : -1.0;
   if (k.mu > 0 && std::abs(start.y[2]) <= kLastingStillSpeed) {
     start.y[2] = 0;
-    const Forces stick = forcesOf(k, start.y, Mode::kSticking, 1.0);
+    const Forces stick = forcesOf(k, start.y, Mode::kHolding, 1.0);
     if (std::abs(stick.friction) <= k.mu * stick.normal) {
-      start.mode = Mode::kSticking;
+      start.mode = Mode::kHolding;
     } else {
       start.sigma = stick.friction > 0 ? -1.0 : 1.0;
     }
@@ -375,41 +345,20 @@ Expected<std::optional<std::pair<double, What>>> integrateMode(EdgeTipPath& path
                                                                double sigma, double tolerance,
                                                                std::size_t& taken) {
   const Setting& k = path.setting;
-  const auto system = [&k, mode, sigma](const State& x, State& rate, double) {
+  const auto rate = [&k, mode, sigma](const State& x) {
     const Forces f = forcesOf(k, x, mode, sigma);
-    rate = {x[2], x[3], f.s_rate, f.phi_rate};
+    return State{x[2], x[3], f.s_rate, f.phi_rate};
   };
-  Dense dense = boost::numeric::odeint::make_dense_output(tolerance, tolerance, Stepper());
-  dense.initialize(y, t, 1e-4);
-  std::optional<std::pair<double, What>> event;
-  while (++taken <= kMaxSteps) {
-    try {
-      dense.do_step(system);
-    } catch (const std::exception&) {
-      return Error{"contact", "the tipping over the face's edge could not be integrated past +" +
-                                  formatNumber(t - path.start_time) + " s"};
-    }
-    const double t0 = dense.previous_time(), t1 = std::min(dense.current_time(), until);
-    const auto value = [&](double time, What what) {
-      State x;
-      dense.calc_state(time, x);
-      return eventValue(k, x, mode, sigma, what);
-    };
-    for (const What what : kEvents) {
-      if (value(t1, what) > 0) continue;
-      double lo = t0, hi = value(t0, what) <= 0 ? t0 : t1;
-      while (hi - lo > kEventResolution * std::max(1.0, std::abs(hi))) {
-        const double mid = 0.5 * (lo + hi);
-        (value(mid, what) > 0 ? lo : hi) = mid;
-      }
-      if (!event || hi < event->first) event = std::make_pair(hi, what);
-    }
-    path.stretches.push_back({dense, event ? event->first : t1, mode, sigma});
-    t = path.stretches.back().to;
-    if (event || t >= until) break;
-  }
-  dense.calc_state(t, y);
-  return event;
+  const auto value = [&k, mode, sigma](const State& x, std::size_t e) {
+    return eventValue(k, x, mode, sigma, kEvents[e]);
+  };
+  auto event =
+      planar::integrateGrip(path.stretches, y, t, until, mode, sigma, tolerance, taken,
+                            kEvents.size(), rate, value, "the tipping over the face's edge");
+  if (!event) return event.error();
+  if (!event.value()) return std::optional<std::pair<double, What>>{};
+  return std::optional<std::pair<double, What>>(
+      std::make_pair(event.value()->first, kEvents[event.value()->second]));
 }
 
 }  // namespace
@@ -427,10 +376,10 @@ Expected<LastingMotion> tipOverFaceEdge(const LastingBody& body, const FlatFace&
   State y = start->y;
   Mode mode = start->mode;
   double sigma = start->sigma;
-  path->start_time = body.time;
-  path->initial = y;
-  path->initial_mode = mode;
-  path->initial_sigma = sigma;
+  path->stretches.start = body.time;
+  path->stretches.initial = y;
+  path->stretches.initial_grip = mode;
+  path->stretches.initial_sigma = sigma;
 
   double t = body.time, until = body.time + horizon, last_change = -1;
   std::size_t taken = 0, changes_at_once = 0;
@@ -457,9 +406,9 @@ Expected<LastingMotion> tipOverFaceEdge(const LastingBody& body, const FlatFace&
     last_change = at;
     if (changes_at_once > 2) return notYet("the edge's stick and slip change at once, again");
     if (what == What::kSlipStops) y[2] = 0.0;
-    const Forces stick = forcesOf(k, y, Mode::kSticking, 1.0);
+    const Forces stick = forcesOf(k, y, Mode::kHolding, 1.0);
     mode = what == What::kSlipStops && std::abs(stick.friction) <= k.mu * stick.normal
-               ? Mode::kSticking
+               ? Mode::kHolding
                : Mode::kSliding;
     if (mode == Mode::kSliding) sigma = stick.friction > 0 ? -1.0 : 1.0;
   }
