@@ -545,6 +545,8 @@ Expected<MaybeOutcomes> jointLaw(std::vector<SolverBody>& bodies,
     const RealL d_normal = d[i].dot(n), d_tangential = (d[i] - d_normal * n).norm();
     const RealL mu = friction[order[pressed[i]]];
     const RealL pressing = (1 + e) * RealL(plastic[pressed[i]]);
+    // Never pulling (where mu is 0 and D has no slip to stop there, the cone says nothing).
+    if (d_normal < 0) kappa = std::min(kappa, pressing / -d_normal);
     if (d_tangential <= mu * (pressing + d_normal)) continue;  // P^ within this cone
     const RealL denominator = d_tangential - mu * d_normal;
     kappa = std::min(kappa,
