@@ -19,6 +19,15 @@ namespace collision_response::core::shaped_scenes {
 
 inline constexpr double kG = 9.81;
 
+/// Every impact the monitor's steps reported, in order.
+inline std::vector<ImpactRecord> impactsOf(const std::vector<StepReport>& reports) {
+  std::vector<ImpactRecord> impacts;
+  for (const StepReport& report : reports) {
+    impacts.insert(impacts.end(), report.impacts.begin(), report.impacts.end());
+  }
+  return impacts;
+}
+
 /// A box of edges 2 half over a concrete floor at z = 0, its material `e` against concrete.
 inline Scene floorScene(double e, const Eigen::Vector3d& half, double mass = 2.0) {
   Scene scene;

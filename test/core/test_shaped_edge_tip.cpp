@@ -397,20 +397,28 @@ TEST(ShapedEdgeTip, WhatIsNotModelledIsRefusedByName) {
     ASSERT_FALSE(motion.ok());
     EXPECT_NE(motion.error().reason.find(what), std::string::npos) << motion.error().message();
   };
-  // Sliding off at an angle to the edge (along it too).
+  // Sliding off at an angle to the edge (along it too): not refused any more, its corners and
+  // crossings of the edge in three dimensions (test_shaped_edge_oblique.cpp).
   LastingBody cube = box(V(0.05, 0.05, 0.05), 1, V(1.0, 0, 0.75));
   cube.velocity = V(0.5, 0.2, 0);
-  refused(lastingOnFace(cube, table), "not yet: sliding off the face's edge along it too");
-  const FlatFace smooth = tableTop(0);
-  refused(lastingOnFace(cube, smooth), "not yet: sliding off the face's edge along it too");
+  for (const double mu : {0.3, 0.0}) {
+    const auto oblique = lastingOnFace(cube, tableTop(mu));
+    ASSERT_TRUE(oblique.ok()) << errorOf(oblique);
+    EXPECT_TRUE(oblique->pivot);
+    expectSound(cube, *oblique, 1e-8);
+  }
   // Over the table's corner.
   cube.velocity = V(0.5, 0, 0);
   cube.centre = V(0.99, 0.49, 0.75);
   refused(lastingOnFace(cube, table), "not yet: the body overhangs two of the face's edges");
-  // A box with three different sides turned about z: the edge's line is not a principal axis.
+  // A box with three different sides turned about z (the edge's line not a principal axis):
+  // not refused any more either (test_shaped_edge_oblique.cpp, the compound pendulum).
   LastingBody block =
       box(V(0.1, 0.05, 0.03), 1, V(1.0, 0, 0.73), Q(Eigen::AngleAxisd(0.3, V::UnitZ())));
-  refused(lastingOnFace(block, smooth), "not yet: tipping over the face's edge about an axis");
+  const auto turned = lastingOnFace(block, tableTop(0));
+  ASSERT_TRUE(turned.ok()) << errorOf(turned);
+  EXPECT_TRUE(turned->pivot);
+  expectSound(block, *turned, 1e-8);
   // A can on its side, its end just at the edge (within the band), rests: a side over the edge
   // is refused only once it is past it.
   LastingBody lying =

@@ -36,6 +36,7 @@ using V = Eigen::Vector3d;
 using shaped_scenes::AcrossSlope;
 using shaped_scenes::EdgeLanding;
 using shaped_scenes::floorScene;
+using shaped_scenes::impactsOf;
 using shaped_scenes::kG;
 using shaped_scenes::RimFall;
 
@@ -93,14 +94,6 @@ std::vector<ImpactRecord> firstInstant(const std::vector<ImpactRecord>& impacts)
     if (impact.time == impacts.front().time) first.push_back(impact);
   }
   return first;
-}
-
-std::vector<ImpactRecord> impactsOf(const std::vector<StepReport>& reports) {
-  std::vector<ImpactRecord> impacts;
-  for (const StepReport& report : reports) {
-    impacts.insert(impacts.end(), report.impacts.begin(), report.impacts.end());
-  }
-  return impacts;
 }
 
 // A box of e = 1/2 dropped flat from rest, frictionless, fed to the monitor by two states on its

@@ -372,7 +372,16 @@ Expected<LastingMotion> tipOverFaceEdge(const LastingBody& body, const FlatFace&
   auto path = std::make_shared<EdgeTipPath>();
   Setting& k = path->setting;
   const auto start = startOf(body, face, edge, up, k);
-  if (!start) return start.error();
+  if (!start) {
+    // Not in the plane at right angles to the edge (sliding along it too, turning about another
+    // axis, the edge not a principal axis, ...): the body's points and crossings of the edge,
+    // in three dimensions.
+    if (start.error().field == "contact" && (std::holds_alternative<Cuboid>(body.shape) ||
+                                             std::holds_alternative<Cylinder>(body.shape))) {
+      return pivotOverFaceEdge(body, face, tolerance, horizon);
+    }
+    return start.error();
+  }
   State y = start->y;
   Mode mode = start->mode;
   double sigma = start->sigma;
@@ -414,9 +423,7 @@ Expected<LastingMotion> tipOverFaceEdge(const LastingBody& body, const FlatFace&
   }
   std::string ends = "stops";
   if (ended == What::kOutOfPlane) {
-    ends =
-        "tipping over the face's edge with the centre of mass past an end of the edge's "
-        "contact (it turns out of its plane)";
+    ends = "stops";  // asked again there: it turns out of its plane (pivotOverFaceEdge)
   } else if (ended == What::kUpright) {
     ends = "tipping over the face's edge past upright";
   } else if (ended == What::kFlat) {

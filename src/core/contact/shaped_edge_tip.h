@@ -14,17 +14,10 @@
 #include <vector>
 
 #include "collision_response/core/expected.h"
+#include "contact/edge_crossing.h"
 #include "contact/shaped_lasting.h"
 
 namespace collision_response::core {
-
-/// A bounded face's edge: the line through `point` along `along` (unit); `out` (unit, in the
-/// face, at right angles to `along`) points off the face.
-struct FaceEdge {
-  Eigen::Vector3d point = Eigen::Vector3d::Zero();
-  Eigen::Vector3d along = Eigen::Vector3d::UnitY();
-  Eigen::Vector3d out = Eigen::Vector3d::UnitX();
-};
 
 /// A bounded face's four edges, each with the bound it is: the face's axis (0: along_u, 1:
 /// along_v) and side (-1, 1).

@@ -1124,7 +1124,15 @@ Expected<LastingMotion> turningOnFace(const LastingBody& body, const FlatFace& f
                                       const Support& support, const Setting& setting,
                                       const Eigen::Matrix3d& rotation, bool overhanging,
                                       const Error& refused, double tolerance) {
-  if (overhanging) return refused;
+  if (overhanging) {
+    // Over a table's edge, spinning or rocking: its corners (or its rim's point farthest from
+    // the edge) on the table and its crossings of the edge (pivotOverFaceEdge).
+    if (std::holds_alternative<Cuboid>(body.shape) ||
+        std::holds_alternative<Cylinder>(body.shape)) {
+      return pivotOverFaceEdge(body, face, tolerance);
+    }
+    return refused;
+  }
   const Vec lowered = body.angular_velocity.cross(setting.n);
   const bool rocks = lowered.norm() * setting.reach > kLastingStillSpeed;
   if (support.kind == SupportKind::kDisc) {
@@ -1164,6 +1172,13 @@ Expected<LastingMotion> plannedOnFace(const LastingBody& body, const FlatFace& f
   Expected<Plan> planned = support.kind == SupportKind::kLine
                                ? rollPlan(body, support, setting, mu, in_face, roll)
                                : translationPlan(in_face, setting.g_t, setting.g_n, mu);
+  if (!planned && support.kind == SupportKind::kLine &&
+      std::abs(in_face.dot(support.axis)) > kLastingStillSpeed) {
+    // A side rolling while it slides along its axis: its contact line's slip turns (its parts
+    // along and across the axis slow at different rates), which no closed form here carries:
+    // its two ends' rim points, each sticking or sliding (pivotOnRound).
+    return pivotOnSupport(body, face, support, rotation, Vec::Zero(), tolerance);
+  }
   if (!planned) return planned.error();
   const Plan& plan = planned.value();
 
@@ -1206,6 +1221,51 @@ Expected<LastingMotion> plannedOnFace(const LastingBody& body, const FlatFace& f
   return motion;
 }
 
+/// A cap or a face whose turning lifts part of its support off the face faster than a settled
+/// body's while no point of it approaches (a can rocking onto its cap, a box onto its face): it
+/// tips over what its turning lowers, the rest leaving (a cap's rim point along w x n; a face's
+/// corners that do not leave), never an impulse that holds the leaving points down. Empty where
+/// it is not so.
+std::optional<Expected<LastingMotion>> rockingOff(const LastingBody& body, const FlatFace& face,
+                                                  const Support& support, const Setting& setting,
+                                                  const Eigen::Matrix3d& rotation,
+                                                  double tolerance) {
+  const Vec lowered = body.angular_velocity.cross(setting.n);
+  if (!(lowered.norm() * setting.reach > kLastingStillSpeed)) return std::nullopt;
+  const auto speed = [&](const Vec& point) {
+    return (body.velocity + body.angular_velocity.cross(point - body.centre)).dot(setting.n);
+  };
+  const std::vector<Vec> outline = outlineOf(support, setting.e1, setting.e2);
+  if (std::any_of(outline.begin(), outline.end(),
+                  [&](const Vec& p) { return speed(p) < -setting.settled_speed; })) {
+    return std::nullopt;  // a point approaches: an impact, not a lasting contact
+  }
+  if (support.kind == SupportKind::kDisc) {
+    return pivotOnSupport(body, face, support, rotation, lowered, tolerance);
+  }
+  if (support.kind == SupportKind::kLine && support.feet.size() == 2) {
+    // A side with one end rising: it tips over the other end's rim (or a capsule's end).
+    const int staying = speed(support.feet[0]) <= speed(support.feet[1]) ? 0 : 1;
+    const Vec axis = rotation.col(2);
+    const int end =
+        axis.dot(support.feet[static_cast<std::size_t>(staying)] - body.centre) < 0 ? -1 : 1;
+    return pivotOnRound(body, face, {end}, Vec::Zero(), tolerance);
+  }
+  if (support.kind == SupportKind::kPolygon && support.corners.size() == support.feet.size()) {
+    Support staying = support;
+    staying.corners.clear();
+    for (std::size_t i = 0; i < support.feet.size(); ++i) {
+      if (speed(support.feet[i]) <= setting.settled_speed) {
+        staying.corners.push_back(support.corners[i]);
+      }
+    }
+    if (!staying.corners.empty()) {
+      return pivotOnSupport(body, face, staying, rotation, lowered, tolerance);
+    }
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& face,
@@ -1230,7 +1290,12 @@ Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& f
   }
   if (!found) return found.error();
   const Support& support = found.value();
-  if (Status status = checkOnFace(body, face, support, setting); !status) return status.error();
+  if (Status status = checkOnFace(body, face, support, setting); !status) {
+    if (const auto rocking = rockingOff(body, face, support, setting, rotation, tolerance)) {
+      return *rocking;
+    }
+    return status.error();
+  }
   // A side whose line lies on the face's edge, going over it: it rolls over the edge.
   if (support.kind == SupportKind::kLine) {
     if (const auto edge = sideOnEdge(body, face)) {

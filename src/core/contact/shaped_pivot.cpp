@@ -26,6 +26,8 @@
 #include <variant>
 
 #include "collision_response/core/validation.h"
+#include "contact/edge_crossing.h"
+#include "contact/shaped_edge_tip.h"
 #include "geometry/convex_distance.h"
 
 namespace collision_response::core {
@@ -61,7 +63,8 @@ struct Feature {
 struct Point {
   std::size_t feature = 0;
   bool sliding = false;
-  /// Unit, in the face: the slip's direction while it is too slow to give one (its onset).
+  /// Unit, in the contact's tangent plane: the slip's direction while it is too slow to give one
+  /// (its onset).
   Vec direction = Vec::Zero();
   /// A rim's: unit, in its plane (principal frame), the direction of its point touching where
   /// that plane is along the face (the cap flat: every point of the rim equally low).
@@ -69,6 +72,10 @@ struct Point {
   /// A rim's point fixed in the body at `lean` (a flat cap's four, carried as a face's corners
   /// are), not its lowest.
   bool fixed = false;
+  /// >= 0: the body's edge (`feature`, into Setting::segments) or rim (`feature`, its crossing on
+  /// `side` of its chord's middle) on the face's edge `line` (into Setting::lines), not the face.
+  int line = -1;
+  int side = 0;
 };
 
 /// The body and the face, fixed over the motion.
@@ -80,6 +87,17 @@ struct Setting {
   Vec n, e1, e2;
   double mu = 0.0;
   std::vector<Feature> features;  // every corner, end or rim of the body
+  ConvexShape shape;
+  /// A bounded face's four edges (each its `point` the middle, to `half_length` either side),
+  /// and a box's twelve edges (its corners' indices): where the body goes on over the face's
+  /// edges (`crosses`: a box or a cylinder).
+  struct Line {
+    FaceEdge edge;
+    double half_length = 0.0;
+  };
+  std::vector<Line> lines;
+  std::vector<std::array<std::size_t, 2>> segments;
+  bool crosses = false;
 };
 
 struct Kinematics {
@@ -108,36 +126,87 @@ State pack(const Kinematics& k) {
 /// Below this |n x a|, a rim's plane is along the face: its point touching is its `lean`'s.
 constexpr double kRimFlat = 1e-12;
 
-/// Where a point touches: its lever from the centre of mass (world) and the rate at which it
-/// moves over the body (`over`, world: 0 at a corner). A ball's lowest point is c - rho n, which
-/// moves over it at rho w x n; a rim's is c + rho d with d the unit -(n - (n.a) a) in its plane
-/// (a its axis), which moves over it at rho (d' - w x d), d' from a' = w x a.
+/// Where a point touches: its lever from the centre of mass (world), the rate at which it moves
+/// over the body (`over`, world: 0 at a corner), the contact's normal (into the body) and
+/// tangents, and `bend`: n'.V, the normal's turning against the body's point's velocity V there
+/// (0 on the face). A ball's lowest point is c - rho n, which moves over it at rho w x n; a rim's
+/// is c + rho d with d the unit -(n - (n.a) a) in its plane (a its axis), which moves over it at
+/// rho (d' - w x d), d' from a' = w x a; an edge's or a rim's crossing of the face's edge is
+/// edge_crossing.h's.
 struct Contact {
   Vec lever = Vec::Zero();
   Vec over = Vec::Zero();
+  Vec normal = Vec::UnitZ();
+  Vec e1 = Vec::UnitX();
+  Vec e2 = Vec::UnitY();
+  double bend = 0.0;
+  Vec on = Vec::Zero();  // a crossing's point on the face's edge
+  double gap = 0.0;      // a crossing's
 };
 
+BodyRates ratesOf(const Kinematics& k) { return {k.centre, k.velocity, k.spin}; }
+
+/// A point on the face's edge: its edge's or rim's crossing of the line (empty where it has none).
+std::optional<LineCrossing> crossingOf(const Setting& s, const Kinematics& k, const Point& p) {
+  const FaceEdge& line = s.lines[static_cast<std::size_t>(p.line)].edge;
+  if (!s.segments.empty()) {
+    const auto& ends = s.segments[p.feature];
+    return segmentCrossing(k.centre + k.rotation * s.features[ends[0]].centre,
+                           k.centre + k.rotation * s.features[ends[1]].centre, ratesOf(k), line);
+  }
+  const Feature& f = s.features[p.feature];
+  return rimCrossing(k.centre + k.rotation * f.centre, k.rotation * f.axis,
+                     k.rotation.col(f.axis.cross(Vec::UnitX()).norm() > 0.5 ? 0 : 1), f.radius,
+                     p.side, ratesOf(k), line);
+}
+
 Contact contactOf(const Setting& s, const Kinematics& k, const Point& p) {
+  Contact c;
+  c.normal = s.n;
+  c.e1 = s.e1;
+  c.e2 = s.e2;
+  if (p.line >= 0) {
+    const auto crossing = crossingOf(s, k, p);
+    if (!crossing) return c;  // gone: its event (inside) ends the segment first
+    c.lever = crossing->point - k.centre;
+    c.over = crossing->over;
+    c.normal = crossing->normal;
+    c.e1 = s.lines[static_cast<std::size_t>(p.line)].edge.along;
+    c.e2 = c.normal.cross(c.e1);
+    c.bend = crossing->normal_rate.dot(k.velocity + k.spin.cross(c.lever));
+    c.on = crossing->on;
+    c.gap = crossing->gap;
+    return c;
+  }
   const Feature& f = s.features[p.feature];
   const Vec centre = k.rotation * f.centre;
-  if (f.radius == 0.0) return {centre, Vec::Zero()};
-  if (f.axis.isZero()) return {centre - f.radius * s.n, f.radius * k.spin.cross(s.n)};
-  if (p.fixed) return {centre + f.radius * (k.rotation * p.lean), Vec::Zero()};
+  c.lever = centre;
+  if (f.radius == 0.0) return c;
+  if (f.axis.isZero()) {
+    c.lever = centre - f.radius * s.n;
+    c.over = f.radius * k.spin.cross(s.n);
+    return c;
+  }
+  c.lever = centre + f.radius * (k.rotation * p.lean);
+  if (p.fixed) return c;
   const Vec a = k.rotation * f.axis;
   const Vec across = a.cross(s.n.cross(a));  // n - (n.a) a, without its cancellation
   const double tilt = across.norm();
-  if (tilt <= kRimFlat) return {centre + f.radius * (k.rotation * p.lean), Vec::Zero()};
+  if (tilt <= kRimFlat) return c;
   const Vec d = -across / tilt;
   const Vec a_rate = k.spin.cross(a);
   const Vec across_rate = -s.n.dot(a_rate) * a - s.n.dot(a) * a_rate;
   const Vec d_rate = (d * d.dot(across_rate) - across_rate) / tilt;
-  return {centre + f.radius * d, f.radius * (d_rate - k.spin.cross(d))};
+  c.lever = centre + f.radius * d;
+  c.over = f.radius * (d_rate - k.spin.cross(d));
+  return c;
 }
 
-/// A point's velocity's part in the face (of the body's point there).
+/// A point's velocity's part in its contact's tangent plane (of the body's point there).
 Vec slipOf(const Setting& s, const Kinematics& k, const Point& p) {
-  const Vec u = k.velocity + k.spin.cross(contactOf(s, k, p).lever);
-  return u - u.dot(s.n) * s.n;
+  const Contact c = contactOf(s, k, p);
+  const Vec u = k.velocity + k.spin.cross(c.lever);
+  return u - u.dot(c.normal) * c.normal;
 }
 
 /// The forces and accelerations of the body with its points as `points` say.
@@ -147,25 +216,29 @@ struct Dynamics {
   std::vector<Vec> forces;
 };
 
-/// The unknowns' directions of the points (a sticking point's n, e1, e2; a sliding point's
-/// n - mu s_hat), each with its point's index.
+/// The unknowns' directions of the points (a sticking point's normal and two tangents; a sliding
+/// point's n - mu s_hat), each with its point's index.
 std::vector<std::pair<std::size_t, Vec>> columnsOf(const Setting& s, const Kinematics& k,
-                                                   const std::vector<Point>& points, double still) {
+                                                   const std::vector<Point>& points,
+                                                   const std::vector<Contact>& contacts,
+                                                   double still) {
   std::vector<std::pair<std::size_t, Vec>> columns;
   for (std::size_t i = 0; i < points.size(); ++i) {
+    const Contact& c = contacts[i];
     if (points[i].sliding) {
       // The slip's direction; below `still`, turned continuously towards the point's given one
       // (its onset's), which it is at 0.
-      const Vec slip = slipOf(s, k, points[i]);
+      const Vec u = k.velocity + k.spin.cross(c.lever);
+      const Vec slip = u - u.dot(c.normal) * c.normal;
       const double speed = slip.norm();
       const Vec towards = speed >= still ? slip : Vec(slip + (still - speed) * points[i].direction);
       const double length = towards.norm();
       const Vec direction = length > 0 ? Vec(towards / length) : points[i].direction;
-      columns.emplace_back(i, s.n - s.mu * direction);
+      columns.emplace_back(i, c.normal - s.mu * direction);
     } else {
-      columns.emplace_back(i, s.n);
-      columns.emplace_back(i, s.e1);
-      columns.emplace_back(i, s.e2);
+      columns.emplace_back(i, c.normal);
+      columns.emplace_back(i, c.e1);
+      columns.emplace_back(i, c.e2);
     }
   }
   return columns;
@@ -173,36 +246,40 @@ std::vector<std::pair<std::size_t, Vec>> columnsOf(const Setting& s, const Kinem
 
 /// Rows of the conditions on the points (a sticking point's three, a sliding point's normal),
 /// given what each unknown (`columns`) does at a point per unit, and `free` per point (the
-/// points' acceleration or velocity without the forces): solved least-norm, the forces per point.
-std::vector<Vec> solveConditions(const Setting& s, const Kinematics& k,
-                                 const std::vector<Point>& points,
+/// points' acceleration or velocity without the forces; `bent`: the normal's turning, n'.V, added
+/// to the normal row, at the accelerations' level): solved least-norm, the forces per point.
+std::vector<Vec> solveConditions(const Setting& s, const std::vector<Point>& points,
+                                 const std::vector<Contact>& contacts,
                                  const std::vector<std::pair<std::size_t, Vec>>& columns,
                                  const std::vector<Vec>& free,
-                                 const Eigen::Matrix3d& inverse_inertia) {
+                                 const Eigen::Matrix3d& inverse_inertia, bool bent) {
   if (points.empty()) return {};  // flying: no force
-  std::vector<Vec> levers;
-  for (const Point& p : points) levers.push_back(contactOf(s, k, p).lever);
-  std::vector<std::pair<std::size_t, Vec>> rows;
+  struct Row {
+    std::size_t point;
+    Vec along;
+    double extra;
+  };
+  std::vector<Row> rows;
   for (std::size_t i = 0; i < points.size(); ++i) {
-    rows.emplace_back(i, s.n);
+    const Contact& c = contacts[i];
+    rows.push_back({i, c.normal, bent ? c.bend : 0.0});
     if (!points[i].sliding) {
-      rows.emplace_back(i, s.e1);
-      rows.emplace_back(i, s.e2);
+      rows.push_back({i, c.e1, 0.0});
+      rows.push_back({i, c.e2, 0.0});
     }
   }
   Eigen::MatrixXd a(rows.size(), columns.size());
   Eigen::VectorXd b(rows.size());
   for (std::size_t c = 0; c < columns.size(); ++c) {
     const auto& [j, force] = columns[c];
-    const Vec turn = inverse_inertia * levers[j].cross(force);
+    const Vec turn = inverse_inertia * contacts[j].lever.cross(force);
     for (std::size_t r = 0; r < rows.size(); ++r) {
-      const auto& [i, along] = rows[r];
       a(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) =
-          along.dot(force / s.mass + turn.cross(levers[i]));
+          rows[r].along.dot(force / s.mass + turn.cross(contacts[rows[r].point].lever));
     }
   }
   for (std::size_t r = 0; r < rows.size(); ++r) {
-    b(static_cast<Eigen::Index>(r)) = -rows[r].second.dot(free[rows[r].first]);
+    b(static_cast<Eigen::Index>(r)) = -rows[r].along.dot(free[rows[r].point]) - rows[r].extra;
   }
   const Eigen::VectorXd x = a.completeOrthogonalDecomposition().solve(b);
   std::vector<Vec> forces(points.size(), Vec::Zero());
@@ -212,26 +289,34 @@ std::vector<Vec> solveConditions(const Setting& s, const Kinematics& k,
   return forces;
 }
 
+std::vector<Contact> contactsOf(const Setting& s, const Kinematics& k,
+                                const std::vector<Point>& points) {
+  std::vector<Contact> contacts;
+  contacts.reserve(points.size());
+  for (const Point& p : points) contacts.push_back(contactOf(s, k, p));
+  return contacts;
+}
+
 Dynamics dynamicsOf(const Setting& s, const Kinematics& k, const std::vector<Point>& points) {
   const Eigen::Matrix3d inertia = k.rotation * s.moments.asDiagonal() * k.rotation.transpose();
   const Eigen::Matrix3d inverse_inertia =
       k.rotation * s.moments.cwiseInverse().asDiagonal() * k.rotation.transpose();
   const Vec gyroscopic = -inverse_inertia * k.spin.cross(inertia * k.spin);
-  // A point's acceleration without the forces; where it moves over the body (a ball's, a rim's)
-  // the body's point there changes at w x (its rate over the body) besides.
+  // A point's acceleration without the forces; where it moves over the body (a ball's, a rim's,
+  // a crossing's) the body's point there changes at w x (its rate over the body) besides.
+  const std::vector<Contact> contacts = contactsOf(s, k, points);
   std::vector<Vec> free;
-  for (const Point& p : points) {
-    const Contact c = contactOf(s, k, p);
+  for (const Contact& c : contacts) {
     free.push_back(s.gravity + gyroscopic.cross(c.lever) +
                    k.spin.cross(k.spin.cross(c.lever) + c.over));
   }
   Dynamics d;
-  d.forces =
-      solveConditions(s, k, points, columnsOf(s, k, points, kSlipStops), free, inverse_inertia);
+  d.forces = solveConditions(s, points, contacts, columnsOf(s, k, points, contacts, kSlipStops),
+                             free, inverse_inertia, true);
   Vec total = Vec::Zero(), moment = Vec::Zero();
   for (std::size_t i = 0; i < points.size(); ++i) {
     total += d.forces[i];
-    moment += contactOf(s, k, points[i]).lever.cross(d.forces[i]);
+    moment += contacts[i].lever.cross(d.forces[i]);
   }
   d.acceleration = s.gravity + total / s.mass;
   d.angular_acceleration = gyroscopic + inverse_inertia * moment;
@@ -265,26 +350,23 @@ void derivative(const Setting& s, const std::vector<Point>& points, const State&
 Kinematics settle(const Setting& s, Kinematics k, const std::vector<Point>& points) {
   const Eigen::Matrix3d inverse_inertia =
       k.rotation * s.moments.cwiseInverse().asDiagonal() * k.rotation.transpose();
+  const std::vector<Contact> contacts = contactsOf(s, k, points);
   std::vector<Vec> free;
-  for (const Point& p : points) {
-    free.push_back(k.velocity + k.spin.cross(contactOf(s, k, p).lever));
-  }
-  std::vector<Point> frictionless = points;
+  for (const Contact& c : contacts) free.push_back(k.velocity + k.spin.cross(c.lever));
   Setting plain = s;
   plain.mu = 0.0;  // a sliding point's impulse is along n: it takes out a settled normal motion
-  const std::vector<Vec> impulses =
-      solveConditions(plain, k, frictionless, columnsOf(plain, k, frictionless, kLastingStillSpeed),
-                      free, inverse_inertia);
+  const std::vector<Vec> impulses = solveConditions(
+      plain, points, contacts, columnsOf(plain, k, points, contacts, kLastingStillSpeed), free,
+      inverse_inertia, false);
   Vec total = Vec::Zero(), moment = Vec::Zero();
   for (std::size_t i = 0; i < points.size(); ++i) {
     total += impulses[i];
-    moment += contactOf(s, k, points[i]).lever.cross(impulses[i]);
+    moment += contacts[i].lever.cross(impulses[i]);
   }
   k.velocity += total / s.mass;
   k.spin += inverse_inertia * moment;
   return k;
 }
-
 /// The height of a feature's lowest point above the face (a rim's: its centre's less rho |n x a|).
 double heightOf(const Setting& s, const Kinematics& k, const Feature& f) {
   const double centre = s.n.dot(k.centre + k.rotation * f.centre - s.face.point);
@@ -295,10 +377,20 @@ double heightOf(const Setting& s, const Kinematics& k, const Feature& f) {
 
 /// How far a sticking point's force is within its cone (mu N, to the solve's rounding): < 0
 /// outside. The sticking's event and the modes' choice both read it.
-double coneMargin(const Setting& s, const Vec& force) {
-  const double normal = force.dot(s.n);
-  const double across = (force - normal * s.n).norm();
+double coneMargin(const Setting& s, const Vec& n, const Vec& force) {
+  const double normal = force.dot(n);
+  const double across = (force - normal * n).norm();
   return s.mu * normal + 1e-12 * std::abs(normal) - across;
+}
+
+/// A point's normal force (along its contact's normal).
+double normalForce(const Setting& s, const Kinematics& k, const Point& p, const Vec& force) {
+  return p.line >= 0 ? force.dot(contactOf(s, k, p).normal) : force.dot(s.n);
+}
+
+/// A point's cone margin (coneMargin along its contact's normal).
+double coneMarginOf(const Setting& s, const Kinematics& k, const Point& p, const Vec& force) {
+  return coneMargin(s, p.line >= 0 ? contactOf(s, k, p).normal : s.n, force);
 }
 
 /// The direction in the face a sticking point `which` starts to slip in: where its acceleration
@@ -307,14 +399,14 @@ double coneMargin(const Setting& s, const Vec& force) {
 std::optional<Vec> slipOnset(const Setting& s, const Kinematics& k, std::vector<Point> points,
                              std::size_t which) {
   points[which].sliding = true;
+  const Contact c = contactOf(s, k, points[which]);
   const auto along = [&](double angle) {
-    points[which].direction = std::cos(angle) * s.e1 + std::sin(angle) * s.e2;
+    points[which].direction = std::cos(angle) * c.e1 + std::sin(angle) * c.e2;
     const Dynamics d = dynamicsOf(s, k, points);
-    const Contact c = contactOf(s, k, points[which]);
     const Vec a = d.acceleration + d.angular_acceleration.cross(c.lever) +
                   k.spin.cross(k.spin.cross(c.lever) + c.over);
-    const Vec in_face = a - a.dot(s.n) * s.n;
-    return std::make_pair(in_face.cross(points[which].direction).dot(s.n),
+    const Vec in_face = a - a.dot(c.normal) * c.normal;
+    return std::make_pair(in_face.cross(points[which].direction).dot(c.normal),
                           in_face.dot(points[which].direction));
   };
   constexpr int kSamples = 72;
@@ -336,7 +428,7 @@ std::optional<Vec> slipOnset(const Setting& s, const Kinematics& k, std::vector<
         }
       }
       const double root = 0.5 * (lo + hi);
-      if (along(root).second > 0) return Vec(std::cos(root) * s.e1 + std::sin(root) * s.e2);
+      if (along(root).second > 0) return Vec(std::cos(root) * c.e1 + std::sin(root) * c.e2);
     }
     previous = now;
     previous_angle = angle;
@@ -389,11 +481,11 @@ Expected<std::vector<Point>> modesAt(const Setting& s, const Kinematics& k,
     const Dynamics d = dynamicsOf(s, k, points);
     bool changed = false;
     for (std::size_t i = 0; i < points.size() && !changed; ++i) {
-      if (d.forces[i].dot(s.n) < 0) {
+      if (normalForce(s, k, points[i], d.forces[i]) < 0) {
         points.erase(points.begin() + static_cast<std::ptrdiff_t>(i));
         points = liftedCap(s, k, std::move(points));
         changed = true;
-      } else if (!points[i].sliding && coneMargin(s, d.forces[i]) < 0) {
+      } else if (!points[i].sliding && coneMarginOf(s, k, points[i], d.forces[i]) < 0) {
         const auto onset = slipOnset(s, k, points, i);
         if (!onset) return notYet("a corner starting to slip with no direction of onset");
         points[i].sliding = true;
@@ -432,22 +524,51 @@ std::vector<Feature> featuresOf(const ConvexShape& shape) {
 }
 
 /// What ends a segment of the motion: each a function of the state that reaches <= 0.
-enum class What { kCorner, kLeaves, kSlips, kSticks, kEdge, kClear };
+enum class What { kCorner, kLeaves, kSlips, kSticks, kEdge, kShift, kClear };
 struct Event {
   What what;
   std::size_t point;
   std::function<double(const Kinematics&)> value;
 };
 
-/// Each feature's height over the lowest point touching (the one stateAt puts on the face):
-/// their drift is not a feature's approach.
+/// How far a feature is off a bounded face's edges, where the body goes on over them (0
+/// otherwise): the most, over the edges, of its distance past the edge's line along its out (a
+/// rim's: of its lowest point, or of its nearest point where it lies flat). > 0: it is not over
+/// the face, and reaching the face's plane there is no contact.
+double offFace(const Setting& s, const Kinematics& k, const Feature& f) {
+  if (!s.crosses) return -std::numeric_limits<double>::infinity();
+  const Vec centre = k.centre + k.rotation * f.centre;
+  Vec lowest = centre;
+  Vec axis = Vec::Zero();
+  if (f.radius > 0) {
+    axis = k.rotation * f.axis;
+    const Vec across = axis.cross(s.n.cross(axis));
+    if (across.norm() > kRimFlat) {
+      lowest = centre - f.radius * across.normalized();
+      axis = Vec::Zero();
+    }
+  }
+  double off = -std::numeric_limits<double>::infinity();
+  for (const Setting::Line& line : s.lines) {
+    const double past = line.edge.out.dot(lowest - line.edge.point);
+    const double reach = axis.isZero() ? 0.0 : f.radius * axis.cross(line.edge.out).norm();
+    off = std::max(off, past - reach);
+  }
+  return off;
+}
+
+/// Each feature's height over the lowest point touching the face (the one stateAt puts on it):
+/// their drift is not a feature's approach; where it is off the face (offFace), how far.
 struct Above {
   const Setting& s;
   const std::vector<Point>& current;
   double operator()(const Kinematics& x, const Feature& feature) const {
-    double base = current.empty() ? 0.0 : std::numeric_limits<double>::infinity();
-    for (const Point& p : current) base = std::min(base, heightOf(s, x, s.features[p.feature]));
-    return heightOf(s, x, feature) - base;
+    double base = std::numeric_limits<double>::infinity();
+    for (const Point& p : current) {
+      if (p.line < 0) base = std::min(base, heightOf(s, x, s.features[p.feature]));
+    }
+    if (!std::isfinite(base)) base = 0.0;
+    return std::max(heightOf(s, x, feature) - base, offFace(s, x, feature));
   }
 };
 
@@ -462,11 +583,86 @@ double capTilt(const Kinematics& x, const Feature& rim, const Vec& towards) {
 /// Where a touching rim's point is, in the face (unit), at `k`; zero for a corner, an end or a
 /// flat cap's fixed point (its cap is flat while it touches).
 Vec rimTowards(const Setting& s, const Kinematics& k, const Point& p) {
+  if (p.line >= 0) return Vec::Zero();
   const Feature& f = s.features[p.feature];
   if (f.radius == 0.0 || f.axis.isZero() || p.fixed) return Vec::Zero();
   const Vec lever = contactOf(s, k, p).lever - k.rotation * f.centre;
   const Vec in_face = lever - lever.dot(s.n) * s.n;
   return in_face.norm() > 0 ? Vec(in_face.normalized()) : Vec::Zero();
+}
+
+/// How far the body is above the face: its lowest feature's height; where it goes on over the
+/// face's edges, its distance to the face (GJK against the face's rectangle).
+double clearanceOf(const Setting& s, const Kinematics& k) {
+  if (!s.crosses) {
+    double lowest = std::numeric_limits<double>::infinity();
+    for (const Feature& f : s.features) lowest = std::min(lowest, heightOf(s, k, f));
+    return lowest;
+  }
+  const ConvexShape face_shape = Cuboid{Vec(s.face.half_extent.x(), s.face.half_extent.y(), 0.0)};
+  Eigen::Matrix3d frame;
+  frame << s.face.along_u, s.face.along_v, s.n;
+  return convexDistance(PlacedConvex(s.shape, k.rotation, k.centre),
+                        PlacedConvex(face_shape, frame, s.face.point), 1e-13)
+      .lower;
+}
+
+/// m: a crossing within it of the face's edge's line touches it (the integration's drift and the
+/// events' resolution within it); m/s: one opening faster does not.
+constexpr double kCrossingBand = 1e-8;
+constexpr double kCrossingOpens = 1e-6;
+
+/// Whether a point on the face (not a crossing) is within its bounded extent (kLastingBand).
+double withinFace(const Setting& s, const Kinematics& k, const Point& p) {
+  const FlatFace& face = s.face;
+  const Vec offset = k.centre + contactOf(s, k, p).lever - face.point;
+  return std::min(face.half_extent.x() + kLastingBand - std::abs(offset.dot(face.along_u)),
+                  face.half_extent.y() + kLastingBand - std::abs(offset.dot(face.along_v)));
+}
+
+/// A point just touching, sliding where it slips (faster than kLastingStillSpeed, or the face
+/// is frictionless) and sticking otherwise; its mode kept where `current` has it.
+Point withMode(const Setting& s, const Kinematics& k, Point p, const std::vector<Point>& current) {
+  for (const Point& q : current) {
+    if (q.feature == p.feature && q.line == p.line && q.side == p.side) return q;
+  }
+  const Vec slip = slipOf(s, k, p);
+  p.sliding = s.mu == 0.0 || slip.norm() > kLastingStillSpeed;
+  p.direction = slip.norm() > kLastingStillSpeed ? Vec(slip.normalized()) : contactOf(s, k, p).e1;
+  return p;
+}
+
+/// The points touching where the body goes on over the face's edges (`crosses`): those of
+/// `current` on the face still within it, and every crossing of its edges (a box's) or rims (a
+/// cylinder's) with the face's edges' lines that touches (within kCrossingBand), is within its
+/// edge or entering it, within the line's length and not opening.
+std::vector<Point> touchingAt(const Setting& s, const Kinematics& k,
+                              const std::vector<Point>& current) {
+  std::vector<Point> points;
+  for (const Point& p : current) {
+    if (p.line < 0 && withinFace(s, k, p) > 0) points.push_back(p);
+  }
+  const std::size_t parts = s.segments.empty() ? s.features.size() : s.segments.size();
+  for (std::size_t l = 0; l < s.lines.size(); ++l) {
+    for (std::size_t f = 0; f < parts; ++f) {
+      for (const int side : s.segments.empty() ? std::vector<int>{-1, 1} : std::vector<int>{0}) {
+        Point p;
+        p.feature = f;
+        p.line = static_cast<int>(l);
+        p.side = side;
+        const auto c = crossingOf(s, k, p);
+        if (!c || std::abs(c->gap) > kCrossingBand ||
+            std::abs(c->on_line) > s.lines[l].half_length) {
+          continue;
+        }
+        if (c->inside < kCrossingBand && !(c->inside > -kCrossingBand && c->entering)) continue;
+        const Vec velocity = k.velocity + k.spin.cross(c->point - k.centre);
+        if (c->normal.dot(velocity) > kCrossingOpens) continue;
+        points.push_back(withMode(s, k, p, current));
+      }
+    }
+  }
+  return points;
 }
 
 /// The events of a step of the segment with `current` touching, from `start` (the state at the
@@ -482,9 +678,9 @@ std::vector<Event> eventsOf(const Setting& s, const std::vector<Point>& current,
   std::vector<Event> events;
   for (std::size_t c = 0; c < s.features.size(); ++c) {
     bool touching = false;
-    for (const Point& p : current) touching = touching || p.feature == c;
+    for (const Point& p : current) touching = touching || (p.line < 0 && p.feature == c);
     if (touching) continue;
-    const double level = below[c] < 0 ? below[c] - 1e-12 : 0.0;
+    const double level = below[c] <= 0 ? below[c] - 1e-12 : 0.0;
     events.push_back(
         {What::kCorner, 0, [&above, &feature = s.features[c], level](const Kinematics& x) {
            return above(x, feature) - level;
@@ -503,21 +699,18 @@ std::vector<Event> eventsOf(const Setting& s, const std::vector<Point>& current,
     // Lifted off: flying until its lowest feature is kPivotClearance of its reach above the
     // face (the certified first contact takes it from there) or one lands.
     events.push_back({What::kClear, 0, [&s, clearance](const Kinematics& x) {
-                        double lowest = std::numeric_limits<double>::infinity();
-                        for (const Feature& f : s.features) {
-                          lowest = std::min(lowest, heightOf(s, x, f));
-                        }
-                        return clearance - lowest;
+                        return clearance - clearanceOf(s, x);
                       }});
   }
   for (std::size_t i = 0; i < current.size(); ++i) {
     events.push_back({What::kLeaves, i, [&s, &current, i](const Kinematics& x) {
-                        return dynamicsOf(s, x, current).forces[i].dot(s.n);
+                        return normalForce(s, x, current[i], dynamicsOf(s, x, current).forces[i]);
                       }});
     if (!current[i].sliding) {
       // Bisected to where the margin is < 0: there the modes' choice slides it.
       events.push_back({What::kSlips, i, [&s, &current, i](const Kinematics& x) {
-                          const double margin = coneMargin(s, dynamicsOf(s, x, current).forces[i]);
+                          const double margin =
+                              coneMarginOf(s, x, current[i], dynamicsOf(s, x, current).forces[i]);
                           return margin < 0 ? margin : std::max(margin, 1e-300);
                         }});
     } else if (s.mu > 0) {
@@ -541,14 +734,28 @@ std::vector<Event> eventsOf(const Setting& s, const std::vector<Point>& current,
         std::vector<Point> held = current;
         held[i].sliding = false;
         events.push_back({What::kSticks, i, [&s, held, i](const Kinematics& x) {
-                            const double margin = coneMargin(s, dynamicsOf(s, x, held).forces[i]);
+                            const double margin =
+                                coneMarginOf(s, x, held[i], dynamicsOf(s, x, held).forces[i]);
                             return margin >= 0 ? -std::max(margin, 1e-300) : -margin;
                           }});
       }
     }
-    if (s.face.bounded) {
+    if (current[i].line >= 0) {
+      // Its crossing leaves its edge (at a corner) or the rim's chord vanishes: the points are
+      // found again there (kShift); it passes an end of the face's edge: its corner (kEdge).
+      const double level = flat[i];
+      events.push_back({What::kShift, i, [&s, &current, i, level](const Kinematics& x) {
+                          const auto c = crossingOf(s, x, current[i]);
+                          return c ? c->inside - level : -1.0;
+                        }});
+      events.push_back({What::kEdge, i, [&s, &current, i](const Kinematics& x) {
+                          const auto c = crossingOf(s, x, current[i]);
+                          const auto& line = s.lines[static_cast<std::size_t>(current[i].line)];
+                          return c ? line.half_length - std::abs(c->on_line) : 1.0;
+                        }});
+    } else if (s.face.bounded) {
       events.push_back(
-          {What::kEdge, i, [&s, &current, i](const Kinematics& x) {
+          {s.crosses ? What::kShift : What::kEdge, i, [&s, &current, i](const Kinematics& x) {
              const FlatFace& face = s.face;
              const Vec offset = x.centre + contactOf(s, x, current[i]).lever - face.point;
              return std::min(
@@ -586,6 +793,24 @@ std::optional<std::pair<double, std::size_t>> firstEvent(const std::vector<Event
   return first;
 }
 
+/// Of a rim's radius: a chord of a rim on the face's edge shorter than it (half of it) has its two
+/// ends' forces ill-conditioned: the moment they hold across the edge costs forces as 1 / its
+/// length squared, and an end leaves on rounding. Where one end of such a chord leaves, the
+/// other leaves with it: the rim passes the edge there (doc/model.md, "At an angle to the edge").
+constexpr double kShortChord = 0.05;
+
+/// Whether `other` is the other end of `leaving`'s chord (the same rim on the same edge) and that
+/// chord is short (kShortChord).
+bool shortChord(const Setting& s, const Kinematics& k, const Point& leaving, const Point& other) {
+  if (!s.segments.empty() || leaving.line < 0 || other.line != leaving.line ||
+      other.feature != leaving.feature || other.side == leaving.side) {
+    return false;
+  }
+  const auto c = crossingOf(s, k, other);
+  const double radius = s.features[other.feature].radius;
+  return c && c->inside * (2 * radius - c->inside) < kShortChord * kShortChord * radius * radius;
+}
+
 /// What a point's event (it leaves, sticks or slips) does at its instant: the points touching
 /// after it and the state there (a stop's slip taken out), or why the motion ends (`ends`), or
 /// that it rests (a face whose every corner sticks).
@@ -600,7 +825,21 @@ Change changeAt(const Setting& s, const std::vector<Point>& current, What what, 
                 Kinematics there) {
   Change change;
   std::vector<Point> next = current;
-  if (what == What::kLeaves) {
+  if (what == What::kLeaves && current[point].line >= 0) {
+    // A crossing of the face's edge leaves, and with it every other one whose normal force is
+    // 0 there to rounding (1e-9 of the weight): a chord's two ends leave together where the body
+    // is symmetric about the chord's middle, as the planar model has it.
+    const Dynamics d = dynamicsOf(s, there, current);
+    next.clear();
+    for (std::size_t i = 0; i < current.size(); ++i) {
+      const bool leaves =
+          i == point ||
+          (current[i].line >= 0 &&
+           (normalForce(s, there, current[i], d.forces[i]) <= 1e-9 * s.mass * s.gravity.norm() ||
+            shortChord(s, there, current[point], current[i])));
+      if (!leaves) next.push_back(current[i]);
+    }
+  } else if (what == What::kLeaves) {
     next.erase(next.begin() + static_cast<std::ptrdiff_t>(point));
     next = liftedCap(s, there, std::move(next));
   } else if (what == What::kSticks) {
@@ -614,6 +853,11 @@ Change changeAt(const Setting& s, const std::vector<Point>& current, What what, 
       for (Point& p : next) p.sliding = false;
     }
     there = settle(s, there, next);  // the slip's rounding left at its stop
+  } else if (what == What::kShift) {
+    // Where a crossing moves onto another edge of the body, or a point on the face passes its
+    // edge: the points touching found again, their normal motion settled.
+    next = touchingAt(s, there, current);
+    there = settle(s, there, next);
   } else {
     auto onset = slipOnset(s, there, next, point);
     if (!onset) {
@@ -631,11 +875,33 @@ Change changeAt(const Setting& s, const std::vector<Point>& current, What what, 
   change.points = std::move(settled.value());
   // A face whose every corner sticks: it rests, as the closed forms say (lastingOnFace), its last
   // slip (within the event's resolution) taken out.
+  // (A crossing of the face's edge only where the body's face is flat on the face.)
   change.rests =
-      change.points.size() >= 3 && std::none_of(change.points.begin(), change.points.end(),
-                                                [](const Point& p) { return p.sliding; });
+      change.points.size() >= 3 &&
+      std::none_of(change.points.begin(), change.points.end(), [&](const Point& p) {
+        return p.sliding || (p.line >= 0 && contactOf(s, there, p).normal.dot(s.n) < 1.0 - 1e-12);
+      });
   change.there = change.rests ? settle(s, there, change.points) : there;
   return change;
+}
+
+/// The least translation that puts each point touching (on the face, or a crossing of its edge)
+/// kPivotHair apart along its own normal: the integration's drift taken out.
+Vec hairApart(const Setting& s, const Kinematics& k, const std::vector<Point>& points) {
+  Eigen::MatrixXd rows(points.size(), 3);
+  Eigen::VectorXd gaps(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Contact c = contactOf(s, k, points[i]);
+    const auto r = static_cast<Eigen::Index>(i);
+    rows.row(r) = c.normal.transpose();
+    gaps(r) =
+        kPivotHair - (points[i].line >= 0 ? c.gap : s.n.dot(k.centre + c.lever - s.face.point));
+  }
+  // Normals that differ by rounding (a chord's two ends on one face) count as one.
+  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> solver;
+  solver.setThreshold(1e-6);
+  solver.compute(rows);
+  return solver.solve(gaps);
 }
 
 }  // namespace
@@ -691,9 +957,26 @@ PathState PivotPath::stateAt(double t) const {
   // (one that reaches it ends the motion: its events take over from a body touching, never
   // overlapping, even by the distance's tolerance against a box). Lifted off (no point
   // touching), only a feature below the hair is lifted.
-  double lowest = std::numeric_limits<double>::infinity();
-  for (const Feature& f : s.features) lowest = std::min(lowest, heightOf(s, k, f));
-  if (!points->empty() || lowest < kPivotHair) k.centre += (kPivotHair - lowest) * s.n;
+  // On the face's edge, each point touching is put a hair apart along its own normal (the
+  // least translation that does so). Features off the face (past its edges) are not on it.
+  const bool crossing =
+      std::any_of(points->begin(), points->end(), [](const Point& p) { return p.line >= 0; });
+  if (crossing) {
+    k.centre += hairApart(s, k, *points);
+    // ... and no feature over the face below the hair (the crossings' normals turned with the
+    // body: their shift may lower a corner on the face's side).
+    double lowest = std::numeric_limits<double>::infinity();
+    for (const Feature& f : s.features) {
+      if (offFace(s, k, f) < 0) lowest = std::min(lowest, heightOf(s, k, f));
+    }
+    if (lowest < kPivotHair) k.centre += (kPivotHair - lowest) * s.n;
+  } else {
+    double lowest = std::numeric_limits<double>::infinity();
+    for (const Feature& f : s.features) {
+      if (offFace(s, k, f) < 0) lowest = std::min(lowest, heightOf(s, k, f));
+    }
+    if (!points->empty() || lowest < kPivotHair) k.centre += (kPivotHair - lowest) * s.n;
+  }
   PathState state;
   state.centre = k.centre;
   state.velocity = k.velocity;
@@ -705,10 +988,18 @@ PathState PivotPath::stateAt(double t) const {
     const Point& p = (*points)[i];
     sliding = sliding || p.sliding;
     SupportForce force;
-    const Vec at = k.centre + contactOf(s, k, p).lever;
-    force.point = at - s.n.dot(at - s.face.point) * s.n;
-    force.normal_force = d.forces[i].dot(s.n);
-    force.friction_force = d.forces[i] - force.normal_force * s.n;
+    const Contact c = contactOf(s, k, p);
+    if (p.line >= 0) {
+      force.point = c.on;
+      force.normal = c.normal;
+      force.normal_force = d.forces[i].dot(c.normal);
+      force.friction_force = d.forces[i] - force.normal_force * c.normal;
+    } else {
+      const Vec at = k.centre + c.lever;
+      force.point = at - s.n.dot(at - s.face.point) * s.n;
+      force.normal_force = d.forces[i].dot(s.n);
+      force.friction_force = d.forces[i] - force.normal_force * s.n;
+    }
     state.forces.push_back(force);
   }
   state.state = sliding ? ContactState::kSliding : ContactState::kRolling;
@@ -717,23 +1008,25 @@ PathState PivotPath::stateAt(double t) const {
 
 namespace {
 
-/// The motion's start: the body's state as `k`, `touching` touching, each sliding where it slips
-/// (faster than kLastingStillSpeed, or the face is frictionless) and sticking with its slip
-/// taken out otherwise (settle), then the modes the forces there allow (modesAt).
-Expected<std::vector<Point>> startOf(const Setting& s, const LastingBody& body,
-                                     std::vector<Point> touching, Kinematics& k) {
+/// The body's state as the integration holds it.
+Kinematics kinematicsOf(const LastingBody& body) {
+  Kinematics k;
   k.orientation = body.orientation.normalized();
   k.rotation = k.orientation.toRotationMatrix();
   k.centre = body.centre;
   k.velocity = body.velocity;
   k.spin = body.angular_velocity;
+  return k;
+}
+
+/// The motion's start: the body's state as `k`, `touching` touching, each sliding where it slips
+/// (faster than kLastingStillSpeed, or the face is frictionless) and sticking with its slip
+/// taken out otherwise (settle), then the modes the forces there allow (modesAt).
+Expected<std::vector<Point>> startOf(const Setting& s, const LastingBody& body,
+                                     std::vector<Point> touching, Kinematics& k) {
+  k = kinematicsOf(body);
   std::vector<Point> points;
-  for (Point p : touching) {
-    const Vec slip = slipOf(s, k, p);
-    p.sliding = s.mu == 0.0 || slip.norm() > kLastingStillSpeed;
-    p.direction = slip.norm() > kLastingStillSpeed ? Vec(slip.normalized()) : s.e1;
-    points.push_back(p);
-  }
+  for (const Point& p : touching) points.push_back(withMode(s, k, p, {}));
   k = settle(s, k, points);
   return modesAt(s, k, points);
 }
@@ -765,6 +1058,14 @@ Expected<SegmentEnd> integrateSegment(const Setting& s, PivotPath::Steps& path, 
   for (const Feature& f : s.features) below.push_back(std::min(0.0, above(initial, f)));
   std::vector<double> flat;
   for (const Point& p : current) {
+    if (p.line >= 0) {
+      // A crossing's: how far within its edge, where it leaves it (1e-12 m beyond where it began,
+      // if at or past an end: one just entering).
+      const auto c = crossingOf(s, initial, p);
+      const double inside = c ? c->inside : 0.0;
+      flat.push_back(inside <= 1e-12 ? inside - 1e-12 : 0.0);
+      continue;
+    }
     const Vec towards = rimTowards(s, initial, p);
     const double tilt = towards.isZero() ? 0.0 : capTilt(initial, s.features[p.feature], towards);
     flat.push_back(tilt <= 1e-12 ? tilt - 1e-12 : 0.0);
@@ -811,6 +1112,23 @@ std::unique_ptr<PivotPath::Steps> pathFor(const LastingBody& body, const FlatFac
   s.e2 = s.n.cross(s.e1);
   s.mu = face.friction;
   s.features = featuresOf(body.shape);
+  s.shape = body.shape;
+  // A box or a cylinder goes on over a bounded face's edges (its edges or rims crossing them).
+  s.crosses = face.bounded && (std::holds_alternative<Cuboid>(body.shape) ||
+                               std::holds_alternative<Cylinder>(body.shape));
+  if (s.crosses) {
+    for (const BoundEdge& bound : edgesOf(face)) {
+      s.lines.push_back(
+          {bound.edge.point, bound.edge.along, bound.edge.out, face.half_extent[1 - bound.axis]});
+    }
+  }
+  if (s.crosses && std::holds_alternative<Cuboid>(body.shape)) {
+    for (std::size_t c = 0; c < 8; ++c) {
+      for (std::size_t bit = 1; bit < 8; bit <<= 1) {
+        if ((c & bit) == 0) s.segments.push_back({c, c | bit});
+      }
+    }
+  }
   return path;
 }
 
@@ -840,6 +1158,8 @@ Expected<LastingMotion> pivotFrom(const LastingBody& body, std::unique_ptr<Pivot
   State y = pack(k);
   std::size_t mode = 0;
   std::string ends = "stops";
+  double last_change = -std::numeric_limits<double>::infinity();
+  int changes_at_once = 0;
   double until = end;
   std::size_t taken = 0;
   for (;;) {
@@ -853,10 +1173,22 @@ Expected<LastingMotion> pivotFrom(const LastingBody& body, std::unique_ptr<Pivot
       break;
     }
     if (what == What::kEdge) {
-      ends = "a point of its support reaches the face's edge";
+      ends = path->modes[mode][segment->point].line >= 0
+                 ? "a point of its support reaches the face's corner"
+                 : "a point of its support reaches the face's edge";
       break;
     }
-    if (until <= path->start && what != What::kSticks) {
+    if (what == What::kShift) {
+      changes_at_once = until == last_change ? changes_at_once + 1 : 0;
+      last_change = until;
+      if (changes_at_once > 8) {
+        return notYet("the points on the face's edge change at once, again and again");
+      }
+    }
+    // (A point leaving at once is one whose force is 0 there: the centre of pressure on the
+    // face's edge; the points only grow fewer.)
+    if (until <= path->start && what != What::kSticks && what != What::kShift &&
+        what != What::kLeaves) {
       return notYet("the tipping's contact changes at once where it starts");
     }
     Change change = changeAt(s, path->modes[mode], what, segment->point, *segment->there);
@@ -920,6 +1252,46 @@ Expected<LastingMotion> spinOnCap(const LastingBody& body, const FlatFace& face,
     p.lean = lean;
     p.fixed = true;
     touching.push_back(p);
+  }
+  return pivotFrom(body, std::move(path), touching, tolerance, horizon);
+}
+
+Expected<LastingMotion> pivotOverFaceEdge(const LastingBody& body, const FlatFace& face,
+                                          double tolerance, double horizon) {
+  if (!face.bounded) return Error{"face", "must be bounded (a box obstacle's face)"};
+  if (!std::holds_alternative<Cuboid>(body.shape) &&
+      !std::holds_alternative<Cylinder>(body.shape)) {
+    return notYet("turning over the face's edge at an angle to it: a hull or a capsule");
+  }
+  auto path = pathFor(body, face);
+  const Setting& s = path->setting;
+  const Kinematics k = kinematicsOf(body);
+  // Its corners, or its rims' lowest points, on the face within the touching band (a rim lying
+  // flat: its point farthest from the edge it crosses), then its crossings of the face's edges.
+  std::vector<Point> on_face;
+  for (std::size_t f = 0; f < s.features.size(); ++f) {
+    const Feature& feature = s.features[f];
+    if (heightOf(s, k, feature) > kLastingBand) continue;
+    Point p;
+    p.feature = f;
+    if (feature.radius > 0) {
+      const FaceEdge* crossed = &s.lines.front().edge;
+      for (const Setting::Line& line : s.lines) {
+        const Vec centre = k.centre + k.rotation * feature.centre;
+        if (line.edge.out.dot(centre - line.edge.point) >
+            crossed->out.dot(centre - crossed->point)) {
+          crossed = &line.edge;
+        }
+      }
+      const Vec away = k.rotation.transpose() * (-crossed->out);
+      p.lean = Vec(away.x(), away.y(), 0.0).normalized();
+    }
+    if (withinFace(s, k, p) > 0) on_face.push_back(p);
+  }
+  const std::vector<Point> touching = touchingAt(s, k, on_face);
+  if (touching.empty()) {
+    return Error{"body.centre", "does not touch the face or its edges (within " +
+                                    formatNumber(kCrossingBand) + " m)"};
   }
   return pivotFrom(body, std::move(path), touching, tolerance, horizon);
 }

@@ -70,6 +70,17 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
                                     const std::vector<Eigen::Vector3d>& corners, double tolerance,
                                     double horizon = 10.0);
 
+/// A box or a cylinder on a bounded face's edge at any angle to it (issue 42, step 6;
+/// doc/model.md, "At an angle to the edge"): its corners and its rims' lowest points on the face,
+/// and its edges' or rims' crossings of the face's edges' lines (edge_crossing.h), each sticking,
+/// sliding or leaving by pivotOnFace's law; a crossing that moves onto another edge of the body,
+/// or a corner that passes the face's edge, changes the points touching there. It ends as
+/// pivotOnFace's ("resumes" where it is clear of the face or another feature reaches it), or
+/// where a crossing passes an end of the face's edge (its corner: not modelled yet). Refused by
+/// name: a hull or a capsule.
+Expected<LastingMotion> pivotOverFaceEdge(const LastingBody& body, const FlatFace& face,
+                                          double tolerance, double horizon = 10.0);
+
 /// A cylinder leaning on a point of its rim, or a capsule on a point of one end, tipping, rolling
 /// or sliding on `face` as pivotOnFace's corners do (the same law, events and ends), where the
 /// point touching moves over the body: a rim's lowest point, an end's point under its centre.
