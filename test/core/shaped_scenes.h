@@ -45,6 +45,15 @@ inline Scene floorScene(double e, const Eigen::Vector3d& half, double mass = 2.0
   return scene;
 }
 
+/// floorScene with a table: a box obstacle 1 m square and 0.5 m tall on the floor, its top at
+/// z = 0.5 and its edges at x, y = +-0.5.
+inline Scene tableScene(double e, const Eigen::Vector3d& half, double mass = 2.0) {
+  Scene scene = floorScene(e, half, mass);
+  scene.obstacles.push_back(scene_builders::box("table", Eigen::Vector3d(0, 0, 0.25),
+                                                Eigen::Vector3d(1.0, 1.0, 0.5), "concrete"));
+  return scene;
+}
+
 /// A solid cylinder (r = 0.05 m, 0.2 m long, 1 kg) over the frictionless floor of floorScene,
 /// given at rest leaning on its rim: its axis turned by `tilt` about x, its rim's lowest point
 /// on the floor. Its centre falls straight down (no force along the floor), at the height
@@ -83,9 +92,16 @@ struct RimFall {
 
 /// A cube (0.1 m, 1 kg) at rest on an incline of tan theta = 3/4 (its normal (0, -3/5, 4/5),
 /// through the origin; no other obstacle), mu 0.9 >= 3/4, given sliding across the slope at
-/// 1 m/s: its slide's direction turns towards the slope's (no closed form), which the model does
-/// not carry yet (`not yet: sliding across the slope`): the example of a lasting contact held
-/// and reported.
+/// 1 m/s. It does not turn (each corner's friction mu N_i is against the one slip, and the
+/// centre of pressure is h mu along it: no moment about the normal), and its slide's direction
+/// turns down the slope: with G = g sin theta, F = mu g cos theta, k = F / G = 1.2 and phi the
+/// angle of its velocity from straight down the slope, v' = G cos phi - F and v phi' = -G sin phi,
+/// so v = v0 (sin phi0 / sin phi) (tan(phi / 2) / tan(phi0 / 2))^k (phi0 = pi / 2 here), the
+/// instant t(phi) = the integral from phi to phi0 of v / (G sin psi) dpsi and the centre's path
+/// the integral of v^2 (cos psi down + sin psi across) / (G sin psi) dpsi, its state at t that at
+/// phi(t) (t(phi) inverted); it stops at t(0) (k > 1:
+/// the integrand ~ psi^(k - 2), integrable), at rest there (mu >= tan theta). The integrals by
+/// 5-point Gauss-Legendre over 400 panels of u = psi^(1/5) (smooth at psi = 0).
 struct AcrossSlope {
   Scene scene() const {
     Scene made = floorScene(0.5, Eigen::Vector3d(0.05, 0.05, 0.05), 1.0);
@@ -102,8 +118,46 @@ struct AcrossSlope {
     made.time = time;
     made.position = 0.05 * normal();
     made.orientation = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), normal());
-    made.velocity = Eigen::Vector3d(1, 0, 0);
+    made.velocity = across();
     return made;
+  }
+  static Eigen::Vector3d down() { return Eigen::Vector3d(0, -0.8, -0.6); }
+  static Eigen::Vector3d across() { return Eigen::Vector3d(1, 0, 0); }
+  static double slope() { return kG * 0.6; }
+  static double k() { return 0.9 * 0.8 / 0.6; }
+  /// m/s: its speed where its velocity is phi from straight down.
+  static double speed(double phi) { return std::pow(std::tan(phi / 2), k()) / std::sin(phi); }
+  /// s: when it is there.
+  static double instant(double phi) {
+    return integral(phi, [](double psi) { return speed(psi) / (slope() * std::sin(psi)); });
+  }
+  /// rad: where it is at `t` (in [0, instant(0)]): t(phi) = t by bisection (t decreases with phi).
+  static double angleAt(double t) {
+    double lo = 0.0, hi = M_PI / 2;
+    for (int i = 0; i < 60; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (instant(mid) > t ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+  }
+  /// m: its centre then, from where it started.
+  static Eigen::Vector3d moved(double phi) {
+    const auto along = [](const Eigen::Vector3d& axis) {
+      return [axis](double psi) {
+        const double v = speed(psi);
+        return v * v * (std::cos(psi) * down() + std::sin(psi) * across()).dot(axis) /
+               (slope() * std::sin(psi));
+      };
+    };
+    return integral(phi, along(down())) * down() + integral(phi, along(across())) * across();
+  }
+
+ private:
+  template <class F>
+  static double integral(double phi, const F& f) {
+    return quadrature::gaussLegendre(
+        [&](double u) { return f(std::pow(u, 5)) * 5 * std::pow(u, 4); }, std::pow(phi, 0.2),
+        std::pow(M_PI / 2, 0.2), 400);
   }
 };
 

@@ -25,6 +25,7 @@ using lasting_bodies::V;
 using shaped_scenes::floorScene;
 using shaped_scenes::impactsOf;
 using shaped_scenes::kG;
+using shaped_scenes::tableScene;
 
 /// The table top of the lasting tests: z = 0.7, x in [-1, 1] (its edge at x = 1), y in
 /// [-0.5, 0.5].
@@ -140,9 +141,7 @@ void expectObliqueAsSquare(const Scene& scene, double height, double inertia, do
 TEST(ShapedEdgeOblique, AFrictionlessCubeSlidingOffAtAnAngleMovesAsSquareToItAndAlongIt) {
   const V half(0.0625, 0.0625, 0.0625);
   const double m = 2.0;
-  Scene scene = floorScene(0.5, half, m);
-  scene.obstacles.push_back(
-      scene_builders::box("table", V(0, 0, 0.25), V(1.0, 1.0, 0.5), "concrete"));
+  Scene scene = tableScene(0.5, half, m);
   expectObliqueAsSquare(scene, half.z(), m * 4 * half.x() * half.x() / 6, 1e-9, 1e-8);
 }
 
@@ -156,13 +155,11 @@ TEST(ShapedEdgeOblique, AFrictionlessCubeSlidingOffAtAnAngleMovesAsSquareToItAnd
 // 5e-7 rad/s of the planar model's (1e-8 m and 3e-7 rad by the floor).
 TEST(ShapedEdgeOblique, AFrictionlessCanSlidingOffAtAnAngleMovesAsSquareToItAndAlongIt) {
   const double r = 0.05, length = 0.15, m = 0.4;
-  Scene scene = floorScene(0.5, V(0.05, 0.05, 0.05), m);
+  Scene scene = tableScene(0.5, V(0.05, 0.05, 0.05), m);
   scene.bodies[0].shape = BodyShape::kCylinder;
   scene.bodies[0].size = V::Zero();
   scene.bodies[0].radius = r;
   scene.bodies[0].length = length;
-  scene.obstacles.push_back(
-      scene_builders::box("table", V(0, 0, 0.25), V(1.0, 1.0, 0.5), "concrete"));
   expectObliqueAsSquare(scene, length / 2, m * (3 * r * r + length * length) / 12, 1e-8, 3e-7);
 }
 

@@ -39,6 +39,7 @@ using shaped_scenes::floorScene;
 using shaped_scenes::impactsOf;
 using shaped_scenes::kG;
 using shaped_scenes::RimFall;
+using shaped_scenes::tableScene;
 
 /// The body dropped from rest with its centre at `height`, turned by `turn`, as a state at `t`
 /// on its parabola (before it lands).
@@ -467,30 +468,72 @@ TEST(ShapedMonitor, ATippingsHandOversAreBoundedAsResumeGuardSays) {
   EXPECT_FALSE(guard.refuse(1.0 + 2e-3));  // a new window
 }
 
-// A cube sliding across an incline (its slide's direction turns: no closed form), which the
-// model does not carry yet: the monitor holds it where it is (never into the incline) and reports
-// the contact once, with lastingOnFace's words, though states of it keep coming. (A can leaning
-// on its rim, then one spinning on its cap, were the example here until each was modelled.)
-TEST(ShapedMonitor, ACubeSlidingAcrossAnInclineIsHeldAndReportedOnce) {
+// A cube slid across an incline (AcrossSlope): before, held where it was and reported, "not yet:
+// sliding across the slope". Now its corners slide on the incline (pivotOnFace) and it moves as
+// the closed form says: at each step t, its velocity v(phi(t)) along phi(t) from straight down
+// (1e-8 m/s) and its centre where the path's integral puts it (1e-8 m), never turning (1e-9
+// rad/s); it stops at t(0) = 0.46335 s and rests there (mu >= tan theta), nothing unmodelled.
+TEST(ShapedMonitor, ACubeSlidingAcrossAnInclineTurnsDownItAndStopsAsTheClosedFormSays) {
   const AcrossSlope slope;
   ImpactMonitor monitor(slope.scene(), MonitorSettings{});
   const std::size_t block = *monitor.bodyIndex("block");
+  const BodyStateSample start = slope.state(block, 0.0);
+  const double stops = AcrossSlope::instant(0.0);
+  std::size_t moving = 0;
+  for (int k = 0; k <= 60; ++k) {
+    const double t = 0.01 * k;
+    const StepReport report = k == 0 ? monitor.step(t, {start}) : monitor.step(t, {});
+    for (const UnmodelledContact& c : report.unmodelled) ADD_FAILURE() << c.what;
+    const auto at = monitor.predictedState(block, t);
+    ASSERT_TRUE(at);
+    EXPECT_LT(monitor.predictedAngularVelocity(block, t).norm(), 1e-9) << t;
+    const V& v = at->second;
+    if (t >= stops) {
+      EXPECT_EQ(v, V::Zero()) << t;
+      EXPECT_LT((at->first - start.position - AcrossSlope::moved(0.0)).norm(), 1e-8) << t;
+      continue;
+    }
+    EXPECT_NEAR(v.dot(AcrossSlope::normal()), 0.0, 1e-12) << t;
+    const double phi = AcrossSlope::angleAt(t);
+    const V closed = AcrossSlope::speed(phi) *
+                     (std::cos(phi) * AcrossSlope::down() + std::sin(phi) * AcrossSlope::across());
+    EXPECT_LT((v - closed).norm(), 1e-8) << t;
+    EXPECT_LT((at->first - start.position - AcrossSlope::moved(phi)).norm(), 1e-8) << t;
+    ++moving;
+  }
+  EXPECT_GT(moving, 40u);
+  EXPECT_NEAR(stops, 0.46335, 1e-5);
+}
+
+// A box sliding across a table's top towards its corner, along the diagonal: where its support
+// reaches the table's two edges at once (its corner) it is not modelled yet: held there and
+// reported once, with lastingOnFace's words, its state held still from then on. (A cube sliding
+// across an incline was the example here until it was modelled, and before it a can leaning on
+// its rim, then one spinning on its cap.)
+TEST(ShapedMonitor, ABoxSlidingOntoATablesCornerIsHeldAndReportedOnce) {
+  Scene scene = tableScene(0.5, V(0.05, 0.05, 0.05), 1.0);
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  const std::size_t block = *monitor.bodyIndex("block");
+  BodyStateSample state;
+  state.body = block;
+  state.position = V(0.3, 0.3, 0.55);
+  state.velocity = V(0.5, 0.5, 0);
   std::vector<UnmodelledContact> unmodelled;
-  for (int k = 0; k <= 5; ++k) {
-    const StepReport report = monitor.step(0.01 * k, {slope.state(block, 0.01 * k)});
+  for (int k = 0; k <= 60; ++k) {
+    const StepReport report = k == 0 ? monitor.step(0.0, {state}) : monitor.step(0.01 * k, {});
     unmodelled.insert(unmodelled.end(), report.unmodelled.begin(), report.unmodelled.end());
   }
   ASSERT_EQ(unmodelled.size(), 1u);
   EXPECT_EQ(unmodelled[0].body, block);
   EXPECT_TRUE(unmodelled[0].other_is_obstacle);
-  EXPECT_EQ(monitor.obstacle(unmodelled[0].other).id, "incline");
-  EXPECT_EQ(unmodelled[0].time, 0.0);
-  EXPECT_NE(unmodelled[0].what.find("not yet: sliding across the slope"), std::string::npos)
-      << unmodelled[0].what;
-  const auto predicted = monitor.predictedState(block, 0.06);
-  ASSERT_TRUE(predicted);
-  EXPECT_EQ(predicted->first, slope.state(block, 0.06).position);
-  EXPECT_EQ(predicted->second, V::Zero());
+  EXPECT_EQ(monitor.obstacle(unmodelled[0].other).id, "table");
+  // Its corner (0.35, 0.35) reaches the edges at x = y = 0.5 after 0.15 / 0.5 s.
+  EXPECT_NEAR(unmodelled[0].time, 0.3, 1e-12);
+  EXPECT_NE(unmodelled[0].what.find("the face's edge"), std::string::npos) << unmodelled[0].what;
+  const auto held = monitor.predictedState(block, 0.6);
+  ASSERT_TRUE(held);
+  EXPECT_LT((held->first - V(0.45, 0.45, 0.55)).norm(), 1e-12);
+  EXPECT_EQ(held->second, V::Zero());
 }
 
 // A can given once at rest leaning on its rim (tilted 0.3 rad) on the frictionless floor tips
@@ -648,9 +691,7 @@ TEST(ShapedMonitor, ABoxSetFlushOnATablesTopRestsThereAndOneSetInsideIsNamed) {
 TEST(ShapedMonitor, ABoxSlidingOffATablesEdgeTipsOverItAndFallsToTheFloor) {
   const V half(0.0625, 0.0625, 0.0625);
   const double m = 2.0, v = 0.5;
-  Scene scene = floorScene(0.5, half, m);
-  scene.obstacles.push_back(
-      scene_builders::box("table", V(0, 0, 0.25), V(1.0, 1.0, 0.5), "concrete"));
+  Scene scene = tableScene(0.5, half, m);
   ImpactMonitor monitor(scene, MonitorSettings{});
   const std::size_t block = *monitor.bodyIndex("block");
   BodyStateSample state;
@@ -714,13 +755,11 @@ TEST(ShapedMonitor, ABoxSlidingOffATablesEdgeTipsOverItAndFallsToTheFloor) {
 // table, nothing unmodelled.
 TEST(ShapedMonitor, ACanRollingOnItsSideOffATablesEdgeLandsOnTheFloorAtTheClosedFormsInstant) {
   const double r = 0.05, half_length = 0.1, m = 0.5, v = 0.5, top = 0.5;
-  Scene scene = floorScene(0.5, V(0.05, 0.05, 0.05), m);
+  Scene scene = tableScene(0.5, V(0.05, 0.05, 0.05), m);
   scene.bodies[0].shape = BodyShape::kCylinder;
   scene.bodies[0].size = V::Zero();
   scene.bodies[0].radius = r;
   scene.bodies[0].length = 2 * half_length;
-  scene.obstacles.push_back(
-      scene_builders::box("table", V(0, 0, 0.25), V(1.0, 1.0, 0.5), "concrete"));
   MonitorSettings settings;
   settings.body_timeout = INFINITY;
   ImpactMonitor monitor(scene, settings);
@@ -772,9 +811,7 @@ TEST(ShapedMonitor, ACanRollingOnItsSideOffATablesEdgeLandsOnTheFloorAtTheClosed
 // and the flight crawled back to the edge in steps of 1e-11 s (0.4 s of CPU an update).
 TEST(ShapedMonitor, AStateHalfwayOverATablesEdgeGoesOnTurningOverIt) {
   const V half(0.0625, 0.0625, 0.0625);
-  Scene scene = floorScene(0.5, half, 2.0);
-  scene.obstacles.push_back(
-      scene_builders::box("table", V(0, 0, 0.25), V(1.0, 1.0, 0.5), "concrete"));
+  Scene scene = tableScene(0.5, half, 2.0);
   ImpactMonitor slid(scene, MonitorSettings{}), given(scene, MonitorSettings{});
   BodyStateSample state;
   state.body = 0;

@@ -1172,12 +1172,17 @@ Expected<LastingMotion> plannedOnFace(const LastingBody& body, const FlatFace& f
   Expected<Plan> planned = support.kind == SupportKind::kLine
                                ? rollPlan(body, support, setting, mu, in_face, roll)
                                : translationPlan(in_face, setting.g_t, setting.g_n, mu);
-  if (!planned && support.kind == SupportKind::kLine &&
-      std::abs(in_face.dot(support.axis)) > kLastingStillSpeed) {
-    // A side rolling while it slides along its axis: its contact line's slip turns (its parts
-    // along and across the axis slow at different rates), which no closed form here carries:
-    // its two ends' rim points, each sticking or sliding (pivotOnRound).
-    return pivotOnSupport(body, face, support, rotation, Vec::Zero(), tolerance);
+  if (!planned && !overhang) {
+    // A slide whose direction turns (across a slope), or a side rolling while it slides along
+    // its axis (its contact line's slip turns: its parts along and across the axis slow at
+    // different rates, gravity along the axis too): no closed form here carries them; its
+    // corners, its cap's four rim points or its side's two ends, each sticking or sliding, do
+    // (pivotOnFace, spinOnCap, pivotOnRound).
+    if (support.kind == SupportKind::kLine ||
+        (support.kind == SupportKind::kPolygon && !support.corners.empty())) {
+      return pivotOnSupport(body, face, support, rotation, Vec::Zero(), tolerance);
+    }
+    if (support.kind == SupportKind::kDisc) return spinOnCap(body, face, support.end, tolerance);
   }
   if (!planned) return planned.error();
   const Plan& plan = planned.value();

@@ -851,6 +851,20 @@ Change changeAt(const Setting& s, const std::vector<Point>& current, What what, 
     for (const Point& p : next) fastest = std::max(fastest, slipOf(s, there, p).norm());
     if (next.size() >= 3 && fastest <= 100 * kSlipStops) {
       for (Point& p : next) p.sliding = false;
+      // Stopped together on the face: where its friction can hold the body there (|g_t| <=
+      // mu g_n, the closed forms' rule) it rests, whichever of the statically indeterminate
+      // distributions holds it (the least-norm one may put a corner past its cone, which
+      // would slip again, stop again, for ever: stick and slip chattering at nanoseconds).
+      const double g_n = -s.gravity.dot(s.n);
+      const Vec g_t = s.gravity + g_n * s.n;
+      const bool on_face =
+          std::none_of(next.begin(), next.end(), [](const Point& p) { return p.line >= 0; });
+      if (on_face && g_n > 0 && g_t.norm() <= s.mu * g_n) {
+        change.points = next;
+        change.rests = true;
+        change.there = settle(s, there, next);
+        return change;
+      }
     }
     there = settle(s, there, next);  // the slip's rounding left at its stop
   } else if (what == What::kShift) {
