@@ -15,6 +15,7 @@
 #include "collision_response/core/monitor.h"
 #include "collision_response/core/prediction.h"
 #include "collision_response/core/scene.h"
+#include "geometry/air_flight.h"
 #include "quadrature.h"
 #include "scene_builders.h"
 #include "shaped_scenes.h"
@@ -271,6 +272,17 @@ TEST(ShapedAir, ATumblingBoxFliesByTheMagnusForceOfItsOwnTurning) {
 
 // A shaped body's air is checked at its keys as a ball's, its area named: a C_d of 1e300 on a box
 // is refused at bodies[0]/drag_coefficient, the message giving the mean cross-section.
+// A flight given its spin as a function of time (a tumbling body's torque-free rotation) answers
+// that spin at each instant, not its first: before, angularVelocity returned w(start) for ever.
+TEST(ShapedAir, AFlightGivenItsSpinAsAFunctionAnswersItAtEachInstant) {
+  const auto spin = [](double t) { return V(std::cos(3 * t), std::sin(3 * t), 0.5); };
+  const AirFactors air{0.01, 0.002};
+  const AirFlight flight(0.0, V::Zero(), V(1, 0, 0), spin, V(0, 0, -kG), air, 1e-9);
+  for (const double t : {0.0, 0.1, 0.7}) EXPECT_EQ(flight.angularVelocity(0, t), spin(t)) << t;
+  const AirFlight steady(0.0, V::Zero(), V(1, 0, 0), V(0, 0, 2), V(0, 0, -kG), air, 1e-9);
+  EXPECT_EQ(steady.angularVelocity(0, 0.7), V(0, 0, 2));
+}
+
 TEST(ShapedAir, AirTooStiffForAShapedBodyIsRefusedAtItsKey) {
   Scene scene = airyScene(0.5, 0.1, true, true, false, 1e300);
   const Status refused = validateScene(scene, "s");

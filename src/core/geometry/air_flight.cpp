@@ -118,6 +118,10 @@ AirFlight::AirFlight(double start, const Eigen::Vector3d& position, const Eigen:
 
 AirFlight::~AirFlight() = default;
 
+Eigen::Vector3d AirFlight::angularVelocity(std::size_t, double time) const {
+  return integration_->spin_at ? integration_->spin_at(time) : spin_;
+}
+
 const Vector6& AirFlight::stateAt(double time) const {
   Integration& integration = *integration_;
   if (!(time > start_)) return integration.initial;

@@ -61,7 +61,8 @@ class AirFlight final : public IntegratedMotion {
 
   Eigen::Vector3d position(std::size_t slot, double time) const override;
   Eigen::Vector3d velocity(std::size_t slot, double time) const override;
-  Eigen::Vector3d angularVelocity(std::size_t, double) const override { return spin_; }
+  /// Its spin at `time`: constant, or the torque-free rotation's `spin_at(time)`.
+  Eigen::Vector3d angularVelocity(std::size_t, double time) const override;
   double end() const override;
   /// Drag and Magnus grow with the speed squared; the speed is bounded by its start and the
   /// terminal speed sqrt(|g| / drag) (drag never lets it grow past both; Magnus does no work), or
