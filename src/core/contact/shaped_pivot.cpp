@@ -214,6 +214,7 @@ struct Dynamics {
   Vec acceleration = Vec::Zero();
   Vec angular_acceleration = Vec::Zero();
   std::vector<Vec> forces;
+  std::vector<Vec> normals;  // each point's contact normal (the face's, or its crossing's)
 };
 
 /// The unknowns' directions of the points (a sticking point's normal and two tangents; a sliding
@@ -311,6 +312,7 @@ Dynamics dynamicsOf(const Setting& s, const Kinematics& k, const std::vector<Poi
                    k.spin.cross(k.spin.cross(c.lever) + c.over));
   }
   Dynamics d;
+  for (const Contact& c : contacts) d.normals.push_back(c.normal);
   d.forces = solveConditions(s, points, contacts, columnsOf(s, k, points, contacts, kSlipStops),
                              free, inverse_inertia, true);
   Vec total = Vec::Zero(), moment = Vec::Zero();
@@ -383,14 +385,10 @@ double coneMargin(const Setting& s, const Vec& n, const Vec& force) {
   return s.mu * normal + 1e-12 * std::abs(normal) - across;
 }
 
-/// A point's normal force (along its contact's normal).
-double normalForce(const Setting& s, const Kinematics& k, const Point& p, const Vec& force) {
-  return p.line >= 0 ? force.dot(contactOf(s, k, p).normal) : force.dot(s.n);
-}
-
-/// A point's cone margin (coneMargin along its contact's normal).
-double coneMarginOf(const Setting& s, const Kinematics& k, const Point& p, const Vec& force) {
-  return coneMargin(s, p.line >= 0 ? contactOf(s, k, p).normal : s.n, force);
+/// Point i's normal force (along its contact's normal) and how far its force is within its cone.
+double normalForce(const Dynamics& d, std::size_t i) { return d.forces[i].dot(d.normals[i]); }
+double coneMarginOf(const Setting& s, const Dynamics& d, std::size_t i) {
+  return coneMargin(s, d.normals[i], d.forces[i]);
 }
 
 /// The direction in the face a sticking point `which` starts to slip in: where its acceleration
@@ -481,11 +479,11 @@ Expected<std::vector<Point>> modesAt(const Setting& s, const Kinematics& k,
     const Dynamics d = dynamicsOf(s, k, points);
     bool changed = false;
     for (std::size_t i = 0; i < points.size() && !changed; ++i) {
-      if (normalForce(s, k, points[i], d.forces[i]) < 0) {
+      if (normalForce(d, i) < 0) {
         points.erase(points.begin() + static_cast<std::ptrdiff_t>(i));
         points = liftedCap(s, k, std::move(points));
         changed = true;
-      } else if (!points[i].sliding && coneMarginOf(s, k, points[i], d.forces[i]) < 0) {
+      } else if (!points[i].sliding && coneMarginOf(s, d, i) < 0) {
         const auto onset = slipOnset(s, k, points, i);
         if (!onset) return notYet("a corner starting to slip with no direction of onset");
         points[i].sliding = true;
@@ -704,13 +702,12 @@ std::vector<Event> eventsOf(const Setting& s, const std::vector<Point>& current,
   }
   for (std::size_t i = 0; i < current.size(); ++i) {
     events.push_back({What::kLeaves, i, [&s, &current, i](const Kinematics& x) {
-                        return normalForce(s, x, current[i], dynamicsOf(s, x, current).forces[i]);
+                        return normalForce(dynamicsOf(s, x, current), i);
                       }});
     if (!current[i].sliding) {
       // Bisected to where the margin is < 0: there the modes' choice slides it.
       events.push_back({What::kSlips, i, [&s, &current, i](const Kinematics& x) {
-                          const double margin =
-                              coneMarginOf(s, x, current[i], dynamicsOf(s, x, current).forces[i]);
+                          const double margin = coneMarginOf(s, dynamicsOf(s, x, current), i);
                           return margin < 0 ? margin : std::max(margin, 1e-300);
                         }});
     } else if (s.mu > 0) {
@@ -734,8 +731,7 @@ std::vector<Event> eventsOf(const Setting& s, const std::vector<Point>& current,
         std::vector<Point> held = current;
         held[i].sliding = false;
         events.push_back({What::kSticks, i, [&s, held, i](const Kinematics& x) {
-                            const double margin =
-                                coneMarginOf(s, x, held[i], dynamicsOf(s, x, held).forces[i]);
+                            const double margin = coneMarginOf(s, dynamicsOf(s, x, held), i);
                             return margin >= 0 ? -std::max(margin, 1e-300) : -margin;
                           }});
       }
@@ -755,13 +751,8 @@ std::vector<Event> eventsOf(const Setting& s, const std::vector<Point>& current,
                         }});
     } else if (s.face.bounded) {
       events.push_back(
-          {s.crosses ? What::kShift : What::kEdge, i, [&s, &current, i](const Kinematics& x) {
-             const FlatFace& face = s.face;
-             const Vec offset = x.centre + contactOf(s, x, current[i]).lever - face.point;
-             return std::min(
-                 face.half_extent.x() + kLastingBand - std::abs(offset.dot(face.along_u)),
-                 face.half_extent.y() + kLastingBand - std::abs(offset.dot(face.along_v)));
-           }});
+          {s.crosses ? What::kShift : What::kEdge, i,
+           [&s, &current, i](const Kinematics& x) { return withinFace(s, x, current[i]); }});
     }
   }
   return events;
@@ -832,11 +823,9 @@ Change changeAt(const Setting& s, const std::vector<Point>& current, What what, 
     const Dynamics d = dynamicsOf(s, there, current);
     next.clear();
     for (std::size_t i = 0; i < current.size(); ++i) {
-      const bool leaves =
-          i == point ||
-          (current[i].line >= 0 &&
-           (normalForce(s, there, current[i], d.forces[i]) <= 1e-9 * s.mass * s.gravity.norm() ||
-            shortChord(s, there, current[point], current[i])));
+      const bool leaves = i == point || (current[i].line >= 0 &&
+                                         (normalForce(d, i) <= 1e-9 * s.mass * s.gravity.norm() ||
+                                          shortChord(s, there, current[point], current[i])));
       if (!leaves) next.push_back(current[i]);
     }
   } else if (what == What::kLeaves) {
