@@ -116,7 +116,8 @@ Status checkRound(const char* what, double radius, double half_length) {
                std::string("a ") + what + "'s radius and half length must be finite and > 0"};
 }
 
-Status checkLasting(const LastingBody& body, const FlatFace& face) {
+/// The body's and the face's numbers, each named where it is wrong (checkLasting's but gravity's).
+Status checkBodyAndFace(const LastingBody& body, const FlatFace& face) {
   if (!(std::isfinite(body.mass) && body.mass > 0)) {
     return Error{"body.mass", "must be finite and > 0, got " + formatNumber(body.mass)};
   }
@@ -152,12 +153,6 @@ Status checkLasting(const LastingBody& body, const FlatFace& face) {
                    "(within 1e-9)"};
     }
   }
-  const double pressing = -body.gravity.dot(face.normal);
-  if (!(pressing > 0)) {
-    return Error{"body.gravity",
-                 "does not press the body onto the face (its part into the face is " +
-                     formatNumber(pressing) + " m/s^2): no lasting contact"};
-  }
   return std::visit(
       Visit{[](const Sphere& sphere) -> Status {
               if (!(std::isfinite(sphere.radius) && sphere.radius > 0)) {
@@ -189,6 +184,17 @@ Status checkLasting(const LastingBody& body, const FlatFace& face) {
               return Ok{};
             }},
       body.shape);
+}
+
+Status checkLasting(const LastingBody& body, const FlatFace& face) {
+  if (Status status = checkBodyAndFace(body, face); !status) return status;
+  const double pressing = -body.gravity.dot(face.normal);
+  if (!(pressing > 0)) {
+    return Error{"body.gravity",
+                 "does not press the body onto the face (its part into the face is " +
+                     formatNumber(pressing) + " m/s^2): no lasting contact"};
+  }
+  return Ok{};
 }
 
 /// Where the body touches the face.
@@ -1325,6 +1331,27 @@ Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& f
   }
   return plannedOnFace(body, face, support, setting, orientation, outline, overhang.value(),
                        spin.value(), tolerance);
+}
+
+Expected<LastingMotion> lastingOnFaces(const LastingBody& body, const std::vector<FlatFace>& faces,
+                                       double tolerance) {
+  if (faces.empty()) return Error{"faces", "must hold at least one face"};
+  if (faces.size() == 1) return lastingOnFace(body, faces.front(), tolerance);
+  bool pressed = false;
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    if (Status status = checkBodyAndFace(body, faces[i]); !status) {
+      Error error = status.error();
+      if (error.field.rfind("face", 0) == 0) {
+        error.field = "faces[" + std::to_string(i) + "]" + error.field.substr(4);
+      }
+      return error;
+    }
+    pressed = pressed || -body.gravity.dot(faces[i].normal) > 0;
+  }
+  if (!pressed) {
+    return Error{"body.gravity", "presses the body onto none of the faces: no lasting contact"};
+  }
+  return pivotOnFaces(body, faces, tolerance);
 }
 
 std::optional<double> flatBouncesEnd(const LastingBody& body, const FlatFace& face,

@@ -72,6 +72,8 @@ struct SupportForce {
   /// Unit, towards the body, where the contact's normal is not the face's (the body's own face
   /// on the face's edge: normal_force along it, friction_force at right angles to it); zero: n.
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  /// Which of lastingOnFaces' faces it is on (0: the one face of lastingOnFace).
+  std::size_t face = 0;
 };
 
 /// What an integrated lasting motion (LastingPath) gives at an instant.
@@ -149,6 +151,15 @@ struct LastingMotion {
 /// or leave it faster than a settled body's are not of the support (they strike or part).
 Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& face,
                                       double tolerance = 1e-9);
+
+/// The lasting motion that starts from `body` touching several fixed flat faces at once (a box
+/// on the floor against a wall, in a bin's corner, a plank leaning on a wall), each face with its
+/// own mu: lastingOnFace's for one face; for several, a box's or a hull's corners within
+/// kLastingBand of each face, each sticking, sliding or leaving its face by pivotOnFaces' law,
+/// at rest where it is still and they hold it. A cylinder or a capsule against several faces is
+/// refused by name (not yet).
+Expected<LastingMotion> lastingOnFaces(const LastingBody& body, const std::vector<FlatFace>& faces,
+                                       double tolerance = 1e-9);
 
 /// Bounces on one face that accumulate: a body landing flat on a face or a side (every point of
 /// its manifold approaching at the same speed u, no slip, no spin about the normal), which the

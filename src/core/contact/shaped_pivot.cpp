@@ -76,16 +76,25 @@ struct Point {
   /// `side` of its chord's middle) on the face's edge `line` (into Setting::lines), not the face.
   int line = -1;
   int side = 0;
+  /// The face it touches (into Setting::faces; a crossing's: the first).
+  std::size_t face = 0;
 };
 
-/// The body and the face, fixed over the motion.
+/// A face the body touches, with its normal (unit, towards the body), tangents and mu.
+struct Side {
+  FlatFace face;
+  Vec n, e1, e2;
+  double mu = 0.0;
+};
+
+/// The body and the faces, fixed over the motion.
 struct Setting {
   Vec moments = Vec::Ones();
   double mass = 0.0;
   Vec gravity = Vec::Zero();
-  FlatFace face;
-  Vec n, e1, e2;
-  double mu = 0.0;
+  /// One face, or several at once (a floor and a wall: pivotOnFaces), the first the one whose
+  /// edges the body goes on over (`crosses`, one face only).
+  std::vector<Side> faces;
   std::vector<Feature> features;  // every corner, end or rim of the body
   ConvexShape shape;
   /// A bounded face's four edges (each its `point` the middle, to `half_length` either side),
@@ -99,6 +108,8 @@ struct Setting {
   std::vector<std::array<std::size_t, 2>> segments;
   bool crosses = false;
 };
+
+const Side& sideOf(const Setting& s, const Point& p) { return s.faces[p.face]; }
 
 struct Kinematics {
   Eigen::Quaterniond orientation;
@@ -161,10 +172,11 @@ std::optional<LineCrossing> crossingOf(const Setting& s, const Kinematics& k, co
 }
 
 Contact contactOf(const Setting& s, const Kinematics& k, const Point& p) {
+  const Side& side = sideOf(s, p);
   Contact c;
-  c.normal = s.n;
-  c.e1 = s.e1;
-  c.e2 = s.e2;
+  c.normal = side.n;
+  c.e1 = side.e1;
+  c.e2 = side.e2;
   if (p.line >= 0) {
     const auto crossing = crossingOf(s, k, p);
     if (!crossing) return c;  // gone: its event (inside) ends the segment first
@@ -183,19 +195,19 @@ Contact contactOf(const Setting& s, const Kinematics& k, const Point& p) {
   c.lever = centre;
   if (f.radius == 0.0) return c;
   if (f.axis.isZero()) {
-    c.lever = centre - f.radius * s.n;
-    c.over = f.radius * k.spin.cross(s.n);
+    c.lever = centre - f.radius * side.n;
+    c.over = f.radius * k.spin.cross(side.n);
     return c;
   }
   c.lever = centre + f.radius * (k.rotation * p.lean);
   if (p.fixed) return c;
   const Vec a = k.rotation * f.axis;
-  const Vec across = a.cross(s.n.cross(a));  // n - (n.a) a, without its cancellation
+  const Vec across = a.cross(side.n.cross(a));  // n - (n.a) a, without its cancellation
   const double tilt = across.norm();
   if (tilt <= kRimFlat) return c;
   const Vec d = -across / tilt;
   const Vec a_rate = k.spin.cross(a);
-  const Vec across_rate = -s.n.dot(a_rate) * a - s.n.dot(a) * a_rate;
+  const Vec across_rate = -side.n.dot(a_rate) * a - side.n.dot(a) * a_rate;
   const Vec d_rate = (d * d.dot(across_rate) - across_rate) / tilt;
   c.lever = centre + f.radius * d;
   c.over = f.radius * (d_rate - k.spin.cross(d));
@@ -215,6 +227,7 @@ struct Dynamics {
   Vec angular_acceleration = Vec::Zero();
   std::vector<Vec> forces;
   std::vector<Vec> normals;  // each point's contact normal (the face's, or its crossing's)
+  std::vector<double> mus;   // each point's face's mu
 };
 
 /// The unknowns' directions of the points (a sticking point's normal and two tangents; a sliding
@@ -235,7 +248,7 @@ std::vector<std::pair<std::size_t, Vec>> columnsOf(const Setting& s, const Kinem
       const Vec towards = speed >= still ? slip : Vec(slip + (still - speed) * points[i].direction);
       const double length = towards.norm();
       const Vec direction = length > 0 ? Vec(towards / length) : points[i].direction;
-      columns.emplace_back(i, c.normal - s.mu * direction);
+      columns.emplace_back(i, c.normal - sideOf(s, points[i]).mu * direction);
     } else {
       columns.emplace_back(i, c.normal);
       columns.emplace_back(i, c.e1);
@@ -248,12 +261,14 @@ std::vector<std::pair<std::size_t, Vec>> columnsOf(const Setting& s, const Kinem
 /// Rows of the conditions on the points (a sticking point's three, a sliding point's normal),
 /// given what each unknown (`columns`) does at a point per unit, and `free` per point (the
 /// points' acceleration or velocity without the forces; `bent`: the normal's turning, n'.V, added
-/// to the normal row, at the accelerations' level): solved least-norm, the forces per point.
+/// to the normal row, at the accelerations' level): solved least-norm, the forces per point
+/// (`scales`, one per column: least-norm in the unknowns divided by them instead).
 std::vector<Vec> solveConditions(const Setting& s, const std::vector<Point>& points,
                                  const std::vector<Contact>& contacts,
                                  const std::vector<std::pair<std::size_t, Vec>>& columns,
                                  const std::vector<Vec>& free,
-                                 const Eigen::Matrix3d& inverse_inertia, bool bent) {
+                                 const Eigen::Matrix3d& inverse_inertia, bool bent,
+                                 const std::vector<double>& scales = {}) {
   if (points.empty()) return {};  // flying: no force
   struct Row {
     std::size_t point;
@@ -272,7 +287,8 @@ std::vector<Vec> solveConditions(const Setting& s, const std::vector<Point>& poi
   Eigen::MatrixXd a(rows.size(), columns.size());
   Eigen::VectorXd b(rows.size());
   for (std::size_t c = 0; c < columns.size(); ++c) {
-    const auto& [j, force] = columns[c];
+    const auto& [j, unit] = columns[c];
+    const Vec force = scales.empty() ? unit : Vec(scales[c] * unit);
     const Vec turn = inverse_inertia * contacts[j].lever.cross(force);
     for (std::size_t r = 0; r < rows.size(); ++r) {
       a(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) =
@@ -285,7 +301,8 @@ std::vector<Vec> solveConditions(const Setting& s, const std::vector<Point>& poi
   const Eigen::VectorXd x = a.completeOrthogonalDecomposition().solve(b);
   std::vector<Vec> forces(points.size(), Vec::Zero());
   for (std::size_t c = 0; c < columns.size(); ++c) {
-    forces[columns[c].first] += x(static_cast<Eigen::Index>(c)) * columns[c].second;
+    const double scale = scales.empty() ? 1.0 : scales[c];
+    forces[columns[c].first] += scale * x(static_cast<Eigen::Index>(c)) * columns[c].second;
   }
   return forces;
 }
@@ -313,6 +330,7 @@ Dynamics dynamicsOf(const Setting& s, const Kinematics& k, const std::vector<Poi
   }
   Dynamics d;
   for (const Contact& c : contacts) d.normals.push_back(c.normal);
+  for (const Point& p : points) d.mus.push_back(sideOf(s, p).mu);
   d.forces = solveConditions(s, points, contacts, columnsOf(s, k, points, contacts, kSlipStops),
                              free, inverse_inertia, true);
   Vec total = Vec::Zero(), moment = Vec::Zero();
@@ -356,7 +374,9 @@ Kinematics settle(const Setting& s, Kinematics k, const std::vector<Point>& poin
   std::vector<Vec> free;
   for (const Contact& c : contacts) free.push_back(k.velocity + k.spin.cross(c.lever));
   Setting plain = s;
-  plain.mu = 0.0;  // a sliding point's impulse is along n: it takes out a settled normal motion
+  for (Side& side : plain.faces)
+    side.mu = 0.0;  // a sliding point's impulse is along n: it
+                    // takes out a settled normal motion
   const std::vector<Vec> impulses = solveConditions(
       plain, points, contacts, columnsOf(plain, k, points, contacts, kLastingStillSpeed), free,
       inverse_inertia, false);
@@ -369,26 +389,26 @@ Kinematics settle(const Setting& s, Kinematics k, const std::vector<Point>& poin
   k.spin += inverse_inertia * moment;
   return k;
 }
-/// The height of a feature's lowest point above the face (a rim's: its centre's less rho |n x a|).
-double heightOf(const Setting& s, const Kinematics& k, const Feature& f) {
-  const double centre = s.n.dot(k.centre + k.rotation * f.centre - s.face.point);
+/// The height of a feature's lowest point above a face (a rim's: its centre's less rho |n x a|).
+double heightOf(const Side& side, const Kinematics& k, const Feature& f) {
+  const double centre = side.n.dot(k.centre + k.rotation * f.centre - side.face.point);
   if (f.radius == 0.0) return centre;
   if (f.axis.isZero()) return centre - f.radius;
-  return centre - f.radius * s.n.cross(k.rotation * f.axis).norm();
+  return centre - f.radius * side.n.cross(k.rotation * f.axis).norm();
 }
 
 /// How far a sticking point's force is within its cone (mu N, to the solve's rounding): < 0
 /// outside. The sticking's event and the modes' choice both read it.
-double coneMargin(const Setting& s, const Vec& n, const Vec& force) {
+double coneMargin(double mu, const Vec& n, const Vec& force) {
   const double normal = force.dot(n);
   const double across = (force - normal * n).norm();
-  return s.mu * normal + 1e-12 * std::abs(normal) - across;
+  return mu * normal + 1e-12 * std::abs(normal) - across;
 }
 
 /// Point i's normal force (along its contact's normal) and how far its force is within its cone.
 double normalForce(const Dynamics& d, std::size_t i) { return d.forces[i].dot(d.normals[i]); }
-double coneMarginOf(const Setting& s, const Dynamics& d, std::size_t i) {
-  return coneMargin(s, d.normals[i], d.forces[i]);
+double coneMarginOf(const Dynamics& d, std::size_t i) {
+  return coneMargin(d.mus[i], d.normals[i], d.forces[i]);
 }
 
 /// The direction in the face a sticking point `which` starts to slip in: where its acceleration
@@ -449,21 +469,22 @@ std::vector<Point> liftedCap(const Setting& s, const Kinematics& k, std::vector<
   for (const Point& p : fixed) mean += p.lean;
   mean /= static_cast<double>(fixed.size());
   Point rim = fixed.front();
+  const Side& side = sideOf(s, rim);
   if (mean.norm() > 0.5) {
     rim.lean = mean.normalized();
   } else {
     for (const Point& p : fixed) {
       const Feature& f = s.features[p.feature];
       const auto height = [&](const Point& q) {
-        return s.n.dot(k.rotation * (f.centre + f.radius * q.lean));
+        return side.n.dot(k.rotation * (f.centre + f.radius * q.lean));
       };
       if (height(p) < height(rim)) rim = p;
     }
   }
   rim.fixed = false;
   const Vec slip = slipOf(s, k, rim);
-  rim.sliding = s.mu == 0.0 || slip.norm() > kLastingStillSpeed;
-  rim.direction = slip.norm() > kLastingStillSpeed ? Vec(slip.normalized()) : s.e1;
+  rim.sliding = side.mu == 0.0 || slip.norm() > kLastingStillSpeed;
+  rim.direction = slip.norm() > kLastingStillSpeed ? Vec(slip.normalized()) : side.e1;
   points.push_back(rim);
   return points;
 }
@@ -483,7 +504,7 @@ Expected<std::vector<Point>> modesAt(const Setting& s, const Kinematics& k,
         points.erase(points.begin() + static_cast<std::ptrdiff_t>(i));
         points = liftedCap(s, k, std::move(points));
         changed = true;
-      } else if (!points[i].sliding && coneMarginOf(s, d, i) < 0) {
+      } else if (!points[i].sliding && coneMarginOf(d, i) < 0) {
         const auto onset = slipOnset(s, k, points, i);
         if (!onset) return notYet("a corner starting to slip with no direction of onset");
         points[i].sliding = true;
@@ -540,7 +561,7 @@ double offFace(const Setting& s, const Kinematics& k, const Feature& f) {
   Vec axis = Vec::Zero();
   if (f.radius > 0) {
     axis = k.rotation * f.axis;
-    const Vec across = axis.cross(s.n.cross(axis));
+    const Vec across = axis.cross(s.faces.front().n.cross(axis));
     if (across.norm() > kRimFlat) {
       lowest = centre - f.radius * across.normalized();
       axis = Vec::Zero();
@@ -555,18 +576,21 @@ double offFace(const Setting& s, const Kinematics& k, const Feature& f) {
   return off;
 }
 
-/// Each feature's height over the lowest point touching the face (the one stateAt puts on it):
-/// their drift is not a feature's approach; where it is off the face (offFace), how far.
+/// Each feature's height over the lowest point touching face `face` (the one stateAt puts on
+/// it): their drift is not a feature's approach; where it is off the face (offFace), how far.
 struct Above {
   const Setting& s;
   const std::vector<Point>& current;
-  double operator()(const Kinematics& x, const Feature& feature) const {
+  double operator()(const Kinematics& x, std::size_t face, const Feature& feature) const {
+    const Side& side = s.faces[face];
     double base = std::numeric_limits<double>::infinity();
     for (const Point& p : current) {
-      if (p.line < 0) base = std::min(base, heightOf(s, x, s.features[p.feature]));
+      if (p.line < 0 && p.face == face) {
+        base = std::min(base, heightOf(side, x, s.features[p.feature]));
+      }
     }
     if (!std::isfinite(base)) base = 0.0;
-    return std::max(heightOf(s, x, feature) - base, offFace(s, x, feature));
+    return std::max(heightOf(side, x, feature) - base, offFace(s, x, feature));
   }
 };
 
@@ -585,23 +609,28 @@ Vec rimTowards(const Setting& s, const Kinematics& k, const Point& p) {
   const Feature& f = s.features[p.feature];
   if (f.radius == 0.0 || f.axis.isZero() || p.fixed) return Vec::Zero();
   const Vec lever = contactOf(s, k, p).lever - k.rotation * f.centre;
-  const Vec in_face = lever - lever.dot(s.n) * s.n;
+  const Vec n = sideOf(s, p).n;
+  const Vec in_face = lever - lever.dot(n) * n;
   return in_face.norm() > 0 ? Vec(in_face.normalized()) : Vec::Zero();
 }
 
-/// How far the body is above the face: its lowest feature's height; where it goes on over the
-/// face's edges, its distance to the face (GJK against the face's rectangle).
+/// How far the body is above the faces: its lowest feature's height over any; where it goes on
+/// over the face's edges, its distance to the face (GJK against the face's rectangle).
 double clearanceOf(const Setting& s, const Kinematics& k) {
   if (!s.crosses) {
     double lowest = std::numeric_limits<double>::infinity();
-    for (const Feature& f : s.features) lowest = std::min(lowest, heightOf(s, k, f));
+    for (const Side& side : s.faces) {
+      for (const Feature& f : s.features) lowest = std::min(lowest, heightOf(side, k, f));
+    }
     return lowest;
   }
-  const ConvexShape face_shape = Cuboid{Vec(s.face.half_extent.x(), s.face.half_extent.y(), 0.0)};
+  const Side& side = s.faces.front();
+  const ConvexShape face_shape =
+      Cuboid{Vec(side.face.half_extent.x(), side.face.half_extent.y(), 0.0)};
   Eigen::Matrix3d frame;
-  frame << s.face.along_u, s.face.along_v, s.n;
+  frame << side.face.along_u, side.face.along_v, side.n;
   return convexDistance(PlacedConvex(s.shape, k.rotation, k.centre),
-                        PlacedConvex(face_shape, frame, s.face.point), 1e-13)
+                        PlacedConvex(face_shape, frame, side.face.point), 1e-13)
       .lower;
 }
 
@@ -612,7 +641,7 @@ constexpr double kCrossingOpens = 1e-6;
 
 /// Whether a point on the face (not a crossing) is within its bounded extent (kLastingBand).
 double withinFace(const Setting& s, const Kinematics& k, const Point& p) {
-  const FlatFace& face = s.face;
+  const FlatFace& face = sideOf(s, p).face;
   const Vec offset = k.centre + contactOf(s, k, p).lever - face.point;
   return std::min(face.half_extent.x() + kLastingBand - std::abs(offset.dot(face.along_u)),
                   face.half_extent.y() + kLastingBand - std::abs(offset.dot(face.along_v)));
@@ -622,10 +651,12 @@ double withinFace(const Setting& s, const Kinematics& k, const Point& p) {
 /// is frictionless) and sticking otherwise; its mode kept where `current` has it.
 Point withMode(const Setting& s, const Kinematics& k, Point p, const std::vector<Point>& current) {
   for (const Point& q : current) {
-    if (q.feature == p.feature && q.line == p.line && q.side == p.side) return q;
+    if (q.feature == p.feature && q.line == p.line && q.side == p.side && q.face == p.face) {
+      return q;
+    }
   }
   const Vec slip = slipOf(s, k, p);
-  p.sliding = s.mu == 0.0 || slip.norm() > kLastingStillSpeed;
+  p.sliding = sideOf(s, p).mu == 0.0 || slip.norm() > kLastingStillSpeed;
   p.direction = slip.norm() > kLastingStillSpeed ? Vec(slip.normalized()) : contactOf(s, k, p).e1;
   return p;
 }
@@ -674,15 +705,20 @@ std::vector<Event> eventsOf(const Setting& s, const std::vector<Point>& current,
                             const std::vector<double>& below, const std::vector<double>& flat,
                             double clearance, const Kinematics& start) {
   std::vector<Event> events;
-  for (std::size_t c = 0; c < s.features.size(); ++c) {
-    bool touching = false;
-    for (const Point& p : current) touching = touching || (p.line < 0 && p.feature == c);
-    if (touching) continue;
-    const double level = below[c] <= 0 ? below[c] - 1e-12 : 0.0;
-    events.push_back(
-        {What::kCorner, 0, [&above, &feature = s.features[c], level](const Kinematics& x) {
-           return above(x, feature) - level;
-         }});
+  for (std::size_t face = 0; face < s.faces.size(); ++face) {
+    for (std::size_t c = 0; c < s.features.size(); ++c) {
+      bool touching = false;
+      for (const Point& p : current) {
+        touching = touching || (p.line < 0 && p.feature == c && p.face == face);
+      }
+      if (touching) continue;
+      const double was = below[face * s.features.size() + c];
+      const double level = was <= 0 ? was - 1e-12 : 0.0;
+      events.push_back(
+          {What::kCorner, 0, [&above, face, &feature = s.features[c], level](const Kinematics& x) {
+             return above(x, face, feature) - level;
+           }});
+    }
   }
   for (std::size_t i = 0; i < current.size(); ++i) {
     const Vec towards = rimTowards(s, start, current[i]);
@@ -707,10 +743,10 @@ std::vector<Event> eventsOf(const Setting& s, const std::vector<Point>& current,
     if (!current[i].sliding) {
       // Bisected to where the margin is < 0: there the modes' choice slides it.
       events.push_back({What::kSlips, i, [&s, &current, i](const Kinematics& x) {
-                          const double margin = coneMarginOf(s, dynamicsOf(s, x, current), i);
+                          const double margin = coneMarginOf(dynamicsOf(s, x, current), i);
                           return margin < 0 ? margin : std::max(margin, 1e-300);
                         }});
-    } else if (s.mu > 0) {
+    } else if (sideOf(s, current[i]).mu > 0) {
       // Its slip stops: it falls to kSlipStops (its direction would turn ever faster as it
       // passes near 0); a slip just begun (slower at the step's start) stops where its part
       // along the onset's direction falls below -kLastingStillSpeed.
@@ -731,7 +767,7 @@ std::vector<Event> eventsOf(const Setting& s, const std::vector<Point>& current,
         std::vector<Point> held = current;
         held[i].sliding = false;
         events.push_back({What::kSticks, i, [&s, held, i](const Kinematics& x) {
-                            const double margin = coneMarginOf(s, dynamicsOf(s, x, held), i);
+                            const double margin = coneMarginOf(dynamicsOf(s, x, held), i);
                             return margin >= 0 ? -std::max(margin, 1e-300) : -margin;
                           }});
       }
@@ -749,7 +785,7 @@ std::vector<Event> eventsOf(const Setting& s, const std::vector<Point>& current,
                           const auto& line = s.lines[static_cast<std::size_t>(current[i].line)];
                           return c ? line.half_length - std::abs(c->on_line) : 1.0;
                         }});
-    } else if (s.face.bounded) {
+    } else if (sideOf(s, current[i]).face.bounded) {
       events.push_back(
           {s.crosses ? What::kShift : What::kEdge, i,
            [&s, &current, i](const Kinematics& x) { return withinFace(s, x, current[i]); }});
@@ -802,6 +838,74 @@ bool shortChord(const Setting& s, const Kinematics& k, const Point& leaving, con
   return c && c->inside * (2 * radius - c->inside) < kShortChord * kShortChord * radius * radius;
 }
 
+/// holdingForces' weight of friction against the normal forces: the normal forces carry what they
+/// can, friction the rest (shared as mu N).
+constexpr double kFrictionShare = 1e-6;
+
+/// Against several faces, the body still: forces that hold it with every point of a face with
+/// friction sticking (a frictionless face's sliding), where there are such within every cone.
+/// Where friction is statically indeterminate, each point's friction is taken in proportion to
+/// mu N there (the least-norm forces in the unknowns over sqrt(mu N / mean N), from the
+/// least-norm normal forces, four rounds: the closed forms' rule, each point's friction in
+/// proportion to its normal force, for faces of different mu); empty where those do not hold it
+/// (a normal force < 0, a force outside its cone, an acceleration past 1e-12 of gravity's).
+std::optional<std::vector<Vec>> holdingForces(const Setting& s, const Kinematics& k,
+                                              std::vector<Point> points) {
+  for (Point& p : points) p.sliding = sideOf(s, p).mu == 0.0;
+  const Eigen::Matrix3d inverse_inertia =
+      k.rotation * s.moments.cwiseInverse().asDiagonal() * k.rotation.transpose();
+  const std::vector<Contact> contacts = contactsOf(s, k, points);
+  const std::vector<Vec> free(points.size(), s.gravity);
+  const auto columns = columnsOf(s, k, points, contacts, kSlipStops);
+  std::vector<double> scales(columns.size(), 1.0);
+  std::vector<Vec> forces;
+  for (int round = 0; round < 4; ++round) {
+    forces = solveConditions(s, points, contacts, columns, free, inverse_inertia, false, scales);
+    double mean = 0.0;
+    for (std::size_t i = 0; i < points.size(); ++i) mean += forces[i].dot(contacts[i].normal);
+    mean /= static_cast<double>(points.size());
+    if (!(mean > 0)) return std::nullopt;
+    for (std::size_t c = 0; c < columns.size(); ++c) {
+      const std::size_t i = columns[c].first;
+      const double normal = forces[i].dot(contacts[i].normal);
+      const bool tangential = std::abs(columns[c].second.dot(contacts[i].normal)) < 0.5;
+      scales[c] =
+          tangential
+              ? kFrictionShare *
+                    std::sqrt(std::max(sideOf(s, points[i]).mu * normal, 1e-12 * mean) / mean)
+              : 1.0;
+    }
+  }
+  Vec total = Vec::Zero(), moment = Vec::Zero();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const double normal = forces[i].dot(contacts[i].normal);
+    if (normal < -1e-12 * s.mass * s.gravity.norm() ||
+        coneMargin(sideOf(s, points[i]).mu, contacts[i].normal, forces[i]) < 0) {
+      return std::nullopt;
+    }
+    total += forces[i];
+    moment += contacts[i].lever.cross(forces[i]);
+  }
+  double reach = 0.0;
+  for (const Feature& f : s.features) reach = std::max(reach, f.centre.norm() + f.radius);
+  const double held = 1e-12 * s.gravity.norm();
+  if ((s.gravity + total / s.mass).norm() > held ||
+      (inverse_inertia * moment).norm() * reach > held) {
+    return std::nullopt;
+  }
+  return forces;
+}
+
+/// Against several faces: whether the body is still (its centre and its reach's turning slower
+/// than kLastingStillSpeed) and its points hold it there (holdingForces): at rest (a box in a
+/// corner, a plank leaning on a wall whose floor's friction holds it).
+bool restingAt(const Setting& s, const Kinematics& k, const std::vector<Point>& points) {
+  double reach = 0.0;
+  for (const Feature& f : s.features) reach = std::max(reach, f.centre.norm() + f.radius);
+  return !points.empty() && k.velocity.norm() <= kLastingStillSpeed &&
+         k.spin.norm() * reach <= kLastingStillSpeed && holdingForces(s, k, points).has_value();
+}
+
 /// What a point's event (it leaves, sticks or slips) does at its instant: the points touching
 /// after it and the state there (a stop's slip taken out), or why the motion ends (`ends`), or
 /// that it rests (a face whose every corner sticks).
@@ -836,22 +940,39 @@ Change changeAt(const Setting& s, const std::vector<Point>& current, What what, 
     // A face's corners (three or more) stop slipping together (Goyal, Ruina and
     // Papadopoulos, Wear 143:307, 1991: a planar slide's translation and turning stop at the
     // same instant): where every one slips slower than 100 kSlipStops, all stick.
+    // (Against several faces, the corners of the face of the point that sticks.)
+    const std::size_t face = next[point].face;
     double fastest = 0.0;
-    for (const Point& p : next) fastest = std::max(fastest, slipOf(s, there, p).norm());
-    if (next.size() >= 3 && fastest <= 100 * kSlipStops) {
-      for (Point& p : next) p.sliding = false;
+    std::size_t of_face = 0;
+    for (const Point& p : next) {
+      if (p.face != face) continue;
+      fastest = std::max(fastest, slipOf(s, there, p).norm());
+      ++of_face;
+    }
+    if (of_face >= 3 && fastest <= 100 * kSlipStops) {
+      for (Point& p : next) p.sliding = p.sliding && p.face != face;
       // Stopped together on the face: where its friction can hold the body there (|g_t| <=
       // mu g_n, the closed forms' rule) it rests, whichever of the statically indeterminate
       // distributions holds it (the least-norm one may put a corner past its cone, which
       // would slip again, stop again, for ever: stick and slip chattering at nanoseconds).
-      const double g_n = -s.gravity.dot(s.n);
-      const Vec g_t = s.gravity + g_n * s.n;
+      const Side& side = s.faces.front();
+      const double g_n = -s.gravity.dot(side.n);
+      const Vec g_t = s.gravity + g_n * side.n;
       const bool on_face =
           std::none_of(next.begin(), next.end(), [](const Point& p) { return p.line >= 0; });
-      if (on_face && g_n > 0 && g_t.norm() <= s.mu * g_n) {
+      if (s.faces.size() == 1 && on_face && g_n > 0 && g_t.norm() <= side.mu * g_n) {
         change.points = next;
         change.rests = true;
         change.there = settle(s, there, next);
+        return change;
+      }
+      // Against several faces: where forces within every cone hold it (restingAt), whichever
+      // the least-norm ones are.
+      const Kinematics stopped = settle(s, there, next);
+      if (s.faces.size() > 1 && restingAt(s, stopped, next)) {
+        change.points = next;
+        change.rests = true;
+        change.there = stopped;
         return change;
       }
     }
@@ -879,11 +1000,16 @@ Change changeAt(const Setting& s, const std::vector<Point>& current, What what, 
   // A face whose every corner sticks: it rests, as the closed forms say (lastingOnFace), its last
   // slip (within the event's resolution) taken out.
   // (A crossing of the face's edge only where the body's face is flat on the face.)
+  // Against several faces: where it is still and its points hold it (restingAt).
   change.rests =
-      change.points.size() >= 3 &&
-      std::none_of(change.points.begin(), change.points.end(), [&](const Point& p) {
-        return p.sliding || (p.line >= 0 && contactOf(s, there, p).normal.dot(s.n) < 1.0 - 1e-12);
-      });
+      (change.points.size() >= 3 &&
+       std::none_of(change.points.begin(), change.points.end(),
+                    [&](const Point& p) {
+                      return p.sliding ||
+                             (p.line >= 0 &&
+                              contactOf(s, there, p).normal.dot(s.faces.front().n) < 1.0 - 1e-12);
+                    })) ||
+      (s.faces.size() > 1 && restingAt(s, there, change.points));
   change.there = change.rests ? settle(s, there, change.points) : there;
   return change;
 }
@@ -897,14 +1023,38 @@ Vec hairApart(const Setting& s, const Kinematics& k, const std::vector<Point>& p
     const Contact c = contactOf(s, k, points[i]);
     const auto r = static_cast<Eigen::Index>(i);
     rows.row(r) = c.normal.transpose();
-    gaps(r) =
-        kPivotHair - (points[i].line >= 0 ? c.gap : s.n.dot(k.centre + c.lever - s.face.point));
+    const Side& side = sideOf(s, points[i]);
+    gaps(r) = kPivotHair -
+              (points[i].line >= 0 ? c.gap : side.n.dot(k.centre + c.lever - side.face.point));
   }
   // Normals that differ by rounding (a chord's two ends on one face) count as one.
   Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> solver;
   solver.setThreshold(1e-6);
   solver.compute(rows);
   return solver.solve(gaps);
+}
+
+/// Against several faces: the least translation that puts each face's lowest feature a hair
+/// (kPivotHair) above it, of the faces it touches or whose lowest feature is below the hair (as
+/// one face's rule, each along its own normal).
+Vec hairOver(const Setting& s, const Kinematics& k, const std::vector<Point>& points) {
+  std::vector<std::pair<Vec, double>> apart;
+  for (std::size_t face = 0; face < s.faces.size(); ++face) {
+    const Side& side = s.faces[face];
+    double lowest = std::numeric_limits<double>::infinity();
+    for (const Feature& f : s.features) lowest = std::min(lowest, heightOf(side, k, f));
+    const bool touching =
+        std::any_of(points.begin(), points.end(), [&](const Point& p) { return p.face == face; });
+    if (touching || lowest < kPivotHair) apart.emplace_back(side.n, kPivotHair - lowest);
+  }
+  if (apart.empty()) return Vec::Zero();
+  Eigen::MatrixXd rows(apart.size(), 3);
+  Eigen::VectorXd gaps(apart.size());
+  for (std::size_t i = 0; i < apart.size(); ++i) {
+    rows.row(static_cast<Eigen::Index>(i)) = apart[i].first.transpose();
+    gaps(static_cast<Eigen::Index>(i)) = apart[i].second;
+  }
+  return rows.completeOrthogonalDecomposition().solve(gaps);
 }
 
 }  // namespace
@@ -968,24 +1118,32 @@ PathState PivotPath::stateAt(double t) const {
     k.centre += hairApart(s, k, *points);
     // ... and no feature over the face below the hair (the crossings' normals turned with the
     // body: their shift may lower a corner on the face's side).
+    const Side& side = s.faces.front();
     double lowest = std::numeric_limits<double>::infinity();
     for (const Feature& f : s.features) {
-      if (offFace(s, k, f) < 0) lowest = std::min(lowest, heightOf(s, k, f));
+      if (offFace(s, k, f) < 0) lowest = std::min(lowest, heightOf(side, k, f));
     }
-    if (lowest < kPivotHair) k.centre += (kPivotHair - lowest) * s.n;
+    if (lowest < kPivotHair) k.centre += (kPivotHair - lowest) * side.n;
+  } else if (s.faces.size() == 1) {
+    const Side& side = s.faces.front();
+    double lowest = std::numeric_limits<double>::infinity();
+    for (const Feature& f : s.features) {
+      if (offFace(s, k, f) < 0) lowest = std::min(lowest, heightOf(side, k, f));
+    }
+    if (!points->empty() || lowest < kPivotHair) k.centre += (kPivotHair - lowest) * side.n;
   } else {
-    double lowest = std::numeric_limits<double>::infinity();
-    for (const Feature& f : s.features) {
-      if (offFace(s, k, f) < 0) lowest = std::min(lowest, heightOf(s, k, f));
-    }
-    if (!points->empty() || lowest < kPivotHair) k.centre += (kPivotHair - lowest) * s.n;
+    k.centre += hairOver(s, k, *points);
   }
   PathState state;
   state.centre = k.centre;
   state.velocity = k.velocity;
   state.angular_velocity = k.spin;
   state.orientation = k.orientation;
-  const Dynamics d = dynamicsOf(s, k, *points);
+  std::vector<Vec> forces = dynamicsOf(s, k, *points).forces;
+  if (s.faces.size() > 1 && path.final && time >= path.until) {
+    // At rest against several faces: the forces that hold it (holdingForces).
+    if (const auto held = holdingForces(s, k, *points)) forces = *held;
+  }
   bool sliding = false;
   for (std::size_t i = 0; i < points->size(); ++i) {
     const Point& p = (*points)[i];
@@ -995,13 +1153,15 @@ PathState PivotPath::stateAt(double t) const {
     if (p.line >= 0) {
       force.point = c.on;
       force.normal = c.normal;
-      force.normal_force = d.forces[i].dot(c.normal);
-      force.friction_force = d.forces[i] - force.normal_force * c.normal;
+      force.normal_force = forces[i].dot(c.normal);
+      force.friction_force = forces[i] - force.normal_force * c.normal;
     } else {
+      const Side& side = sideOf(s, p);
       const Vec at = k.centre + c.lever;
-      force.point = at - s.n.dot(at - s.face.point) * s.n;
-      force.normal_force = d.forces[i].dot(s.n);
-      force.friction_force = d.forces[i] - force.normal_force * s.n;
+      force.point = at - side.n.dot(at - side.face.point) * side.n;
+      force.normal_force = forces[i].dot(side.n);
+      force.friction_force = forces[i] - force.normal_force * side.n;
+      force.face = p.face;
     }
     state.forces.push_back(force);
   }
@@ -1058,7 +1218,9 @@ Expected<SegmentEnd> integrateSegment(const Setting& s, PivotPath::Steps& path, 
   // where its tilt passes 0, or 1e-12 m below where it began if flat or past.
   const Kinematics initial = unpack(y);
   std::vector<double> below;
-  for (const Feature& f : s.features) below.push_back(std::min(0.0, above(initial, f)));
+  for (std::size_t face = 0; face < s.faces.size(); ++face) {
+    for (const Feature& f : s.features) below.push_back(std::min(0.0, above(initial, face, f)));
+  }
   std::vector<double> flat;
   for (const Point& p : current) {
     if (p.line >= 0) {
@@ -1102,23 +1264,30 @@ Expected<SegmentEnd> integrateSegment(const Setting& s, PivotPath::Steps& path, 
   }
 }
 
-/// The body and the face as the motion sees them: its features (featuresOf), none for a ball.
-std::unique_ptr<PivotPath::Steps> pathFor(const LastingBody& body, const FlatFace& face) {
+/// The body and the faces as the motion sees them: its features (featuresOf), none for a ball.
+std::unique_ptr<PivotPath::Steps> pathFor(const LastingBody& body,
+                                          const std::vector<FlatFace>& faces) {
   auto path = std::make_unique<PivotPath::Steps>();
   Setting& s = path->setting;
   s.moments = body.moments;
   s.mass = body.mass;
   s.gravity = body.gravity;
-  s.face = face;
-  s.n = face.normal.normalized();
-  s.e1 = s.n.unitOrthogonal();
-  s.e2 = s.n.cross(s.e1);
-  s.mu = face.friction;
+  for (const FlatFace& face : faces) {
+    Side side;
+    side.face = face;
+    side.n = face.normal.normalized();
+    side.e1 = side.n.unitOrthogonal();
+    side.e2 = side.n.cross(side.e1);
+    side.mu = face.friction;
+    s.faces.push_back(side);
+  }
   s.features = featuresOf(body.shape);
   s.shape = body.shape;
-  // A box or a cylinder goes on over a bounded face's edges (its edges or rims crossing them).
-  s.crosses = face.bounded && (std::holds_alternative<Cuboid>(body.shape) ||
-                               std::holds_alternative<Cylinder>(body.shape));
+  // A box or a cylinder goes on over one bounded face's edges (its edges or rims crossing them).
+  const FlatFace& face = faces.front();
+  s.crosses =
+      faces.size() == 1 && face.bounded &&
+      (std::holds_alternative<Cuboid>(body.shape) || std::holds_alternative<Cylinder>(body.shape));
   if (s.crosses) {
     for (const BoundEdge& bound : edgesOf(face)) {
       s.lines.push_back(
@@ -1135,6 +1304,24 @@ std::unique_ptr<PivotPath::Steps> pathFor(const LastingBody& body, const FlatFac
   return path;
 }
 
+/// Against several faces, still and held from the path's start: at rest there for ever (its
+/// velocity's rounding taken out), the forces its points hold it with.
+LastingMotion restingFrom(std::unique_ptr<PivotPath::Steps> path) {
+  path->initial.velocity.setZero();
+  path->initial.spin.setZero();
+  path->final = path->initial;
+  path->until = path->start;
+  const PivotPath still(std::move(path));
+  const PathState there = still.stateAt(still.start());
+  LastingMotion rest;
+  rest.state = ContactState::kResting;
+  rest.start = still.start();
+  rest.centre0 = there.centre;
+  rest.orientation0 = there.orientation;
+  rest.forces = there.forces;
+  return rest;
+}
+
 /// The motion of the body of `path` (pathFor) from `touching` touching the face.
 Expected<LastingMotion> pivotFrom(const LastingBody& body, std::unique_ptr<PivotPath::Steps> path,
                                   const std::vector<Point>& touching, double tolerance,
@@ -1147,11 +1334,27 @@ Expected<LastingMotion> pivotFrom(const LastingBody& body, std::unique_ptr<Pivot
   for (const Feature& f : s.features) reach = std::max(reach, f.centre.norm() + f.radius);
   const double clearance = kPivotClearance * reach;
 
+  path->start = body.time;
+  if (s.faces.size() > 1) {
+    // Still against several faces and held there (restingAt): at rest, each point of a face
+    // with friction sticking, its slip's rounding taken out.
+    std::vector<Point> held = touching;
+    for (Point& p : held) {
+      p.sliding = sideOf(s, p).mu == 0.0;
+      p.direction = sideOf(s, p).e1;
+    }
+    const Kinematics still = kinematicsOf(body);
+    if (restingAt(s, still, held)) {
+      path->initial = settle(s, still, held);
+      path->initial_points = held;
+      path->modes.push_back(held);
+      return restingFrom(std::move(path));
+    }
+  }
   Kinematics k;
   auto start = startOf(s, body, touching, k);
   if (!start) return start.error();
   const std::vector<Point> points = std::move(start.value());
-  path->start = body.time;
   path->initial = k;
   path->initial_points = points;
   path->modes.push_back(points);
@@ -1224,7 +1427,7 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
       !std::holds_alternative<ConvexHull>(body.shape)) {
     return Error{"body.shape", "corners are a box's or a hull's (a round body: pivotOnRound)"};
   }
-  auto path = pathFor(body, face);
+  auto path = pathFor(body, {face});
   std::vector<Point> touching;
   for (const Vec& corner : corners) {
     const auto& features = path->setting.features;
@@ -1239,6 +1442,56 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
   return pivotFrom(body, std::move(path), touching, tolerance, horizon);
 }
 
+Expected<LastingMotion> pivotOnFaces(const LastingBody& body, const std::vector<FlatFace>& faces,
+                                     double tolerance, double horizon) {
+  if (faces.empty()) return Error{"faces", "must hold at least one face"};
+  if (!std::holds_alternative<Cuboid>(body.shape) &&
+      !std::holds_alternative<ConvexHull>(body.shape)) {
+    return notYet("a cylinder or a capsule against several obstacles at once");
+  }
+  auto path = pathFor(body, faces);
+  const Setting& s = path->setting;
+  const Kinematics k = kinematicsOf(body);
+  double reach = 0.0;
+  for (const Feature& f : s.features) reach = std::max(reach, f.centre.norm());
+  // As lastingOnFace's manifold: within the settled band of the lowest corner, moving along the
+  // face's normal no faster than a settled point (an elastic rise of kLastingSettled of the
+  // reach under the whole of gravity: a wall's points as a floor's).
+  const double band = std::max(kLastingBand, kLastingSettled * reach);
+  const double settled_speed =
+      std::max(kLastingStillSpeed, std::sqrt(2 * s.gravity.norm() * kLastingSettled * reach));
+  std::vector<Point> touching;
+  for (std::size_t face = 0; face < s.faces.size(); ++face) {
+    const Side& side = s.faces[face];
+    const std::string field = "faces[" + std::to_string(face) + "]";
+    double lowest = std::numeric_limits<double>::infinity();
+    for (const Feature& f : s.features) lowest = std::min(lowest, heightOf(side, k, f));
+    if (!(std::abs(lowest) <= kLastingBand)) {
+      return Error{field, "the body's lowest corner over it is " + formatNumber(lowest) +
+                              " m from it: it does not touch it (within " +
+                              formatNumber(kLastingBand) + " m)"};
+    }
+    const std::size_t before = touching.size();
+    for (std::size_t c = 0; c < s.features.size(); ++c) {
+      const Vec lever = k.rotation * s.features[c].centre;
+      const double speed = side.n.dot(k.velocity + k.spin.cross(lever));
+      if (heightOf(side, k, s.features[c]) - lowest <= band && std::abs(speed) <= settled_speed) {
+        Point p;
+        p.feature = c;
+        p.face = face;
+        touching.push_back(p);
+      }
+    }
+    if (touching.size() == before) {
+      return Error{"body.velocity", "every corner of the body near " + field +
+                                        " approaches or leaves it faster than " +
+                                        formatNumber(settled_speed) +
+                                        " m/s: not a lasting contact with it"};
+    }
+  }
+  return pivotFrom(body, std::move(path), touching, tolerance, horizon);
+}
+
 Expected<LastingMotion> spinOnCap(const LastingBody& body, const FlatFace& face, int end,
                                   double tolerance, double horizon) {
   if (!std::holds_alternative<Cylinder>(body.shape)) {
@@ -1247,7 +1500,7 @@ Expected<LastingMotion> spinOnCap(const LastingBody& body, const FlatFace& face,
   if (end != -1 && end != 1) {
     return Error{"end", "must be -1 or 1 (the cap at -half_length or +half_length)"};
   }
-  auto path = pathFor(body, face);
+  auto path = pathFor(body, {face});
   std::vector<Point> touching;
   for (const Vec& lean : {Vec(1, 0, 0), Vec(0, 1, 0), Vec(-1, 0, 0), Vec(0, -1, 0)}) {
     Point p;
@@ -1266,7 +1519,7 @@ Expected<LastingMotion> pivotOverFaceEdge(const LastingBody& body, const FlatFac
       !std::holds_alternative<Cylinder>(body.shape)) {
     return notYet("turning over the face's edge at an angle to it: a hull or a capsule");
   }
-  auto path = pathFor(body, face);
+  auto path = pathFor(body, {face});
   const Setting& s = path->setting;
   const Kinematics k = kinematicsOf(body);
   // Its corners, or its rims' lowest points, on the face within the touching band (a rim lying
@@ -1274,7 +1527,7 @@ Expected<LastingMotion> pivotOverFaceEdge(const LastingBody& body, const FlatFac
   std::vector<Point> on_face;
   for (std::size_t f = 0; f < s.features.size(); ++f) {
     const Feature& feature = s.features[f];
-    if (heightOf(s, k, feature) > kLastingBand) continue;
+    if (heightOf(s.faces.front(), k, feature) > kLastingBand) continue;
     Point p;
     p.feature = f;
     if (feature.radius > 0) {
@@ -1320,7 +1573,7 @@ Expected<LastingMotion> pivotOnRound(const LastingBody& body, const FlatFace& fa
     const Vec down = rotation.transpose() * (-across);
     in_plane = Vec(down.x(), down.y(), 0.0);
   }
-  auto path = pathFor(body, face);
+  auto path = pathFor(body, {face});
   std::vector<Point> touching;
   for (const int end : ends) {
     if (end != -1 && end != 1) {

@@ -70,6 +70,19 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
                                     const std::vector<Eigen::Vector3d>& corners, double tolerance,
                                     double horizon = 10.0);
 
+/// A box or a hull touching several fixed faces at once (`faces`, each its own mu; a floor and
+/// a wall, a bin's corner): its corners touching each face (within the settled band of its
+/// lowest one there, as lastingOnFace's manifold, and moving along the face's normal no faster
+/// than a settled point does) each stick, slide or leave their face by pivotOnFace's law, all the
+/// faces' forces solved together (least-norm). Another corner reaching any of the faces, or the
+/// last point leaving them all, "resumes"; a point reaching a bounded face's edge ends it (not
+/// modelled yet). Where the body is still and its points hold it (its accelerations within 1e-12
+/// of gravity's, every sticking point's force within its cone) it rests: from the start for ever
+/// (a closed form), after a motion "stops" there. An Error names a face the body does not touch
+/// (`faces[i]`) or one whose every near point approaches or leaves it (`body.velocity`).
+Expected<LastingMotion> pivotOnFaces(const LastingBody& body, const std::vector<FlatFace>& faces,
+                                     double tolerance, double horizon = 10.0);
+
 /// A box or a cylinder on a bounded face's edge at any angle to it (issue 42, step 6;
 /// doc/model.md, "At an angle to the edge"): its corners and its rims' lowest points on the face,
 /// and its edges' or rims' crossings of the face's edges' lines (edge_crossing.h), each sticking,
