@@ -878,9 +878,11 @@ std::optional<std::vector<Vec>> holdingForces(const Setting& s, const Kinematics
   }
   Vec total = Vec::Zero(), moment = Vec::Zero();
   for (std::size_t i = 0; i < points.size(); ++i) {
+    // (To rounding: 1e-12 of the weight; a point that carries nothing has no force to hold.)
+    const double rounding = 1e-12 * s.mass * s.gravity.norm();
     const double normal = forces[i].dot(contacts[i].normal);
-    if (normal < -1e-12 * s.mass * s.gravity.norm() ||
-        coneMargin(sideOf(s, points[i]).mu, contacts[i].normal, forces[i]) < 0) {
+    if (normal < -rounding ||
+        coneMargin(sideOf(s, points[i]).mu, contacts[i].normal, forces[i]) < -rounding) {
       return std::nullopt;
     }
     total += forces[i];

@@ -226,10 +226,9 @@ std::optional<double> apartFrom(const BoundedMotion& moving, const PlacedShape& 
 
 }  // namespace
 
-std::optional<ShapedMotion::Strike> ShapedMotion::struckWhileLasting(const LastingMotion& lasting,
-                                                                     std::size_t resting_on,
-                                                                     double from,
-                                                                     double until) const {
+std::optional<ShapedMotion::Strike> ShapedMotion::struckWhileLasting(
+    const LastingMotion& lasting, const std::vector<std::size_t>& resting_on, double from,
+    double until) const {
   if (!(from < until)) return std::nullopt;
   BoundedMotion moving;
   const auto [centre_speed, angular_speed] =
@@ -246,7 +245,9 @@ std::optional<ShapedMotion::Strike> ShapedMotion::struckWhileLasting(const Lasti
   };
   std::optional<Strike> first;
   for (const Watched& w : obstacles_) {
-    if (w.placed.obstacle == resting_on) continue;
+    if (std::find(resting_on.begin(), resting_on.end(), w.placed.obstacle) != resting_on.end()) {
+      continue;
+    }
     const double horizon = first ? first->time : until;
     // Its step budget may run out on a slow approach: it goes on from where it is known apart
     // (an obstacle just struck and parted from: from where it is apart).
@@ -435,8 +436,16 @@ bool ShapedMotion::part(double horizon) {
   return false;
 }
 
-Expected<std::pair<LastingBody, FlatFace>> ShapedMotion::lastingFace() const {
-  return faceOf(lasting_, flight_, lasting_time_);
+Expected<std::pair<LastingBody, std::vector<FlatFace>>> ShapedMotion::lastingFaces() const {
+  if (lasting_.empty()) return faceOf(lasting_, flight_, lasting_time_).error();
+  std::pair<LastingBody, std::vector<FlatFace>> faces;
+  for (const ObstacleContact& contact : lasting_) {
+    auto face = faceOf({contact}, flight_, lasting_time_);
+    if (!face) return face.error();
+    faces.first = face->first;
+    faces.second.push_back(face->second);
+  }
+  return faces;
 }
 
 std::optional<double> ShapedMotion::flatBouncesEnd() const {

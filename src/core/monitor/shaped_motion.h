@@ -170,23 +170,24 @@ class ShapedMotion {
     std::size_t obstacle = 0;
     bool closing = false;
   };
-  /// A lasting motion (`lasting`, on the face of obstacle `resting_on`: shaped_lasting.h) watches
-  /// its face alone: the first instant in [from, until] at which another obstacle, fixed or
-  /// moving, touches the body moving so (certified as firstContact, by a BoundedMotion: its
+  /// A lasting motion (`lasting`, on the faces of the obstacles `resting_on`: shaped_lasting.h)
+  /// watches its faces alone: the first instant in [from, until] at which another obstacle, fixed
+  /// or moving, touches the body moving so (certified as firstContact, by a BoundedMotion: its
   /// centre's and its turn's speeds at either end of the span where they are closed forms, a
   /// tipping's by its energy); empty where none does.
-  std::optional<Strike> struckWhileLasting(const LastingMotion& lasting, std::size_t resting_on,
-                                           double from, double until) const;
+  std::optional<Strike> struckWhileLasting(const LastingMotion& lasting,
+                                           const std::vector<std::size_t>& resting_on, double from,
+                                           double until) const;
   /// The obstacles as placed now (a tf frame's link moved: the monitor's revisions), looked at
   /// from `time` on; the motion found so far is kept.
   void placeObstacles(std::vector<ShapedObstacle> placed, double time);
 
   /// The obstacles (model indices) of the contact found to last, and its manifold.
   std::vector<std::size_t> lastingWith() const;
-  /// The contact found to last as the body on one flat face there, for lastingOnFace: with one
-  /// fixed obstacle, a plane or a box whose face the manifold lies on (within its band); else an
-  /// Error naming what is not modelled yet.
-  Expected<std::pair<LastingBody, FlatFace>> lastingFace() const;
+  /// The contact found to last as the body on flat faces there, for lastingOnFaces: one per
+  /// obstacle of lastingWith() (in its order), each a fixed plane or a box whose face the
+  /// manifold lies on (within its band); else an Error naming what is not modelled yet.
+  Expected<std::pair<LastingBody, std::vector<FlatFace>>> lastingFaces() const;
   /// After an impact (kImpact): the instant a flat landing's bounces accumulate on the face
   /// struck (flatBouncesEnd, from the body as it landed), if they do; none through air (its
   /// closed form is the parabola's).

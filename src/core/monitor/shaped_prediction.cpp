@@ -160,7 +160,7 @@ class ShapedRun {
   }
 
   /// Why the prediction ends at a lasting contact with `obstacles` at `time`: `why`, what is not
-  /// modelled of it (lastingFace's or lastingOnFace's refusal).
+  /// modelled of it (lastingFaces' or lastingOnFaces' refusal).
   std::string lastingContact(const std::vector<std::size_t>& obstacles, double time,
                              const std::string& why) const {
     std::string ids;
@@ -190,14 +190,14 @@ class ShapedRun {
   std::optional<Expected<Prediction>> lastingFrom(ShapedMotion& motion, const TumblingBody& body,
                                                   double time, std::vector<std::string>& cut) {
     const std::vector<std::size_t> with = motion.lastingWith();
-    auto face = motion.lastingFace();
-    if (!face) {
-      cut.push_back(lastingContact(with, time, face.error().message()));
+    auto faces = motion.lastingFaces();
+    if (!faces) {
+      cut.push_back(lastingContact(with, time, faces.error().message()));
       return finish(motion, body, time);
     }
-    LastingBody on = face->first;
+    LastingBody on = faces->first;
     for (bool first = true;; first = false) {
-      auto lasting = lastingOnFace(on, face->second, motion.integrationTolerance());
+      auto lasting = lastingOnFaces(on, faces->second, motion.integrationTolerance());
       if (!lasting && first && lasting.error().field == "body.velocity" && motion.part(horizon_)) {
         return std::nullopt;  // no lasting contact: its points part from the face
       }
@@ -212,17 +212,12 @@ class ShapedRun {
         return finishWith(motion, state);
       }
       const LastingMotion& along = *lasting;
-      // Its lasting motion watches its face alone: another obstacle it meets ends it first.
+      // Its lasting motion watches its faces alone: another obstacle it meets ends it first (a
+      // strike's impact, or a touch that does not close found to last with both).
       const auto strike =
-          motion.struckWhileLasting(along, with.front(), on.time, std::min(along.until, horizon_));
+          motion.struckWhileLasting(along, with, on.time, std::min(along.until, horizon_));
       const double until = strike ? strike->time : std::min(along.until, horizon_);
       sampleUntil(on.time, until, [&](double t) { return stateOn(along, t); });
-      if (strike && !strike->closing) {
-        cut.push_back(lastingContact({with.front(), strike->obstacle}, until,
-                                     "it meets a second obstacle without striking it (a body "
-                                     "against two obstacles at once)"));
-        return finishWith(motion, stateOn(along, until));
-      }
       if (strike || (until < horizon_ && along.ends == "resumes")) {
         const BodyStateSample there = stateOn(along, until);
         if (const auto refused = resumes_.refuse(until)) {  // beyond its bounds: cut there
@@ -248,11 +243,12 @@ class ShapedRun {
         for (const SupportForce& force : along.forcesAt(until)) {
           ContactRecord record;
           record.time = until;
-          record.other = with.front();
+          record.other = force.face < with.size() ? with[force.face] : with.front();
           record.other_is_obstacle = true;
           record.contact_point = force.point;
-          record.normal = force.normal.isZero(0.0) ? Eigen::Vector3d(-face->second.normal)
-                                                   : Eigen::Vector3d(-force.normal);
+          record.normal = force.normal.isZero(0.0)
+                              ? Eigen::Vector3d(-faces->second.at(force.face).normal)
+                              : Eigen::Vector3d(-force.normal);
           record.normal_force = force.normal_force;
           record.friction_force = -force.friction_force;
           record.state = along.stateAt(until);

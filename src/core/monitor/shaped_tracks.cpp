@@ -110,7 +110,7 @@ void ShapedTrack::advanceTo(double time, std::vector<ImpactRecord>& impacts,
       const double watch_end = std::min(time, lasting_->until);
       if (watched_until_ < watch_end) {
         if (const auto strike =
-                motion_.struckWhileLasting(*lasting_, *against_, watched_until_, watch_end)) {
+                motion_.struckWhileLasting(*lasting_, lasting_with_, watched_until_, watch_end)) {
           struck(*strike, unmodelled);
           continue;
         }
@@ -175,7 +175,7 @@ void ShapedTrack::endLasting(std::vector<UnmodelledContact>& unmodelled) {
     body.angular_velocity = lasting_->angularVelocityAt(until);
     body.orientation = lasting_->orientationAt(until);
     body.gravity = motion_.flight().acceleration();
-    startLasting(body, face_, unmodelled);
+    startLasting(body, faces_, unmodelled);
     if (mode_ == Mode::kLasting && !(lasting_->until > until)) {
       hold(there, *against_, "its lasting contact ends where it starts", unmodelled);
     }
@@ -205,19 +205,12 @@ void ShapedTrack::endLasting(std::vector<UnmodelledContact>& unmodelled) {
   hold(there, *against_, ends, unmodelled);
 }
 
-/// Another obstacle meets the body in its lasting motion: a strike ends the lasting motion there,
-/// its events going on from there (the impact with it, the face's points taking part); a touch
-/// that does not close (resting or sliding against two obstacles) is held, not modelled yet.
+/// Another obstacle meets the body in its lasting motion: its lasting motion ends there, its
+/// events going on from there: a strike's impact with it (the face's points taking part), or a
+/// touch that does not close found to last with both (lastingOnFaces).
 void ShapedTrack::struck(const ShapedMotion::Strike& strike,
                          std::vector<UnmodelledContact>& unmodelled) {
   const BodyStateSample there = stateAt(strike.time);
-  if (!strike.closing) {
-    hold(there, strike.obstacle,
-         "its lasting contact meets a second obstacle without striking it (a body against two "
-         "obstacles at once)",
-         unmodelled);
-    return;
-  }
   if (const auto refused = resumes_.refuse(strike.time)) {
     hold(there, strike.obstacle, *refused, unmodelled);
     return;
@@ -251,19 +244,20 @@ void ShapedTrack::placeObstacles(std::vector<ShapedObstacle> placed, double time
 void ShapedTrack::enterLasting(double time, std::vector<UnmodelledContact>& unmodelled) {
   const std::vector<std::size_t> with = motion_.lastingWith();
   const std::size_t obstacle = with.empty() ? 0 : with.front();
-  auto face = motion_.lastingFace();
-  if (!face) {
-    hold(stateAt(time), obstacle, face.error().message(), unmodelled);
+  auto faces = motion_.lastingFaces();
+  if (!faces) {
+    hold(stateAt(time), obstacle, faces.error().message(), unmodelled);
     return;
   }
   against_ = obstacle;
-  startLasting(face->first, face->second, unmodelled);
+  lasting_with_ = with;
+  startLasting(faces->first, faces->second, unmodelled);
 }
 
-void ShapedTrack::startLasting(const LastingBody& body, const FlatFace& face,
+void ShapedTrack::startLasting(const LastingBody& body, const std::vector<FlatFace>& faces,
                                std::vector<UnmodelledContact>& unmodelled) {
   const std::size_t obstacle = against_.value_or(0);
-  auto motion = lastingOnFace(body, face, motion_.integrationTolerance());
+  auto motion = lastingOnFaces(body, faces, motion_.integrationTolerance());
   if (!motion && mode_ == Mode::kFlying && motion.error().field == "body.velocity" &&
       motion_.part(kInfinity)) {
     return;  // no lasting contact: its points part from the face, and the flight goes on
@@ -280,7 +274,7 @@ void ShapedTrack::startLasting(const LastingBody& body, const FlatFace& face,
   const bool resting_again = mode_ == Mode::kLasting;
   mode_ = Mode::kLasting;
   lasting_ = std::move(motion.value());
-  face_ = face;
+  faces_ = faces;
   since_ = body.time;
   watched_until_ = body.time;
   against_ = obstacle;
@@ -356,12 +350,13 @@ std::vector<ContactRecord> ShapedTrack::contacts(double time) const {
     ContactRecord record;
     record.time = time;
     record.body_a = body;
-    record.other = against_.value_or(0);
+    record.other =
+        force.face < lasting_with_.size() ? lasting_with_[force.face] : against_.value_or(0);
     record.other_is_obstacle = true;
     record.contact_point = force.point;
     // From the body into the face (or into the face's edge, along the body's own face).
-    record.normal =
-        force.normal.isZero(0.0) ? Eigen::Vector3d(-face_.normal) : Eigen::Vector3d(-force.normal);
+    record.normal = force.normal.isZero(0.0) ? Eigen::Vector3d(-faces_.at(force.face).normal)
+                                             : Eigen::Vector3d(-force.normal);
     record.normal_force = force.normal_force;
     record.friction_force = -force.friction_force;  // on the face
     record.state = lasting_->stateAt(time);

@@ -96,7 +96,7 @@ class ShapedTrack {
   void endLasting(std::vector<UnmodelledContact>& unmodelled);
   /// The contact the engine found to last: on one flat face by lastingOnFace, or held.
   void enterLasting(double time, std::vector<UnmodelledContact>& unmodelled);
-  void startLasting(const LastingBody& body, const FlatFace& face,
+  void startLasting(const LastingBody& body, const std::vector<FlatFace>& faces,
                     std::vector<UnmodelledContact>& unmodelled);
   void struck(const ShapedMotion::Strike& strike, std::vector<UnmodelledContact>& unmodelled);
   void hold(const BodyStateSample& state, std::size_t obstacle, const std::string& what,
@@ -110,7 +110,8 @@ class ShapedTrack {
   std::optional<double> rests_from_;  // a flat landing's bounces accumulate then
   ResumeGuard resumes_;               // a tipping's hand-overs to its events
   std::optional<LastingMotion> lasting_;
-  FlatFace face_;
+  std::vector<FlatFace> faces_;            // its lasting motion's, one per obstacle of ...
+  std::vector<std::size_t> lasting_with_;  // ... these (model indices)
   double lasting_since_ = 0.0;
   double watched_until_ = 0.0;  // no other obstacle meets its lasting motion before it
   std::optional<std::size_t> against_;
