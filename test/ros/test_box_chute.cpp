@@ -1,0 +1,130 @@
+// A box sliding down a chute on two obstacles at once, played through demo.launch over real
+// topics (config/scenes/box_chute.yaml): a cube of m = 0.5 kg in the corner of a chute falling at
+// beta = 20 degrees along x, rolled by gamma = 30 degrees towards its wall; the floor's mu1 = 0.4,
+// the wall's mu2 = 0.3, launched down it at v0 = 0.6 m/s. Closed forms, worked here:
+//  - across the chute nothing moves: the floor carries N1 = m g cos(beta) cos(gamma), the wall
+//    N2 = m g cos(beta) sin(gamma) (gravity's parts along their normals);
+//  - along it, a = g sin(beta) - (mu1 N1 + mu2 N2) / m while it slides: s = v0 t + a t^2 / 2,
+//    both faces' friction summing to m (a - g sin(beta)) along the chute;
+//  - it stops at -v0 / a and rests there, held by friction summing to -m g sin(beta).
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include <Eigen/Core>
+#include <cmath>
+#include <map>
+#include <vector>
+
+#include "collision_response/BodyStateArray.h"
+#include "collision_response/ContactArray.h"
+#include "collision_response/ImpactArray.h"
+
+namespace {
+
+constexpr double kG = 9.81, kMass = 0.5, kV0 = 0.6, kMu1 = 0.4, kMu2 = 0.3;
+const double kBeta = 20 * M_PI / 180, kGamma = 30 * M_PI / 180;
+
+Eigen::Vector3d vec(const geometry_msgs::Point& p) { return {p.x, p.y, p.z}; }
+Eigen::Vector3d vec(const geometry_msgs::Vector3& v) { return {v.x, v.y, v.z}; }
+
+TEST(BoxChute, TheBoxSlidesDownTheChuteOnBothFacesToTheClosedFormsRest) {
+  const Eigen::Vector3d down(std::cos(kBeta), 0, -std::sin(kBeta));
+  const double a = kG * (std::sin(kBeta) - kMu1 * std::cos(kBeta) * std::cos(kGamma) -
+                         kMu2 * std::cos(kBeta) * std::sin(kGamma));
+  const double stops = -kV0 / a, weight = kMass * kG;
+  ros::NodeHandle node;
+  ros::Time start;
+  Eigen::Vector3d first = Eigen::Vector3d::Constant(NAN);
+  struct Heard {
+    double time;
+    Eigen::Vector3d position, velocity;
+  };
+  std::vector<Heard> states;
+  struct Carried {
+    double time;
+    std::map<std::string, double> normal;  // per obstacle
+    Eigen::Vector3d friction = Eigen::Vector3d::Zero();
+    std::vector<std::string> modes;
+  };
+  std::vector<Carried> carried;
+  std::size_t impacts = 0;
+  ros::Subscriber state_sub = node.subscribe<collision_response::BodyStateArray>(
+      "body_states", 1000, [&](const collision_response::BodyStateArray::ConstPtr& array) {
+        if (start.isZero()) start = array->header.stamp;
+        const double t = (array->header.stamp - start).toSec();
+        for (const auto& state : array->states) {
+          if (t == 0.0) first = vec(state.pose.position);
+          states.push_back({t, vec(state.pose.position), vec(state.twist.linear)});
+        }
+      });
+  ros::Subscriber contact_sub = node.subscribe<collision_response::ContactArray>(
+      "contacts", 1000, [&](const collision_response::ContactArray::ConstPtr& array) {
+        if (start.isZero() || array->contacts.empty()) return;
+        Carried c;
+        c.time = (array->header.stamp - start).toSec();
+        for (const auto& contact : array->contacts) {
+          c.normal[contact.body_b] += contact.normal_force;
+          c.friction -= vec(contact.friction_force);  // on the body
+          c.modes.push_back(contact.state);
+        }
+        carried.push_back(c);
+      });
+  ros::Subscriber impact_sub = node.subscribe<collision_response::ImpactArray>(
+      "impacts", 100, [&](const collision_response::ImpactArray::ConstPtr& array) {
+        impacts += array->impacts.size();
+      });
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(40.0);
+  while (ros::ok() && ros::WallTime::now() < end &&
+         (states.empty() || states.back().time < 0.9 || carried.empty() ||
+          carried.back().time < 0.9)) {
+    ros::spinOnce();
+    ros::WallDuration(0.01).sleep();
+  }
+  ASSERT_TRUE(first.allFinite()) << "the first state heard was not the scene's first";
+  ASSERT_GT(states.size(), 50u);
+  EXPECT_EQ(impacts, 0u) << "it slides on both from the start: nothing strikes";
+  double worst_position = 0, worst_velocity = 0;
+  for (const Heard& state : states) {
+    const double t = std::min(state.time, stops);
+    const Eigen::Vector3d expected = first + (kV0 * t + a * t * t / 2) * down;
+    worst_position = std::max(worst_position, (state.position - expected).norm());
+    const Eigen::Vector3d velocity =
+        state.time < stops ? Eigen::Vector3d((kV0 + a * t) * down) : Eigen::Vector3d::Zero();
+    // (Within the slip's last 1e-6 m/s of the stop: taken out there.)
+    if (std::abs(state.time - stops) > 1e-5) {
+      worst_velocity = std::max(worst_velocity, (state.velocity - velocity).norm());
+    }
+  }
+  EXPECT_LT(worst_position, 1e-9);
+  EXPECT_LT(worst_velocity, 1e-8);
+  ASSERT_GT(carried.size(), 50u);
+  double worst_force = 0;
+  bool rested = false;
+  for (const Carried& c : carried) {
+    SCOPED_TRACE("contacts at " + std::to_string(c.time) + " s");
+    ASSERT_EQ(c.normal.size(), 2u) << "on the floor and the wall at once";
+    worst_force = std::max(
+        {worst_force, std::abs(c.normal.at("floor") - weight * std::cos(kBeta) * std::cos(kGamma)),
+         std::abs(c.normal.at("wall") - weight * std::cos(kBeta) * std::sin(kGamma))});
+    const double along =
+        c.time < stops ? kMass * (a - kG * std::sin(kBeta)) : -weight * std::sin(kBeta);
+    worst_force = std::max(worst_force, (c.friction - along * down).norm());
+    if (c.time > stops) {
+      rested = true;
+      for (const std::string& mode : c.modes) EXPECT_NE(mode, "sliding");
+    }
+  }
+  EXPECT_TRUE(rested);
+  EXPECT_LT(worst_force, 1e-9 * weight);
+  std::printf("position %.3g m, velocity %.3g m/s, forces %.3g N\n", worst_position, worst_velocity,
+              worst_force);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "box_chute_test");
+  ros::NodeHandle node;
+  return RUN_ALL_TESTS();
+}
