@@ -611,7 +611,12 @@ Vec rimTowards(const Setting& s, const Kinematics& k, const Point& p) {
   const Vec lever = contactOf(s, k, p).lever - k.rotation * f.centre;
   const Vec n = sideOf(s, p).n;
   const Vec in_face = lever - lever.dot(n) * n;
-  return in_face.norm() > 0 ? Vec(in_face.normalized()) : Vec::Zero();
+  // Against several faces, a cap at right angles to its face (its point straight below its
+  // centre: its in-face part rounding) has no direction, and cannot land flat before it turns.
+  // (On one face that rounding's direction is kept: its event restarts the step, and the one-face
+  // tipping paths, a side rolling off a table's edge among them, were checked with it.)
+  const double rounding = s.faces.size() > 1 ? 1e-12 * f.radius : 0.0;
+  return in_face.norm() > rounding ? Vec(in_face.normalized()) : Vec::Zero();
 }
 
 /// How far the body is above the faces: its lowest feature's height over any; where it goes on
@@ -1444,19 +1449,48 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
   return pivotFrom(body, std::move(path), touching, tolerance, horizon);
 }
 
+namespace {
+
+/// The points by which feature `f` of the body may touch face `face`: a corner or a capsule's end
+/// itself; a cylinder's rim its lowest point over the face, or, its cap flat on the face, four
+/// points of it fixed in the body (spinOnCap's).
+std::vector<Point> pointsOf(const Setting& s, const Kinematics& k, std::size_t face,
+                            std::size_t f) {
+  const Feature& feature = s.features[f];
+  Point p;
+  p.feature = f;
+  p.face = face;
+  if (feature.radius == 0.0 || feature.axis.isZero()) return {p};
+  const Vec axis = k.rotation * feature.axis;
+  const Vec across = axis.cross(s.faces[face].n.cross(axis));
+  if (across.norm() > kRimFlat) {
+    const Vec down = k.rotation.transpose() * (-across);
+    p.lean = Vec(down.x(), down.y(), 0.0).normalized();
+    return {p};
+  }
+  std::vector<Point> cap;
+  for (const Vec& lean : {Vec(1, 0, 0), Vec(0, 1, 0), Vec(-1, 0, 0), Vec(0, -1, 0)}) {
+    p.lean = lean;
+    p.fixed = true;
+    cap.push_back(p);
+  }
+  return cap;
+}
+
+}  // namespace
+
 Expected<LastingMotion> pivotOnFaces(const LastingBody& body, const std::vector<FlatFace>& faces,
                                      double tolerance, double horizon) {
   if (faces.empty()) return Error{"faces", "must hold at least one face"};
-  if (!std::holds_alternative<Cuboid>(body.shape) &&
-      !std::holds_alternative<ConvexHull>(body.shape)) {
-    return notYet("a cylinder or a capsule against several obstacles at once");
+  if (std::holds_alternative<Sphere>(body.shape)) {
+    return Error{"body.shape", "a sphere's lasting contact is a ball's"};
   }
   auto path = pathFor(body, faces);
   const Setting& s = path->setting;
   const Kinematics k = kinematicsOf(body);
   double reach = 0.0;
-  for (const Feature& f : s.features) reach = std::max(reach, f.centre.norm());
-  // As lastingOnFace's manifold: within the settled band of the lowest corner, moving along the
+  for (const Feature& f : s.features) reach = std::max(reach, f.centre.norm() + f.radius);
+  // As lastingOnFace's manifold: within the settled band of the lowest point, moving along the
   // face's normal no faster than a settled point (an elastic rise of kLastingSettled of the
   // reach under the whole of gravity: a wall's points as a floor's).
   const double band = std::max(kLastingBand, kLastingSettled * reach);
@@ -1469,23 +1503,21 @@ Expected<LastingMotion> pivotOnFaces(const LastingBody& body, const std::vector<
     double lowest = std::numeric_limits<double>::infinity();
     for (const Feature& f : s.features) lowest = std::min(lowest, heightOf(side, k, f));
     if (!(std::abs(lowest) <= kLastingBand)) {
-      return Error{field, "the body's lowest corner over it is " + formatNumber(lowest) +
+      return Error{field, "the body's lowest point over it is " + formatNumber(lowest) +
                               " m from it: it does not touch it (within " +
                               formatNumber(kLastingBand) + " m)"};
     }
     const std::size_t before = touching.size();
-    for (std::size_t c = 0; c < s.features.size(); ++c) {
-      const Vec lever = k.rotation * s.features[c].centre;
-      const double speed = side.n.dot(k.velocity + k.spin.cross(lever));
-      if (heightOf(side, k, s.features[c]) - lowest <= band && std::abs(speed) <= settled_speed) {
-        Point p;
-        p.feature = c;
-        p.face = face;
-        touching.push_back(p);
+    for (std::size_t f = 0; f < s.features.size(); ++f) {
+      for (const Point& p : pointsOf(s, k, face, f)) {
+        const Vec lever = contactOf(s, k, p).lever;
+        const double height = side.n.dot(k.centre + lever - side.face.point);
+        const double speed = side.n.dot(k.velocity + k.spin.cross(lever));
+        if (height - lowest <= band && std::abs(speed) <= settled_speed) touching.push_back(p);
       }
     }
     if (touching.size() == before) {
-      return Error{"body.velocity", "every corner of the body near " + field +
+      return Error{"body.velocity", "every point of the body near " + field +
                                         " approaches or leaves it faster than " +
                                         formatNumber(settled_speed) +
                                         " m/s: not a lasting contact with it"};
