@@ -28,6 +28,67 @@ inline std::vector<ImpactRecord> impactsOf(const std::vector<StepReport>& report
   return impacts;
 }
 
+/// The body's state every `dt` to `until` through the monitor, from `state` at 0.
+struct Played {
+  std::vector<StepReport> reports;
+  std::vector<double> times;
+  std::vector<Eigen::Vector3d> centres, velocities, spins;
+  std::vector<Eigen::Quaterniond> orientations;
+};
+
+inline Played play(const Scene& scene, const BodyStateSample& state, double dt, double until) {
+  ImpactMonitor monitor(scene, MonitorSettings{});
+  Played played;
+  played.reports.push_back(monitor.step(0.0, {state}));
+  for (int k = 1; k * dt <= until + 1e-12; ++k) {
+    const double t = k * dt;
+    played.reports.push_back(monitor.step(t, {}));
+    const auto at = monitor.predictedState(state.body, t);
+    EXPECT_TRUE(at) << t;
+    if (!at) break;
+    played.times.push_back(t);
+    played.centres.push_back(at->first);
+    played.velocities.push_back(at->second);
+    played.spins.push_back(monitor.predictedAngularVelocity(state.body, t));
+    played.orientations.push_back(monitor.predictedOrientation(state.body, t));
+  }
+  return played;
+}
+
+/// The body's points that may touch: a box's corners, or 64 points of each rim of a cylinder.
+inline std::vector<Eigen::Vector3d> outlineOf(const BodySpec& body) {
+  std::vector<Eigen::Vector3d> points;
+  if (body.shape == BodyShape::kBox) {
+    for (int k = 0; k < 8; ++k) {
+      points.push_back(Eigen::Vector3d((k & 1) ? 1 : -1, (k & 2) ? 1 : -1, (k & 4) ? 1 : -1)
+                           .cwiseProduct(body.size / 2));
+    }
+  } else {
+    for (int k = 0; k < 64; ++k) {
+      const double a = 2 * M_PI * k / 64;
+      for (const double z : {-0.5, 0.5}) {
+        points.push_back(
+            Eigen::Vector3d(body.radius * std::cos(a), body.radius * std::sin(a), z * body.length));
+      }
+    }
+  }
+  return points;
+}
+
+/// The body's moments of inertia about its own axes: a uniform box's or cylinder's.
+inline Eigen::Vector3d momentsOf(const BodySpec& body) {
+  const double m = body.mass;
+  if (body.shape == BodyShape::kBox) {
+    const Eigen::Vector3d s = body.size;
+    return m / 12 *
+           Eigen::Vector3d(s.y() * s.y() + s.z() * s.z(), s.x() * s.x() + s.z() * s.z(),
+                           s.x() * s.x() + s.y() * s.y());
+  }
+  const double r = body.radius, l = body.length;
+  const double across = m * (3 * r * r + l * l) / 12;
+  return Eigen::Vector3d(across, across, m * r * r / 2);
+}
+
 /// A box of edges 2 half over a concrete floor at z = 0, its material `e` against concrete.
 inline Scene floorScene(double e, const Eigen::Vector3d& half, double mass = 2.0) {
   Scene scene;

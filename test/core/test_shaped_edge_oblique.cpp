@@ -25,6 +25,10 @@ using lasting_bodies::V;
 using shaped_scenes::floorScene;
 using shaped_scenes::impactsOf;
 using shaped_scenes::kG;
+using shaped_scenes::momentsOf;
+using shaped_scenes::outlineOf;
+using shaped_scenes::play;
+using shaped_scenes::Played;
 using shaped_scenes::tableScene;
 
 /// The table top of the lasting tests: z = 0.7, x in [-1, 1] (its edge at x = 1), y in
@@ -35,52 +39,6 @@ FlatFace tableTop(double mu) {
   table.bounded = true;
   table.half_extent = Eigen::Vector2d(1, 0.5);
   return table;
-}
-
-/// The body's state every `dt` to `until` through the monitor, from `state` at 0.
-struct Played {
-  std::vector<StepReport> reports;
-  std::vector<double> times;
-  std::vector<V> centres, velocities, spins;
-  std::vector<Eigen::Quaterniond> orientations;
-};
-
-Played play(const Scene& scene, const BodyStateSample& state, double dt, double until) {
-  ImpactMonitor monitor(scene, MonitorSettings{});
-  Played played;
-  played.reports.push_back(monitor.step(0.0, {state}));
-  for (int k = 1; k * dt <= until + 1e-12; ++k) {
-    const double t = k * dt;
-    played.reports.push_back(monitor.step(t, {}));
-    const auto at = monitor.predictedState(state.body, t);
-    EXPECT_TRUE(at) << t;
-    if (!at) break;
-    played.times.push_back(t);
-    played.centres.push_back(at->first);
-    played.velocities.push_back(at->second);
-    played.spins.push_back(monitor.predictedAngularVelocity(state.body, t));
-    played.orientations.push_back(monitor.predictedOrientation(state.body, t));
-  }
-  return played;
-}
-
-/// The body's points that may touch: a box's corners, or 64 points of each rim of a cylinder.
-std::vector<V> outlineOf(const BodySpec& body) {
-  std::vector<V> points;
-  if (body.shape == BodyShape::kBox) {
-    for (int k = 0; k < 8; ++k) {
-      points.push_back(
-          V((k & 1) ? 1 : -1, (k & 2) ? 1 : -1, (k & 4) ? 1 : -1).cwiseProduct(body.size / 2));
-    }
-  } else {
-    for (int k = 0; k < 64; ++k) {
-      const double a = 2 * M_PI * k / 64;
-      for (const double z : {-0.5, 0.5}) {
-        points.push_back(V(body.radius * std::cos(a), body.radius * std::sin(a), z * body.length));
-      }
-    }
-  }
-  return points;
 }
 
 /// The scene's body 0 (its lowest face or cap on the frictionless table top z = 0.5, x <= 0.5,
@@ -210,20 +168,6 @@ TEST(ShapedEdgeOblique, ABoxTurnedOnTheEdgeTurnsAboutItAsACompoundPendulumWhileI
     EXPECT_LE(f.friction_force.norm(), 5 * f.normal_force * (1 + 1e-9));
   }
   EXPECT_EQ(tips->forcesAt(0.5 * (tips->start + sticking)).size(), 2u);
-}
-
-/// The body's moments of inertia about its own axes: a uniform box's or cylinder's.
-V momentsOf(const BodySpec& body) {
-  const double m = body.mass;
-  if (body.shape == BodyShape::kBox) {
-    const V s = body.size;
-    return m / 12 *
-           V(s.y() * s.y() + s.z() * s.z(), s.x() * s.x() + s.z() * s.z(),
-             s.x() * s.x() + s.y() * s.y());
-  }
-  const double r = body.radius, l = body.length;
-  const double across = m * (3 * r * r + l * l) / 12;
-  return V(across, across, m * r * r / 2);
 }
 
 // 40 boxes of random sides (0.03 to 0.1 m half sizes) turned at random about the vertical, and 20

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 #include <vector>
 
 #include "collision_response/core/monitor.h"
@@ -14,6 +15,7 @@
 #include "contact/shaped_pivot.h"
 #include "lasting_bodies.h"
 #include "scene_builders.h"
+#include "shaped_scenes.h"
 
 namespace collision_response::core {
 namespace {
@@ -521,16 +523,116 @@ TEST(ShapedFaces, TheMonitorLetsAFrictionlessPlankSlideDownTheWallAsItsEnergyInt
   EXPECT_LT(worst_rate, 1e-8);
 }
 
+// 30 boxes of random sides and 10 cans standing on their caps, sliding on a floor into a room's
+// corner (the walls x = 0.5 and y = 0.5; mu in [0, 1] for each pair, e in [0, 1] against the
+// floor, and against the walls 0 for half of them, at random for the others), at 0.5 to 2.5 m/s
+// within 36 degrees of the corner's diagonal, turning at up to 5 rad/s about the vertical.
+// Through the monitor for 1 s (they strike the walls, slide along them or stay against them,
+// tip, come to rest in the corner): no corner (or rim point) inside a wall or the floor (1e-9 m),
+// no energy gained from one 5 ms sample to the next (1e-8 J), many samples in lasting contact
+// with two obstacles at once, and nothing unmodelled but a wall touched alone in the air (2 of
+// the 40: held there, said; doc/model.md, "Against several obstacles at once").
+TEST(ShapedFaces, RandomSlidesIntoACornerNeverGoInsideNorGainEnergy) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int against_both = 0, on_a_wall_in_the_air = 0;
+  for (int k = 0; k < 40; ++k) {
+    std::mt19937 random(4242 + k);
+    const bool can = k >= 30;
+    Scene scene = shaped_scenes::floorScene(0.5, V(0.05, 0.05, 0.05), 0.2 + unit(random));
+    scene.effects.friction = true;
+    scene.effects.spin = true;
+    scene.materials = MaterialTable{};
+    const double wall_e = k % 2 == 0 ? 0.0 : unit(random);
+    for (const auto& [name, e] :
+         {std::make_pair("block", unit(random)), std::make_pair("concrete", unit(random)),
+          std::make_pair("wallboard", wall_e)}) {
+      ASSERT_TRUE(scene.materials.addMaterial(name, Material{e, unit(random)}, "m").ok());
+    }
+    scene.obstacles.push_back(scene_builders::plane("wall_x", -V::UnitX(), -0.5, "wallboard"));
+    scene.obstacles.push_back(scene_builders::plane("wall_y", -V::UnitY(), -0.5, "wallboard"));
+    BodySpec& body = scene.bodies[0];
+    double height = 0;
+    if (can) {
+      body.shape = BodyShape::kCylinder;
+      body.size = V::Zero();
+      body.radius = 0.03 + 0.03 * unit(random);
+      body.length = 0.08 + 0.17 * unit(random);
+      height = body.length / 2;
+    } else {
+      body.size =
+          2 * V(0.03 + 0.07 * unit(random), 0.03 + 0.07 * unit(random), 0.03 + 0.07 * unit(random));
+      height = body.size.z() / 2;
+    }
+    const double angle = M_PI / 4 + (2 * unit(random) - 1) * M_PI / 5;
+    const double speed = 0.5 + 2 * unit(random);
+    BodyStateSample state;
+    state.body = 0;
+    state.position = V(0.0, 0.0, height);
+    state.orientation = Q(Eigen::AngleAxisd(2 * M_PI * unit(random), V::UnitZ()));
+    state.velocity = speed * V(std::cos(angle), std::sin(angle), 0);
+    state.angular_velocity = V(0, 0, 5 * (2 * unit(random) - 1));
+    const shaped_scenes::Played played = shaped_scenes::play(scene, state, 0.005, 1.0);
+    for (const StepReport& report : played.reports) {
+      for (const UnmodelledContact& c : report.unmodelled) {
+        // Not modelled yet, said: a body touching a wall alone in the air, its normal motion 0
+        // (a can bouncing on the floor as it strikes the wall plastically).
+        if (c.what.rfind("body.gravity: does not press the body onto the face", 0) == 0) {
+          ++on_a_wall_in_the_air;
+        } else {
+          ADD_FAILURE() << k << ": " << c.what;
+        }
+      }
+      std::size_t touched = 0;  // a bit per obstacle
+      for (const ContactRecord& c : report.contacts) touched |= std::size_t{1} << c.other;
+      if ((touched & (touched - 1)) != 0) ++against_both;
+    }
+    const std::vector<V> outline = shaped_scenes::outlineOf(body);
+    const V moments = shaped_scenes::momentsOf(body);
+    const double m = body.mass;
+    double previous = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < played.times.size(); ++i) {
+      const double t = played.times[i];
+      const V& c = played.centres[i];
+      const Eigen::Matrix3d r = played.orientations[i].toRotationMatrix();
+      for (const V& p : outline) {
+        const V at = c + r * p;
+        EXPECT_LE(std::max(at.x(), at.y()), 0.5 + 1e-9) << k << " inside a wall at " << t;
+        EXPECT_GE(at.z(), -1e-9) << k << " below the floor at " << t;
+      }
+      const V& w = played.spins[i];
+      const double energy = 0.5 * m * played.velocities[i].squaredNorm() +
+                            0.5 * w.dot(r * moments.asDiagonal() * r.transpose() * w) +
+                            m * kG * c.z();
+      EXPECT_LE(energy, previous + 1e-8) << k << " at " << t;
+      previous = energy;
+    }
+  }
+  EXPECT_GT(against_both, 100) << "samples in lasting contact with two obstacles at once";
+  EXPECT_LE(on_a_wall_in_the_air, 2);
+  std::printf("samples on two obstacles at once: %d; held on a wall in the air: %d of 40\n",
+              against_both, on_a_wall_in_the_air);
+}
+
 TEST(ShapedFaces, WhatIsNotModelledOrWrongIsNamed) {
   const Plank plank;
   const LastingBody body = plank.at(plank.theta0);
   EXPECT_EQ(errorOf(lastingOnFaces(body, {})), "faces: must hold at least one face");
-  // Not touching the second face: named.
-  std::vector<FlatFace> far = floorAndWall(0, 0);
-  far[1].point = V(-0.1, 0, 0);
-  EXPECT_NE(errorOf(lastingOnFaces(body, far)).find("faces[1]: the body's lowest point"),
+  // Inside the second face: named; 0.1 m off it, it carries nothing (the plank falls freely
+  // along its floor, frictionless, until it meets the wall or lands).
+  std::vector<FlatFace> inside = floorAndWall(0, 0);
+  inside[1].point = V(0.1, 0, 0);
+  EXPECT_NE(errorOf(lastingOnFaces(body, inside)).find("faces[1]: the body's lowest point"),
             std::string::npos)
-      << errorOf(lastingOnFaces(body, far));
+      << errorOf(lastingOnFaces(body, inside));
+  std::vector<FlatFace> off = floorAndWall(0, 0);
+  off[1].point = V(-0.1, 0, 0);
+  const auto falls = lastingOnFaces(body, off, 1e-11);
+  ASSERT_TRUE(falls.ok()) << errorOf(falls);
+  for (const SupportForce& force : falls->forcesAt(0.0)) EXPECT_EQ(force.face, 0u);
+  std::vector<FlatFace> neither = off;
+  neither[0].point = V(0, 0, -0.1);
+  EXPECT_EQ(errorOf(lastingOnFaces(body, neither)),
+            "body.centre: touches none of the faces (within 1e-09 m)");
   std::vector<FlatFace> zero = floorAndWall(0, 0);
   zero[1].normal = V::Zero();
   EXPECT_EQ(errorOf(lastingOnFaces(body, zero)).rfind("faces[1].normal", 0), 0u)

@@ -1502,11 +1502,12 @@ Expected<LastingMotion> pivotOnFaces(const LastingBody& body, const std::vector<
     const std::string field = "faces[" + std::to_string(face) + "]";
     double lowest = std::numeric_limits<double>::infinity();
     for (const Feature& f : s.features) lowest = std::min(lowest, heightOf(side, k, f));
-    if (!(std::abs(lowest) <= kLastingBand)) {
-      return Error{field, "the body's lowest point over it is " + formatNumber(lowest) +
-                              " m from it: it does not touch it (within " +
-                              formatNumber(kLastingBand) + " m)"};
+    if (!(lowest >= -kLastingBand)) {
+      return Error{field, "the body's lowest point over it is " + formatNumber(-lowest) +
+                              " m inside it (beyond " + formatNumber(kLastingBand) + " m)"};
     }
+    // A face it does not touch (just left, bouncing off it) carries nothing: its events watch it.
+    if (lowest > kLastingBand) continue;
     const std::size_t before = touching.size();
     for (std::size_t f = 0; f < s.features.size(); ++f) {
       for (const Point& p : pointsOf(s, k, face, f)) {
@@ -1522,6 +1523,10 @@ Expected<LastingMotion> pivotOnFaces(const LastingBody& body, const std::vector<
                                         formatNumber(settled_speed) +
                                         " m/s: not a lasting contact with it"};
     }
+  }
+  if (touching.empty()) {
+    return Error{"body.centre",
+                 "touches none of the faces (within " + formatNumber(kLastingBand) + " m)"};
   }
   return pivotFrom(body, std::move(path), touching, tolerance, horizon);
 }

@@ -78,8 +78,10 @@ Expected<LastingMotion> pivotOnFace(const LastingBody& body, const FlatFace& fac
 /// last point leaving them all, "resumes"; a point reaching a bounded face's edge ends it (not
 /// modelled yet). Where the body is still and its points hold it (its accelerations within 1e-12
 /// of gravity's, every sticking point's force within its cone) it rests: from the start for ever
-/// (a closed form), after a motion "stops" there. An Error names a face the body does not touch
-/// (`faces[i]`) or one whose every near point approaches or leaves it (`body.velocity`).
+/// (a closed form), after a motion "stops" there. A face it does not touch (within kLastingBand)
+/// carries nothing, its events watching it. An Error names a face it is inside (`faces[i]`), one
+/// whose every near point approaches or leaves it (`body.velocity`), or that it touches none
+/// (`body.centre`).
 Expected<LastingMotion> pivotOnFaces(const LastingBody& body, const std::vector<FlatFace>& faces,
                                      double tolerance, double horizon = 10.0);
 

@@ -407,7 +407,30 @@ bool ShapedMotion::leave(double horizon) {
     obstacles_[slot].clear_from = from;
     obstacles_[slot].parted = true;
   }
+  if (!lasting_.empty()) addTouching();
   return lasting_.empty();  // each obstacle's points part on their own: apart
+}
+
+void ShapedMotion::addTouching() {
+  // Obstacles the body touches without being struck there (the floor under a box whose corner
+  // strikes a wall as it slides): within the touching band, neither approaching nor leaving
+  // faster than a settled body's, the contact lasts with them too.
+  const double band = FirstContactOptions{}.manifold_band;
+  for (std::size_t slot = 0; slot < obstacles_.size(); ++slot) {
+    const bool in = std::any_of(lasting_.begin(), lasting_.end(),
+                                [slot](const ObstacleContact& c) { return c.slot == slot; });
+    if (in) continue;
+    const PlacedShape& placed = obstacles_[slot].placed.placed;
+    const SurfaceGap gap = gapAt(flight_, placed, time_);
+    if (gap.overlapping || !(gap.gap_upper <= band)) continue;
+    FirstContactOptions at_once;
+    at_once.time_tolerance = std::numeric_limits<double>::infinity();
+    const FirstContactResult result = firstContact(flight_, placed, time_, 0.0, at_once);
+    if (!result.contact || std::abs(result.contact->closest.approach_speed) > kLastingSettled) {
+      continue;
+    }
+    lasting_.push_back({obstacles_[slot].placed.obstacle, slot, *result.contact});
+  }
 }
 
 bool ShapedMotion::part(double horizon) {

@@ -211,6 +211,9 @@ class ShapedMotion {
     std::size_t slot = 0;      ///< in obstacles_
     TumblingContact contact;
   };
+  /// After an impact whose contact lasts: the obstacles the body touches there without having
+  /// struck them join the lasting contact (lasting_).
+  void addTouching();
   /// An obstacle placed, and from when it is looked at: no contact with it before clear_from;
   /// parted: clear_from is where the body was found apart from it after touching it.
   struct Watched {
