@@ -28,10 +28,11 @@ fi
 # once each in LastingContact.*Edge*), and the cluster's friction on 2,000 random clusters (45
 # CPU-seconds; solveCluster with friction runs in the other ClusterFriction and LargeCluster
 # tests), and the random lasting contacts of shaped bodies whose tipping is integrated (800
-# bodies: the tipping runs in ShapedPivot's closed-form tests). Their code runs in the other tests
+# bodies: the tipping runs in ShapedPivot's closed-form tests) and the random slides into a
+# room's corner (12 CPU-seconds: the several faces' law runs in ShapedFaces' closed-form tests). Their code runs in the other tests
 # under the sanitizers, and their answers are checked in the main build.
 declare -A filters=(
-  [core_tests]="-Trace.*:Monitor.BroadphaseGivesTheSameImpactsAsEveryPair:Calibration.NinetyFivePercentIntervalsCoverTheTruth*:Calibration.AStuckBounceIsNotReadAsSliding:EdgeScan.*:ClusterFriction.EnergyNeverIncreases:ShapedPivot.Random*:ShapedLasting.Random*:TumblingContact.Fuzz*:SteppedClusters.APileSettlesInABox*"
+  [core_tests]="-Trace.*:Monitor.BroadphaseGivesTheSameImpactsAsEveryPair:Calibration.NinetyFivePercentIntervalsCoverTheTruth*:Calibration.AStuckBounceIsNotReadAsSliding:EdgeScan.*:ClusterFriction.EnergyNeverIncreases:ShapedPivot.Random*:ShapedLasting.Random*:ShapedFaces.Random*:TumblingContact.Fuzz*:SteppedClusters.APileSettlesInABox*"
 )
 # Each program in two shards side by side (gtest's GTEST_TOTAL_SHARDS): the two cores.
 run_shard() {
