@@ -27,10 +27,11 @@ fi
 # 40 phases of an update at 100 Hz and 1 kHz (80 CPU-seconds: the edge's passage and leave run
 # once each in LastingContact.*Edge*), and the cluster's friction on 2,000 random clusters (45
 # CPU-seconds; solveCluster with friction runs in the other ClusterFriction and LargeCluster
-# tests), and the random lasting contacts of shaped bodies whose tipping is integrated (800
-# bodies: the tipping runs in ShapedPivot's closed-form tests) and the random slides into a
-# room's corner (12 CPU-seconds: the several faces' law runs in ShapedFaces' closed-form tests). Their code runs in the other tests
-# under the sanitizers, and their answers are checked in the main build.
+# tests), the random lasting contacts of shaped bodies whose tipping is integrated (800 bodies:
+# the tipping runs in ShapedPivot's closed-form tests), and the random slides into a room's
+# corner (12 CPU-seconds: the law on several faces runs in ShapedFaces' closed-form tests). Their
+# code runs in the other tests under the sanitizers, and their answers are checked in the main
+# build.
 declare -A filters=(
   [core_tests]="-Trace.*:Monitor.BroadphaseGivesTheSameImpactsAsEveryPair:Calibration.NinetyFivePercentIntervalsCoverTheTruth*:Calibration.AStuckBounceIsNotReadAsSliding:EdgeScan.*:ClusterFriction.EnergyNeverIncreases:ShapedPivot.Random*:ShapedLasting.Random*:ShapedFaces.Random*:TumblingContact.Fuzz*:SteppedClusters.APileSettlesInABox*"
 )
