@@ -373,10 +373,9 @@ Kinematics settle(const Setting& s, Kinematics k, const std::vector<Point>& poin
   const std::vector<Contact> contacts = contactsOf(s, k, points);
   std::vector<Vec> free;
   for (const Contact& c : contacts) free.push_back(k.velocity + k.spin.cross(c.lever));
+  // A sliding point's impulse is along n: it takes out a settled normal motion.
   Setting plain = s;
-  for (Side& side : plain.faces)
-    side.mu = 0.0;  // a sliding point's impulse is along n: it
-                    // takes out a settled normal motion
+  for (Side& side : plain.faces) side.mu = 0.0;
   const std::vector<Vec> impulses = solveConditions(
       plain, points, contacts, columnsOf(plain, k, points, contacts, kLastingStillSpeed), free,
       inverse_inertia, false);
@@ -850,10 +849,11 @@ constexpr double kFrictionShare = 1e-6;
 /// Against several faces, the body still: forces that hold it with every point of a face with
 /// friction sticking (a frictionless face's sliding), where there are such within every cone.
 /// Where friction is statically indeterminate, each point's friction is taken in proportion to
-/// mu N there (the least-norm forces in the unknowns over sqrt(mu N / mean N), from the
-/// least-norm normal forces, four rounds: the closed forms' rule, each point's friction in
-/// proportion to its normal force, for faces of different mu); empty where those do not hold it
-/// (a normal force < 0, a force outside its cone, an acceleration past 1e-12 of gravity's).
+/// mu N there: the least-norm forces in the unknowns, a friction unknown divided by
+/// kFrictionShare sqrt(mu N / mean N) with N the previous round's normal force (four rounds,
+/// from the least-norm forces): the closed forms' rule, each point's friction in proportion to
+/// its normal force, for faces of different mu. Empty where those do not hold it (a normal force
+/// < 0, a force outside its cone, an acceleration past 1e-12 of gravity's).
 std::optional<std::vector<Vec>> holdingForces(const Setting& s, const Kinematics& k,
                                               std::vector<Point> points) {
   for (Point& p : points) p.sliding = sideOf(s, p).mu == 0.0;
