@@ -4,6 +4,7 @@
 // ("not yet: a shaped body's lasting contact with 2 obstacles at once").
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -543,9 +544,9 @@ TEST(ShapedFaces, RandomSlidesIntoACornerNeverGoInsideNorGainEnergy) {
     scene.effects.spin = true;
     scene.materials = MaterialTable{};
     const double wall_e = k % 2 == 0 ? 0.0 : unit(random);
-    for (const auto& [name, e] :
-         {std::make_pair("block", unit(random)), std::make_pair("concrete", unit(random)),
-          std::make_pair("wallboard", wall_e)}) {
+    const std::array<std::pair<const char*, double>, 3> restitutions = {
+        {{"block", unit(random)}, {"concrete", unit(random)}, {"wallboard", wall_e}}};
+    for (const auto& [name, e] : restitutions) {
       ASSERT_TRUE(scene.materials.addMaterial(name, Material{e, unit(random)}, "m").ok());
     }
     scene.obstacles.push_back(scene_builders::plane("wall_x", -V::UnitX(), -0.5, "wallboard"));
