@@ -7,6 +7,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cmath>
+#include <limits>
+#include <random>
 #include <vector>
 
 #include "collision_response/core/monitor.h"
@@ -87,6 +89,48 @@ inline Eigen::Vector3d momentsOf(const BodySpec& body) {
   const double r = body.radius, l = body.length;
   const double across = m * (3 * r * r + l * l) / 12;
   return Eigen::Vector3d(across, across, m * r * r / 2);
+}
+
+/// The random slides' body: a box of half sizes 0.03 to 0.1 m, or a can (`can`) of radius 0.03
+/// to 0.06 m, 0.08 to 0.25 m tall, drawn in that order; its half height.
+inline double randomBlock(BodySpec& body, bool can, std::mt19937& random) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  if (can) {
+    body.shape = BodyShape::kCylinder;
+    body.size = Eigen::Vector3d::Zero();
+    body.radius = 0.03 + 0.03 * unit(random);
+    body.length = 0.08 + 0.17 * unit(random);
+    return body.length / 2;
+  }
+  body.size = 2 * Eigen::Vector3d(0.03 + 0.07 * unit(random), 0.03 + 0.07 * unit(random),
+                                  0.03 + 0.07 * unit(random));
+  return body.size.z() / 2;
+}
+
+/// The random slides' checks on a played body: every point of its outline (outlineOf) outside
+/// the obstacles, `outside(point)` >= -1e-9 m (its least distance past their surfaces, signed),
+/// and no energy gained from one sample to the next (1e-8 J: the integration's tolerance).
+template <class Outside>
+void expectOutsideAndNotGaining(const Played& played, const BodySpec& body, int k,
+                                const Outside& outside) {
+  const std::vector<Eigen::Vector3d> outline = outlineOf(body);
+  const Eigen::Vector3d moments = momentsOf(body);
+  const double m = body.mass;
+  double previous = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < played.times.size(); ++i) {
+    const double t = played.times[i];
+    const Eigen::Vector3d& c = played.centres[i];
+    const Eigen::Matrix3d r = played.orientations[i].toRotationMatrix();
+    for (const Eigen::Vector3d& p : outline) {
+      EXPECT_GE(outside(Eigen::Vector3d(c + r * p)), -1e-9) << k << ": inside at " << t;
+    }
+    const Eigen::Vector3d& w = played.spins[i];
+    const double energy = 0.5 * m * played.velocities[i].squaredNorm() +
+                          0.5 * w.dot(r * moments.asDiagonal() * r.transpose() * w) +
+                          m * kG * c.z();
+    EXPECT_LE(energy, previous + 1e-8) << k << " at " << t;
+    previous = energy;
+  }
 }
 
 /// A box of edges 2 half over a concrete floor at z = 0, its material `e` against concrete.

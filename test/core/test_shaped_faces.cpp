@@ -552,18 +552,7 @@ TEST(ShapedFaces, RandomSlidesIntoACornerNeverGoInsideNorGainEnergy) {
     scene.obstacles.push_back(scene_builders::plane("wall_x", -V::UnitX(), -0.5, "wallboard"));
     scene.obstacles.push_back(scene_builders::plane("wall_y", -V::UnitY(), -0.5, "wallboard"));
     BodySpec& body = scene.bodies[0];
-    double height = 0;
-    if (can) {
-      body.shape = BodyShape::kCylinder;
-      body.size = V::Zero();
-      body.radius = 0.03 + 0.03 * unit(random);
-      body.length = 0.08 + 0.17 * unit(random);
-      height = body.length / 2;
-    } else {
-      body.size =
-          2 * V(0.03 + 0.07 * unit(random), 0.03 + 0.07 * unit(random), 0.03 + 0.07 * unit(random));
-      height = body.size.z() / 2;
-    }
+    const double height = shaped_scenes::randomBlock(body, can, random);
     const double angle = M_PI / 4 + (2 * unit(random) - 1) * M_PI / 5;
     const double speed = 0.5 + 2 * unit(random);
     BodyStateSample state;
@@ -587,26 +576,9 @@ TEST(ShapedFaces, RandomSlidesIntoACornerNeverGoInsideNorGainEnergy) {
       for (const ContactRecord& c : report.contacts) touched |= std::size_t{1} << c.other;
       if ((touched & (touched - 1)) != 0) ++against_both;
     }
-    const std::vector<V> outline = shaped_scenes::outlineOf(body);
-    const V moments = shaped_scenes::momentsOf(body);
-    const double m = body.mass;
-    double previous = std::numeric_limits<double>::infinity();
-    for (std::size_t i = 0; i < played.times.size(); ++i) {
-      const double t = played.times[i];
-      const V& c = played.centres[i];
-      const Eigen::Matrix3d r = played.orientations[i].toRotationMatrix();
-      for (const V& p : outline) {
-        const V at = c + r * p;
-        EXPECT_LE(std::max(at.x(), at.y()), 0.5 + 1e-9) << k << " inside a wall at " << t;
-        EXPECT_GE(at.z(), -1e-9) << k << " below the floor at " << t;
-      }
-      const V& w = played.spins[i];
-      const double energy = 0.5 * m * played.velocities[i].squaredNorm() +
-                            0.5 * w.dot(r * moments.asDiagonal() * r.transpose() * w) +
-                            m * kG * c.z();
-      EXPECT_LE(energy, previous + 1e-8) << k << " at " << t;
-      previous = energy;
-    }
+    shaped_scenes::expectOutsideAndNotGaining(played, body, k, [](const V& at) {
+      return std::min(0.5 - std::max(at.x(), at.y()), at.z());
+    });
   }
   EXPECT_GT(against_both, 100) << "samples in lasting contact with two obstacles at once";
   EXPECT_LE(on_a_wall_in_the_air, 2);
