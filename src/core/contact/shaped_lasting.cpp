@@ -934,12 +934,12 @@ Expected<LastingMotion> ballOnFace(const LastingBody& body, const FlatFace& face
 struct Overhang {
   FaceEdge edge;
   std::pair<int, double> bound;  ///< the face's axis (0: along_u, 1: along_v) and side (-1, 1)
+  bool corner = false;           ///< past two of the face's edges: over its corner
 };
 
 /// The face's edge the support's outline is past or at (within the touching band); none on an
-/// unbounded face or where nothing is; not modelled where it is past two (the face's corner).
-Expected<std::optional<Overhang>> overhangOf(const std::vector<Vec>& outline,
-                                             const FlatFace& face) {
+/// unbounded face or where nothing is; past two, the first, `corner` set (over the face's corner).
+std::optional<Overhang> overhangOf(const std::vector<Vec>& outline, const FlatFace& face) {
   std::optional<Overhang> found;
   if (!face.bounded) return found;
   for (const BoundEdge& bound : edgesOf(face)) {
@@ -948,8 +948,11 @@ Expected<std::optional<Overhang>> overhangOf(const std::vector<Vec>& outline,
       return bound.edge.out.dot(point - face.point) > face.half_extent[bound.axis] - kLastingBand;
     });
     if (!past) continue;
-    if (found) return notYet("the body overhangs two of the face's edges (its corner)");
-    found = Overhang{bound.edge, {bound.axis, bound.side}};
+    if (found) {
+      found->corner = true;
+      return found;
+    }
+    found = Overhang{bound.edge, {bound.axis, bound.side}, false};
   }
   return found;
 }
@@ -1102,7 +1105,7 @@ Expected<LastingMotion> overhangMotion(const LastingBody& body, const FlatFace& 
   }
   if (edge_reached < lasts) {
     lasts = edge_reached;
-    motion.ends = "a point of its support reaches the face's edge";
+    motion.ends = "stops";  // asked again there: over the face's corner (pivotOverFaceEdge)
   }
   if (std::isfinite(lasts)) motion.until = body.time + lasts;
   return motion;
@@ -1298,6 +1301,13 @@ Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& f
     if (const auto edge = sideOnEdge(body, face)) {
       return rollOverFaceEdge(body, face, *edge, tolerance);
     }
+    // Or on the face's edge by an edge or a rim of its own, no point of it on the face (a box
+    // that struck the table's edge with its own): its crossings of the edge.
+    if (face.bounded && (std::holds_alternative<Cuboid>(body.shape) ||
+                         std::holds_alternative<Cylinder>(body.shape))) {
+      auto over = pivotOverFaceEdge(body, face, tolerance);
+      if (over || over.error().field != "body.centre") return over;
+    }
   }
   if (!found) return found.error();
   const Support& support = found.value();
@@ -1320,17 +1330,24 @@ Expected<LastingMotion> lastingOnFace(const LastingBody& body, const FlatFace& f
   // Outlines taken before supportForces chooses a cap's four points. A side's line over the
   // edge is checkOnFace's (not modelled yet); a face or a cap goes on over it.
   const std::vector<Vec> outline = outlineOf(support, face.along_u, face.along_v);
-  const auto overhang = support.kind == SupportKind::kLine
-                            ? Expected<std::optional<Overhang>>(std::optional<Overhang>{})
-                            : overhangOf(outline, face);
-  if (!overhang) return overhang.error();
+  const std::optional<Overhang> overhang =
+      support.kind == SupportKind::kLine ? std::nullopt : overhangOf(outline, face);
+  if (overhang && overhang->corner) {
+    // Over the face's corner: its corners (or its rims' lowest points) on the table, its
+    // crossings of the table's edges and the table's corner on its face (pivotOverFaceEdge).
+    if (std::holds_alternative<Cuboid>(body.shape) ||
+        std::holds_alternative<Cylinder>(body.shape)) {
+      return pivotOverFaceEdge(body, face, tolerance);
+    }
+    return notYet("a hull over the face's corner (past two of its edges)");
+  }
   const auto spin = keptSpin(support, setting, body.angular_velocity);
   if (!spin) {
-    return turningOnFace(body, face, support, setting, rotation, overhang.value().has_value(),
-                         spin.error(), tolerance);
+    return turningOnFace(body, face, support, setting, rotation, overhang.has_value(), spin.error(),
+                         tolerance);
   }
-  return plannedOnFace(body, face, support, setting, orientation, outline, overhang.value(),
-                       spin.value(), tolerance);
+  return plannedOnFace(body, face, support, setting, orientation, outline, overhang, spin.value(),
+                       tolerance);
 }
 
 Expected<LastingMotion> lastingOnFaces(const LastingBody& body, const std::vector<FlatFace>& faces,

@@ -78,6 +78,19 @@ struct Point {
   int side = 0;
   /// The face it touches (into Setting::faces; a crossing's: the first).
   std::size_t face = 0;
+  /// >= 0: the face's corner `corner` (into Setting::corners) on the body's flat side `feature`
+  /// (into Setting::sides), not the face: a box's face or a can's cap over the table's corner.
+  int corner = -1;
+};
+
+/// On the face's plane (a feature's point), not on its edge or its corner.
+bool onFace(const Point& p) { return p.line < 0 && p.corner < 0; }
+
+/// A flat side of the body (a box's face, a cylinder's cap): its outward unit normal and its
+/// distance from the centre, in the principal frame.
+struct FlatSide {
+  Vec normal = Vec::UnitZ();
+  double offset = 0.0;
 };
 
 /// A face the body touches, with its normal (unit, towards the body), tangents and mu.
@@ -106,6 +119,10 @@ struct Setting {
   };
   std::vector<Line> lines;
   std::vector<std::array<std::size_t, 2>> segments;
+  /// Where the body goes on over the face's edges: the face's four corners (world) and the body's
+  /// flat sides they may touch.
+  std::vector<Vec> corners;
+  std::vector<FlatSide> sides;
   bool crosses = false;
 };
 
@@ -177,6 +194,23 @@ Contact contactOf(const Setting& s, const Kinematics& k, const Point& p) {
   c.normal = side.n;
   c.e1 = side.e1;
   c.e2 = side.e2;
+  if (p.corner >= 0) {
+    // The face's corner X (fixed) on the body's side (normal N, turning with it): the gap
+    // N.(X - c) - offset changes at -N.V (V the body's point's velocity at X, which moves over the
+    // body at -V), and nu' = w x nu (edge_crossing.h's terms for a fixed point on a flat side).
+    const FlatSide& side_of_body = s.sides[p.feature];
+    const Vec out = k.rotation * side_of_body.normal;
+    c.on = s.corners[static_cast<std::size_t>(p.corner)];
+    c.lever = c.on - k.centre;
+    c.normal = -out;
+    c.e1 = c.normal.unitOrthogonal();
+    c.e2 = c.normal.cross(c.e1);
+    const Vec velocity = k.velocity + k.spin.cross(c.lever);
+    c.over = -velocity;
+    c.bend = k.spin.cross(c.normal).dot(velocity);
+    c.gap = out.dot(c.lever) - side_of_body.offset;
+    return c;
+  }
   if (p.line >= 0) {
     const auto crossing = crossingOf(s, k, p);
     if (!crossing) return c;  // gone: its event (inside) ends the segment first
@@ -584,7 +618,7 @@ struct Above {
     const Side& side = s.faces[face];
     double base = std::numeric_limits<double>::infinity();
     for (const Point& p : current) {
-      if (p.line < 0 && p.face == face) {
+      if (onFace(p) && p.face == face) {
         base = std::min(base, heightOf(side, x, s.features[p.feature]));
       }
     }
@@ -604,7 +638,7 @@ double capTilt(const Kinematics& x, const Feature& rim, const Vec& towards) {
 /// Where a touching rim's point is, in the face (unit), at `k`; zero for a corner, an end or a
 /// flat cap's fixed point (its cap is flat while it touches).
 Vec rimTowards(const Setting& s, const Kinematics& k, const Point& p) {
-  if (p.line >= 0) return Vec::Zero();
+  if (!onFace(p)) return Vec::Zero();
   const Feature& f = s.features[p.feature];
   if (f.radius == 0.0 || f.axis.isZero() || p.fixed) return Vec::Zero();
   const Vec lever = contactOf(s, k, p).lever - k.rotation * f.centre;
@@ -643,6 +677,67 @@ double clearanceOf(const Setting& s, const Kinematics& k) {
 constexpr double kCrossingBand = 1e-8;
 constexpr double kCrossingOpens = 1e-6;
 
+/// The body's flat sides a face's corner may touch: a box's six faces, a cylinder's two caps.
+std::vector<FlatSide> flatSidesOf(const ConvexShape& shape) {
+  std::vector<FlatSide> sides;
+  if (const auto* box = std::get_if<Cuboid>(&shape)) {
+    for (int axis = 0; axis < 3; ++axis) {
+      for (const double sign : {-1.0, 1.0}) {
+        sides.push_back({sign * Vec::Unit(axis), box->half_size[axis]});
+      }
+    }
+  } else if (const auto* cylinder = std::get_if<Cylinder>(&shape)) {
+    for (const double sign : {-1.0, 1.0})
+      sides.push_back({sign * Vec::UnitZ(), cylinder->half_length});
+  }
+  return sides;
+}
+
+/// How far within the body's flat side `side` the foot of the world point `x` is, and the rate
+/// of that as the body moves past the fixed point (m, m/s): a box face's least distance to its
+/// edges, a cap's radius less the foot's distance from its centre; < 0 off the side.
+std::pair<double, double> withinSide(const Setting& s, const Kinematics& k, std::size_t side,
+                                     const Vec& x) {
+  const Vec lever = x - k.centre;
+  const Vec local = k.rotation.transpose() * lever;
+  const Vec rate = k.rotation.transpose() * -(k.velocity + k.spin.cross(lever));
+  const FlatSide& flat = s.sides[side];
+  if (const auto* box = std::get_if<Cuboid>(&s.shape)) {
+    // The nearer edge's; at the side's corner (both within kCrossingBand), the slower inwards.
+    std::array<double, 2> margins{}, rates{};
+    std::size_t n = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+      if (std::abs(flat.normal[axis]) > 0.5) continue;
+      margins[n] = box->half_size[axis] - std::abs(local[axis]);
+      rates[n++] = -(local[axis] < 0 ? -1.0 : 1.0) * rate[axis];
+    }
+    const double margin = std::min(margins[0], margins[1]);
+    double inwards = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < 2; ++i) {
+      if (margins[i] <= margin + kCrossingBand) inwards = std::min(inwards, rates[i]);
+    }
+    return {margin, inwards};
+  }
+  const double radius = std::get<Cylinder>(s.shape).radius;
+  const double from_axis = std::hypot(local.x(), local.y());
+  const double outward =
+      from_axis > 0 ? (local.x() * rate.x() + local.y() * rate.y()) / from_axis : 0.0;
+  return {radius - from_axis, -outward};
+}
+
+/// How deep the world point `x` is in the body, by its sides' planes (m: > 0 outside, 0 on its
+/// surface): a box's max over its axes of |x_a| - h_a, a cylinder's of |z| - h and its distance
+/// from the axis less its radius.
+double depthOf(const Setting& s, const Kinematics& k, const Vec& x) {
+  const Vec local = k.rotation.transpose() * (x - k.centre);
+  if (const auto* box = std::get_if<Cuboid>(&s.shape)) {
+    return (local.cwiseAbs() - box->half_size).maxCoeff();
+  }
+  const auto& cylinder = std::get<Cylinder>(s.shape);
+  return std::max(std::abs(local.z()) - cylinder.half_length,
+                  std::hypot(local.x(), local.y()) - cylinder.radius);
+}
+
 /// Whether a point on the face (not a crossing) is within its bounded extent (kLastingBand).
 double withinFace(const Setting& s, const Kinematics& k, const Point& p) {
   const FlatFace& face = sideOf(s, p).face;
@@ -655,7 +750,8 @@ double withinFace(const Setting& s, const Kinematics& k, const Point& p) {
 /// is frictionless) and sticking otherwise; its mode kept where `current` has it.
 Point withMode(const Setting& s, const Kinematics& k, Point p, const std::vector<Point>& current) {
   for (const Point& q : current) {
-    if (q.feature == p.feature && q.line == p.line && q.side == p.side && q.face == p.face) {
+    if (q.feature == p.feature && q.line == p.line && q.side == p.side && q.face == p.face &&
+        q.corner == p.corner) {
       return q;
     }
   }
@@ -673,7 +769,7 @@ std::vector<Point> touchingAt(const Setting& s, const Kinematics& k,
                               const std::vector<Point>& current) {
   std::vector<Point> points;
   for (const Point& p : current) {
-    if (p.line < 0 && withinFace(s, k, p) > 0) points.push_back(p);
+    if (onFace(p) && withinFace(s, k, p) > 0) points.push_back(p);
   }
   const std::size_t parts = s.segments.empty() ? s.features.size() : s.segments.size();
   for (std::size_t l = 0; l < s.lines.size(); ++l) {
@@ -684,15 +780,38 @@ std::vector<Point> touchingAt(const Setting& s, const Kinematics& k,
         p.line = static_cast<int>(l);
         p.side = side;
         const auto c = crossingOf(s, k, p);
-        if (!c || std::abs(c->gap) > kCrossingBand ||
-            std::abs(c->on_line) > s.lines[l].half_length) {
+        if (!c || std::abs(c->gap) > kCrossingBand) continue;
+        // Within its edge, or at an end moving into it (faster than the rounding of a settled
+        // state: a box's upright edge whose lower end is on the line, sliding along, is not).
+        if (c->inside < kCrossingBand && !(c->inside > -kCrossingBand && c->entering &&
+                                           std::abs(c->along_feature) > kCrossingOpens)) {
           continue;
         }
-        if (c->inside < kCrossingBand && !(c->inside > -kCrossingBand && c->entering)) continue;
         const Vec velocity = k.velocity + k.spin.cross(c->point - k.centre);
+        // Within the line's length, or at an end (the face's corner) moving along it inwards.
+        const double end = s.lines[l].half_length - std::abs(c->on_line);
+        const double inwards =
+            -std::copysign(1.0, c->on_line) * (c->over + velocity).dot(s.lines[l].edge.along);
+        if (end < kCrossingBand && !(end > -kCrossingBand && inwards > 0)) continue;
         if (c->normal.dot(velocity) > kCrossingOpens) continue;
         points.push_back(withMode(s, k, p, current));
       }
+    }
+  }
+  // The face's corners on a flat side of the body (within it, or at its edge moving into it).
+  for (std::size_t j = 0; j < s.corners.size(); ++j) {
+    for (std::size_t side = 0; side < s.sides.size(); ++side) {
+      Point p;
+      p.corner = static_cast<int>(j);
+      p.feature = side;
+      const Contact c = contactOf(s, k, p);
+      if (std::abs(c.gap) > kCrossingBand) continue;
+      const auto [within, entering] = withinSide(s, k, side, c.on);
+      if (within < kCrossingBand && !(within > -kCrossingBand && entering > kCrossingOpens)) {
+        continue;
+      }
+      if (c.normal.dot(k.velocity + k.spin.cross(c.lever)) > kCrossingOpens) continue;
+      points.push_back(withMode(s, k, p, current));
     }
   }
   return points;
@@ -704,16 +823,37 @@ std::vector<Point> touchingAt(const Setting& s, const Kinematics& k,
 /// landing flat (where its tilt, signed along where its point touched at the step's start,
 /// passes `flat`: 0, or 1e-12 m below a segment's start flat), a point leaving (its normal force
 /// 0), a sticking point leaving its cone, a sliding one's slip stopping, a point reaching a bounded
-/// face's edge, and, lifted off, the lowest feature `clearance` above the face.
+/// face's edge, a crossing reaching an end of the face's edge (past `ends`, as `flat`), the
+/// face's corner leaving the body's side it touches, or reaching the body elsewhere (`below`'s
+/// last four, as the features'), and, lifted off, the lowest feature `clearance` above the face.
 std::vector<Event> eventsOf(const Setting& s, const std::vector<Point>& current, const Above& above,
                             const std::vector<double>& below, const std::vector<double>& flat,
-                            double clearance, const Kinematics& start) {
+                            const std::vector<double>& ends, double clearance,
+                            const Kinematics& start) {
   std::vector<Event> events;
+  for (std::size_t j = 0; j < s.corners.size(); ++j) {
+    // A corner of the face that is neither touching nor an end of a line a crossing is on
+    // (that crossing's end event takes it) reaching the body: it resumes.
+    const bool taken = std::any_of(current.begin(), current.end(), [&](const Point& p) {
+      if (p.corner == static_cast<int>(j)) return true;
+      if (p.line < 0) return false;
+      const Setting::Line& line = s.lines[static_cast<std::size_t>(p.line)];
+      return std::abs((s.corners[j] - line.edge.point).dot(line.edge.along)) >=
+                 line.half_length - kCrossingBand &&
+             (s.corners[j] - line.edge.point).cross(line.edge.along).norm() <= kCrossingBand;
+    });
+    if (taken) continue;
+    const double was = below[s.faces.size() * s.features.size() + j];
+    const double level = was <= 0 ? was - 1e-12 : 0.0;
+    events.push_back({What::kCorner, 0, [&s, j, level](const Kinematics& x) {
+                        return depthOf(s, x, s.corners[j]) - level;
+                      }});
+  }
   for (std::size_t face = 0; face < s.faces.size(); ++face) {
     for (std::size_t c = 0; c < s.features.size(); ++c) {
       bool touching = false;
       for (const Point& p : current) {
-        touching = touching || (p.line < 0 && p.feature == c && p.face == face);
+        touching = touching || (onFace(p) && p.feature == c && p.face == face);
       }
       if (touching) continue;
       const double was = below[face * s.features.size() + c];
@@ -777,17 +917,27 @@ std::vector<Event> eventsOf(const Setting& s, const std::vector<Point>& current,
       }
     }
     if (current[i].line >= 0) {
-      // Its crossing leaves its edge (at a corner) or the rim's chord vanishes: the points are
-      // found again there (kShift); it passes an end of the face's edge: its corner (kEdge).
-      const double level = flat[i];
+      // Its crossing leaves its edge (at a corner) or the rim's chord vanishes, or it passes an
+      // end of the face's edge (onto the face's corner): the points are found again there.
+      const double level = flat[i], end = ends[i];
       events.push_back({What::kShift, i, [&s, &current, i, level](const Kinematics& x) {
                           const auto c = crossingOf(s, x, current[i]);
                           return c ? c->inside - level : -1.0;
                         }});
-      events.push_back({What::kEdge, i, [&s, &current, i](const Kinematics& x) {
+      events.push_back({What::kShift, i, [&s, &current, i, end](const Kinematics& x) {
                           const auto c = crossingOf(s, x, current[i]);
                           const auto& line = s.lines[static_cast<std::size_t>(current[i].line)];
-                          return c ? line.half_length - std::abs(c->on_line) : 1.0;
+                          return c ? line.half_length - std::abs(c->on_line) - end : -1.0;
+                        }});
+    } else if (current[i].corner >= 0) {
+      // The face's corner leaves the body's side (over its edge or rim): found again there.
+      const double level = flat[i];
+      events.push_back({What::kShift, i, [&s, &current, i, level](const Kinematics& x) {
+                          const Point& p = current[i];
+                          return withinSide(s, x, p.feature,
+                                            s.corners[static_cast<std::size_t>(p.corner)])
+                                     .first -
+                                 level;
                         }});
     } else if (sideOf(s, current[i]).face.bounded) {
       events.push_back(
@@ -927,14 +1077,15 @@ Change changeAt(const Setting& s, const std::vector<Point>& current, What what, 
                 Kinematics there) {
   Change change;
   std::vector<Point> next = current;
-  if (what == What::kLeaves && current[point].line >= 0) {
-    // A crossing of the face's edge leaves, and with it every other one whose normal force is
-    // 0 there to rounding (1e-9 of the weight): a chord's two ends leave together where the body
-    // is symmetric about the chord's middle, as the planar model has it.
+  if (what == What::kLeaves && !onFace(current[point])) {
+    // A crossing of the face's edge (or its corner on the body) leaves, and with it every other
+    // one whose normal force is 0 there to rounding (1e-9 of the weight): a chord's two ends
+    // leave together where the body is symmetric about the chord's middle, as the planar model
+    // has it.
     const Dynamics d = dynamicsOf(s, there, current);
     next.clear();
     for (std::size_t i = 0; i < current.size(); ++i) {
-      const bool leaves = i == point || (current[i].line >= 0 &&
+      const bool leaves = i == point || (!onFace(current[i]) &&
                                          (normalForce(d, i) <= 1e-9 * s.mass * s.gravity.norm() ||
                                           shortChord(s, there, current[point], current[i])));
       if (!leaves) next.push_back(current[i]);
@@ -966,17 +1117,17 @@ Change changeAt(const Setting& s, const std::vector<Point>& current, What what, 
       const double g_n = -s.gravity.dot(side.n);
       const Vec g_t = s.gravity + g_n * side.n;
       const bool on_face =
-          std::none_of(next.begin(), next.end(), [](const Point& p) { return p.line >= 0; });
+          std::all_of(next.begin(), next.end(), [](const Point& p) { return onFace(p); });
       if (s.faces.size() == 1 && on_face && g_n > 0 && g_t.norm() <= side.mu * g_n) {
         change.points = next;
         change.rests = true;
         change.there = settle(s, there, next);
         return change;
       }
-      // Against several faces: where forces within every cone hold it (restingAt), whichever
-      // the least-norm ones are.
+      // Against several faces, or over the face's edges: where forces within every cone hold it
+      // (restingAt), whichever the least-norm ones are.
       const Kinematics stopped = settle(s, there, next);
-      if (s.faces.size() > 1 && restingAt(s, stopped, next)) {
+      if ((s.faces.size() > 1 || s.crosses) && restingAt(s, stopped, next)) {
         change.points = next;
         change.rests = true;
         change.there = stopped;
@@ -1007,16 +1158,17 @@ Change changeAt(const Setting& s, const std::vector<Point>& current, What what, 
   // A face whose every corner sticks: it rests, as the closed forms say (lastingOnFace), its last
   // slip (within the event's resolution) taken out.
   // (A crossing of the face's edge only where the body's face is flat on the face.)
-  // Against several faces: where it is still and its points hold it (restingAt).
+  // Against several faces, or over the face's edges: where it is still and its points hold it
+  // (restingAt).
   change.rests =
       (change.points.size() >= 3 &&
        std::none_of(change.points.begin(), change.points.end(),
                     [&](const Point& p) {
                       return p.sliding ||
-                             (p.line >= 0 &&
+                             (!onFace(p) &&
                               contactOf(s, there, p).normal.dot(s.faces.front().n) < 1.0 - 1e-12);
                     })) ||
-      (s.faces.size() > 1 && restingAt(s, there, change.points));
+      ((s.faces.size() > 1 || s.crosses) && restingAt(s, there, change.points));
   change.there = change.rests ? settle(s, there, change.points) : there;
   return change;
 }
@@ -1032,7 +1184,7 @@ Vec hairApart(const Setting& s, const Kinematics& k, const std::vector<Point>& p
     rows.row(r) = c.normal.transpose();
     const Side& side = sideOf(s, points[i]);
     gaps(r) = kPivotHair -
-              (points[i].line >= 0 ? c.gap : side.n.dot(k.centre + c.lever - side.face.point));
+              (!onFace(points[i]) ? c.gap : side.n.dot(k.centre + c.lever - side.face.point));
   }
   // Normals that differ by rounding (a chord's two ends on one face) count as one.
   Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> solver;
@@ -1120,7 +1272,7 @@ PathState PivotPath::stateAt(double t) const {
   // On the face's edge, each point touching is put a hair apart along its own normal (the
   // least translation that does so). Features off the face (past its edges) are not on it.
   const bool crossing =
-      std::any_of(points->begin(), points->end(), [](const Point& p) { return p.line >= 0; });
+      std::any_of(points->begin(), points->end(), [](const Point& p) { return !onFace(p); });
   if (crossing) {
     k.centre += hairApart(s, k, *points);
     // ... and no feature over the face below the hair (the crossings' normals turned with the
@@ -1147,8 +1299,9 @@ PathState PivotPath::stateAt(double t) const {
   state.angular_velocity = k.spin;
   state.orientation = k.orientation;
   std::vector<Vec> forces = dynamicsOf(s, k, *points).forces;
-  if (s.faces.size() > 1 && path.final && time >= path.until) {
-    // At rest against several faces: the forces that hold it (holdingForces).
+  if ((s.faces.size() > 1 || s.crosses) && path.final && time >= path.until) {
+    // At rest against several faces, or over the face's edges: the forces that hold it
+    // (holdingForces).
     if (const auto held = holdingForces(s, k, *points)) forces = *held;
   }
   bool sliding = false;
@@ -1157,7 +1310,7 @@ PathState PivotPath::stateAt(double t) const {
     sliding = sliding || p.sliding;
     SupportForce force;
     const Contact c = contactOf(s, k, p);
-    if (p.line >= 0) {
+    if (!onFace(p)) {
       force.point = c.on;
       force.normal = c.normal;
       force.normal_force = forces[i].dot(c.normal);
@@ -1228,14 +1381,24 @@ Expected<SegmentEnd> integrateSegment(const Setting& s, PivotPath::Steps& path, 
   for (std::size_t face = 0; face < s.faces.size(); ++face) {
     for (const Feature& f : s.features) below.push_back(std::min(0.0, above(initial, face, f)));
   }
-  std::vector<double> flat;
-  for (const Point& p : current) {
+  for (const Vec& corner : s.corners) below.push_back(std::min(0.0, depthOf(s, initial, corner)));
+  // Where one is at or past its limit as the segment begins (one just entering): 1e-12 m beyond.
+  const auto beyond = [](double within) { return within <= 1e-12 ? within - 1e-12 : 0.0; };
+  std::vector<double> flat, ends(current.size(), 0.0);
+  for (std::size_t i = 0; i < current.size(); ++i) {
+    const Point& p = current[i];
     if (p.line >= 0) {
-      // A crossing's: how far within its edge, where it leaves it (1e-12 m beyond where it began,
-      // if at or past an end: one just entering).
+      // A crossing's: how far within its edge, where it leaves it, and within the face's edge.
       const auto c = crossingOf(s, initial, p);
-      const double inside = c ? c->inside : 0.0;
-      flat.push_back(inside <= 1e-12 ? inside - 1e-12 : 0.0);
+      flat.push_back(beyond(c ? c->inside : 0.0));
+      const double half = s.lines[static_cast<std::size_t>(p.line)].half_length;
+      ends[i] = beyond(c ? half - std::abs(c->on_line) : 0.0);
+      continue;
+    }
+    if (p.corner >= 0) {
+      // The face's corner's: how far within the body's side.
+      flat.push_back(beyond(
+          withinSide(s, initial, p.feature, s.corners[static_cast<std::size_t>(p.corner)]).first));
       continue;
     }
     const Vec towards = rimTowards(s, initial, p);
@@ -1259,7 +1422,8 @@ Expected<SegmentEnd> integrateSegment(const Setting& s, PivotPath::Steps& path, 
       dense.calc_state(time, x);
       return unpack(x);
     };
-    const std::vector<Event> events = eventsOf(s, current, above, below, flat, clearance, at(t0));
+    const std::vector<Event> events =
+        eventsOf(s, current, above, below, flat, ends, clearance, at(t0));
     const auto first = firstEvent(events, at, t0, t1);
     path.steps.push_back({dense, first ? first->first : t1, mode});
     if (first) {
@@ -1300,6 +1464,13 @@ std::unique_ptr<PivotPath::Steps> pathFor(const LastingBody& body,
       s.lines.push_back(
           {bound.edge.point, bound.edge.along, bound.edge.out, face.half_extent[1 - bound.axis]});
     }
+    for (const double u : {-1.0, 1.0}) {
+      for (const double v : {-1.0, 1.0}) {
+        s.corners.push_back(face.point + u * face.half_extent.x() * face.along_u +
+                            v * face.half_extent.y() * face.along_v);
+      }
+    }
+    s.sides = flatSidesOf(body.shape);
   }
   if (s.crosses && std::holds_alternative<Cuboid>(body.shape)) {
     for (std::size_t c = 0; c < 8; ++c) {
@@ -1342,9 +1513,9 @@ Expected<LastingMotion> pivotFrom(const LastingBody& body, std::unique_ptr<Pivot
   const double clearance = kPivotClearance * reach;
 
   path->start = body.time;
-  if (s.faces.size() > 1) {
-    // Still against several faces and held there (restingAt): at rest, each point of a face
-    // with friction sticking, its slip's rounding taken out.
+  if (s.faces.size() > 1 || s.crosses) {
+    // Still against several faces, or over the face's edges, and held there (restingAt): at
+    // rest, each point of a face with friction sticking, its slip's rounding taken out.
     std::vector<Point> held = touching;
     for (Point& p : held) {
       p.sliding = sideOf(s, p).mu == 0.0;
@@ -1386,9 +1557,7 @@ Expected<LastingMotion> pivotFrom(const LastingBody& body, std::unique_ptr<Pivot
       break;
     }
     if (what == What::kEdge) {
-      ends = path->modes[mode][segment->point].line >= 0
-                 ? "a point of its support reaches the face's corner"
-                 : "a point of its support reaches the face's edge";
+      ends = "a point of its support reaches the face's edge";
       break;
     }
     if (what == What::kShift) {

@@ -90,9 +90,11 @@ Expected<LastingMotion> pivotOnFaces(const LastingBody& body, const std::vector<
 /// and its edges' or rims' crossings of the face's edges' lines (edge_crossing.h), each sticking,
 /// sliding or leaving by pivotOnFace's law; a crossing that moves onto another edge of the body,
 /// or a corner that passes the face's edge, changes the points touching there. It ends as
-/// pivotOnFace's ("resumes" where it is clear of the face or another feature reaches it), or
-/// where a crossing passes an end of the face's edge (its corner: not modelled yet). Refused by
-/// name: a hull or a capsule.
+/// pivotOnFace's ("resumes" where it is clear of the face or another feature reaches it). Over the
+/// face's corner, the corner on the body's flat side (a box's face, a can's cap) is a point too,
+/// each of its own normal (the side's), sticking, sliding or leaving by the same law; a crossing
+/// that reaches an end of the face's edge, or the corner leaving the side, changes the points
+/// there. Refused by name: a hull or a capsule.
 Expected<LastingMotion> pivotOverFaceEdge(const LastingBody& body, const FlatFace& face,
                                           double tolerance, double horizon = 10.0);
 
