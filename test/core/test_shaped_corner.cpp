@@ -161,28 +161,51 @@ TEST(ShapedCorner, ACubeOverTheTableCornerTurnsAboutItAsAPendulumUntilItSlips) {
       worst_force, tips->ends.c_str(), tips->until - tips->start);
 }
 
-/// A cube (half side h, mass m, its faces square to the table's edges) sliding along the diagonal
-/// d with mu against the table: on the table or over its corner alike, s(t) = s0 + u t - mu g
+/// A cube (half side h, mass m, its faces square to the table's edges), or a can standing on its
+/// cap (radius r, half length h), sliding along the diagonal d with mu against the table: on the
+/// table or over its corner alike, s(t) = s0 + u t - mu g
 /// t^2 / 2 along d, without turning, and the centre of pressure is h mu ahead of the centre's foot
 /// (the friction's moment: h (g_t - a) / g_n). Over the corner, the part of its face on the
 /// table ends at the corner along d: it holds the cube until the centre of pressure reaches the
-/// corner, where s = -h mu (s measured from the corner along d), then the cube tips over it.
+/// corner, where s = -h mu (s measured from the corner along d), then it tips over it. The can's
+/// cap covers the corner from s0 = -0.04 (r = 0.06).
 struct CornerSlide {
-  double h = 0.05, m = 2.0, mu = 0.4, s0 = -0.06, u = 1.0;
+  double h = 0.05, m = 2.0, mu = 0.4, s0 = -0.06, u = 1.0, r = 0.06;
+  bool can = false;
   double along(double t) const { return s0 + u * t - 0.5 * mu * kG * t * t; }
   double tips() const {  // s(t) = -h mu: the smaller root
     const double a = mu * kG, c = s0 + h * mu;
     return (u - std::sqrt(u * u + 2 * a * c)) / a;
   }
   LastingBody body() const {
-    LastingBody made = box(V(h, h, h), m, kCorner + s0 * kOut + h * V::UnitZ());
+    const V centre = kCorner + s0 * kOut + h * V::UnitZ();
+    LastingBody made = can ? lasting_bodies::cylinder(r, h, m, m * r * r / 2, centre, Q::Identity())
+                           : box(V(h, h, h), m, centre);
     made.velocity = u * kOut;
     return made;
   }
+  /// Its points that may touch (a cube's corners, 64 points of each rim), in its frame.
+  std::vector<V> outline() const {
+    std::vector<V> points;
+    for (int c = 0; c < (can ? 128 : 8); ++c) {
+      const double a = 2 * M_PI * (c / 2) / 64, z = (c & 1) ? h : -h;
+      points.push_back(can ? V(r * std::cos(a), r * std::sin(a), z)
+                           : V((c & 1) ? h : -h, (c & 2) ? h : -h, (c & 4) ? h : -h));
+    }
+    return points;
+  }
+  /// How deep a point (its frame) is in it: <= 0 inside.
+  double depth(const V& x) const {
+    return can ? std::max(std::abs(x.z()) - h, std::hypot(x.x(), x.y()) - r)
+               : (x.cwiseAbs() - V::Constant(h)).maxCoeff();
+  }
 };
 
-TEST(ShapedCorner, ACubeSlidingOverTheCornerSlidesAsOnTheTableUntilItsCentreOfPressureReachesIt) {
-  const CornerSlide slide;
+/// CornerSlide's closed forms against lastingOnFace from its start (over the corner already):
+/// the slide until the tip (1e-9 m, no turning), the table's forces (1e-9 of the weight), the
+/// tip where the corner alone carries it (1e-9 s); then never inside the table, never gaining
+/// energy.
+void expectTheSlideOverTheCorner(const CornerSlide& slide) {
   const LastingBody body = slide.body();
   const auto motion = lastingOnFace(body, tableTop(slide.mu), 1e-12);
   ASSERT_TRUE(motion.ok()) << errorOf(motion);
@@ -231,22 +254,28 @@ TEST(ShapedCorner, ACubeSlidingOverTheCornerSlidesAsOnTheTableUntilItsCentreOfPr
     const double t = motion->start + (motion->until - motion->start) * k / 400.0;
     EXPECT_LE(lasting_bodies::energy(body, *motion, t), e0 + 1e-9 * std::abs(e0)) << t;
     const Eigen::Matrix3d r = motion->orientationAt(t).toRotationMatrix();
-    for (int c = 0; c < 8; ++c) {
-      const V corner =
-          motion->centreAt(t) + r * V((c & 1) ? slide.h : -slide.h, (c & 2) ? slide.h : -slide.h,
-                                      (c & 4) ? slide.h : -slide.h);
-      if (corner.x() < 1 && corner.y() < 0.5) {
-        EXPECT_GT(corner.z(), 0.7 - 1e-9) << t;
+    for (const V& point : slide.outline()) {
+      const V at = motion->centreAt(t) + r * point;
+      if (at.x() < 1 && at.y() < 0.5) {
+        EXPECT_GT(at.z(), 0.7 - 1e-9) << t;
       }
     }
-    const V in_cube = r.transpose() * (kCorner - motion->centreAt(t));
-    EXPECT_GT((in_cube.cwiseAbs() - V::Constant(slide.h)).maxCoeff(), -1e-9) << t;
+    EXPECT_GT(slide.depth(r.transpose() * (kCorner - motion->centreAt(t))), -1e-9) << t;
   }
   std::printf(
       "tips at +%.12f s (closed form %.12f), centre %.3g m, forces %.3g of mg; %s at +%.6f s\n", lo,
       tips, worst, worst_force, motion->ends.c_str(), motion->until);
 }
 
+TEST(ShapedCorner, ACubeOrACanSlidingOverTheCornerSlidesAsOnTheTableUntilItsPressureReachesIt) {
+  CornerSlide cube, can;
+  can.can = true;
+  can.s0 = -0.04;
+  for (const CornerSlide& slide : {cube, can}) {
+    SCOPED_TRACE(slide.can ? "can" : "cube");
+    expectTheSlideOverTheCorner(slide);
+  }
+}
 // The same cube, e = 0 and mu 0.4 against the table of tableScene (top z = 0.5, its corner
 // (0.5, 0.5)), through the monitor: slid along the diagonal from 0.3 m before the corner at u =
 // sqrt(2 mu g 0.27), it reaches both edges at once, slides on over the corner by the same closed
