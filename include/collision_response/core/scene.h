@@ -164,7 +164,9 @@ Status validateScene(const Scene& scene, const std::string& prefix,
 /// `frame`: tf places the others at run time) by more than the touching band, naming both and
 /// the depth: "body 'ball' at [0, 0, 0.7] starts 0.05 m inside obstacle 'table'". The monitor
 /// and the scene player run such a scene (a state inside is no impact: its impact was when it
-/// began), but the user most likely placed it wrongly. For a scene validateScene accepted.
+/// began), but the user most likely placed it wrongly. For a scene validateScene accepted. A ball
+/// only: a shaped body (its sizes are not its radius) is looked at by the monitor, which holds a
+/// state inside an obstacle and reports it (StepReport::unmodelled).
 std::vector<std::string> bodiesStartingInside(const Scene& scene);
 
 /// A warning for each obstacle (but a plane) whose position has a coordinate at or beyond 2^47

@@ -781,10 +781,12 @@ std::vector<Point> touchingAt(const Setting& s, const Kinematics& k,
         p.side = side;
         const auto c = crossingOf(s, k, p);
         if (!c || std::abs(c->gap) > kCrossingBand) continue;
-        // Within its edge, or at an end moving into it (faster than the rounding of a settled
-        // state: a box's upright edge whose lower end is on the line, sliding along, is not).
-        if (c->inside < kCrossingBand && !(c->inside > -kCrossingBand && c->entering &&
-                                           std::abs(c->along_feature) > kCrossingOpens)) {
+        // Within its edge, or at an end moving into it (a box's edge: faster than the rounding
+        // of a settled state: its upright edge whose lower end is on the line, sliding along, is
+        // not; a rim's tangent to the line, its chord opening, is).
+        if (c->inside < kCrossingBand &&
+            !(c->inside > -kCrossingBand && c->entering &&
+              (s.segments.empty() || std::abs(c->along_feature) > kCrossingOpens))) {
           continue;
         }
         const Vec velocity = k.velocity + k.spin.cross(c->point - k.centre);

@@ -380,6 +380,7 @@ std::vector<std::string> bodiesStartingInside(const Scene& scene) {
     if (!obstacle.frame.empty()) continue;
     const PlacedShape placed = placeFixed(obstacle);
     for (const BodySpec& body : scene.bodies) {
+      if (body.shape != BodyShape::kSphere) continue;  // not a ball of its radius
       const ContactGeometry g = contactGeometry(body.position, body.radius, placed, 1e-9, [] {
         return Eigen::Vector3d(Eigen::Vector3d::Zero());
       });
