@@ -53,6 +53,16 @@ inline FlatFace plane(const V& normal, double mu) {
   return face;
 }
 
+/// The lasting tests' table top: z = 0.7, x in [-1, 1] (its edge at x = 1), y in [-0.5, 0.5];
+/// its corner (1, 0.5, 0.7).
+inline FlatFace tableTop(double mu) {
+  FlatFace table = plane(V::UnitZ(), mu);
+  table.point = V(0, 0, 0.7);
+  table.bounded = true;
+  table.half_extent = Eigen::Vector2d(1, 0.5);
+  return table;
+}
+
 inline double energy(const LastingBody& body, const LastingMotion& motion, double t) {
   const Eigen::Matrix3d r = motion.orientationAt(t).toRotationMatrix();
   const Eigen::Matrix3d inertia = r * body.moments.asDiagonal() * r.transpose();

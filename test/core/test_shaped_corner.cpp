@@ -25,17 +25,10 @@ using lasting_bodies::box;
 using lasting_bodies::errorOf;
 using lasting_bodies::kG;
 using lasting_bodies::Q;
+using lasting_bodies::tableTop;
 using lasting_bodies::V;
 
-/// The table top of the lasting tests: z = 0.7, x in [-1, 1], y in [-0.5, 0.5]; its corner
-/// (1, 0.5, 0.7), the diagonal d = (1, 1, 0) / sqrt 2 out of it.
-FlatFace tableTop(double mu) {
-  FlatFace table = lasting_bodies::plane(V::UnitZ(), mu);
-  table.point = V(0, 0, 0.7);
-  table.bounded = true;
-  table.half_extent = Eigen::Vector2d(1, 0.5);
-  return table;
-}
+/// tableTop's corner, and the diagonal d out of it.
 const V kCorner(1, 0.5, 0.7);
 const V kOut = V(1, 1, 0).normalized();
 const V kAxis = V::UnitZ().cross(kOut);  // s: tipping out turns z towards d about it

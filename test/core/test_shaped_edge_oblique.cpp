@@ -21,6 +21,7 @@ namespace {
 using lasting_bodies::box;
 using lasting_bodies::errorOf;
 using lasting_bodies::Q;
+using lasting_bodies::tableTop;
 using lasting_bodies::V;
 using shaped_scenes::floorScene;
 using shaped_scenes::impactsOf;
@@ -30,16 +31,6 @@ using shaped_scenes::outlineOf;
 using shaped_scenes::play;
 using shaped_scenes::Played;
 using shaped_scenes::tableScene;
-
-/// The table top of the lasting tests: z = 0.7, x in [-1, 1] (its edge at x = 1), y in
-/// [-0.5, 0.5].
-FlatFace tableTop(double mu) {
-  FlatFace table = lasting_bodies::plane(V::UnitZ(), mu);
-  table.point = V(0, 0, 0.7);
-  table.bounded = true;
-  table.half_extent = Eigen::Vector2d(1, 0.5);
-  return table;
-}
 
 /// The scene's body 0 (its lowest face or cap on the frictionless table top z = 0.5, x <= 0.5,
 /// its centre `height` above it, at x = 0.25) slid at (u, w, 0): as the header of the test says.

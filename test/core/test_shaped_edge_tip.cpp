@@ -20,15 +20,6 @@ namespace {
 
 using namespace lasting_bodies;  // NOLINT(google-build-using-namespace): the tests' bodies
 
-/// The table top: z = 0.7, x in [-1, 1] (its edge at x = 1), y in [-0.5, 0.5].
-FlatFace tableTop(double mu) {
-  FlatFace table = plane(V::UnitZ(), mu);
-  table.point = V(0, 0, 0.7);
-  table.bounded = true;
-  table.half_extent = Eigen::Vector2d(1, 0.5);
-  return table;
-}
-
 /// How far the body's deepest point is inside the table (x < 1 and z < 0.7), over its corners
 /// (a box) or 64 points of each rim (a cylinder): > 0 inside.
 double insideTable(const LastingBody& body, const LastingMotion& motion, double t) {

@@ -17,9 +17,7 @@
 #include <map>
 #include <vector>
 
-#include "collision_response/BodyStateArray.h"
-#include "collision_response/ContactArray.h"
-#include "collision_response/ImpactArray.h"
+#include "played_scene.h"
 
 namespace {
 
@@ -27,8 +25,7 @@ constexpr double kG = 9.81, kV0 = 0.6, kMu1 = 0.4, kMu2 = 0.3;
 const std::map<std::string, double> kMasses = {{"block", 0.5}, {"can", 0.4}};
 const double kBeta = 20 * M_PI / 180, kGamma = 30 * M_PI / 180;
 
-Eigen::Vector3d vec(const geometry_msgs::Point& p) { return {p.x, p.y, p.z}; }
-Eigen::Vector3d vec(const geometry_msgs::Vector3& v) { return {v.x, v.y, v.z}; }
+using collision_response::testing::vec;
 
 TEST(BoxChute, TheBoxAndTheCanSlideDownTheChuteOnBothFacesToTheClosedFormsRest) {
   const Eigen::Vector3d down(std::cos(kBeta), 0, -std::sin(kBeta));
@@ -36,61 +33,30 @@ TEST(BoxChute, TheBoxAndTheCanSlideDownTheChuteOnBothFacesToTheClosedFormsRest) 
                          kMu2 * std::cos(kBeta) * std::sin(kGamma));
   const double stops = -kV0 / a;
   ros::NodeHandle node;
-  ros::Time start;
-  std::map<std::string, Eigen::Vector3d> first;
-  struct Heard {
-    double time;
-    Eigen::Vector3d position, velocity;
-  };
-  std::map<std::string, std::vector<Heard>> states;
+  collision_response::testing::PlayedScene played(node);
+  played.waitFor({"block", "can"}, 0.9, 40.0);
+  auto& first = played.first;
+  auto& states = played.states;
+  // Per body, each contacts message's normal force per obstacle, friction on the body, modes.
   struct Carried {
     double time;
-    std::map<std::string, double> normal;  // per obstacle
+    std::map<std::string, double> normal;
     Eigen::Vector3d friction = Eigen::Vector3d::Zero();
     std::vector<std::string> modes;
   };
-  std::map<std::string, std::vector<Carried>> carried;  // per body
-  std::size_t impacts = 0;
-  ros::Subscriber state_sub = node.subscribe<collision_response::BodyStateArray>(
-      "body_states", 1000, [&](const collision_response::BodyStateArray::ConstPtr& array) {
-        if (start.isZero()) start = array->header.stamp;
-        const double t = (array->header.stamp - start).toSec();
-        for (const auto& state : array->states) {
-          if (t == 0.0) first[state.id] = vec(state.pose.position);
-          states[state.id].push_back({t, vec(state.pose.position), vec(state.twist.linear)});
-        }
-      });
-  ros::Subscriber contact_sub = node.subscribe<collision_response::ContactArray>(
-      "contacts", 1000, [&](const collision_response::ContactArray::ConstPtr& array) {
-        if (start.isZero() || array->contacts.empty()) return;
-        std::map<std::string, Carried> now;
-        for (const auto& contact : array->contacts) {
-          Carried& c = now[contact.body_a];
-          c.time = (array->header.stamp - start).toSec();
-          c.normal[contact.body_b] += contact.normal_force;
-          c.friction -= vec(contact.friction_force);  // on the body
-          c.modes.push_back(contact.state);
-        }
-        for (const auto& [body, c] : now) carried[body].push_back(c);
-      });
-  ros::Subscriber impact_sub = node.subscribe<collision_response::ImpactArray>(
-      "impacts", 100, [&](const collision_response::ImpactArray::ConstPtr& array) {
-        impacts += array->impacts.size();
-      });
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(40.0);
-  const auto heard_all = [&] {
-    for (const auto& [body, mass] : kMasses) {
-      if (states[body].empty() || states[body].back().time < 0.9 || carried[body].empty() ||
-          carried[body].back().time < 0.9) {
-        return false;
+  std::map<std::string, std::vector<Carried>> carried;
+  for (const auto& [body, messages] : played.contacts) {
+    for (const auto& message : messages) {
+      Carried c{message.time, {}, Eigen::Vector3d::Zero(), {}};
+      for (const auto& contact : message.contacts) {
+        c.normal[contact.body_b] += contact.normal_force;
+        c.friction -= vec(contact.friction_force);  // on the body
+        c.modes.push_back(contact.state);
       }
+      carried[body].push_back(c);
     }
-    return true;
-  };
-  while (ros::ok() && ros::WallTime::now() < end && !heard_all()) {
-    ros::spinOnce();
-    ros::WallDuration(0.01).sleep();
   }
+  const std::size_t impacts = played.impacts;
   EXPECT_EQ(impacts, 0u) << "they slide on both from the start: nothing strikes";
   double worst_position = 0, worst_velocity = 0, worst_force = 0;
   for (const auto& [body, mass] : kMasses) {
@@ -98,7 +64,7 @@ TEST(BoxChute, TheBoxAndTheCanSlideDownTheChuteOnBothFacesToTheClosedFormsRest) 
     const double weight = mass * kG;
     ASSERT_EQ(first.count(body), 1u) << "the first state heard was not the scene's first";
     ASSERT_GT(states[body].size(), 50u);
-    for (const Heard& state : states[body]) {
+    for (const auto& state : states[body]) {
       const double t = std::min(state.time, stops);
       const Eigen::Vector3d expected = first[body] + (kV0 * t + a * t * t / 2) * down;
       worst_position = std::max(worst_position, (state.position - expected).norm());

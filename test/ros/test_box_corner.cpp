@@ -17,9 +17,7 @@
 #include <map>
 #include <vector>
 
-#include "collision_response/BodyStateArray.h"
-#include "collision_response/ContactArray.h"
-#include "collision_response/ImpactArray.h"
+#include "played_scene.h"
 
 namespace {
 
@@ -32,72 +30,42 @@ struct Slide {
 const std::map<std::string, Slide> kBodies = {
     {"block", {0.5, Eigen::Vector3d(1, 1, 0).normalized(), Eigen::Vector3d(0.5, 0.5, kTop)}}};
 
-Eigen::Vector3d vec(const geometry_msgs::Point& p) { return {p.x, p.y, p.z}; }
-Eigen::Vector3d vec(const geometry_msgs::Vector3& v) { return {v.x, v.y, v.z}; }
+using collision_response::testing::vec;
 
 TEST(BoxCorner, TheBoxSlidesOverTheTablesCornerToTheClosedFormsRest) {
   const double stops = kU / (kMu * kG);
   ros::NodeHandle node;
-  ros::Time start;
-  std::map<std::string, Eigen::Vector3d> first;
-  struct Heard {
-    double time;
-    Eigen::Vector3d position, velocity;
-  };
-  std::map<std::string, std::vector<Heard>> states;
+  collision_response::testing::PlayedScene played(node);
+  played.waitFor({"block"}, 0.9, 40.0);
+  auto& first = played.first;
+  auto& states = played.states;
+  // Per body, each contacts message's normal force, the part at the table's corner, the friction
+  // on the body and the modes.
   struct Carried {
     double time;
     double normal = 0.0;
-    double on_corner = 0.0;  // the normal force at the table's corner
+    double on_corner = 0.0;
     Eigen::Vector3d friction = Eigen::Vector3d::Zero();
     std::vector<std::string> modes;
   };
-  std::map<std::string, std::vector<Carried>> carried;  // per body
-  std::size_t impacts = 0;
-  ros::Subscriber state_sub = node.subscribe<collision_response::BodyStateArray>(
-      "body_states", 1000, [&](const collision_response::BodyStateArray::ConstPtr& array) {
-        if (start.isZero()) start = array->header.stamp;
-        const double t = (array->header.stamp - start).toSec();
-        for (const auto& state : array->states) {
-          if (t == 0.0) first[state.id] = vec(state.pose.position);
-          states[state.id].push_back({t, vec(state.pose.position), vec(state.twist.linear)});
+  std::map<std::string, std::vector<Carried>> carried;
+  for (const auto& [body, messages] : played.contacts) {
+    for (const auto& message : messages) {
+      Carried c;
+      c.time = message.time;
+      for (const auto& contact : message.contacts) {
+        EXPECT_EQ(contact.body_b, "table");
+        c.normal += contact.normal_force;
+        if ((vec(contact.contact_point) - kBodies.at(body).corner).norm() < 1e-9) {
+          c.on_corner += contact.normal_force;
         }
-      });
-  ros::Subscriber contact_sub = node.subscribe<collision_response::ContactArray>(
-      "contacts", 1000, [&](const collision_response::ContactArray::ConstPtr& array) {
-        if (start.isZero() || array->contacts.empty()) return;
-        std::map<std::string, Carried> now;
-        for (const auto& contact : array->contacts) {
-          Carried& c = now[contact.body_a];
-          c.time = (array->header.stamp - start).toSec();
-          EXPECT_EQ(contact.body_b, "table");
-          c.normal += contact.normal_force;
-          if ((vec(contact.contact_point) - kBodies.at(contact.body_a).corner).norm() < 1e-9) {
-            c.on_corner += contact.normal_force;
-          }
-          c.friction -= vec(contact.friction_force);  // on the body
-          c.modes.push_back(contact.state);
-        }
-        for (const auto& [body, c] : now) carried[body].push_back(c);
-      });
-  ros::Subscriber impact_sub = node.subscribe<collision_response::ImpactArray>(
-      "impacts", 100, [&](const collision_response::ImpactArray::ConstPtr& array) {
-        impacts += array->impacts.size();
-      });
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(40.0);
-  const auto heard_all = [&] {
-    for (const auto& [body, slide] : kBodies) {
-      if (states[body].empty() || states[body].back().time < 0.9 || carried[body].empty() ||
-          carried[body].back().time < 0.9) {
-        return false;
+        c.friction -= vec(contact.friction_force);  // on the body
+        c.modes.push_back(contact.state);
       }
+      carried[body].push_back(c);
     }
-    return true;
-  };
-  while (ros::ok() && ros::WallTime::now() < end && !heard_all()) {
-    ros::spinOnce();
-    ros::WallDuration(0.01).sleep();
   }
+  const std::size_t impacts = played.impacts;
   EXPECT_EQ(impacts, 0u) << "they slide on the table from the start: nothing strikes";
   double worst_position = 0, worst_velocity = 0, worst_force = 0;
   for (const auto& [body, slide] : kBodies) {
@@ -105,7 +73,7 @@ TEST(BoxCorner, TheBoxSlidesOverTheTablesCornerToTheClosedFormsRest) {
     const double weight = slide.mass * kG;
     ASSERT_EQ(first.count(body), 1u) << "the first state heard was not the scene's first";
     ASSERT_GT(states[body].size(), 50u);
-    for (const Heard& state : states[body]) {
+    for (const auto& state : states[body]) {
       const double t = std::min(state.time, stops);
       const Eigen::Vector3d expected = first[body] + (kU * t - kMu * kG * t * t / 2) * slide.along;
       worst_position = std::max(worst_position, (state.position - expected).norm());
