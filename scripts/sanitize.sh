@@ -33,7 +33,7 @@ fi
 # code runs in the other tests under the sanitizers, and their answers are checked in the main
 # build.
 declare -A filters=(
-  [core_tests]="-Trace.*:Monitor.BroadphaseGivesTheSameImpactsAsEveryPair:Calibration.NinetyFivePercentIntervalsCoverTheTruth*:Calibration.AStuckBounceIsNotReadAsSliding:EdgeScan.*:ClusterFriction.EnergyNeverIncreases:ShapedPivot.Random*:ShapedLasting.Random*:ShapedFaces.Random*:TumblingContact.Fuzz*:SteppedClusters.APileSettlesInABox*"
+  [core_tests]="-Trace.*:Monitor.BroadphaseGivesTheSameImpactsAsEveryPair:Calibration.NinetyFivePercentIntervalsCoverTheTruth*:Calibration.AStuckBounceIsNotReadAsSliding:EdgeScan.*:ClusterFriction.EnergyNeverIncreases:ShapedPivot.Random*:ShapedLasting.Random*:ShapedFaces.Random*:ShapedCorner.Random*:TumblingContact.Fuzz*:SteppedClusters.APileSettlesInABox*"
 )
 # Each program in two shards side by side (gtest's GTEST_TOTAL_SHARDS): the two cores.
 run_shard() {
