@@ -819,20 +819,16 @@ std::vector<Point> touchingAt(const Setting& s, const Kinematics& k,
   return points;
 }
 
-/// The events of a step of the segment with `current` touching, from `start` (the state at the
-/// step's start): another feature reaching the face (one below it as the segment began, one
-/// that just left, where it comes back 1e-12 m below where it was: `below`), a touching rim's cap
-/// landing flat (where its tilt, signed along where its point touched at the step's start,
-/// passes `flat`: 0, or 1e-12 m below a segment's start flat), a point leaving (its normal force
-/// 0), a sticking point leaving its cone, a sliding one's slip stopping, a point reaching a bounded
-/// face's edge, a crossing reaching an end of the face's edge (past `ends`, as `flat`), the
-/// face's corner leaving the body's side it touches, or reaching the body elsewhere (`below`'s
-/// last four, as the features'), and, lifted off, the lowest feature `clearance` above the face.
-std::vector<Event> eventsOf(const Setting& s, const std::vector<Point>& current, const Above& above,
-                            const std::vector<double>& below, const std::vector<double>& flat,
-                            const std::vector<double>& ends, double clearance,
-                            const Kinematics& start) {
-  std::vector<Event> events;
+/// The events that end a segment where something new touches (the body's events take over, or
+/// the points are found again): the face's corner reaching the body (`below`'s last four: where
+/// it comes back 1e-12 m below where it was, as the features'), another feature reaching the face
+/// (one below it as the segment began, one that just left: `below`), a touching rim's cap landing
+/// flat (where its tilt, signed along where its point touched at the step's start `start`, passes
+/// `flat`: 0, or 1e-12 m below a segment's start flat), and, lifted off, the lowest feature
+/// `clearance` above the face.
+void arrivalEvents(const Setting& s, const std::vector<Point>& current, const Above& above,
+                   const std::vector<double>& below, const std::vector<double>& flat,
+                   double clearance, const Kinematics& start, std::vector<Event>& events) {
   for (std::size_t j = 0; j < s.corners.size(); ++j) {
     // A corner of the face that is neither touching nor an end of a line a crossing is on
     // (that crossing's end event takes it) reaching the body: it resumes.
@@ -882,70 +878,96 @@ std::vector<Event> eventsOf(const Setting& s, const std::vector<Point>& current,
                         return clearance - clearanceOf(s, x);
                       }});
   }
-  for (std::size_t i = 0; i < current.size(); ++i) {
-    events.push_back({What::kLeaves, i, [&s, &current, i](const Kinematics& x) {
-                        return normalForce(dynamicsOf(s, x, current), i);
+}
+
+/// Point i's events of its force: it leaves (its normal force 0), a sticking point leaves its
+/// cone, a sliding one's slip stops (from `start`, the step's start).
+void forceEvents(const Setting& s, const std::vector<Point>& current, std::size_t i,
+                 const Kinematics& start, std::vector<Event>& events) {
+  events.push_back({What::kLeaves, i, [&s, &current, i](const Kinematics& x) {
+                      return normalForce(dynamicsOf(s, x, current), i);
+                    }});
+  if (!current[i].sliding) {
+    // Bisected to where the margin is < 0: there the modes' choice slides it.
+    events.push_back({What::kSlips, i, [&s, &current, i](const Kinematics& x) {
+                        const double margin = coneMarginOf(dynamicsOf(s, x, current), i);
+                        return margin < 0 ? margin : std::max(margin, 1e-300);
                       }});
-    if (!current[i].sliding) {
-      // Bisected to where the margin is < 0: there the modes' choice slides it.
-      events.push_back({What::kSlips, i, [&s, &current, i](const Kinematics& x) {
-                          const double margin = coneMarginOf(dynamicsOf(s, x, current), i);
-                          return margin < 0 ? margin : std::max(margin, 1e-300);
+  } else if (sideOf(s, current[i]).mu > 0) {
+    // Its slip stops: it falls to kSlipStops (its direction would turn ever faster as it
+    // passes near 0); a slip just begun (slower at the step's start) stops where its part
+    // along the onset's direction falls below -kLastingStillSpeed.
+    const Vec before = slipOf(s, start, current[i]);
+    if (before.norm() > kSlipStops) {
+      events.push_back({What::kSticks, i, [&s, &current, i](const Kinematics& x) {
+                          return slipOf(s, x, current[i]).norm() - kSlipStops;
                         }});
-    } else if (sideOf(s, current[i]).mu > 0) {
-      // Its slip stops: it falls to kSlipStops (its direction would turn ever faster as it
-      // passes near 0); a slip just begun (slower at the step's start) stops where its part
-      // along the onset's direction falls below -kLastingStillSpeed.
-      const Vec before = slipOf(s, start, current[i]);
-      if (before.norm() > kSlipStops) {
-        events.push_back({What::kSticks, i, [&s, &current, i](const Kinematics& x) {
-                            return slipOf(s, x, current[i]).norm() - kSlipStops;
-                          }});
-      } else {
-        const Vec reference =
-            before.norm() > kLastingStillSpeed ? Vec(before.normalized()) : current[i].direction;
-        events.push_back({What::kSticks, i, [&s, &current, i, reference](const Kinematics& x) {
-                            return slipOf(s, x, current[i]).dot(reference) + kLastingStillSpeed;
-                          }});
-        // ... or where the force that would hold it comes back within its cone (a slip that
-        // began at the cone's edge and does not grow: it would hover below kSlipStops, its
-        // friction's direction turning ever faster).
-        std::vector<Point> held = current;
-        held[i].sliding = false;
-        events.push_back({What::kSticks, i, [&s, held, i](const Kinematics& x) {
-                            const double margin = coneMarginOf(dynamicsOf(s, x, held), i);
-                            return margin >= 0 ? -std::max(margin, 1e-300) : -margin;
-                          }});
-      }
+    } else {
+      const Vec reference =
+          before.norm() > kLastingStillSpeed ? Vec(before.normalized()) : current[i].direction;
+      events.push_back({What::kSticks, i, [&s, &current, i, reference](const Kinematics& x) {
+                          return slipOf(s, x, current[i]).dot(reference) + kLastingStillSpeed;
+                        }});
+      // ... or where the force that would hold it comes back within its cone (a slip that
+      // began at the cone's edge and does not grow: it would hover below kSlipStops, its
+      // friction's direction turning ever faster).
+      std::vector<Point> held = current;
+      held[i].sliding = false;
+      events.push_back({What::kSticks, i, [&s, held, i](const Kinematics& x) {
+                          const double margin = coneMarginOf(dynamicsOf(s, x, held), i);
+                          return margin >= 0 ? -std::max(margin, 1e-300) : -margin;
+                        }});
     }
-    if (current[i].line >= 0) {
-      // Its crossing leaves its edge (at a corner) or the rim's chord vanishes, or it passes an
-      // end of the face's edge (onto the face's corner): the points are found again there.
-      const double level = flat[i], end = ends[i];
-      events.push_back({What::kShift, i, [&s, &current, i, level](const Kinematics& x) {
-                          const auto c = crossingOf(s, x, current[i]);
-                          return c ? c->inside - level : -1.0;
-                        }});
-      events.push_back({What::kShift, i, [&s, &current, i, end](const Kinematics& x) {
-                          const auto c = crossingOf(s, x, current[i]);
-                          const auto& line = s.lines[static_cast<std::size_t>(current[i].line)];
-                          return c ? line.half_length - std::abs(c->on_line) - end : -1.0;
-                        }});
-    } else if (current[i].corner >= 0) {
-      // The face's corner leaves the body's side (over its edge or rim): found again there.
-      const double level = flat[i];
-      events.push_back({What::kShift, i, [&s, &current, i, level](const Kinematics& x) {
-                          const Point& p = current[i];
-                          return withinSide(s, x, p.feature,
-                                            s.corners[static_cast<std::size_t>(p.corner)])
-                                     .first -
-                                 level;
-                        }});
-    } else if (sideOf(s, current[i]).face.bounded) {
-      events.push_back(
-          {s.crosses ? What::kShift : What::kEdge, i,
-           [&s, &current, i](const Kinematics& x) { return withinFace(s, x, current[i]); }});
-    }
+  }
+}
+
+/// Point i's events of where it is: a crossing leaving its edge or reaching an end of the face's
+/// edge (past `ends`, as `flat`), the face's corner leaving the body's side, a point on the face
+/// reaching its bounded edge.
+void placeEvents(const Setting& s, const std::vector<Point>& current, std::size_t i,
+                 const std::vector<double>& flat, const std::vector<double>& ends,
+                 std::vector<Event>& events) {
+  if (current[i].line >= 0) {
+    // Its crossing leaves its edge (at a corner) or the rim's chord vanishes, or it passes an
+    // end of the face's edge (onto the face's corner): the points are found again there.
+    const double level = flat[i], end = ends[i];
+    events.push_back({What::kShift, i, [&s, &current, i, level](const Kinematics& x) {
+                        const auto c = crossingOf(s, x, current[i]);
+                        return c ? c->inside - level : -1.0;
+                      }});
+    events.push_back({What::kShift, i, [&s, &current, i, end](const Kinematics& x) {
+                        const auto c = crossingOf(s, x, current[i]);
+                        const auto& line = s.lines[static_cast<std::size_t>(current[i].line)];
+                        return c ? line.half_length - std::abs(c->on_line) - end : -1.0;
+                      }});
+  } else if (current[i].corner >= 0) {
+    // The face's corner leaves the body's side (over its edge or rim): found again there.
+    const double level = flat[i];
+    events.push_back(
+        {What::kShift, i, [&s, &current, i, level](const Kinematics& x) {
+           const Point& p = current[i];
+           return withinSide(s, x, p.feature, s.corners[static_cast<std::size_t>(p.corner)]).first -
+                  level;
+         }});
+  } else if (sideOf(s, current[i]).face.bounded) {
+    events.push_back(
+        {s.crosses ? What::kShift : What::kEdge, i,
+         [&s, &current, i](const Kinematics& x) { return withinFace(s, x, current[i]); }});
+  }
+}
+
+/// The events of a step of the segment with `current` touching, from `start` (the state at the
+/// step's start): arrivalEvents, then each point's forceEvents and placeEvents (in this order:
+/// of events at one instant, the first listed is taken).
+std::vector<Event> eventsOf(const Setting& s, const std::vector<Point>& current, const Above& above,
+                            const std::vector<double>& below, const std::vector<double>& flat,
+                            const std::vector<double>& ends, double clearance,
+                            const Kinematics& start) {
+  std::vector<Event> events;
+  arrivalEvents(s, current, above, below, flat, clearance, start, events);
+  for (std::size_t i = 0; i < current.size(); ++i) {
+    forceEvents(s, current, i, start, events);
+    placeEvents(s, current, i, flat, ends, events);
   }
   return events;
 }
